@@ -1,0 +1,152 @@
+//! `alhazen-geom`: geometric data that the scene, the renderer and the line drawer share.
+//!
+//! Today: [`TriangleMesh`], an indexed triangle list (course, §"Representations of 3D scenes":
+//! a boundary representation reduced to the list of triangles needed to draw a solid).
+//!
+//! ```
+//! use alhazen_geom::TriangleMesh;
+//! use alhazen_math::Vec3;
+//! let m = TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap();
+//! assert_eq!(m.triangle_count(), 1);
+//! ```
+
+use alhazen_math::{Bounds3, Vec2, Vec3};
+
+/// Why a mesh is unusable.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshError {
+    /// A triangle names a vertex that does not exist.
+    IndexOutOfRange {
+        /// Triangle number.
+        triangle: usize,
+        /// The bad index.
+        index: u32,
+    },
+    /// A vertex position is NaN or infinite.
+    NonFiniteVertex(usize),
+    /// Per-vertex attribute arrays differ in length from the positions.
+    AttributeLength(&'static str),
+    /// No triangles.
+    Empty,
+}
+
+impl std::fmt::Display for MeshError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::IndexOutOfRange { triangle, index } => {
+                write!(f, "triangle {triangle} uses vertex {index}, which does not exist")
+            }
+            Self::NonFiniteVertex(i) => write!(f, "vertex {i} has a non-finite coordinate"),
+            Self::AttributeLength(a) => write!(f, "the {a} array does not match the vertex count"),
+            Self::Empty => write!(f, "the mesh has no triangles"),
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+/// An indexed triangle mesh with optional per-vertex normals and texture coordinates, and an
+/// optional per-triangle material slot.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals (same length as `positions`) or empty.
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates (same length as `positions`) or empty.
+    pub uvs: Vec<Vec2>,
+    /// Vertex indices, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+    /// Per-triangle material slot (index into `material_names`) or empty.
+    pub material_slots: Vec<u32>,
+    /// Names of the materials the slots refer to.
+    pub material_names: Vec<String>,
+}
+
+impl TriangleMesh {
+    /// A validated mesh from positions and triangles.
+    pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
+        let m = Self { positions, triangles, ..Self::default() };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Checks indices, finiteness and attribute lengths.
+    pub fn validate(&self) -> Result<(), MeshError> {
+        if self.triangles.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(MeshError::NonFiniteVertex(i));
+        }
+        let n = self.positions.len() as u32;
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if let Some(&index) = tri.iter().find(|&&i| i >= n) {
+                return Err(MeshError::IndexOutOfRange { triangle: t, index });
+            }
+        }
+        if !self.normals.is_empty() && self.normals.len() != self.positions.len() {
+            return Err(MeshError::AttributeLength("normal"));
+        }
+        if !self.uvs.is_empty() && self.uvs.len() != self.positions.len() {
+            return Err(MeshError::AttributeLength("texture coordinate"));
+        }
+        if !self.material_slots.is_empty() && self.material_slots.len() != self.triangles.len() {
+            return Err(MeshError::AttributeLength("material slot"));
+        }
+        Ok(())
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The three corners of triangle `i`.
+    pub fn corners(&self, i: usize) -> [Vec3; 3] {
+        self.triangles[i].map(|v| self.positions[v as usize])
+    }
+
+    /// Bounding box of all vertices.
+    pub fn bounds(&self) -> Bounds3 {
+        Bounds3::from_points(self.positions.iter().copied())
+    }
+
+    /// Area-weighted vertex normals, for smooth shading of meshes that have none.
+    pub fn compute_smooth_normals(&mut self) {
+        let mut acc = vec![Vec3::ZERO; self.positions.len()];
+        for tri in &self.triangles {
+            let [a, b, c] = tri.map(|v| self.positions[v as usize]);
+            let n = (b - a).cross(c - a);
+            for &v in tri {
+                acc[v as usize] += n;
+            }
+        }
+        self.normals = acc.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_catches_bad_indices_and_nan() {
+        let e = TriangleMesh::new(vec![Vec3::ZERO, Vec3::X], vec![[0, 1, 2]]).unwrap_err();
+        assert_eq!(e, MeshError::IndexOutOfRange { triangle: 0, index: 2 });
+        let e = TriangleMesh::new(vec![Vec3::NAN, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap_err();
+        assert_eq!(e, MeshError::NonFiniteVertex(0));
+        assert_eq!(TriangleMesh::new(vec![], vec![]).unwrap_err(), MeshError::Empty);
+    }
+
+    #[test]
+    fn smooth_normals_of_a_flat_fan_are_the_face_normal() {
+        let mut m = TriangleMesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+        .unwrap();
+        m.compute_smooth_normals();
+        assert!(m.normals.iter().all(|n| (*n - Vec3::Z).length() < 1e-12));
+    }
+}
