@@ -11,6 +11,7 @@
 //! * [`viewing`] — the lecture's and course's viewing pipeline: the look-at frame `(u, v, w)`,
 //!   orthographic and perspective frustum matrices `(l, r, b, t, n, f)` and their inverses,
 //!   window→viewport, homogenisation, stereo frusta;
+//! * [`color`] — the course's sRGB transfer function and the XYZ→sRGB matrix;
 //! * [`poly`] — numerically careful real roots of low-degree polynomials.
 //!
 //! ```
@@ -21,6 +22,7 @@
 //! ```
 
 pub mod bounds;
+pub mod color;
 pub mod poly;
 pub mod ray;
 pub mod transform;

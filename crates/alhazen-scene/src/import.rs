@@ -1,0 +1,355 @@
+//! Importers for data a scene file refers to: OBJ/MTL meshes (via `tobj`), PLY meshes (ASCII and
+//! binary, hand-written), and images for textures (PNG, decoded from sRGB to linear).
+
+use crate::model::{ImageData, Material, Texture};
+use alhazen_geom::TriangleMesh;
+use alhazen_math::color::srgb_to_linear;
+use alhazen_math::{Vec2, Vec3};
+use std::path::Path;
+
+/// A mesh and the materials its file defines, in slot order.
+#[derive(Debug)]
+pub struct LoadedMesh {
+    /// The geometry.
+    pub mesh: TriangleMesh,
+    /// Materials referenced by `mesh.material_slots`.
+    pub materials: Vec<Material>,
+}
+
+/// Loads an `.obj` or `.ply` file; the error message names the file.
+pub fn load_mesh(path: &Path) -> Result<LoadedMesh, String> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let result = match ext.as_deref() {
+        Some("obj") => load_obj(path),
+        Some("ply") => std::fs::read(path).map_err(|e| e.to_string()).and_then(|b| parse_ply(&b)).map(|mesh| LoadedMesh { mesh, materials: vec![] }),
+        _ => Err("unsupported mesh format (expected .obj or .ply)".into()),
+    };
+    let loaded = result.map_err(|e| format!("cannot load mesh {}: {e}", path.display()))?;
+    loaded.mesh.validate().map_err(|e| format!("mesh {} is invalid: {e}", path.display()))?;
+    Ok(loaded)
+}
+
+fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
+    let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let (models, mtl) = tobj::load_obj(path, &opts).map_err(|e| e.to_string())?;
+    // A missing .mtl file is not fatal: the object's own material is used.
+    let mtl = mtl.unwrap_or_default();
+    let mut mesh = TriangleMesh::default();
+    let mut any_normals = true;
+    let mut any_uvs = true;
+    for m in &models {
+        let mm = &m.mesh;
+        let base = mesh.positions.len() as u32;
+        let n = mm.positions.len() / 3;
+        mesh.positions.extend(mm.positions.chunks_exact(3).map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)));
+        any_normals &= mm.normals.len() == mm.positions.len();
+        any_uvs &= mm.texcoords.len() / 2 == n;
+        if any_normals {
+            mesh.normals.extend(mm.normals.chunks_exact(3).map(|v| Vec3::new(v[0] as f64, v[1] as f64, v[2] as f64)));
+        }
+        if any_uvs {
+            mesh.uvs.extend(mm.texcoords.chunks_exact(2).map(|v| Vec2::new(v[0] as f64, v[1] as f64)));
+        }
+        let slot = mm.material_id.map_or(u32::MAX, |i| i as u32);
+        for tri in mm.indices.chunks_exact(3) {
+            mesh.triangles.push([base + tri[0], base + tri[1], base + tri[2]]);
+            mesh.material_slots.push(slot);
+        }
+    }
+    if !any_normals {
+        mesh.normals.clear();
+    }
+    if !any_uvs {
+        mesh.uvs.clear();
+    }
+    let materials: Vec<Material> = mtl.iter().map(mtl_material).collect();
+    if materials.is_empty() || mesh.material_slots.iter().all(|s| *s == u32::MAX) {
+        mesh.material_slots.clear();
+    } else {
+        // Faces without a material use slot 0's material rather than failing.
+        for s in &mut mesh.material_slots {
+            if *s as usize >= materials.len() {
+                *s = 0;
+            }
+        }
+    }
+    mesh.material_names = materials.iter().map(|m| m.name.clone()).collect();
+    Ok(LoadedMesh { mesh, materials })
+}
+
+/// MTL → Whitted material: `Kd` colour, `Ks`/`Ns` highlight, `d`/`Tr` transparency, `Ni` ior;
+/// illumination models 3–7 add a mirror term of `Ks`.
+fn mtl_material(m: &tobj::Material) -> Material {
+    let rgb = |c: Option<[f32; 3]>, d: Vec3| c.map_or(d, |c| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64));
+    let d = Material::default();
+    let specular = rgb(m.specular, Vec3::ZERO);
+    let opacity = m.dissolve.map_or(1.0, |x| x.clamp(0.0, 1.0) as f64);
+    let illum = m.illumination_model.unwrap_or(2);
+    Material {
+        name: m.name.clone(),
+        color: Texture::Solid(rgb(m.diffuse, Vec3::splat(0.8))),
+        specular,
+        shininess: m.shininess.map_or(d.shininess, |s| s.max(0.0) as f64),
+        mirror: if (3..=7).contains(&illum) { specular } else { Vec3::ZERO },
+        transparency: Vec3::splat(1.0 - opacity),
+        ior: m.optical_density.filter(|n| *n > 0.0).map_or(d.ior, |n| n as f64),
+        ..d
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum PlyFormat {
+    Ascii,
+    BinaryLe,
+    BinaryBe,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum PlyType {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl PlyType {
+    fn parse(s: &str) -> Option<Self> {
+        Some(match s {
+            "char" | "int8" => Self::I8,
+            "uchar" | "uint8" => Self::U8,
+            "short" | "int16" => Self::I16,
+            "ushort" | "uint16" => Self::U16,
+            "int" | "int32" => Self::I32,
+            "uint" | "uint32" => Self::U32,
+            "float" | "float32" => Self::F32,
+            "double" | "float64" => Self::F64,
+            _ => return None,
+        })
+    }
+    fn size(self) -> usize {
+        match self {
+            Self::I8 | Self::U8 => 1,
+            Self::I16 | Self::U16 => 2,
+            Self::I32 | Self::U32 | Self::F32 => 4,
+            Self::F64 => 8,
+        }
+    }
+}
+
+#[derive(Debug)]
+struct PlyProperty {
+    name: String,
+    ty: PlyType,
+    /// Count type for list properties.
+    list: Option<PlyType>,
+}
+
+#[derive(Debug)]
+struct PlyElement {
+    name: String,
+    count: usize,
+    props: Vec<PlyProperty>,
+}
+
+/// A cursor over PLY body data in one of the three encodings.
+struct PlyReader<'a> {
+    format: PlyFormat,
+    bytes: &'a [u8],
+    pos: usize,
+}
+
+impl PlyReader<'_> {
+    fn read(&mut self, ty: PlyType) -> Result<f64, String> {
+        if self.format == PlyFormat::Ascii {
+            return self.read_ascii();
+        }
+        let n = ty.size();
+        let b = self.bytes.get(self.pos..self.pos + n).ok_or("unexpected end of binary data")?;
+        self.pos += n;
+        let mut a = [0u8; 8];
+        a[..n].copy_from_slice(b);
+        if self.format == PlyFormat::BinaryBe {
+            a[..n].reverse();
+        }
+        Ok(match ty {
+            PlyType::I8 => a[0] as i8 as f64,
+            PlyType::U8 => a[0] as f64,
+            PlyType::I16 => i16::from_le_bytes([a[0], a[1]]) as f64,
+            PlyType::U16 => u16::from_le_bytes([a[0], a[1]]) as f64,
+            PlyType::I32 => i32::from_le_bytes([a[0], a[1], a[2], a[3]]) as f64,
+            PlyType::U32 => u32::from_le_bytes([a[0], a[1], a[2], a[3]]) as f64,
+            PlyType::F32 => f32::from_le_bytes([a[0], a[1], a[2], a[3]]) as f64,
+            PlyType::F64 => f64::from_le_bytes(a),
+        })
+    }
+
+    fn read_ascii(&mut self) -> Result<f64, String> {
+        let rest = &self.bytes[self.pos..];
+        let start = rest.iter().position(|c| !c.is_ascii_whitespace()).ok_or("unexpected end of ASCII data")?;
+        let len = rest[start..].iter().position(|c| c.is_ascii_whitespace()).unwrap_or(rest.len() - start);
+        let tok = std::str::from_utf8(&rest[start..start + len]).map_err(|_| "non-UTF-8 number")?;
+        self.pos += start + len;
+        tok.parse::<f64>().map_err(|_| format!("bad number `{tok}` in ASCII data"))
+    }
+}
+
+/// Parses a PLY file: `vertex` (x, y, z, optional nx ny nz, u v / s t) and `face`
+/// (`vertex_indices` or `vertex_index` lists, fan-triangulated); other elements are skipped.
+pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
+    let (format, elements, body) = parse_ply_header(bytes)?;
+    let mut rd = PlyReader { format, bytes: body, pos: 0 };
+    let mut mesh = TriangleMesh::default();
+    for el in &elements {
+        let idx = |n: &str| el.props.iter().position(|p| p.name == n);
+        let (xyz, nrm) = ([idx("x"), idx("y"), idx("z")], [idx("nx"), idx("ny"), idx("nz")]);
+        let uv = [idx("u").or(idx("s")).or(idx("texture_u")), idx("v").or(idx("t")).or(idx("texture_v"))];
+        let face_list = idx("vertex_indices").or(idx("vertex_index"));
+        if el.name == "vertex" && xyz.iter().any(Option::is_none) {
+            return Err("the vertex element lacks x, y or z".into());
+        }
+        let mut vals = vec![0.0; el.props.len()];
+        for _ in 0..el.count {
+            let mut list = Vec::new();
+            for (i, p) in el.props.iter().enumerate() {
+                match p.list {
+                    None => vals[i] = rd.read(p.ty)?,
+                    Some(ct) => {
+                        let n = rd.read(ct)?;
+                        if !(0.0..=1e6).contains(&n) {
+                            return Err(format!("list length {n} out of range"));
+                        }
+                        let items: Vec<f64> = (0..n as usize).map(|_| rd.read(p.ty)).collect::<Result<_, _>>()?;
+                        if Some(i) == face_list {
+                            list = items;
+                        }
+                    }
+                }
+            }
+            if el.name == "vertex" {
+                let g = |o: Option<usize>| o.map(|i| vals[i]);
+                mesh.positions.push(Vec3::new(vals[xyz[0].unwrap()], vals[xyz[1].unwrap()], vals[xyz[2].unwrap()]));
+                if let [Some(x), Some(y), Some(z)] = nrm.map(g) {
+                    mesh.normals.push(Vec3::new(x, y, z));
+                }
+                if let [Some(u), Some(v)] = uv.map(g) {
+                    mesh.uvs.push(Vec2::new(u, v));
+                }
+            } else if el.name == "face" {
+                if list.len() < 3 {
+                    return Err("a face has fewer than 3 vertices".into());
+                }
+                let v: Vec<u32> = list.iter().map(|x| if *x >= 0.0 && *x < u32::MAX as f64 { Ok(*x as u32) } else { Err(format!("bad vertex index {x}")) }).collect::<Result<_, _>>()?;
+                for k in 1..v.len() - 1 {
+                    mesh.triangles.push([v[0], v[k], v[k + 1]]);
+                }
+            }
+        }
+    }
+    Ok(mesh)
+}
+
+fn parse_ply_header(bytes: &[u8]) -> Result<(PlyFormat, Vec<PlyElement>, &[u8]), String> {
+    const END: &[u8] = b"end_header";
+    let end = bytes.windows(END.len()).position(|w| w == END).ok_or("not a PLY file (no end_header)")?;
+    let mut body_start = end + END.len();
+    while body_start < bytes.len() && bytes[body_start] != b'\n' {
+        body_start += 1;
+    }
+    let header = std::str::from_utf8(&bytes[..end]).map_err(|_| "PLY header is not text")?;
+    let mut lines = header.lines().enumerate();
+    if lines.next().map(|(_, l)| l.trim()) != Some("ply") {
+        return Err("not a PLY file (first line is not `ply`)".into());
+    }
+    let mut format = None;
+    let mut elements: Vec<PlyElement> = vec![];
+    for (no, line) in lines {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        let bad = || format!("PLY header line {}: cannot read `{}`", no + 1, line.trim());
+        match w.as_slice() {
+            ["format", f, _] => {
+                format = Some(match *f {
+                    "ascii" => PlyFormat::Ascii,
+                    "binary_little_endian" => PlyFormat::BinaryLe,
+                    "binary_big_endian" => PlyFormat::BinaryBe,
+                    _ => return Err(bad()),
+                })
+            }
+            ["element", name, count] => {
+                let count = count.parse::<usize>().map_err(|_| bad())?;
+                if count > 1 << 28 {
+                    return Err(format!("PLY element `{name}` has {count} items, too many to load"));
+                }
+                elements.push(PlyElement { name: name.to_string(), count, props: vec![] });
+            }
+            ["property", "list", ct, ty, name] => {
+                let el = elements.last_mut().ok_or_else(bad)?;
+                el.props.push(PlyProperty { name: name.to_string(), ty: PlyType::parse(ty).ok_or_else(bad)?, list: Some(PlyType::parse(ct).ok_or_else(bad)?) });
+            }
+            ["property", ty, name] => {
+                let el = elements.last_mut().ok_or_else(bad)?;
+                el.props.push(PlyProperty { name: name.to_string(), ty: PlyType::parse(ty).ok_or_else(bad)?, list: None });
+            }
+            ["comment", ..] | ["obj_info", ..] | [] => {}
+            _ => return Err(bad()),
+        }
+    }
+    let format = format.ok_or("PLY header has no format line")?;
+    Ok((format, elements, &bytes[(body_start + 1).min(bytes.len())..]))
+}
+
+/// Loads an image and converts it from sRGB to linear RGB.
+pub fn load_image(path: &Path) -> Result<ImageData, String> {
+    let img = image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))?.to_rgb8();
+    let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f64 / 255.0) as f32).collect();
+    Ok(ImageData {
+        width: img.width(),
+        height: img.height(),
+        pixels: img.pixels().map(|p| [lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]]).collect(),
+    })
+}
+
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ASCII_QUAD: &str = "ply\nformat ascii 1.0\ncomment a unit square\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+
+    #[test]
+    fn ascii_ply_quad_is_fan_triangulated() {
+        let m = parse_ply(ASCII_QUAD.as_bytes()).unwrap();
+        assert_eq!(m.positions.len(), 4);
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn binary_ply_matches_ascii() {
+        for big in [false, true] {
+            let fmt = if big { "binary_big_endian" } else { "binary_little_endian" };
+            let mut b = format!("ply\nformat {fmt} 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n").into_bytes();
+            for v in [[0.0f64, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.5]] {
+                for x in v {
+                    b.extend(if big { x.to_be_bytes() } else { x.to_le_bytes() });
+                }
+            }
+            b.push(3);
+            for i in [0u32, 1, 2] {
+                b.extend(if big { i.to_be_bytes() } else { i.to_le_bytes() });
+            }
+            let m = parse_ply(&b).unwrap();
+            assert_eq!(m.positions[2], Vec3::new(0.0, 2.0, 0.5));
+            assert_eq!(m.triangles, vec![[0, 1, 2]]);
+        }
+    }
+
+    #[test]
+    fn truncated_ply_is_an_error_not_a_panic() {
+        let cut = &ASCII_QUAD.as_bytes()[..ASCII_QUAD.len() - 6];
+        assert!(parse_ply(cut).is_err());
+        assert!(parse_ply(b"hello").is_err());
+    }
+}

@@ -1,0 +1,64 @@
+//! `alhazen-scene`: what a scene is, and how it is read.
+//!
+//! * [`model`] — the scene as plain data: camera, lights, materials (the course's local
+//!   lighting models plus the lecture's mirror and transparency coefficients), shapes, CSG;
+//! * the native TOML format ([`parse_scene`], [`load_scene`]), documented field by field in
+//!   `docs/scene-format.md`; every error is a [`Diagnostic`] with `file:line:col`, a caret
+//!   under the offending text, what was expected and, for typos, a "did you mean";
+//! * [`import`] — OBJ/MTL and PLY meshes, PNG textures.
+//!
+//! ```
+//! let text = "[[object]]\nshape = \"sphere\"\nradius = 1.0\n";
+//! let scene = alhazen_scene::parse_scene("inline.toml".as_ref(), text).unwrap();
+//! assert_eq!(scene.objects.len(), 1);
+//! let bad = "[[object]]\nshape = \"sphere\"\nradus = 1.0\n";
+//! let err = alhazen_scene::parse_scene("inline.toml".as_ref(), bad).unwrap_err();
+//! assert!(err.to_string().contains("inline.toml:3:1: unknown key `radus`"));
+//! ```
+
+mod diagnostic;
+pub mod import;
+pub mod model;
+mod parse;
+mod reader;
+
+pub use diagnostic::{Diagnostic, did_you_mean};
+pub use model::*;
+pub use parse::{MAX_PIXELS, MAX_SIDE, parse_scene};
+use std::path::{Path, PathBuf};
+
+/// Why a scene could not be loaded.
+#[derive(Debug)]
+pub enum SceneError {
+    /// The file could not be read.
+    Io {
+        /// The path.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The file was read but is not a valid scene.
+    Syntax(Box<Diagnostic>),
+}
+
+impl std::fmt::Display for SceneError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Io { path, source } => write!(f, "cannot read {}: {source}", path.display()),
+            Self::Syntax(d) => d.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// Reads and parses a scene file.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+        SceneError::Syntax(Box::new(Diagnostic::at(path, &text, at..at + 1, "the scene file is not valid UTF-8")))
+    })?;
+    parse_scene(path, &text)
+}

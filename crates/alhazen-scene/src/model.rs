@@ -1,0 +1,416 @@
+//! The scene model: plain data, independent of any file format and of the renderer.
+//!
+//! Colours are linear RGB ([`Rgb`]); angles are stored in radians (the file uses degrees).
+
+use alhazen_geom::TriangleMesh;
+use alhazen_math::{Transform, Vec2, Vec3};
+use std::sync::Arc;
+
+/// A linear RGB triple.
+pub type Rgb = Vec3;
+
+/// Index into [`Scene::materials`].
+pub type MaterialId = u32;
+
+/// A whole scene, as read from a scene file.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Image size, sampling and recursion settings.
+    pub render: RenderSettings,
+    /// The camera.
+    pub camera: CameraDesc,
+    /// What rays that leave the scene see.
+    pub background: Background,
+    /// Ambient light `I^amb` (course, Lambert/Phong models).
+    pub ambient: Rgb,
+    /// Light sources.
+    pub lights: Vec<Light>,
+    /// Materials; objects refer to them by index. Index 0 is the default material.
+    pub materials: Vec<Material>,
+    /// Geometry.
+    pub objects: Vec<Object>,
+    /// Meshes shared between instances.
+    pub meshes: Vec<Arc<TriangleMesh>>,
+    /// Decoded image textures (linear RGB).
+    pub images: Vec<Arc<ImageData>>,
+}
+
+/// The integrator that computes the image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorKind {
+    /// Recursive ray tracing (the lecture's `RT_trace`/`RT_shade`).
+    Whitted,
+}
+
+/// Image size and sampling.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Width in pixels (per eye for a stereo camera).
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Maximum depth of the ray tree.
+    pub max_depth: u32,
+    /// Seed of every random decision.
+    pub seed: u64,
+    /// The integrator.
+    pub integrator: IntegratorKind,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self { width: 640, height: 480, spp: 4, max_depth: 8, seed: 0, integrator: IntegratorKind::Whitted }
+    }
+}
+
+/// Where the camera stands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LookAt {
+    /// Eye point.
+    pub eye: Vec3,
+    /// Point looked at.
+    pub target: Vec3,
+    /// View-up vector.
+    pub up: Vec3,
+}
+
+/// How a perspective camera's opening is given.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PerspectiveOpening {
+    /// Field of view in radians across the image's width (`horizontal`) or height.
+    Fov {
+        /// Angle in radians.
+        angle: f64,
+        /// True when `angle` spans the width.
+        horizontal: bool,
+    },
+    /// The course's frustum `l, r, b, t` on the near plane at distance `n`.
+    Frustum {
+        /// Left, right, bottom, top, near.
+        lrbtn: [f64; 5],
+    },
+}
+
+/// Parallel projections of technical drawing (course, §"Projections").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axonometry {
+    /// Orthographic along `(1, 1, 1)`: the three axes equally foreshortened.
+    Isometric,
+    /// Oblique: the front plane undistorted, depth at 45° and full length.
+    Cavalier,
+    /// Oblique: like cavalier with depth at half length.
+    Cabinet,
+    /// Oblique: the ground plan undistorted (rotated), verticals vertical at full length.
+    Military,
+}
+
+/// A camera description.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CameraDesc {
+    /// Pinhole perspective.
+    Perspective {
+        /// Placement.
+        look: LookAt,
+        /// Field of view or frustum.
+        opening: PerspectiveOpening,
+    },
+    /// Orthographic, `width` world units across the image.
+    Orthographic {
+        /// Placement.
+        look: LookAt,
+        /// Visible width in world units.
+        width: f64,
+    },
+    /// An axonometric (parallel, possibly oblique) view centred on `target`.
+    Axonometric {
+        /// The axonometry.
+        style: Axonometry,
+        /// The point at the image centre.
+        target: Vec3,
+        /// Visible width in world units.
+        width: f64,
+        /// Rotation of the scene about the vertical axis before projecting, radians.
+        azimuth: f64,
+    },
+    /// Two perspective views side by side (left eye on the left).
+    Stereo {
+        /// Placement of the point between the eyes.
+        look: LookAt,
+        /// Distance between the eyes.
+        eye_distance: f64,
+        /// Distance from the eyes to the screen.
+        screen_distance: f64,
+        /// Screen width (the height follows from the image aspect).
+        screen_width: f64,
+    },
+    /// Central projection on a cylinder around the vertical axis of the view, developed flat.
+    Panorama {
+        /// Placement.
+        look: LookAt,
+        /// Horizontal angle covered, radians (up to 2π).
+        angle: f64,
+    },
+}
+
+/// What a ray that hits nothing sees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Background {
+    /// A constant colour.
+    Solid(Rgb),
+    /// Blend from `horizon` (direction y = 0) to `zenith` (y = 1); `ground` below the horizon.
+    Gradient {
+        /// Colour straight up.
+        zenith: Rgb,
+        /// Colour at the horizon.
+        horizon: Rgb,
+        /// Colour below the horizon.
+        ground: Rgb,
+    },
+}
+
+/// A light source with the course's distance attenuation `1/(a d² + b d + c)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Emits equally in all directions from a point.
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Emitted intensity `I^em`.
+        intensity: Rgb,
+        /// `[a, b, c]`.
+        attenuation: [f64; 3],
+    },
+    /// Parallel light from infinitely far away.
+    Directional {
+        /// Direction the light travels (unit).
+        direction: Vec3,
+        /// Intensity `I^dir`.
+        intensity: Rgb,
+    },
+    /// A point light restricted to a cone, with falloff `cos^e` inside it.
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Axis direction (unit).
+        direction: Vec3,
+        /// Cosine of the half-angle of the cone.
+        cos_cutoff: f64,
+        /// Exponent of the cosine falloff.
+        falloff: f64,
+        /// Emitted intensity.
+        intensity: Rgb,
+        /// `[a, b, c]`.
+        attenuation: [f64; 3],
+    },
+}
+
+/// A colour that may vary over a surface.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Texture {
+    /// One colour.
+    Solid(Rgb),
+    /// Alternating squares of `size` in texture space.
+    Checker {
+        /// Colour of squares with even `⌊u/size⌋+⌊v/size⌋`.
+        even: Rgb,
+        /// The other colour.
+        odd: Rgb,
+        /// Edge of a square in texture units.
+        size: f64,
+    },
+    /// An image (index into [`Scene::images`]) repeated with `scale` images per texture unit.
+    Image {
+        /// Which image.
+        image: usize,
+        /// Repeats per texture unit in u and v.
+        scale: Vec2,
+    },
+}
+
+/// Which specular highlight formula.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Highlight {
+    /// `max(0, ⟨r, v⟩)^m`.
+    Phong,
+    /// `⟨h, n⟩^{2m}` (course: exponent `2m` so highlights match Phong's size).
+    BlinnPhong,
+}
+
+/// How reflectance at a dielectric boundary depends on the angle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FresnelMode {
+    /// The course's exact unpolarised formula.
+    Exact,
+    /// Schlick's approximation.
+    Schlick,
+    /// No Fresnel: `mirror` and `transparency` are used as given.
+    Off,
+}
+
+/// A Whitted material: the course's local model plus mirror and transparency coefficients.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name in the scene file.
+    pub name: String,
+    /// Surface colour `a` (before `diffuse`).
+    pub color: Texture,
+    /// Diffuse weight multiplied into `a`.
+    pub diffuse: f64,
+    /// Specular colour `s`.
+    pub specular: Rgb,
+    /// Exponent `m`.
+    pub shininess: f64,
+    /// Highlight formula.
+    pub highlight: Highlight,
+    /// Mirror reflectance.
+    pub mirror: Rgb,
+    /// Transmission coefficient.
+    pub transparency: Rgb,
+    /// Index of refraction of the inside relative to the outside.
+    pub ior: f64,
+    /// Beer absorption coefficient per unit length inside (linear RGB).
+    pub absorption: Rgb,
+    /// Fresnel treatment of transparent surfaces.
+    pub fresnel: FresnelMode,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            color: Texture::Solid(Vec3::splat(0.8)),
+            diffuse: 1.0,
+            specular: Vec3::ZERO,
+            shininess: 32.0,
+            highlight: Highlight::Phong,
+            mirror: Vec3::ZERO,
+            transparency: Vec3::ZERO,
+            ior: 1.5,
+            absorption: Vec3::ZERO,
+            fresnel: FresnelMode::Exact,
+        }
+    }
+}
+
+/// A boolean operation of constructive solid geometry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CsgOp {
+    /// A ∪ B.
+    Union,
+    /// A ∩ B.
+    Intersection,
+    /// A − B.
+    Difference,
+}
+
+/// A primitive or compound shape, in its own (object) coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A ball's surface.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f64,
+    },
+    /// A finite circular cylinder from `base` to `top`.
+    Cylinder {
+        /// Centre of the bottom.
+        base: Vec3,
+        /// Centre of the top.
+        top: Vec3,
+        /// Radius.
+        radius: f64,
+        /// Closed by two disks.
+        capped: bool,
+    },
+    /// A finite circular cone from a base disk to an apex.
+    Cone {
+        /// Centre of the base.
+        base: Vec3,
+        /// Apex.
+        apex: Vec3,
+        /// Base radius.
+        radius: f64,
+        /// Closed by the base disk.
+        capped: bool,
+    },
+    /// A flat disk.
+    Disk {
+        /// Centre.
+        center: Vec3,
+        /// Normal (unit).
+        normal: Vec3,
+        /// Radius.
+        radius: f64,
+    },
+    /// An infinite plane.
+    Plane {
+        /// A point on it.
+        point: Vec3,
+        /// Normal (unit).
+        normal: Vec3,
+    },
+    /// An axis-aligned box (before the object's transform).
+    Box {
+        /// Lower corner.
+        min: Vec3,
+        /// Upper corner.
+        max: Vec3,
+    },
+    /// A triangle mesh, index into [`Scene::meshes`].
+    Mesh {
+        /// Which mesh.
+        mesh: usize,
+        /// Interpolate vertex normals.
+        smooth: bool,
+    },
+    /// Constructive solid geometry of two closed shapes.
+    Csg {
+        /// The operation.
+        op: CsgOp,
+        /// Left operand.
+        a: Box<Object>,
+        /// Right operand.
+        b: Box<Object>,
+    },
+}
+
+impl Shape {
+    /// True when the shape bounds a volume, as CSG needs.
+    pub fn is_closed(&self) -> bool {
+        match self {
+            Shape::Sphere { .. } | Shape::Box { .. } | Shape::Mesh { .. } | Shape::Csg { .. } => true,
+            Shape::Cylinder { capped, .. } | Shape::Cone { capped, .. } => *capped,
+            Shape::Disk { .. } | Shape::Plane { .. } => false,
+        }
+    }
+}
+
+/// A shape placed in the world with a material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    /// Optional name (for messages).
+    pub name: Option<String>,
+    /// Geometry in object space.
+    pub shape: Shape,
+    /// Object → world.
+    pub transform: Transform,
+    /// Material; for meshes with per-triangle materials see [`Object::mesh_materials`].
+    pub material: MaterialId,
+    /// Per-slot materials of a mesh from its MTL file (empty when `material` applies to all).
+    pub mesh_materials: Vec<MaterialId>,
+}
+
+/// A decoded image in linear RGB, rows top to bottom.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageData {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width × height` linear RGB values.
+    pub pixels: Vec<[f32; 3]>,
+}

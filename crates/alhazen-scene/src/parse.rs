@@ -1,0 +1,519 @@
+//! The native scene format (TOML), documented field by field in `docs/scene-format.md`.
+
+use crate::diagnostic::did_you_mean;
+use crate::model::*;
+use crate::reader::{Node, R, Src, Table};
+use crate::{SceneError, import};
+use alhazen_math::{Mat4, Transform, Vec2, Vec3};
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+use toml::de::DeTable;
+
+/// Largest image side accepted, and largest pixel count: beyond these the film cannot be
+/// allocated on an ordinary machine, so we refuse before trying.
+pub const MAX_SIDE: u64 = 1 << 16;
+/// See [`MAX_SIDE`].
+pub const MAX_PIXELS: u64 = 1 << 28;
+
+const TOP_KEYS: &[&str] = &["render", "camera", "background", "ambient", "light", "materials", "meshes", "object"];
+
+/// Parses scene text; `file` names it in messages and anchors relative paths.
+pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
+    let src = Src { file, text };
+    let root = DeTable::parse(text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        let msg = e.message().lines().next().unwrap_or("invalid TOML").trim_end_matches('.').to_string();
+        SceneError::Syntax(Box::new(crate::Diagnostic::at(file, text, span, format!("TOML syntax error: {msg}"))))
+    })?;
+    let top = Table { src, t: root.get_ref(), span: root.span(), name: "scene" };
+    let mut p = Parser { dir: file.parent().unwrap_or(Path::new(".")), scene: empty_scene(), material_names: HashMap::new(), mesh_names: HashMap::new() };
+    p.scene_from(&top).map_err(SceneError::Syntax)?;
+    Ok(p.scene)
+}
+
+fn empty_scene() -> Scene {
+    Scene {
+        render: RenderSettings::default(),
+        camera: CameraDesc::Perspective {
+            look: LookAt { eye: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y },
+            opening: PerspectiveOpening::Fov { angle: 45f64.to_radians(), horizontal: true },
+        },
+        background: Background::Solid(Vec3::ZERO),
+        ambient: Vec3::ZERO,
+        lights: vec![],
+        materials: vec![Material::default()],
+        objects: vec![],
+        meshes: vec![],
+        images: vec![],
+    }
+}
+
+struct Parser<'a> {
+    dir: &'a Path,
+    scene: Scene,
+    material_names: HashMap<String, MaterialId>,
+    mesh_names: HashMap<String, (usize, Vec<MaterialId>)>,
+}
+
+impl Parser<'_> {
+    fn scene_from(&mut self, top: &Table) -> R<()> {
+        top.check_keys(TOP_KEYS)?;
+        if let Some(n) = top.get("render") {
+            self.scene.render = render_settings(&n)?;
+        }
+        if let Some(n) = top.get("camera") {
+            self.scene.camera = camera(&n)?;
+        }
+        if let Some(n) = top.get("background") {
+            self.scene.background = background(&n)?;
+        }
+        self.scene.ambient = top.opt_rgb("ambient", Vec3::ZERO)?;
+        if let Some(n) = top.get("materials") {
+            let t = n.table_any()?;
+            for (name, _) in t.keys() {
+                let m = t.get(name).expect("key listed");
+                let mat = self.material(&m, name)?;
+                self.add_material(name, mat);
+            }
+        }
+        if let Some(n) = top.get("meshes") {
+            let t = n.table_any()?;
+            for (name, _) in t.keys() {
+                let m = t.get(name).expect("key listed");
+                let mesh = self.mesh_decl(&m)?;
+                self.mesh_names.insert(name.to_string(), mesh);
+            }
+        }
+        for n in top.get("light").map(|n| n.array()).transpose()?.unwrap_or_default() {
+            self.scene.lights.push(light(&n)?);
+        }
+        for n in top.get("object").map(|n| n.array()).transpose()?.unwrap_or_default() {
+            let o = self.object(&n, 0)?;
+            self.scene.objects.push(o);
+        }
+        Ok(())
+    }
+
+    fn add_material(&mut self, name: &str, mat: Material) -> MaterialId {
+        let id = self.scene.materials.len() as MaterialId;
+        self.scene.materials.push(mat);
+        self.material_names.insert(name.to_string(), id);
+        id
+    }
+
+    fn material(&mut self, n: &Node, name: &str) -> R<Material> {
+        const KEYS: &[&str] = &["color", "diffuse", "specular", "shininess", "highlight", "mirror", "transparency", "ior", "absorption", "fresnel"];
+        let t = n.table(KEYS)?;
+        let d = Material::default();
+        let color = match t.get("color") {
+            Some(c) => self.texture(&c)?,
+            None => d.color,
+        };
+        Ok(Material {
+            name: name.to_string(),
+            color,
+            diffuse: t.get("diffuse").map_or(Ok(d.diffuse), |n| n.non_negative())?,
+            specular: t.opt_rgb("specular", d.specular)?,
+            shininess: t.get("shininess").map_or(Ok(d.shininess), |n| n.non_negative())?,
+            highlight: match t.get("highlight") {
+                Some(h) => match h.choice(&["phong", "blinn-phong"])? {
+                    "phong" => Highlight::Phong,
+                    _ => Highlight::BlinnPhong,
+                },
+                None => d.highlight,
+            },
+            mirror: t.opt_rgb("mirror", d.mirror)?,
+            transparency: t.opt_rgb("transparency", d.transparency)?,
+            ior: t.get("ior").map_or(Ok(d.ior), |n| n.positive())?,
+            absorption: t.opt_rgb("absorption", d.absorption)?,
+            fresnel: match t.get("fresnel") {
+                Some(f) => match f.choice(&["exact", "schlick", "off"])? {
+                    "exact" => FresnelMode::Exact,
+                    "schlick" => FresnelMode::Schlick,
+                    _ => FresnelMode::Off,
+                },
+                None => d.fresnel,
+            },
+        })
+    }
+
+    fn texture(&mut self, n: &Node) -> R<Texture> {
+        if !n.is_table() {
+            return Ok(Texture::Solid(n.rgb()?));
+        }
+        let t = n.table(&["checker", "image"])?;
+        if let Some(c) = t.get("checker") {
+            let c = c.table(&["even", "odd", "size"])?;
+            return Ok(Texture::Checker {
+                even: c.opt_rgb("even", Vec3::splat(0.9))?,
+                odd: c.opt_rgb("odd", Vec3::splat(0.1))?,
+                size: c.get("size").map_or(Ok(1.0), |n| n.positive())?,
+            });
+        }
+        if let Some(i) = t.get("image") {
+            let i = i.table(&["file", "scale"])?;
+            let file = i.req("file")?;
+            let path = self.dir.join(file.str()?);
+            let data = import::load_image(&path).map_err(|e| file.err(e))?;
+            let scale = match i.get("scale") {
+                Some(s) if s.is_table() => return Err(s.err("`scale`: expected a number or [u, v]")),
+                Some(s) => match s.v {
+                    toml::de::DeValue::Array(_) => Vec2::from_array(s.numbers::<2>()?),
+                    _ => Vec2::splat(s.positive()?),
+                },
+                None => Vec2::ONE,
+            };
+            self.scene.images.push(Arc::new(data));
+            return Ok(Texture::Image { image: self.scene.images.len() - 1, scale });
+        }
+        Err(n.err("`color`: expected a colour, { checker = {...} } or { image = {...} }"))
+    }
+
+    fn material_ref(&mut self, n: &Node, object_name: &str) -> R<MaterialId> {
+        if n.is_table() {
+            let name = format!("{object_name} (inline)");
+            let m = self.material(n, &name)?;
+            return Ok(self.add_material(&name, m));
+        }
+        let name = n.str()?;
+        self.material_names.get(name).copied().ok_or_else(|| {
+            let mut d = n.err(format!("unknown material \"{name}\"; define it under [materials.{name}]"));
+            if let Some(m) = did_you_mean(name, self.material_names.keys().map(String::as_str)) {
+                *d = d.with_help(format!("did you mean \"{m}\"?"));
+            }
+            d
+        })
+    }
+
+    fn mesh_decl(&mut self, n: &Node) -> R<(usize, Vec<MaterialId>)> {
+        let t = n.table(&["file"])?;
+        self.load_mesh(&t.req("file")?)
+    }
+
+    fn load_mesh(&mut self, file: &Node) -> R<(usize, Vec<MaterialId>)> {
+        let path = self.dir.join(file.str()?);
+        let loaded = import::load_mesh(&path).map_err(|e| file.err(e))?;
+        let slots = loaded
+            .materials
+            .into_iter()
+            .map(|m| {
+                let name = format!("{}:{}", path.display(), m.name);
+                self.add_material(&name, m)
+            })
+            .collect();
+        self.scene.meshes.push(Arc::new(loaded.mesh));
+        Ok((self.scene.meshes.len() - 1, slots))
+    }
+
+    fn object(&mut self, n: &Node, depth: usize) -> R<Object> {
+        const COMMON: &[&str] = &["shape", "name", "material", "transform"];
+        let t = n.table_any()?;
+        let shape_node = t.req("shape")?;
+        let kind = shape_node.choice(&["sphere", "cylinder", "cone", "disk", "plane", "box", "mesh", "csg"])?;
+        let specific: &[&str] = match kind {
+            "sphere" => &["center", "radius"],
+            "cylinder" => &["base", "top", "radius", "capped"],
+            "cone" => &["base", "apex", "radius", "capped"],
+            "disk" => &["center", "normal", "radius"],
+            "plane" => &["point", "normal"],
+            "box" => &["min", "max"],
+            "mesh" => &["file", "mesh", "smooth"],
+            _ => &["op", "a", "b"],
+        };
+        let keys: Vec<&str> = COMMON.iter().chain(specific).copied().collect();
+        t.check_keys(&keys)?;
+        let name = t.get("name").map(|n| n.str().map(str::to_string)).transpose()?;
+        let label = name.clone().unwrap_or_else(|| format!("{kind} object"));
+        let transform = match t.get("transform") {
+            Some(tr) => transform(&tr)?,
+            None => Transform::IDENTITY,
+        };
+        let mut mesh_materials = vec![];
+        let shape = match kind {
+            "sphere" => Shape::Sphere { center: t.opt_vec3("center", Vec3::ZERO)?, radius: t.req("radius")?.positive()? },
+            "cylinder" => {
+                let (base, top) = (t.opt_vec3("base", Vec3::ZERO)?, t.opt_vec3("top", Vec3::Y)?);
+                distinct(&t, "top", base, top)?;
+                Shape::Cylinder { base, top, radius: t.req("radius")?.positive()?, capped: t.opt_bool("capped", true)? }
+            }
+            "cone" => {
+                let (base, apex) = (t.opt_vec3("base", Vec3::ZERO)?, t.opt_vec3("apex", Vec3::Y)?);
+                distinct(&t, "apex", base, apex)?;
+                Shape::Cone { base, apex, radius: t.req("radius")?.positive()?, capped: t.opt_bool("capped", true)? }
+            }
+            "disk" => Shape::Disk {
+                center: t.opt_vec3("center", Vec3::ZERO)?,
+                normal: t.get("normal").map_or(Ok(Vec3::Y), |n| n.unit_vec3())?,
+                radius: t.req("radius")?.positive()?,
+            },
+            "plane" => Shape::Plane {
+                point: t.opt_vec3("point", Vec3::ZERO)?,
+                normal: t.get("normal").map_or(Ok(Vec3::Y), |n| n.unit_vec3())?,
+            },
+            "box" => {
+                let (min, max) = (t.opt_vec3("min", Vec3::splat(-1.0))?, t.opt_vec3("max", Vec3::ONE)?);
+                if min.cmpge(max).any() {
+                    return Err(t.req("max")?.err("`max` must exceed `min` in every coordinate"));
+                }
+                Shape::Box { min, max }
+            }
+            "mesh" => {
+                let (mesh, slots) = match (t.get("mesh"), t.get("file")) {
+                    (Some(m), None) => {
+                        let name = m.str()?;
+                        self.mesh_names.get(name).cloned().ok_or_else(|| {
+                            let mut d = m.err(format!("unknown mesh \"{name}\"; declare it under [meshes.{name}]"));
+                            if let Some(s) = did_you_mean(name, self.mesh_names.keys().map(String::as_str)) {
+                                *d = d.with_help(format!("did you mean \"{s}\"?"));
+                            }
+                            d
+                        })?
+                    }
+                    (None, Some(f)) => self.load_mesh(&f)?,
+                    _ => return Err(shape_node.err("a mesh object needs exactly one of `file` or `mesh`")),
+                };
+                mesh_materials = slots;
+                Shape::Mesh { mesh, smooth: t.opt_bool("smooth", true)? }
+            }
+            _ => {
+                if depth > 64 {
+                    return Err(shape_node.err("CSG nested deeper than 64 levels"));
+                }
+                let op = match t.req("op")?.choice(&["union", "intersection", "difference"])? {
+                    "union" => CsgOp::Union,
+                    "intersection" => CsgOp::Intersection,
+                    _ => CsgOp::Difference,
+                };
+                let mut operand = |key: &str| -> R<Box<Object>> {
+                    let node = t.req(key)?;
+                    let o = self.object(&node, depth + 1)?;
+                    if !o.shape.is_closed() {
+                        return Err(node.err(format!("CSG operand `{key}` must be a closed shape (sphere, box, capped cylinder or cone, closed mesh, csg)")));
+                    }
+                    Ok(Box::new(o))
+                };
+                let a = operand("a")?;
+                let b = operand("b")?;
+                Shape::Csg { op, a, b }
+            }
+        };
+        let material = match t.get("material") {
+            Some(m) => {
+                mesh_materials.clear();
+                self.material_ref(&m, &label)?
+            }
+            None => 0,
+        };
+        Ok(Object { name, shape, transform, material, mesh_materials })
+    }
+}
+
+fn distinct(t: &Table, key: &str, a: Vec3, b: Vec3) -> R<()> {
+    if (a - b).length() > 0.0 {
+        return Ok(());
+    }
+    let n = t.get(key).unwrap_or_else(|| t.req("shape").expect("shape was read"));
+    Err(n.err(format!("`{key}` must differ from `base`")))
+}
+
+impl<'a, 'i> Node<'a, 'i> {
+    /// A table whose keys the caller checks itself.
+    pub(crate) fn table_any(&self) -> R<Table<'a, 'i>> {
+        let toml::de::DeValue::Table(t) = self.v else {
+            return Err(self.err(format!("`{}`: expected a table", self.key)));
+        };
+        Ok(Table { src: self.src, t, span: self.span.clone(), name: self.key })
+    }
+}
+
+fn render_settings(n: &Node) -> R<RenderSettings> {
+    let t = n.table(&["width", "height", "spp", "max_depth", "seed", "integrator"])?;
+    let d = RenderSettings::default();
+    let r = RenderSettings {
+        width: t.get("width").map_or(Ok(d.width as u64), |n| n.integer(1, MAX_SIDE))? as u32,
+        height: t.get("height").map_or(Ok(d.height as u64), |n| n.integer(1, MAX_SIDE))? as u32,
+        spp: t.get("spp").map_or(Ok(d.spp as u64), |n| n.integer(1, 1 << 20))? as u32,
+        max_depth: t.get("max_depth").map_or(Ok(d.max_depth as u64), |n| n.integer(0, 1000))? as u32,
+        seed: t.get("seed").map_or(Ok(0), |n| n.integer(0, i64::MAX as u64))?,
+        integrator: match t.get("integrator") {
+            Some(i) => {
+                i.choice(&["whitted"])?;
+                IntegratorKind::Whitted
+            }
+            None => d.integrator,
+        },
+    };
+    if r.width as u64 * r.height as u64 > MAX_PIXELS {
+        return Err(t.req("width")?.err(format!("{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate", r.width, r.height)));
+    }
+    Ok(r)
+}
+
+fn look_at(t: &Table) -> R<LookAt> {
+    let look = LookAt {
+        eye: t.req("eye")?.vec3()?,
+        target: t.opt_vec3("target", Vec3::ZERO)?,
+        up: t.opt_vec3("up", Vec3::Y)?,
+    };
+    if alhazen_math::viewing::ViewFrame::look_at(look.eye, look.target, look.up).is_none() {
+        let n = t.get("target").unwrap_or(t.req("eye")?);
+        return Err(n.err("the camera's eye and target coincide, or `up` is parallel to the view direction"));
+    }
+    Ok(look)
+}
+
+fn camera(n: &Node) -> R<CameraDesc> {
+    let t = n.table_any()?;
+    let kind = match t.get("type") {
+        Some(k) => k.choice(&["perspective", "orthographic", "axonometric", "stereo", "panorama"])?,
+        None => "perspective",
+    };
+    let keys: &[&str] = match kind {
+        "perspective" => &["type", "eye", "target", "up", "fov", "fov_axis", "frustum"],
+        "orthographic" => &["type", "eye", "target", "up", "width"],
+        "axonometric" => &["type", "style", "target", "width", "azimuth"],
+        "stereo" => &["type", "eye", "target", "up", "eye_distance", "screen_distance", "screen_width"],
+        _ => &["type", "eye", "target", "up", "fov"],
+    };
+    t.check_keys(keys)?;
+    Ok(match kind {
+        "perspective" => {
+            let look = look_at(&t)?;
+            let opening = match (t.get("fov"), t.get("frustum")) {
+                (Some(_), Some(f)) => return Err(f.err("give either `fov` or `frustum`, not both")),
+                (_, Some(f)) => {
+                    let ft = f.table(&["left", "right", "bottom", "top", "near"])?;
+                    let v = ["left", "right", "bottom", "top"].map(|k| ft.req(k).and_then(|n| n.f64()));
+                    let [l, r, b, tp] = [v[0].clone()?, v[1].clone()?, v[2].clone()?, v[3].clone()?];
+                    let near = ft.req("near")?.positive()?;
+                    if l >= r || b >= tp {
+                        return Err(f.err("the frustum needs left < right and bottom < top"));
+                    }
+                    PerspectiveOpening::Frustum { lrbtn: [l, r, b, tp, near] }
+                }
+                (fov, None) => PerspectiveOpening::Fov {
+                    angle: fov.map_or(Ok(45.0), |n| n.in_range(1e-3, 179.0))?.to_radians(),
+                    horizontal: match t.get("fov_axis") {
+                        Some(a) => a.choice(&["horizontal", "vertical"])? == "horizontal",
+                        None => true,
+                    },
+                },
+            };
+            CameraDesc::Perspective { look, opening }
+        }
+        "orthographic" => CameraDesc::Orthographic { look: look_at(&t)?, width: t.req("width")?.positive()? },
+        "axonometric" => CameraDesc::Axonometric {
+            style: match t.req("style")?.choice(&["isometric", "cavalier", "cabinet", "military"])? {
+                "isometric" => Axonometry::Isometric,
+                "cavalier" => Axonometry::Cavalier,
+                "cabinet" => Axonometry::Cabinet,
+                _ => Axonometry::Military,
+            },
+            target: t.opt_vec3("target", Vec3::ZERO)?,
+            width: t.req("width")?.positive()?,
+            azimuth: t.opt_f64("azimuth", 0.0)?.to_radians(),
+        },
+        "stereo" => CameraDesc::Stereo {
+            look: look_at(&t)?,
+            eye_distance: t.get("eye_distance").map_or(Ok(0.065), |n| n.positive())?,
+            screen_distance: t.get("screen_distance").map_or(Ok(0.6), |n| n.positive())?,
+            screen_width: t.get("screen_width").map_or(Ok(0.5), |n| n.positive())?,
+        },
+        _ => CameraDesc::Panorama {
+            look: look_at(&t)?,
+            angle: t.get("fov").map_or(Ok(360.0), |n| n.in_range(1e-3, 360.0))?.to_radians(),
+        },
+    })
+}
+
+fn background(n: &Node) -> R<Background> {
+    if !n.is_table() {
+        return Ok(Background::Solid(n.rgb()?));
+    }
+    let t = n.table(&["color", "zenith", "horizon", "ground"])?;
+    if let Some(c) = t.get("color") {
+        if let Some(other) = t.get("zenith").or(t.get("horizon")) {
+            return Err(other.err("give either `color` or a gradient (`zenith`, `horizon`), not both"));
+        }
+        return Ok(Background::Solid(c.rgb()?));
+    }
+    let horizon = t.opt_rgb("horizon", Vec3::splat(1.0))?;
+    Ok(Background::Gradient {
+        zenith: t.opt_rgb("zenith", Vec3::new(0.3, 0.5, 0.9))?,
+        horizon,
+        ground: t.opt_rgb("ground", horizon)?,
+    })
+}
+
+fn attenuation(t: &Table) -> R<[f64; 3]> {
+    let Some(n) = t.get("attenuation") else { return Ok([0.0, 0.0, 1.0]) };
+    let abc = n.numbers::<3>()?;
+    if abc.iter().any(|x| *x < 0.0) || abc.iter().all(|x| *x == 0.0) {
+        return Err(n.err("`attenuation` [a, b, c] needs a, b, c ≥ 0, not all zero (intensity / (a d² + b d + c))"));
+    }
+    Ok(abc)
+}
+
+fn light(n: &Node) -> R<Light> {
+    let t = n.table_any()?;
+    let kind = t.req("type")?.choice(&["point", "directional", "spot"])?;
+    let keys: &[&str] = match kind {
+        "point" => &["type", "position", "intensity", "attenuation"],
+        "directional" => &["type", "direction", "intensity"],
+        _ => &["type", "position", "direction", "angle", "falloff", "intensity", "attenuation"],
+    };
+    t.check_keys(keys)?;
+    let intensity = t.opt_rgb("intensity", Vec3::ONE)?;
+    Ok(match kind {
+        "point" => Light::Point { position: t.req("position")?.vec3()?, intensity, attenuation: attenuation(&t)? },
+        "directional" => Light::Directional { direction: t.req("direction")?.unit_vec3()?, intensity },
+        _ => Light::Spot {
+            position: t.req("position")?.vec3()?,
+            direction: t.req("direction")?.unit_vec3()?,
+            cos_cutoff: t.get("angle").map_or(Ok(30.0), |n| n.in_range(0.0, 180.0))?.to_radians().cos(),
+            falloff: t.get("falloff").map_or(Ok(1.0), |n| n.non_negative())?,
+            intensity,
+            attenuation: attenuation(&t)?,
+        },
+    })
+}
+
+/// `transform = [ { translate = [..] }, { rotate = { axis = [..], angle = deg } }, … ]`, applied
+/// in the order listed.
+fn transform(n: &Node) -> R<Transform> {
+    let mut total = Transform::IDENTITY;
+    for step in n.array()? {
+        let t = step.table(&["translate", "scale", "rotate", "rotate_x", "rotate_y", "rotate_z", "matrix"])?;
+        let mut keys = t.keys();
+        let (Some((key, _)), None) = (keys.next(), keys.next()) else {
+            return Err(step.err("each transform step is a table with exactly one key, e.g. { translate = [0, 1, 0] }"));
+        };
+        let v = t.get(key).expect("key listed");
+        let m = match key {
+            "translate" => Transform::translate(v.vec3()?),
+            "scale" => {
+                let s = if v.is_table() { return Err(v.err("`scale`: expected a number or [x, y, z]")) } else if matches!(v.v, toml::de::DeValue::Array(_)) { v.vec3()? } else { Vec3::splat(v.f64()?) };
+                Transform::try_scale(s).map_err(|e| v.err(format!("`scale`: {e}")))?
+            }
+            "rotate" => {
+                let r = v.table(&["axis", "angle"])?;
+                Transform::rotate(r.req("axis")?.unit_vec3()?, r.req("angle")?.f64()?.to_radians())
+            }
+            "rotate_x" => Transform::rotate(Vec3::X, v.f64()?.to_radians()),
+            "rotate_y" => Transform::rotate(Vec3::Y, v.f64()?.to_radians()),
+            "rotate_z" => Transform::rotate(Vec3::Z, v.f64()?.to_radians()),
+            _ => {
+                let rows = v.array()?;
+                if rows.len() != 4 {
+                    return Err(v.err("`matrix`: expected 4 rows of 4 numbers"));
+                }
+                let r: Vec<[f64; 4]> = rows.iter().map(|r| r.numbers::<4>()).collect::<R<_>>()?;
+                let m = Mat4::from_cols_array_2d(&r.try_into().expect("4 rows")).transpose();
+                Transform::from_matrix(m).map_err(|e| v.err(format!("`matrix`: {e}")))?
+            }
+        };
+        total = m * total;
+    }
+    Ok(total)
+}

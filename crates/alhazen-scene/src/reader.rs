@@ -1,0 +1,236 @@
+//! A typed view of a spanned TOML tree: every accessor knows where its value came from, so
+//! every error can point at it.
+
+use crate::diagnostic::{Diagnostic, did_you_mean};
+use alhazen_math::Vec3;
+use std::ops::Range;
+use std::path::Path;
+use toml::de::{DeTable, DeValue};
+
+pub(crate) type R<T> = Result<T, Box<Diagnostic>>;
+
+/// The file being read.
+#[derive(Clone, Copy)]
+pub(crate) struct Src<'s> {
+    pub file: &'s Path,
+    pub text: &'s str,
+}
+
+impl Src<'_> {
+    pub fn error(&self, span: Range<usize>, msg: impl Into<String>) -> Box<Diagnostic> {
+        Box::new(Diagnostic::at(self.file, self.text, span, msg))
+    }
+}
+
+/// A value with its span.
+#[derive(Clone)]
+pub(crate) struct Node<'a, 'i> {
+    pub src: Src<'a>,
+    pub v: &'a DeValue<'i>,
+    pub span: Range<usize>,
+    /// The key this value was found under, for messages.
+    pub key: &'a str,
+}
+
+fn kind(v: &DeValue<'_>) -> &'static str {
+    match v {
+        DeValue::String(_) => "a string",
+        DeValue::Integer(_) => "an integer",
+        DeValue::Float(_) => "a float",
+        DeValue::Boolean(_) => "a boolean",
+        DeValue::Datetime(_) => "a date",
+        DeValue::Array(_) => "an array",
+        DeValue::Table(_) => "a table",
+    }
+}
+
+impl<'a, 'i> Node<'a, 'i> {
+    pub fn err(&self, msg: impl Into<String>) -> Box<Diagnostic> {
+        self.src.error(self.span.clone(), msg)
+    }
+
+    fn expected(&self, what: &str) -> Box<Diagnostic> {
+        self.err(format!("`{}`: expected {what}, found {}", self.key, kind(self.v)))
+    }
+
+    pub fn f64(&self) -> R<f64> {
+        let parsed = match self.v {
+            DeValue::Integer(i) => {
+                let digits = i.as_str().replace('_', "");
+                i64::from_str_radix(&digits, i.radix()).map(|x| x as f64).ok()
+            }
+            DeValue::Float(x) => x.as_str().replace('_', "").parse::<f64>().ok(),
+            _ => return Err(self.expected("a number")),
+        };
+        match parsed {
+            Some(x) if x.is_finite() => Ok(x),
+            _ => Err(self.err(format!("`{}`: expected a finite number", self.key))),
+        }
+    }
+
+    pub fn positive(&self) -> R<f64> {
+        let x = self.f64()?;
+        if x > 0.0 { Ok(x) } else { Err(self.err(format!("`{}` must be positive, found {x}", self.key))) }
+    }
+
+    pub fn non_negative(&self) -> R<f64> {
+        let x = self.f64()?;
+        if x >= 0.0 { Ok(x) } else { Err(self.err(format!("`{}` must be ≥ 0, found {x}", self.key))) }
+    }
+
+    pub fn in_range(&self, lo: f64, hi: f64) -> R<f64> {
+        let x = self.f64()?;
+        if (lo..=hi).contains(&x) {
+            Ok(x)
+        } else {
+            Err(self.err(format!("`{}` must lie in [{lo}, {hi}], found {x}", self.key)))
+        }
+    }
+
+    pub fn integer(&self, lo: u64, hi: u64) -> R<u64> {
+        let DeValue::Integer(i) = self.v else { return Err(self.expected("an integer")) };
+        let digits = i.as_str().replace('_', "");
+        match i64::from_str_radix(&digits, i.radix()) {
+            Ok(x) if x >= 0 && (lo..=hi).contains(&(x as u64)) => Ok(x as u64),
+            _ => Err(self.err(format!("`{}` must be an integer in {lo}..={hi}, found {}", self.key, i.as_str()))),
+        }
+    }
+
+    pub fn bool(&self) -> R<bool> {
+        self.v.as_bool().ok_or_else(|| self.expected("true or false"))
+    }
+
+    pub fn str(&self) -> R<&'a str> {
+        self.v.as_str().ok_or_else(|| self.expected("a string"))
+    }
+
+    /// One of `choices`, with a suggestion for near misses.
+    pub fn choice<'c>(&self, choices: &[&'c str]) -> R<&'c str> {
+        let s = self.str()?;
+        if let Some(c) = choices.iter().find(|c| **c == s) {
+            return Ok(c);
+        }
+        let list = choices.iter().map(|c| format!("\"{c}\"")).collect::<Vec<_>>().join(", ");
+        let mut d = self.err(format!("`{}`: unknown value \"{s}\", expected one of {list}", self.key));
+        if let Some(m) = did_you_mean(s, choices.iter().copied()) {
+            *d = d.with_help(format!("did you mean \"{m}\"?"));
+        }
+        Err(d)
+    }
+
+    pub fn array(&self) -> R<Vec<Node<'a, 'i>>> {
+        let DeValue::Array(items) = self.v else { return Err(self.expected("an array")) };
+        Ok(items
+            .iter()
+            .map(|item| Node { src: self.src, v: item.get_ref(), span: item.span(), key: self.key })
+            .collect())
+    }
+
+    pub fn numbers<const N: usize>(&self) -> R<[f64; N]> {
+        let items = self.array().map_err(|_| self.expected(&format!("an array of {N} numbers")))?;
+        if items.len() != N {
+            return Err(self.err(format!("`{}`: expected {N} numbers, found {}", self.key, items.len())));
+        }
+        let mut out = [0.0; N];
+        for (o, item) in out.iter_mut().zip(&items) {
+            *o = item.f64()?;
+        }
+        Ok(out)
+    }
+
+    pub fn vec3(&self) -> R<Vec3> {
+        self.numbers::<3>().map(Vec3::from_array)
+    }
+
+    pub fn unit_vec3(&self) -> R<Vec3> {
+        self.vec3()?.try_normalize().ok_or_else(|| self.err(format!("`{}` must be a non-zero vector", self.key)))
+    }
+
+    /// A colour: one number (grey) or `[r, g, b]`, each ≥ 0.
+    pub fn rgb(&self) -> R<Vec3> {
+        let c = match self.v {
+            DeValue::Integer(_) | DeValue::Float(_) => Vec3::splat(self.f64()?),
+            DeValue::Array(_) => self.vec3()?,
+            _ => return Err(self.expected("a colour (a number or [r, g, b])")),
+        };
+        if c.min_element() < 0.0 {
+            return Err(self.err(format!("`{}`: colour components must be ≥ 0", self.key)));
+        }
+        Ok(c)
+    }
+
+    pub fn table(&self, keys: &[&str]) -> R<Table<'a, 'i>> {
+        let DeValue::Table(t) = self.v else { return Err(self.expected("a table")) };
+        let table = Table { src: self.src, t, span: self.span.clone(), name: self.key };
+        table.check_keys(keys)?;
+        Ok(table)
+    }
+
+    pub fn is_table(&self) -> bool {
+        matches!(self.v, DeValue::Table(_))
+    }
+}
+
+/// A table with its span and the name it is known by in messages.
+#[derive(Clone)]
+pub(crate) struct Table<'a, 'i> {
+    pub src: Src<'a>,
+    pub t: &'a DeTable<'i>,
+    pub span: Range<usize>,
+    pub name: &'a str,
+}
+
+impl<'a, 'i> Table<'a, 'i> {
+    pub fn get(&self, key: &str) -> Option<Node<'a, 'i>> {
+        self.t.iter().find(|(k, _)| k.get_ref().as_ref() == key).map(|(k, v)| Node {
+            src: self.src,
+            v: v.get_ref(),
+            span: v.span(),
+            key: k.get_ref().as_ref(),
+        })
+    }
+
+    pub fn req(&self, key: &str) -> R<Node<'a, 'i>> {
+        self.get(key).ok_or_else(|| self.src.error(self.header_span(), format!("`{}` is missing the required key `{key}`", self.name)))
+    }
+
+    /// The start of the table for messages about the whole table.
+    fn header_span(&self) -> Range<usize> {
+        let start = self.span.start;
+        start..start + 1
+    }
+
+    pub fn keys(&self) -> impl Iterator<Item = (&'a str, Range<usize>)> + '_ {
+        self.t.iter().map(|(k, _)| (k.get_ref().as_ref(), k.span()))
+    }
+
+    pub fn check_keys(&self, known: &[&str]) -> R<()> {
+        for (k, span) in self.keys() {
+            if !known.contains(&k) {
+                let list = known.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", ");
+                let mut d = self.src.error(span, format!("unknown key `{k}` in `{}`; expected one of {list}", self.name));
+                if let Some(m) = did_you_mean(k, known.iter().copied()) {
+                    *d = d.with_help(format!("did you mean `{m}`?"));
+                }
+                return Err(d);
+            }
+        }
+        Ok(())
+    }
+
+    pub fn opt_f64(&self, key: &str, default: f64) -> R<f64> {
+        self.get(key).map_or(Ok(default), |n| n.f64())
+    }
+
+    pub fn opt_rgb(&self, key: &str, default: Vec3) -> R<Vec3> {
+        self.get(key).map_or(Ok(default), |n| n.rgb())
+    }
+
+    pub fn opt_bool(&self, key: &str, default: bool) -> R<bool> {
+        self.get(key).map_or(Ok(default), |n| n.bool())
+    }
+
+    pub fn opt_vec3(&self, key: &str, default: Vec3) -> R<Vec3> {
+        self.get(key).map_or(Ok(default), |n| n.vec3())
+    }
+}
