@@ -16,7 +16,7 @@ pub const MAX_SIDE: u64 = 1 << 16;
 /// See [`MAX_SIDE`].
 pub const MAX_PIXELS: u64 = 1 << 28;
 
-const TOP_KEYS: &[&str] = &["render", "camera", "background", "ambient", "light", "materials", "meshes", "object"];
+pub(crate) const TOP_KEYS: &[&str] = &["render", "camera", "background", "ambient", "light", "materials", "meshes", "object"];
 
 /// Parses scene text; `file` names it in messages and anchors relative paths.
 pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {

@@ -211,6 +211,8 @@ impl<'a, 'i> Table<'a, 'i> {
                 let mut d = self.src.error(span, format!("unknown key `{k}` in `{}`; expected one of {list}", self.name));
                 if let Some(m) = did_you_mean(k, known.iter().copied()) {
                     *d = d.with_help(format!("did you mean `{m}`?"));
+                } else if crate::parse::TOP_KEYS.contains(&k) {
+                    *d = d.with_help(format!("`{k}` is a top-level key: in TOML it must come before the first [table] header"));
                 }
                 return Err(d);
             }

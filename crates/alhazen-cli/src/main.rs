@@ -1,0 +1,156 @@
+//! `alhazen`: the command-line front end. The only crate that reads argv and the environment,
+//! writes to stdout/stderr and chooses exit codes:
+//! 0 success, 1 a failure while working (e.g. the output cannot be written), 2 bad input (usage,
+//! an unreadable or invalid scene file, impossible sizes).
+
+use alhazen_render::output::{Format, write_image};
+use alhazen_scene::{MAX_PIXELS, Scene, SceneError, load_scene};
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(name = "alhazen", version, about = "Mirrors, glass and line art: one scene, exact reflections.")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image (PNG, EXR or PFM) with the Whitted ray tracer.
+    #[command(after_help = "Example:\n  alhazen render scenes/glass-balls.toml -o glass-balls.png --spp 16\n\nThe scene format is described in docs/scene-format.md.")]
+    Render(RenderArgs),
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Output image; the format follows the extension: .png, .exr, .pfm.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Image width in pixels (overrides the scene).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    width: Option<u32>,
+    /// Image height in pixels (overrides the scene).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    height: Option<u32>,
+    /// Samples per pixel (overrides the scene).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
+    spp: Option<u32>,
+    /// Maximum ray depth (overrides the scene).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    depth: Option<u32>,
+    /// Random seed (overrides the scene).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    /// Write EXR as 16-bit half floats instead of 32-bit floats.
+    #[arg(long)]
+    half: bool,
+    /// No progress bar or summary.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// An error and the exit code it deserves.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+impl Failure {
+    fn input(message: impl Into<String>) -> Self {
+        Self { code: 2, message: message.into() }
+    }
+    fn work(message: impl Into<String>) -> Self {
+        Self { code: 1, message: message.into() }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => run_render(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("error: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), Failure> {
+    let r = &mut scene.render;
+    r.width = a.width.unwrap_or(r.width);
+    r.height = a.height.unwrap_or(r.height);
+    r.spp = a.spp.unwrap_or(r.spp);
+    r.max_depth = a.depth.unwrap_or(r.max_depth);
+    r.seed = a.seed.unwrap_or(r.seed);
+    if r.width as u64 * r.height as u64 > MAX_PIXELS {
+        return Err(Failure::input(format!("{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate", r.width, r.height)));
+    }
+    Ok(())
+}
+
+fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
+    let format = Format::from_path(path, half).ok_or_else(|| Failure::input(format!("{}: unknown image format; use .png, .exr or .pfm", path.display())))?;
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        return Err(Failure::input(format!("{}: the directory {} does not exist", path.display(), dir.display())));
+    }
+    Ok(format)
+}
+
+fn run_render(a: &RenderArgs) -> Result<(), Failure> {
+    let format = check_output(&a.output, a.half)?;
+    let mut scene = load_scene(&a.scene).map_err(|e| match e {
+        SceneError::Io { .. } => Failure::input(e.to_string()),
+        SceneError::Syntax(d) => Failure::input(d.to_string()),
+    })?;
+    apply_overrides(&mut scene, a)?;
+    let threads = a.threads.map_or(0, |t| t as usize);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Failure::work(e.to_string()))?;
+    let bar = progress_bar(a.quiet);
+    let start = Instant::now();
+    let image = pool.install(|| {
+        alhazen_render::render(&scene, &|done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        })
+    });
+    bar.finish_and_clear();
+    let elapsed = start.elapsed();
+    write_image(&image, &a.output, format).map_err(|e| Failure::work(format!("cannot write {}: {e}", a.output.display())))?;
+    if !a.quiet {
+        let r = &scene.render;
+        eprintln!(
+            "rendered {} ({}×{}, {} spp, depth {}) in {:.3} s on {} threads → {}",
+            a.scene.display(),
+            image.width,
+            image.height,
+            r.spp,
+            r.max_depth,
+            elapsed.as_secs_f64(),
+            pool.current_num_threads(),
+            a.output.display()
+        );
+    }
+    Ok(())
+}
+
+fn progress_bar(quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(1);
+    bar.set_style(ProgressStyle::with_template("{spinner} rendering [{bar:40}] {percent:>3}% tiles {pos}/{len} elapsed {elapsed} eta {eta}").unwrap_or_else(|_| ProgressStyle::default_bar()).progress_chars("=> "));
+    bar
+}

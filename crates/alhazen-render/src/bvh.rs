@@ -1,0 +1,176 @@
+//! A bounding volume hierarchy built with the surface area heuristic (binned SAH, 12 bins),
+//! flattened depth-first so that a node's first child follows it. Used twice: over the objects
+//! of a scene and over the triangles of each mesh.
+
+use alhazen_math::{Bounds3, Ray, Vec3};
+
+const BINS: usize = 12;
+const MAX_LEAF: usize = 4;
+/// Deeper subtrees become leaves, so traversal's fixed stack never overflows.
+const MAX_DEPTH: usize = 96;
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    bounds: Bounds3,
+    /// Leaf: first primitive index; interior: index of the second child.
+    offset: u32,
+    /// Number of primitives in a leaf, 0 for an interior node.
+    count: u32,
+    /// Split axis of an interior node (to visit the nearer child first).
+    axis: u8,
+}
+
+/// A BVH over primitives given by their bounds; it stores indices, not primitives.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    /// Primitive indices in leaf order.
+    order: Vec<u32>,
+}
+
+struct Item {
+    bounds: Bounds3,
+    centroid: Vec3,
+    index: u32,
+}
+
+impl Bvh {
+    /// Builds over `bounds[i]` for every primitive `i`.
+    pub fn build(bounds: &[Bounds3]) -> Self {
+        let mut items: Vec<Item> = bounds
+            .iter()
+            .enumerate()
+            .map(|(i, b)| Item { bounds: *b, centroid: b.centroid(), index: i as u32 })
+            .collect();
+        let mut bvh = Bvh { nodes: Vec::with_capacity(2 * bounds.len()), order: Vec::with_capacity(bounds.len()) };
+        if !items.is_empty() {
+            bvh.build_node(&mut items, 0);
+        }
+        bvh
+    }
+
+    fn build_node(&mut self, items: &mut [Item], depth: usize) -> usize {
+        let bounds = items.iter().fold(Bounds3::EMPTY, |b, it| b.union(it.bounds));
+        let me = self.nodes.len();
+        self.nodes.push(Node { bounds, offset: 0, count: 0, axis: 0 });
+        let split = if items.len() <= MAX_LEAF || depth >= MAX_DEPTH { None } else { sah_split(items, &bounds) };
+        match split {
+            None => {
+                self.nodes[me].offset = self.order.len() as u32;
+                self.nodes[me].count = items.len() as u32;
+                self.order.extend(items.iter().map(|it| it.index));
+            }
+            Some((axis, mid)) => {
+                let (left, right) = items.split_at_mut(mid);
+                self.build_node(left, depth + 1);
+                let second = self.build_node(right, depth + 1);
+                self.nodes[me].offset = second as u32;
+                self.nodes[me].axis = axis as u8;
+            }
+        }
+        me
+    }
+
+    /// Visits candidate primitives front to back. `visit(index, t_max)` returns a closer hit
+    /// distance, which prunes the rest of the traversal.
+    #[inline]
+    pub fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
+        if self.nodes.is_empty() {
+            return t_max;
+        }
+        let inv = 1.0 / ray.dir;
+        let neg = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
+        let mut stack = [0u32; MAX_DEPTH + 2];
+        let mut sp = 0;
+        let mut at = 0usize;
+        loop {
+            let node = &self.nodes[at];
+            if node.bounds.hit_interval(ray, inv, t_max).is_some() {
+                if node.count > 0 {
+                    let first = node.offset as usize;
+                    for &prim in &self.order[first..first + node.count as usize] {
+                        if let Some(t) = visit(prim, t_max) {
+                            t_max = t_max.min(t);
+                        }
+                    }
+                } else {
+                    // Near child first.
+                    let (near, far) = if neg[node.axis as usize] { (node.offset as usize, at + 1) } else { (at + 1, node.offset as usize) };
+                    stack[sp] = far as u32;
+                    sp += 1;
+                    at = near;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                return t_max;
+            }
+            sp -= 1;
+            at = stack[sp] as usize;
+        }
+    }
+
+    /// The bounds of everything (empty for an empty BVH).
+    pub fn bounds(&self) -> Bounds3 {
+        self.nodes.first().map_or(Bounds3::EMPTY, |n| n.bounds)
+    }
+}
+
+/// The best binned SAH split `(axis, position in items)`, or `None` when a leaf is cheaper.
+fn sah_split(items: &mut [Item], bounds: &Bounds3) -> Option<(usize, usize)> {
+    let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.grow(it.centroid));
+    let extent = cb.extent();
+    let axis = if extent.x >= extent.y && extent.x >= extent.z { 0 } else if extent.y >= extent.z { 1 } else { 2 };
+    if extent[axis] <= 0.0 || !extent[axis].is_finite() {
+        // All centroids coincide: split in the middle to keep leaves small.
+        if items.len() > 255 {
+            return Some((axis, items.len() / 2));
+        }
+        return None;
+    }
+    let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) / extent[axis] * BINS as f64) as usize).min(BINS - 1);
+    let mut bins = [(Bounds3::EMPTY, 0usize); BINS];
+    for it in items.iter() {
+        let b = &mut bins[bin_of(it.centroid)];
+        b.0 = b.0.union(it.bounds);
+        b.1 += 1;
+    }
+    // Sweep from the right to get suffix areas, then from the left.
+    let mut right_area = [0.0; BINS];
+    let mut acc = (Bounds3::EMPTY, 0);
+    for i in (1..BINS).rev() {
+        acc = (acc.0.union(bins[i].0), acc.1 + bins[i].1);
+        right_area[i] = acc.0.surface_area() * acc.1 as f64;
+    }
+    let (mut best, mut best_cost) = (0, f64::INFINITY);
+    let mut left = (Bounds3::EMPTY, 0);
+    for i in 0..BINS - 1 {
+        left = (left.0.union(bins[i].0), left.1 + bins[i].1);
+        let cost = left.0.surface_area() * left.1 as f64 + right_area[i + 1];
+        if cost < best_cost {
+            best_cost = cost;
+            best = i;
+        }
+    }
+    let leaf_cost = items.len() as f64 * bounds.surface_area();
+    let split_cost = 0.125 * bounds.surface_area() + best_cost;
+    if split_cost >= leaf_cost && items.len() <= 255 {
+        return None;
+    }
+    let mid = partition(items, |it| bin_of(it.centroid) <= best);
+    if mid == 0 || mid == items.len() {
+        return Some((axis, items.len() / 2));
+    }
+    Some((axis, mid))
+}
+
+fn partition(items: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
+    let mut i = 0;
+    for j in 0..items.len() {
+        if pred(&items[j]) {
+            items.swap(i, j);
+            i += 1;
+        }
+    }
+    i
+}

@@ -1,0 +1,74 @@
+//! The film: linear radiance per pixel, rendered in parallel tiles. The tile order and the
+//! thread count do not affect any pixel (each sample's randomness is seeded from its pixel and
+//! index), so images are identical at any thread count.
+
+use crate::camera::Camera;
+use crate::sampler::stratified_offset;
+use crate::whitted::Whitted;
+use alhazen_math::Vec3;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+const TILE: u32 = 32;
+
+/// A rendered image: linear RGB, rows top to bottom.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width × height` pixels.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl Image {
+    /// The pixel at `(x, y)`.
+    pub fn get(&self, x: u32, y: u32) -> Vec3 {
+        let p = self.pixels[(y * self.width + x) as usize];
+        Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+    }
+}
+
+/// Renders every pixel with `spp` stratified samples; `progress(done, total)` is called as
+/// tiles finish (from worker threads).
+pub fn render_image(camera: &Camera, integrator: &Whitted, spp: u32, seed: u64, progress: &(dyn Fn(usize, usize) + Sync)) -> Image {
+    let (w, h) = (camera.film_width, camera.film_height);
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
+    let done = AtomicUsize::new(0);
+    let rendered: Vec<Vec<[f32; 3]>> = tiles
+        .par_iter()
+        .map(|&(x0, y0)| {
+            let mut out = Vec::with_capacity((TILE * TILE) as usize);
+            for y in y0..(y0 + TILE).min(h) {
+                for x in x0..(x0 + TILE).min(w) {
+                    out.push(pixel(camera, integrator, x, y, spp, seed));
+                }
+            }
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1, tiles.len());
+            out
+        })
+        .collect();
+    let mut pixels = vec![[0f32; 3]; (w * h) as usize];
+    for (&(x0, y0), tile) in tiles.iter().zip(&rendered) {
+        let tw = (x0 + TILE).min(w) - x0;
+        for (k, px) in tile.iter().enumerate() {
+            let (x, y) = (x0 + k as u32 % tw, y0 + k as u32 / tw);
+            pixels[(y * w + x) as usize] = *px;
+        }
+    }
+    Image { width: w, height: h, pixels }
+}
+
+fn pixel(camera: &Camera, integrator: &Whitted, x: u32, y: u32, spp: u32, seed: u64) -> [f32; 3] {
+    let mut sum = Vec3::ZERO;
+    for s in 0..spp {
+        let (dx, dy) = stratified_offset(seed, x, y, s, spp);
+        let ray = camera.ray(x as f64 + dx, y as f64 + dy);
+        let c = integrator.trace(&ray, 1, 1.0);
+        // A NaN or infinity from a degenerate input must not poison the pixel.
+        sum += if c.is_finite() { c } else { Vec3::ZERO };
+    }
+    let c = sum / spp as f64;
+    [c.x as f32, c.y as f32, c.z as f32]
+}

@@ -1,0 +1,56 @@
+//! `alhazen-render`: the photoreal path of alhazen — a Whitted ray tracer (lecture
+//! "Viewing and recursive ray tracing"; course §"Lighting models") over an SAH BVH.
+//!
+//! Data flow: [`alhazen_scene::Scene`] → [`World`] (shapes placed, BVH built) and [`Camera`] →
+//! [`Whitted`] traces stratified samples per pixel in parallel tiles → [`Image`] (linear RGB) →
+//! [`output::write_image`] (PNG / EXR / PFM, atomically).
+//!
+//! ```
+//! let text = r#"
+//! [render]
+//! width = 8
+//! height = 6
+//! spp = 1
+//! [camera]
+//! eye = [0, 0, 5]
+//! [[light]]
+//! type = "point"
+//! position = [5, 5, 5]
+//! [[object]]
+//! shape = "sphere"
+//! radius = 1
+//! "#;
+//! let scene = alhazen_scene::parse_scene("doc.toml".as_ref(), text).unwrap();
+//! let img = alhazen_render::render(&scene, &|_, _| {});
+//! assert_eq!((img.width, img.height), (8, 6));
+//! assert!(img.get(4, 3).x > 0.0, "the sphere is lit in the middle");
+//! assert_eq!(img.get(0, 0).x, 0.0, "black background in the corner");
+//! ```
+
+pub mod bvh;
+pub mod camera;
+pub mod film;
+pub mod optics;
+pub mod output;
+pub mod sampler;
+pub mod shape;
+pub mod texture;
+pub mod whitted;
+pub mod world;
+
+pub use camera::Camera;
+pub use film::Image;
+pub use whitted::Whitted;
+pub use world::World;
+
+use alhazen_scene::Scene;
+
+/// Renders `scene` with its own settings (`scene.render`); `progress(done, total)` reports
+/// finished tiles. Runs on the current rayon pool.
+pub fn render(scene: &Scene, progress: &(dyn Fn(usize, usize) + Sync)) -> Image {
+    let world = World::build(scene);
+    let s = &scene.render;
+    let camera = Camera::new(&scene.camera, s.width, s.height);
+    let integrator = Whitted::new(scene, &world);
+    film::render_image(&camera, &integrator, s.spp, s.seed, progress)
+}

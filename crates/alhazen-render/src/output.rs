@@ -1,0 +1,126 @@
+//! Image files: PNG (8-bit sRGB through the course's transfer function), OpenEXR (linear, half
+//! or float) and PFM (linear float). Every file is written to a temporary file in the target
+//! directory and renamed into place, so a reader never sees half an image and an existing file
+//! is only replaced by a complete one.
+
+use crate::film::Image;
+use alhazen_math::color::srgb_encode;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+/// Output file formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// 8-bit sRGB PNG.
+    Png,
+    /// OpenEXR with 16-bit half floats.
+    ExrHalf,
+    /// OpenEXR with 32-bit floats.
+    ExrFloat,
+    /// Portable float map.
+    Pfm,
+}
+
+impl Format {
+    /// The format for a file name's extension (`.exr` means float unless `half`).
+    pub fn from_path(path: &Path, half: bool) -> Option<Self> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "png" => Some(Self::Png),
+            "exr" if half => Some(Self::ExrHalf),
+            "exr" => Some(Self::ExrFloat),
+            "pfm" => Some(Self::Pfm),
+            _ => None,
+        }
+    }
+}
+
+/// Writes `img` to `path` atomically.
+pub fn write_image(img: &Image, path: &Path, format: Format) -> io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new().prefix(".alhazen-").suffix(".part").tempfile_in(dir)?;
+    match format {
+        Format::Png => encode_png(img, tmp.as_file_mut())?,
+        Format::ExrHalf | Format::ExrFloat => encode_exr(img, tmp.as_file_mut(), format == Format::ExrHalf)?,
+        Format::Pfm => encode_pfm(img, &mut BufWriter::new(tmp.as_file_mut()))?,
+    }
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// 8-bit sRGB bytes, row-major RGB.
+pub fn to_srgb8(img: &Image) -> Vec<u8> {
+    img.pixels.iter().flat_map(|p| p.map(|c| (srgb_encode(c as f64) * 255.0 + 0.5) as u8)).collect()
+}
+
+fn encode_png(img: &Image, out: &mut std::fs::File) -> io::Result<()> {
+    use image::ImageEncoder;
+    let enc = image::codecs::png::PngEncoder::new(BufWriter::new(out));
+    enc.write_image(&to_srgb8(img), img.width, img.height, image::ExtendedColorType::Rgb8).map_err(io::Error::other)
+}
+
+fn encode_exr(img: &Image, out: &mut std::fs::File, half: bool) -> io::Result<()> {
+    use exr::prelude::*;
+    let (w, h) = (img.width as usize, img.height as usize);
+    let px = |x: usize, y: usize| img.pixels[y * w + x];
+    let result = if half {
+        let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+            let c = px(p.x(), p.y());
+            (f16::from_f32(c[0]), f16::from_f32(c[1]), f16::from_f32(c[2]))
+        });
+        Image::from_channels((w, h), channels).write().to_buffered(BufWriter::new(out))
+    } else {
+        let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+            let c = px(p.x(), p.y());
+            (c[0], c[1], c[2])
+        });
+        Image::from_channels((w, h), channels).write().to_buffered(BufWriter::new(out))
+    };
+    result.map_err(io::Error::other)
+}
+
+/// PFM: `PF`, size, a negative scale for little-endian, then rows bottom to top.
+fn encode_pfm(img: &Image, out: &mut impl Write) -> io::Result<()> {
+    write!(out, "PF\n{} {}\n-1.0\n", img.width, img.height)?;
+    for y in (0..img.height as usize).rev() {
+        let row = &img.pixels[y * img.width as usize..(y + 1) * img.width as usize];
+        for p in row {
+            for c in p {
+                out.write_all(&c.to_le_bytes())?;
+            }
+        }
+    }
+    out.flush()
+}
+
+/// Reads a PFM written by [`write_image`] (for tests and image comparison tools).
+pub fn read_pfm(bytes: &[u8]) -> Option<Image> {
+    let mut fields = Vec::new();
+    let mut pos = 0;
+    while fields.len() < 4 {
+        while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while pos < bytes.len() && !bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        fields.push(std::str::from_utf8(&bytes[start..pos]).ok()?.to_string());
+    }
+    pos += 1;
+    let (w, h): (u32, u32) = (fields[1].parse().ok()?, fields[2].parse().ok()?);
+    if fields[0] != "PF" || fields[3].parse::<f32>().ok()? >= 0.0 {
+        return None;
+    }
+    let data = bytes.get(pos..pos + (w * h * 12) as usize)?;
+    let mut pixels = vec![[0f32; 3]; (w * h) as usize];
+    for (i, c) in data.chunks_exact(12).enumerate() {
+        let (x, y) = (i as u32 % w, h - 1 - i as u32 / w);
+        let f = |k: usize| f32::from_le_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+        pixels[(y * w + x) as usize] = [f(0), f(4), f(8)];
+    }
+    Some(Image { width: w, height: h, pixels })
+}

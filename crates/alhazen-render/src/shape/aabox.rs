@@ -1,0 +1,71 @@
+//! Axis-aligned boxes (the slab method, keeping the face of entry and exit).
+
+use super::{Crossing, SurfaceHit};
+use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
+
+/// A solid axis-aligned box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AaBox {
+    /// Lower corner.
+    pub min: Vec3,
+    /// Upper corner.
+    pub max: Vec3,
+}
+
+impl AaBox {
+    /// Entry and exit parameters along the whole line with their face axes, if it meets the box.
+    fn slab(&self, ray: &Ray) -> Option<((f64, usize), (f64, usize))> {
+        let (mut near, mut far) = ((f64::NEG_INFINITY, 0), (f64::INFINITY, 0));
+        for a in 0..3 {
+            let inv = 1.0 / ray.dir[a];
+            let mut t0 = (self.min[a] - ray.origin[a]) * inv;
+            let mut t1 = (self.max[a] - ray.origin[a]) * inv;
+            if t0.is_nan() || t1.is_nan() {
+                // Parallel and in a face plane: treat as outside.
+                return None;
+            }
+            if t0 > t1 {
+                std::mem::swap(&mut t0, &mut t1);
+            }
+            if t0 > near.0 {
+                near = (t0, a);
+            }
+            if t1 < far.0 {
+                far = (t1, a);
+            }
+        }
+        (near.0 <= far.0 && near.0.is_finite() && far.0.is_finite()).then_some((near, far))
+    }
+
+    fn hit_at(&self, ray: &Ray, t: f64, axis: usize) -> SurfaceHit {
+        let p = ray.at(t);
+        let mid = (self.min[axis] + self.max[axis]) * 0.5;
+        let mut n = Vec3::ZERO;
+        n[axis] = if p[axis] > mid { 1.0 } else { -1.0 };
+        let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+        let size = self.max - self.min;
+        let uv = Vec2::new((p[i] - self.min[i]) / size[i], (p[j] - self.min[j]) / size[j]);
+        SurfaceHit::flat(t, p, n, uv)
+    }
+
+    /// Nearest hit in `(0, t_max)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let ((t0, a0), (t1, a1)) = self.slab(ray)?;
+        let (t, a) = if t0 > 0.0 { (t0, a0) } else { (t1, a1) };
+        (t > 0.0 && t < t_max).then(|| self.hit_at(ray, t, a))
+    }
+
+    /// Entry and exit of the line.
+    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
+        if let Some(((t0, a0), (t1, a1))) = self.slab(ray) {
+            out.push(Crossing { hit: self.hit_at(ray, t0, a0), entering: true });
+            out.push(Crossing { hit: self.hit_at(ray, t1, a1), entering: false });
+        }
+    }
+
+    /// Bounding box.
+    pub fn bounds(&self) -> Bounds3 {
+        Bounds3::new(self.min, self.max)
+    }
+}

@@ -1,0 +1,77 @@
+//! Constructive solid geometry for ray tracing (course, §"Constructive solid geometry"): the
+//! crossings of the line with both operands are merged in order of `t`, and a boundary of the
+//! result is kept exactly where membership of the combined set changes. Keeping only changes of
+//! membership is the regularisation: surfaces where the set is inside on both sides (or outside
+//! on both) are dropped.
+
+use super::{Crossing, Placed, SurfaceHit};
+use alhazen_math::{Bounds3, Ray};
+use alhazen_scene::CsgOp;
+
+/// A boolean combination of two closed shapes.
+#[derive(Clone, Debug)]
+pub struct Csg {
+    /// The operation.
+    pub op: CsgOp,
+    /// Left operand.
+    pub a: Placed,
+    /// Right operand.
+    pub b: Placed,
+}
+
+impl Csg {
+    fn inside(&self, in_a: bool, in_b: bool) -> bool {
+        match self.op {
+            CsgOp::Union => in_a || in_b,
+            CsgOp::Intersection => in_a && in_b,
+            CsgOp::Difference => in_a && !in_b,
+        }
+    }
+
+    /// Crossings of the result along the whole line, sorted.
+    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
+        let (mut ca, mut cb) = (Vec::new(), Vec::new());
+        self.a.crossings(ray, &mut ca);
+        self.b.crossings(ray, &mut cb);
+        let (mut i, mut j) = (0, 0);
+        let (mut in_a, mut in_b) = (false, false);
+        let mut inside = false;
+        while i < ca.len() || j < cb.len() {
+            let take_a = j >= cb.len() || (i < ca.len() && ca[i].hit.t <= cb[j].hit.t);
+            let (c, from_b) = if take_a {
+                i += 1;
+                (ca[i - 1], false)
+            } else {
+                j += 1;
+                (cb[j - 1], true)
+            };
+            if from_b { in_b = c.entering } else { in_a = c.entering }
+            let now = self.inside(in_a, in_b);
+            if now != inside {
+                inside = now;
+                let mut hit = c.hit;
+                if from_b && self.op == CsgOp::Difference {
+                    // B's surface bounds A − B from the other side.
+                    hit.n = -hit.n;
+                    hit.ns = -hit.ns;
+                }
+                out.push(Crossing { hit, entering: now });
+            }
+        }
+    }
+
+    /// Nearest boundary point of the result in `(0, t_max)`.
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let mut all = Vec::new();
+        self.crossings(ray, &mut all);
+        all.into_iter().map(|c| c.hit).find(|h| h.t > 0.0 && h.t < t_max)
+    }
+
+    /// Bounding box (A's alone for intersection and difference).
+    pub fn bounds(&self) -> Bounds3 {
+        match self.op {
+            CsgOp::Union => self.a.bounds().union(self.b.bounds()),
+            CsgOp::Intersection | CsgOp::Difference => self.a.bounds(),
+        }
+    }
+}

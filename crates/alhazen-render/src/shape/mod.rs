@@ -1,0 +1,195 @@
+//! Shapes and their ray intersection. Each shape lives in its own file; [`Shape`] dispatches
+//! over the closed set without virtual calls. All work happens in object space; [`Placed`]
+//! carries the object→world transform (normals by the inverse transpose).
+//!
+//! Rays need not have unit directions here: transformed rays keep the world parameter `t`.
+
+mod aabox;
+mod csg;
+mod cylinder;
+mod mesh;
+mod plane;
+mod sphere;
+
+pub use aabox::AaBox;
+pub use csg::Csg;
+pub use cylinder::{Cone, Cylinder};
+pub use mesh::{MeshAccel, MeshShape};
+pub use plane::{Disk, Plane};
+pub use sphere::Sphere;
+
+use alhazen_math::{Bounds3, Ray, Transform, Vec2, Vec3};
+
+/// A ray–surface intersection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    /// Ray parameter.
+    pub t: f64,
+    /// Point.
+    pub p: Vec3,
+    /// Geometric normal, unit, pointing out of the solid (or to the shape's front side).
+    pub n: Vec3,
+    /// Shading normal, unit, on the same side as `n`.
+    pub ns: Vec3,
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Material slot of a mesh triangle (0 elsewhere).
+    pub slot: u32,
+}
+
+impl SurfaceHit {
+    /// A hit whose shading normal is its geometric normal.
+    pub fn flat(t: f64, p: Vec3, n: Vec3, uv: Vec2) -> Self {
+        Self { t, p, n, ns: n, uv, slot: 0 }
+    }
+}
+
+/// A point where a line enters or leaves a closed shape; used by CSG.
+#[derive(Clone, Copy, Debug)]
+pub struct Crossing {
+    /// The surface point (its `t` may be negative: crossings cover the whole line).
+    pub hit: SurfaceHit,
+    /// True where the line goes from outside to inside.
+    pub entering: bool,
+}
+
+/// Every kind of shape.
+#[derive(Clone, Debug)]
+pub enum Shape {
+    /// Sphere.
+    Sphere(Sphere),
+    /// Finite cylinder.
+    Cylinder(Cylinder),
+    /// Finite cone.
+    Cone(Cone),
+    /// Disk.
+    Disk(Disk),
+    /// Infinite plane.
+    Plane(Plane),
+    /// Axis-aligned box.
+    Box(AaBox),
+    /// Triangle mesh.
+    Mesh(MeshShape),
+    /// Constructive solid geometry.
+    Csg(Box<Csg>),
+}
+
+impl Shape {
+    /// The nearest hit with `0 < t < t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        match self {
+            Shape::Sphere(s) => s.intersect(ray, t_max),
+            Shape::Cylinder(s) => s.intersect(ray, t_max),
+            Shape::Cone(s) => s.intersect(ray, t_max),
+            Shape::Disk(s) => s.intersect(ray, t_max),
+            Shape::Plane(s) => s.intersect(ray, t_max),
+            Shape::Box(s) => s.intersect(ray, t_max),
+            Shape::Mesh(s) => s.intersect(ray, t_max),
+            Shape::Csg(s) => s.intersect(ray, t_max),
+        }
+    }
+
+    /// Object-space bounds (infinite for a plane).
+    pub fn bounds(&self) -> Bounds3 {
+        match self {
+            Shape::Sphere(s) => s.bounds(),
+            Shape::Cylinder(s) => s.bounds(),
+            Shape::Cone(s) => s.bounds(),
+            Shape::Disk(s) => s.bounds(),
+            Shape::Plane(_) => Bounds3 { min: Vec3::NEG_INFINITY, max: Vec3::INFINITY },
+            Shape::Box(s) => s.bounds(),
+            Shape::Mesh(s) => s.bounds(),
+            Shape::Csg(s) => s.bounds(),
+        }
+    }
+
+    /// All crossings of the whole line through `ray`, sorted by `t`; only for closed shapes
+    /// (open ones contribute nothing).
+    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
+        let start = out.len();
+        match self {
+            Shape::Sphere(s) => s.crossings(ray, out),
+            Shape::Cylinder(s) => s.crossings(ray, out),
+            Shape::Cone(s) => s.crossings(ray, out),
+            Shape::Box(s) => s.crossings(ray, out),
+            Shape::Mesh(s) => s.crossings(ray, out),
+            Shape::Csg(s) => s.crossings(ray, out),
+            Shape::Disk(_) | Shape::Plane(_) => {}
+        }
+        out[start..].sort_by(|a, b| a.hit.t.total_cmp(&b.hit.t));
+    }
+}
+
+/// Crossings of a convex closed shape from its hits along the whole line: alternately entering
+/// and leaving in order of `t`.
+pub(crate) fn convex_crossings(mut hits: Vec<SurfaceHit>, out: &mut Vec<Crossing>) {
+    hits.sort_by(|a, b| a.t.total_cmp(&b.t));
+    if hits.len() >= 2 {
+        let (first, last) = (hits[0], hits[hits.len() - 1]);
+        out.push(Crossing { hit: first, entering: true });
+        out.push(Crossing { hit: last, entering: false });
+    }
+}
+
+/// A shape with an optional object→world transform.
+#[derive(Clone, Debug)]
+pub struct Placed {
+    /// The shape in object space.
+    pub shape: Shape,
+    /// Object → world; `None` for the identity (saves two matrix products per ray).
+    pub to_world: Option<Transform>,
+}
+
+impl Placed {
+    /// Places `shape` with `to_world` (dropped when it is the identity).
+    pub fn new(shape: Shape, to_world: Transform) -> Self {
+        Self { shape, to_world: (!to_world.is_identity()).then_some(to_world) }
+    }
+
+    /// The nearest hit in world space.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        match &self.to_world {
+            None => self.shape.intersect(ray, t_max),
+            Some(tf) => {
+                let local = tf.inverse().ray(ray);
+                self.shape.intersect(&local, t_max).map(|h| to_world(tf, h))
+            }
+        }
+    }
+
+    /// World-space crossings (see [`Shape::crossings`]).
+    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
+        match &self.to_world {
+            None => self.shape.crossings(ray, out),
+            Some(tf) => {
+                let start = out.len();
+                self.shape.crossings(&tf.inverse().ray(ray), out);
+                for c in &mut out[start..] {
+                    c.hit = to_world(tf, c.hit);
+                }
+            }
+        }
+    }
+
+    /// World-space bounds.
+    pub fn bounds(&self) -> Bounds3 {
+        let b = self.shape.bounds();
+        match &self.to_world {
+            None => b,
+            Some(_) if !b.is_finite() => b,
+            Some(tf) => tf.bounds(&b),
+        }
+    }
+}
+
+#[inline]
+fn to_world(tf: &Transform, h: SurfaceHit) -> SurfaceHit {
+    let n = tf.normal(h.n).normalize();
+    let ns = if h.ns == h.n { n } else { tf.normal(h.ns).normalize() };
+    SurfaceHit { p: tf.point(h.p), n, ns, ..h }
+}
+
+#[cfg(test)]
+mod tests;

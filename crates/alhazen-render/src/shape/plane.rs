@@ -1,0 +1,72 @@
+//! Planes `n·(p − q) = 0` and disks (the part of a plane within a radius of a centre).
+
+use alhazen_math::{Bounds3, Ray, Vec2, Vec3, orthonormal_basis};
+
+use super::SurfaceHit;
+
+/// An infinite plane; its texture coordinates are lengths along a tangent frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    /// A point on the plane.
+    pub point: Vec3,
+    /// Unit normal (the front side).
+    pub normal: Vec3,
+}
+
+#[inline]
+fn plane_t(point: Vec3, normal: Vec3, ray: &Ray) -> f64 {
+    let denom = normal.dot(ray.dir);
+    if denom == 0.0 { f64::NAN } else { normal.dot(point - ray.origin) / denom }
+}
+
+impl Plane {
+    /// Nearest hit in `(0, t_max)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let t = plane_t(self.point, self.normal, ray);
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let p = ray.at(t);
+        let (tu, tv) = orthonormal_basis(self.normal);
+        let d = p - self.point;
+        Some(SurfaceHit::flat(t, p, self.normal, Vec2::new(d.dot(tu), d.dot(tv))))
+    }
+}
+
+/// A flat disk.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Disk {
+    /// Centre.
+    pub center: Vec3,
+    /// Unit normal.
+    pub normal: Vec3,
+    /// Radius.
+    pub radius: f64,
+}
+
+impl Disk {
+    /// Nearest hit in `(0, t_max)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let t = plane_t(self.center, self.normal, ray);
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let p = ray.at(t);
+        let d = p - self.center;
+        if d.length_squared() > self.radius * self.radius {
+            return None;
+        }
+        let (tu, tv) = orthonormal_basis(self.normal);
+        let uv = Vec2::new(d.dot(tu), d.dot(tv)) / (2.0 * self.radius) + 0.5;
+        Some(SurfaceHit::flat(t, p, self.normal, uv))
+    }
+
+    /// Bounding box (tight per axis).
+    pub fn bounds(&self) -> Bounds3 {
+        let n = self.normal;
+        let e = Vec3::new((1.0 - n.x * n.x).max(0.0).sqrt(), (1.0 - n.y * n.y).max(0.0).sqrt(), (1.0 - n.z * n.z).max(0.0).sqrt()) * self.radius;
+        Bounds3::new(self.center - e, self.center + e)
+    }
+}

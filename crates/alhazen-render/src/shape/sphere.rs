@@ -1,0 +1,56 @@
+//! Sphere `|p − c| = r`: the quadratic `|o + t d − c|² = r²`.
+
+use super::{Crossing, SurfaceHit, convex_crossings};
+use alhazen_math::poly::solve_quadratic;
+use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
+use std::f64::consts::{PI, TAU};
+
+/// A sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius (> 0).
+    pub radius: f64,
+}
+
+impl Sphere {
+    fn roots(&self, ray: &Ray) -> [f64; 2] {
+        let oc = ray.origin - self.center;
+        let r = solve_quadratic(ray.dir.length_squared(), 2.0 * oc.dot(ray.dir), oc.length_squared() - self.radius * self.radius);
+        match r.as_slice() {
+            [a, b] => [*a, *b],
+            _ => [f64::NAN; 2],
+        }
+    }
+
+    fn hit_at(&self, ray: &Ray, t: f64) -> SurfaceHit {
+        let p = ray.at(t);
+        let n = (p - self.center) / self.radius;
+        // Texture coordinates: longitude around +y, latitude from the north pole.
+        let u = (n.z.atan2(-n.x) + PI) / TAU;
+        let v = n.y.clamp(-1.0, 1.0).acos() / PI;
+        SurfaceHit::flat(t, p, n.normalize(), Vec2::new(u, v))
+    }
+
+    /// Nearest hit in `(0, t_max)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let [t0, t1] = self.roots(ray);
+        let t = if t0 > 0.0 { t0 } else { t1 };
+        (t > 0.0 && t < t_max).then(|| self.hit_at(ray, t))
+    }
+
+    /// Both crossings of the line.
+    pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
+        let [t0, t1] = self.roots(ray);
+        if t0.is_finite() {
+            convex_crossings(vec![self.hit_at(ray, t0), self.hit_at(ray, t1)], out);
+        }
+    }
+
+    /// Bounding box.
+    pub fn bounds(&self) -> Bounds3 {
+        Bounds3::new(self.center - Vec3::splat(self.radius), self.center + Vec3::splat(self.radius))
+    }
+}

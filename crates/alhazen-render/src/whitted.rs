@@ -1,0 +1,191 @@
+//! Recursive ray tracing as in the lecture (`RT_trace`, `RT_shade`): at the closest hit, the
+//! ambient term plus, for each light on the viewer's side, the course's Lambert + Phong (or
+//! Blinn–Phong) terms scaled by how much light transparent and opaque occluders let through;
+//! then reflection and refraction rays up to the maximum depth. Transparent surfaces split their
+//! transmission coefficient by a Fresnel factor; light travelling inside an absorbing medium
+//! decays by Beer's law `exp(−σ d)`.
+
+use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
+use crate::texture;
+use crate::world::{World, WorldHit};
+use alhazen_math::{Ray, Vec3};
+use alhazen_scene::{Background, FresnelMode, Highlight, Light, Material, Scene};
+
+/// Rays whose contribution to the pixel would fall below this are not traced (like POV-Ray's
+/// `adc_bailout` of 1/255, but finer).
+const MIN_WEIGHT: f64 = 1.0 / 1024.0;
+/// How many transparent surfaces a shadow ray may pass before it counts as blocked.
+const MAX_SHADOW_SURFACES: usize = 64;
+
+/// The Whitted integrator over a built world.
+pub struct Whitted<'a> {
+    scene: &'a Scene,
+    world: &'a World,
+    max_depth: u32,
+}
+
+/// A self-intersection guard scaled to the magnitude of the coordinates.
+#[inline]
+fn epsilon(p: Vec3) -> f64 {
+    1e-9 * (1.0 + p.abs().max_element())
+}
+
+/// The lights' contribution to a point: direction towards the light, distance and the
+/// intensity `I^dir` arriving there.
+fn light_at(light: &Light, p: Vec3) -> Option<(Vec3, f64, Vec3)> {
+    let falloff = |abc: &[f64; 3], d: f64| abc[0] * d * d + abc[1] * d + abc[2];
+    match light {
+        Light::Point { position, intensity, attenuation } => {
+            let to = *position - p;
+            let d = to.length();
+            (d > 0.0).then(|| (to / d, d, *intensity / falloff(attenuation, d)))
+        }
+        Light::Directional { direction, intensity } => Some((-*direction, f64::INFINITY, *intensity)),
+        Light::Spot { position, direction, cos_cutoff, falloff: e, intensity, attenuation } => {
+            let to = *position - p;
+            let d = to.length();
+            let l = to / d;
+            let cos = -l.dot(*direction);
+            (d > 0.0 && cos >= *cos_cutoff).then(|| (l, d, *intensity * cos.powf(*e) / falloff(attenuation, d)))
+        }
+    }
+}
+
+/// Fresnel reflectance for `cos` at a boundary with relative index `eta = η_T/η_I`.
+fn fresnel(m: &Material, cos: f64, eta: f64) -> f64 {
+    match m.fresnel {
+        FresnelMode::Exact => fresnel_dielectric(cos, eta),
+        FresnelMode::Schlick => fresnel_schlick(cos, eta),
+        FresnelMode::Off => 0.0,
+    }
+}
+
+fn beer(sigma: Vec3, d: f64) -> Vec3 {
+    if sigma == Vec3::ZERO { Vec3::ONE } else { (-sigma * d).exp() }
+}
+
+impl<'a> Whitted<'a> {
+    /// The integrator for `scene` over `world`.
+    pub fn new(scene: &'a Scene, world: &'a World) -> Self {
+        Self { scene, world, max_depth: scene.render.max_depth.max(1) }
+    }
+
+    /// `RT_trace`: radiance along `ray` (unit direction); `depth` starts at 1 for camera rays,
+    /// `weight` is the ray's share of the pixel.
+    pub fn trace(&self, ray: &Ray, depth: u32, weight: f64) -> Vec3 {
+        match self.world.intersect(ray, f64::INFINITY) {
+            Some(hit) => self.shade(&hit, ray, depth, weight),
+            None => self.background(ray.dir),
+        }
+    }
+
+    fn background(&self, dir: Vec3) -> Vec3 {
+        match self.scene.background {
+            Background::Solid(c) => c,
+            Background::Gradient { zenith, horizon, ground } => {
+                if dir.y >= 0.0 { horizon.lerp(zenith, dir.y.min(1.0)) } else { ground }
+            }
+        }
+    }
+
+    /// `RT_shade`.
+    fn shade(&self, wh: &WorldHit, ray: &Ray, depth: u32, weight: f64) -> Vec3 {
+        let m = &self.scene.materials[wh.material as usize];
+        let h = &wh.hit;
+        let v = -ray.dir;
+        let front = h.n.dot(v) > 0.0;
+        let (ng, mut n) = if front { (h.n, h.ns) } else { (-h.n, -h.ns) };
+        if n.dot(v) <= 0.0 {
+            n = ng;
+        }
+        let a = texture::eval(&m.color, h.uv, &self.scene.images) * m.diffuse;
+        let mut color = a * self.scene.ambient + self.direct(m, a, h.p, n, ng, v);
+        if depth < self.max_depth {
+            color += self.secondary(m, h.p, n, ng, v, front, depth, weight);
+        }
+        if !front {
+            // The ray travelled h.t inside this object's medium.
+            color *= beer(m.absorption, h.t);
+        }
+        color
+    }
+
+    /// The course's local model summed over the lights (ν: light and viewer on one side).
+    fn direct(&self, m: &Material, a: Vec3, p: Vec3, n: Vec3, ng: Vec3, v: Vec3) -> Vec3 {
+        let has_specular = m.specular != Vec3::ZERO;
+        let mut sum = Vec3::ZERO;
+        for light in &self.scene.lights {
+            let Some((l, dist, i_dir)) = light_at(light, p) else { continue };
+            let cos = n.dot(l);
+            if cos <= 0.0 || ng.dot(l) <= 0.0 {
+                continue;
+            }
+            let through = self.transmittance(p + ng * epsilon(p), l, dist);
+            if through == Vec3::ZERO {
+                continue;
+            }
+            let mut local = a * cos;
+            if has_specular {
+                let spec = match m.highlight {
+                    Highlight::Phong => reflect(l, n).dot(v).max(0.0).powf(m.shininess),
+                    Highlight::BlinnPhong => (l + v).normalize().dot(n).max(0.0).powf(2.0 * m.shininess),
+                };
+                local += m.specular * spec;
+            }
+            sum += through * i_dir * local;
+        }
+        sum
+    }
+
+    /// How much light passes from `origin` along `l` over `dist`: 0 at an opaque surface; at a
+    /// transparent one its transmission times `1 − F`, and Beer's law inside absorbing media.
+    fn transmittance(&self, mut origin: Vec3, l: Vec3, mut dist: f64) -> Vec3 {
+        let mut through = Vec3::ONE;
+        for _ in 0..MAX_SHADOW_SURFACES {
+            let Some(wh) = self.world.intersect(&Ray::new(origin, l), dist) else { return through };
+            let m = &self.scene.materials[wh.material as usize];
+            if m.transparency == Vec3::ZERO {
+                return Vec3::ZERO;
+            }
+            let cos_n = wh.hit.n.dot(l);
+            let entering = cos_n < 0.0;
+            let eta = if entering { m.ior } else { 1.0 / m.ior };
+            through *= m.transparency * (1.0 - fresnel(m, cos_n, eta));
+            if !entering {
+                through *= beer(m.absorption, wh.hit.t);
+            }
+            if through.max_element() < 1e-6 {
+                return Vec3::ZERO;
+            }
+            origin = wh.hit.p + wh.hit.n * (cos_n.signum() * epsilon(wh.hit.p));
+            dist -= wh.hit.t;
+        }
+        Vec3::ZERO
+    }
+
+    /// Reflected and refracted rays.
+    fn secondary(&self, m: &Material, p: Vec3, n: Vec3, ng: Vec3, v: Vec3, front: bool, depth: u32, weight: f64) -> Vec3 {
+        let mut color = Vec3::ZERO;
+        let mut reflect_w = m.mirror;
+        if m.transparency != Vec3::ZERO {
+            // eta = η_I/η_T for the lecture's T; the Fresnel formula takes η_T/η_I.
+            let eta = if front { 1.0 / m.ior } else { m.ior };
+            let f = fresnel(m, n.dot(v), 1.0 / eta);
+            reflect_w += m.transparency * f;
+            let trans_w = m.transparency * (1.0 - f);
+            if let Some(t) = refract(v, n, eta) {
+                let w = weight * trans_w.max_element();
+                if w > MIN_WEIGHT {
+                    let origin = p - ng * epsilon(p);
+                    color += trans_w * self.trace(&Ray::new(origin, t.normalize()), depth + 1, w);
+                }
+            }
+        }
+        let w = weight * reflect_w.max_element();
+        if w > MIN_WEIGHT {
+            let r = reflect(v, n).normalize();
+            color += reflect_w * self.trace(&Ray::new(p + ng * epsilon(p), r), depth + 1, w);
+        }
+        color
+    }
+}

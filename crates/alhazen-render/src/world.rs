@@ -1,0 +1,115 @@
+//! The renderable world: every object of the scene placed, with a top-level BVH over the
+//! bounded ones and a plain list of unbounded ones (planes).
+
+use crate::bvh::Bvh;
+use crate::shape::{AaBox, Cone, Csg, Cylinder, Disk, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit};
+use alhazen_math::{Bounds3, Ray};
+use alhazen_scene as scene;
+use std::sync::Arc;
+
+/// An object ready to be intersected.
+#[derive(Clone, Debug)]
+pub struct WorldObject {
+    /// Geometry in world space.
+    pub placed: Placed,
+    /// Its material.
+    pub material: u32,
+    /// Per-slot materials of a mesh (empty: `material` everywhere).
+    pub slot_materials: Vec<u32>,
+}
+
+/// All objects with their acceleration structure.
+#[derive(Debug, Default)]
+pub struct World {
+    objects: Vec<WorldObject>,
+    bvh: Bvh,
+    bounded: Vec<u32>,
+    unbounded: Vec<u32>,
+}
+
+/// A hit with the material to shade it with.
+#[derive(Clone, Copy, Debug)]
+pub struct WorldHit {
+    /// The surface point.
+    pub hit: SurfaceHit,
+    /// Material index.
+    pub material: u32,
+}
+
+fn build_shape(s: &scene::Shape, meshes: &[Arc<MeshAccel>]) -> Shape {
+    match s {
+        scene::Shape::Sphere { center, radius } => Shape::Sphere(Sphere { center: *center, radius: *radius }),
+        scene::Shape::Cylinder { base, top, radius, capped } => Shape::Cylinder(Cylinder::new(*base, *top, *radius, *capped)),
+        scene::Shape::Cone { base, apex, radius, capped } => Shape::Cone(Cone::new(*base, *apex, *radius, *capped)),
+        scene::Shape::Disk { center, normal, radius } => Shape::Disk(Disk { center: *center, normal: *normal, radius: *radius }),
+        scene::Shape::Plane { point, normal } => Shape::Plane(Plane { point: *point, normal: *normal }),
+        scene::Shape::Box { min, max } => Shape::Box(AaBox { min: *min, max: *max }),
+        scene::Shape::Mesh { mesh, smooth } => Shape::Mesh(MeshShape { accel: meshes[*mesh].clone(), smooth: *smooth }),
+        scene::Shape::Csg { op, a, b } => Shape::Csg(Box::new(Csg {
+            op: *op,
+            a: Placed::new(build_shape(&a.shape, meshes), a.transform),
+            b: Placed::new(build_shape(&b.shape, meshes), b.transform),
+        })),
+    }
+}
+
+impl World {
+    /// Places every object of `scene` and builds the BVH.
+    pub fn build(scene: &scene::Scene) -> Self {
+        let meshes: Vec<Arc<MeshAccel>> = scene.meshes.iter().map(|m| Arc::new(MeshAccel::new(m.clone()))).collect();
+        let objects: Vec<WorldObject> = scene
+            .objects
+            .iter()
+            .map(|o| WorldObject {
+                placed: Placed::new(build_shape(&o.shape, &meshes), o.transform),
+                material: o.material,
+                slot_materials: o.mesh_materials.clone(),
+            })
+            .collect();
+        let bounds: Vec<Bounds3> = objects.iter().map(|o| o.placed.bounds()).collect();
+        let (bounded, unbounded): (Vec<u32>, Vec<u32>) = (0..objects.len() as u32).partition(|&i| bounds[i as usize].is_finite());
+        let bvh = Bvh::build(&bounded.iter().map(|&i| bounds[i as usize]).collect::<Vec<_>>());
+        Self { objects, bvh, bounded, unbounded }
+    }
+
+    /// Bounds of the bounded objects.
+    pub fn bounds(&self) -> Bounds3 {
+        self.bvh.bounds()
+    }
+
+    /// The nearest hit in `(0, t_max)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<WorldHit> {
+        let mut best: Option<(SurfaceHit, u32)> = None;
+        let mut t_best = t_max;
+        for &i in &self.unbounded {
+            if let Some(h) = self.objects[i as usize].placed.intersect(ray, t_best) {
+                t_best = h.t;
+                best = Some((h, i));
+            }
+        }
+        self.bvh.traverse(ray, t_best, |k, t_max| {
+            let i = self.bounded[k as usize];
+            let h = self.objects[i as usize].placed.intersect(ray, t_max)?;
+            best = Some((h, i));
+            Some(h.t)
+        });
+        best.map(|(hit, i)| {
+            let o = &self.objects[i as usize];
+            let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
+            WorldHit { hit, material }
+        })
+    }
+
+    /// The nearest hit by testing every object (the reference for BVH tests).
+    pub fn intersect_brute_force(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+        let mut best: Option<SurfaceHit> = None;
+        for o in &self.objects {
+            let limit = best.map_or(t_max, |b| b.t);
+            if let Some(h) = o.placed.intersect(ray, limit) {
+                best = Some(h);
+            }
+        }
+        best
+    }
+}
