@@ -69,7 +69,7 @@ mod tests {
 
     #[test]
     fn fresnel_limits() {
-        for eta in [1.33, 1.5, 2.419] {
+        for eta in [1.33f64, 1.5, 2.419] {
             let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
             assert!((fresnel_dielectric(1.0, eta) - f0).abs() < 1e-12, "normal incidence");
             assert!((fresnel_dielectric(0.0, eta) - 1.0).abs() < 1e-12, "grazing incidence");

@@ -30,7 +30,7 @@ impl Axis {
     }
 
     /// Hits of the cap disk at axial position `s` with radius `r` (normal `sign · dir`).
-    fn cap(&self, ray: &Ray, s: f64, r: f64, sign: f64, hits: &mut Vec<SurfaceHit>) {
+    fn cap(&self, ray: &Ray, s: f64, r: f64, sign: f64, hits: &mut Hits) {
         let denom = ray.dir.dot(self.dir);
         if denom == 0.0 {
             return;
@@ -53,8 +53,28 @@ impl Axis {
     }
 }
 
-fn nearest(hits: &[SurfaceHit], t_max: f64) -> Option<SurfaceHit> {
-    hits.iter().filter(|h| h.t > 0.0 && h.t < t_max).min_by(|a, b| a.t.total_cmp(&b.t)).copied()
+/// Up to four hits, on the stack (this is on the hot path of every ray).
+#[derive(Default)]
+struct Hits {
+    items: [Option<SurfaceHit>; 4],
+    len: usize,
+}
+
+impl Hits {
+    fn push(&mut self, h: SurfaceHit) {
+        if self.len < self.items.len() {
+            self.items[self.len] = Some(h);
+            self.len += 1;
+        }
+    }
+
+    fn iter(&self) -> impl Iterator<Item = SurfaceHit> + '_ {
+        self.items[..self.len].iter().flatten().copied()
+    }
+
+    fn nearest(&self, t_max: f64) -> Option<SurfaceHit> {
+        self.iter().filter(|h| h.t > 0.0 && h.t < t_max).min_by(|a, b| a.t.total_cmp(&b.t))
+    }
 }
 
 /// A finite circular cylinder.
@@ -72,7 +92,7 @@ impl Cylinder {
     }
 
     /// All hits of the whole line, unsorted.
-    fn hits(&self, ray: &Ray, hits: &mut Vec<SurfaceHit>) {
+    fn hits(&self, ray: &Ray, hits: &mut Hits) {
         let ax = &self.axis;
         let oc = ray.origin - ax.base;
         let (od, dd) = (oc.dot(ax.dir), ray.dir.dot(ax.dir));
@@ -94,17 +114,17 @@ impl Cylinder {
 
     /// Nearest hit in `(0, t_max)`.
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
-        let mut hits = Vec::with_capacity(4);
+        let mut hits = Hits::default();
         self.hits(ray, &mut hits);
-        nearest(&hits, t_max)
+        hits.nearest(t_max)
     }
 
     /// Entry and exit of the (capped, hence convex) solid.
     pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
         if self.capped {
-            let mut hits = Vec::with_capacity(4);
+            let mut hits = Hits::default();
             self.hits(ray, &mut hits);
-            convex_crossings(hits, out);
+            convex_crossings(hits.iter().collect(), out);
         }
     }
 
@@ -128,7 +148,7 @@ impl Cone {
         Self { axis: Axis::new(base, apex), radius, capped }
     }
 
-    fn hits(&self, ray: &Ray, hits: &mut Vec<SurfaceHit>) {
+    fn hits(&self, ray: &Ray, hits: &mut Hits) {
         let ax = &self.axis;
         let k = self.radius / ax.height;
         let oc = ray.origin - ax.base;
@@ -156,17 +176,17 @@ impl Cone {
 
     /// Nearest hit in `(0, t_max)`.
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
-        let mut hits = Vec::with_capacity(3);
+        let mut hits = Hits::default();
         self.hits(ray, &mut hits);
-        nearest(&hits, t_max)
+        hits.nearest(t_max)
     }
 
     /// Entry and exit of the (capped, hence convex) solid.
     pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
         if self.capped {
-            let mut hits = Vec::with_capacity(3);
+            let mut hits = Hits::default();
             self.hits(ray, &mut hits);
-            convex_crossings(hits, out);
+            convex_crossings(hits.iter().collect(), out);
         }
     }
 

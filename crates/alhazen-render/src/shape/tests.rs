@@ -1,0 +1,156 @@
+//! Property tests of the shapes: hits lie on the surface, normals are unit and outward, CSG
+//! keeps only the boundary of the combined set, transformed shapes agree with direct ones.
+
+use super::*;
+use alhazen_geom::TriangleMesh;
+use alhazen_scene::CsgOp;
+use proptest::prelude::*;
+use std::sync::Arc;
+
+fn arb_dir() -> impl Strategy<Value = Vec3> {
+    (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_filter_map("non-zero", |(x, y, z)| Vec3::new(x, y, z).try_normalize())
+}
+
+fn arb_point(r: f64) -> impl Strategy<Value = Vec3> {
+    (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+/// A ray from far away aimed near the origin.
+fn arb_ray() -> impl Strategy<Value = Ray> {
+    (arb_dir(), arb_point(0.8)).prop_map(|(d, aim)| Ray::new(aim - d * 6.0, d))
+}
+
+fn unit_box_mesh() -> Arc<MeshAccel> {
+    let p = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
+    let positions = vec![p(-1., -1., -1.), p(1., -1., -1.), p(1., 1., -1.), p(-1., 1., -1.), p(-1., -1., 1.), p(1., -1., 1.), p(1., 1., 1.), p(-1., 1., 1.)];
+    let triangles = vec![[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [3, 7, 6], [3, 6, 2], [0, 4, 7], [0, 7, 3], [1, 2, 6], [1, 6, 5]];
+    Arc::new(MeshAccel::new(Arc::new(TriangleMesh::new(positions, triangles).unwrap())))
+}
+
+/// Signed distance-like implicit functions: zero on the surface.
+fn shapes_with_implicit() -> Vec<(Shape, Box<dyn Fn(Vec3) -> f64>)> {
+    let cyl_axis = |p: Vec3| Vec2::new(p.x, p.z).length();
+    vec![
+        (Shape::Sphere(Sphere { center: Vec3::new(0.1, 0.2, 0.0), radius: 1.0 }), Box::new(|p: Vec3| (p - Vec3::new(0.1, 0.2, 0.0)).length() - 1.0)),
+        (
+            Shape::Cylinder(Cylinder::new(Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 0.7, true)),
+            Box::new(move |p: Vec3| {
+                let side = (cyl_axis(p) - 0.7).abs().max(if p.y.abs() <= 1.0 + 1e-9 { 0.0 } else { 1.0 });
+                let cap = (p.y.abs() - 1.0).abs().max(if cyl_axis(p) <= 0.7 + 1e-9 { 0.0 } else { 1.0 });
+                side.min(cap)
+            }),
+        ),
+        (
+            Shape::Cone(Cone::new(Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 1.0, true)),
+            Box::new(move |p: Vec3| {
+                let r = (1.0 - p.y) / 2.0;
+                let side = (cyl_axis(p) - r).abs().max(if (-1.0 - 1e-9..=1.0).contains(&p.y) { 0.0 } else { 1.0 });
+                let cap = (p.y + 1.0).abs().max(if cyl_axis(p) <= 1.0 + 1e-9 { 0.0 } else { 1.0 });
+                side.min(cap)
+            }),
+        ),
+        (Shape::Box(AaBox { min: Vec3::splat(-0.9), max: Vec3::new(0.9, 0.5, 0.7) }), Box::new(|p: Vec3| {
+            let q = (p - Vec3::new(0.0, -0.2, -0.1)).abs() - Vec3::new(0.9, 0.7, 0.8);
+            q.max_element()
+        })),
+        (Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false }), Box::new(|p: Vec3| p.abs().max_element() - 1.0)),
+        (Shape::Disk(Disk { center: Vec3::ZERO, normal: Vec3::Y, radius: 1.0 }), Box::new(|p: Vec3| p.y.abs().max((p.length() - 1.0).max(0.0)))),
+        (Shape::Plane(Plane { point: Vec3::ZERO, normal: Vec3::new(0.0, 0.6, 0.8) }), Box::new(|p: Vec3| p.dot(Vec3::new(0.0, 0.6, 0.8)))),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    #[test]
+    fn hits_lie_on_the_surface_with_unit_normals(ray in arb_ray()) {
+        for (shape, f) in shapes_with_implicit() {
+            if let Some(h) = shape.intersect(&ray, f64::INFINITY) {
+                prop_assert!(f(h.p).abs() < 1e-9, "{shape:?}: f = {}", f(h.p));
+                prop_assert!((h.p - ray.at(h.t)).length() < 1e-12);
+                prop_assert!((h.n.length() - 1.0).abs() < 1e-9);
+                prop_assert!(h.t > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn closed_shapes_enter_against_and_leave_along_the_normal(ray in arb_ray()) {
+        for (shape, _) in shapes_with_implicit() {
+            let mut cs = Vec::new();
+            shape.crossings(&ray, &mut cs);
+            prop_assert!(cs.len() % 2 == 0);
+            for c in &cs {
+                prop_assert_eq!(c.entering, c.hit.n.dot(ray.dir) < 0.0, "{:?}", shape);
+            }
+        }
+    }
+
+    #[test]
+    fn transforms_preserve_hits(ray in arb_ray(), t in arb_point(2.0), angle in 0.0..6.0f64, axis in arb_dir(), s in 0.5..2.0f64) {
+        // A unit sphere transformed equals the sphere with transformed centre and radius.
+        let tf = Transform::translate(t) * Transform::rotate(axis, angle) * Transform::scale(Vec3::splat(s));
+        let placed = Placed::new(Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }), tf);
+        let direct = Sphere { center: t, radius: s };
+        let a = placed.intersect(&ray, f64::INFINITY);
+        let b = direct.intersect(&ray, f64::INFINITY);
+        prop_assert_eq!(a.is_some(), b.is_some());
+        if let (Some(a), Some(b)) = (a, b) {
+            prop_assert!((a.t - b.t).abs() < 1e-9);
+            prop_assert!((a.n - b.n).length() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn csg_difference_is_a_minus_b(ray in arb_ray()) {
+        // Unit sphere minus a sphere of radius 0.6 centred at (0.7, 0, 0): a hit belongs to the
+        // boundary of A − B: on A's surface outside B, or on B's surface inside A.
+        let a = Placed::new(Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }), Transform::IDENTITY);
+        let b = Placed::new(Shape::Sphere(Sphere { center: Vec3::new(0.7, 0.0, 0.0), radius: 0.6 }), Transform::IDENTITY);
+        let csg = Csg { op: CsgOp::Difference, a, b };
+        if let Some(h) = csg.intersect(&ray, f64::INFINITY) {
+            let (da, db) = (h.p.length(), (h.p - Vec3::new(0.7, 0.0, 0.0)).length());
+            let on_a = (da - 1.0).abs() < 1e-9 && db >= 0.6 - 1e-9;
+            let on_b = (db - 0.6).abs() < 1e-9 && da <= 1.0 + 1e-9;
+            prop_assert!(on_a || on_b);
+            // The normal points out of A − B: into B on B's surface.
+            if on_b && !on_a {
+                prop_assert!(h.n.dot(h.p - Vec3::new(0.7, 0.0, 0.0)) < 0.0);
+            }
+            // Nothing of A − B lies before the hit: sample the segment.
+            for k in 1..50 {
+                let q = ray.at(h.t * k as f64 / 50.0);
+                let inside = q.length() < 1.0 && (q - Vec3::new(0.7, 0.0, 0.0)).length() > 0.6;
+                prop_assert!(!inside || h.t < 1e-9);
+            }
+        }
+    }
+}
+
+#[test]
+fn csg_union_and_intersection_of_overlapping_balls() {
+    let ball = |x: f64| Placed::new(Shape::Sphere(Sphere { center: Vec3::new(x, 0.0, 0.0), radius: 1.0 }), Transform::IDENTITY);
+    let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
+    let union = Csg { op: CsgOp::Union, a: ball(-0.5), b: ball(0.5) };
+    let inter = Csg { op: CsgOp::Intersection, a: ball(-0.5), b: ball(0.5) };
+    let (mut cu, mut ci) = (vec![], vec![]);
+    union.crossings(&ray, &mut cu);
+    inter.crossings(&ray, &mut ci);
+    // Regularised union: the inner surfaces vanish; only x = −1.5 and x = 1.5 remain.
+    assert_eq!(cu.iter().map(|c| c.hit.p.x).collect::<Vec<_>>(), vec![-1.5, 1.5]);
+    assert_eq!(ci.iter().map(|c| c.hit.p.x).collect::<Vec<_>>(), vec![-0.5, 0.5]);
+    // A ray starting inside the union leaves at 1.5.
+    let inside = Ray::new(Vec3::ZERO, Vec3::X);
+    assert_eq!(union.intersect(&inside, f64::INFINITY).unwrap().p.x, 1.5);
+}
+
+#[test]
+fn open_cylinder_is_seen_from_inside() {
+    let c = Cylinder::new(Vec3::ZERO, Vec3::Y, 1.0, false);
+    let ray = Ray::new(Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.1, -1.0, 0.0).normalize());
+    let h = c.intersect(&ray, f64::INFINITY);
+    assert!(h.is_none(), "the ray goes down the open tube and misses both walls above y=0");
+    let ray = Ray::new(Vec3::new(0.0, 0.5, 0.0), Vec3::X);
+    let h = c.intersect(&ray, f64::INFINITY).unwrap();
+    assert!((h.p.x - 1.0).abs() < 1e-12 && h.n.x > 0.0, "outward normal even when hit from inside");
+}

@@ -1,0 +1,38 @@
+//! The BVH must return the same nearest hit as testing every object.
+
+use alhazen_math::{Ray, Vec3};
+use alhazen_render::World;
+use alhazen_scene::parse_scene;
+use proptest::prelude::*;
+
+fn random_scene(spheres: &[(f64, f64, f64, f64)], boxes: &[(f64, f64, f64)]) -> String {
+    let mut s = String::from("[[object]]\nshape = \"plane\"\npoint = [0, -3, 0]\n");
+    for (x, y, z, r) in spheres {
+        s += &format!("[[object]]\nshape = \"sphere\"\ncenter = [{x}, {y}, {z}]\nradius = {r}\n");
+    }
+    for (x, y, z) in boxes {
+        s += &format!("[[object]]\nshape = \"box\"\nmin = [{x}, {y}, {z}]\nmax = [{}, {}, {}]\ntransform = [{{ rotate_y = 30 }}]\n", x + 0.5, y + 0.8, z + 0.3);
+        s += &format!("[[object]]\nshape = \"cylinder\"\nbase = [{x}, {y}, {z}]\ntop = [{}, {}, {}]\nradius = 0.2\n", x + 0.1, y + 1.0, z);
+    }
+    s
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+    #[test]
+    fn bvh_equals_brute_force(
+        spheres in prop::collection::vec((-5.0..5.0f64, -2.0..5.0f64, -5.0..5.0f64, 0.1..1.0f64), 1..40),
+        boxes in prop::collection::vec((-5.0..5.0f64, -2.0..5.0f64, -5.0..5.0f64), 0..20),
+        rays in prop::collection::vec(((-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64), (-6.0..6.0f64, -6.0..6.0f64, -6.0..6.0f64)), 50),
+    ) {
+        let scene = parse_scene("random.toml".as_ref(), &random_scene(&spheres, &boxes)).unwrap();
+        let world = World::build(&scene);
+        for ((dx, dy, dz), (ox, oy, oz)) in rays {
+            let Some(d) = Vec3::new(dx, dy, dz).try_normalize() else { continue };
+            let ray = Ray::new(Vec3::new(ox, oy, oz), d);
+            let fast = world.intersect(&ray, f64::INFINITY).map(|h| h.hit.t);
+            let slow = world.intersect_brute_force(&ray, f64::INFINITY).map(|h| h.t);
+            prop_assert_eq!(fast, slow);
+        }
+    }
+}
