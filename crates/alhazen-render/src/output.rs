@@ -47,7 +47,22 @@ pub fn write_image(img: &Image, path: &Path, format: Format) -> io::Result<()> {
         Format::Pfm => encode_pfm(img, &mut BufWriter::new(tmp.as_file_mut()))?,
     }
     tmp.as_file().sync_all()?;
+    set_readable_permissions(tmp.path(), path)?;
     tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+/// Temporary files are private (0600); give the image the permissions of the file it
+/// replaces, or the usual 0644 for a new one.
+#[cfg(unix)]
+fn set_readable_permissions(tmp: &Path, target: &Path) -> io::Result<()> {
+    use std::os::unix::fs::PermissionsExt;
+    let perms = std::fs::metadata(target).map(|m| m.permissions()).unwrap_or_else(|_| std::fs::Permissions::from_mode(0o644));
+    std::fs::set_permissions(tmp, perms)
+}
+
+#[cfg(not(unix))]
+fn set_readable_permissions(_tmp: &Path, _target: &Path) -> io::Result<()> {
     Ok(())
 }
 
