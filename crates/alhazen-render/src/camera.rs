@@ -156,3 +156,105 @@ fn parallel(a: Vec3, b: Vec3, dir: Vec3, center: Vec3, view_width: f64, (px_w, p
     let (dx, dy) = (ea * (view_width / px_w as f64), -eb * (view_height / px_h as f64));
     Kind::Parallel { corner: origin - ea * (view_width / 2.0) + eb * (view_height / 2.0), dx, dy, dir }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alhazen_scene::LookAt;
+
+    const LOOK: LookAt = LookAt { eye: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y };
+
+    #[test]
+    fn perspective_edges_span_the_horizontal_fov() {
+        let desc = CameraDesc::Perspective { look: LOOK, opening: PerspectiveOpening::Fov { angle: 60f64.to_radians(), horizontal: true } };
+        let cam = Camera::new(&desc, 400, 300);
+        let (left, right) = (cam.ray(0.0, 150.0).dir, cam.ray(400.0, 150.0).dir);
+        assert!((left.angle_between(right) - 60f64.to_radians()).abs() < 1e-12);
+        let centre = cam.ray(200.0, 150.0).dir;
+        assert!((centre - Vec3::NEG_Z).length() < 1e-12);
+        // Right-handed: looking down −z, the image's right is +x and its top +y.
+        assert!(right.x > 0.0 && cam.ray(200.0, 0.0).dir.y > 0.0);
+    }
+
+    #[test]
+    fn frustum_camera_matches_the_course_frustum() {
+        let desc = CameraDesc::Perspective { look: LOOK, opening: PerspectiveOpening::Frustum { lrbtn: [-0.2, 0.6, -0.3, 0.3, 1.0] } };
+        let cam = Camera::new(&desc, 80, 60);
+        // The film's top-left corner looks through (l, t, −n).
+        let d = cam.ray(0.0, 0.0).dir;
+        assert!((d - Vec3::new(-0.2, 0.3, -1.0).normalize()).length() < 1e-12);
+    }
+
+    /// Where a parallel camera's film shows world point `p`, by intersecting its ray grid.
+    fn film_position(cam: &Camera, p: Vec3) -> (f64, f64) {
+        let Kind::Parallel { corner, dx, dy, dir } = &cam.kind else { panic!("parallel camera") };
+        let m = Mat3::from_cols(*dx, *dy, *dir);
+        let s = m.inverse() * (p - *corner);
+        (s.x, s.y)
+    }
+
+    #[test]
+    fn isometric_foreshortens_the_three_axes_equally() {
+        let desc = CameraDesc::Axonometric { style: Axonometry::Isometric, target: Vec3::ZERO, width: 10.0, azimuth: 0.0 };
+        let cam = Camera::new(&desc, 100, 100);
+        let o = film_position(&cam, Vec3::ZERO);
+        let lens: Vec<f64> = [Vec3::X, Vec3::Y, Vec3::Z]
+            .iter()
+            .map(|a| {
+                let q = film_position(&cam, *a);
+                ((q.0 - o.0).powi(2) + (q.1 - o.1).powi(2)).sqrt()
+            })
+            .collect();
+        assert!((lens[0] - lens[1]).abs() < 1e-9 && (lens[1] - lens[2]).abs() < 1e-9, "{lens:?}");
+        // Vertical stays vertical.
+        let up = film_position(&cam, Vec3::Y);
+        assert!((up.0 - o.0).abs() < 1e-9 && up.1 < o.1);
+    }
+
+    #[test]
+    fn cavalier_keeps_the_front_and_draws_depth_at_45_degrees() {
+        let desc = CameraDesc::Axonometric { style: Axonometry::Cavalier, target: Vec3::ZERO, width: 10.0, azimuth: 0.0 };
+        let cam = Camera::new(&desc, 100, 100);
+        let o = film_position(&cam, Vec3::ZERO);
+        let x = film_position(&cam, Vec3::X);
+        let depth = film_position(&cam, Vec3::NEG_Z);
+        assert!(((x.0 - o.0) - 10.0).abs() < 1e-9 && (x.1 - o.1).abs() < 1e-9, "x axis unscaled");
+        let (ddx, ddy) = (depth.0 - o.0, o.1 - depth.1);
+        assert!((ddx - ddy).abs() < 1e-9 && ((ddx * ddx + ddy * ddy).sqrt() - 10.0).abs() < 1e-9, "full length at 45°");
+    }
+
+    #[test]
+    fn military_keeps_the_ground_plan() {
+        let desc = CameraDesc::Axonometric { style: Axonometry::Military, target: Vec3::ZERO, width: 10.0, azimuth: 0.7 };
+        let cam = Camera::new(&desc, 100, 100);
+        // Distances and right angles in the ground plane are preserved.
+        let (o, a, b) = (film_position(&cam, Vec3::ZERO), film_position(&cam, Vec3::X), film_position(&cam, Vec3::Z));
+        let (va, vb) = ((a.0 - o.0, a.1 - o.1), (b.0 - o.0, b.1 - o.1));
+        assert!((va.0 * vb.0 + va.1 * vb.1).abs() < 1e-9);
+        assert!(((va.0.hypot(va.1)) - 10.0).abs() < 1e-9 && ((vb.0.hypot(vb.1)) - 10.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn stereo_eyes_are_apart_and_converge_on_the_screen() {
+        let desc = CameraDesc::Stereo { look: LOOK, eye_distance: 0.5, screen_distance: 5.0, screen_width: 4.0 };
+        let cam = Camera::new(&desc, 100, 50);
+        assert_eq!(cam.film_width, 200);
+        let (l, r) = (cam.ray(50.0, 25.0), cam.ray(150.0, 25.0));
+        assert!(((r.origin - l.origin).length() - 0.5).abs() < 1e-12);
+        // Both centre rays meet at the screen centre, the target.
+        let pl = l.at(5.0 / -l.dir.z);
+        let pr = r.at(5.0 / -r.dir.z);
+        assert!(pl.length() < 1e-9 && pr.length() < 1e-9, "{pl} {pr}");
+    }
+
+    #[test]
+    fn panorama_columns_are_equal_angles() {
+        let desc = CameraDesc::Panorama { look: LOOK, angle: std::f64::consts::PI };
+        let cam = Camera::new(&desc, 180, 60);
+        let a = cam.ray(90.0, 30.0).dir;
+        let b = cam.ray(135.0, 30.0).dir;
+        let c = cam.ray(180.0, 30.0).dir;
+        assert!((a.angle_between(b) - std::f64::consts::FRAC_PI_4).abs() < 1e-12);
+        assert!((a.angle_between(c) - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    }
+}

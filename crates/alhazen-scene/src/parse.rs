@@ -403,17 +403,22 @@ fn camera(n: &Node) -> R<CameraDesc> {
             CameraDesc::Perspective { look, opening }
         }
         "orthographic" => CameraDesc::Orthographic { look: look_at(&t)?, width: t.req("width")?.positive()? },
-        "axonometric" => CameraDesc::Axonometric {
-            style: match t.req("style")?.choice(&["isometric", "cavalier", "cabinet", "military"])? {
+        "axonometric" => {
+            let style = match t.req("style")?.choice(&["isometric", "cavalier", "cabinet", "military"])? {
                 "isometric" => Axonometry::Isometric,
                 "cavalier" => Axonometry::Cavalier,
                 "cabinet" => Axonometry::Cabinet,
                 _ => Axonometry::Military,
-            },
-            target: t.opt_vec3("target", Vec3::ZERO)?,
-            width: t.req("width")?.positive()?,
-            azimuth: t.opt_f64("azimuth", 0.0)?.to_radians(),
-        },
+            };
+            // Military views are customarily drawn with the plan turned by 45°.
+            let default_azimuth = if style == Axonometry::Military { 45.0 } else { 0.0 };
+            CameraDesc::Axonometric {
+                style,
+                target: t.opt_vec3("target", Vec3::ZERO)?,
+                width: t.req("width")?.positive()?,
+                azimuth: t.opt_f64("azimuth", default_azimuth)?.to_radians(),
+            }
+        }
         "stereo" => CameraDesc::Stereo {
             look: look_at(&t)?,
             eye_distance: t.get("eye_distance").map_or(Ok(0.065), |n| n.positive())?,

@@ -1,0 +1,138 @@
+//! The `alhazen` binary as a user meets it: exit codes, messages pointing into the scene file,
+//! and files written completely or not at all.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn alhazen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_alhazen")).args(args).output().expect("the binary runs")
+}
+
+fn scene_file(dir: &Path, text: &str) -> PathBuf {
+    let p = dir.join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Renders `text` into a temp dir and returns (exit code, stderr, whether an output exists).
+fn render(text: &str, extra: &[&str]) -> (i32, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), text);
+    let out = dir.path().join("out.png");
+    let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet"];
+    args.extend_from_slice(extra);
+    let o = alhazen(&args);
+    (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).into_owned(), out.exists())
+}
+
+const OK: &str = "[render]\nwidth = 16\nheight = 12\nspp = 1\n[camera]\neye = [0, 0, 5]\n[[light]]\ntype = \"point\"\nposition = [3, 3, 3]\n[[object]]\nshape = \"sphere\"\nradius = 1\n";
+
+#[test]
+fn renders_a_png() {
+    let (code, err, exists) = render(OK, &[]);
+    assert_eq!(code, 0, "{err}");
+    assert!(exists);
+}
+
+#[test]
+fn bad_toml_points_at_the_line() {
+    let (code, err, exists) = render("[render]\nwidth = = 3\n", &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("scene.toml:2:"), "{err}");
+    assert!(err.contains("TOML syntax error"), "{err}");
+    assert!(!exists);
+}
+
+#[test]
+fn unknown_key_suggests_the_right_one() {
+    let (code, err, _) = render(&OK.replace("radius = 1", "radus = 1"), &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("scene.toml:12:1: unknown key `radus`"), "{err}");
+    assert!(err.contains("did you mean `radius`?"), "{err}");
+    assert!(err.contains("12 | radus = 1\n   | ^^^^^"), "caret under the key: {err}");
+}
+
+#[test]
+fn negative_radius_is_refused() {
+    let (code, err, _) = render(&OK.replace("radius = 1", "radius = -1"), &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("scene.toml:12:10: `radius` must be positive, found -1"), "{err}");
+}
+
+#[test]
+fn absurd_resolution_is_refused_before_allocating() {
+    let (code, err, _) = render(&OK.replace("width = 16", "width = 60000").replace("height = 12", "height = 60000"), &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("more than the"), "{err}");
+    let (code, err, _) = render(OK, &["--width", "65536", "--height", "65536"]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, _) = render(OK, &["--width", "0"]);
+    assert_eq!(code, 2);
+}
+
+#[test]
+fn missing_scene_file() {
+    let o = alhazen(&["render", "/nonexistent/scene.toml", "-o", "/tmp/x.png"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read /nonexistent/scene.toml"));
+}
+
+#[test]
+fn unknown_material_and_enum_values_get_suggestions() {
+    let (code, err, _) = render(&OK.replace("shape = \"sphere\"", "shape = \"spere\""), &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("did you mean \"sphere\"?"), "{err}");
+    let (code, err, _) = render(&format!("{OK}material = \"glas\"\n[materials.glass]\nior = 1.5\n"), &[]);
+    assert_eq!(code, 2, "{err}");
+}
+
+#[test]
+fn unknown_output_format_fails_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), OK);
+    let o = alhazen(&["render", scene.to_str().unwrap(), "-o", dir.path().join("x.jpg").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown image format"));
+}
+
+#[test]
+fn failed_write_keeps_the_old_file() {
+    // The output path is a directory: the write fails, nothing is half-written.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), OK);
+    let target = dir.path().join("taken.png");
+    std::fs::create_dir(&target).unwrap();
+    let o = alhazen(&["render", scene.to_str().unwrap(), "-o", target.to_str().unwrap(), "--quiet"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(target.is_dir());
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains(".part")).collect();
+    assert!(leftovers.is_empty());
+}
+
+#[test]
+fn help_shows_an_example() {
+    let o = alhazen(&["render", "--help"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("alhazen render scenes/glass-balls.toml -o glass-balls.png"));
+}
+
+#[test]
+fn every_example_scene_parses() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut n = 0;
+    for entry in walk(&dir) {
+        if entry.extension().is_some_and(|e| e == "toml") {
+            alhazen_scene::load_scene(&entry).unwrap_or_else(|e| panic!("{e}"));
+            n += 1;
+        }
+    }
+    assert!(n >= 15, "found {n} scenes");
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = vec![];
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() { out.extend(walk(&p)) } else { out.push(p) }
+    }
+    out
+}
