@@ -7,7 +7,7 @@ use alhazen_math::{Bounds3, Ray, Vec3};
 const BINS: usize = 12;
 const MAX_LEAF: usize = 4;
 /// Deeper subtrees become leaves, so traversal's fixed stack never overflows.
-const MAX_DEPTH: usize = 96;
+const MAX_DEPTH: usize = 48;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {

@@ -73,7 +73,9 @@ pub fn to_srgb8(img: &Image) -> Vec<u8> {
 
 fn encode_png(img: &Image, out: &mut std::fs::File) -> io::Result<()> {
     use image::ImageEncoder;
-    let enc = image::codecs::png::PngEncoder::new(BufWriter::new(out));
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    // Fast deflate: a render's PNG is written once and read by people, not shipped.
+    let enc = PngEncoder::new_with_quality(BufWriter::new(out), CompressionType::Fast, FilterType::Adaptive);
     enc.write_image(&to_srgb8(img), img.width, img.height, image::ExtendedColorType::Rgb8).map_err(io::Error::other)
 }
 

@@ -142,11 +142,11 @@ impl<'a> Whitted<'a> {
     fn transmittance(&self, mut origin: Vec3, l: Vec3, mut dist: f64) -> Vec3 {
         let mut through = Vec3::ONE;
         for _ in 0..MAX_SHADOW_SURFACES {
-            let Some(wh) = self.world.intersect(&Ray::new(origin, l), dist) else { return through };
-            let m = &self.scene.materials[wh.material as usize];
-            if m.transparency == Vec3::ZERO {
-                return Vec3::ZERO;
-            }
+            let materials = &self.scene.materials;
+            let opaque = |id: u32| materials[id as usize].transparency == Vec3::ZERO;
+            let Ok(hit) = self.world.intersect_unless_opaque(&Ray::new(origin, l), dist, opaque) else { return Vec3::ZERO };
+            let Some(wh) = hit else { return through };
+            let m = &materials[wh.material as usize];
             let cos_n = wh.hit.n.dot(l);
             let entering = cos_n < 0.0;
             let eta = if entering { m.ior } else { 1.0 / m.ior };

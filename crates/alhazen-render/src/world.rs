@@ -2,7 +2,7 @@
 //! bounded ones and a plain list of unbounded ones (planes).
 
 use crate::bvh::Bvh;
-use crate::shape::{AaBox, Cone, Csg, Cylinder, Disk, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit};
+use crate::shape::{AaBox, Candidate, Cone, Csg, Cylinder, Disk, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit};
 use alhazen_math::{Bounds3, Ray};
 use alhazen_scene as scene;
 use std::sync::Arc;
@@ -77,28 +77,51 @@ impl World {
         self.bvh.bounds()
     }
 
-    /// The nearest hit in `(0, t_max)`.
+    /// The nearest hit in `(0, t_max)`: the object and its candidate, no surface details.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<WorldHit> {
-        let mut best: Option<(SurfaceHit, u32)> = None;
+    fn nearest(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
+        let mut best: Option<(Candidate, u32)> = None;
         let mut t_best = t_max;
         for &i in &self.unbounded {
-            if let Some(h) = self.objects[i as usize].placed.intersect(ray, t_best) {
-                t_best = h.t;
-                best = Some((h, i));
+            if let Some(c) = self.objects[i as usize].placed.hit(ray, t_best) {
+                t_best = c.t;
+                best = Some((c, i));
             }
         }
         self.bvh.traverse(ray, t_best, |k, t_max| {
             let i = self.bounded[k as usize];
-            let h = self.objects[i as usize].placed.intersect(ray, t_max)?;
-            best = Some((h, i));
-            Some(h.t)
+            let c = self.objects[i as usize].placed.hit(ray, t_max)?;
+            best = Some((c, i));
+            Some(c.t)
         });
-        best.map(|(hit, i)| {
-            let o = &self.objects[i as usize];
-            let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
-            WorldHit { hit, material }
-        })
+        best
+    }
+
+    /// The nearest hit in `(0, t_max)` with its surface and material.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<WorldHit> {
+        let (c, i) = self.nearest(ray, t_max)?;
+        let o = &self.objects[i as usize];
+        let hit = o.placed.surface(ray, c);
+        let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
+        Some(WorldHit { hit, material })
+    }
+
+    /// Like [`World::intersect`], but asks `is_opaque(material)` before computing the surface,
+    /// and stops with `Err(())` at an opaque hit: what shadow rays need.
+    #[inline]
+    pub fn intersect_unless_opaque(&self, ray: &Ray, t_max: f64, is_opaque: impl Fn(u32) -> bool) -> Result<Option<WorldHit>, ()> {
+        let Some((c, i)) = self.nearest(ray, t_max) else { return Ok(None) };
+        let o = &self.objects[i as usize];
+        if o.slot_materials.is_empty() && is_opaque(o.material) {
+            return Err(());
+        }
+        let hit = o.placed.surface(ray, c);
+        let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
+        if is_opaque(material) {
+            return Err(());
+        }
+        Ok(Some(WorldHit { hit, material }))
     }
 
     /// The nearest hit by testing every object (the reference for BVH tests).

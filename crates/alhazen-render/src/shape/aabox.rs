@@ -1,6 +1,6 @@
 //! Axis-aligned boxes (the slab method, keeping the face of entry and exit).
 
-use super::{Crossing, SurfaceHit};
+use super::{Candidate, Crossing, SurfaceHit};
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
 
 /// A solid axis-aligned box.
@@ -48,12 +48,17 @@ impl AaBox {
         SurfaceHit::flat(t, p, n, uv)
     }
 
-    /// Nearest hit in `(0, t_max)`.
+    /// Nearest hit in `(0, t_max)`; `aux` is the axis of the face.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let ((t0, a0), (t1, a1)) = self.slab(ray)?;
         let (t, a) = if t0 > 0.0 { (t0, a0) } else { (t1, a1) };
-        (t > 0.0 && t < t_max).then(|| self.hit_at(ray, t, a))
+        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: a as u32 })
+    }
+
+    /// The surface at a hit.
+    pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        self.hit_at(ray, c.t, c.aux as usize)
     }
 
     /// Entry and exit of the line.

@@ -4,7 +4,7 @@
 //! membership is the regularisation: surfaces where the set is inside on both sides (or outside
 //! on both) are dropped.
 
-use super::{Crossing, Placed, SurfaceHit};
+use super::{Candidate, Crossing, Placed, SurfaceHit};
 use alhazen_math::{Bounds3, Ray};
 use alhazen_scene::CsgOp;
 
@@ -58,6 +58,16 @@ impl Csg {
                 out.push(Crossing { hit, entering: now });
             }
         }
+    }
+
+    /// Nearest boundary point of the result in `(0, t_max)` (only its `t` is kept).
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        self.intersect(ray, t_max).map(|h| Candidate { t: h.t, aux: 0 })
+    }
+
+    /// The surface at a hit found by [`Csg::hit`] (recomputed: CSG hits are rare enough).
+    pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        self.intersect(ray, c.t * (1.0 + 1e-12) + f64::MIN_POSITIVE).unwrap_or(SurfaceHit::flat(c.t, ray.at(c.t), -ray.dir.normalize(), alhazen_math::Vec2::ZERO))
     }
 
     /// Nearest boundary point of the result in `(0, t_max)`.

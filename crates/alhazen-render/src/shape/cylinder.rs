@@ -1,11 +1,16 @@
 //! Finite cylinders and cones of revolution about the segment `base → top/apex`, open or capped
 //! by disks. Both reduce to a quadratic in the ray parameter after splitting vectors into their
-//! components along the axis and across it.
+//! components along the axis and across it. The search ([`Cylinder::hit`]) finds only `t` and
+//! which part was hit; the surface details are computed for the winning hit alone.
 
-use super::{Crossing, SurfaceHit, convex_crossings};
+use super::{Candidate, Crossing, SurfaceHit};
 use alhazen_math::poly::solve_quadratic;
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3, orthonormal_basis};
 use std::f64::consts::{PI, TAU};
+
+const SIDE: u32 = 0;
+const BOTTOM: u32 = 1;
+const TOP: u32 = 2;
 
 /// The axis of a solid of revolution.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,6 +22,45 @@ struct Axis {
     e2: Vec3,
 }
 
+/// Up to four `(t, part)` pairs, on the stack (this is on the hot path of every ray).
+#[derive(Default)]
+struct Parts {
+    items: [Candidate; 4],
+    len: usize,
+}
+
+impl Parts {
+    fn push(&mut self, t: f64, aux: u32) {
+        if self.len < self.items.len() {
+            self.items[self.len] = Candidate { t, aux };
+            self.len += 1;
+        }
+    }
+
+    fn nearest(&self, t_max: f64) -> Option<Candidate> {
+        self.items[..self.len].iter().filter(|c| c.t > 0.0 && c.t < t_max).min_by(|a, b| a.t.total_cmp(&b.t)).copied()
+    }
+
+    /// Entry and exit of a convex solid: the first and last of the whole line.
+    fn crossings(&self, surface: impl Fn(Candidate) -> SurfaceHit, out: &mut Vec<Crossing>) {
+        let items = &self.items[..self.len];
+        let first = items.iter().min_by(|a, b| a.t.total_cmp(&b.t));
+        let last = items.iter().max_by(|a, b| a.t.total_cmp(&b.t));
+        if let (Some(f), Some(l), true) = (first, last, self.len >= 2) {
+            out.push(Crossing { hit: surface(*f), entering: true });
+            out.push(Crossing { hit: surface(*l), entering: false });
+        }
+    }
+}
+
+/// Axial and radial components of a ray relative to an axis.
+struct Split {
+    od: f64,
+    dd: f64,
+    op: Vec3,
+    dp: Vec3,
+}
+
 impl Axis {
     fn new(base: Vec3, end: Vec3) -> Self {
         let height = (end - base).length();
@@ -25,24 +69,30 @@ impl Axis {
         Self { base, dir, height, e1, e2 }
     }
 
+    fn split(&self, ray: &Ray) -> Split {
+        let oc = ray.origin - self.base;
+        let (od, dd) = (oc.dot(self.dir), ray.dir.dot(self.dir));
+        Split { od, dd, op: oc - self.dir * od, dp: ray.dir - self.dir * dd }
+    }
+
     fn angle_u(&self, radial: Vec3) -> f64 {
         (radial.dot(self.e2).atan2(radial.dot(self.e1)) + PI) / TAU
     }
 
-    /// Hits of the cap disk at axial position `s` with radius `r` (normal `sign · dir`).
-    fn cap(&self, ray: &Ray, s: f64, r: f64, sign: f64, hits: &mut Hits) {
-        let denom = ray.dir.dot(self.dir);
-        if denom == 0.0 {
-            return;
+    /// Ray parameter of the cap disk at axial position `s` and radius `r`, if hit.
+    fn cap_t(&self, sp: &Split, s: f64, r: f64) -> Option<f64> {
+        if sp.dd == 0.0 {
+            return None;
         }
-        let center = self.base + self.dir * s;
-        let t = (center - ray.origin).dot(self.dir) / denom;
+        let t = (s - sp.od) / sp.dd;
+        ((sp.op + sp.dp * t).length_squared() <= r * r).then_some(t)
+    }
+
+    fn cap_surface(&self, ray: &Ray, t: f64, r: f64, sign: f64) -> SurfaceHit {
         let p = ray.at(t);
-        let d = p - center;
-        if d.length_squared() <= r * r {
-            let uv = Vec2::new(d.dot(self.e1), d.dot(self.e2)) / (2.0 * r) + 0.5;
-            hits.push(SurfaceHit::flat(t, p, self.dir * sign, uv));
-        }
+        let d = p - self.base - self.dir * (self.dir.dot(p - self.base));
+        let uv = Vec2::new(d.dot(self.e1), d.dot(self.e2)) / (2.0 * r) + 0.5;
+        SurfaceHit::flat(t, p, self.dir * sign, uv)
     }
 
     fn bounds(&self, r_base: f64, r_end: f64) -> Bounds3 {
@@ -50,30 +100,6 @@ impl Axis {
         let e = Vec3::new((1.0 - d.x * d.x).max(0.0).sqrt(), (1.0 - d.y * d.y).max(0.0).sqrt(), (1.0 - d.z * d.z).max(0.0).sqrt());
         let end = self.base + d * self.height;
         Bounds3::new(self.base - e * r_base, self.base + e * r_base).union(Bounds3::new(end - e * r_end, end + e * r_end))
-    }
-}
-
-/// Up to four hits, on the stack (this is on the hot path of every ray).
-#[derive(Default)]
-struct Hits {
-    items: [Option<SurfaceHit>; 4],
-    len: usize,
-}
-
-impl Hits {
-    fn push(&mut self, h: SurfaceHit) {
-        if self.len < self.items.len() {
-            self.items[self.len] = Some(h);
-            self.len += 1;
-        }
-    }
-
-    fn iter(&self) -> impl Iterator<Item = SurfaceHit> + '_ {
-        self.items[..self.len].iter().flatten().copied()
-    }
-
-    fn nearest(&self, t_max: f64) -> Option<SurfaceHit> {
-        self.iter().filter(|h| h.t > 0.0 && h.t < t_max).min_by(|a, b| a.t.total_cmp(&b.t))
     }
 }
 
@@ -91,40 +117,51 @@ impl Cylinder {
         Self { axis: Axis::new(base, top), radius, capped }
     }
 
-    /// All hits of the whole line, unsorted.
-    fn hits(&self, ray: &Ray, hits: &mut Hits) {
+    fn parts(&self, ray: &Ray) -> Parts {
         let ax = &self.axis;
-        let oc = ray.origin - ax.base;
-        let (od, dd) = (oc.dot(ax.dir), ray.dir.dot(ax.dir));
-        let (op, dp) = (oc - ax.dir * od, ray.dir - ax.dir * dd);
-        let roots = solve_quadratic(dp.length_squared(), 2.0 * op.dot(dp), op.length_squared() - self.radius * self.radius);
+        let sp = ax.split(ray);
+        let mut parts = Parts::default();
+        let roots = solve_quadratic(sp.dp.length_squared(), 2.0 * sp.op.dot(sp.dp), sp.op.length_squared() - self.radius * self.radius);
         for &t in roots.as_slice() {
-            let s = od + t * dd;
-            if (0.0..=ax.height).contains(&s) {
-                let radial = (op + dp * t) / self.radius;
-                let uv = Vec2::new(ax.angle_u(radial), s / ax.height);
-                hits.push(SurfaceHit::flat(t, ray.at(t), radial.normalize(), uv));
+            if (0.0..=ax.height).contains(&(sp.od + t * sp.dd)) {
+                parts.push(t, SIDE);
             }
         }
         if self.capped {
-            ax.cap(ray, 0.0, self.radius, -1.0, hits);
-            ax.cap(ray, ax.height, self.radius, 1.0, hits);
+            for (s, part) in [(0.0, BOTTOM), (ax.height, TOP)] {
+                if let Some(t) = ax.cap_t(&sp, s, self.radius) {
+                    parts.push(t, part);
+                }
+            }
         }
+        parts
     }
 
-    /// Nearest hit in `(0, t_max)`.
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
-        let mut hits = Hits::default();
-        self.hits(ray, &mut hits);
-        hits.nearest(t_max)
+    /// Nearest hit in `(0, t_max)`: its `t` and part.
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        self.parts(ray).nearest(t_max)
+    }
+
+    /// The surface at a hit found by [`Cylinder::hit`].
+    pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        let ax = &self.axis;
+        match c.aux {
+            BOTTOM => ax.cap_surface(ray, c.t, self.radius, -1.0),
+            TOP => ax.cap_surface(ray, c.t, self.radius, 1.0),
+            _ => {
+                let sp = ax.split(ray);
+                let radial = (sp.op + sp.dp * c.t) / self.radius;
+                let uv = Vec2::new(ax.angle_u(radial), (sp.od + c.t * sp.dd) / ax.height);
+                SurfaceHit::flat(c.t, ray.at(c.t), radial.normalize(), uv)
+            }
+        }
     }
 
     /// Entry and exit of the (capped, hence convex) solid.
     pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
         if self.capped {
-            let mut hits = Hits::default();
-            self.hits(ray, &mut hits);
-            convex_crossings(hits.iter().collect(), out);
+            self.parts(ray).crossings(|c| self.surface(ray, c), out);
         }
     }
 
@@ -148,45 +185,52 @@ impl Cone {
         Self { axis: Axis::new(base, apex), radius, capped }
     }
 
-    fn hits(&self, ray: &Ray, hits: &mut Hits) {
+    fn parts(&self, ray: &Ray) -> Parts {
         let ax = &self.axis;
-        let k = self.radius / ax.height;
-        let oc = ray.origin - ax.base;
-        let (od, dd) = (oc.dot(ax.dir), ray.dir.dot(ax.dir));
-        let (op, dp) = (oc - ax.dir * od, ray.dir - ax.dir * dd);
-        let (k2, h0) = (k * k, ax.height - od);
+        let sp = ax.split(ray);
+        let k2 = (self.radius / ax.height).powi(2);
+        let h0 = ax.height - sp.od;
         // |op + t dp|² = k² (h − s)², s = od + t dd.
-        let a = dp.length_squared() - k2 * dd * dd;
-        let b = 2.0 * (op.dot(dp) + k2 * h0 * dd);
-        let c = op.length_squared() - k2 * h0 * h0;
+        let a = sp.dp.length_squared() - k2 * sp.dd * sp.dd;
+        let b = 2.0 * (sp.op.dot(sp.dp) + k2 * h0 * sp.dd);
+        let c = sp.op.length_squared() - k2 * h0 * h0;
+        let mut parts = Parts::default();
         for &t in solve_quadratic(a, b, c).as_slice() {
-            let s = od + t * dd;
-            if (0.0..ax.height).contains(&s) {
-                let q = op + dp * t;
-                let radial = q.try_normalize().unwrap_or(ax.e1);
-                let n = (radial * ax.height + ax.dir * self.radius).normalize();
-                let uv = Vec2::new(ax.angle_u(radial), s / ax.height);
-                hits.push(SurfaceHit::flat(t, ray.at(t), n, uv));
+            if (0.0..ax.height).contains(&(sp.od + t * sp.dd)) {
+                parts.push(t, SIDE);
             }
         }
         if self.capped {
-            ax.cap(ray, 0.0, self.radius, -1.0, hits);
+            if let Some(t) = ax.cap_t(&sp, 0.0, self.radius) {
+                parts.push(t, BOTTOM);
+            }
         }
+        parts
     }
 
-    /// Nearest hit in `(0, t_max)`.
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
-        let mut hits = Hits::default();
-        self.hits(ray, &mut hits);
-        hits.nearest(t_max)
+    /// Nearest hit in `(0, t_max)`: its `t` and part.
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        self.parts(ray).nearest(t_max)
+    }
+
+    /// The surface at a hit found by [`Cone::hit`].
+    pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        let ax = &self.axis;
+        if c.aux == BOTTOM {
+            return ax.cap_surface(ray, c.t, self.radius, -1.0);
+        }
+        let sp = ax.split(ray);
+        let radial = (sp.op + sp.dp * c.t).try_normalize().unwrap_or(ax.e1);
+        let n = (radial * ax.height + ax.dir * self.radius).normalize();
+        let uv = Vec2::new(ax.angle_u(radial), (sp.od + c.t * sp.dd) / ax.height);
+        SurfaceHit::flat(c.t, ray.at(c.t), n, uv)
     }
 
     /// Entry and exit of the (capped, hence convex) solid.
     pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
         if self.capped {
-            let mut hits = Hits::default();
-            self.hits(ray, &mut hits);
-            convex_crossings(hits.iter().collect(), out);
+            self.parts(ray).crossings(|c| self.surface(ray, c), out);
         }
     }
 

@@ -1,7 +1,7 @@
 //! Triangle meshes: Möller–Trumbore intersection over a per-mesh BVH. One [`MeshAccel`] is
 //! shared by every instance of the mesh (instancing = one mesh, many transforms).
 
-use super::{Crossing, SurfaceHit};
+use super::{Candidate, Crossing, SurfaceHit};
 use crate::bvh::Bvh;
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
@@ -74,16 +74,23 @@ impl MeshShape {
         SurfaceHit { t, p: ray.at(t), n, ns, uv, slot }
     }
 
-    /// Nearest hit in `(0, t_max)`.
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+    /// Nearest hit in `(0, t_max)`; `aux` is the triangle.
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let m = &self.accel.mesh;
-        let mut best: Option<(usize, (f64, f64, f64))> = None;
+        let mut best = None;
         self.accel.bvh.traverse(ray, t_max, |i, t_max| {
             let h = triangle_hit(ray, m.corners(i as usize)).filter(|h| h.0 > 0.0 && h.0 < t_max)?;
-            best = Some((i as usize, h));
+            best = Some(Candidate { t: h.0, aux: i });
             Some(h.0)
         });
-        best.map(|(i, h)| self.surface(ray, i, h))
+        best
+    }
+
+    /// The surface at a hit found by [`MeshShape::hit`].
+    pub fn surface_at(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        let tri = c.aux as usize;
+        let (_, b1, b2) = triangle_hit(ray, self.accel.mesh.corners(tri)).unwrap_or((c.t, 1.0 / 3.0, 1.0 / 3.0));
+        self.surface(ray, tri, (c.t, b1, b2))
     }
 
     /// Every triangle crossing of the whole line; entering where the ray meets the front.

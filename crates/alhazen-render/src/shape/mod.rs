@@ -44,6 +44,17 @@ impl SurfaceHit {
     }
 }
 
+/// The result of the hit search: the ray parameter and a shape-specific tag (a triangle
+/// index, a face, a part) from which [`Shape::surface`] computes the full [`SurfaceHit`] for
+/// the winning hit only.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Candidate {
+    /// Ray parameter.
+    pub t: f64,
+    /// Shape-specific tag.
+    pub aux: u32,
+}
+
 /// A point where a line enters or leaves a closed shape; used by CSG.
 #[derive(Clone, Copy, Debug)]
 pub struct Crossing {
@@ -75,19 +86,39 @@ pub enum Shape {
 }
 
 impl Shape {
-    /// The nearest hit with `0 < t < t_max`.
+    /// The nearest hit with `0 < t < t_max`, without surface details.
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        match self {
+            Shape::Sphere(s) => s.hit(ray, t_max),
+            Shape::Cylinder(s) => s.hit(ray, t_max),
+            Shape::Cone(s) => s.hit(ray, t_max),
+            Shape::Disk(s) => s.hit(ray, t_max),
+            Shape::Plane(s) => s.hit(ray, t_max),
+            Shape::Box(s) => s.hit(ray, t_max),
+            Shape::Mesh(s) => s.hit(ray, t_max),
+            Shape::Csg(s) => s.hit(ray, t_max),
+        }
+    }
+
+    /// The surface at a hit found by [`Shape::hit`] on the same ray.
+    pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        match self {
+            Shape::Sphere(s) => s.hit_at(ray, c.t),
+            Shape::Cylinder(s) => s.surface(ray, c),
+            Shape::Cone(s) => s.surface(ray, c),
+            Shape::Disk(s) => s.surface(ray, c),
+            Shape::Plane(s) => s.surface(ray, c),
+            Shape::Box(s) => s.surface(ray, c),
+            Shape::Mesh(s) => s.surface_at(ray, c),
+            Shape::Csg(s) => s.surface(ray, c),
+        }
+    }
+
+    /// The nearest hit with `0 < t < t_max`, with its surface.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
-        match self {
-            Shape::Sphere(s) => s.intersect(ray, t_max),
-            Shape::Cylinder(s) => s.intersect(ray, t_max),
-            Shape::Cone(s) => s.intersect(ray, t_max),
-            Shape::Disk(s) => s.intersect(ray, t_max),
-            Shape::Plane(s) => s.intersect(ray, t_max),
-            Shape::Box(s) => s.intersect(ray, t_max),
-            Shape::Mesh(s) => s.intersect(ray, t_max),
-            Shape::Csg(s) => s.intersect(ray, t_max),
-        }
+        self.hit(ray, t_max).map(|c| self.surface(ray, c))
     }
 
     /// Object-space bounds (infinite for a plane).
@@ -147,16 +178,27 @@ impl Placed {
         Self { shape, to_world: (!to_world.is_identity()).then_some(to_world) }
     }
 
+    /// The nearest hit of a world-space ray, without surface details.
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        match &self.to_world {
+            None => self.shape.hit(ray, t_max),
+            Some(tf) => self.shape.hit(&tf.inverse().ray(ray), t_max),
+        }
+    }
+
+    /// The world-space surface at a hit found by [`Placed::hit`].
+    pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        match &self.to_world {
+            None => self.shape.surface(ray, c),
+            Some(tf) => to_world(tf, self.shape.surface(&tf.inverse().ray(ray), c)),
+        }
+    }
+
     /// The nearest hit in world space.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
-        match &self.to_world {
-            None => self.shape.intersect(ray, t_max),
-            Some(tf) => {
-                let local = tf.inverse().ray(ray);
-                self.shape.intersect(&local, t_max).map(|h| to_world(tf, h))
-            }
-        }
+        self.hit(ray, t_max).map(|c| self.surface(ray, c))
     }
 
     /// World-space crossings (see [`Shape::crossings`]).

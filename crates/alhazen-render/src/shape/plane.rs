@@ -2,7 +2,7 @@
 
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3, orthonormal_basis};
 
-use super::SurfaceHit;
+use super::{Candidate, SurfaceHit};
 
 /// An infinite plane; its texture coordinates are lengths along a tangent frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,15 +22,17 @@ fn plane_t(point: Vec3, normal: Vec3, ray: &Ray) -> f64 {
 impl Plane {
     /// Nearest hit in `(0, t_max)`.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let t = plane_t(self.point, self.normal, ray);
-        if !(t > 0.0 && t < t_max) {
-            return None;
-        }
-        let p = ray.at(t);
+        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: 0 })
+    }
+
+    /// The surface at a hit.
+    pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        let (t, p) = (c.t, ray.at(c.t));
         let (tu, tv) = orthonormal_basis(self.normal);
         let d = p - self.point;
-        Some(SurfaceHit::flat(t, p, self.normal, Vec2::new(d.dot(tu), d.dot(tv))))
+        SurfaceHit::flat(t, p, self.normal, Vec2::new(d.dot(tu), d.dot(tv)))
     }
 }
 
@@ -48,19 +50,19 @@ pub struct Disk {
 impl Disk {
     /// Nearest hit in `(0, t_max)`.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let t = plane_t(self.center, self.normal, ray);
-        if !(t > 0.0 && t < t_max) {
-            return None;
-        }
-        let p = ray.at(t);
+        let inside = (ray.at(t) - self.center).length_squared() <= self.radius * self.radius;
+        (t > 0.0 && t < t_max && inside).then_some(Candidate { t, aux: 0 })
+    }
+
+    /// The surface at a hit.
+    pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        let p = ray.at(c.t);
         let d = p - self.center;
-        if d.length_squared() > self.radius * self.radius {
-            return None;
-        }
         let (tu, tv) = orthonormal_basis(self.normal);
         let uv = Vec2::new(d.dot(tu), d.dot(tv)) / (2.0 * self.radius) + 0.5;
-        Some(SurfaceHit::flat(t, p, self.normal, uv))
+        SurfaceHit::flat(c.t, p, self.normal, uv)
     }
 
     /// Bounding box (tight per axis).

@@ -1,6 +1,6 @@
 //! Sphere `|p − c| = r`: the quadratic `|o + t d − c|² = r²`.
 
-use super::{Crossing, SurfaceHit, convex_crossings};
+use super::{Candidate, Crossing, SurfaceHit, convex_crossings};
 use alhazen_math::poly::solve_quadratic;
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
 use std::f64::consts::{PI, TAU};
@@ -24,7 +24,8 @@ impl Sphere {
         }
     }
 
-    fn hit_at(&self, ray: &Ray, t: f64) -> SurfaceHit {
+    /// The surface at parameter `t`.
+    pub fn hit_at(&self, ray: &Ray, t: f64) -> SurfaceHit {
         let p = ray.at(t);
         let n = (p - self.center) / self.radius;
         // Texture coordinates: longitude around +y, latitude from the north pole.
@@ -35,10 +36,10 @@ impl Sphere {
 
     /// Nearest hit in `(0, t_max)`.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<SurfaceHit> {
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let [t0, t1] = self.roots(ray);
         let t = if t0 > 0.0 { t0 } else { t1 };
-        (t > 0.0 && t < t_max).then(|| self.hit_at(ray, t))
+        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: 0 })
     }
 
     /// Both crossings of the line.
