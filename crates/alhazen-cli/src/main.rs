@@ -21,7 +21,9 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to an image (PNG, EXR or PFM) with the Whitted ray tracer.
-    #[command(after_help = "Example:\n  alhazen render scenes/glass-balls.toml -o glass-balls.png --spp 16\n\nThe scene format is described in docs/scene-format.md.")]
+    #[command(
+        after_help = "Example:\n  alhazen render scenes/glass-balls.toml -o glass-balls.png --spp 16\n\nThe scene format is described in docs/scene-format.md."
+    )]
     Render(RenderArgs),
 }
 
@@ -95,13 +97,17 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), Failure> {
     r.max_depth = a.depth.unwrap_or(r.max_depth);
     r.seed = a.seed.unwrap_or(r.seed);
     if r.width as u64 * r.height as u64 > MAX_PIXELS {
-        return Err(Failure::input(format!("{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate", r.width, r.height)));
+        return Err(Failure::input(format!(
+            "{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate",
+            r.width, r.height
+        )));
     }
     Ok(())
 }
 
 fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
-    let format = Format::from_path(path, half).ok_or_else(|| Failure::input(format!("{}: unknown image format; use .png, .exr or .pfm", path.display())))?;
+    let format = Format::from_path(path, half)
+        .ok_or_else(|| Failure::input(format!("{}: unknown image format; use .png, .exr or .pfm", path.display())))?;
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {
         return Err(Failure::input(format!("{}: the directory {} does not exist", path.display(), dir.display())));
@@ -117,7 +123,8 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     })?;
     apply_overrides(&mut scene, a)?;
     let threads = a.threads.map_or(0, |t| t as usize);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Failure::work(e.to_string()))?;
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Failure::work(e.to_string()))?;
     let bar = progress_bar(a.quiet);
     let start = Instant::now();
     let image = pool.install(|| {
@@ -128,7 +135,8 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     });
     bar.finish_and_clear();
     let elapsed = start.elapsed();
-    write_image(&image, &a.output, format).map_err(|e| Failure::work(format!("cannot write {}: {e}", a.output.display())))?;
+    write_image(&image, &a.output, format)
+        .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.output.display())))?;
     if !a.quiet {
         let r = &scene.render;
         eprintln!(
@@ -151,6 +159,12 @@ fn progress_bar(quiet: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(1);
-    bar.set_style(ProgressStyle::with_template("{spinner} rendering [{bar:40}] {percent:>3}% tiles {pos}/{len} elapsed {elapsed} eta {eta}").unwrap_or_else(|_| ProgressStyle::default_bar()).progress_chars("=> "));
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} rendering [{bar:40}] {percent:>3}% tiles {pos}/{len} elapsed {elapsed} eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
     bar
 }

@@ -61,7 +61,8 @@ fn negative_radius_is_refused() {
 
 #[test]
 fn absurd_resolution_is_refused_before_allocating() {
-    let (code, err, _) = render(&OK.replace("width = 16", "width = 60000").replace("height = 12", "height = 60000"), &[]);
+    let (code, err, _) =
+        render(&OK.replace("width = 16", "width = 60000").replace("height = 12", "height = 60000"), &[]);
     assert_eq!(code, 2);
     assert!(err.contains("more than the"), "{err}");
     let (code, err, _) = render(OK, &["--width", "65536", "--height", "65536"]);
@@ -105,7 +106,11 @@ fn failed_write_keeps_the_old_file() {
     let o = alhazen(&["render", scene.to_str().unwrap(), "-o", target.to_str().unwrap(), "--quiet"]);
     assert_eq!(o.status.code(), Some(1));
     assert!(target.is_dir());
-    let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains(".part")).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".part"))
+        .collect();
     assert!(leftovers.is_empty());
 }
 

@@ -141,11 +141,9 @@ mod tests {
 
     #[test]
     fn smooth_normals_of_a_flat_fan_are_the_face_normal() {
-        let mut m = TriangleMesh::new(
-            vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
-            vec![[0, 1, 2], [0, 2, 3]],
-        )
-        .unwrap();
+        let mut m =
+            TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y], vec![[0, 1, 2], [0, 2, 3]])
+                .unwrap();
         m.compute_smooth_normals();
         assert!(m.normals.iter().all(|n| (*n - Vec3::Z).length() < 1e-12));
     }

@@ -115,11 +115,7 @@ impl Transform {
     pub fn normal(&self, n: Vec3) -> Vec3 {
         let i = &self.inv;
         // (L^{-1})^T n: dot n with the columns of L^{-1}.
-        Vec3::new(
-            i.x_axis.truncate().dot(n),
-            i.y_axis.truncate().dot(n),
-            i.z_axis.truncate().dot(n),
-        )
+        Vec3::new(i.x_axis.truncate().dot(n), i.y_axis.truncate().dot(n), i.z_axis.truncate().dot(n))
     }
 
     /// The ray with both origin and direction mapped (the direction is not renormalised, so
@@ -166,9 +162,7 @@ mod tests {
         (arb_vec(), arb_vec(), 0.0..6.3f64, (0.2..3.0f64, 0.2..3.0f64, 0.2..3.0f64)).prop_map(
             |(t, axis, angle, (sx, sy, sz))| {
                 let axis = if axis.length() < 1e-3 { Vec3::Y } else { axis };
-                Transform::translate(t)
-                    * Transform::rotate(axis, angle)
-                    * Transform::scale(Vec3::new(sx, sy, sz))
+                Transform::translate(t) * Transform::rotate(axis, angle) * Transform::scale(Vec3::new(sx, sy, sz))
             },
         )
     }

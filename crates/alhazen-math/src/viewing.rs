@@ -50,12 +50,7 @@ impl ViewFrame {
 
     /// The inverse of [`ViewFrame::world_to_view`]: columns `u, v, w, e`.
     pub fn view_to_world(&self) -> Mat4 {
-        Mat4::from_cols(
-            self.u.extend(0.0),
-            self.v.extend(0.0),
-            self.w.extend(0.0),
-            self.eye.extend(1.0),
-        )
+        Mat4::from_cols(self.u.extend(0.0), self.v.extend(0.0), self.w.extend(0.0), self.eye.extend(1.0))
     }
 
     /// A view-space direction `(x, y, z)` expressed in world space: `x u + y v + z w`.
@@ -236,6 +231,7 @@ mod tests {
         let p = FR.perspective();
         let (l, r, b, t, n, f) = (FR.l, FR.r, FR.b, FR.t, FR.n, FR.f);
         assert_eq!(p.row(0), Vec4::new(2.0 * n / (r - l), 0.0, (r + l) / (r - l), 0.0));
+        assert_eq!(p.row(1), Vec4::new(0.0, 2.0 * n / (t - b), (t + b) / (t - b), 0.0));
         assert_eq!(p.row(2), Vec4::new(0.0, 0.0, (n + f) / (n - f), 2.0 * f * n / (n - f)));
         assert_eq!(p.row(3), Vec4::new(0.0, 0.0, -1.0, 0.0));
         let pi = FR.perspective_inverse();

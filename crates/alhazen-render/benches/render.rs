@@ -19,7 +19,9 @@ fn bench_render(c: &mut Criterion) {
     let mut g = c.benchmark_group("glass-balls");
     g.sample_size(10);
     g.throughput(Throughput::Elements(200 * 150 * 4));
-    g.bench_function("200x150 4spp (camera samples/s)", |b| b.iter(|| alhazen_render::render(black_box(&scene), &|_, _| {})));
+    g.bench_function("200x150 4spp (camera samples/s)", |b| {
+        b.iter(|| alhazen_render::render(black_box(&scene), &|_, _| {}))
+    });
     g.finish();
 }
 
@@ -34,7 +36,9 @@ fn bench_intersect(c: &mut Criterion) {
         .collect();
     let mut g = c.benchmark_group("intersect");
     g.throughput(Throughput::Elements(rays.len() as u64));
-    g.bench_function("glass-balls world (rays/s)", |b| b.iter(|| rays.iter().filter(|r| world.intersect(black_box(r), f64::INFINITY).is_some()).count()));
+    g.bench_function("glass-balls world (rays/s)", |b| {
+        b.iter(|| rays.iter().filter(|r| world.intersect(black_box(r), f64::INFINITY).is_some()).count())
+    });
     g.finish();
 }
 

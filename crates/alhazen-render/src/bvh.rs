@@ -95,7 +95,11 @@ impl Bvh {
                     }
                 } else {
                     // Near child first.
-                    let (near, far) = if neg[node.axis as usize] { (node.offset as usize, at + 1) } else { (at + 1, node.offset as usize) };
+                    let (near, far) = if neg[node.axis as usize] {
+                        (node.offset as usize, at + 1)
+                    } else {
+                        (at + 1, node.offset as usize)
+                    };
                     stack[sp] = far as u32;
                     sp += 1;
                     at = near;
@@ -120,7 +124,13 @@ impl Bvh {
 fn sah_split(items: &mut [Item], bounds: &Bounds3) -> Option<(usize, usize)> {
     let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.grow(it.centroid));
     let extent = cb.extent();
-    let axis = if extent.x >= extent.y && extent.x >= extent.z { 0 } else if extent.y >= extent.z { 1 } else { 2 };
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
     if extent[axis] <= 0.0 || !extent[axis].is_finite() {
         // All centroids coincide: split in the middle to keep leaves small.
         if items.len() > 255 {

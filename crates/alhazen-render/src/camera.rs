@@ -25,6 +25,8 @@ pub struct Camera {
     pub film_height: u32,
 }
 
+// Built once per render, so the size of the largest variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 enum Kind {
     Perspective(Pinhole),
@@ -55,7 +57,12 @@ impl Pinhole {
 
 fn frame(look: &alhazen_scene::LookAt) -> ViewFrame {
     // The scene reader has checked the frame is well defined; fall back to a fixed one anyway.
-    ViewFrame::look_at(look.eye, look.target, look.up).unwrap_or(ViewFrame { eye: look.eye, u: Vec3::X, v: Vec3::Y, w: Vec3::Z })
+    ViewFrame::look_at(look.eye, look.target, look.up).unwrap_or(ViewFrame {
+        eye: look.eye,
+        u: Vec3::X,
+        v: Vec3::Y,
+        w: Vec3::Z,
+    })
 }
 
 impl Camera {
@@ -84,7 +91,8 @@ impl Camera {
             }
             CameraDesc::Stereo { look, eye_distance, screen_distance, screen_width } => {
                 let f = frame(look);
-                let (l, r) = stereo_frusta(*eye_distance, *screen_distance, *screen_width, screen_width / aspect, 1.0, 1000.0);
+                let (l, r) =
+                    stereo_frusta(*eye_distance, *screen_distance, *screen_width, screen_width / aspect, 1.0, 1000.0);
                 let eye = |s: f64| ViewFrame { eye: f.eye + f.u * (s * eye_distance / 2.0), ..f };
                 (Kind::Stereo { left: Pinhole::new(eye(-1.0), l), right: Pinhole::new(eye(1.0), r) }, width * 2)
             }
@@ -166,7 +174,10 @@ mod tests {
 
     #[test]
     fn perspective_edges_span_the_horizontal_fov() {
-        let desc = CameraDesc::Perspective { look: LOOK, opening: PerspectiveOpening::Fov { angle: 60f64.to_radians(), horizontal: true } };
+        let desc = CameraDesc::Perspective {
+            look: LOOK,
+            opening: PerspectiveOpening::Fov { angle: 60f64.to_radians(), horizontal: true },
+        };
         let cam = Camera::new(&desc, 400, 300);
         let (left, right) = (cam.ray(0.0, 150.0).dir, cam.ray(400.0, 150.0).dir);
         assert!((left.angle_between(right) - 60f64.to_radians()).abs() < 1e-12);
@@ -178,7 +189,10 @@ mod tests {
 
     #[test]
     fn frustum_camera_matches_the_course_frustum() {
-        let desc = CameraDesc::Perspective { look: LOOK, opening: PerspectiveOpening::Frustum { lrbtn: [-0.2, 0.6, -0.3, 0.3, 1.0] } };
+        let desc = CameraDesc::Perspective {
+            look: LOOK,
+            opening: PerspectiveOpening::Frustum { lrbtn: [-0.2, 0.6, -0.3, 0.3, 1.0] },
+        };
         let cam = Camera::new(&desc, 80, 60);
         // The film's top-left corner looks through (l, t, −n).
         let d = cam.ray(0.0, 0.0).dir;
@@ -195,7 +209,8 @@ mod tests {
 
     #[test]
     fn isometric_foreshortens_the_three_axes_equally() {
-        let desc = CameraDesc::Axonometric { style: Axonometry::Isometric, target: Vec3::ZERO, width: 10.0, azimuth: 0.0 };
+        let desc =
+            CameraDesc::Axonometric { style: Axonometry::Isometric, target: Vec3::ZERO, width: 10.0, azimuth: 0.0 };
         let cam = Camera::new(&desc, 100, 100);
         let o = film_position(&cam, Vec3::ZERO);
         let lens: Vec<f64> = [Vec3::X, Vec3::Y, Vec3::Z]
@@ -213,7 +228,8 @@ mod tests {
 
     #[test]
     fn cavalier_keeps_the_front_and_draws_depth_at_45_degrees() {
-        let desc = CameraDesc::Axonometric { style: Axonometry::Cavalier, target: Vec3::ZERO, width: 10.0, azimuth: 0.0 };
+        let desc =
+            CameraDesc::Axonometric { style: Axonometry::Cavalier, target: Vec3::ZERO, width: 10.0, azimuth: 0.0 };
         let cam = Camera::new(&desc, 100, 100);
         let o = film_position(&cam, Vec3::ZERO);
         let x = film_position(&cam, Vec3::X);
@@ -225,7 +241,8 @@ mod tests {
 
     #[test]
     fn military_keeps_the_ground_plan() {
-        let desc = CameraDesc::Axonometric { style: Axonometry::Military, target: Vec3::ZERO, width: 10.0, azimuth: 0.7 };
+        let desc =
+            CameraDesc::Axonometric { style: Axonometry::Military, target: Vec3::ZERO, width: 10.0, azimuth: 0.7 };
         let cam = Camera::new(&desc, 100, 100);
         // Distances and right angles in the ground plane are preserved.
         let (o, a, b) = (film_position(&cam, Vec3::ZERO), film_position(&cam, Vec3::X), film_position(&cam, Vec3::Z));

@@ -32,9 +32,16 @@ impl Image {
 
 /// Renders every pixel with `spp` stratified samples; `progress(done, total)` is called as
 /// tiles finish (from worker threads).
-pub fn render_image(camera: &Camera, integrator: &Whitted, spp: u32, seed: u64, progress: &(dyn Fn(usize, usize) + Sync)) -> Image {
+pub fn render_image(
+    camera: &Camera,
+    integrator: &Whitted,
+    spp: u32,
+    seed: u64,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Image {
     let (w, h) = (camera.film_width, camera.film_height);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
+    let tiles: Vec<(u32, u32)> =
+        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
     let done = AtomicUsize::new(0);
     let rendered: Vec<Vec<[f32; 3]>> = tiles
         .par_iter()

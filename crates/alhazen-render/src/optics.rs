@@ -117,7 +117,7 @@ mod tests {
 
     proptest! {
         #[test]
-        fn snell_law_holds(theta in 0.0..1.5f64, phi in 0.0..6.28f64, eta in 0.3..3.0f64) {
+        fn snell_law_holds(theta in 0.0..1.5f64, phi in 0.0..std::f64::consts::TAU, eta in 0.3..3.0f64) {
             let i = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
             let n = Vec3::Z;
             match refract(i, n, eta) {

@@ -57,7 +57,8 @@ pub fn write_image(img: &Image, path: &Path, format: Format) -> io::Result<()> {
 #[cfg(unix)]
 fn set_readable_permissions(tmp: &Path, target: &Path) -> io::Result<()> {
     use std::os::unix::fs::PermissionsExt;
-    let perms = std::fs::metadata(target).map(|m| m.permissions()).unwrap_or_else(|_| std::fs::Permissions::from_mode(0o644));
+    let perms =
+        std::fs::metadata(target).map(|m| m.permissions()).unwrap_or_else(|_| std::fs::Permissions::from_mode(0o644));
     std::fs::set_permissions(tmp, perms)
 }
 

@@ -116,12 +116,14 @@ mod tests {
             let pts: Vec<_> = (0..n).map(|i| stratified_offset(3, 10, 20, i, n)).collect();
             let k = (n as f64).sqrt().round() as u32;
             if k * k == n {
-                let mut cells: Vec<u32> = pts.iter().map(|(x, y)| (y * k as f64) as u32 * k + (x * k as f64) as u32).collect();
+                let mut cells: Vec<u32> =
+                    pts.iter().map(|(x, y)| (y * k as f64) as u32 * k + (x * k as f64) as u32).collect();
                 cells.sort();
                 assert_eq!(cells, (0..n).collect::<Vec<_>>());
             } else {
                 for coord in [0, 1] {
-                    let mut rows: Vec<u32> = pts.iter().map(|p| ((if coord == 0 { p.0 } else { p.1 }) * n as f64) as u32).collect();
+                    let mut rows: Vec<u32> =
+                        pts.iter().map(|p| ((if coord == 0 { p.0 } else { p.1 }) * n as f64) as u32).collect();
                     rows.sort();
                     assert_eq!(rows, (0..n).collect::<Vec<_>>());
                 }

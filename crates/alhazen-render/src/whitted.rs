@@ -7,7 +7,7 @@
 
 use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use crate::texture;
-use crate::world::{World, WorldHit};
+use crate::world::{ShadowHit, World, WorldHit};
 use alhazen_math::{Ray, Vec3};
 use alhazen_scene::{Background, FresnelMode, Highlight, Light, Material, Scene};
 
@@ -83,7 +83,11 @@ impl<'a> Whitted<'a> {
         match self.scene.background {
             Background::Solid(c) => c,
             Background::Gradient { zenith, horizon, ground } => {
-                if dir.y >= 0.0 { horizon.lerp(zenith, dir.y.min(1.0)) } else { ground }
+                if dir.y >= 0.0 {
+                    horizon.lerp(zenith, dir.y.min(1.0))
+                } else {
+                    ground
+                }
             }
         }
     }
@@ -144,8 +148,11 @@ impl<'a> Whitted<'a> {
         for _ in 0..MAX_SHADOW_SURFACES {
             let materials = &self.scene.materials;
             let opaque = |id: u32| materials[id as usize].transparency == Vec3::ZERO;
-            let Ok(hit) = self.world.intersect_unless_opaque(&Ray::new(origin, l), dist, opaque) else { return Vec3::ZERO };
-            let Some(wh) = hit else { return through };
+            let wh = match self.world.shadow_hit(&Ray::new(origin, l), dist, opaque) {
+                ShadowHit::Clear => return through,
+                ShadowHit::Opaque => return Vec3::ZERO,
+                ShadowHit::Transparent(wh) => wh,
+            };
             let m = &materials[wh.material as usize];
             let cos_n = wh.hit.n.dot(l);
             let entering = cos_n < 0.0;
@@ -164,7 +171,17 @@ impl<'a> Whitted<'a> {
     }
 
     /// Reflected and refracted rays.
-    fn secondary(&self, m: &Material, p: Vec3, n: Vec3, ng: Vec3, v: Vec3, front: bool, depth: u32, weight: f64) -> Vec3 {
+    fn secondary(
+        &self,
+        m: &Material,
+        p: Vec3,
+        n: Vec3,
+        ng: Vec3,
+        v: Vec3,
+        front: bool,
+        depth: u32,
+        weight: f64,
+    ) -> Vec3 {
         let mut color = Vec3::ZERO;
         let mut reflect_w = m.mirror;
         if m.transparency != Vec3::ZERO {

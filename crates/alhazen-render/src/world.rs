@@ -2,7 +2,9 @@
 //! bounded ones and a plain list of unbounded ones (planes).
 
 use crate::bvh::Bvh;
-use crate::shape::{AaBox, Candidate, Cone, Csg, Cylinder, Disk, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit};
+use crate::shape::{
+    AaBox, Candidate, Cone, Csg, Cylinder, Disk, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit,
+};
 use alhazen_math::{Bounds3, Ray};
 use alhazen_scene as scene;
 use std::sync::Arc;
@@ -27,6 +29,17 @@ pub struct World {
     unbounded: Vec<u32>,
 }
 
+/// The first thing a shadow ray meets.
+#[derive(Clone, Copy, Debug)]
+pub enum ShadowHit {
+    /// Nothing before the light.
+    Clear,
+    /// An opaque surface: no light passes.
+    Opaque,
+    /// A transparent surface that light may pass.
+    Transparent(WorldHit),
+}
+
 /// A hit with the material to shade it with.
 #[derive(Clone, Copy, Debug)]
 pub struct WorldHit {
@@ -39,9 +52,13 @@ pub struct WorldHit {
 fn build_shape(s: &scene::Shape, meshes: &[Arc<MeshAccel>]) -> Shape {
     match s {
         scene::Shape::Sphere { center, radius } => Shape::Sphere(Sphere { center: *center, radius: *radius }),
-        scene::Shape::Cylinder { base, top, radius, capped } => Shape::Cylinder(Cylinder::new(*base, *top, *radius, *capped)),
+        scene::Shape::Cylinder { base, top, radius, capped } => {
+            Shape::Cylinder(Cylinder::new(*base, *top, *radius, *capped))
+        }
         scene::Shape::Cone { base, apex, radius, capped } => Shape::Cone(Cone::new(*base, *apex, *radius, *capped)),
-        scene::Shape::Disk { center, normal, radius } => Shape::Disk(Disk { center: *center, normal: *normal, radius: *radius }),
+        scene::Shape::Disk { center, normal, radius } => {
+            Shape::Disk(Disk { center: *center, normal: *normal, radius: *radius })
+        }
         scene::Shape::Plane { point, normal } => Shape::Plane(Plane { point: *point, normal: *normal }),
         scene::Shape::Box { min, max } => Shape::Box(AaBox { min: *min, max: *max }),
         scene::Shape::Mesh { mesh, smooth } => Shape::Mesh(MeshShape { accel: meshes[*mesh].clone(), smooth: *smooth }),
@@ -67,7 +84,8 @@ impl World {
             })
             .collect();
         let bounds: Vec<Bounds3> = objects.iter().map(|o| o.placed.bounds()).collect();
-        let (bounded, unbounded): (Vec<u32>, Vec<u32>) = (0..objects.len() as u32).partition(|&i| bounds[i as usize].is_finite());
+        let (bounded, unbounded): (Vec<u32>, Vec<u32>) =
+            (0..objects.len() as u32).partition(|&i| bounds[i as usize].is_finite());
         let bvh = Bvh::build(&bounded.iter().map(|&i| bounds[i as usize]).collect::<Vec<_>>());
         Self { objects, bvh, bounded, unbounded }
     }
@@ -107,21 +125,21 @@ impl World {
         Some(WorldHit { hit, material })
     }
 
-    /// Like [`World::intersect`], but asks `is_opaque(material)` before computing the surface,
-    /// and stops with `Err(())` at an opaque hit: what shadow rays need.
+    /// What a shadow ray meets first: asks `is_opaque(material)` before computing the
+    /// surface, so an opaque blocker costs no shading work.
     #[inline]
-    pub fn intersect_unless_opaque(&self, ray: &Ray, t_max: f64, is_opaque: impl Fn(u32) -> bool) -> Result<Option<WorldHit>, ()> {
-        let Some((c, i)) = self.nearest(ray, t_max) else { return Ok(None) };
+    pub fn shadow_hit(&self, ray: &Ray, t_max: f64, is_opaque: impl Fn(u32) -> bool) -> ShadowHit {
+        let Some((c, i)) = self.nearest(ray, t_max) else { return ShadowHit::Clear };
         let o = &self.objects[i as usize];
         if o.slot_materials.is_empty() && is_opaque(o.material) {
-            return Err(());
+            return ShadowHit::Opaque;
         }
         let hit = o.placed.surface(ray, c);
         let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
         if is_opaque(material) {
-            return Err(());
+            return ShadowHit::Opaque;
         }
-        Ok(Some(WorldHit { hit, material }))
+        ShadowHit::Transparent(WorldHit { hit, material })
     }
 
     /// The nearest hit by testing every object (the reference for BVH tests).

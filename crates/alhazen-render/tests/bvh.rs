@@ -11,8 +11,18 @@ fn random_scene(spheres: &[(f64, f64, f64, f64)], boxes: &[(f64, f64, f64)]) -> 
         s += &format!("[[object]]\nshape = \"sphere\"\ncenter = [{x}, {y}, {z}]\nradius = {r}\n");
     }
     for (x, y, z) in boxes {
-        s += &format!("[[object]]\nshape = \"box\"\nmin = [{x}, {y}, {z}]\nmax = [{}, {}, {}]\ntransform = [{{ rotate_y = 30 }}]\n", x + 0.5, y + 0.8, z + 0.3);
-        s += &format!("[[object]]\nshape = \"cylinder\"\nbase = [{x}, {y}, {z}]\ntop = [{}, {}, {}]\nradius = 0.2\n", x + 0.1, y + 1.0, z);
+        s += &format!(
+            "[[object]]\nshape = \"box\"\nmin = [{x}, {y}, {z}]\nmax = [{}, {}, {}]\ntransform = [{{ rotate_y = 30 }}]\n",
+            x + 0.5,
+            y + 0.8,
+            z + 0.3
+        );
+        s += &format!(
+            "[[object]]\nshape = \"cylinder\"\nbase = [{x}, {y}, {z}]\ntop = [{}, {}, {}]\nradius = 0.2\n",
+            x + 0.1,
+            y + 1.0,
+            z
+        );
     }
     s
 }

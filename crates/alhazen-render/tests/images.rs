@@ -31,7 +31,9 @@ material = { color = 0.5 }
 
 #[test]
 fn lambert_under_a_directional_light_is_albedo_times_cosine() {
-    let img = render_text(&format!("{FLAT}[[light]]\ntype = \"directional\"\ndirection = [0, -0.6, -0.8]\nintensity = 1.0\n"));
+    let img = render_text(&format!(
+        "{FLAT}[[light]]\ntype = \"directional\"\ndirection = [0, -0.6, -0.8]\nintensity = 1.0\n"
+    ));
     let c = img.get(4, 4);
     assert!((c.x - 0.5 * 0.8).abs() < 1e-6, "{c}");
 }
@@ -39,7 +41,8 @@ fn lambert_under_a_directional_light_is_albedo_times_cosine() {
 #[test]
 fn point_light_follows_the_course_attenuation() {
     // Light 2 units above the plane: I = 1 / (a d² + b d + c) with a=1, b=0.5, c=1 at d = 2.
-    let img = render_text(&format!("{FLAT}[[light]]\ntype = \"point\"\nposition = [0, 0, 2]\nattenuation = [1, 0.5, 1]\n"));
+    let img =
+        render_text(&format!("{FLAT}[[light]]\ntype = \"point\"\nposition = [0, 0, 2]\nattenuation = [1, 0.5, 1]\n"));
     let expected = 0.5 / (4.0 + 1.0 + 1.0);
     assert!((img.get(4, 4).x - expected).abs() < 1e-6);
 }
@@ -51,7 +54,9 @@ fn opaque_occluder_casts_full_shadow_and_glass_a_partial_one() {
     assert_eq!(opaque.get(4, 4).x, 0.0);
     // A glass ball above the camera plane: its shadow passes through two surfaces at normal
     // incidence, each transmitting 1 − F(0°) = 0.96.
-    let glass = render_text(&format!("{base}[[object]]\nshape = \"sphere\"\ncenter = [0, 0, 8]\nradius = 0.5\nmaterial = {{ transparency = 1, ior = 1.5 }}\n"));
+    let glass = render_text(&format!(
+        "{base}[[object]]\nshape = \"sphere\"\ncenter = [0, 0, 8]\nradius = 0.5\nmaterial = {{ transparency = 1, ior = 1.5 }}\n"
+    ));
     let expected = 0.5 * 0.96 * 0.96;
     assert!((glass.get(4, 4).x - expected).abs() < 1e-6, "{}", glass.get(4, 4));
 }
@@ -124,7 +129,9 @@ fn output_formats_round_trip() {
     let pfm = dir.path().join("a.pfm");
     output::write_image(&img, &pfm, output::Format::Pfm).unwrap();
     assert_eq!(output::read_pfm(&std::fs::read(&pfm).unwrap()).unwrap(), img);
-    for (name, f) in [("a.exr", output::Format::ExrFloat), ("b.exr", output::Format::ExrHalf), ("c.png", output::Format::Png)] {
+    for (name, f) in
+        [("a.exr", output::Format::ExrFloat), ("b.exr", output::Format::ExrHalf), ("c.png", output::Format::Png)]
+    {
         let p = dir.path().join(name);
         output::write_image(&img, &p, f).unwrap();
         assert!(std::fs::metadata(&p).unwrap().len() > 0);

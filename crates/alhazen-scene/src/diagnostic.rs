@@ -56,12 +56,8 @@ impl fmt::Display for Diagnostic {
         let gutter = self.line.to_string().len();
         writeln!(f, "{:gutter$} |", "")?;
         writeln!(f, "{} | {}", self.line, self.source_line)?;
-        let pad: String = self
-            .source_line
-            .chars()
-            .take(self.column - 1)
-            .map(|c| if c == '\t' { '\t' } else { ' ' })
-            .collect();
+        let pad: String =
+            self.source_line.chars().take(self.column - 1).map(|c| if c == '\t' { '\t' } else { ' ' }).collect();
         write!(f, "{:gutter$} | {pad}{}", "", "^".repeat(self.caret_width))?;
         if let Some(h) = &self.help {
             write!(f, "\n{:gutter$} = help: {h}", "")?;

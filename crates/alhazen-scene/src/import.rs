@@ -21,7 +21,10 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh, String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let result = match ext.as_deref() {
         Some("obj") => load_obj(path),
-        Some("ply") => std::fs::read(path).map_err(|e| e.to_string()).and_then(|b| parse_ply(&b)).map(|mesh| LoadedMesh { mesh, materials: vec![] }),
+        Some("ply") => std::fs::read(path)
+            .map_err(|e| e.to_string())
+            .and_then(|b| parse_ply(&b))
+            .map(|mesh| LoadedMesh { mesh, materials: vec![] }),
         _ => Err("unsupported mesh format (expected .obj or .ply)".into()),
     };
     let loaded = result.map_err(|e| format!("cannot load mesh {}: {e}", path.display()))?;
@@ -242,7 +245,16 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
                 if list.len() < 3 {
                     return Err("a face has fewer than 3 vertices".into());
                 }
-                let v: Vec<u32> = list.iter().map(|x| if *x >= 0.0 && *x < u32::MAX as f64 { Ok(*x as u32) } else { Err(format!("bad vertex index {x}")) }).collect::<Result<_, _>>()?;
+                let v: Vec<u32> = list
+                    .iter()
+                    .map(|x| {
+                        if *x >= 0.0 && *x < u32::MAX as f64 {
+                            Ok(*x as u32)
+                        } else {
+                            Err(format!("bad vertex index {x}"))
+                        }
+                    })
+                    .collect::<Result<_, _>>()?;
                 for k in 1..v.len() - 1 {
                     mesh.triangles.push([v[0], v[k], v[k + 1]]);
                 }
@@ -287,11 +299,19 @@ fn parse_ply_header(bytes: &[u8]) -> Result<(PlyFormat, Vec<PlyElement>, &[u8]),
             }
             ["property", "list", ct, ty, name] => {
                 let el = elements.last_mut().ok_or_else(bad)?;
-                el.props.push(PlyProperty { name: name.to_string(), ty: PlyType::parse(ty).ok_or_else(bad)?, list: Some(PlyType::parse(ct).ok_or_else(bad)?) });
+                el.props.push(PlyProperty {
+                    name: name.to_string(),
+                    ty: PlyType::parse(ty).ok_or_else(bad)?,
+                    list: Some(PlyType::parse(ct).ok_or_else(bad)?),
+                });
             }
             ["property", ty, name] => {
                 let el = elements.last_mut().ok_or_else(bad)?;
-                el.props.push(PlyProperty { name: name.to_string(), ty: PlyType::parse(ty).ok_or_else(bad)?, list: None });
+                el.props.push(PlyProperty {
+                    name: name.to_string(),
+                    ty: PlyType::parse(ty).ok_or_else(bad)?,
+                    list: None,
+                });
             }
             ["comment", ..] | ["obj_info", ..] | [] => {}
             _ => return Err(bad()),
@@ -311,7 +331,6 @@ pub fn load_image(path: &Path) -> Result<ImageData, String> {
         pixels: img.pixels().map(|p| [lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]]).collect(),
     })
 }
-
 
 #[cfg(test)]
 mod tests {

@@ -16,7 +16,8 @@ pub const MAX_SIDE: u64 = 1 << 16;
 /// See [`MAX_SIDE`].
 pub const MAX_PIXELS: u64 = 1 << 28;
 
-pub(crate) const TOP_KEYS: &[&str] = &["render", "camera", "background", "ambient", "light", "materials", "meshes", "object"];
+pub(crate) const TOP_KEYS: &[&str] =
+    &["render", "camera", "background", "ambient", "light", "materials", "meshes", "object"];
 
 /// Parses scene text; `file` names it in messages and anchors relative paths.
 pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
@@ -27,7 +28,12 @@ pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
         SceneError::Syntax(Box::new(crate::Diagnostic::at(file, text, span, format!("TOML syntax error: {msg}"))))
     })?;
     let top = Table { src, t: root.get_ref(), span: root.span(), name: "scene" };
-    let mut p = Parser { dir: file.parent().unwrap_or(Path::new(".")), scene: empty_scene(), material_names: HashMap::new(), mesh_names: HashMap::new() };
+    let mut p = Parser {
+        dir: file.parent().unwrap_or(Path::new(".")),
+        scene: empty_scene(),
+        material_names: HashMap::new(),
+        mesh_names: HashMap::new(),
+    };
     p.scene_from(&top).map_err(SceneError::Syntax)?;
     Ok(p.scene)
 }
@@ -103,7 +109,18 @@ impl Parser<'_> {
     }
 
     fn material(&mut self, n: &Node, name: &str) -> R<Material> {
-        const KEYS: &[&str] = &["color", "diffuse", "specular", "shininess", "highlight", "mirror", "transparency", "ior", "absorption", "fresnel"];
+        const KEYS: &[&str] = &[
+            "color",
+            "diffuse",
+            "specular",
+            "shininess",
+            "highlight",
+            "mirror",
+            "transparency",
+            "ior",
+            "absorption",
+            "fresnel",
+        ];
         let t = n.table(KEYS)?;
         let d = Material::default();
         let color = match t.get("color") {
@@ -231,7 +248,9 @@ impl Parser<'_> {
         };
         let mut mesh_materials = vec![];
         let shape = match kind {
-            "sphere" => Shape::Sphere { center: t.opt_vec3("center", Vec3::ZERO)?, radius: t.req("radius")?.positive()? },
+            "sphere" => {
+                Shape::Sphere { center: t.opt_vec3("center", Vec3::ZERO)?, radius: t.req("radius")?.positive()? }
+            }
             "cylinder" => {
                 let (base, top) = (t.opt_vec3("base", Vec3::ZERO)?, t.opt_vec3("top", Vec3::Y)?);
                 distinct(&t, "top", base, top)?;
@@ -345,7 +364,9 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
         },
     };
     if r.width as u64 * r.height as u64 > MAX_PIXELS {
-        return Err(t.req("width")?.err(format!("{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate", r.width, r.height)));
+        return Err(t
+            .req("width")?
+            .err(format!("{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate", r.width, r.height)));
     }
     Ok(r)
 }
@@ -498,7 +519,13 @@ fn transform(n: &Node) -> R<Transform> {
         let m = match key {
             "translate" => Transform::translate(v.vec3()?),
             "scale" => {
-                let s = if v.is_table() { return Err(v.err("`scale`: expected a number or [x, y, z]")) } else if matches!(v.v, toml::de::DeValue::Array(_)) { v.vec3()? } else { Vec3::splat(v.f64()?) };
+                let s = if v.is_table() {
+                    return Err(v.err("`scale`: expected a number or [x, y, z]"));
+                } else if matches!(v.v, toml::de::DeValue::Array(_)) {
+                    v.vec3()?
+                } else {
+                    Vec3::splat(v.f64()?)
+                };
                 Transform::try_scale(s).map_err(|e| v.err(format!("`scale`: {e}")))?
             }
             "rotate" => {

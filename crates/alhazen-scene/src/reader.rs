@@ -191,7 +191,9 @@ impl<'a, 'i> Table<'a, 'i> {
     }
 
     pub fn req(&self, key: &str) -> R<Node<'a, 'i>> {
-        self.get(key).ok_or_else(|| self.src.error(self.header_span(), format!("`{}` is missing the required key `{key}`", self.name)))
+        self.get(key).ok_or_else(|| {
+            self.src.error(self.header_span(), format!("`{}` is missing the required key `{key}`", self.name))
+        })
     }
 
     /// The start of the table for messages about the whole table.
@@ -208,11 +210,14 @@ impl<'a, 'i> Table<'a, 'i> {
         for (k, span) in self.keys() {
             if !known.contains(&k) {
                 let list = known.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", ");
-                let mut d = self.src.error(span, format!("unknown key `{k}` in `{}`; expected one of {list}", self.name));
+                let mut d =
+                    self.src.error(span, format!("unknown key `{k}` in `{}`; expected one of {list}", self.name));
                 if let Some(m) = did_you_mean(k, known.iter().copied()) {
                     *d = d.with_help(format!("did you mean `{m}`?"));
                 } else if crate::parse::TOP_KEYS.contains(&k) {
-                    *d = d.with_help(format!("`{k}` is a top-level key: in TOML it must come before the first [table] header"));
+                    *d = d.with_help(format!(
+                        "`{k}` is a top-level key: in TOML it must come before the first [table] header"
+                    ));
                 }
                 return Err(d);
             }

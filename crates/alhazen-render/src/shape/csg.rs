@@ -45,7 +45,11 @@ impl Csg {
                 j += 1;
                 (cb[j - 1], true)
             };
-            if from_b { in_b = c.entering } else { in_a = c.entering }
+            if from_b {
+                in_b = c.entering
+            } else {
+                in_a = c.entering
+            }
             let now = self.inside(in_a, in_b);
             if now != inside {
                 inside = now;
@@ -67,7 +71,12 @@ impl Csg {
 
     /// The surface at a hit found by [`Csg::hit`] (recomputed: CSG hits are rare enough).
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
-        self.intersect(ray, c.t * (1.0 + 1e-12) + f64::MIN_POSITIVE).unwrap_or(SurfaceHit::flat(c.t, ray.at(c.t), -ray.dir.normalize(), alhazen_math::Vec2::ZERO))
+        self.intersect(ray, c.t * (1.0 + 1e-12) + f64::MIN_POSITIVE).unwrap_or(SurfaceHit::flat(
+            c.t,
+            ray.at(c.t),
+            -ray.dir.normalize(),
+            alhazen_math::Vec2::ZERO,
+        ))
     }
 
     /// Nearest boundary point of the result in `(0, t_max)`.

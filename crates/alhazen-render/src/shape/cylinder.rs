@@ -97,9 +97,14 @@ impl Axis {
 
     fn bounds(&self, r_base: f64, r_end: f64) -> Bounds3 {
         let d = self.dir;
-        let e = Vec3::new((1.0 - d.x * d.x).max(0.0).sqrt(), (1.0 - d.y * d.y).max(0.0).sqrt(), (1.0 - d.z * d.z).max(0.0).sqrt());
+        let e = Vec3::new(
+            (1.0 - d.x * d.x).max(0.0).sqrt(),
+            (1.0 - d.y * d.y).max(0.0).sqrt(),
+            (1.0 - d.z * d.z).max(0.0).sqrt(),
+        );
         let end = self.base + d * self.height;
-        Bounds3::new(self.base - e * r_base, self.base + e * r_base).union(Bounds3::new(end - e * r_end, end + e * r_end))
+        Bounds3::new(self.base - e * r_base, self.base + e * r_base)
+            .union(Bounds3::new(end - e * r_end, end + e * r_end))
     }
 }
 
@@ -121,7 +126,11 @@ impl Cylinder {
         let ax = &self.axis;
         let sp = ax.split(ray);
         let mut parts = Parts::default();
-        let roots = solve_quadratic(sp.dp.length_squared(), 2.0 * sp.op.dot(sp.dp), sp.op.length_squared() - self.radius * self.radius);
+        let roots = solve_quadratic(
+            sp.dp.length_squared(),
+            2.0 * sp.op.dot(sp.dp),
+            sp.op.length_squared() - self.radius * self.radius,
+        );
         for &t in roots.as_slice() {
             if (0.0..=ax.height).contains(&(sp.od + t * sp.dd)) {
                 parts.push(t, SIDE);
@@ -200,10 +209,10 @@ impl Cone {
                 parts.push(t, SIDE);
             }
         }
-        if self.capped {
-            if let Some(t) = ax.cap_t(&sp, 0.0, self.radius) {
-                parts.push(t, BOTTOM);
-            }
+        if self.capped
+            && let Some(t) = ax.cap_t(&sp, 0.0, self.radius)
+        {
+            parts.push(t, BOTTOM);
         }
         parts
     }

@@ -69,7 +69,11 @@ impl MeshShape {
         } else {
             n
         };
-        let uv = if m.uvs.is_empty() { Vec2::new(b1, b2) } else { m.uvs[idx[0]] * b0 + m.uvs[idx[1]] * b1 + m.uvs[idx[2]] * b2 };
+        let uv = if m.uvs.is_empty() {
+            Vec2::new(b1, b2)
+        } else {
+            m.uvs[idx[0]] * b0 + m.uvs[idx[1]] * b1 + m.uvs[idx[2]] * b2
+        };
         let slot = m.material_slots.get(tri).copied().unwrap_or(0);
         SurfaceHit { t, p: ray.at(t), n, ns, uv, slot }
     }
@@ -97,7 +101,9 @@ impl MeshShape {
     pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
         // Move the origin behind the mesh so the whole line lies at t > 0 for the BVH.
         let b = self.bounds();
-        let back = (b.centroid() - ray.origin).dot(ray.dir) / ray.dir.length_squared() - b.extent().length() / ray.dir.length() - 1.0;
+        let back = (b.centroid() - ray.origin).dot(ray.dir) / ray.dir.length_squared()
+            - b.extent().length() / ray.dir.length()
+            - 1.0;
         let back = back.min(0.0);
         let shifted = Ray::new(ray.at(back), ray.dir);
         let m = &self.accel.mesh;

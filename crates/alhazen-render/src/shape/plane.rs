@@ -68,7 +68,11 @@ impl Disk {
     /// Bounding box (tight per axis).
     pub fn bounds(&self) -> Bounds3 {
         let n = self.normal;
-        let e = Vec3::new((1.0 - n.x * n.x).max(0.0).sqrt(), (1.0 - n.y * n.y).max(0.0).sqrt(), (1.0 - n.z * n.z).max(0.0).sqrt()) * self.radius;
+        let e = Vec3::new(
+            (1.0 - n.x * n.x).max(0.0).sqrt(),
+            (1.0 - n.y * n.y).max(0.0).sqrt(),
+            (1.0 - n.z * n.z).max(0.0).sqrt(),
+        ) * self.radius;
         Bounds3::new(self.center - e, self.center + e)
     }
 }

@@ -17,7 +17,11 @@ pub struct Sphere {
 impl Sphere {
     fn roots(&self, ray: &Ray) -> [f64; 2] {
         let oc = ray.origin - self.center;
-        let r = solve_quadratic(ray.dir.length_squared(), 2.0 * oc.dot(ray.dir), oc.length_squared() - self.radius * self.radius);
+        let r = solve_quadratic(
+            ray.dir.length_squared(),
+            2.0 * oc.dot(ray.dir),
+            oc.length_squared() - self.radius * self.radius,
+        );
         match r.as_slice() {
             [a, b] => [*a, *b],
             _ => [f64::NAN; 2],

@@ -8,7 +8,8 @@ use proptest::prelude::*;
 use std::sync::Arc;
 
 fn arb_dir() -> impl Strategy<Value = Vec3> {
-    (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64).prop_filter_map("non-zero", |(x, y, z)| Vec3::new(x, y, z).try_normalize())
+    (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)
+        .prop_filter_map("non-zero", |(x, y, z)| Vec3::new(x, y, z).try_normalize())
 }
 
 fn arb_point(r: f64) -> impl Strategy<Value = Vec3> {
@@ -22,16 +23,44 @@ fn arb_ray() -> impl Strategy<Value = Ray> {
 
 fn unit_box_mesh() -> Arc<MeshAccel> {
     let p = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
-    let positions = vec![p(-1., -1., -1.), p(1., -1., -1.), p(1., 1., -1.), p(-1., 1., -1.), p(-1., -1., 1.), p(1., -1., 1.), p(1., 1., 1.), p(-1., 1., 1.)];
-    let triangles = vec![[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [3, 7, 6], [3, 6, 2], [0, 4, 7], [0, 7, 3], [1, 2, 6], [1, 6, 5]];
+    let positions = vec![
+        p(-1., -1., -1.),
+        p(1., -1., -1.),
+        p(1., 1., -1.),
+        p(-1., 1., -1.),
+        p(-1., -1., 1.),
+        p(1., -1., 1.),
+        p(1., 1., 1.),
+        p(-1., 1., 1.),
+    ];
+    let triangles = vec![
+        [0, 2, 1],
+        [0, 3, 2],
+        [4, 5, 6],
+        [4, 6, 7],
+        [0, 1, 5],
+        [0, 5, 4],
+        [3, 7, 6],
+        [3, 6, 2],
+        [0, 4, 7],
+        [0, 7, 3],
+        [1, 2, 6],
+        [1, 6, 5],
+    ];
     Arc::new(MeshAccel::new(Arc::new(TriangleMesh::new(positions, triangles).unwrap())))
 }
 
 /// Signed distance-like implicit functions: zero on the surface.
-fn shapes_with_implicit() -> Vec<(Shape, Box<dyn Fn(Vec3) -> f64>)> {
+/// A function that vanishes on a shape's surface.
+type Implicit = Box<dyn Fn(Vec3) -> f64>;
+
+fn shapes_with_implicit() -> Vec<(Shape, Implicit)> {
     let cyl_axis = |p: Vec3| Vec2::new(p.x, p.z).length();
     vec![
-        (Shape::Sphere(Sphere { center: Vec3::new(0.1, 0.2, 0.0), radius: 1.0 }), Box::new(|p: Vec3| (p - Vec3::new(0.1, 0.2, 0.0)).length() - 1.0)),
+        (
+            Shape::Sphere(Sphere { center: Vec3::new(0.1, 0.2, 0.0), radius: 1.0 }),
+            Box::new(|p: Vec3| (p - Vec3::new(0.1, 0.2, 0.0)).length() - 1.0),
+        ),
         (
             Shape::Cylinder(Cylinder::new(Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 0.7, true)),
             Box::new(move |p: Vec3| {
@@ -49,13 +78,25 @@ fn shapes_with_implicit() -> Vec<(Shape, Box<dyn Fn(Vec3) -> f64>)> {
                 side.min(cap)
             }),
         ),
-        (Shape::Box(AaBox { min: Vec3::splat(-0.9), max: Vec3::new(0.9, 0.5, 0.7) }), Box::new(|p: Vec3| {
-            let q = (p - Vec3::new(0.0, -0.2, -0.1)).abs() - Vec3::new(0.9, 0.7, 0.8);
-            q.max_element()
-        })),
-        (Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false }), Box::new(|p: Vec3| p.abs().max_element() - 1.0)),
-        (Shape::Disk(Disk { center: Vec3::ZERO, normal: Vec3::Y, radius: 1.0 }), Box::new(|p: Vec3| p.y.abs().max((p.length() - 1.0).max(0.0)))),
-        (Shape::Plane(Plane { point: Vec3::ZERO, normal: Vec3::new(0.0, 0.6, 0.8) }), Box::new(|p: Vec3| p.dot(Vec3::new(0.0, 0.6, 0.8)))),
+        (
+            Shape::Box(AaBox { min: Vec3::splat(-0.9), max: Vec3::new(0.9, 0.5, 0.7) }),
+            Box::new(|p: Vec3| {
+                let q = (p - Vec3::new(0.0, -0.2, -0.1)).abs() - Vec3::new(0.9, 0.7, 0.8);
+                q.max_element()
+            }),
+        ),
+        (
+            Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false }),
+            Box::new(|p: Vec3| p.abs().max_element() - 1.0),
+        ),
+        (
+            Shape::Disk(Disk { center: Vec3::ZERO, normal: Vec3::Y, radius: 1.0 }),
+            Box::new(|p: Vec3| p.y.abs().max((p.length() - 1.0).max(0.0))),
+        ),
+        (
+            Shape::Plane(Plane { point: Vec3::ZERO, normal: Vec3::new(0.0, 0.6, 0.8) }),
+            Box::new(|p: Vec3| p.dot(Vec3::new(0.0, 0.6, 0.8))),
+        ),
     ]
 }
 
@@ -129,7 +170,9 @@ proptest! {
 
 #[test]
 fn csg_union_and_intersection_of_overlapping_balls() {
-    let ball = |x: f64| Placed::new(Shape::Sphere(Sphere { center: Vec3::new(x, 0.0, 0.0), radius: 1.0 }), Transform::IDENTITY);
+    let ball = |x: f64| {
+        Placed::new(Shape::Sphere(Sphere { center: Vec3::new(x, 0.0, 0.0), radius: 1.0 }), Transform::IDENTITY)
+    };
     let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
     let union = Csg { op: CsgOp::Union, a: ball(-0.5), b: ball(0.5) };
     let inter = Csg { op: CsgOp::Intersection, a: ball(-0.5), b: ball(0.5) };
