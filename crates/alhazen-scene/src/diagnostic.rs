@@ -27,11 +27,18 @@ pub struct Diagnostic {
 impl Diagnostic {
     /// Locates byte range `span` of `src`.
     pub fn at(file: &Path, src: &str, span: Range<usize>, message: impl Into<String>) -> Self {
-        let start = span.start.min(src.len());
+        let mut start = span.start.min(src.len());
+        while !src.is_char_boundary(start) {
+            start -= 1;
+        }
+        let mut span_end = span.end.max(start).min(src.len());
+        while !src.is_char_boundary(span_end) {
+            span_end += 1;
+        }
         let line_start = src[..start].rfind('\n').map_or(0, |i| i + 1);
         let line_end = src[start..].find('\n').map_or(src.len(), |i| start + i);
         let source_line = src[line_start..line_end].trim_end_matches('\r').to_string();
-        let end = span.end.clamp(start, line_end);
+        let end = span_end.clamp(start, line_end);
         Self {
             file: file.to_path_buf(),
             line: src[..start].matches('\n').count() + 1,

@@ -1,0 +1,121 @@
+//! The scene reader on real files and on the mistakes users make.
+
+use alhazen_math::Vec3;
+use alhazen_scene::{CameraDesc, Light, PerspectiveOpening, Shape, Texture, load_scene, parse_scene};
+use std::path::Path;
+
+fn err(text: &str) -> String {
+    parse_scene("s.toml".as_ref(), text).unwrap_err().to_string()
+}
+
+#[test]
+fn obj_with_mtl_materials_and_instancing() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/instancing.toml");
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.meshes.len(), 2, "each mesh is loaded once however often it is used");
+    let ico = &scene.meshes[0];
+    // tobj splits the file by material, so shared corners are duplicated.
+    assert_eq!(ico.triangle_count(), 20);
+    assert!(ico.positions.iter().all(|p| (p.length() - 1.0).abs() < 1e-6));
+    let objs: Vec<_> = scene.objects.iter().filter(|o| matches!(o.shape, Shape::Mesh { mesh: 0, .. })).collect();
+    assert_eq!(objs.len(), 3);
+    let gold = &scene.materials[objs[0].mesh_materials[0] as usize];
+    assert_eq!(gold.color, Texture::Solid(Vec3::new(0.8f32 as f64, 0.6f32 as f64, 0.2f32 as f64)));
+    assert_eq!(gold.shininess, 60.0);
+    let octa = &scene.meshes[1];
+    assert_eq!((octa.positions.len(), octa.triangle_count()), (6, 8));
+}
+
+#[test]
+fn transforms_apply_in_the_order_written() {
+    let s = parse_scene(
+        "s.toml".as_ref(),
+        "[[object]]\nshape = \"sphere\"\nradius = 1\ntransform = [{ translate = [1, 0, 0] }, { rotate_z = 90 }, { scale = 2 }]\n",
+    )
+    .unwrap();
+    // (0,0,0) → (1,0,0) → (0,1,0) → (0,2,0).
+    let p = s.objects[0].transform.point(Vec3::ZERO);
+    assert!((p - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-12, "{p}");
+}
+
+#[test]
+fn image_texture_is_loaded_and_linearised() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 0])).save(dir.path().join("t.png")).unwrap();
+    let file = dir.path().join("s.toml");
+    std::fs::write(&file, "[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = { color = { image = { file = \"t.png\", scale = 2 } } }\n").unwrap();
+    let s = load_scene(&file).unwrap();
+    let px = s.images[0].pixels[0];
+    assert_eq!(px[0], 1.0);
+    assert!((px[1] - 0.2158605).abs() < 1e-6, "sRGB 128 is linear 0.216");
+    let missing =
+        err("[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = { color = { image = { file = \"nope.png\" } } }\n");
+    assert!(missing.contains("s.toml:4:41: cannot load image"), "{missing}");
+}
+
+#[test]
+fn cameras_and_lights_are_read() {
+    let s = parse_scene(
+        "s.toml".as_ref(),
+        "[camera]\neye = [0, 0, 5]\nfrustum = { left = -1, right = 1, bottom = -0.5, top = 0.5, near = 2 }\n[[light]]\ntype = \"spot\"\nposition = [0, 5, 0]\ndirection = [0, -1, 0]\nangle = 60\n",
+    )
+    .unwrap();
+    assert!(matches!(s.camera, CameraDesc::Perspective { opening: PerspectiveOpening::Frustum { .. }, .. }));
+    let Light::Spot { cos_cutoff, .. } = s.lights[0] else { panic!() };
+    assert!((cos_cutoff - 0.5).abs() < 1e-12);
+}
+
+#[test]
+fn mistakes_are_located_and_explained() {
+    assert!(err("[[object]]\nradius = 1\n").contains("s.toml:1:1: `object` is missing the required key `shape`"));
+    assert!(err("[render]\nwidth = \"big\"\n").contains("s.toml:2:9: `width`: expected an integer, found a string"));
+    assert!(err("[render]\nspp = 0\n").contains("`spp` must be an integer in 1..=1048576, found 0"));
+    assert!(err("[camera]\neye = [0, 0]\n").contains("s.toml:2:7: `eye`: expected 3 numbers, found 2"));
+    assert!(err("[camera]\neye = [0, 0, 0]\n").contains("eye and target coincide"));
+    assert!(err("[[object]]\nshape = \"box\"\nmin = [1, 1, 1]\nmax = [0, 2, 2]\n").contains("`max` must exceed `min`"));
+    assert!(err("[[object]]\nshape = \"sphere\"\nradius = 1\ntransform = [{ scale = 0 }]\n").contains("singular"));
+    assert!(err("[[object]]\nshape = \"csg\"\nop = \"union\"\na = { shape = \"plane\" }\nb = { shape = \"sphere\", radius = 1 }\n").contains("must be a closed shape"));
+    assert!(
+        err("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nattenuation = [0, 0, 0]\n").contains("not all zero")
+    );
+    assert!(err("[[object]]\nshape = \"sphere\"\nradius = nan\n").contains("expected a finite number"));
+    assert!(err("[[object]]\nshape = \"mesh\"\nfile = \"missing.obj\"\n").contains("cannot load mesh"));
+    let typo = err("[materials.glass]\nior = 1.5\n[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"glas\"\n");
+    assert!(typo.contains("unknown material \"glas\"") && typo.contains("did you mean \"glass\"?"), "{typo}");
+    let late = err("[render]\nwidth = 10\nbackground = 1\n");
+    assert!(late.contains("must come before the first [table] header"), "{late}");
+}
+
+#[test]
+fn invalid_utf8_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("bad.toml");
+    std::fs::write(&file, b"ambient = 0.1\n# \xff\n").unwrap();
+    let e = load_scene(&file).unwrap_err().to_string();
+    assert!(e.contains("bad.toml:2:3: the scene file is not valid UTF-8"), "{e}");
+}
+
+mod no_panic {
+    use proptest::prelude::*;
+
+    const VALID: &str = "background = [0.1, 0.2, 0.3]\n[render]\nwidth = 8\n[camera]\ntype = \"axonometric\"\nstyle = \"military\"\nwidth = 3\n[[light]]\ntype = \"spot\"\nposition = [0, 3, 0]\ndirection = [0, -1, 0]\n[materials.m]\ncolor = { checker = { size = 0.5 } }\n[[object]]\nshape = \"csg\"\nop = \"difference\"\nmaterial = \"m\"\na = { shape = \"box\" }\nb = { shape = \"cone\", radius = 0.5, transform = [{ matrix = [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]] }] }\n";
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+        /// Damaged scene files give errors, never panics.
+        #[test]
+        fn mutated_scenes_never_panic(at in 0usize..VALID.len(), len in 0usize..8, insert in "[\\[\\]{}=\"., 0-9a-z\\n\u{e9}-]{0,6}") {
+            let mut s = VALID.to_string();
+            let (a, b) = (at.min(s.len()), (at + len).min(s.len()));
+            if s.is_char_boundary(a) && s.is_char_boundary(b) {
+                s.replace_range(a..b, &insert);
+            }
+            let _ = alhazen_scene::parse_scene("m.toml".as_ref(), &s);
+        }
+    }
+
+    #[test]
+    fn the_unmutated_scene_is_valid() {
+        alhazen_scene::parse_scene("m.toml".as_ref(), VALID).unwrap();
+    }
+}
