@@ -1,0 +1,1 @@
+//! Caustic placeholder replaced below.
