@@ -227,6 +227,33 @@ impl Canonical {
     /// `[max(0, σ − α_S), min(σ, α_E)]` (between the two directions and on the arcs both can
     /// see), where the balance changes sign from + to −. `None` in the forbidden region.
     pub fn visible(&self) -> Option<f64> {
+        if let (Site2::At(e), Site2::At(s)) = (self.eye, self.source)
+            && let Some(phi) = crate::batch::fast_visible(self.r, e.x, s.x, s.y)
+        {
+            return Some(phi);
+        }
+        self.visible_bracketed().map(|phi| self.refine_line(phi))
+    }
+
+    /// Finishes a solution with Newton steps on the line condition `m × b̂`, which measures the
+    /// angle error directly (the balance does not, near grazing incidence); a step is kept only
+    /// if it lowers the residual.
+    fn refine_line(&self, mut phi: f64) -> f64 {
+        for _ in 0..4 {
+            let (f, d) = self.condition_slope(phi);
+            if f == 0.0 || d == 0.0 || !d.is_finite() {
+                break;
+            }
+            let next = phi - f / d;
+            if self.condition(next).0.abs() >= f.abs() {
+                break;
+            }
+            phi = next;
+        }
+        phi
+    }
+
+    fn visible_bracketed(&self) -> Option<f64> {
         if matches!(self.eye, Site2::At(e) if e.length() <= self.r)
             || matches!(self.source, Site2::At(s) if s.length() <= self.r)
         {

@@ -186,6 +186,36 @@ fn solve(fr: &Frame, on_axis: bool) -> Reflexes {
     out
 }
 
+/// A site projected along a cylinder's axis, with its height (or, at infinity, its slope).
+type Projected = (Site, f64);
+
+/// The height of a cylinder's reflex above the projection plane, from (10): the unfolded path
+/// `E → R → S` is straight. For a site at infinity the "height" slot holds its slope.
+fn height(
+    foot: Vec3,
+    kind: ReflexKind,
+    (pe, he): (Site, f64),
+    (ps, hs): (Site, f64),
+) -> Result<Option<f64>, MirrorError> {
+    let dist = |site: Site| match site {
+        Site::At(p) => Some((p - foot).length()),
+        Site::Toward(_) => None,
+    };
+    let virtual_sign = if kind == ReflexKind::Virtual { -1.0 } else { 1.0 };
+    Ok(match (dist(pe), dist(ps)) {
+        (Some(le), Some(ls)) => {
+            let denom = le + virtual_sign * ls;
+            (denom.abs() >= 1e-300).then(|| he + (hs - he) * le / denom)
+        }
+        // Eye at infinity: reflection keeps the axial slope `he` of the eye ray, so the light
+        // climbs by `he` per unit of horizontal length from S to R.
+        (None, Some(ls)) => Some(hs + virtual_sign * he * ls),
+        // Light at infinity with slope `hs` towards it: symmetric.
+        (Some(le), None) => Some(he + virtual_sign * hs * le),
+        (None, None) => return Err(MirrorError::Indeterminate),
+    })
+}
+
 impl Circle {
     /// All reflexes of `source` seen from `eye`, in the plane (z = 0 of the results).
     pub fn reflexes(&self, eye: Site, source: Site) -> Result<Reflexes, MirrorError> {
@@ -206,10 +236,24 @@ impl Sphere {
         frame(self.center, self.radius, finite_site(eye)?, finite_site(source)?, None)
     }
 
+    /// Checks the mirror and a finite eye: errors as [`Sphere::reflexes`] would give them.
+    pub(crate) fn check_eye(&self, eye: Vec3) -> Result<(), MirrorError> {
+        self.frame(Site::At(eye), Site::Toward(Vec3::ONE)).map(|_| ())
+    }
+
     /// All reflexes of `source` seen from `eye`: solved in the plane `MES` (§1).
     pub fn reflexes(&self, eye: Site, source: Site) -> Result<Reflexes, MirrorError> {
         let (fr, on_axis) = self.frame(eye, source)?;
         Ok(solve(&fr, on_axis))
+    }
+
+    /// Only the visible reflex (the bracketed search of [`crate::circle`], no quartic).
+    pub fn visible_reflex(&self, eye: Site, source: Site) -> Result<Option<Reflex>, MirrorError> {
+        let (fr, _) = self.frame(eye, source)?;
+        Ok(fr.problem.visible().map(|phi| {
+            let (point, normal) = fr.to_3d(phi);
+            Reflex { point, normal, kind: ReflexKind::Outside }
+        }))
     }
 
     /// True when `source` has no visible reflex from `eye` (inside the sphere, or hidden behind
@@ -231,7 +275,7 @@ impl Cylinder {
     }
 
     /// Projects along the axis onto the plane through `center`; returns the site and its height.
-    fn project(&self, a: Vec3, s: Site) -> Result<(Site, f64), MirrorError> {
+    fn project(&self, a: Vec3, s: Site) -> Result<Projected, MirrorError> {
         Ok(match finite_site(s)? {
             Site::At(p) => {
                 let h = (p - self.center).dot(a);
@@ -249,7 +293,7 @@ impl Cylinder {
         })
     }
 
-    fn frame(&self, eye: Site, source: Site) -> Result<(Frame, Vec3, (Site, f64), (Site, f64)), MirrorError> {
+    fn frame(&self, eye: Site, source: Site) -> Result<(Frame, Vec3, Projected, Projected), MirrorError> {
         let a = self.unit_axis()?;
         let pe = self.project(a, eye)?;
         let ps = self.project(a, source)?;
@@ -257,37 +301,37 @@ impl Cylinder {
         Ok((fr, a, pe, ps))
     }
 
+    /// Checks the mirror and a finite eye: errors as [`Cylinder::reflexes`] would give them.
+    pub(crate) fn check_eye(&self, eye: Vec3) -> Result<(), MirrorError> {
+        let a = self.unit_axis()?;
+        let (pe, _) = self.project(a, Site::At(eye))?;
+        frame(self.center, self.radius, pe, Site::Toward(a.any_orthonormal_vector()), Some(a)).map(|_| ())
+    }
+
     /// All reflexes of `source` seen from `eye`: solved in the projection along the axis, the
     /// height from (10).
     pub fn reflexes(&self, eye: Site, source: Site) -> Result<Reflexes, MirrorError> {
-        let (fr, a, (pe, he), (ps, hs)) = self.frame(eye, source)?;
+        let (fr, a, pe, ps) = self.frame(eye, source)?;
         let mut out = Reflexes::default();
         for s in fr.problem.solve().iter() {
             let (foot, normal) = fr.to_3d(s.phi);
-            let dist = |site: Site| match site {
-                Site::At(p) => Some((p - foot).length()),
-                Site::Toward(_) => None,
-            };
-            let virtual_sign = if s.kind == ReflexKind::Virtual { -1.0 } else { 1.0 };
-            let h = match (dist(pe), dist(ps)) {
-                // (10): the unfolded path E → R → S is straight.
-                (Some(le), Some(ls)) => {
-                    let denom = le + virtual_sign * ls;
-                    if denom.abs() < 1e-300 {
-                        continue;
-                    }
-                    he + (hs - he) * le / denom
-                }
-                // Eye at infinity: reflection keeps the axial slope `he` of the eye ray, so the
-                // light climbs by `he` per unit of horizontal length from S to R.
-                (None, Some(ls)) => hs + virtual_sign * he * ls,
-                // Light at infinity with slope `hs` towards it: symmetric.
-                (Some(le), None) => he + virtual_sign * hs * le,
-                (None, None) => return Err(MirrorError::Indeterminate),
-            };
-            out.push(Reflex { point: foot + a * h, normal, kind: s.kind });
+            if let Some(h) = height(foot, s.kind, pe, ps)? {
+                out.push(Reflex { point: foot + a * h, normal, kind: s.kind });
+            }
         }
         Ok(out)
+    }
+
+    /// Only the visible reflex (the bracketed search of [`crate::circle`], no quartic).
+    pub fn visible_reflex(&self, eye: Site, source: Site) -> Result<Option<Reflex>, MirrorError> {
+        let (fr, a, pe, ps) = self.frame(eye, source)?;
+        let Some(phi) = fr.problem.visible() else { return Ok(None) };
+        let (foot, normal) = fr.to_3d(phi);
+        Ok(height(foot, ReflexKind::Outside, pe, ps)?.map(|h| Reflex {
+            point: foot + a * h,
+            normal,
+            kind: ReflexKind::Outside,
+        }))
     }
 
     /// True when `source` has no visible reflex from `eye`.

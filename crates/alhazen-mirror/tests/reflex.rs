@@ -243,3 +243,46 @@ fn grazing_configurations_stay_accurate() {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// The batch API gives the scalar solver's visible reflexes.
+    #[test]
+    fn batch_agrees_with_scalar((s, eye, _src) in config(), pts in prop::collection::vec((-30.0..30.0f64, -30.0..30.0f64, -30.0..30.0f64), 1..64), axis in unit()) {
+        let scale = s.radius;
+        let pts: Vec<Vec3> = pts.into_iter().map(|(x, y, z)| s.center + Vec3::new(x, y, z) * scale).collect();
+        let soa = |f: fn(&Vec3) -> f64| pts.iter().map(f).collect::<Vec<f64>>();
+        let (xs, ys, zs) = (soa(|p| p.x), soa(|p| p.y), soa(|p| p.z));
+        let soa = alhazen_mirror::batch::PointsSoA { x: &xs, y: &ys, z: &zs };
+        let mut out = alhazen_mirror::batch::ReflexesSoA::default();
+        let cyl = Cylinder { center: s.center, axis, radius: s.radius };
+        for mirror in 0..2 {
+            let ok = if mirror == 0 { s.visible_reflexes_batch(eye, soa, &mut out) } else { cyl.visible_reflexes_batch(eye, soa, &mut out) };
+            if ok.is_err() { continue; }
+            for (i, p) in pts.iter().enumerate() {
+                let scalar = if mirror == 0 { s.reflexes(Site::At(eye), Site::At(*p)) } else { cyl.reflexes(Site::At(eye), Site::At(*p)) };
+                let expected = scalar.ok().and_then(|r| r.visible().map(|v| v.point));
+                prop_assert_eq!(out.visible[i], expected.is_some(), "point {} {:?}", p, expected);
+                if let Some(q) = expected {
+                    let got = Vec3::new(out.x[i], out.y[i], out.z[i]);
+                    prop_assert!((got - q).length() < 1e-9 * (scale + q.length()), "{got} vs {q}");
+                }
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+    #[test]
+    fn visible_reflex_is_the_outside_solution((s, eye, src) in config(), axis in unit()) {
+        let cyl = Cylinder { center: s.center, axis, radius: s.radius };
+        if let (Ok(all), Ok(one)) = (s.reflexes(Site::At(eye), Site::At(src)), s.visible_reflex(Site::At(eye), Site::At(src))) {
+            prop_assert_eq!(all.visible().copied(), one);
+        }
+        if let (Ok(all), Ok(one)) = (cyl.reflexes(Site::At(eye), Site::At(src)), cyl.visible_reflex(Site::At(eye), Site::At(src))) {
+            prop_assert_eq!(all.visible().copied(), one);
+        }
+    }
+}
