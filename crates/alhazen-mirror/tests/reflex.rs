@@ -113,7 +113,7 @@ proptest! {
     }
 
     #[test]
-    fn solutions_move_with_the_configuration((s, eye, src) in config(), axis in unit(), angle in 0.0..6.28f64, shift in unit()) {
+    fn solutions_move_with_the_configuration((s, eye, src) in config(), axis in unit(), angle in 0.0..std::f64::consts::TAU, shift in unit()) {
         let t = Transform::translate(shift * 3.0) * Transform::rotate(axis, angle);
         let (Ok(a), Ok(b)) = (
             s.reflexes(Site::At(eye), Site::At(src)),
