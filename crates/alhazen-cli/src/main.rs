@@ -1,4 +1,4 @@
-//! `alhazen`: the command-line front end. The only crate that reads argv and the environment,
+//! `alhazen`: the command-line front end (`render`, `mirror`). The only crate that reads argv and the environment,
 //! writes to stdout/stderr and chooses exit codes:
 //! 0 success, 1 a failure while working (e.g. the output cannot be written), 2 bad input (usage,
 //! an unreadable or invalid scene file, impossible sizes).
@@ -10,6 +10,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
+
+mod mirror;
 
 #[derive(Parser)]
 #[command(name = "alhazen", version, about = "Mirrors, glass and line art: one scene, exact reflections.")]
@@ -25,6 +27,9 @@ enum Command {
         after_help = "Example:\n  alhazen render scenes/glass-balls.toml -o glass-balls.png --spp 16\n\nThe scene format is described in docs/scene-format.md."
     )]
     Render(RenderArgs),
+    /// Exact reflexes on spheres and cylinders (Glaeser), catacaustics and their figures.
+    #[command(subcommand)]
+    Mirror(mirror::MirrorCommand),
 }
 
 #[derive(Args)]
@@ -61,7 +66,7 @@ struct RenderArgs {
 }
 
 /// An error and the exit code it deserves.
-struct Failure {
+pub(crate) struct Failure {
     code: u8,
     message: String,
 }
@@ -79,6 +84,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => run_render(&args),
+        Command::Mirror(cmd) => mirror::run(&cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -141,3 +141,75 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
     }
     out
 }
+
+mod mirror {
+    use super::alhazen;
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+
+    fn reflex(input: &str) -> (i32, Vec<serde_json::Value>) {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_alhazen"))
+            .args(["mirror", "reflex"])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child.stdin.take().unwrap().write_all(input.as_bytes()).unwrap();
+        let out = child.wait_with_output().unwrap();
+        let lines = String::from_utf8(out.stdout).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+        (out.status.code().unwrap(), lines)
+    }
+
+    #[test]
+    fn json_lines_in_json_lines_out() {
+        let (code, lines) = reflex(concat!(
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1,"eye":[0,0,5],"point":[3,0,4]}"#,
+            "\n",
+            r#"{"mirror":"cylinder","center":[0,0,0],"axis":[0,1,0],"radius":1,"eye":[0,1,6],"point":[2,3,1]}"#,
+            "\n"
+        ));
+        assert_eq!(code, 0);
+        assert_eq!(lines.len(), 2);
+        let v = &lines[0]["reflexes"][0];
+        let p: Vec<f64> = v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        // Eye and point at equal distance 5 from the centre, 36.87° apart: the reflex bisects.
+        let half = (3f64.atan2(4.0) / 2.0).tan();
+        assert!((p[0] / p[2] - half).abs() < 1e-12, "{p:?}");
+        assert_eq!(lines[0]["all"].as_array().unwrap().len(), 4);
+        assert_eq!(lines[1]["reflexes"].as_array().unwrap().len(), 1);
+    }
+
+    #[test]
+    fn bad_lines_are_reported_and_skipped() {
+        let (code, lines) = reflex(concat!(
+            "not json\n",
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":-1,"eye":[0,0,5],"point":[3,0,4]}"#,
+            "\n",
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1,"eye":[0,0,5],"point":[0,0,-3]}"#,
+            "\n"
+        ));
+        assert_eq!(code, 2);
+        assert_eq!(lines[0]["line"], 1);
+        assert!(lines[1]["error"].as_str().unwrap().contains("radius"));
+        // Straight behind the ball: forbidden, no visible reflex, but other solutions.
+        assert_eq!(lines[2]["reflexes"].as_array().unwrap().len(), 0);
+        assert!(!lines[2]["all"].as_array().unwrap().is_empty());
+    }
+
+    #[test]
+    fn figures_are_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("c.svg");
+        let o = alhazen(&["mirror", "caustic", "--radius", "1", "--eye-distance", "inf", "-o", f.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(std::fs::read_to_string(&f).unwrap().starts_with("<svg"));
+        let o = alhazen(&["mirror", "caustic", "--radius", "1", "--eye-distance", "0.5", "-o", f.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "an eye inside needs --inside");
+        let g = dir.path().join("g.svg");
+        let o = alhazen(&["mirror", "conics", "--eye", "3,0", "--point", "-1.2,1.8", "-o", g.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let o = alhazen(&["mirror", "conics", "--eye", "3", "--point", "1,1", "-o", g.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2));
+    }
+}

@@ -132,7 +132,16 @@ pub fn reflected_ray(r: f64, eye: Eye, phi: f64) -> (Vec2, Vec2) {
 
 /// The catacaustic surface of a sphere of radius `r` centred at `center`, the eye at distance
 /// `e` along `axis`: the curve of `side` rotated about the axis, `segments` steps around.
-pub fn sphere_surface(center: Vec3, axis: Vec3, r: f64, eye: Eye, side: Side, samples: usize, segments: usize, clip: f64) -> TriangleMesh {
+pub fn sphere_surface(
+    center: Vec3,
+    axis: Vec3,
+    r: f64,
+    eye: Eye,
+    side: Side,
+    samples: usize,
+    segments: usize,
+    clip: f64,
+) -> TriangleMesh {
     let axis = axis.normalize();
     let (u, v) = alhazen_math::orthonormal_basis(axis);
     let mut mesh = TriangleMesh::default();
@@ -156,7 +165,17 @@ pub fn sphere_surface(center: Vec3, axis: Vec3, r: f64, eye: Eye, side: Side, sa
 
 /// The catacaustic surface of a cylinder (axis through `center` along `axis`, eye direction in
 /// the normal projection `toward_eye`): the curve translated from height 0 to `height`.
-pub fn cylinder_surface(center: Vec3, axis: Vec3, toward_eye: Vec3, r: f64, eye: Eye, side: Side, samples: usize, height: f64, clip: f64) -> TriangleMesh {
+pub fn cylinder_surface(
+    center: Vec3,
+    axis: Vec3,
+    toward_eye: Vec3,
+    r: f64,
+    eye: Eye,
+    side: Side,
+    samples: usize,
+    height: f64,
+    clip: f64,
+) -> TriangleMesh {
     let axis = axis.normalize();
     let x = (toward_eye - axis * toward_eye.dot(axis)).normalize();
     let y = axis.cross(x);
@@ -194,7 +213,8 @@ mod tests {
         for k in 0..50 {
             let phi = -1.5 + 3.0 * k as f64 / 50.0;
             let p = point(r, Eye::AtInfinity, phi).unwrap();
-            let nephroid = Vec2::new(3.0 * phi.cos() - (3.0 * phi).cos(), 3.0 * phi.sin() - (3.0 * phi).sin()) * (r / 4.0);
+            let nephroid =
+                Vec2::new(3.0 * phi.cos() - (3.0 * phi).cos(), 3.0 * phi.sin() - (3.0 * phi).sin()) * (r / 4.0);
             assert!((p - nephroid).length() < 1e-14);
             // And it is the limit of large e.
             let far = point(r, Eye::At(1e9), phi).unwrap();
@@ -278,7 +298,10 @@ mod tests {
         // Every vertex of the cylinder's surface projects onto the planar caustic.
         for p in &c.positions {
             let q = Vec2::new(p.x, -p.z);
-            let near = curve(1.0, Eye::At(0.5), Side::Inside, 64, 10.0).into_iter().flatten().any(|c| (c - q).length() < 1e-12);
+            let near = curve(1.0, Eye::At(0.5), Side::Inside, 64, 10.0)
+                .into_iter()
+                .flatten()
+                .any(|c| (c - q).length() < 1e-12);
             assert!(near);
         }
     }

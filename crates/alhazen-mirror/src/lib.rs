@@ -41,6 +41,7 @@
 pub mod batch;
 pub mod caustic;
 pub mod circle;
+pub mod figures;
 mod poly;
 mod solids;
 

@@ -36,16 +36,22 @@ impl Format {
 
 /// Writes `img` to `path` atomically.
 pub fn write_image(img: &Image, path: &Path, format: Format) -> io::Result<()> {
+    write_atomically(path, |file| match format {
+        Format::Png => encode_png(img, file),
+        Format::ExrHalf | Format::ExrFloat => encode_exr(img, file, format == Format::ExrHalf),
+        Format::Pfm => encode_pfm(img, &mut BufWriter::new(file)),
+    })
+}
+
+/// Creates `path` through a temporary file in the same directory, filled by `fill`, synced and
+/// renamed into place: readers see the old file or the complete new one, never a part.
+pub fn write_atomically(path: &Path, fill: impl FnOnce(&mut std::fs::File) -> io::Result<()>) -> io::Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
     let mut tmp = tempfile::Builder::new().prefix(".alhazen-").suffix(".part").tempfile_in(dir)?;
-    match format {
-        Format::Png => encode_png(img, tmp.as_file_mut())?,
-        Format::ExrHalf | Format::ExrFloat => encode_exr(img, tmp.as_file_mut(), format == Format::ExrHalf)?,
-        Format::Pfm => encode_pfm(img, &mut BufWriter::new(tmp.as_file_mut()))?,
-    }
+    fill(tmp.as_file_mut())?;
     tmp.as_file().sync_all()?;
     set_readable_permissions(tmp.path(), path)?;
     tmp.persist(path).map_err(|e| e.error)?;

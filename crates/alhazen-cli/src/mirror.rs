@@ -1,0 +1,174 @@
+//! `alhazen mirror …`: the exact reflex solver and the paper's figures from the command line.
+
+use crate::Failure;
+use alhazen_math::{Vec2, Vec3};
+use alhazen_mirror::caustic::Side;
+use alhazen_mirror::{Cylinder, MirrorError, Reflexes, Site, Sphere, figures};
+use clap::{Args, Subcommand};
+use serde::Deserialize;
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+
+#[derive(Subcommand)]
+pub enum MirrorCommand {
+    /// Reflexes of points: reads JSON lines, writes one JSON line per query.
+    #[command(after_help = r#"Input, one JSON object per line (from FILE or standard input):
+  {"mirror":"sphere","center":[0,0,0],"radius":1,"eye":[0,0,5],"point":[3,0,4]}
+  {"mirror":"cylinder","center":[0,0,0],"axis":[0,1,0],"radius":1,"eye":[0,1,6],"point":[2,3,1]}
+Output, one line per input line:
+  {"reflexes":[[x,y,z]],"all":[{"point":[x,y,z],"kind":"outside"},…]}
+"reflexes" holds the visible reflection on the outside (empty in the forbidden region); "all" every
+real solution of the reflection condition ("outside", "inside", "virtual"), plus "circle" when a
+point on a sphere's axis reflects in a whole circle (Theorem 2). A bad line gives
+  {"line":N,"error":"…"}
+and processing continues; the exit code is 2 if any line was bad."#)]
+    Reflex {
+        /// JSON-lines file (default: standard input).
+        input: Option<PathBuf>,
+    },
+    /// Draws the catacaustic of a circle with its reflected rays (the paper's Fig. 5/9) as SVG.
+    #[command(
+        after_help = "Example:\n  alhazen mirror caustic --radius 1 --eye-distance 3 -o caustic.svg\n  alhazen mirror caustic --radius 1 --eye-distance inf -o nephroid.svg\n  alhazen mirror caustic --radius 1 --eye-distance 1 --inside -o cardioid.svg"
+    )]
+    Caustic(CausticArgs),
+    /// Draws the confocal conics (foci eye and point) that touch the circle at the reflexes
+    /// (the paper's Fig. 12) as SVG.
+    #[command(after_help = "Example:\n  alhazen mirror conics --radius 1 --eye 3,0 --point 1.2,1.8 -o conics.svg")]
+    Conics(ConicsArgs),
+}
+
+#[derive(Args)]
+pub struct CausticArgs {
+    /// Radius of the mirror circle.
+    #[arg(long, default_value_t = 1.0)]
+    radius: f64,
+    /// Distance of the eye from the centre; `inf` for parallel rays.
+    #[arg(long)]
+    eye_distance: f64,
+    /// Reflection on the inside of the circle instead of the outside.
+    #[arg(long)]
+    inside: bool,
+    /// Number of reflected rays drawn.
+    #[arg(long, default_value_t = 48, value_parser = clap::value_parser!(u32).range(0..=100000))]
+    rays: u32,
+    /// Output SVG file.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+#[derive(Args)]
+pub struct ConicsArgs {
+    /// Radius of the mirror circle (centred at the origin).
+    #[arg(long, default_value_t = 1.0)]
+    radius: f64,
+    /// Eye position `x,y`.
+    #[arg(long, value_parser = parse_vec2, allow_hyphen_values = true)]
+    eye: Vec2,
+    /// Point position `x,y`.
+    #[arg(long, value_parser = parse_vec2, allow_hyphen_values = true)]
+    point: Vec2,
+    /// Output SVG file.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+fn parse_vec2(s: &str) -> Result<Vec2, String> {
+    let parts: Vec<f64> =
+        s.split(',').map(|p| p.trim().parse::<f64>().map_err(|e| format!("`{p}`: {e}"))).collect::<Result<_, _>>()?;
+    match parts.as_slice() {
+        [x, y] if x.is_finite() && y.is_finite() => Ok(Vec2::new(*x, *y)),
+        _ => Err("expected two finite numbers: x,y".into()),
+    }
+}
+
+pub fn run(cmd: &MirrorCommand) -> Result<(), Failure> {
+    match cmd {
+        MirrorCommand::Reflex { input } => run_reflex(input.as_deref()),
+        MirrorCommand::Caustic(a) => {
+            if !(a.radius > 0.0 && a.radius.is_finite()) || !(a.eye_distance > 0.0) || a.eye_distance.is_nan() {
+                return Err(Failure::input("--radius must be positive and finite, --eye-distance positive (or inf)"));
+            }
+            if !a.inside && a.eye_distance <= a.radius {
+                return Err(Failure::input(
+                    "an eye inside the circle sees only reflections on the inside: add --inside",
+                ));
+            }
+            let side = if a.inside { Side::Inside } else { Side::Outside };
+            write_text(&a.output, &figures::caustic_svg(a.radius, a.eye_distance, side, a.rays as usize))
+        }
+        MirrorCommand::Conics(a) => {
+            let svg = figures::conics_svg(a.radius, a.eye, a.point).map_err(|e| Failure::input(e.to_string()))?;
+            write_text(&a.output, &svg)
+        }
+    }
+}
+
+/// Writes a text file atomically.
+pub fn write_text(path: &Path, text: &str) -> Result<(), Failure> {
+    alhazen_render::output::write_atomically(path, |f| f.write_all(text.as_bytes()))
+        .map_err(|e| Failure::work(format!("cannot write {}: {e}", path.display())))
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Query {
+    mirror: String,
+    center: [f64; 3],
+    radius: f64,
+    eye: [f64; 3],
+    point: [f64; 3],
+    axis: Option<[f64; 3]>,
+}
+
+fn solve(q: &Query) -> Result<Reflexes, String> {
+    let (eye, point) = (Site::At(Vec3::from_array(q.eye)), Site::At(Vec3::from_array(q.point)));
+    let center = Vec3::from_array(q.center);
+    let result: Result<Reflexes, MirrorError> = match (q.mirror.as_str(), q.axis) {
+        ("sphere", None) => Sphere { center, radius: q.radius }.reflexes(eye, point),
+        ("sphere", Some(_)) => return Err("a sphere takes no \"axis\"".into()),
+        ("cylinder", Some(axis)) => {
+            Cylinder { center, axis: Vec3::from_array(axis), radius: q.radius }.reflexes(eye, point)
+        }
+        ("cylinder", None) => return Err("a cylinder needs \"axis\"".into()),
+        (other, _) => return Err(format!("unknown mirror \"{other}\": expected \"sphere\" or \"cylinder\"")),
+    };
+    result.map_err(|e| e.to_string())
+}
+
+fn answer(r: &Reflexes) -> serde_json::Value {
+    let p = |v: Vec3| serde_json::json!([v.x, v.y, v.z]);
+    let kind = |k: alhazen_mirror::ReflexKind| format!("{k:?}").to_lowercase();
+    let mut all: Vec<serde_json::Value> =
+        r.all().map(|x| serde_json::json!({"point": p(x.point), "kind": kind(x.kind)})).collect();
+    if let Some(c) = r.circle {
+        all.push(serde_json::json!({"circle": {"center": p(c.center), "axis": p(c.axis), "radius": c.radius}, "kind": kind(c.kind)}));
+    }
+    serde_json::json!({"reflexes": r.visible().map(|v| vec![p(v.point)]).unwrap_or_default(), "all": all})
+}
+
+fn run_reflex(input: Option<&Path>) -> Result<(), Failure> {
+    let reader: Box<dyn BufRead> = match input {
+        Some(path) => Box::new(std::io::BufReader::new(
+            std::fs::File::open(path).map_err(|e| Failure::input(format!("cannot read {}: {e}", path.display())))?,
+        )),
+        None => Box::new(std::io::stdin().lock()),
+    };
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    let mut bad = 0usize;
+    for (no, line) in reader.lines().enumerate() {
+        let line = line.map_err(|e| Failure::input(format!("cannot read input: {e}")))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let reply =
+            serde_json::from_str::<Query>(&line).map_err(|e| e.to_string()).and_then(|q| solve(&q)).map(|r| answer(&r));
+        let value = reply.unwrap_or_else(|e| {
+            bad += 1;
+            serde_json::json!({"line": no + 1, "error": e})
+        });
+        writeln!(out, "{value}").map_err(|e| Failure::work(format!("cannot write output: {e}")))?;
+    }
+    out.flush().map_err(|e| Failure::work(format!("cannot write output: {e}")))?;
+    if bad > 0 { Err(Failure::input(format!("{bad} input line(s) could not be answered"))) } else { Ok(()) }
+}
