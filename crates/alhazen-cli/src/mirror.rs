@@ -85,7 +85,8 @@ pub fn run(cmd: &MirrorCommand) -> Result<(), Failure> {
     match cmd {
         MirrorCommand::Reflex { input } => run_reflex(input.as_deref()),
         MirrorCommand::Caustic(a) => {
-            if !(a.radius > 0.0 && a.radius.is_finite()) || !(a.eye_distance > 0.0) || a.eye_distance.is_nan() {
+            let radius_ok = a.radius > 0.0 && a.radius.is_finite();
+            if !radius_ok || a.eye_distance.is_nan() || a.eye_distance <= 0.0 {
                 return Err(Failure::input("--radius must be positive and finite, --eye-distance positive (or inf)"));
             }
             if !a.inside && a.eye_distance <= a.radius {
