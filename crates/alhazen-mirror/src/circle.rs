@@ -225,14 +225,15 @@ impl Canonical {
     /// The visible reflex (reflection on the outside), by a bracketed search: with the eye at
     /// polar angle 0 and the source at `σ ∈ [0, π]`, the reflex lies in
     /// `[max(0, σ − α_S), min(σ, α_E)]` (between the two directions and on the arcs both can
-    /// see), where the balance changes sign from + to −. `None` in the forbidden region.
-    pub fn visible(&self) -> Option<f64> {
+    /// see), where the balance changes sign from + to −. Returns the unit normal
+    /// `(cos φ, sin φ)`; `None` in the forbidden region.
+    pub fn visible(&self) -> Option<Vec2> {
         if let (Site2::At(e), Site2::At(s)) = (self.eye, self.source)
-            && let Some(phi) = crate::batch::fast_visible(self.r, e.x, s.x, s.y)
+            && let Some(n) = crate::batch::fast_visible(self.r, e.x, s.x, s.y)
         {
-            return Some(phi);
+            return Some(n);
         }
-        self.visible_bracketed().map(|phi| self.refine_line(phi))
+        self.visible_bracketed().map(|phi| Vec2::from_angle(self.refine_line(phi)))
     }
 
     /// Finishes a solution with Newton steps on the line condition `m × b̂`, which measures the
@@ -327,8 +328,8 @@ impl Canonical {
         let mut out = Reflexes2::default();
         // The bracketed search is authoritative for the visible reflex; the quartic's own
         // Outside candidates are duplicates of it (or spurious near the forbidden boundary).
-        if let Some(phi) = self.visible() {
-            out.push(Reflex2 { phi: phi.rem_euclid(std::f64::consts::TAU), kind: ReflexKind::Outside });
+        if let Some(n) = self.visible() {
+            out.push(Reflex2 { phi: n.y.atan2(n.x).rem_euclid(std::f64::consts::TAU), kind: ReflexKind::Outside });
         }
         for r in found.into_iter().filter(|r| r.kind != ReflexKind::Outside) {
             out.push(r);

@@ -44,7 +44,12 @@ struct Frame {
 
 impl Frame {
     fn to_3d(&self, phi: f64) -> (Vec3, Vec3) {
-        let n = self.x * phi.cos() + self.y * phi.sin();
+        self.normal_to_3d(Vec2::from_angle(phi))
+    }
+
+    /// The mirror point and normal for the canonical unit normal `(cos φ, sin φ)`.
+    fn normal_to_3d(&self, n2: Vec2) -> (Vec3, Vec3) {
+        let n = self.x * n2.x + self.y * n2.y;
         (self.origin + n * self.problem.r, n)
     }
 }
@@ -250,8 +255,8 @@ impl Sphere {
     /// Only the visible reflex (the bracketed search of [`crate::circle`], no quartic).
     pub fn visible_reflex(&self, eye: Site, source: Site) -> Result<Option<Reflex>, MirrorError> {
         let (fr, _) = self.frame(eye, source)?;
-        Ok(fr.problem.visible().map(|phi| {
-            let (point, normal) = fr.to_3d(phi);
+        Ok(fr.problem.visible().map(|n| {
+            let (point, normal) = fr.normal_to_3d(n);
             Reflex { point, normal, kind: ReflexKind::Outside }
         }))
     }
@@ -325,8 +330,8 @@ impl Cylinder {
     /// Only the visible reflex (the bracketed search of [`crate::circle`], no quartic).
     pub fn visible_reflex(&self, eye: Site, source: Site) -> Result<Option<Reflex>, MirrorError> {
         let (fr, a, pe, ps) = self.frame(eye, source)?;
-        let Some(phi) = fr.problem.visible() else { return Ok(None) };
-        let (foot, normal) = fr.to_3d(phi);
+        let Some(n) = fr.problem.visible() else { return Ok(None) };
+        let (foot, normal) = fr.normal_to_3d(n);
         Ok(height(foot, ReflexKind::Outside, pe, ps)?.map(|h| Reflex {
             point: foot + a * h,
             normal,

@@ -278,11 +278,16 @@ proptest! {
     #[test]
     fn visible_reflex_is_the_outside_solution((s, eye, src) in config(), axis in unit()) {
         let cyl = Cylinder { center: s.center, axis, radius: s.radius };
+        let same = |a: Option<&Reflex>, b: Option<Reflex>| match (a, b) {
+            (None, None) => true,
+            (Some(a), Some(b)) => (a.point - b.point).length() <= 1e-13 * (1.0 + a.point.length()),
+            _ => false,
+        };
         if let (Ok(all), Ok(one)) = (s.reflexes(Site::At(eye), Site::At(src)), s.visible_reflex(Site::At(eye), Site::At(src))) {
-            prop_assert_eq!(all.visible().copied(), one);
+            prop_assert!(same(all.visible(), one));
         }
         if let (Ok(all), Ok(one)) = (cyl.reflexes(Site::At(eye), Site::At(src)), cyl.visible_reflex(Site::At(eye), Site::At(src))) {
-            prop_assert_eq!(all.visible().copied(), one);
+            prop_assert!(same(all.visible(), one));
         }
     }
 }
