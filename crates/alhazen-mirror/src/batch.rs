@@ -97,25 +97,29 @@ fn start(sx: f64, sy: f64) -> f64 {
 fn kernel(r: f64, e: f64, sx: f64, sy: f64, mut t: f64, steps: usize) -> (f64, bool) {
     let mut ok = false;
     for _ in 0..steps {
+        // Everything is scaled by u = 1 + t² (the denominator of (14)), which cancels in the
+        // unit vectors: the mirror point is r(1 − t², 2t)/u, so u·(E − R) and u·(S − R) are
+        // polynomial in t. Two square roots and two divisions a step.
         let t2 = t * t;
-        let k = 1.0 / (1.0 + t2);
-        let (c, s) = ((1.0 - t2) * k, 2.0 * t * k);
-        let (px, py) = (r * c, r * s);
-        let (dex, dey, dsx, dsy) = (e - px, -py, sx - px, sy - py);
+        let (u, ct, st) = (1.0 + t2, 1.0 - t2, 2.0 * t);
+        let (dex, dey) = (e * u - r * ct, -r * st);
+        let (dsx, dsy) = (sx * u - r * ct, sy * u - r * st);
         let (la, lb) = ((dex * dex + dey * dey).sqrt(), (dsx * dsx + dsy * dsy).sqrt());
         let inv = 1.0 / (la * lb);
         let (ie, is) = (lb * inv, la * inv);
         let (ax, ay, bx, by) = (dex * ie, dey * ie, dsx * is, dsy * is);
-        let (ta, tb) = (-s * ax + c * ay, -s * bx + c * by);
-        let (na, nb) = (c * ax + s * ay, c * bx + s * by);
+        // u·(tangential) and u·(normal) components of the unit rays.
+        let (ta, tb) = (-st * ax + ct * ay, -st * bx + ct * by);
+        let (na, nb) = (ct * ax + st * ay, ct * bx + st * by);
         let g = ta + tb;
-        let dg = -na - r * ie * (1.0 - ta * ta) - nb - r * is * (1.0 - tb * tb);
-        // dφ = 2 dt / (1 + t²).
-        t -= g * (1.0 + t2) / (2.0 * dg);
+        // u²·dg/dφ with the true distances |E − R| = la/u, |S − R| = lb/u.
+        let dg = -u * (na + nb) - r * u * (ie * (u * u - ta * ta) + is * (u * u - tb * tb));
+        // dφ = 2 dt / u: Newton in t.
+        t -= g * u * u / (2.0 * dg);
         // Quadratic convergence: a balance below 1e-9 before this step is squared by it. Near
         // grazing (n·â < 1e-3) the balance's rounding alone is worth 1e-13 rad of angle: those
         // points go to the scalar solver, which finishes on the line condition instead.
-        ok = g.abs() < 1e-9 && na > 1e-3 && nb > 1e-3;
+        ok = g.abs() < 1e-9 * u && na > 1e-3 * u && nb > 1e-3 * u;
     }
     (t, ok)
 }
