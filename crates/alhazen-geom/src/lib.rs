@@ -1,7 +1,8 @@
 //! `alhazen-geom`: geometric data that the scene, the renderer and the line drawer share.
 //!
-//! Today: [`TriangleMesh`], an indexed triangle list (course, §"Representations of 3D scenes":
-//! a boundary representation reduced to the list of triangles needed to draw a solid).
+//! * [`TriangleMesh`], an indexed triangle list (course, §"Representations of 3D scenes": a
+//!   boundary representation reduced to the list of triangles needed to draw a solid);
+//! * [`bezier`], Bézier curves (course, §"Elements of geometric design").
 //!
 //! ```
 //! use alhazen_geom::TriangleMesh;
@@ -9,6 +10,8 @@
 //! let m = TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap();
 //! assert_eq!(m.triangle_count(), 1);
 //! ```
+
+pub mod bezier;
 
 use alhazen_math::{Bounds3, Vec2, Vec3};
 
