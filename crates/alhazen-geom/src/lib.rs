@@ -2,7 +2,8 @@
 //!
 //! * [`TriangleMesh`], an indexed triangle list (course, §"Representations of 3D scenes": a
 //!   boundary representation reduced to the list of triangles needed to draw a solid);
-//! * [`bezier`], Bézier curves (course, §"Elements of geometric design").
+//! * [`bezier`], Bézier curves (course, §"Elements of geometric design");
+//! * [`bspline`], B-spline and NURBS curves (course, §"B-spline curves", rational curves).
 //!
 //! ```
 //! use alhazen_geom::TriangleMesh;
@@ -12,6 +13,7 @@
 //! ```
 
 pub mod bezier;
+pub mod bspline;
 
 use alhazen_math::{Bounds3, Vec2, Vec3};
 
