@@ -3,7 +3,8 @@
 //! * [`TriangleMesh`], an indexed triangle list (course, §"Representations of 3D scenes": a
 //!   boundary representation reduced to the list of triangles needed to draw a solid);
 //! * [`bezier`], Bézier curves (course, §"Elements of geometric design");
-//! * [`bspline`], B-spline and NURBS curves (course, §"B-spline curves", rational curves).
+//! * [`bspline`], B-spline and NURBS curves (course, §"B-spline curves", rational curves);
+//! * [`patch`], tensor-product Bézier and B-spline patches, rational normals by the 4D wedge.
 //!
 //! ```
 //! use alhazen_geom::TriangleMesh;
@@ -14,6 +15,7 @@
 
 pub mod bezier;
 pub mod bspline;
+pub mod patch;
 
 use alhazen_math::{Bounds3, Vec2, Vec3};
 

@@ -1,0 +1,255 @@
+//! Tensor-product patches (course, §"Tensor product Bézier and B-spline patches", §"Rational
+//! Bézier and B-spline patches"): points by evaluating curves of curves, first partial
+//! derivatives from the curves' hodographs, knot insertion per direction, and the normal of a
+//! rational patch as the 4D vector product `N = P ∧ P_v ∧ P_u` of the homogeneous point and its
+//! derivatives.
+//!
+//! The control net is stored row-major: `points[i * cols + j]` is `p_ij`, `i` along `u`.
+
+use crate::bezier::{Bezier, ControlPoint};
+use crate::bspline::{BSpline, SplineError};
+use alhazen_math::{Mat3, Vec3, Vec4};
+
+/// A control net of `rows × cols` points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Net<P> {
+    /// Number of points along `u`.
+    pub rows: usize,
+    /// Number of points along `v`.
+    pub cols: usize,
+    /// Row-major points.
+    pub points: Vec<P>,
+}
+
+impl<P: ControlPoint> Net<P> {
+    /// A net; `None` when the sizes disagree or it is empty.
+    pub fn new(rows: usize, cols: usize, points: Vec<P>) -> Option<Self> {
+        (rows > 0 && cols > 0 && points.len() == rows * cols).then_some(Self { rows, cols, points })
+    }
+
+    fn row(&self, i: usize) -> Vec<P> {
+        self.points[i * self.cols..(i + 1) * self.cols].to_vec()
+    }
+}
+
+/// A Bézier patch of degree `(rows − 1, cols − 1)` on `[0, 1]²`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BezierPatch<P> {
+    /// The control net.
+    pub net: Net<P>,
+}
+
+impl<P: ControlPoint> BezierPatch<P> {
+    /// The points `q_i = Σ_j p_ij B_j(v)`, then a Bézier curve in `u`.
+    fn column(&self, v: f64) -> Bezier<P> {
+        Bezier::new((0..self.net.rows).map(|i| Bezier::new(self.net.row(i)).expect("cols > 0").eval(v)).collect())
+            .expect("rows > 0")
+    }
+
+    /// `p(u, v)`.
+    pub fn eval(&self, u: f64, v: f64) -> P {
+        self.column(v).eval(u)
+    }
+
+    /// `∂p/∂u` (zero for degree 0 in `u`).
+    pub fn du(&self, u: f64, v: f64) -> P {
+        self.column(v).derivative().map_or(self.net.points[0] * 0.0, |d| d.eval(u))
+    }
+
+    /// `∂p/∂v`.
+    pub fn dv(&self, u: f64, v: f64) -> P {
+        let q: Vec<P> = (0..self.net.rows)
+            .map(|i| {
+                Bezier::new(self.net.row(i))
+                    .expect("cols > 0")
+                    .derivative()
+                    .map_or(self.net.points[0] * 0.0, |d| d.eval(v))
+            })
+            .collect();
+        Bezier::new(q).expect("rows > 0").eval(u)
+    }
+}
+
+/// A B-spline patch of degree `(n, m)` on knots `u_0…u_N`, `v_0…v_M`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BSplinePatch<P> {
+    /// Degree along `u`.
+    pub n: usize,
+    /// Degree along `v`.
+    pub m: usize,
+    /// Knots along `u`.
+    pub u_knots: Vec<f64>,
+    /// Knots along `v`.
+    pub v_knots: Vec<f64>,
+    /// The control net (`rows = N − n`, `cols = M − m`).
+    pub net: Net<P>,
+}
+
+impl<P: ControlPoint> BSplinePatch<P> {
+    /// Checks the counting rule in both directions.
+    pub fn new(n: usize, m: usize, u_knots: Vec<f64>, v_knots: Vec<f64>, net: Net<P>) -> Result<Self, SplineError> {
+        BSpline::new(n, u_knots.clone(), vec![net.points[0]; net.rows])?;
+        BSpline::new(m, v_knots.clone(), vec![net.points[0]; net.cols])?;
+        Ok(Self { n, m, u_knots, v_knots, net })
+    }
+
+    fn row_curve(&self, i: usize) -> BSpline<P> {
+        BSpline::new(self.m, self.v_knots.clone(), self.net.row(i)).expect("checked in new")
+    }
+
+    fn column(&self, v: f64, derive_v: bool) -> BSpline<P> {
+        let q = (0..self.net.rows)
+            .map(|i| {
+                let c = self.row_curve(i);
+                if derive_v { c.derivative().map_or(self.net.points[0] * 0.0, |d| d.eval(v)) } else { c.eval(v) }
+            })
+            .collect();
+        BSpline::new(self.n, self.u_knots.clone(), q).expect("checked in new")
+    }
+
+    /// The parameter domain `([u_n, u_{N−n}], [v_m, v_{M−m}])`.
+    pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
+        (self.column(self.v_knots[self.m], false).domain(), self.row_curve(0).domain())
+    }
+
+    /// `s(u, v)`.
+    pub fn eval(&self, u: f64, v: f64) -> P {
+        self.column(v, false).eval(u)
+    }
+
+    /// `∂s/∂u`.
+    pub fn du(&self, u: f64, v: f64) -> P {
+        self.column(v, false).derivative().map_or(self.net.points[0] * 0.0, |d| d.eval(u))
+    }
+
+    /// `∂s/∂v`.
+    pub fn dv(&self, u: f64, v: f64) -> P {
+        self.column(v, true).eval(u)
+    }
+
+    /// Boehm's insertion of `t` into the `v` knots of every row.
+    pub fn insert_v_knot(&self, t: f64) -> BSplinePatch<P> {
+        let rows: Vec<BSpline<P>> = (0..self.net.rows).map(|i| self.row_curve(i).insert_knot(t)).collect();
+        let cols = rows[0].points().len();
+        let points = rows.iter().flat_map(|r| r.points().to_vec()).collect();
+        BSplinePatch {
+            v_knots: rows[0].knots().to_vec(),
+            net: Net { rows: self.net.rows, cols, points },
+            ..self.clone()
+        }
+    }
+
+    /// Boehm's insertion of `t` into the `u` knots of every column.
+    pub fn insert_u_knot(&self, t: f64) -> BSplinePatch<P> {
+        let columns: Vec<BSpline<P>> = (0..self.net.cols)
+            .map(|j| {
+                let col = (0..self.net.rows).map(|i| self.net.points[i * self.net.cols + j]).collect();
+                BSpline::new(self.n, self.u_knots.clone(), col).expect("checked in new").insert_knot(t)
+            })
+            .collect();
+        let rows = columns[0].points().len();
+        let points = (0..rows).flat_map(|i| columns.iter().map(move |c| c.points()[i])).collect();
+        BSplinePatch {
+            u_knots: columns[0].knots().to_vec(),
+            net: Net { rows, cols: self.net.cols, points },
+            ..self.clone()
+        }
+    }
+}
+
+/// The vector product of three vectors of R⁴: the `N` with `N·x = det[x; a; b; c]`, so `N` is
+/// orthogonal to `a`, `b` and `c`.
+pub fn wedge4(a: Vec4, b: Vec4, c: Vec4) -> Vec4 {
+    let minor = |skip: usize| {
+        let pick = |v: Vec4| {
+            let all = v.to_array();
+            let kept: Vec<f64> = (0..4).filter(|&k| k != skip).map(|k| all[k]).collect();
+            Vec3::new(kept[0], kept[1], kept[2])
+        };
+        Mat3::from_cols(pick(a), pick(b), pick(c)).determinant()
+    };
+    Vec4::new(minor(0), -minor(1), minor(2), -minor(3))
+}
+
+/// The unit normal of a rational patch from its homogeneous point and derivatives (course:
+/// `N = P ∧ P_v ∧ P_u`, first three coordinates).
+pub fn rational_normal(p: Vec4, pu: Vec4, pv: Vec4) -> Option<Vec3> {
+    wedge4(p, pv, pu).truncate().try_normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bezier::bernstein;
+    use proptest::prelude::*;
+
+    fn arb_net(rows: usize, cols: usize) -> impl Strategy<Value = Net<Vec3>> {
+        prop::collection::vec((-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64), rows * cols).prop_map(move |v| {
+            Net::new(rows, cols, v.into_iter().map(|(x, y, z)| Vec3::new(x, y, z)).collect()).unwrap()
+        })
+    }
+
+    fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
+        (a - b).length() <= tol * (1.0 + a.length())
+    }
+
+    proptest! {
+        #[test]
+        fn bezier_patch_is_the_double_sum(net in arb_net(3, 4), u in 0.0..1.0f64, v in 0.0..1.0f64) {
+            let p = BezierPatch { net: net.clone() };
+            let mut sum = Vec3::ZERO;
+            for i in 0..3 {
+                for j in 0..4 {
+                    sum += net.points[i * 4 + j] * (bernstein(2, i, u) * bernstein(3, j, v));
+                }
+            }
+            prop_assert!(close(p.eval(u, v), sum, 1e-12));
+            let h = 1e-6;
+            let fu = (p.eval(u + h, v) - p.eval(u - h, v)) / (2.0 * h);
+            let fv = (p.eval(u, v + h) - p.eval(u, v - h)) / (2.0 * h);
+            prop_assert!(close(p.du(u, v), fu, 1e-6) && close(p.dv(u, v), fv, 1e-6));
+        }
+
+        #[test]
+        fn b_spline_patch_insertion_and_derivatives(net in arb_net(5, 5), u in 0.1..0.9f64, v in 0.1..0.9f64, t in 0.0..1.0f64) {
+            let knots: Vec<f64> = vec![0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0, 2.0];
+            let s = BSplinePatch::new(3, 3, knots.clone(), knots, net).unwrap();
+            let (uu, vv) = (2.0 * u, 2.0 * v);
+            let a = s.insert_u_knot(2.0 * t).insert_v_knot(2.0 * (1.0 - t));
+            prop_assert!(close(a.eval(uu, vv), s.eval(uu, vv), 1e-10));
+            let h = 1e-6;
+            prop_assume!((uu - 1.0).abs() > 1e-3 && (vv - 1.0).abs() > 1e-3);
+            let fu = (s.eval(uu + h, vv) - s.eval(uu - h, vv)) / (2.0 * h);
+            let fv = (s.eval(uu, vv + h) - s.eval(uu, vv - h)) / (2.0 * h);
+            prop_assert!(close(s.du(uu, vv), fu, 1e-5) && close(s.dv(uu, vv), fv, 1e-5));
+        }
+
+        #[test]
+        fn rational_normal_is_the_normal_of_the_projected_patch(net in arb_net(3, 3), w in prop::collection::vec(0.3..3.0f64, 9), u in 0.05..0.95f64, v in 0.05..0.95f64) {
+            let hom = Net::new(3, 3, net.points.iter().zip(&w).map(|(p, w)| (*p * *w).extend(*w)).collect()).unwrap();
+            let p = BezierPatch { net: hom };
+            let n = rational_normal(p.eval(u, v), p.du(u, v), p.dv(u, v));
+            // Cartesian derivatives by finite differences of the projected patch.
+            let proj = |u: f64, v: f64| { let h = p.eval(u, v); h.truncate() / h.w };
+            let h = 1e-6;
+            let cu = (proj(u + h, v) - proj(u - h, v)) / (2.0 * h);
+            let cv = (proj(u, v + h) - proj(u, v - h)) / (2.0 * h);
+            if let (Some(n), Some(c)) = (n, cu.cross(cv).try_normalize()) {
+                prop_assume!(cu.length() > 1e-3 && cv.length() > 1e-3 && cu.cross(cv).length() > 1e-3 * cu.length() * cv.length());
+                prop_assert!(n.cross(c).length() < 1e-5, "{n} vs {c}");
+            }
+        }
+    }
+
+    #[test]
+    fn wedge4_is_orthogonal_to_its_factors() {
+        let (a, b, c) = (Vec4::new(1.0, 2.0, 0.5, 1.0), Vec4::new(-0.3, 1.0, 2.0, 0.2), Vec4::new(0.7, -1.0, 0.1, 3.0));
+        let n = wedge4(a, b, c);
+        for x in [a, b, c] {
+            assert!(n.dot(x).abs() < 1e-12);
+        }
+        let x = Vec4::new(0.2, 0.3, -0.4, 0.5);
+        let det = alhazen_math::Mat4::from_cols(x, a, b, c).transpose().determinant();
+        assert!((n.dot(x) - det).abs() < 1e-12);
+    }
+}
