@@ -4,7 +4,8 @@
 //!   boundary representation reduced to the list of triangles needed to draw a solid);
 //! * [`bezier`], Bézier curves (course, §"Elements of geometric design");
 //! * [`bspline`], B-spline and NURBS curves (course, §"B-spline curves", rational curves);
-//! * [`patch`], tensor-product Bézier and B-spline patches, rational normals by the 4D wedge.
+//! * [`patch`], tensor-product Bézier and B-spline patches, rational normals by the 4D wedge;
+//! * [`halfedge`] polygon meshes and their [`subdivision`] (Catmull–Clark, Doo–Sabin).
 //!
 //! ```
 //! use alhazen_geom::TriangleMesh;
@@ -15,7 +16,9 @@
 
 pub mod bezier;
 pub mod bspline;
+pub mod halfedge;
 pub mod patch;
+pub mod subdivision;
 
 use alhazen_math::{Bounds3, Vec2, Vec3};
 
