@@ -5,7 +5,8 @@
 //! * [`bezier`], Bézier curves (course, §"Elements of geometric design");
 //! * [`bspline`], B-spline and NURBS curves (course, §"B-spline curves", rational curves);
 //! * [`patch`], tensor-product Bézier and B-spline patches, rational normals by the 4D wedge;
-//! * [`halfedge`] polygon meshes and their [`subdivision`] (Catmull–Clark, Doo–Sabin).
+//! * [`halfedge`] polygon meshes and their [`subdivision`] (Catmull–Clark, Doo–Sabin);
+//! * [`tessellate`]: patches, polygon meshes and tubes around curves as triangle meshes.
 //!
 //! ```
 //! use alhazen_geom::TriangleMesh;
@@ -19,6 +20,7 @@ pub mod bspline;
 pub mod halfedge;
 pub mod patch;
 pub mod subdivision;
+pub mod tessellate;
 
 use alhazen_math::{Bounds3, Vec2, Vec3};
 

@@ -223,11 +223,67 @@ impl Parser<'_> {
         Ok((self.scene.meshes.len() - 1, slots))
     }
 
+    /// `shape = "subdivision"`: a polygon mesh (`base = "cube"`, or a mesh `file`/`mesh`)
+    /// refined `levels` times by Catmull–Clark or Doo–Sabin.
+    fn subdivision(&mut self, t: &Table) -> R<alhazen_geom::TriangleMesh> {
+        use alhazen_geom::halfedge::HalfedgeMesh;
+        let base = match (t.get("base"), t.get("file"), t.get("mesh")) {
+            (Some(b), None, None) => {
+                b.choice(&["cube"])?;
+                HalfedgeMesh::cube()
+            }
+            (None, Some(_), None) | (None, None, Some(_)) => {
+                let (index, _) = match t.get("mesh") {
+                    Some(m) => {
+                        let name = m.str()?;
+                        self.mesh_names.get(name).cloned().ok_or_else(|| m.err(format!("unknown mesh \"{name}\"")))?
+                    }
+                    None => self.load_mesh(&t.req("file")?)?,
+                };
+                let tm = self.scene.meshes[index].clone();
+                let polys: Vec<Vec<usize>> =
+                    tm.triangles.iter().map(|t| t.iter().map(|&v| v as usize).collect()).collect();
+                let node = t.get("mesh").or(t.get("file")).expect("one is present");
+                HalfedgeMesh::from_polygons(tm.positions.clone(), &polys)
+                    .map_err(|e| node.err(format!("cannot subdivide: {e}")))?
+            }
+            _ => {
+                return Err(t.req("shape")?.err("a subdivision surface needs exactly one of `base`, `file` or `mesh`"));
+            }
+        };
+        let doo_sabin = match t.get("scheme") {
+            Some(s) => s.choice(&["catmull-clark", "doo-sabin"])? == "doo-sabin",
+            None => false,
+        };
+        let levels = t.get("levels").map_or(Ok(3), |n| n.integer(0, 6))?;
+        let mut m = base;
+        for _ in 0..levels {
+            m = if doo_sabin {
+                alhazen_geom::subdivision::doo_sabin(&m)
+            } else {
+                alhazen_geom::subdivision::catmull_clark(&m)
+            };
+        }
+        Ok(alhazen_geom::tessellate::polygons_to_triangles(&m))
+    }
+
     fn object(&mut self, n: &Node, depth: usize) -> R<Object> {
         const COMMON: &[&str] = &["shape", "name", "material", "transform"];
         let t = n.table_any()?;
         let shape_node = t.req("shape")?;
-        let kind = shape_node.choice(&["sphere", "cylinder", "cone", "disk", "plane", "box", "mesh", "csg"])?;
+        let kind = shape_node.choice(&[
+            "sphere",
+            "cylinder",
+            "cone",
+            "disk",
+            "plane",
+            "box",
+            "mesh",
+            "csg",
+            "subdivision",
+            "patch",
+            "curve",
+        ])?;
         let specific: &[&str] = match kind {
             "sphere" => &["center", "radius"],
             "cylinder" => &["base", "top", "radius", "capped"],
@@ -236,6 +292,9 @@ impl Parser<'_> {
             "plane" => &["point", "normal"],
             "box" => &["min", "max"],
             "mesh" => &["file", "mesh", "smooth"],
+            "subdivision" => &["base", "file", "mesh", "scheme", "levels", "smooth"],
+            "patch" => &["rows", "points", "weights", "tolerance"],
+            "curve" => &["kind", "degree", "points", "radius"],
             _ => &["op", "a", "b"],
         };
         let keys: Vec<&str> = COMMON.iter().chain(specific).copied().collect();
@@ -276,6 +335,15 @@ impl Parser<'_> {
                     return Err(t.req("max")?.err("`max` must exceed `min` in every coordinate"));
                 }
                 Shape::Box { min, max }
+            }
+            "subdivision" | "patch" | "curve" => {
+                let mesh = match kind {
+                    "subdivision" => self.subdivision(&t)?,
+                    "patch" => patch(&t)?,
+                    _ => curve(&t)?,
+                };
+                self.scene.meshes.push(Arc::new(mesh));
+                Shape::Mesh { mesh: self.scene.meshes.len() - 1, smooth: t.opt_bool("smooth", true)? }
             }
             "mesh" => {
                 let (mesh, slots) = match (t.get("mesh"), t.get("file")) {
@@ -326,6 +394,58 @@ impl Parser<'_> {
         };
         Ok(Object { name, shape, transform, material, mesh_materials })
     }
+}
+
+/// `shape = "patch"`: a (rational) Bézier patch, control points row-major, tessellated to the
+/// chordal `tolerance`.
+fn patch(t: &Table) -> R<alhazen_geom::TriangleMesh> {
+    use alhazen_geom::patch::{BezierPatch, Net};
+    use alhazen_geom::tessellate::tessellate;
+    let pts_node = t.req("points")?;
+    let points: Vec<Vec3> = pts_node.array()?.iter().map(|p| p.vec3()).collect::<R<_>>()?;
+    let rows = t.req("rows")?.integer(1, 64)? as usize;
+    if points.len() < 2 * rows || points.len() % rows != 0 {
+        return Err(pts_node.err(format!("{} points do not form {rows} rows of at least 2", points.len())));
+    }
+    let cols = points.len() / rows;
+    let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
+    Ok(match t.get("weights") {
+        None => tessellate(&BezierPatch { net: Net::new(rows, cols, points).expect("sizes checked") }, tol),
+        Some(w) => {
+            let ws: Vec<f64> = w.array()?.iter().map(|x| x.positive()).collect::<R<_>>()?;
+            if ws.len() != points.len() {
+                return Err(w.err(format!("{} weights for {} points", ws.len(), points.len())));
+            }
+            let hom = points.iter().zip(&ws).map(|(p, w)| (*p * *w).extend(*w)).collect();
+            tessellate(&BezierPatch { net: Net::new(rows, cols, hom).expect("sizes checked") }, tol)
+        }
+    })
+}
+
+/// `shape = "curve"`: a Bézier or clamped uniform B-spline curve drawn as a tube.
+fn curve(t: &Table) -> R<alhazen_geom::TriangleMesh> {
+    use alhazen_geom::bezier::Bezier;
+    use alhazen_geom::bspline::BSpline;
+    let pts_node = t.req("points")?;
+    let points: Vec<Vec3> = pts_node.array()?.iter().map(|p| p.vec3()).collect::<R<_>>()?;
+    if points.len() < 2 {
+        return Err(pts_node.err("a curve needs at least 2 control points"));
+    }
+    let radius = t.get("radius").map_or(Ok(0.02), |n| n.positive())?;
+    let bspline = match t.get("kind") {
+        Some(k) => k.choice(&["bezier", "bspline"])? == "bspline",
+        None => false,
+    };
+    let line: Vec<Vec3> = if bspline {
+        let degree = t.get("degree").map_or(Ok(3), |n| n.integer(1, 10))? as usize;
+        let s =
+            BSpline::clamped_uniform(degree.min(points.len() - 1), points).map_err(|e| pts_node.err(e.to_string()))?;
+        let (a, b) = s.domain();
+        (0..=400).map(|k| s.eval(a + (b - a) * k as f64 / 400.0)).collect()
+    } else {
+        Bezier::new(points).expect("non-empty").flatten(radius * 0.05)
+    };
+    Ok(alhazen_geom::tessellate::tube(&line, radius, 16))
 }
 
 fn distinct(t: &Table, key: &str, a: Vec3, b: Vec3) -> R<()> {
