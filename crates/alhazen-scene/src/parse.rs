@@ -404,7 +404,7 @@ fn patch(t: &Table) -> R<alhazen_geom::TriangleMesh> {
     let pts_node = t.req("points")?;
     let points: Vec<Vec3> = pts_node.array()?.iter().map(|p| p.vec3()).collect::<R<_>>()?;
     let rows = t.req("rows")?.integer(1, 64)? as usize;
-    if points.len() < 2 * rows || points.len() % rows != 0 {
+    if points.len() < 2 * rows || !points.len().is_multiple_of(rows) {
         return Err(pts_node.err(format!("{} points do not form {rows} rows of at least 2", points.len())));
     }
     let cols = points.len() / rows;
