@@ -123,6 +123,11 @@ fn golden_haas_haus() {
 }
 
 #[test]
+fn golden_geometric_design() {
+    golden("geometric-design");
+}
+
+#[test]
 fn output_formats_round_trip() {
     let img = render_text(&format!("{FLAT}[[light]]\ntype = \"directional\"\ndirection = [0, 0, -1]\n"));
     let dir = tempfile::tempdir().unwrap();
