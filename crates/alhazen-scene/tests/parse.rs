@@ -82,10 +82,16 @@ fn mistakes_are_located_and_explained() {
     assert!(err("[[object]]\nshape = \"mesh\"\nfile = \"missing.obj\"\n").contains("cannot load mesh"));
     let typo = err("[materials.glass]\nior = 1.5\n[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"glas\"\n");
     assert!(typo.contains("unknown material \"glas\"") && typo.contains("did you mean \"glass\"?"), "{typo}");
-    assert!(err("[[object]]\nshape = \"patch\"\nrows = 2\npoints = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n").contains("do not form 2 rows"));
+    assert!(
+        err("[[object]]\nshape = \"patch\"\nrows = 2\npoints = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n")
+            .contains("do not form 2 rows")
+    );
     assert!(err("[[object]]\nshape = \"curve\"\npoints = [[0, 0, 0]]\n").contains("at least 2 control points"));
     assert!(err("[[object]]\nshape = \"subdivision\"\nbase = \"cuboid\"\n").contains("did you mean \"cube\"?"));
-    assert!(err("[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 9\n").contains("`levels` must be an integer in 0..=6"));
+    assert!(
+        err("[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 9\n")
+            .contains("`levels` must be an integer in 0..=6")
+    );
     let late = err("[render]\nwidth = 10\nbackground = 1\n");
     assert!(late.contains("must come before the first [table] header"), "{late}");
 }
