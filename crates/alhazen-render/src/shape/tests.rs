@@ -2,7 +2,6 @@
 //! keeps only the boundary of the combined set, transformed shapes agree with direct ones.
 
 use super::*;
-use alhazen_geom::TriangleMesh;
 use alhazen_scene::CsgOp;
 use proptest::prelude::*;
 use std::sync::Arc;
@@ -22,32 +21,8 @@ fn arb_ray() -> impl Strategy<Value = Ray> {
 }
 
 fn unit_box_mesh() -> Arc<MeshAccel> {
-    let p = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
-    let positions = vec![
-        p(-1., -1., -1.),
-        p(1., -1., -1.),
-        p(1., 1., -1.),
-        p(-1., 1., -1.),
-        p(-1., -1., 1.),
-        p(1., -1., 1.),
-        p(1., 1., 1.),
-        p(-1., 1., 1.),
-    ];
-    let triangles = vec![
-        [0, 2, 1],
-        [0, 3, 2],
-        [4, 5, 6],
-        [4, 6, 7],
-        [0, 1, 5],
-        [0, 5, 4],
-        [3, 7, 6],
-        [3, 6, 2],
-        [0, 4, 7],
-        [0, 7, 3],
-        [1, 2, 6],
-        [1, 6, 5],
-    ];
-    Arc::new(MeshAccel::new(Arc::new(TriangleMesh::new(positions, triangles).unwrap())))
+    let cube = alhazen_geom::halfedge::HalfedgeMesh::cube();
+    Arc::new(MeshAccel::new(Arc::new(alhazen_geom::tessellate::polygons_to_triangles(&cube))))
 }
 
 /// Signed distance-like implicit functions: zero on the surface.
