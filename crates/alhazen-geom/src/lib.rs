@@ -4,6 +4,7 @@
 //!   boundary representation reduced to the list of triangles needed to draw a solid);
 //! * [`bezier`], Bézier curves (course, §"Elements of geometric design");
 //! * [`bspline`], B-spline and NURBS curves (course, §"B-spline curves", rational curves);
+//! * [`construct`]: cubic interpolation, lofting, sweeps, spherical products;
 //! * [`patch`], tensor-product Bézier and B-spline patches, rational normals by the 4D wedge;
 //! * [`halfedge`] polygon meshes and their [`subdivision`] (Catmull–Clark, Doo–Sabin);
 //! * [`tessellate`]: patches, polygon meshes and tubes around curves as triangle meshes.
@@ -17,6 +18,7 @@
 
 pub mod bezier;
 pub mod bspline;
+pub mod construct;
 pub mod halfedge;
 pub mod patch;
 pub mod subdivision;
