@@ -144,6 +144,44 @@ pub fn half_circle(r: f64) -> BSpline<Vec4> {
     BSpline::new(2, vec![0.0, 0.0, 0.0, 1.0, 1.0, 2.0, 2.0, 2.0], pts).expect("valid by construction")
 }
 
+/// A surface of revolution about the `z` axis: the spherical product of the unit circle and the
+/// cubic interpolant of the profile points `(radius, height)`.
+pub fn revolution(profile: &[(f64, f64)]) -> Option<BSplinePatch<Vec4>> {
+    let q: Vec<Vec3> = profile.iter().map(|&(r, h)| Vec3::new(r, h, 0.0)).collect();
+    let meridian = interpolate_cubic(&q, &chord_lengths(&q))?;
+    let homogeneous =
+        BSpline::new(3, meridian.knots().to_vec(), meridian.points().iter().map(|p| p.extend(1.0)).collect()).ok()?;
+    spherical_product(&crate::bspline::nurbs_circle(Vec3::ZERO, 1.0), &homogeneous)
+}
+
+/// A tube swept along the cubic interpolant of `guide` with a circular cross-section of
+/// `radius`: the auxiliary guides are a rotation-minimising frame carried along the guide's
+/// control polygon, the cross-section a 16-gon (a linear B-spline), so the result is the
+/// course's swept B-spline surface.
+pub fn swept_tube(guide: &[Vec3], radius: f64) -> Option<BSplinePatch<Vec3>> {
+    let p = interpolate_cubic(guide, &chord_lengths(guide))?;
+    let cp = p.points();
+    let tangent = |i: usize| (cp[(i + 1).min(cp.len() - 1)] - cp[i.saturating_sub(1)]).normalize_or(Vec3::Z);
+    let mut n = alhazen_math::orthonormal_basis(tangent(0)).0;
+    let (mut x1, mut x2, mut x3) = (vec![], vec![], vec![]);
+    for i in 0..cp.len() {
+        let t = tangent(i);
+        n = (n - t * n.dot(t)).normalize_or(alhazen_math::orthonormal_basis(t).0);
+        x1.push(n * radius);
+        x2.push(t.cross(n) * radius);
+        x3.push(t * 0.0);
+    }
+    let guide_of = |pts: Vec<Vec3>| BSpline::new(3, p.knots().to_vec(), pts).ok();
+    let (g1, g2, g3) = (guide_of(x1)?, guide_of(x2)?, guide_of(x3)?);
+    let ring: Vec<Vec3> = (0..=16)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / 16.0;
+            Vec3::new(a.cos(), a.sin(), 0.0)
+        })
+        .collect();
+    sweep(&p, [&g1, &g2, &g3], &BSpline::clamped_uniform(1, ring).ok()?)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,6 +231,32 @@ mod tests {
             let p = s.net.points[s.net.cols + k];
             assert!(((p.x * p.x + p.y * p.y).sqrt() - 1.0).abs() < 1e-12 && (p.z - 3.0).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn revolution_keeps_the_profile_radius() {
+        let s = revolution(&[(1.0, 0.0), (1.5, 1.0), (0.8, 2.0), (1.2, 3.0)]).unwrap();
+        let ((u0, u1), (v0, v1)) = s.domain();
+        for j in 0..=10 {
+            let v = v0 + (v1 - v0) * j as f64 / 10.0;
+            let radii: Vec<f64> = (0..=12)
+                .map(|i| {
+                    let h = s.eval(u0 + (u1 - u0) * i as f64 / 12.0, v);
+                    (h.truncate() / h.w).truncate().length()
+                })
+                .collect();
+            assert!(radii.iter().all(|r| (r - radii[0]).abs() < 1e-12), "{radii:?}");
+        }
+    }
+
+    #[test]
+    fn swept_tube_has_constant_radius_at_the_control_frames() {
+        let guide = [Vec3::ZERO, Vec3::new(1.0, 0.5, 0.0), Vec3::new(2.0, 0.0, 1.0), Vec3::new(3.0, 1.0, 1.0)];
+        let s = swept_tube(&guide, 0.2).unwrap();
+        s.net.points.chunks(s.net.cols).for_each(|row| {
+            let c = row[0] - (row[0] - row[8]) * 0.5;
+            assert!(row[..16].iter().all(|p| ((*p - c).length() - 0.2).abs() < 1e-9));
+        });
     }
 
     #[test]

@@ -50,6 +50,16 @@ impl Surface for BSplinePatch<Vec3> {
     }
 }
 
+impl Surface for BSplinePatch<Vec4> {
+    fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3) {
+        let ((u0, u1), (v0, v1)) = self.domain();
+        let (uu, vv) = (u0 + (u1 - u0) * u, v0 + (v1 - v0) * v);
+        let h = self.eval(uu, vv);
+        let n = rational_normal(h, self.du(uu, vv), self.dv(uu, vv)).unwrap_or(Vec3::Z);
+        (h.truncate() / h.w, n)
+    }
+}
+
 /// The largest distance between the surface at cell centres and edge midpoints and the
 /// triangles of a `k × k` grid.
 fn chordal_error<S: Surface>(s: &S, k: usize) -> f64 {

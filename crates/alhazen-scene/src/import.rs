@@ -21,11 +21,15 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh, String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let result = match ext.as_deref() {
         Some("obj") => load_obj(path),
+        Some("bpt") => std::fs::read_to_string(path)
+            .map_err(|e| e.to_string())
+            .and_then(|t| parse_bpt(&t))
+            .map(|mesh| LoadedMesh { mesh, materials: vec![] }),
         Some("ply") => std::fs::read(path)
             .map_err(|e| e.to_string())
             .and_then(|b| parse_ply(&b))
             .map(|mesh| LoadedMesh { mesh, materials: vec![] }),
-        _ => Err("unsupported mesh format (expected .obj or .ply)".into()),
+        _ => Err("unsupported mesh format (expected .obj, .ply or .bpt)".into()),
     };
     let loaded = result.map_err(|e| format!("cannot load mesh {}: {e}", path.display()))?;
     loaded.mesh.validate().map_err(|e| format!("mesh {} is invalid: {e}", path.display()))?;
@@ -321,6 +325,64 @@ fn parse_ply_header(bytes: &[u8]) -> Result<(PlyFormat, Vec<PlyElement>, &[u8]),
     Ok((format, elements, &bytes[(body_start + 1).min(bytes.len())..]))
 }
 
+/// Parses bicubic Bézier patches in the classic Newell text format (`.bpt`: the number of
+/// patches, one line of 16 one-based control point indices per patch, the number of points, one
+/// `x,y,z` line per point; `#` comments) and tessellates them to a chordal tolerance of 0.002.
+pub fn parse_bpt(text: &str) -> Result<TriangleMesh, String> {
+    use alhazen_geom::patch::{BezierPatch, Net};
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let mut next = |what: &str| lines.next().ok_or_else(|| format!("unexpected end of file, expected {what}"));
+    let count = |(no, l): (usize, &str), what: &str| {
+        l.trim().parse::<usize>().map_err(|_| format!("line {}: expected the number of {what}", no + 1))
+    };
+    let numbers = |(no, l): (usize, &str), n: usize| -> Result<Vec<f64>, String> {
+        let v: Vec<f64> = l
+            .split(',')
+            .map(|x| x.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| format!("line {}: expected {n} comma-separated numbers", no + 1))?;
+        if v.len() == n && v.iter().all(|x| x.is_finite()) {
+            Ok(v)
+        } else {
+            Err(format!("line {}: expected {n} numbers, found {}", no + 1, v.len()))
+        }
+    };
+    let np = count(next("the patch count")?, "patches")?;
+    if np > 100_000 {
+        return Err(format!("{np} patches is too many"));
+    }
+    let patches: Vec<(usize, Vec<f64>)> =
+        (0..np).map(|_| next("patch indices").and_then(|l| Ok((l.0, numbers(l, 16)?)))).collect::<Result<_, _>>()?;
+    let nv = count(next("the point count")?, "points")?;
+    if nv > 1_000_000 {
+        return Err(format!("{nv} points is too many"));
+    }
+    let points: Vec<Vec3> = (0..nv)
+        .map(|_| next("a point").and_then(|l| numbers(l, 3)).map(|v| Vec3::new(v[0], v[1], v[2])))
+        .collect::<Result<_, _>>()?;
+    let mut mesh = TriangleMesh::default();
+    for (no, idx) in patches {
+        let net: Vec<Vec3> = idx
+            .iter()
+            .map(|&i| {
+                if i >= 1.0 && i <= nv as f64 && i.fract() == 0.0 {
+                    Ok(points[i as usize - 1])
+                } else {
+                    Err(format!("line {}: index {i} is not a point", no + 1))
+                }
+            })
+            .collect::<Result<_, _>>()?;
+        let part =
+            alhazen_geom::tessellate::tessellate(&BezierPatch { net: Net::new(4, 4, net).expect("16 points") }, 0.002);
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(part.positions);
+        mesh.normals.extend(part.normals);
+        mesh.uvs.extend(part.uvs);
+        mesh.triangles.extend(part.triangles.iter().map(|t| t.map(|v| v + base)));
+    }
+    Ok(mesh)
+}
+
 /// Loads an image and converts it from sRGB to linear RGB.
 pub fn load_image(path: &Path) -> Result<ImageData, String> {
     let img = image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))?.to_rgb8();
@@ -363,6 +425,20 @@ mod tests {
             assert_eq!(m.positions[2], Vec3::new(0.0, 2.0, 0.5));
             assert_eq!(m.triangles, vec![[0, 1, 2]]);
         }
+    }
+
+    #[test]
+    fn the_teapot_data_set_tessellates() {
+        let text =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/data/teapot.bpt")).unwrap();
+        let m = parse_bpt(&text).unwrap();
+        m.validate().unwrap();
+        let b = m.bounds();
+        // The classic teapot: 3.15 high, about 6.4 from spout to handle.
+        assert!((b.max.z - 3.15).abs() < 1e-9 && b.min.z.abs() < 1e-9, "{b:?}");
+        assert!((b.max.x - b.min.x) > 6.0 && (b.max.x - b.min.x) < 6.6);
+        assert!(parse_bpt("1\n1,2,3\n").unwrap_err().contains("line 2"));
+        assert!(parse_bpt("1\n1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,9\n1\n0,0,0\n").unwrap_err().contains("index 9"));
     }
 
     #[test]

@@ -283,6 +283,8 @@ impl Parser<'_> {
             "subdivision",
             "patch",
             "curve",
+            "revolution",
+            "sweep",
         ])?;
         let specific: &[&str] = match kind {
             "sphere" => &["center", "radius"],
@@ -295,6 +297,8 @@ impl Parser<'_> {
             "subdivision" => &["base", "file", "mesh", "scheme", "levels", "smooth"],
             "patch" => &["rows", "points", "weights", "tolerance"],
             "curve" => &["kind", "degree", "points", "radius"],
+            "revolution" => &["profile", "tolerance", "smooth"],
+            "sweep" => &["guide", "radius", "tolerance", "smooth"],
             _ => &["op", "a", "b"],
         };
         let keys: Vec<&str> = COMMON.iter().chain(specific).copied().collect();
@@ -336,10 +340,12 @@ impl Parser<'_> {
                 }
                 Shape::Box { min, max }
             }
-            "subdivision" | "patch" | "curve" => {
+            "subdivision" | "patch" | "curve" | "revolution" | "sweep" => {
                 let mesh = match kind {
                     "subdivision" => self.subdivision(&t)?,
                     "patch" => patch(&t)?,
+                    "revolution" => revolution(&t)?,
+                    "sweep" => sweep(&t)?,
                     _ => curve(&t)?,
                 };
                 self.scene.meshes.push(Arc::new(mesh));
@@ -420,6 +426,34 @@ fn patch(t: &Table) -> R<alhazen_geom::TriangleMesh> {
             tessellate(&BezierPatch { net: Net::new(rows, cols, hom).expect("sizes checked") }, tol)
         }
     })
+}
+
+/// `shape = "revolution"`: the NURBS surface of revolution about the `y` axis of the cubic
+/// interpolant of `profile = [[radius, height], …]`.
+fn revolution(t: &Table) -> R<alhazen_geom::TriangleMesh> {
+    let node = t.req("profile")?;
+    let profile: Vec<(f64, f64)> =
+        node.array()?.iter().map(|p| p.numbers::<2>().map(|[r, h]| (r, h))).collect::<R<_>>()?;
+    let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
+    let surface = alhazen_geom::construct::revolution(&profile)
+        .ok_or_else(|| node.err("a profile needs at least 2 points with distinct consecutive positions"))?;
+    let mut mesh = alhazen_geom::tessellate::tessellate(&surface, tol);
+    // The construction revolves about z; scenes are y-up: rotate by −90° about x.
+    for p in mesh.positions.iter_mut().chain(mesh.normals.iter_mut()) {
+        *p = Vec3::new(p.x, p.z, -p.y);
+    }
+    Ok(mesh)
+}
+
+/// `shape = "sweep"`: a tube of `radius` swept along the cubic interpolant of `guide`.
+fn sweep(t: &Table) -> R<alhazen_geom::TriangleMesh> {
+    let node = t.req("guide")?;
+    let guide: Vec<Vec3> = node.array()?.iter().map(|p| p.vec3()).collect::<R<_>>()?;
+    let radius = t.get("radius").map_or(Ok(0.1), |n| n.positive())?;
+    let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
+    let surface = alhazen_geom::construct::swept_tube(&guide, radius)
+        .ok_or_else(|| node.err("a guide needs at least 2 distinct points"))?;
+    Ok(alhazen_geom::tessellate::tessellate(&surface, tol))
 }
 
 /// `shape = "curve"`: a Bézier or clamped uniform B-spline curve drawn as a tube.
