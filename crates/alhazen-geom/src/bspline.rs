@@ -232,6 +232,14 @@ pub fn weighted(p: Vec3, w: f64) -> Vec4 {
     (p * w).extend(w)
 }
 
+/// A conic arc as a rational quadratic Bézier curve (homogeneous control points): from `p0` to
+/// `p2` with tangents meeting at `p1`, middle weight `w` — an ellipse for `w < 1`, a parabola for
+/// `w = 1`, a hyperbola for `w > 1` (the course's circle arc is `w = cos φ` with equal legs).
+pub fn conic_arc(p0: Vec3, p1: Vec3, p2: Vec3, w: f64) -> BSpline<Vec4> {
+    BSpline::new(2, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0], vec![weighted(p0, 1.0), weighted(p1, w), weighted(p2, 1.0)])
+        .expect("valid by construction")
+}
+
 /// The course's full circle of three equal arcs in the plane `z = center.z`: quadratic rational
 /// Bézier arcs of angle 2φ = 120°, end weights 1 and middle weights `cos φ = ½`, joined as one
 /// NURBS with double interior knots.
@@ -359,6 +367,24 @@ mod tests {
             let p = rational_point(&c, 3.0 * k as f64 / 3000.0);
             assert!(((p - Vec3::new(3.0, -1.0, 2.0)).length() - 2.5).abs() < 1e-12, "{p}");
         }
+    }
+
+    #[test]
+    fn conic_arcs_are_conics() {
+        // Legs (1,0)→(1,1)→(0,1): w = √2/2 is the unit circle arc; w = 1 the polynomial
+        // (parabolic) quadratic Bézier arc.
+        let circle = conic_arc(Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y, std::f64::consts::FRAC_1_SQRT_2);
+        let parabola = conic_arc(Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y, 1.0);
+        for k in 0..=20 {
+            let t = k as f64 / 20.0;
+            assert!((rational_point(&circle, t).length() - 1.0).abs() < 1e-14);
+            let p = rational_point(&parabola, t);
+            let q = Vec3::X * (1.0 - t) * (1.0 - t) + Vec3::new(1.0, 1.0, 0.0) * 2.0 * t * (1.0 - t) + Vec3::Y * t * t;
+            assert!((p - q).length() < 1e-14);
+        }
+        // A hyperbola arc leaves the triangle's incircle side: it bulges towards p1 more.
+        let hyper = conic_arc(Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y, 3.0);
+        assert!(rational_point(&hyper, 0.5).x > rational_point(&parabola, 0.5).x);
     }
 
     #[test]

@@ -157,6 +157,28 @@ impl<P: ControlPoint> BSplinePatch<P> {
     }
 }
 
+/// One Lane–Riesenfeld refinement of a uniform B-spline patch of degree `(n, n)` on a regular
+/// net (course, §"Mesh methods"): double rows and columns, then average each 2×2 block `n`
+/// times. The result is the control net on knots twice as dense.
+pub fn lane_riesenfeld_net<P: ControlPoint>(net: &Net<P>, n: usize) -> Net<P> {
+    let (mut rows, mut cols) = (net.rows * 2, net.cols * 2);
+    let mut d: Vec<P> = (0..rows)
+        .flat_map(|i| (0..cols).map(move |j| (i / 2, j / 2)))
+        .map(|(i, j)| net.points[i * net.cols + j])
+        .collect();
+    for _ in 0..n {
+        let (r2, c2) = (rows - 1, cols - 1);
+        d = (0..r2)
+            .flat_map(|i| (0..c2).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                (d[i * cols + j] + d[i * cols + j + 1] + d[(i + 1) * cols + j] + d[(i + 1) * cols + j + 1]) * 0.25
+            })
+            .collect();
+        (rows, cols) = (r2, c2);
+    }
+    Net { rows, cols, points: d }
+}
+
 /// The vector product of three vectors of R⁴: the `N` with `N·x = det[x; a; b; c]`, so `N` is
 /// orthogonal to `a`, `b` and `c`.
 pub fn wedge4(a: Vec4, b: Vec4, c: Vec4) -> Vec4 {
@@ -239,6 +261,29 @@ mod tests {
                 prop_assert!(n.cross(c).length() < 1e-5, "{n} vs {c}");
             }
         }
+    }
+
+    #[test]
+    fn lane_riesenfeld_net_converges_to_the_uniform_bicubic_patch() {
+        let pts: Vec<Vec3> =
+            (0..36).map(|k| Vec3::new((k / 6) as f64, (k % 6) as f64, ((k * 7919) % 11) as f64 * 0.1)).collect();
+        let net = Net::new(6, 6, pts).unwrap();
+        let knots: Vec<f64> = (0..10).map(|i| i as f64).collect();
+        let s = BSplinePatch::new(3, 3, knots.clone(), knots, net.clone()).unwrap();
+        let mut refined = net;
+        let mut errors = vec![];
+        for _ in 0..4 {
+            refined = lane_riesenfeld_net(&refined, 3);
+            let err = (0..=10)
+                .flat_map(|i| (0..=10).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    let p = s.eval(3.0 + 3.0 * i as f64 / 10.0, 3.0 + 3.0 * j as f64 / 10.0);
+                    refined.points.iter().map(|q| (*q - p).length()).fold(f64::INFINITY, f64::min)
+                })
+                .fold(0.0, f64::max);
+            errors.push(err);
+        }
+        assert!(errors.windows(2).all(|w| w[1] < 0.7 * w[0]), "{errors:?}");
     }
 
     #[test]

@@ -285,6 +285,7 @@ impl Parser<'_> {
             "curve",
             "revolution",
             "sweep",
+            "loft",
         ])?;
         let specific: &[&str] = match kind {
             "sphere" => &["center", "radius"],
@@ -295,7 +296,8 @@ impl Parser<'_> {
             "box" => &["min", "max"],
             "mesh" => &["file", "mesh", "smooth"],
             "subdivision" => &["base", "file", "mesh", "scheme", "levels", "smooth"],
-            "patch" => &["rows", "points", "weights", "tolerance"],
+            "patch" => &["rows", "points", "weights", "tolerance", "degree", "knots_u", "knots_v"],
+            "loft" => &["curves", "tolerance", "smooth"],
             "curve" => &["kind", "degree", "points", "radius"],
             "revolution" => &["profile", "tolerance", "smooth"],
             "sweep" => &["guide", "radius", "tolerance", "smooth"],
@@ -340,12 +342,13 @@ impl Parser<'_> {
                 }
                 Shape::Box { min, max }
             }
-            "subdivision" | "patch" | "curve" | "revolution" | "sweep" => {
+            "subdivision" | "patch" | "curve" | "revolution" | "sweep" | "loft" => {
                 let mesh = match kind {
                     "subdivision" => self.subdivision(&t)?,
                     "patch" => patch(&t)?,
                     "revolution" => revolution(&t)?,
                     "sweep" => sweep(&t)?,
+                    "loft" => loft(&t)?,
                     _ => curve(&t)?,
                 };
                 self.scene.meshes.push(Arc::new(mesh));
@@ -402,30 +405,96 @@ impl Parser<'_> {
     }
 }
 
-/// `shape = "patch"`: a (rational) Bézier patch, control points row-major, tessellated to the
-/// chordal `tolerance`.
+/// `shape = "patch"`: a (rational) Bézier patch — or, with `degree = [n, m]`, `knots_u` and
+/// `knots_v`, a (rational) B-spline patch — control points row-major, tessellated to the chordal
+/// `tolerance`.
 fn patch(t: &Table) -> R<alhazen_geom::TriangleMesh> {
-    use alhazen_geom::patch::{BezierPatch, Net};
+    use alhazen_geom::patch::{BSplinePatch, BezierPatch, Net};
     use alhazen_geom::tessellate::tessellate;
     let pts_node = t.req("points")?;
     let points: Vec<Vec3> = pts_node.array()?.iter().map(|p| p.vec3()).collect::<R<_>>()?;
-    let rows = t.req("rows")?.integer(1, 64)? as usize;
+    let rows = t.req("rows")?.integer(1, 256)? as usize;
     if points.len() < 2 * rows || !points.len().is_multiple_of(rows) {
         return Err(pts_node.err(format!("{} points do not form {rows} rows of at least 2", points.len())));
     }
     let cols = points.len() / rows;
     let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
-    Ok(match t.get("weights") {
-        None => tessellate(&BezierPatch { net: Net::new(rows, cols, points).expect("sizes checked") }, tol),
+    let weights: Option<Vec<f64>> = match t.get("weights") {
+        None => None,
         Some(w) => {
             let ws: Vec<f64> = w.array()?.iter().map(|x| x.positive()).collect::<R<_>>()?;
             if ws.len() != points.len() {
                 return Err(w.err(format!("{} weights for {} points", ws.len(), points.len())));
             }
+            Some(ws)
+        }
+    };
+    let knots = |key: &str| -> R<Option<Vec<f64>>> {
+        t.get(key).map(|k| k.array()?.iter().map(|x| x.f64()).collect::<R<Vec<f64>>>()).transpose()
+    };
+    let spline = match (t.get("degree"), knots("knots_u")?, knots("knots_v")?) {
+        (None, None, None) => None,
+        (Some(d), Some(ku), Some(kv)) => {
+            let [n, m] = d.numbers::<2>()?;
+            if n < 1.0 || m < 1.0 || n.fract() != 0.0 || m.fract() != 0.0 || n > 10.0 || m > 10.0 {
+                return Err(d.err("`degree`: expected two integers from 1 to 10"));
+            }
+            Some((n as usize, m as usize, ku, kv, d))
+        }
+        _ => return Err(pts_node.err("a B-spline patch needs all of `degree`, `knots_u` and `knots_v`")),
+    };
+    let mesh = match (spline, weights) {
+        (None, None) => tessellate(&BezierPatch { net: Net::new(rows, cols, points).expect("sizes checked") }, tol),
+        (None, Some(ws)) => {
             let hom = points.iter().zip(&ws).map(|(p, w)| (*p * *w).extend(*w)).collect();
             tessellate(&BezierPatch { net: Net::new(rows, cols, hom).expect("sizes checked") }, tol)
         }
-    })
+        (Some((n, m, ku, kv, d)), ws) => {
+            let bad = |e: alhazen_geom::bspline::SplineError| d.err(format!("B-spline patch: {e}"));
+            match ws {
+                None => tessellate(
+                    &BSplinePatch::new(n, m, ku, kv, Net::new(rows, cols, points).expect("sizes checked"))
+                        .map_err(bad)?,
+                    tol,
+                ),
+                Some(ws) => {
+                    let hom = points.iter().zip(&ws).map(|(p, w)| (*p * *w).extend(*w)).collect();
+                    tessellate(
+                        &BSplinePatch::new(n, m, ku, kv, Net::new(rows, cols, hom).expect("sizes checked"))
+                            .map_err(bad)?,
+                        tol,
+                    )
+                }
+            }
+        }
+    };
+    Ok(mesh)
+}
+
+/// `shape = "loft"`: the surface through `curves` (each a list of control points of a clamped
+/// uniform cubic B-spline, all of the same length), interpolated across by chord length.
+fn loft(t: &Table) -> R<alhazen_geom::TriangleMesh> {
+    use alhazen_geom::bspline::BSpline;
+    let node = t.req("curves")?;
+    let lists: Vec<Vec<Vec3>> = node
+        .array()?
+        .iter()
+        .map(|c| c.array()?.iter().map(|p| p.vec3()).collect::<R<Vec<Vec3>>>())
+        .collect::<R<_>>()?;
+    if lists.len() < 2 || lists.iter().any(|l| l.len() != lists[0].len() || l.len() < 2) {
+        return Err(node.err("`curves`: expected at least 2 curves with the same number (≥ 2) of control points"));
+    }
+    let degree = (lists[0].len() - 1).min(3);
+    let curves: Vec<BSpline<Vec3>> =
+        lists.into_iter().map(|l| BSpline::clamped_uniform(degree, l).expect("valid")).collect();
+    // Parameters across the curves: chord lengths between their first control points' centroids.
+    let centroids: Vec<Vec3> =
+        curves.iter().map(|c| c.points().iter().sum::<Vec3>() / c.points().len() as f64).collect();
+    let params = alhazen_geom::construct::chord_lengths(&centroids);
+    let surface =
+        alhazen_geom::construct::loft(&curves, &params).ok_or_else(|| node.err("the curves cannot be lofted"))?;
+    let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
+    Ok(alhazen_geom::tessellate::tessellate(&surface, tol))
 }
 
 /// `shape = "revolution"`: the NURBS surface of revolution about the `y` axis of the cubic

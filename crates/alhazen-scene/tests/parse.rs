@@ -92,6 +92,9 @@ fn mistakes_are_located_and_explained() {
         err("[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 9\n")
             .contains("`levels` must be an integer in 0..=6")
     );
+    assert!(err("[[object]]\nshape = \"patch\"\nrows = 2\ndegree = [1, 1]\npoints = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]\n").contains("needs all of `degree`, `knots_u` and `knots_v`"));
+    assert!(err("[[object]]\nshape = \"loft\"\ncurves = [[[0, 0, 0], [1, 0, 0]]]\n").contains("at least 2 curves"));
+    assert!(err("[[object]]\nshape = \"revolution\"\nprofile = [[1, 0]]\n").contains("at least 2 points"));
     let late = err("[render]\nwidth = 10\nbackground = 1\n");
     assert!(late.contains("must come before the first [table] header"), "{late}");
 }
