@@ -4,7 +4,8 @@
 //! * [`bresenham_line`] — integer-only lines in all octants;
 //! * [`midpoint_circle`] — integer-only circles (eight-way symmetry);
 //! * [`clip`] — Cohen–Sutherland and Liang–Barsky segment clipping, Sutherland–Hodgman polygon
-//!   clipping against a convex window.
+//!   clipping against a convex window;
+//! * [`fill`] — scanline filling with an active edge table and exact pixel ownership.
 //!
 //! ```
 //! let px = alhazen_raster::bresenham_line((0, 0), (5, 2));
@@ -12,6 +13,7 @@
 //! ```
 
 pub mod clip;
+pub mod fill;
 
 /// The pixels of the segment between two pixel centres, by the course's Bresenham algorithm
 /// generalised to all octants (the roles of `x` and `y` swap when `|Δy| > |Δx|`; increments take
