@@ -58,6 +58,13 @@ impl ReflexesSoA {
         self.visible.resize(n, false);
     }
 
+    /// Stores the scalar solver's answer for a point the fast kernel left undecided.
+    fn set_from_scalar(&mut self, i: usize, answer: Result<Option<crate::Reflex>, MirrorError>) {
+        if let Ok(Some(v)) = answer {
+            self.set(i, v.point);
+        }
+    }
+
     fn set(&mut self, i: usize, p: Vec3) {
         (self.x[i], self.y[i], self.z[i]) = (p.x, p.y, p.z);
         self.visible[i] = true;
@@ -247,10 +254,8 @@ impl Sphere {
                 let perp = (points.get(i) - m) - xh * sx;
                 let (c, s) = cn.normal(i);
                 out.set(i, m + (xh * c + perp * (s / sy)) * r);
-            } else if !forbidden(r, e, sx, sy)
-                && let Ok(Some(v)) = self.visible_reflex(crate::Site::At(eye), crate::Site::At(points.get(i)))
-            {
-                out.set(i, v.point);
+            } else if !forbidden(r, e, sx, sy) {
+                out.set_from_scalar(i, self.visible_reflex(crate::Site::At(eye), crate::Site::At(points.get(i))));
             }
         }
         Ok(())
@@ -292,10 +297,8 @@ impl Cylinder {
                 let (le, ls) = ((Vec2::new(e, 0.0) - foot).length(), (Vec2::new(sx, rel.dot(yh)) - foot).length());
                 let h = he + (rel.dot(a) - he) * le / (le + ls);
                 out.set(i, m + (xh * c + yh * s) * r + a * h);
-            } else if !forbidden(r, e, sx, sy)
-                && let Ok(Some(v)) = self.visible_reflex(crate::Site::At(eye), crate::Site::At(points.get(i)))
-            {
-                out.set(i, v.point);
+            } else if !forbidden(r, e, sx, sy) {
+                out.set_from_scalar(i, self.visible_reflex(crate::Site::At(eye), crate::Site::At(points.get(i))));
             }
         }
         Ok(())

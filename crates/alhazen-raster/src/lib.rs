@@ -19,32 +19,22 @@ pub mod fill;
 /// generalised to all octants (the roles of `x` and `y` swap when `|Δy| > |Δx|`; increments take
 /// the signs of the deltas). Integers only; both end points are included.
 pub fn bresenham_line((x0, y0): (i64, i64), (x1, y1): (i64, i64)) -> Vec<(i64, i64)> {
-    let (dx, dy) = ((x1 - x0).abs(), (y1 - y0).abs());
-    let (g, h) = ((x1 - x0).signum(), (y1 - y0).signum());
-    let mut out = Vec::with_capacity((dx.max(dy) + 1) as usize);
-    let (mut x, mut y) = (x0, y0);
-    if dx >= dy {
-        let mut c = -dx;
-        for _ in 0..=dx {
-            out.push((x, y));
-            c += 2 * dy;
-            if c > 0 {
-                y += h;
-                c -= 2 * dx;
-            }
-            x += g;
+    // Walk the major axis `a` one step at a time; the minor axis `b` steps when the integer error
+    // term `c` (the course's numerator over 2Δa) turns positive.
+    let steep = (y1 - y0).abs() > (x1 - x0).abs();
+    let (a0, b0, a1, b1) = if steep { (y0, x0, y1, x1) } else { (x0, y0, x1, y1) };
+    let (da, db) = ((a1 - a0).abs(), (b1 - b0).abs());
+    let (g, h) = ((a1 - a0).signum(), (b1 - b0).signum());
+    let (mut a, mut b, mut c) = (a0, b0, -da);
+    let mut out = Vec::with_capacity(da as usize + 1);
+    for _ in 0..=da {
+        out.push(if steep { (b, a) } else { (a, b) });
+        c += 2 * db;
+        if c > 0 {
+            b += h;
+            c -= 2 * da;
         }
-    } else {
-        let mut c = -dy;
-        for _ in 0..=dy {
-            out.push((x, y));
-            c += 2 * dx;
-            if c > 0 {
-                x += g;
-                c -= 2 * dy;
-            }
-            y += h;
-        }
+        a += g;
     }
     out
 }

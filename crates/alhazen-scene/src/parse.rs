@@ -443,28 +443,23 @@ fn patch(t: &Table) -> R<alhazen_geom::TriangleMesh> {
         }
         _ => return Err(pts_node.err("a B-spline patch needs all of `degree`, `knots_u` and `knots_v`")),
     };
-    let mesh = match (spline, weights) {
+    // Rational patches live in homogeneous coordinates (w p, w).
+    let homogeneous = weights.map(|ws| points.iter().zip(&ws).map(|(p, w)| (*p * *w).extend(*w)).collect::<Vec<_>>());
+    let mesh = match (spline, homogeneous) {
         (None, None) => tessellate(&BezierPatch { net: Net::new(rows, cols, points).expect("sizes checked") }, tol),
-        (None, Some(ws)) => {
-            let hom = points.iter().zip(&ws).map(|(p, w)| (*p * *w).extend(*w)).collect();
-            tessellate(&BezierPatch { net: Net::new(rows, cols, hom).expect("sizes checked") }, tol)
-        }
-        (Some((n, m, ku, kv, d)), ws) => {
+        (None, Some(hom)) => tessellate(&BezierPatch { net: Net::new(rows, cols, hom).expect("sizes checked") }, tol),
+        (Some((n, m, ku, kv, d)), hom) => {
             let bad = |e: alhazen_geom::bspline::SplineError| d.err(format!("B-spline patch: {e}"));
-            match ws {
+            match hom {
                 None => tessellate(
                     &BSplinePatch::new(n, m, ku, kv, Net::new(rows, cols, points).expect("sizes checked"))
                         .map_err(bad)?,
                     tol,
                 ),
-                Some(ws) => {
-                    let hom = points.iter().zip(&ws).map(|(p, w)| (*p * *w).extend(*w)).collect();
-                    tessellate(
-                        &BSplinePatch::new(n, m, ku, kv, Net::new(rows, cols, hom).expect("sizes checked"))
-                            .map_err(bad)?,
-                        tol,
-                    )
-                }
+                Some(hom) => tessellate(
+                    &BSplinePatch::new(n, m, ku, kv, Net::new(rows, cols, hom).expect("sizes checked")).map_err(bad)?,
+                    tol,
+                ),
             }
         }
     };
