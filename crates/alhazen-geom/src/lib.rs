@@ -117,6 +117,7 @@ impl TriangleMesh {
     }
 
     /// The three corners of triangle `i`.
+    #[inline]
     pub fn corners(&self, i: usize) -> [Vec3; 3] {
         self.triangles[i].map(|v| self.positions[v as usize])
     }

@@ -2,9 +2,6 @@
 //! thread count do not affect any pixel (each sample's randomness is seeded from its pixel and
 //! index), so images are identical at any thread count.
 
-use crate::camera::Camera;
-use crate::sampler::stratified_offset;
-use crate::whitted::Whitted;
 use alhazen_math::Vec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -30,16 +27,21 @@ impl Image {
     }
 }
 
-/// Renders every pixel with `spp` stratified samples; `progress(done, total)` is called as
-/// tiles finish (from worker threads).
+/// Something that estimates the colour of one sample of one pixel.
+pub trait PixelEstimator: Sync {
+    /// Linear RGB of sample `index` of pixel `(x, y)`: a pure function of its arguments.
+    fn sample(&self, x: u32, y: u32, index: u32) -> Vec3;
+}
+
+/// Renders a `w × h` image with `spp` samples per pixel, averaged with a box filter;
+/// `progress(done, total)` is called as tiles finish (from worker threads).
 pub fn render_image(
-    camera: &Camera,
-    integrator: &Whitted,
+    w: u32,
+    h: u32,
+    estimator: &dyn PixelEstimator,
     spp: u32,
-    seed: u64,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Image {
-    let (w, h) = (camera.film_width, camera.film_height);
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
     let done = AtomicUsize::new(0);
@@ -49,7 +51,7 @@ pub fn render_image(
             let mut out = Vec::with_capacity((TILE * TILE) as usize);
             for y in y0..(y0 + TILE).min(h) {
                 for x in x0..(x0 + TILE).min(w) {
-                    out.push(pixel(camera, integrator, x, y, spp, seed));
+                    out.push(pixel(estimator, x, y, spp));
                 }
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, tiles.len());
@@ -67,12 +69,10 @@ pub fn render_image(
     Image { width: w, height: h, pixels }
 }
 
-fn pixel(camera: &Camera, integrator: &Whitted, x: u32, y: u32, spp: u32, seed: u64) -> [f32; 3] {
+fn pixel(estimator: &dyn PixelEstimator, x: u32, y: u32, spp: u32) -> [f32; 3] {
     let mut sum = Vec3::ZERO;
     for s in 0..spp {
-        let (dx, dy) = stratified_offset(seed, x, y, s, spp);
-        let ray = camera.ray(x as f64 + dx, y as f64 + dy);
-        let c = integrator.trace(&ray, 1, 1.0);
+        let c = estimator.sample(x, y, s);
         // A NaN or infinity from a degenerate input must not poison the pixel.
         sum += if c.is_finite() { c } else { Vec3::ZERO };
     }

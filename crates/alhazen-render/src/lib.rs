@@ -27,13 +27,19 @@
 //! assert_eq!(img.get(0, 0).x, 0.0, "black background in the corner");
 //! ```
 
+pub mod bsdf;
 pub mod bvh;
 pub mod camera;
+pub mod distribution;
+pub mod envmap;
 pub mod film;
+pub mod lights;
 pub mod optics;
 pub mod output;
+pub mod path;
 pub mod sampler;
 pub mod shape;
+pub mod spectrum;
 pub mod texture;
 pub mod whitted;
 pub mod world;
@@ -43,7 +49,9 @@ pub use film::Image;
 pub use whitted::Whitted;
 pub use world::World;
 
-use alhazen_scene::Scene;
+use alhazen_scene::{IntegratorKind, Scene};
+use path::PathTracer;
+use whitted::WhittedEstimator;
 
 /// Renders `scene` with its own settings (`scene.render`); `progress(done, total)` reports
 /// finished tiles. Runs on the current rayon pool.
@@ -51,6 +59,16 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(usize, usize) + Sync)) -> Image 
     let world = World::build(scene);
     let s = &scene.render;
     let camera = Camera::new(&scene.camera, s.width, s.height);
-    let integrator = Whitted::new(scene, &world);
-    film::render_image(&camera, &integrator, s.spp, s.seed, progress)
+    let (w, h) = (camera.film_width, camera.film_height);
+    match s.integrator {
+        IntegratorKind::Whitted => {
+            let estimator =
+                WhittedEstimator { whitted: Whitted::new(scene, &world), camera: &camera, spp: s.spp, seed: s.seed };
+            film::render_image(w, h, &estimator, s.spp, progress)
+        }
+        IntegratorKind::Path => {
+            let estimator = PathTracer::new(scene, &world, &camera);
+            film::render_image(w, h, &estimator, s.spp, progress)
+        }
+    }
 }

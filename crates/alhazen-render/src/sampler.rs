@@ -1,6 +1,12 @@
 //! Deterministic randomness: every sample's generator is seeded by hashing
 //! `(seed, pixel x, pixel y, sample index)`, so an image does not depend on thread count or
 //! tile order. Never seeded from entropy.
+//!
+//! Two samplers feed the path tracer through [`SampleStream`]: independent numbers, and a
+//! padded Sobol sequence with Owen scrambling (Burley 2020, "Practical Hash-based Owen
+//! Scrambling"): each pair of dimensions uses the first two Sobol dimensions (a (0,2)-sequence),
+//! with the sample index shuffled and the digits scrambled by hashes of
+//! `(seed, pixel, dimension)`, so strata stay intact at power-of-two sample counts.
 
 /// A small, fast generator (SplitMix64 sequence), adequate for jitter and stratification.
 #[derive(Clone, Debug)]
@@ -33,6 +39,121 @@ impl Rng {
     #[inline]
     pub fn uniform(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// Which sequence a [`SampleStream`] draws from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sequence {
+    /// Independent uniform numbers.
+    Independent,
+    /// Owen-scrambled Sobol points.
+    Sobol,
+}
+
+/// The numbers of one sample of one pixel, dimension after dimension.
+#[derive(Clone, Debug)]
+pub struct SampleStream {
+    sequence: Sequence,
+    pixel_seed: u64,
+    index: u32,
+    dimension: u32,
+    rng: Rng,
+}
+
+/// Laine–Karras style nested uniform scramble of the bits of `x` (reversed order).
+#[inline]
+fn owen_scramble(x: u32, seed: u32) -> u32 {
+    let mut x = x.reverse_bits();
+    x ^= x.wrapping_mul(0x3d20adea);
+    x = x.wrapping_add(seed);
+    x = x.wrapping_mul((seed >> 16) | 1);
+    x ^= x.wrapping_mul(0x05526c56);
+    x ^= x.wrapping_mul(0x53a22864);
+    x.reverse_bits()
+}
+
+/// Column `k` of the generator matrix of the second Sobol dimension (primitive polynomial
+/// `x + 1`, all direction numbers 1): `v_k = v_{k−1} ⊕ (v_{k−1} ≫ 1)`, `v_0 = 2³¹`.
+const fn sobol1_columns() -> [u32; 32] {
+    let mut c = [0u32; 32];
+    let mut v = 1u32 << 31;
+    let mut k = 0;
+    while k < 32 {
+        c[k] = v;
+        v ^= v >> 1;
+        k += 1;
+    }
+    c
+}
+
+/// XOR of the generator columns selected by each byte value, per byte of the index.
+const SOBOL1_BYTES: [[u32; 256]; 4] = {
+    let cols = sobol1_columns();
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut v = 0;
+        while v < 256 {
+            let mut acc = 0u32;
+            let mut bit = 0;
+            while bit < 8 {
+                if v & (1 << bit) != 0 {
+                    acc ^= cols[b * 8 + bit];
+                }
+                bit += 1;
+            }
+            t[b][v] = acc;
+            v += 1;
+        }
+        b += 1;
+    }
+    t
+};
+
+/// The first two Sobol dimensions of point `i`: van der Corput and the `x + 1` polynomial.
+#[inline]
+fn sobol_pair(i: u32) -> (u32, u32) {
+    let t = &SOBOL1_BYTES;
+    let y = t[0][(i & 0xff) as usize]
+        ^ t[1][(i >> 8 & 0xff) as usize]
+        ^ t[2][(i >> 16 & 0xff) as usize]
+        ^ t[3][(i >> 24) as usize];
+    (i.reverse_bits(), y)
+}
+
+#[inline]
+fn to_unit(x: u32) -> f64 {
+    x as f64 * (1.0 / 4_294_967_296.0)
+}
+
+impl SampleStream {
+    /// The stream of sample `index` of pixel `(x, y)`.
+    pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, index: u32) -> Self {
+        let pixel_seed = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d) ^ ((x as u64) << 32 | y as u64));
+        Self { sequence, pixel_seed, index, dimension: 0, rng: Rng::for_sample(seed, x, y, index) }
+    }
+
+    /// The next pair of numbers in `[0, 1)²`.
+    #[inline]
+    pub fn next_2d(&mut self) -> alhazen_math::Vec2 {
+        match self.sequence {
+            Sequence::Independent => alhazen_math::Vec2::new(self.rng.uniform(), self.rng.uniform()),
+            Sequence::Sobol => {
+                let h = mix(self.pixel_seed ^ self.dimension as u64);
+                self.dimension += 1;
+                let shuffled = owen_scramble(self.index, h as u32);
+                let (a, b) = sobol_pair(shuffled);
+                let (sa, sb) = ((h >> 32) as u32, mix(h) as u32);
+                alhazen_math::Vec2::new(to_unit(owen_scramble(a, sa)), to_unit(owen_scramble(b, sb)))
+            }
+        }
+    }
+
+    /// The next number in `[0, 1)`.
+    #[inline]
+    pub fn next_1d(&mut self) -> f64 {
+        self.next_2d().x
     }
 }
 
@@ -107,6 +228,53 @@ mod tests {
             bins[(rng.uniform() * 10.0) as usize] += 1;
         }
         let chi2: f64 = bins.iter().map(|&b| (b as f64 - 10_000.0).powi(2) / 10_000.0).sum();
+        assert!(chi2 < 27.9, "χ² = {chi2}");
+    }
+
+    #[test]
+    fn sobol_tables_match_the_bitwise_definition() {
+        let cols = sobol1_columns();
+        for i in [0u32, 1, 2, 3, 77, 1 << 20, 0xdead_beef, u32::MAX] {
+            let y = (0..32).filter(|k| i >> k & 1 == 1).fold(0, |acc, k| acc ^ cols[k]);
+            assert_eq!(sobol_pair(i).1, y, "{i}");
+        }
+    }
+
+    #[test]
+    fn sobol_points_are_stratified_in_every_dimension_pair() {
+        // 64 scrambled (0,2)-points: one per cell of every elementary 2^a × 2^b interval grid.
+        for dim in 0..4 {
+            let pts: Vec<_> = (0..64)
+                .map(|i| {
+                    let mut s = SampleStream::new(Sequence::Sobol, 9, 5, 7, i);
+                    for _ in 0..dim {
+                        s.next_2d();
+                    }
+                    s.next_2d()
+                })
+                .collect();
+            for a in 0..=6 {
+                let (nx, ny) = (1u32 << a, 1u32 << (6 - a));
+                let mut cells: Vec<u32> =
+                    pts.iter().map(|p| (p.y * ny as f64) as u32 * nx + (p.x * nx as f64) as u32).collect();
+                cells.sort();
+                assert_eq!(cells, (0..64).collect::<Vec<_>>(), "dimension pair {dim}, {nx}×{ny}");
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_differs_between_pixels_and_is_uniform() {
+        let a = SampleStream::new(Sequence::Sobol, 1, 0, 0, 3).next_2d();
+        let b = SampleStream::new(Sequence::Sobol, 1, 1, 0, 3).next_2d();
+        assert_ne!(a, b);
+        let mut bins = [0u32; 10];
+        for px in 0..200 {
+            for i in 0..50 {
+                bins[(SampleStream::new(Sequence::Sobol, 4, px, 1, i).next_1d() * 10.0) as usize] += 1;
+            }
+        }
+        let chi2: f64 = bins.iter().map(|&b| (b as f64 - 1000.0).powi(2) / 1000.0).sum();
         assert!(chi2 < 27.9, "χ² = {chi2}");
     }
 

@@ -5,7 +5,11 @@
 //! transmission coefficient by a Fresnel factor; light travelling inside an absorbing medium
 //! decays by Beer's law `exp(−σ d)`.
 
+use crate::camera::Camera;
+use crate::envmap::EnvMap;
+use crate::film::PixelEstimator;
 use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
+use crate::sampler::stratified_offset;
 use crate::texture;
 use crate::world::{ShadowHit, World, WorldHit};
 use alhazen_math::{Ray, Vec3};
@@ -22,6 +26,7 @@ pub struct Whitted<'a> {
     scene: &'a Scene,
     world: &'a World,
     max_depth: u32,
+    environment: Option<EnvMap>,
 }
 
 /// A self-intersection guard scaled to the magnitude of the coordinates.
@@ -48,6 +53,8 @@ fn light_at(light: &Light, p: Vec3) -> Option<(Vec3, f64, Vec3)> {
             let cos = -l.dot(*direction);
             (d > 0.0 && cos >= *cos_cutoff).then(|| (l, d, *intensity * cos.powf(*e) / falloff(attenuation, d)))
         }
+        // The environment is seen by rays that leave the scene (see `background`).
+        Light::Environment { .. } => None,
     }
 }
 
@@ -64,10 +71,36 @@ fn beer(sigma: Vec3, d: f64) -> Vec3 {
     if sigma == Vec3::ZERO { Vec3::ONE } else { (-sigma * d).exp() }
 }
 
+/// Whitted over a camera with stratified pixel samples.
+pub struct WhittedEstimator<'a> {
+    /// The integrator.
+    pub whitted: Whitted<'a>,
+    /// The camera.
+    pub camera: &'a Camera,
+    /// Samples per pixel (for stratification).
+    pub spp: u32,
+    /// Seed.
+    pub seed: u64,
+}
+
+impl PixelEstimator for WhittedEstimator<'_> {
+    fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
+        let (dx, dy) = stratified_offset(self.seed, x, y, index, self.spp);
+        let ray = self.camera.ray(x as f64 + dx, y as f64 + dy);
+        self.whitted.trace(&ray, 1, 1.0)
+    }
+}
+
 impl<'a> Whitted<'a> {
     /// The integrator for `scene` over `world`.
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
-        Self { scene, world, max_depth: scene.render.max_depth.max(1) }
+        let environment = scene.lights.iter().find_map(|l| match *l {
+            Light::Environment { image, scale, rotation } => {
+                Some(EnvMap::new(scene.images[image].clone(), scale, rotation))
+            }
+            _ => None,
+        });
+        Self { scene, world, max_depth: scene.render.max_depth.max(1), environment }
     }
 
     /// `RT_trace`: radiance along `ray` (unit direction); `depth` starts at 1 for camera rays,
@@ -80,6 +113,9 @@ impl<'a> Whitted<'a> {
     }
 
     fn background(&self, dir: Vec3) -> Vec3 {
+        if let Some(env) = &self.environment {
+            return env.radiance(dir);
+        }
         match self.scene.background {
             Background::Solid(c) => c,
             Background::Gradient { zenith, horizon, ground } => {

@@ -5,7 +5,7 @@ use crate::bvh::Bvh;
 use crate::shape::{
     AaBox, Candidate, Cone, Csg, Cylinder, Disk, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit,
 };
-use alhazen_math::{Bounds3, Ray};
+use alhazen_math::{Bounds3, Ray, Vec3};
 use alhazen_scene as scene;
 use std::sync::Arc;
 
@@ -47,6 +47,8 @@ pub struct WorldHit {
     pub hit: SurfaceHit,
     /// Material index.
     pub material: u32,
+    /// Index of the scene object.
+    pub object: u32,
 }
 
 fn build_shape(s: &scene::Shape, meshes: &[Arc<MeshAccel>]) -> Shape {
@@ -70,6 +72,33 @@ fn build_shape(s: &scene::Shape, meshes: &[Arc<MeshAccel>]) -> Shape {
     }
 }
 
+/// Meshes up to this size are copied into world space when placed, so their rays need no
+/// transform; larger ones are shared between instances.
+const BAKE_TRIANGLES: usize = 256;
+
+/// A small mesh with `tf` applied to its positions and normals.
+fn baked(mesh: &alhazen_geom::TriangleMesh, tf: &alhazen_math::Transform) -> alhazen_geom::TriangleMesh {
+    let mut m = mesh.clone();
+    m.positions.iter_mut().for_each(|p| *p = tf.point(*p));
+    m.normals.iter_mut().for_each(|n| *n = tf.normal(*n).normalize_or_zero());
+    // A mirroring transform reverses the winding; keep the outside outside.
+    if tf.vector(Vec3::X).cross(tf.vector(Vec3::Y)).dot(tf.vector(Vec3::Z)) < 0.0 {
+        m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    m
+}
+
+fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene) -> Placed {
+    if let scene::Shape::Mesh { mesh, smooth } = o.shape {
+        let m = &scene.meshes[mesh];
+        if !o.transform.is_identity() && m.triangle_count() <= BAKE_TRIANGLES {
+            let accel = Arc::new(MeshAccel::new(Arc::new(baked(m, &o.transform))));
+            return Placed::new(Shape::Mesh(MeshShape { accel, smooth }), alhazen_math::Transform::IDENTITY);
+        }
+    }
+    Placed::new(build_shape(&o.shape, meshes), o.transform)
+}
+
 impl World {
     /// Places every object of `scene` and builds the BVH.
     pub fn build(scene: &scene::Scene) -> Self {
@@ -78,7 +107,7 @@ impl World {
             .objects
             .iter()
             .map(|o| WorldObject {
-                placed: Placed::new(build_shape(&o.shape, &meshes), o.transform),
+                placed: place(o, &meshes, scene),
                 material: o.material,
                 slot_materials: o.mesh_materials.clone(),
             })
@@ -122,7 +151,7 @@ impl World {
         let o = &self.objects[i as usize];
         let hit = o.placed.surface(ray, c);
         let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
-        Some(WorldHit { hit, material })
+        Some(WorldHit { hit, material, object: i })
     }
 
     /// What a shadow ray meets first: asks `is_opaque(material)` before computing the
@@ -139,7 +168,13 @@ impl World {
         if is_opaque(material) {
             return ShadowHit::Opaque;
         }
-        ShadowHit::Transparent(WorldHit { hit, material })
+        ShadowHit::Transparent(WorldHit { hit, material, object: i })
+    }
+
+    /// True when nothing blocks the segment from `origin` along unit `dir` over `dist`.
+    #[inline]
+    pub fn unoccluded(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
+        self.nearest(&Ray::new(origin, dir), dist).is_none()
     }
 
     /// The nearest hit by testing every object (the reference for BVH tests).

@@ -394,6 +394,17 @@ pub fn load_image(path: &Path) -> Result<ImageData, String> {
     })
 }
 
+/// Loads a high-dynamic-range image (Radiance `.hdr` or OpenEXR), whose values are linear
+/// radiance already.
+pub fn load_hdr_image(path: &Path) -> Result<ImageData, String> {
+    let img = image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))?.to_rgb32f();
+    let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
+    if pixels.iter().flatten().any(|v| !v.is_finite() || *v < 0.0) {
+        return Err(format!("{}: the image has negative, infinite or NaN values", path.display()));
+    }
+    Ok(ImageData { width: img.width(), height: img.height(), pixels })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -16,10 +16,12 @@
 //! assert!(err.to_string().contains("inline.toml:3:1: unknown key `radus`"));
 //! ```
 
+pub mod bsdf;
 mod diagnostic;
 pub mod import;
 pub mod model;
 mod parse;
+mod parse_bsdf;
 mod reader;
 
 pub use diagnostic::{Diagnostic, did_you_mean};

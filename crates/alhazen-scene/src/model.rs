@@ -40,6 +40,17 @@ pub struct Scene {
 pub enum IntegratorKind {
     /// Recursive ray tracing (the lecture's `RT_trace`/`RT_shade`).
     Whitted,
+    /// Unidirectional path tracing of the rendering equation (course, §"Global lighting models").
+    Path,
+}
+
+/// Where the path tracer's random numbers come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerKind {
+    /// Independent uniform numbers per sample.
+    Independent,
+    /// Sobol points, Owen-scrambled per pixel and dimension (low discrepancy).
+    Sobol,
 }
 
 /// Image size and sampling.
@@ -57,11 +68,21 @@ pub struct RenderSettings {
     pub seed: u64,
     /// The integrator.
     pub integrator: IntegratorKind,
+    /// The path tracer's sampler.
+    pub sampler: SamplerKind,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { width: 640, height: 480, spp: 4, max_depth: 8, seed: 0, integrator: IntegratorKind::Whitted }
+        Self {
+            width: 640,
+            height: 480,
+            spp: 4,
+            max_depth: 8,
+            seed: 0,
+            integrator: IntegratorKind::Whitted,
+            sampler: SamplerKind::Sobol,
+        }
     }
 }
 
@@ -204,6 +225,15 @@ pub enum Light {
         /// `[a, b, c]`.
         attenuation: [f64; 3],
     },
+    /// Light from infinitely far away in every direction, given by an equirectangular image.
+    Environment {
+        /// Index into [`Scene::images`] (linear radiance).
+        image: usize,
+        /// Multiplier of the image's values.
+        scale: f64,
+        /// Rotation of the map about the vertical axis, radians.
+        rotation: f64,
+    },
 }
 
 /// A colour that may vary over a surface.
@@ -274,6 +304,11 @@ pub struct Material {
     pub absorption: Rgb,
     /// Fresnel treatment of transparent surfaces.
     pub fresnel: FresnelMode,
+    /// Radiance emitted from the front side: a non-zero value makes the object an area light.
+    pub emission: Rgb,
+    /// The scattering function for the path tracer; `None` derives one from the Whitted
+    /// coefficients (see [`crate::bsdf`]).
+    pub bsdf: Option<crate::bsdf::BsdfDesc>,
 }
 
 impl Default for Material {
@@ -290,6 +325,8 @@ impl Default for Material {
             ior: 1.5,
             absorption: Vec3::ZERO,
             fresnel: FresnelMode::Exact,
+            emission: Vec3::ZERO,
+            bsdf: None,
         }
     }
 }

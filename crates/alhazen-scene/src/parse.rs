@@ -55,9 +55,9 @@ fn empty_scene() -> Scene {
     }
 }
 
-struct Parser<'a> {
-    dir: &'a Path,
-    scene: Scene,
+pub(crate) struct Parser<'a> {
+    pub(crate) dir: &'a Path,
+    pub(crate) scene: Scene,
     material_names: HashMap<String, MaterialId>,
     mesh_names: HashMap<String, (usize, Vec<MaterialId>)>,
 }
@@ -92,7 +92,11 @@ impl Parser<'_> {
             }
         }
         for n in top.get("light").map(|n| n.array()).transpose()?.unwrap_or_default() {
-            self.scene.lights.push(light(&n)?);
+            let l = match n.table_any()?.get("type") {
+                Some(k) if k.str()? == "environment" => self.environment_light(&n)?,
+                _ => light(&n)?,
+            };
+            self.scene.lights.push(l);
         }
         for n in top.get("object").map(|n| n.array()).transpose()?.unwrap_or_default() {
             let o = self.object(&n, 0)?;
@@ -120,13 +124,16 @@ impl Parser<'_> {
             "ior",
             "absorption",
             "fresnel",
+            "emission",
+            "bsdf",
         ];
         let t = n.table(KEYS)?;
         let d = Material::default();
         let color = match t.get("color") {
             Some(c) => self.texture(&c)?,
-            None => d.color,
+            None => d.color.clone(),
         };
+        let bsdf = t.get("bsdf").map(|b| self.bsdf(&b, &color)).transpose()?;
         Ok(Material {
             name: name.to_string(),
             color,
@@ -152,10 +159,12 @@ impl Parser<'_> {
                 },
                 None => d.fresnel,
             },
+            emission: t.opt_rgb("emission", d.emission)?,
+            bsdf,
         })
     }
 
-    fn texture(&mut self, n: &Node) -> R<Texture> {
+    pub(crate) fn texture(&mut self, n: &Node) -> R<Texture> {
         if !n.is_table() {
             return Ok(Texture::Solid(n.rgb()?));
         }
@@ -286,6 +295,7 @@ impl Parser<'_> {
             "revolution",
             "sweep",
             "loft",
+            "rectangle",
         ])?;
         let specific: &[&str] = match kind {
             "sphere" => &["center", "radius"],
@@ -301,6 +311,7 @@ impl Parser<'_> {
             "curve" => &["kind", "degree", "points", "radius"],
             "revolution" => &["profile", "tolerance", "smooth"],
             "sweep" => &["guide", "radius", "tolerance", "smooth"],
+            "rectangle" => &[],
             _ => &["op", "a", "b"],
         };
         let keys: Vec<&str> = COMMON.iter().chain(specific).copied().collect();
@@ -342,8 +353,9 @@ impl Parser<'_> {
                 }
                 Shape::Box { min, max }
             }
-            "subdivision" | "patch" | "curve" | "revolution" | "sweep" | "loft" => {
+            "subdivision" | "patch" | "curve" | "revolution" | "sweep" | "loft" | "rectangle" => {
                 let mesh = match kind {
+                    "rectangle" => rectangle(),
                     "subdivision" => self.subdivision(&t)?,
                     "patch" => patch(&t)?,
                     "revolution" => revolution(&t)?,
@@ -466,6 +478,24 @@ fn patch(t: &Table) -> R<alhazen_geom::TriangleMesh> {
     Ok(mesh)
 }
 
+/// `shape = "rectangle"`: the square `[−1, 1]²` in the plane `z = 0`, facing `+z` (as Mitsuba's
+/// `rectangle`); place and size it with `transform`.
+fn rectangle() -> alhazen_geom::TriangleMesh {
+    let positions = vec![
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 0.0),
+    ];
+    alhazen_geom::TriangleMesh {
+        positions,
+        normals: vec![Vec3::Z; 4],
+        uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        ..Default::default()
+    }
+}
+
 /// `shape = "loft"`: the surface through `curves` (each a list of control points of a clamped
 /// uniform cubic B-spline, all of the same length), interpolated across by chord length.
 fn loft(t: &Table) -> R<alhazen_geom::TriangleMesh> {
@@ -565,7 +595,7 @@ impl<'a, 'i> Node<'a, 'i> {
 }
 
 fn render_settings(n: &Node) -> R<RenderSettings> {
-    let t = n.table(&["width", "height", "spp", "max_depth", "seed", "integrator"])?;
+    let t = n.table(&["width", "height", "spp", "max_depth", "seed", "integrator", "sampler"])?;
     let d = RenderSettings::default();
     let r = RenderSettings {
         width: t.get("width").map_or(Ok(d.width as u64), |n| n.integer(1, MAX_SIDE))? as u32,
@@ -574,11 +604,18 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
         max_depth: t.get("max_depth").map_or(Ok(d.max_depth as u64), |n| n.integer(0, 1000))? as u32,
         seed: t.get("seed").map_or(Ok(0), |n| n.integer(0, i64::MAX as u64))?,
         integrator: match t.get("integrator") {
-            Some(i) => {
-                i.choice(&["whitted"])?;
-                IntegratorKind::Whitted
-            }
+            Some(i) => match i.choice(&["whitted", "path"])? {
+                "whitted" => IntegratorKind::Whitted,
+                _ => IntegratorKind::Path,
+            },
             None => d.integrator,
+        },
+        sampler: match t.get("sampler") {
+            Some(i) => match i.choice(&["sobol", "independent"])? {
+                "sobol" => SamplerKind::Sobol,
+                _ => SamplerKind::Independent,
+            },
+            None => d.sampler,
         },
     };
     if r.width as u64 * r.height as u64 > MAX_PIXELS {
@@ -701,7 +738,7 @@ fn attenuation(t: &Table) -> R<[f64; 3]> {
 
 fn light(n: &Node) -> R<Light> {
     let t = n.table_any()?;
-    let kind = t.req("type")?.choice(&["point", "directional", "spot"])?;
+    let kind = t.req("type")?.choice(&["point", "directional", "spot", "environment"])?;
     let keys: &[&str] = match kind {
         "point" => &["type", "position", "intensity", "attenuation"],
         "directional" => &["type", "direction", "intensity"],

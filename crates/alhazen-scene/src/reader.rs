@@ -233,6 +233,10 @@ impl<'a, 'i> Table<'a, 'i> {
         self.get(key).map_or(Ok(default), |n| n.rgb())
     }
 
+    pub fn opt_positive(&self, key: &str, default: f64) -> R<f64> {
+        self.get(key).map_or(Ok(default), |n| n.positive())
+    }
+
     pub fn opt_bool(&self, key: &str, default: bool) -> R<bool> {
         self.get(key).map_or(Ok(default), |n| n.bool())
     }

@@ -1,0 +1,119 @@
+//! From a scene material to the [`Bsdf`] at one surface point: textures looked up, colours
+//! converted to the path's wavelengths when rendering spectrally, the index of a dispersive
+//! glass taken at the hero wavelength.
+
+use super::*;
+use crate::texture;
+use alhazen_scene::bsdf::{BsdfDesc, Ior};
+use alhazen_scene::{FresnelMode, ImageData, Material};
+use std::sync::Arc;
+
+/// What the path knows about colour: RGB, or three wavelengths (hero first).
+#[derive(Clone, Copy, Debug)]
+pub enum ColorMode {
+    /// Channels are linear RGB.
+    Rgb,
+    /// Channels are radiance at these wavelengths (nm).
+    Spectral([f64; 3]),
+}
+
+impl ColorMode {
+    /// An RGB reflectance or radiance in this mode's channels.
+    pub fn color(&self, rgb: Vec3) -> Vec3 {
+        match self {
+            ColorMode::Rgb => rgb,
+            ColorMode::Spectral(l) => crate::spectrum::rgb_to_spectrum(rgb, l),
+        }
+    }
+
+    fn ior(&self, ior: &Ior) -> f64 {
+        match self {
+            ColorMode::Spectral(l) if ior.is_dispersive() => ior.at(l[0]),
+            _ => ior.nominal(),
+        }
+    }
+}
+
+/// The BSDF of `m` at texture coordinates `uv`.
+pub fn bsdf_at(m: &Material, uv: Vec2, images: &[Arc<ImageData>], mode: ColorMode) -> Bsdf {
+    let tex = |t: &alhazen_scene::Texture| mode.color(texture::eval(t, uv, images));
+    match &m.bsdf {
+        Some(desc) => from_desc(desc, &tex, mode),
+        None => whitted_equivalent(m, &tex, mode),
+    }
+}
+
+/// The path tracer's reading of a Whitted material: glass when transparent, else Lambert plus
+/// an ideal mirror of weight `max(mirror)`.
+fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mode: ColorMode) -> Bsdf {
+    if m.transparency != Vec3::ZERO {
+        return Bsdf::Dielectric(Dielectric {
+            facets: None,
+            eta: m.ior,
+            schlick: m.fresnel == FresnelMode::Schlick,
+            dispersive: false,
+        });
+    }
+    let lambert = Bsdf::Lambert(Lambert { albedo: tex(&m.color) * m.diffuse });
+    let w = m.mirror.max_element().min(1.0);
+    if w <= 0.0 {
+        return lambert;
+    }
+    let mirror = Bsdf::Conductor(Conductor {
+        facets: None,
+        eta: Vec3::ZERO,
+        k: Vec3::ZERO,
+        tint: mode.color(m.mirror / w),
+        schlick: false,
+    });
+    Bsdf::Mix(Box::new(Mix { a: mirror, b: lambert, weight: w }))
+}
+
+fn from_desc(desc: &BsdfDesc, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mode: ColorMode) -> Bsdf {
+    match desc {
+        BsdfDesc::Lambert { albedo } => Bsdf::Lambert(Lambert { albedo: tex(albedo) }),
+        BsdfDesc::OrenNayar { albedo, sigma, interreflection } => {
+            Bsdf::OrenNayar(OrenNayar { albedo: tex(albedo), sigma: *sigma, interreflection: *interreflection })
+        }
+        BsdfDesc::Phong { albedo, kd, ks, exponent } => {
+            Bsdf::Phong(Phong { diffuse: tex(albedo) * *kd, ks: *ks, exponent: *exponent })
+        }
+        BsdfDesc::BlinnPhong { albedo, kd, ks, exponent, anisotropy, .. } => Bsdf::BlinnPhong(BlinnPhong {
+            diffuse: tex(albedo) * *kd,
+            ks: *ks,
+            exponent: *exponent,
+            anisotropy: *anisotropy,
+        }),
+        BsdfDesc::CookTorrance { albedo, kd, ks, facets, ior, fresnel } => Bsdf::CookTorrance(CookTorrance {
+            diffuse: tex(albedo) * *kd,
+            ks: *ks,
+            facets: Microfacet::new(facets),
+            ior: *ior,
+            schlick: *fresnel == FresnelMode::Schlick,
+        }),
+        BsdfDesc::Conductor { facets, eta, k, tint, fresnel } => Bsdf::Conductor(Conductor {
+            facets: facets.as_ref().map(Microfacet::new),
+            eta: mode.color(*eta),
+            k: mode.color(*k),
+            tint: mode.color(*tint),
+            schlick: *fresnel == FresnelMode::Schlick,
+        }),
+        BsdfDesc::Dielectric { facets, ior, fresnel } => Bsdf::Dielectric(Dielectric {
+            facets: facets.as_ref().map(Microfacet::new),
+            eta: mode.ior(ior),
+            schlick: *fresnel == FresnelMode::Schlick,
+            dispersive: ior.is_dispersive() && matches!(mode, ColorMode::Spectral(_)),
+        }),
+        BsdfDesc::Mix { a, b, weight } => {
+            Bsdf::Mix(Box::new(Mix { a: from_desc(a, tex, mode), b: from_desc(b, tex, mode), weight: *weight }))
+        }
+    }
+}
+
+/// The tangent direction that anisotropic lobes align with (world space).
+pub fn tangent_hint(m: &Material) -> Vec3 {
+    match &m.bsdf {
+        Some(BsdfDesc::BlinnPhong { scratches, .. }) => *scratches,
+        _ => Vec3::X,
+    }
+}

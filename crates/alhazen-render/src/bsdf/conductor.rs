@@ -1,0 +1,124 @@
+//! Metals: Fresnel reflection with a complex index of refraction `η + iκ` per RGB channel
+//! (course: "F_λ depends … on its refraction index, which depends on the wavelength"), as a
+//! perfect mirror or as the microfacet `ρ = D G F / (4⟨l,n⟩⟨v,n⟩)`; Schlick's approximation from
+//! the exact normal-incidence reflectance as an option.
+//!
+//! Parameters: `eta`, `k` (per channel), roughness/distribution/shadowing or none (smooth),
+//! `tint` (a multiplier, 1 is physical), Fresnel mode. `η = κ = 0` is an ideal mirror (`F = tint`).
+
+use super::microfacet::Microfacet;
+use super::{BsdfSample, reflect, same_side};
+use alhazen_math::{Vec2, Vec3};
+
+/// A conductor.
+#[derive(Clone, Copy, Debug)]
+pub struct Conductor {
+    /// Rough, or smooth when `None`.
+    pub facets: Option<Microfacet>,
+    /// Real part of the index.
+    pub eta: Vec3,
+    /// Imaginary part.
+    pub k: Vec3,
+    /// Multiplier.
+    pub tint: Vec3,
+    /// Schlick instead of the exact formula.
+    pub schlick: bool,
+}
+
+/// Minimal complex arithmetic for the conductor Fresnel equations.
+#[derive(Clone, Copy, Debug)]
+struct C(f64, f64);
+
+impl C {
+    fn add(self, o: C) -> C {
+        C(self.0 + o.0, self.1 + o.1)
+    }
+    fn sub(self, o: C) -> C {
+        C(self.0 - o.0, self.1 - o.1)
+    }
+    fn mul(self, o: C) -> C {
+        C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
+    }
+    fn div(self, o: C) -> C {
+        let d = o.0 * o.0 + o.1 * o.1;
+        C((self.0 * o.0 + self.1 * o.1) / d, (self.1 * o.0 - self.0 * o.1) / d)
+    }
+    fn norm2(self) -> f64 {
+        self.0 * self.0 + self.1 * self.1
+    }
+    fn sqrt(self) -> C {
+        let r = self.norm2().sqrt();
+        let re = ((r + self.0) / 2.0).max(0.0).sqrt();
+        let im = ((r - self.0) / 2.0).max(0.0).sqrt();
+        C(re, if self.1 < 0.0 { -im } else { im })
+    }
+}
+
+/// Unpolarised reflectance of a conductor `η + iκ` at incidence cosine `cos_i`:
+/// `½(|r_∥|² + |r_⊥|²)` with the complex cosine of the transmitted angle.
+pub fn fresnel_conductor(cos_i: f64, eta: f64, k: f64) -> f64 {
+    let c = cos_i.abs().min(1.0);
+    let n = C(eta, k);
+    let sin2_t = C(1.0 - c * c, 0.0).div(n.mul(n));
+    let cos_t = C(1.0, 0.0).sub(sin2_t).sqrt();
+    let ci = C(c, 0.0);
+    let r_par = n.mul(ci).sub(cos_t).div(n.mul(ci).add(cos_t));
+    let r_perp = ci.sub(n.mul(cos_t)).div(ci.add(n.mul(cos_t)));
+    ((r_par.norm2() + r_perp.norm2()) / 2.0).min(1.0)
+}
+
+impl Conductor {
+    /// `F` per channel at `cos`; `η = κ = 0` stands for an ideal mirror of reflectance `tint`.
+    pub fn fresnel(&self, cos: f64) -> Vec3 {
+        if self.eta == Vec3::ZERO && self.k == Vec3::ZERO {
+            return self.tint;
+        }
+        let f = |i: usize| {
+            if self.schlick {
+                let f0 = fresnel_conductor(1.0, self.eta[i], self.k[i]);
+                f0 + (1.0 - f0) * (1.0 - cos.abs().min(1.0)).powi(5)
+            } else {
+                fresnel_conductor(cos, self.eta[i], self.k[i])
+            }
+        };
+        Vec3::new(f(0), f(1), f(2)) * self.tint
+    }
+
+    fn half(v: Vec3, l: Vec3) -> Option<Vec3> {
+        let h = (v + l).normalize_or_zero();
+        (h != Vec3::ZERO).then(|| h * h.z.signum())
+    }
+
+    /// `D G F / (4⟨l,n⟩⟨v,n⟩)`; 0 for a smooth metal.
+    pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
+        let Some(f) = &self.facets else { return Vec3::ZERO };
+        if !same_side(v, l) {
+            return Vec3::ZERO;
+        }
+        let Some(h) = Self::half(v, l) else { return Vec3::ZERO };
+        self.fresnel(h.dot(l)) * (f.d(h) * f.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()))
+    }
+
+    /// `D(h) cos ϑ_h / (4⟨h,v⟩)`.
+    pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
+        let Some(f) = &self.facets else { return 0.0 };
+        if !same_side(v, l) {
+            return 0.0;
+        }
+        let Some(h) = Self::half(v, l) else { return 0.0 };
+        f.pdf_h(h) / (4.0 * h.dot(v).abs())
+    }
+
+    /// The mirror direction, or reflection about a sampled facet.
+    pub fn sample(&self, v: Vec3, _uc: f64, u: Vec2) -> Option<BsdfSample> {
+        let Some(facets) = &self.facets else {
+            let l = Vec3::new(-v.x, -v.y, v.z);
+            let f = self.fresnel(v.z) / v.z.abs();
+            return Some(BsdfSample { l, f, pdf: 1.0, delta: true, eta: 1.0, dispersive: false });
+        };
+        let h = facets.sample_h(u)?;
+        let l = reflect(v, h * v.z.signum());
+        let pdf = self.pdf(v, l);
+        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+}

@@ -1,0 +1,47 @@
+//! A convex combination `w·ρ_a + (1 − w)·ρ_b` of two scattering functions (the course's "convex
+//! combination of the distributions" for surfaces with several families of microfacets).
+//!
+//! Parameters: the two BSDFs and the weight `w ∈ [0, 1]` of the first.
+
+use super::{Bsdf, BsdfSample};
+use alhazen_math::{Vec2, Vec3};
+
+/// A blend of two BSDFs.
+#[derive(Clone, Debug)]
+pub struct Mix {
+    /// First.
+    pub a: Bsdf,
+    /// Second.
+    pub b: Bsdf,
+    /// Weight of `a`.
+    pub weight: f64,
+}
+
+impl Mix {
+    /// Weighted sum.
+    pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
+        self.a.eval(v, l) * self.weight + self.b.eval(v, l) * (1.0 - self.weight)
+    }
+
+    /// Weighted sum of the densities.
+    pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
+        self.a.pdf(v, l) * self.weight + self.b.pdf(v, l) * (1.0 - self.weight)
+    }
+
+    /// Picks a component by `uc` (rescaled for the component's own use). A delta sample keeps its
+    /// own weight times the choice probability; a smooth one is re-evaluated as the full mixture.
+    pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
+        let (first, uc2) =
+            if uc < self.weight { (true, uc / self.weight) } else { (false, (uc - self.weight) / (1.0 - self.weight)) };
+        let (chosen, p) = if first { (&self.a, self.weight) } else { (&self.b, 1.0 - self.weight) };
+        let mut s = chosen.sample(v, uc2.min(1.0 - 1e-16), u)?;
+        if s.delta {
+            s.f *= p;
+            s.pdf *= p;
+            return Some(s);
+        }
+        s.f = self.eval(v, s.l);
+        s.pdf = self.pdf(v, s.l);
+        (s.pdf > 0.0).then_some(s)
+    }
+}

@@ -1,0 +1,203 @@
+//! Physically based scattering functions (course §"Physically based models"), one file each.
+//!
+//! Conventions (the course's): `v` is the unit direction towards the viewer (where the path came
+//! from), `l` towards the light (where it goes next); both point away from the surface and are
+//! given in the local shading frame, whose `z` axis is the normal. `eval` returns `ρ(l, v)`
+//! without the cosine; `pdf` is the solid-angle density of `sample` choosing `l`; delta lobes
+//! (mirrors, smooth glass) are reached only through `sample`. Reflection lobes carry the
+//! course's same-side factor `v`: zero unless `l` and `v` are on the same side of the surface.
+
+mod blinn_phong;
+mod build;
+mod conductor;
+mod cook_torrance;
+mod dielectric;
+mod lambert;
+pub mod microfacet;
+mod mix;
+mod oren_nayar;
+mod phong;
+
+pub use blinn_phong::BlinnPhong;
+pub use build::{ColorMode, bsdf_at, tangent_hint};
+pub use conductor::Conductor;
+pub use cook_torrance::CookTorrance;
+pub use dielectric::Dielectric;
+pub use lambert::Lambert;
+pub use microfacet::Microfacet;
+pub use mix::Mix;
+pub use oren_nayar::OrenNayar;
+pub use phong::Phong;
+
+use alhazen_math::{Vec2, Vec3};
+use std::f64::consts::PI;
+
+/// What `sample` chose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Direction towards the light, local frame.
+    pub l: Vec3,
+    /// `ρ(l, v)` (for delta lobes: the weight divided by `|cos|`).
+    pub f: Vec3,
+    /// Density of choosing `l` (for delta lobes: the discrete probability).
+    pub pdf: f64,
+    /// True for a mirror or smooth refraction.
+    pub delta: bool,
+    /// Relative index `η_l/η_v` crossed (1 for reflection).
+    pub eta: f64,
+    /// True when the index that bent this ray depends on wavelength.
+    pub dispersive: bool,
+}
+
+/// One scattering function at one surface point, colours resolved.
+#[derive(Clone, Debug)]
+pub enum Bsdf {
+    /// Lambert.
+    Lambert(Lambert),
+    /// Oren–Nayar.
+    OrenNayar(OrenNayar),
+    /// Normalised Phong.
+    Phong(Phong),
+    /// Normalised (anisotropic) Blinn–Phong.
+    BlinnPhong(BlinnPhong),
+    /// Cook–Torrance.
+    CookTorrance(CookTorrance),
+    /// Metal.
+    Conductor(Conductor),
+    /// Glass.
+    Dielectric(Dielectric),
+    /// Blend of two.
+    Mix(Box<Mix>),
+}
+
+macro_rules! dispatch {
+    ($self:ident, $b:ident => $e:expr) => {
+        match $self {
+            Bsdf::Lambert($b) => $e,
+            Bsdf::OrenNayar($b) => $e,
+            Bsdf::Phong($b) => $e,
+            Bsdf::BlinnPhong($b) => $e,
+            Bsdf::CookTorrance($b) => $e,
+            Bsdf::Conductor($b) => $e,
+            Bsdf::Dielectric($b) => $e,
+            Bsdf::Mix($b) => $e,
+        }
+    };
+}
+
+impl Bsdf {
+    /// `ρ(l, v)`; zero for delta lobes.
+    pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
+        dispatch!(self, b => b.eval(v, l))
+    }
+
+    /// Density of `sample` returning `l` (non-delta part).
+    pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
+        dispatch!(self, b => b.pdf(v, l))
+    }
+
+    /// Chooses `l` from `v`; `uc` picks a lobe, `u` places the direction.
+    pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
+        dispatch!(self, b => b.sample(v, uc, u))
+    }
+
+    /// True when every lobe is a delta (no light sampling helps).
+    pub fn is_delta(&self) -> bool {
+        match self {
+            Bsdf::Conductor(c) => c.facets.is_none(),
+            Bsdf::Dielectric(d) => d.facets.is_none(),
+            Bsdf::Mix(m) => m.a.is_delta() && m.b.is_delta(),
+            _ => false,
+        }
+    }
+
+    /// True when light passes through (the surface has an inside).
+    pub fn transmits(&self) -> bool {
+        match self {
+            Bsdf::Dielectric(_) => true,
+            Bsdf::Mix(m) => m.a.transmits() || m.b.transmits(),
+            _ => false,
+        }
+    }
+}
+
+/// A right-handed frame `(s, t, n)`.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    /// Tangent.
+    pub s: Vec3,
+    /// Bitangent.
+    pub t: Vec3,
+    /// Normal.
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// A frame around `n` with `s` along the projection of `tangent` on the tangent plane (any
+    /// tangent when that is degenerate).
+    pub fn new(n: Vec3, tangent: Vec3) -> Self {
+        let s = tangent - n * n.dot(tangent);
+        let s = if s.length_squared() > 1e-12 { s.normalize() } else { alhazen_math::orthonormal_basis(n).0 };
+        Self { s, t: n.cross(s), n }
+    }
+
+    /// World → local.
+    pub fn to_local(&self, w: Vec3) -> Vec3 {
+        Vec3::new(w.dot(self.s), w.dot(self.t), w.dot(self.n))
+    }
+
+    /// Local → world.
+    pub fn to_world(&self, w: Vec3) -> Vec3 {
+        self.s * w.x + self.t * w.y + self.n * w.z
+    }
+}
+
+/// The course's same-side factor `v` for a reflection lobe.
+#[inline]
+pub(crate) fn same_side(v: Vec3, l: Vec3) -> bool {
+    v.z * l.z > 0.0
+}
+
+/// Cosine-weighted direction in the hemisphere of `v` (Malley's method), density `|cos|/π`.
+pub(crate) fn cosine_hemisphere(u: Vec2, v: Vec3) -> Vec3 {
+    let r = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    let z = (1.0 - u.x).max(0.0).sqrt();
+    Vec3::new(r * phi.cos(), r * phi.sin(), if v.z < 0.0 { -z } else { z })
+}
+
+/// Density of [`cosine_hemisphere`].
+#[inline]
+pub(crate) fn cosine_pdf(v: Vec3, l: Vec3) -> f64 {
+    if same_side(v, l) { l.z.abs() / PI } else { 0.0 }
+}
+
+/// Mirror of `v` about `n` (both local).
+#[inline]
+pub(crate) fn reflect(v: Vec3, n: Vec3) -> Vec3 {
+    2.0 * v.dot(n) * n - v
+}
+
+/// The direction `v` refracts into through a surface with normal `n` and relative index
+/// `eta = η_inside/η_outside` (inside is `−n`); `None` under total internal reflection. Returns
+/// the direction and the index ratio `η_l/η_v` crossed.
+pub(crate) fn refract(v: Vec3, mut n: Vec3, mut eta: f64) -> Option<(Vec3, f64)> {
+    let mut cos_i = n.dot(v);
+    if cos_i < 0.0 {
+        eta = 1.0 / eta;
+        cos_i = -cos_i;
+        n = -n;
+    }
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((-v / eta + (cos_i / eta - cos_t) * n, eta))
+}
+
+/// Lobe choice probability proportional to two non-negative weights (0.5 each when both vanish).
+#[inline]
+pub(crate) fn lobe_probability(a: f64, b: f64) -> f64 {
+    if a + b > 0.0 { a / (a + b) } else { 0.5 }
+}

@@ -1,0 +1,379 @@
+//! The path tracer's light sources: point, spot and directional lights (delta), area lights
+//! (any object whose material emits: spheres sampled by solid angle, triangles — meshes,
+//! rectangles, boxes — and disks by area), the environment map and a coloured background
+//! (uniformly over the sphere). Lights are chosen uniformly; every density here includes that
+//! choice. Emitters of other shapes still shine when paths hit them, without light sampling.
+
+use crate::distribution::Distribution1D;
+use crate::envmap::EnvMap;
+use alhazen_math::{Vec2, Vec3, orthonormal_basis};
+use alhazen_scene::{Background, Light, Scene, Shape};
+use std::f64::consts::PI;
+
+/// Geometry of an area light, in world space.
+#[derive(Clone, Debug)]
+pub enum Emitter {
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f64,
+    },
+    /// Triangles, chosen by area.
+    Triangles {
+        /// Corners.
+        triangles: Vec<[Vec3; 3]>,
+        /// Choice by area.
+        by_area: Distribution1D,
+        /// Total area.
+        area: f64,
+    },
+    /// A disk.
+    Disk {
+        /// Centre.
+        center: Vec3,
+        /// Unit normal (the emitting side).
+        normal: Vec3,
+        /// Radius.
+        radius: f64,
+    },
+}
+
+/// One light of the path tracer.
+#[derive(Clone, Debug)]
+pub enum PathLight {
+    /// Point light, intensity falling off as `1/d²`.
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Intensity (W/sr per channel).
+        intensity: Vec3,
+    },
+    /// Spot light: a point light times `cos^e` inside its cone.
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Axis.
+        direction: Vec3,
+        /// Cosine of the half-angle.
+        cos_cutoff: f64,
+        /// Falloff exponent.
+        falloff: f64,
+        /// Intensity on the axis.
+        intensity: Vec3,
+    },
+    /// Parallel light.
+    Directional {
+        /// Direction of travel.
+        direction: Vec3,
+        /// Irradiance on a perpendicular surface.
+        irradiance: Vec3,
+    },
+    /// An emitting object.
+    Area {
+        /// Geometry.
+        emitter: Emitter,
+        /// Radiance from the front side.
+        radiance: Vec3,
+    },
+    /// An environment map.
+    Environment(Box<EnvMap>),
+    /// A solid or gradient background.
+    Background(Background),
+}
+
+/// A point on a light seen from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shading point to the light.
+    pub dir: Vec3,
+    /// Distance to the light point (infinite for distant lights).
+    pub dist: f64,
+    /// Radiance arriving (for delta lights: irradiance-like `I/d²`).
+    pub radiance: Vec3,
+    /// Solid-angle density including the light choice (the choice probability for delta lights).
+    pub pdf: f64,
+    /// True for point, spot and directional lights.
+    pub delta: bool,
+}
+
+/// All lights of a scene.
+#[derive(Clone, Debug, Default)]
+pub struct Lights {
+    lights: Vec<PathLight>,
+    /// Light index of each scene object that can be sampled.
+    by_object: Vec<Option<u32>>,
+    /// The light that rays leaving the scene see.
+    sky: Option<u32>,
+}
+
+fn background_radiance(b: &Background, dir: Vec3) -> Vec3 {
+    match *b {
+        Background::Solid(c) => c,
+        Background::Gradient { zenith, horizon, ground } => {
+            if dir.y >= 0.0 {
+                horizon.lerp(zenith, dir.y.min(1.0))
+            } else {
+                ground
+            }
+        }
+    }
+}
+
+/// The world-space geometry of an emitting object, when it can be sampled.
+fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
+    let t = &o.transform;
+    // Uniform scale factor of a similarity transform (None for shears and unequal scales).
+    let similarity = || {
+        let (a, b, c) = (t.vector(Vec3::X), t.vector(Vec3::Y), t.vector(Vec3::Z));
+        let s = a.length();
+        let same = |v: Vec3| (v.length() - s).abs() < 1e-9 * s;
+        let orthogonal = a.dot(b).abs() + b.dot(c).abs() + a.dot(c).abs() < 1e-9 * s * s;
+        (same(b) && same(c) && orthogonal).then_some(s)
+    };
+    let triangles = |tris: Vec<[Vec3; 3]>| {
+        let areas: Vec<f64> = tris.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
+        let area: f64 = areas.iter().sum();
+        (area > 0.0).then(|| Emitter::Triangles { triangles: tris, by_area: Distribution1D::new(&areas), area })
+    };
+    match &o.shape {
+        Shape::Sphere { center, radius } => {
+            similarity().map(|s| Emitter::Sphere { center: t.point(*center), radius: radius * s })
+        }
+        Shape::Disk { center, normal, radius } => similarity().map(|s| Emitter::Disk {
+            center: t.point(*center),
+            normal: t.normal(*normal),
+            radius: radius * s,
+        }),
+        Shape::Mesh { mesh, .. } => {
+            let m = &scene.meshes[*mesh];
+            let tris = m.triangles.iter().map(|tri| tri.map(|i| t.point(m.positions[i as usize]))).collect();
+            triangles(tris)
+        }
+        Shape::Box { min, max } => {
+            let corner = |i: usize| {
+                t.point(Vec3::new(
+                    if i & 1 == 0 { min.x } else { max.x },
+                    if i & 2 == 0 { min.y } else { max.y },
+                    if i & 4 == 0 { min.z } else { max.z },
+                ))
+            };
+            // Faces as corner quads, counter-clockwise seen from outside.
+            const FACES: [[usize; 4]; 6] =
+                [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+            let tris = FACES
+                .iter()
+                .flat_map(|f| [[corner(f[0]), corner(f[1]), corner(f[2])], [corner(f[0]), corner(f[2]), corner(f[3])]])
+                .collect();
+            triangles(tris)
+        }
+        _ => None,
+    }
+}
+
+fn uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+impl Lights {
+    /// The lights of `scene`: its light list, then one area light per emitting object.
+    pub fn build(scene: &Scene) -> Self {
+        let mut lights = Vec::new();
+        let mut sky = None;
+        for l in &scene.lights {
+            lights.push(match *l {
+                Light::Point { position, intensity, .. } => PathLight::Point { position, intensity },
+                Light::Spot { position, direction, cos_cutoff, falloff, intensity, .. } => {
+                    PathLight::Spot { position, direction, cos_cutoff, falloff, intensity }
+                }
+                Light::Directional { direction, intensity } => {
+                    PathLight::Directional { direction, irradiance: intensity }
+                }
+                Light::Environment { image, scale, rotation } => {
+                    sky = Some(lights.len() as u32);
+                    PathLight::Environment(Box::new(EnvMap::new(scene.images[image].clone(), scale, rotation)))
+                }
+            });
+        }
+        let black = matches!(scene.background, Background::Solid(c) if c == Vec3::ZERO);
+        if sky.is_none() && !black {
+            sky = Some(lights.len() as u32);
+            lights.push(PathLight::Background(scene.background));
+        }
+        let mut by_object = vec![None; scene.objects.len()];
+        for (i, o) in scene.objects.iter().enumerate() {
+            let radiance = scene.materials[o.material as usize].emission;
+            if radiance == Vec3::ZERO {
+                continue;
+            }
+            if let Some(emitter) = emitter_of(scene, o) {
+                by_object[i] = Some(lights.len() as u32);
+                lights.push(PathLight::Area { emitter, radiance });
+            }
+        }
+        Self { lights, by_object, sky }
+    }
+
+    /// Number of lights.
+    pub fn len(&self) -> usize {
+        self.lights.len()
+    }
+
+    /// True when there is nothing to sample.
+    pub fn is_empty(&self) -> bool {
+        self.lights.is_empty()
+    }
+
+    fn choice_pdf(&self) -> f64 {
+        1.0 / self.lights.len() as f64
+    }
+
+    /// Radiance of the sky (environment or background) in direction `dir`.
+    pub fn sky_radiance(&self, dir: Vec3) -> Vec3 {
+        match self.sky.map(|i| &self.lights[i as usize]) {
+            Some(PathLight::Environment(m)) => m.radiance(dir),
+            Some(PathLight::Background(b)) => background_radiance(b, dir),
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// Density of sampling the sky in direction `dir`.
+    pub fn sky_pdf(&self, dir: Vec3) -> f64 {
+        match self.sky.map(|i| &self.lights[i as usize]) {
+            Some(PathLight::Environment(m)) => m.pdf(dir) * self.choice_pdf(),
+            Some(PathLight::Background(_)) => self.choice_pdf() / (4.0 * PI),
+            _ => 0.0,
+        }
+    }
+
+    /// Density of sampling the point `q` (normal `n`) of scene object `object` from `p`; 0 when
+    /// the object is not a sampled light.
+    pub fn area_pdf(&self, object: u32, p: Vec3, q: Vec3, n: Vec3) -> f64 {
+        let Some(Some(i)) = self.by_object.get(object as usize) else { return 0.0 };
+        let PathLight::Area { emitter, .. } = &self.lights[*i as usize] else { return 0.0 };
+        let to = q - p;
+        let d2 = to.length_squared();
+        let cos = n.dot(to).abs() / d2.sqrt();
+        let area_to_solid = |pdf_area: f64| if cos > 0.0 { pdf_area * d2 / cos } else { 0.0 };
+        let pdf = match emitter {
+            Emitter::Sphere { center, radius } => match cone(p, *center, *radius) {
+                Some((_, one_minus_cos)) => 1.0 / (2.0 * PI * one_minus_cos),
+                None => area_to_solid(1.0 / (4.0 * PI * radius * radius)),
+            },
+            Emitter::Triangles { area, .. } => area_to_solid(1.0 / area),
+            Emitter::Disk { radius, .. } => area_to_solid(1.0 / (PI * radius * radius)),
+        };
+        pdf * self.choice_pdf()
+    }
+
+    /// Chooses a light by `u_choice` and a point on it by `u`, as seen from `p`.
+    pub fn sample(&self, p: Vec3, u_choice: f64, u: Vec2) -> Option<LightSample> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let i = ((u_choice * self.lights.len() as f64) as usize).min(self.lights.len() - 1);
+        let mut s = self.sample_one(&self.lights[i], p, u)?;
+        s.pdf *= self.choice_pdf();
+        Some(s)
+    }
+
+    fn sample_one(&self, light: &PathLight, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let delta = |to: Vec3, radiance: Vec3| {
+            let d = to.length();
+            (d > 0.0).then(|| LightSample { dir: to / d, dist: d, radiance: radiance / (d * d), pdf: 1.0, delta: true })
+        };
+        match light {
+            PathLight::Point { position, intensity } => delta(*position - p, *intensity),
+            PathLight::Spot { position, direction, cos_cutoff, falloff, intensity } => {
+                let to = *position - p;
+                let cos = -to.normalize_or_zero().dot(*direction);
+                if cos < *cos_cutoff {
+                    return None;
+                }
+                delta(to, *intensity * cos.powf(*falloff))
+            }
+            PathLight::Directional { direction, irradiance } => Some(LightSample {
+                dir: -*direction,
+                dist: f64::INFINITY,
+                radiance: *irradiance,
+                pdf: 1.0,
+                delta: true,
+            }),
+            PathLight::Environment(m) => {
+                let (dir, radiance, pdf) = m.sample(u)?;
+                Some(LightSample { dir, dist: f64::INFINITY, radiance, pdf, delta: false })
+            }
+            PathLight::Background(b) => {
+                let dir = uniform_sphere(u);
+                let radiance = background_radiance(b, dir);
+                Some(LightSample { dir, dist: f64::INFINITY, radiance, pdf: 1.0 / (4.0 * PI), delta: false })
+            }
+            PathLight::Area { emitter, radiance } => sample_area(emitter, *radiance, p, u),
+        }
+    }
+}
+
+/// The cone of directions from `p` to a sphere: its axis and `1 − cos θ_max`; `None` inside.
+fn cone(p: Vec3, center: Vec3, radius: f64) -> Option<(Vec3, f64)> {
+    let to = center - p;
+    let d2 = to.length_squared();
+    if d2 <= radius * radius * (1.0 + 1e-9) {
+        return None;
+    }
+    let sin2 = radius * radius / d2;
+    let cos = (1.0 - sin2).max(0.0).sqrt();
+    Some((to / d2.sqrt(), sin2 / (1.0 + cos)))
+}
+
+/// A point on an area light: the direction, distance, radiance (0 from its back) and density.
+fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<LightSample> {
+    let (q, n, pdf_area) = match emitter {
+        Emitter::Sphere { center, radius } => {
+            if let Some((axis, one_minus_cos)) = cone(p, *center, *radius) {
+                // Uniform in the cone, then the near intersection with the sphere.
+                let cos = 1.0 - u.x * one_minus_cos;
+                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                let phi = 2.0 * PI * u.y;
+                let (s, t) = orthonormal_basis(axis);
+                let dir = (s * phi.cos() + t * phi.sin()) * sin + axis * cos;
+                let d = (*center - p).length();
+                let disc = (radius * radius - d * d * sin * sin).max(0.0);
+                let dist = d * cos - disc.sqrt();
+                let pdf = 1.0 / (2.0 * PI * one_minus_cos);
+                return Some(LightSample { dir, dist, radiance, pdf, delta: false });
+            }
+            let n = uniform_sphere(u);
+            (*center + n * *radius, n, 1.0 / (4.0 * PI * radius * radius))
+        }
+        Emitter::Triangles { triangles, by_area, area } => {
+            let (x, _, i) = by_area.sample_continuous(u.x);
+            let ux = x * by_area.len() as f64 - i as f64;
+            let [a, b, c] = triangles[i];
+            let su = ux.clamp(0.0, 1.0).sqrt();
+            let (b0, b1) = (1.0 - su, u.y * su);
+            let q = a * b0 + b * b1 + c * (1.0 - b0 - b1);
+            ((q), (b - a).cross(c - a).normalize_or_zero(), 1.0 / area)
+        }
+        Emitter::Disk { center, normal, radius } => {
+            let (s, t) = orthonormal_basis(*normal);
+            let (r, phi) = (radius * u.x.sqrt(), 2.0 * PI * u.y);
+            (*center + (s * phi.cos() + t * phi.sin()) * r, *normal, 1.0 / (PI * radius * radius))
+        }
+    };
+    let to = q - p;
+    let d2 = to.length_squared();
+    let dist = d2.sqrt();
+    if dist == 0.0 {
+        return None;
+    }
+    let dir = to / dist;
+    let cos = -n.dot(dir);
+    if cos <= 0.0 {
+        return None; // the back of a one-sided emitter
+    }
+    Some(LightSample { dir, dist, radiance, pdf: pdf_area * d2 / cos, delta: false })
+}

@@ -1,0 +1,213 @@
+//! Unidirectional path tracing of the rendering equation (course §"Global lighting models":
+//! `L = L_e + ∫ ρ I dS`, Kajiya 1986).
+//!
+//! At each vertex: emitted radiance (weighted against light sampling by multiple importance
+//! sampling, power heuristic), next-event estimation towards one light chosen uniformly (weighted
+//! against BSDF sampling), then a BSDF-sampled continuation; Russian roulette from depth 5 on.
+//! Delta lights and delta BSDF lobes skip the heuristic (their densities are not comparable).
+//!
+//! Depth follows Mitsuba's `max_depth`: a path of `k` segments from the camera contributes when
+//! `k ≤ max_depth` (1 = emitters seen directly, 2 = direct lighting). Emitters shine from the
+//! side their normal points to. Scenes whose glass disperses (`cauchy`, `sellmeier`, `glass`)
+//! are rendered spectrally ([`crate::spectrum`]); all others in RGB.
+
+use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_hint};
+use crate::camera::Camera;
+use crate::film::PixelEstimator;
+use crate::lights::Lights;
+use crate::sampler::{SampleStream, Sequence};
+use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
+use crate::world::{World, WorldHit};
+use alhazen_math::{Ray, Vec3};
+use alhazen_scene::{SamplerKind, Scene};
+
+/// Depth from which Russian roulette may end paths (Mitsuba's `rr_depth`).
+const RR_DEPTH: u32 = 5;
+
+/// The path tracer over a built world and camera.
+pub struct PathTracer<'a> {
+    scene: &'a Scene,
+    world: &'a World,
+    camera: &'a Camera,
+    lights: Lights,
+    spectral: bool,
+    sequence: Sequence,
+}
+
+/// Power heuristic with β = 2.
+#[inline]
+fn power_heuristic(a: f64, b: f64) -> f64 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
+}
+
+/// The self-intersection guard at `p`, scaled to the magnitude of its coordinates.
+#[inline]
+fn epsilon(p: Vec3) -> f64 {
+    1e-9 * (1.0 + p.abs().max_element())
+}
+
+/// A point moved off its surface towards the side of `dir`.
+#[inline]
+fn offset(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
+    let eps = epsilon(p);
+    p + ng * if ng.dot(dir) >= 0.0 { eps } else { -eps }
+}
+
+/// What the previous vertex left for the next one.
+struct Previous {
+    p: Vec3,
+    pdf: f64,
+    delta: bool,
+}
+
+impl<'a> PathTracer<'a> {
+    /// Prepares the lights of `scene`.
+    pub fn new(scene: &'a Scene, world: &'a World, camera: &'a Camera) -> Self {
+        let spectral = scene.materials.iter().any(|m| m.bsdf.as_ref().is_some_and(|b| b.is_dispersive()));
+        let sequence = match scene.render.sampler {
+            SamplerKind::Sobol => Sequence::Sobol,
+            SamplerKind::Independent => Sequence::Independent,
+        };
+        Self { scene, world, camera, lights: Lights::build(scene), spectral, sequence }
+    }
+
+    /// Radiance along `ray` in the channels of `mode`.
+    pub fn radiance(&self, mut ray: Ray, mode: ColorMode, s: &mut SampleStream) -> Vec3 {
+        let max_depth = self.scene.render.max_depth;
+        let (mut l, mut beta, mut eta_scale) = (Vec3::ZERO, Vec3::ONE, 1.0);
+        let mut hero_only = false;
+        let mut prev = Previous { p: ray.origin, pdf: 1.0, delta: true };
+        for depth in 1..=max_depth {
+            let Some(wh) = self.world.intersect(&ray, f64::INFINITY) else {
+                let le = self.lights.sky_radiance(ray.dir);
+                if le != Vec3::ZERO {
+                    let w = if prev.delta { 1.0 } else { power_heuristic(prev.pdf, self.lights.sky_pdf(ray.dir)) };
+                    l += beta * mode.color(le) * w;
+                }
+                break;
+            };
+            l += beta * self.emitted(&wh, &ray, &prev, mode);
+            if depth == max_depth {
+                break;
+            }
+            let m = &self.scene.materials[wh.material as usize];
+            let bsdf = bsdf_at(m, wh.hit.uv, &self.scene.images, mode);
+            if self.spectral && !hero_only && is_dispersive(&bsdf) {
+                // Wavelength-dependent paths: only the hero survives (×3 keeps it unbiased).
+                beta *= Vec3::new(3.0, 0.0, 0.0);
+                hero_only = true;
+            }
+            let wo = -ray.dir;
+            let (frame, ng) = self.shading_frame(&wh, &bsdf, wo, tangent_hint(m));
+            let v = frame.to_local(wo);
+            if !bsdf.is_delta() {
+                l += beta * self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, s);
+            }
+            let (uc, u) = (s.next_1d(), s.next_2d());
+            let Some(bs) = bsdf.sample(v, uc, u) else { break };
+            let dir = frame.to_world(bs.l);
+            let weight = bs.f * bs.l.z.abs() / bs.pdf;
+            if !weight.is_finite() || weight == Vec3::ZERO {
+                break;
+            }
+            beta *= weight;
+            eta_scale *= bs.eta * bs.eta;
+            if depth >= RR_DEPTH {
+                let q = (beta.max_element() * eta_scale).min(0.95);
+                if s.next_1d() >= q {
+                    break;
+                }
+                beta /= q;
+            }
+            prev = Previous { p: wh.hit.p, pdf: bs.pdf, delta: bs.delta };
+            ray = Ray::new(offset(wh.hit.p, ng, dir), dir);
+        }
+        l
+    }
+
+    /// Emission of the surface hit, weighted against light sampling.
+    fn emitted(&self, wh: &WorldHit, ray: &Ray, prev: &Previous, mode: ColorMode) -> Vec3 {
+        let le = self.scene.materials[wh.material as usize].emission;
+        if le == Vec3::ZERO || wh.hit.n.dot(ray.dir) >= 0.0 {
+            return Vec3::ZERO;
+        }
+        let w = if prev.delta {
+            1.0
+        } else {
+            power_heuristic(prev.pdf, self.lights.area_pdf(wh.object, prev.p, wh.hit.p, wh.hit.n))
+        };
+        mode.color(le) * w
+    }
+
+    /// The local frame (normal on the viewer's side for opaque surfaces — the course's two-sided
+    /// reading of the same-side factor) and the geometric normal on the same side.
+    fn shading_frame(&self, wh: &WorldHit, bsdf: &Bsdf, wo: Vec3, tangent: Vec3) -> (Frame, Vec3) {
+        let (mut ng, mut ns) = (wh.hit.n, wh.hit.ns);
+        if !bsdf.transmits() && ng.dot(wo) < 0.0 {
+            ng = -ng;
+            ns = -ns;
+        }
+        // A shading normal that puts the viewer on the other side than the geometry would leak.
+        if ns.dot(wo) * ng.dot(wo) <= 0.0 {
+            ns = ng;
+        }
+        (Frame::new(ns, tangent), ng)
+    }
+
+    /// One light sample, weighted by the power heuristic against the BSDF's density.
+    fn next_event(
+        &self,
+        bsdf: &Bsdf,
+        frame: &Frame,
+        p: Vec3,
+        ng: Vec3,
+        v: Vec3,
+        mode: ColorMode,
+        s: &mut SampleStream,
+    ) -> Vec3 {
+        let (uc, u) = (s.next_1d(), s.next_2d());
+        let Some(ls) = self.lights.sample(p, uc, u) else { return Vec3::ZERO };
+        if ls.radiance == Vec3::ZERO || ls.pdf <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let l = frame.to_local(ls.dir);
+        let f = bsdf.eval(v, l) * l.z.abs();
+        // Light must leave from the side of the geometry the BSDF sends it to.
+        if f == Vec3::ZERO || (ng.dot(ls.dir) > 0.0) != (l.z > 0.0) && !bsdf.transmits() {
+            return Vec3::ZERO;
+        }
+        let origin = offset(p, ng, ls.dir);
+        // Stop short of the light point by more than the origin moved, so the light does not
+        // shadow itself.
+        let dist = if ls.dist.is_finite() { ls.dist * (1.0 - 1e-7) - 4.0 * epsilon(p) } else { f64::INFINITY };
+        if !self.world.unoccluded(origin, ls.dir, dist) {
+            return Vec3::ZERO;
+        }
+        let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf.pdf(v, l)) };
+        f * mode.color(ls.radiance) * (w / ls.pdf)
+    }
+}
+
+fn is_dispersive(b: &Bsdf) -> bool {
+    match b {
+        Bsdf::Dielectric(d) => d.dispersive,
+        Bsdf::Mix(m) => is_dispersive(&m.a) || is_dispersive(&m.b),
+        _ => false,
+    }
+}
+
+impl PixelEstimator for PathTracer<'_> {
+    fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
+        let mut s = SampleStream::new(self.sequence, self.scene.render.seed, x, y, index);
+        let film = s.next_2d();
+        let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
+        if self.spectral {
+            let lambdas = sample_wavelengths(s.next_1d());
+            let values = self.radiance(ray, ColorMode::Spectral(lambdas), &mut s);
+            spectrum_to_rgb(values, &lambdas)
+        } else {
+            self.radiance(ray, ColorMode::Rgb, &mut s)
+        }
+    }
+}

@@ -1,0 +1,192 @@
+//! Descriptions of the physically based scattering functions of the course (§"Physically based
+//! models"): plain data, evaluated by `alhazen-render`'s `bsdf` module.
+//!
+//! A material without an explicit `bsdf` is read by the path tracer as: a smooth dielectric when
+//! it is transparent, else Lambert (`color × diffuse`) plus a perfect mirror of weight `mirror`.
+
+use crate::model::{FresnelMode, Rgb, Texture};
+
+use alhazen_math::Vec3;
+
+/// The microfacet normal distribution `D`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Distribution {
+    /// Beckmann–Spizzichino (Cook–Torrance 1981).
+    Beckmann,
+    /// Trowbridge–Reitz ("GGX").
+    TrowbridgeReitz,
+    /// The Gaussian `a·exp(−(ϑ/m)²)` of Torrance–Sparrow (1967), normalised numerically.
+    Gaussian,
+}
+
+/// The shadowing–masking term `G`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shadowing {
+    /// The V-groove `min{1, 2⟨h,n⟩⟨v,n⟩/⟨v,h⟩, 2⟨h,n⟩⟨l,n⟩/⟨l,h⟩}`.
+    CookTorrance,
+    /// Smith's separable `G₁(l)·G₁(v)` for the chosen distribution.
+    Smith,
+}
+
+/// A rough surface: distribution, roughness along the tangent `u` and `v` (`m_u`, `m_v`; equal
+/// for isotropic surfaces) and shadowing term.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Microfacets {
+    /// `D`.
+    pub distribution: Distribution,
+    /// `m_u` (the course's `m`; Mitsuba's `alpha_u`).
+    pub alpha_u: f64,
+    /// `m_v`.
+    pub alpha_v: f64,
+    /// `G`.
+    pub shadowing: Shadowing,
+}
+
+/// An index of refraction, possibly depending on wavelength (nanometres).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Ior {
+    /// The same for every wavelength.
+    Constant(f64),
+    /// Cauchy: `η(λ) = A + B/λ²` with `λ` in micrometres.
+    Cauchy {
+        /// `A`.
+        a: f64,
+        /// `B` in µm².
+        b: f64,
+    },
+    /// Sellmeier: `η² = 1 + Σ Bᵢλ²/(λ² − Cᵢ)` with `λ` in micrometres.
+    Sellmeier {
+        /// `B₁..B₃`.
+        b: [f64; 3],
+        /// `C₁..C₃` in µm².
+        c: [f64; 3],
+    },
+}
+
+impl Ior {
+    /// The index at wavelength `lambda_nm`.
+    pub fn at(&self, lambda_nm: f64) -> f64 {
+        let l = lambda_nm * 1e-3;
+        match *self {
+            Ior::Constant(eta) => eta,
+            Ior::Cauchy { a, b } => a + b / (l * l),
+            Ior::Sellmeier { b, c } => {
+                let l2 = l * l;
+                (1.0 + (0..3).map(|i| b[i] * l2 / (l2 - c[i])).sum::<f64>()).sqrt()
+            }
+        }
+    }
+
+    /// The index at the sodium D line (589.3 nm), used where light is not split by wavelength.
+    pub fn nominal(&self) -> f64 {
+        self.at(589.3)
+    }
+
+    /// True when the index varies with wavelength.
+    pub fn is_dispersive(&self) -> bool {
+        !matches!(self, Ior::Constant(_))
+    }
+}
+
+/// A scattering function.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BsdfDesc {
+    /// `ρ = albedo/π`.
+    Lambert {
+        /// Albedo.
+        albedo: Texture,
+    },
+    /// Oren–Nayar, the course's `ρ_d,1` plus optionally the interreflection term `ρ_d,2`.
+    OrenNayar {
+        /// Albedo `c_λ`.
+        albedo: Texture,
+        /// Roughness `σ` in radians.
+        sigma: f64,
+        /// Add `ρ_d,2`.
+        interreflection: bool,
+    },
+    /// Energy-normalised Phong: `kd·albedo/π + ks (m+2)/(2π) cos^m α`.
+    Phong {
+        /// Diffuse albedo.
+        albedo: Texture,
+        /// Diffuse weight `k_d`.
+        kd: f64,
+        /// Specular weight `k_s`.
+        ks: f64,
+        /// `m`.
+        exponent: f64,
+    },
+    /// Energy-normalised (anisotropic) Blinn–Phong with the course's `⟨ĥ, n⟩^{2m}` lobe.
+    BlinnPhong {
+        /// Diffuse albedo.
+        albedo: Texture,
+        /// Diffuse weight `k_d`.
+        kd: f64,
+        /// Specular weight `k_s`.
+        ks: f64,
+        /// `m` (the lobe is `cos^{2m}`).
+        exponent: f64,
+        /// The course's `a ∈ (0, 1]`: 1 is isotropic.
+        anisotropy: f64,
+        /// Direction of the scratches, projected on the tangent plane.
+        scratches: Vec3,
+    },
+    /// `v(kd ρ_d + ks ρ_s)` with Lambert `ρ_d` and the microfacet `ρ_s = DGF/(4⟨l,n⟩⟨v,n⟩)` of a
+    /// dielectric coating of index `ior`.
+    CookTorrance {
+        /// Diffuse albedo.
+        albedo: Texture,
+        /// Diffuse weight `k_d`.
+        kd: f64,
+        /// Specular weight `k_s`.
+        ks: f64,
+        /// `D`, roughness, `G`.
+        facets: Microfacets,
+        /// Index of refraction for `F`.
+        ior: f64,
+        /// Exact or Schlick.
+        fresnel: FresnelMode,
+    },
+    /// A metal: Fresnel with a complex index `η + iκ` per RGB channel; smooth when `facets` is `None`.
+    Conductor {
+        /// Roughness, or a perfect mirror.
+        facets: Option<Microfacets>,
+        /// Real part `η`.
+        eta: Rgb,
+        /// Imaginary part `κ`.
+        k: Rgb,
+        /// Multiplier (1 is physical).
+        tint: Rgb,
+        /// Exact or Schlick (from the normal-incidence reflectance).
+        fresnel: FresnelMode,
+    },
+    /// Glass and the like: reflection and refraction with the course's transmission term.
+    Dielectric {
+        /// Roughness, or smooth when `None`.
+        facets: Option<Microfacets>,
+        /// Index of refraction of the inside relative to the outside.
+        ior: Ior,
+        /// Exact or Schlick.
+        fresnel: FresnelMode,
+    },
+    /// `weight · a + (1 − weight) · b`.
+    Mix {
+        /// First BSDF.
+        a: Box<BsdfDesc>,
+        /// Second BSDF.
+        b: Box<BsdfDesc>,
+        /// Weight of `a`.
+        weight: f64,
+    },
+}
+
+impl BsdfDesc {
+    /// True when some part of it refracts with a wavelength-dependent index.
+    pub fn is_dispersive(&self) -> bool {
+        match self {
+            BsdfDesc::Dielectric { ior, .. } => ior.is_dispersive(),
+            BsdfDesc::Mix { a, b, .. } => a.is_dispersive() || b.is_dispersive(),
+            _ => false,
+        }
+    }
+}

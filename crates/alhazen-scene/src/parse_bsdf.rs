@@ -1,0 +1,254 @@
+//! The `bsdf` table of a material and the environment light (docs/scene-format.md,
+//! "Physically based materials").
+
+use crate::bsdf::*;
+use crate::import;
+use crate::model::{FresnelMode, Light, Texture};
+use crate::parse::Parser;
+use crate::reader::{Node, R, Table};
+use alhazen_math::Vec3;
+use std::sync::Arc;
+
+const MICROFACET_KEYS: &[&str] = &["roughness", "distribution", "shadowing"];
+
+/// Complex indices of refraction `(η, κ)` at red, green and blue of common metals (pbrt-v3's
+/// RGB values of measured spectra).
+const METALS: &[(&str, [f64; 3], [f64; 3])] = &[
+    ("gold", [0.143119, 0.374957, 1.44248], [3.98316, 2.38572, 1.60322]),
+    ("silver", [0.155265, 0.116723, 0.138342], [4.82835, 3.12225, 2.14696]),
+    ("copper", [0.200438, 0.924033, 1.10221], [3.91295, 2.45285, 2.14219]),
+    ("aluminium", [1.65746, 0.880369, 0.521229], [9.22387, 6.26952, 4.837]),
+];
+
+/// Sellmeier coefficients of common glasses (Schott data sheets).
+const GLASSES: &[(&str, [f64; 3], [f64; 3])] = &[
+    ("bk7", [1.03961212, 0.231792344, 1.01046945], [0.00600069867, 0.0200179144, 103.560653]),
+    ("sf11", [1.73759695, 0.313747346, 1.89878101], [0.013188707, 0.0623068142, 155.23629]),
+    ("fused-silica", [0.6961663, 0.4079426, 0.8974794], [0.0046791483, 0.0135120631, 97.9340025]),
+];
+
+fn names<T>(list: &[(&'static str, T, T)]) -> Vec<&'static str> {
+    list.iter().map(|e| e.0).collect()
+}
+
+impl Parser<'_> {
+    /// A `bsdf` table; `albedo` is the material's `color`, the default albedo.
+    pub(crate) fn bsdf(&mut self, n: &Node, albedo: &Texture) -> R<BsdfDesc> {
+        let t = n.table_any()?;
+        let kind = t.req("type")?.choice(&[
+            "lambert",
+            "oren-nayar",
+            "phong",
+            "blinn-phong",
+            "cook-torrance",
+            "conductor",
+            "dielectric",
+            "mix",
+        ])?;
+        let keys: Vec<&str> = match kind {
+            "lambert" => vec!["color"],
+            "oren-nayar" => vec!["color", "sigma", "interreflection"],
+            "phong" => vec!["color", "kd", "ks", "exponent"],
+            "blinn-phong" => vec!["color", "kd", "ks", "exponent", "anisotropy", "scratches"],
+            "cook-torrance" => [&["color", "kd", "ks", "ior", "fresnel"][..], MICROFACET_KEYS].concat(),
+            "conductor" => [&["metal", "eta", "k", "tint", "fresnel"][..], MICROFACET_KEYS].concat(),
+            "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
+            _ => vec!["a", "b", "weight"],
+        };
+        t.check_keys(&[&["type"][..], &keys].concat())?;
+        let albedo = match t.get("color") {
+            Some(c) => self.texture(&c)?,
+            None => albedo.clone(),
+        };
+        Ok(match kind {
+            "lambert" => BsdfDesc::Lambert { albedo },
+            "oren-nayar" => BsdfDesc::OrenNayar {
+                albedo,
+                sigma: t.get("sigma").map_or(Ok(20.0), |n| n.in_range(0.0, 90.0))?.to_radians(),
+                interreflection: t.opt_bool("interreflection", true)?,
+            },
+            "phong" | "blinn-phong" => {
+                let (kd, ks) = weights(&t, 0.2)?;
+                let exponent = t.get("exponent").map_or(Ok(32.0), |n| n.in_range(0.0, 1e6))?;
+                if kind == "phong" {
+                    BsdfDesc::Phong { albedo, kd, ks, exponent }
+                } else {
+                    BsdfDesc::BlinnPhong {
+                        albedo,
+                        kd,
+                        ks,
+                        exponent,
+                        anisotropy: t.get("anisotropy").map_or(Ok(1.0), |n| n.in_range(1e-3, 1.0))?,
+                        scratches: t.opt_vec3("scratches", Vec3::X)?,
+                    }
+                }
+            }
+            "cook-torrance" => {
+                let (kd, ks) = weights(&t, 0.5)?;
+                let facets = microfacets(&t)?.unwrap_or(default_facets(0.3));
+                BsdfDesc::CookTorrance {
+                    albedo,
+                    kd,
+                    ks,
+                    facets,
+                    ior: t.opt_positive("ior", 1.5)?,
+                    fresnel: fresnel(&t)?,
+                }
+            }
+            "conductor" => {
+                let (eta, k) = match t.get("metal") {
+                    Some(m) => {
+                        if let Some(e) = t.get("eta").or(t.get("k")) {
+                            return Err(e.err("give either `metal` or `eta` and `k`, not both"));
+                        }
+                        let name = m.choice(&names(METALS))?;
+                        let (_, eta, k) = METALS.iter().find(|e| e.0 == name).expect("a listed metal");
+                        (Vec3::from_array(*eta), Vec3::from_array(*k))
+                    }
+                    None => (
+                        t.opt_rgb("eta", Vec3::from_array(METALS[2].1))?,
+                        t.opt_rgb("k", Vec3::from_array(METALS[2].2))?,
+                    ),
+                };
+                let facets = microfacets(&t)?;
+                BsdfDesc::Conductor { facets, eta, k, tint: t.opt_rgb("tint", Vec3::ONE)?, fresnel: fresnel(&t)? }
+            }
+            "dielectric" => BsdfDesc::Dielectric { facets: microfacets(&t)?, ior: ior(&t)?, fresnel: fresnel(&t)? },
+            _ => BsdfDesc::Mix {
+                a: Box::new(self.bsdf(&t.req("a")?, &albedo)?),
+                b: Box::new(self.bsdf(&t.req("b")?, &albedo)?),
+                weight: t.get("weight").map_or(Ok(0.5), |n| n.in_range(0.0, 1.0))?,
+            },
+        })
+    }
+
+    /// `[[light]] type = "environment"`: an equirectangular `.hdr` or `.exr` map.
+    pub(crate) fn environment_light(&mut self, n: &Node) -> R<Light> {
+        let t = n.table(&["type", "file", "scale", "rotate_y"])?;
+        let file = t.req("file")?;
+        let path = self.dir.join(file.str()?);
+        let data = import::load_hdr_image(&path).map_err(|e| file.err(e))?;
+        self.scene.images.push(Arc::new(data));
+        Ok(Light::Environment {
+            image: self.scene.images.len() - 1,
+            scale: t.get("scale").map_or(Ok(1.0), |n| n.non_negative())?,
+            rotation: t.opt_f64("rotate_y", 0.0)?.to_radians(),
+        })
+    }
+}
+
+/// `kd` and `ks` with the course's `k_d + k_s ≤ 1`.
+fn weights(t: &Table, default_ks: f64) -> R<(f64, f64)> {
+    let ks = t.get("ks").map_or(Ok(default_ks), |n| n.in_range(0.0, 1.0))?;
+    let kd = t.get("kd").map_or(Ok(1.0 - ks), |n| n.in_range(0.0, 1.0))?;
+    if kd + ks > 1.0 + 1e-9 {
+        let node = t.get("kd").or(t.get("ks")).expect("one was given");
+        return Err(node.err(format!("kd + ks = {} exceeds 1: the surface would create energy", kd + ks)));
+    }
+    Ok((kd, ks))
+}
+
+fn default_facets(alpha: f64) -> Microfacets {
+    Microfacets {
+        distribution: Distribution::TrowbridgeReitz,
+        alpha_u: alpha,
+        alpha_v: alpha,
+        shadowing: Shadowing::Smith,
+    }
+}
+
+/// `roughness` (number or `[u, v]`), `distribution`, `shadowing`; `None` for a smooth surface.
+fn microfacets(t: &Table) -> R<Option<Microfacets>> {
+    let (alpha_u, alpha_v) = match t.get("roughness") {
+        None => return Ok(None),
+        Some(r) if matches!(r.v, toml::de::DeValue::Array(_)) => {
+            let [u, v] = r.numbers::<2>()?;
+            if !(0.0..=4.0).contains(&u) || !(0.0..=4.0).contains(&v) {
+                return Err(r.err("`roughness`: expected values from 0 to 4"));
+            }
+            (u, v)
+        }
+        Some(r) => {
+            let a = r.in_range(0.0, 4.0)?;
+            (a, a)
+        }
+    };
+    if alpha_u == 0.0 && alpha_v == 0.0 {
+        return Ok(None);
+    }
+    if alpha_u < 1e-4 || alpha_v < 1e-4 {
+        let r = t.req("roughness")?;
+        return Err(r.err("`roughness` below 1e-4 is numerically a mirror: use 0 for a smooth surface"));
+    }
+    let distribution = match t.get("distribution") {
+        Some(d) => match d.choice(&["beckmann", "trowbridge-reitz", "ggx", "gaussian"])? {
+            "beckmann" => Distribution::Beckmann,
+            "gaussian" => Distribution::Gaussian,
+            _ => Distribution::TrowbridgeReitz,
+        },
+        None => Distribution::TrowbridgeReitz,
+    };
+    let shadowing = match t.get("shadowing") {
+        Some(s) => match s.choice(&["smith", "cook-torrance"])? {
+            "smith" => Shadowing::Smith,
+            _ => Shadowing::CookTorrance,
+        },
+        None if distribution == Distribution::Gaussian => Shadowing::CookTorrance,
+        None => Shadowing::Smith,
+    };
+    if distribution == Distribution::Gaussian {
+        if shadowing == Shadowing::Smith {
+            let s = t.req("shadowing")?;
+            return Err(
+                s.err("Smith shadowing has no closed form for the Gaussian distribution; use \"cook-torrance\"")
+            );
+        }
+        if alpha_u != alpha_v {
+            return Err(t.req("roughness")?.err("the Gaussian distribution is isotropic: give one roughness"));
+        }
+    }
+    Ok(Some(Microfacets { distribution, alpha_u, alpha_v, shadowing }))
+}
+
+fn fresnel(t: &Table) -> R<FresnelMode> {
+    Ok(match t.get("fresnel") {
+        Some(f) => match f.choice(&["exact", "schlick"])? {
+            "exact" => FresnelMode::Exact,
+            _ => FresnelMode::Schlick,
+        },
+        None => FresnelMode::Exact,
+    })
+}
+
+/// `ior`, `cauchy = [A, B]`, `sellmeier = { b = [..], c = [..] }` or `glass = "bk7"`.
+fn ior(t: &Table) -> R<Ior> {
+    let given: Vec<Node> = ["ior", "cauchy", "sellmeier", "glass"].iter().filter_map(|k| t.get(k)).collect();
+    if given.len() > 1 {
+        return Err(given[1].err("give one of `ior`, `cauchy`, `sellmeier` or `glass`"));
+    }
+    let Some(n) = given.first() else { return Ok(Ior::Constant(1.5)) };
+    let ior = match n.key {
+        "ior" => Ior::Constant(n.positive()?),
+        "cauchy" => {
+            let [a, b] = n.numbers::<2>()?;
+            Ior::Cauchy { a, b }
+        }
+        "sellmeier" => {
+            let s = n.table(&["b", "c"])?;
+            Ior::Sellmeier { b: s.req("b")?.numbers::<3>()?, c: s.req("c")?.numbers::<3>()? }
+        }
+        _ => {
+            let name = n.choice(&names(GLASSES))?;
+            let (_, b, c) = GLASSES.iter().find(|e| e.0 == name).expect("a listed glass");
+            Ior::Sellmeier { b: *b, c: *c }
+        }
+    };
+    // The visible range must give a real index above zero.
+    for lambda in [360.0, 589.3, 830.0] {
+        let eta = ior.at(lambda);
+        if !(eta.is_finite() && eta > 0.0) {
+            return Err(n.err(format!("the index of refraction at {lambda} nm would be {eta}")));
+        }
+    }
+    Ok(ior)
+}
