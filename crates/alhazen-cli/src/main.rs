@@ -54,6 +54,12 @@ struct RenderArgs {
     /// Random seed (overrides the scene).
     #[arg(long)]
     seed: Option<u64>,
+    /// Integrator (overrides the scene): recursive ray tracing or path tracing.
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorArg>,
+    /// The path tracer's sampler (overrides the scene).
+    #[arg(long, value_enum)]
+    sampler: Option<SamplerArg>,
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     threads: Option<u32>,
@@ -63,6 +69,24 @@ struct RenderArgs {
     /// No progress bar or summary.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// `--integrator`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum IntegratorArg {
+    /// The lecture's recursive ray tracer.
+    Whitted,
+    /// Path tracing with next-event estimation and MIS.
+    Path,
+}
+
+/// `--sampler`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum SamplerArg {
+    /// Owen-scrambled Sobol points.
+    Sobol,
+    /// Independent uniform numbers.
+    Independent,
 }
 
 /// An error and the exit code it deserves.
@@ -102,6 +126,18 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), Failure> {
     r.spp = a.spp.unwrap_or(r.spp);
     r.max_depth = a.depth.unwrap_or(r.max_depth);
     r.seed = a.seed.unwrap_or(r.seed);
+    if let Some(i) = a.integrator {
+        r.integrator = match i {
+            IntegratorArg::Whitted => alhazen_scene::IntegratorKind::Whitted,
+            IntegratorArg::Path => alhazen_scene::IntegratorKind::Path,
+        };
+    }
+    if let Some(s) = a.sampler {
+        r.sampler = match s {
+            SamplerArg::Sobol => alhazen_scene::SamplerKind::Sobol,
+            SamplerArg::Independent => alhazen_scene::SamplerKind::Independent,
+        };
+    }
     if r.width as u64 * r.height as u64 > MAX_PIXELS {
         return Err(Failure::input(format!(
             "{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate",
@@ -146,12 +182,13 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     if !a.quiet {
         let r = &scene.render;
         eprintln!(
-            "rendered {} ({}×{}, {} spp, depth {}) in {:.3} s on {} threads → {}",
+            "rendered {} ({}×{}, {} spp, depth {}, {:?}) in {:.3} s on {} threads → {}",
             a.scene.display(),
             image.width,
             image.height,
             r.spp,
             r.max_depth,
+            r.integrator,
             elapsed.as_secs_f64(),
             pool.current_num_threads(),
             a.output.display()

@@ -72,7 +72,8 @@ impl Bvh {
     }
 
     /// Visits candidate primitives front to back. `visit(index, t_max)` returns a closer hit
-    /// distance, which prunes the rest of the traversal.
+    /// distance, which prunes the rest of the traversal; `Some(0.0)` ends it at once (for
+    /// any-hit queries such as shadow rays).
     #[inline]
     pub fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
         if self.nodes.is_empty() {
@@ -90,6 +91,9 @@ impl Bvh {
                     let first = node.offset as usize;
                     for &prim in &self.order[first..first + node.count as usize] {
                         if let Some(t) = visit(prim, t_max) {
+                            if t <= 0.0 {
+                                return 0.0;
+                            }
                             t_max = t_max.min(t);
                         }
                     }

@@ -1,6 +1,6 @@
 //! The path tracer's light sources: point, spot and directional lights (delta), area lights
-//! (any object whose material emits: spheres sampled by solid angle, triangles — meshes,
-//! rectangles, boxes — and disks by area), the environment map and a coloured background
+//! (any object whose material emits: spheres sampled by solid angle, rectangles, triangles —
+//! meshes, boxes — and disks by area), the environment map and a coloured background
 //! (uniformly over the sphere). Lights are chosen uniformly; every density here includes that
 //! choice. Emitters of other shapes still shine when paths hit them, without light sampling.
 
@@ -28,6 +28,16 @@ pub enum Emitter {
         by_area: Distribution1D,
         /// Total area.
         area: f64,
+    },
+    /// A parallelogram `origin + s·e1 + t·e2`, `s, t ∈ [0, 1]` (rectangles), sampled without
+    /// choosing a triangle.
+    Parallelogram {
+        /// A corner.
+        origin: Vec3,
+        /// First edge.
+        e1: Vec3,
+        /// Second edge.
+        e2: Vec3,
     },
     /// A disk.
     Disk {
@@ -148,8 +158,9 @@ fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
         }),
         Shape::Mesh { mesh, .. } => {
             let m = &scene.meshes[*mesh];
-            let tris = m.triangles.iter().map(|tri| tri.map(|i| t.point(m.positions[i as usize]))).collect();
-            triangles(tris)
+            let tris: Vec<[Vec3; 3]> =
+                m.triangles.iter().map(|tri| tri.map(|i| t.point(m.positions[i as usize]))).collect();
+            parallelogram(&m.triangles, &tris).or_else(|| triangles(tris))
         }
         Shape::Box { min, max } => {
             let corner = |i: usize| {
@@ -170,6 +181,18 @@ fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
         }
         _ => None,
     }
+}
+
+/// Two triangles `[a, b, c], [a, c, d]` with `c = b + d − a` form a parallelogram.
+fn parallelogram(indices: &[[u32; 3]], corners: &[[Vec3; 3]]) -> Option<Emitter> {
+    let ([i, j], [[a, b, c], [_, _, d]]) = (indices, corners) else { return None };
+    if i[0] != j[0] || i[2] != j[1] {
+        return None;
+    }
+    let (e1, e2) = (*b - *a, *d - *a);
+    let scale = e1.length() + e2.length();
+    let flat = (*b + *d - *a - *c).length() <= 1e-12 * scale;
+    (flat && e1.cross(e2).length() > 0.0).then_some(Emitter::Parallelogram { origin: *a, e1, e2 })
 }
 
 fn uniform_sphere(u: Vec2) -> Vec3 {
@@ -265,6 +288,7 @@ impl Lights {
                 None => area_to_solid(1.0 / (4.0 * PI * radius * radius)),
             },
             Emitter::Triangles { area, .. } => area_to_solid(1.0 / area),
+            Emitter::Parallelogram { e1, e2, .. } => area_to_solid(1.0 / e1.cross(*e2).length()),
             Emitter::Disk { radius, .. } => area_to_solid(1.0 / (PI * radius * radius)),
         };
         pdf * self.choice_pdf()
@@ -356,7 +380,12 @@ fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<Li
             let su = ux.clamp(0.0, 1.0).sqrt();
             let (b0, b1) = (1.0 - su, u.y * su);
             let q = a * b0 + b * b1 + c * (1.0 - b0 - b1);
-            ((q), (b - a).cross(c - a).normalize_or_zero(), 1.0 / area)
+            (q, (b - a).cross(c - a).normalize_or_zero(), 1.0 / area)
+        }
+        Emitter::Parallelogram { origin, e1, e2 } => {
+            let n = e1.cross(*e2);
+            let area = n.length();
+            (*origin + *e1 * u.x + *e2 * u.y, n / area, 1.0 / area)
         }
         Emitter::Disk { center, normal, radius } => {
             let (s, t) = orthonormal_basis(*normal);

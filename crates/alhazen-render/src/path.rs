@@ -101,11 +101,12 @@ impl<'a> PathTracer<'a> {
             let wo = -ray.dir;
             let (frame, ng) = self.shading_frame(&wh, &bsdf, wo, tangent_hint(m));
             let v = frame.to_local(wo);
+            // One pair picks the light and the BSDF lobe; one pair each places the points.
+            let choices = s.next_2d();
             if !bsdf.is_delta() {
-                l += beta * self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, s);
+                l += beta * self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, choices.x, s);
             }
-            let (uc, u) = (s.next_1d(), s.next_2d());
-            let Some(bs) = bsdf.sample(v, uc, u) else { break };
+            let Some(bs) = bsdf.sample(v, choices.y, s.next_2d()) else { break };
             let dir = frame.to_world(bs.l);
             let weight = bs.f * bs.l.z.abs() / bs.pdf;
             if !weight.is_finite() || weight == Vec3::ZERO {
@@ -164,10 +165,10 @@ impl<'a> PathTracer<'a> {
         ng: Vec3,
         v: Vec3,
         mode: ColorMode,
+        u_choice: f64,
         s: &mut SampleStream,
     ) -> Vec3 {
-        let (uc, u) = (s.next_1d(), s.next_2d());
-        let Some(ls) = self.lights.sample(p, uc, u) else { return Vec3::ZERO };
+        let Some(ls) = self.lights.sample(p, u_choice, s.next_2d()) else { return Vec3::ZERO };
         if ls.radiance == Vec3::ZERO || ls.pdf <= 0.0 {
             return Vec3::ZERO;
         }

@@ -61,16 +61,22 @@ pub struct SampleStream {
     rng: Rng,
 }
 
-/// Laine–Karras style nested uniform scramble of the bits of `x` (reversed order).
+/// Laine–Karras style hash of bit-reversed values: every output bit depends only on the same
+/// and lower input bits, so applied to a reversed value it is a nested uniform (Owen) scramble.
 #[inline]
-fn owen_scramble(x: u32, seed: u32) -> u32 {
-    let mut x = x.reverse_bits();
+fn scramble_reversed(mut x: u32, seed: u32) -> u32 {
     x ^= x.wrapping_mul(0x3d20adea);
     x = x.wrapping_add(seed);
     x = x.wrapping_mul((seed >> 16) | 1);
     x ^= x.wrapping_mul(0x05526c56);
     x ^= x.wrapping_mul(0x53a22864);
-    x.reverse_bits()
+    x
+}
+
+/// Owen scrambling of `x`.
+#[inline]
+fn owen_scramble(x: u32, seed: u32) -> u32 {
+    scramble_reversed(x.reverse_bits(), seed).reverse_bits()
 }
 
 /// Column `k` of the generator matrix of the second Sobol dimension (primitive polynomial
@@ -87,9 +93,15 @@ const fn sobol1_columns() -> [u32; 32] {
     c
 }
 
-/// XOR of the generator columns selected by each byte value, per byte of the index.
-const SOBOL1_BYTES: [[u32; 256]; 4] = {
-    let cols = sobol1_columns();
+/// XOR of the bit-reversed generator columns selected by each byte value, per byte of the
+/// index: the second dimension with its bits reversed, ready for [`scramble_reversed`].
+const SOBOL1_REVERSED_BYTES: [[u32; 256]; 4] = {
+    let mut cols = sobol1_columns();
+    let mut k = 0;
+    while k < 32 {
+        cols[k] = cols[k].reverse_bits();
+        k += 1;
+    }
     let mut t = [[0u32; 256]; 4];
     let mut b = 0;
     while b < 4 {
@@ -111,15 +123,14 @@ const SOBOL1_BYTES: [[u32; 256]; 4] = {
     t
 };
 
-/// The first two Sobol dimensions of point `i`: van der Corput and the `x + 1` polynomial.
+/// The second Sobol dimension of point `i`, bits reversed.
 #[inline]
-fn sobol_pair(i: u32) -> (u32, u32) {
-    let t = &SOBOL1_BYTES;
-    let y = t[0][(i & 0xff) as usize]
+fn sobol1_reversed(i: u32) -> u32 {
+    let t = &SOBOL1_REVERSED_BYTES;
+    t[0][(i & 0xff) as usize]
         ^ t[1][(i >> 8 & 0xff) as usize]
         ^ t[2][(i >> 16 & 0xff) as usize]
-        ^ t[3][(i >> 24) as usize];
-    (i.reverse_bits(), y)
+        ^ t[3][(i >> 24) as usize]
 }
 
 #[inline]
@@ -143,9 +154,11 @@ impl SampleStream {
                 let h = mix(self.pixel_seed ^ self.dimension as u64);
                 self.dimension += 1;
                 let shuffled = owen_scramble(self.index, h as u32);
-                let (a, b) = sobol_pair(shuffled);
-                let (sa, sb) = ((h >> 32) as u32, mix(h) as u32);
-                alhazen_math::Vec2::new(to_unit(owen_scramble(a, sa)), to_unit(owen_scramble(b, sb)))
+                let (sa, sb) = ((h >> 32) as u32, (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32);
+                // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
+                let a = scramble_reversed(shuffled, sa).reverse_bits();
+                let b = scramble_reversed(sobol1_reversed(shuffled), sb).reverse_bits();
+                alhazen_math::Vec2::new(to_unit(a), to_unit(b))
             }
         }
     }
@@ -236,7 +249,18 @@ mod tests {
         let cols = sobol1_columns();
         for i in [0u32, 1, 2, 3, 77, 1 << 20, 0xdead_beef, u32::MAX] {
             let y = (0..32).filter(|k| i >> k & 1 == 1).fold(0, |acc, k| acc ^ cols[k]);
-            assert_eq!(sobol_pair(i).1, y, "{i}");
+            assert_eq!(sobol1_reversed(i).reverse_bits(), y, "{i}");
+        }
+    }
+
+    #[test]
+    fn owen_scrambling_permutes_elementary_intervals() {
+        // Values sharing their top k bits keep sharing them after scrambling.
+        for seed in [1u32, 0xabcdef, 0x1234_5678] {
+            for k in [1, 4, 9] {
+                let (a, b) = (0xf000_0000u32 | 0x35, 0xf000_0000u32 | 0x9a00);
+                assert_eq!(owen_scramble(a, seed) >> (32 - k), owen_scramble(b, seed) >> (32 - k));
+            }
         }
     }
 

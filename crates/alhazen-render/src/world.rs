@@ -4,6 +4,7 @@
 use crate::bvh::Bvh;
 use crate::shape::{
     AaBox, Candidate, Cone, Csg, Cylinder, Disk, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit,
+    triangle_hit,
 };
 use alhazen_math::{Bounds3, Ray, Vec3};
 use alhazen_scene as scene;
@@ -20,12 +21,22 @@ pub struct WorldObject {
     pub slot_materials: Vec<u32>,
 }
 
+/// What a leaf of the top-level BVH holds: a whole object, or one triangle of a small mesh
+/// placed in world space (flattened so its rays skip the nested mesh BVH).
+#[derive(Clone, Copy, Debug)]
+enum Primitive {
+    Object(u32),
+    Triangle { object: u32, triangle: u32 },
+}
+
 /// All objects with their acceleration structure.
 #[derive(Debug, Default)]
 pub struct World {
     objects: Vec<WorldObject>,
     bvh: Bvh,
-    bounded: Vec<u32>,
+    primitives: Vec<Primitive>,
+    /// Corners of the flattened triangles, parallel to `primitives`.
+    corners: Vec<[Vec3; 3]>,
     unbounded: Vec<u32>,
 }
 
@@ -88,13 +99,26 @@ fn baked(mesh: &alhazen_geom::TriangleMesh, tf: &alhazen_math::Transform) -> alh
     m
 }
 
+/// The world-space mesh of a small mesh object without a transform, whose triangles go
+/// straight into the top-level BVH.
+fn flattenable(p: &Placed) -> Option<&alhazen_geom::TriangleMesh> {
+    match (&p.shape, &p.to_world) {
+        (Shape::Mesh(m), None) if m.accel.mesh.triangle_count() <= BAKE_TRIANGLES => Some(&m.accel.mesh),
+        _ => None,
+    }
+}
+
 fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene) -> Placed {
-    if let scene::Shape::Mesh { mesh, smooth } = o.shape {
-        let m = &scene.meshes[mesh];
-        if !o.transform.is_identity() && m.triangle_count() <= BAKE_TRIANGLES {
-            let accel = Arc::new(MeshAccel::new(Arc::new(baked(m, &o.transform))));
-            return Placed::new(Shape::Mesh(MeshShape { accel, smooth }), alhazen_math::Transform::IDENTITY);
+    let small = match &o.shape {
+        scene::Shape::Mesh { mesh, smooth } if !o.transform.is_identity() => {
+            let m = &scene.meshes[*mesh];
+            (m.triangle_count() <= BAKE_TRIANGLES).then(|| (m.clone(), *smooth))
         }
+        _ => None,
+    };
+    if let Some((m, smooth)) = small {
+        let accel = Arc::new(MeshAccel::new(Arc::new(baked(&m, &o.transform))));
+        return Placed::new(Shape::Mesh(MeshShape { accel, smooth }), alhazen_math::Transform::IDENTITY);
     }
     Placed::new(build_shape(&o.shape, meshes), o.transform)
 }
@@ -112,11 +136,29 @@ impl World {
                 slot_materials: o.mesh_materials.clone(),
             })
             .collect();
-        let bounds: Vec<Bounds3> = objects.iter().map(|o| o.placed.bounds()).collect();
-        let (bounded, unbounded): (Vec<u32>, Vec<u32>) =
-            (0..objects.len() as u32).partition(|&i| bounds[i as usize].is_finite());
-        let bvh = Bvh::build(&bounded.iter().map(|&i| bounds[i as usize]).collect::<Vec<_>>());
-        Self { objects, bvh, bounded, unbounded }
+        let (mut primitives, mut corners, mut prim_bounds, mut unbounded) = (vec![], vec![], vec![], vec![]);
+        for (i, o) in objects.iter().enumerate() {
+            let i = i as u32;
+            if let Some(mesh) = flattenable(&o.placed) {
+                for t in 0..mesh.triangle_count() {
+                    let c = mesh.corners(t);
+                    primitives.push(Primitive::Triangle { object: i, triangle: t as u32 });
+                    corners.push(c);
+                    prim_bounds.push(Bounds3::from_points(c));
+                }
+                continue;
+            }
+            let b = o.placed.bounds();
+            if b.is_finite() {
+                primitives.push(Primitive::Object(i));
+                corners.push([Vec3::ZERO; 3]);
+                prim_bounds.push(b);
+            } else {
+                unbounded.push(i);
+            }
+        }
+        let bvh = Bvh::build(&prim_bounds);
+        Self { objects, bvh, primitives, corners, unbounded }
     }
 
     /// Bounds of the bounded objects.
@@ -135,11 +177,17 @@ impl World {
                 best = Some((c, i));
             }
         }
-        self.bvh.traverse(ray, t_best, |k, t_max| {
-            let i = self.bounded[k as usize];
-            let c = self.objects[i as usize].placed.hit(ray, t_max)?;
-            best = Some((c, i));
-            Some(c.t)
+        self.bvh.traverse(ray, t_best, |k, t_max| match self.primitives[k as usize] {
+            Primitive::Object(i) => {
+                let c = self.objects[i as usize].placed.hit(ray, t_max)?;
+                best = Some((c, i));
+                Some(c.t)
+            }
+            Primitive::Triangle { object, triangle } => {
+                let (t, b1, b2) = triangle_hit(ray, self.corners[k as usize]).filter(|h| h.0 > 0.0 && h.0 < t_max)?;
+                best = Some((Candidate { t, aux: triangle, bary: [b1, b2] }, object));
+                Some(t)
+            }
         });
         best
     }
@@ -171,10 +219,26 @@ impl World {
         ShadowHit::Transparent(WorldHit { hit, material, object: i })
     }
 
-    /// True when nothing blocks the segment from `origin` along unit `dir` over `dist`.
+    /// True when nothing blocks the segment from `origin` along unit `dir` over `dist`; stops at
+    /// the first blocker found.
     #[inline]
     pub fn unoccluded(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
-        self.nearest(&Ray::new(origin, dir), dist).is_none()
+        let ray = Ray::new(origin, dir);
+        if self.unbounded.iter().any(|&i| self.objects[i as usize].placed.hit(&ray, dist).is_some()) {
+            return false;
+        }
+        let mut blocked = false;
+        self.bvh.traverse(&ray, dist, |k, t_max| {
+            let hit = match self.primitives[k as usize] {
+                Primitive::Object(i) => self.objects[i as usize].placed.hit(&ray, t_max).is_some(),
+                Primitive::Triangle { .. } => {
+                    triangle_hit(&ray, self.corners[k as usize]).is_some_and(|h| h.0 > 0.0 && h.0 < t_max)
+                }
+            };
+            blocked |= hit;
+            hit.then_some(0.0)
+        });
+        !blocked
     }
 
     /// The nearest hit by testing every object (the reference for BVH tests).

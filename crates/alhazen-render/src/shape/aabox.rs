@@ -53,7 +53,7 @@ impl AaBox {
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let ((t0, a0), (t1, a1)) = self.slab(ray)?;
         let (t, a) = if t0 > 0.0 { (t0, a0) } else { (t1, a1) };
-        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: a as u32 })
+        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: a as u32, bary: [0.0; 2] })
     }
 
     /// The surface at a hit.

@@ -66,7 +66,7 @@ impl Csg {
 
     /// Nearest boundary point of the result in `(0, t_max)` (only its `t` is kept).
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
-        self.intersect(ray, t_max).map(|h| Candidate { t: h.t, aux: 0 })
+        self.intersect(ray, t_max).map(|h| Candidate { t: h.t, aux: 0, bary: [0.0; 2] })
     }
 
     /// The surface at a hit found by [`Csg::hit`] (recomputed: CSG hits are rare enough).

@@ -32,7 +32,7 @@ struct Parts {
 impl Parts {
     fn push(&mut self, t: f64, aux: u32) {
         if self.len < self.items.len() {
-            self.items[self.len] = Candidate { t, aux };
+            self.items[self.len] = Candidate { t, aux, bary: [0.0; 2] };
             self.len += 1;
         }
     }

@@ -34,7 +34,7 @@ pub struct MeshShape {
 
 /// Barycentric hit `(t, b1, b2)` of Möller–Trumbore, for any `t`.
 #[inline]
-fn triangle_hit(ray: &Ray, [p0, p1, p2]: [Vec3; 3]) -> Option<(f64, f64, f64)> {
+pub fn triangle_hit(ray: &Ray, [p0, p1, p2]: [Vec3; 3]) -> Option<(f64, f64, f64)> {
     let (e1, e2) = (p1 - p0, p2 - p0);
     let pv = ray.dir.cross(e2);
     let det = e1.dot(pv);
@@ -84,7 +84,7 @@ impl MeshShape {
         let mut best = None;
         self.accel.bvh.traverse(ray, t_max, |i, t_max| {
             let h = triangle_hit(ray, m.corners(i as usize)).filter(|h| h.0 > 0.0 && h.0 < t_max)?;
-            best = Some(Candidate { t: h.0, aux: i });
+            best = Some(Candidate { t: h.0, aux: i, bary: [h.1, h.2] });
             Some(h.0)
         });
         best
@@ -92,9 +92,7 @@ impl MeshShape {
 
     /// The surface at a hit found by [`MeshShape::hit`].
     pub fn surface_at(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
-        let tri = c.aux as usize;
-        let (_, b1, b2) = triangle_hit(ray, self.accel.mesh.corners(tri)).unwrap_or((c.t, 1.0 / 3.0, 1.0 / 3.0));
-        self.surface(ray, tri, (c.t, b1, b2))
+        self.surface(ray, c.aux as usize, (c.t, c.bary[0], c.bary[1]))
     }
 
     /// Every triangle crossing of the whole line; entering where the ray meets the front.

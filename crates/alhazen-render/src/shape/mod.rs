@@ -14,7 +14,7 @@ mod sphere;
 pub use aabox::AaBox;
 pub use csg::Csg;
 pub use cylinder::{Cone, Cylinder};
-pub use mesh::{MeshAccel, MeshShape};
+pub use mesh::{MeshAccel, MeshShape, triangle_hit};
 pub use plane::{Disk, Plane};
 pub use sphere::Sphere;
 
@@ -53,6 +53,8 @@ pub struct Candidate {
     pub t: f64,
     /// Shape-specific tag.
     pub aux: u32,
+    /// Barycentric coordinates `(b1, b2)` of a triangle hit (unused by other shapes).
+    pub bary: [f64; 2],
 }
 
 /// A point where a line enters or leaves a closed shape; used by CSG.

@@ -24,7 +24,7 @@ impl Plane {
     #[inline]
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let t = plane_t(self.point, self.normal, ray);
-        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: 0 })
+        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: 0, bary: [0.0; 2] })
     }
 
     /// The surface at a hit.
@@ -53,7 +53,7 @@ impl Disk {
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let t = plane_t(self.center, self.normal, ray);
         let inside = (ray.at(t) - self.center).length_squared() <= self.radius * self.radius;
-        (t > 0.0 && t < t_max && inside).then_some(Candidate { t, aux: 0 })
+        (t > 0.0 && t < t_max && inside).then_some(Candidate { t, aux: 0, bary: [0.0; 2] })
     }
 
     /// The surface at a hit.

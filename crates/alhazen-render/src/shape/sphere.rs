@@ -43,7 +43,7 @@ impl Sphere {
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let [t0, t1] = self.roots(ray);
         let t = if t0 > 0.0 { t0 } else { t1 };
-        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: 0 })
+        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: 0, bary: [0.0; 2] })
     }
 
     /// Both crossings of the line.
