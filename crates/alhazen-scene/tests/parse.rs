@@ -132,3 +132,62 @@ mod no_panic {
         alhazen_scene::parse_scene("m.toml".as_ref(), VALID).unwrap();
     }
 }
+
+#[test]
+fn physically_based_materials_are_read() {
+    use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Shadowing};
+    let text = r#"
+[render]
+integrator = "path"
+sampler = "independent"
+[materials.gold]
+bsdf = { type = "conductor", metal = "gold", roughness = [0.1, 0.3], distribution = "beckmann" }
+[materials.prism]
+bsdf = { type = "dielectric", glass = "bk7" }
+[materials.lamp]
+emission = [5, 4, 3]
+[materials.blend]
+bsdf = { type = "mix", weight = 0.25, a = { type = "lambert" }, b = { type = "cook-torrance", distribution = "gaussian", roughness = 0.2, kd = 0.3, ks = 0.7 } }
+[[object]]
+shape = "rectangle"
+material = "lamp"
+"#;
+    let s = parse_scene("pbr.toml".as_ref(), text).unwrap();
+    assert_eq!(s.render.integrator, alhazen_scene::IntegratorKind::Path);
+    assert_eq!(s.render.sampler, alhazen_scene::SamplerKind::Independent);
+    let mat = |name: &str| s.materials.iter().find(|m| m.name == name).unwrap();
+    let Some(BsdfDesc::Conductor { facets: Some(f), .. }) = &mat("gold").bsdf else { panic!() };
+    assert_eq!(
+        (f.distribution, f.alpha_u, f.alpha_v, f.shadowing),
+        (Distribution::Beckmann, 0.1, 0.3, Shadowing::Smith)
+    );
+    let Some(BsdfDesc::Dielectric { ior, facets: None, .. }) = &mat("prism").bsdf else { panic!() };
+    // BK7: n_d = 1.5168 at the sodium line.
+    assert!(matches!(ior, Ior::Sellmeier { .. }) && (ior.nominal() - 1.5168).abs() < 1e-4, "{}", ior.nominal());
+    assert!(ior.at(450.0) > ior.at(650.0), "normal dispersion");
+    assert_eq!(mat("lamp").emission, Vec3::new(5.0, 4.0, 3.0));
+    let Some(BsdfDesc::Mix { weight, b, .. }) = &mat("blend").bsdf else { panic!() };
+    assert_eq!(*weight, 0.25);
+    assert!(matches!(**b, BsdfDesc::CookTorrance { kd: 0.3, ks: 0.7, .. }));
+    let Shape::Mesh { mesh, .. } = s.objects[0].shape else { panic!() };
+    assert_eq!(s.meshes[mesh].triangle_count(), 2);
+}
+
+#[test]
+fn physically_based_mistakes_are_explained() {
+    let m = |bsdf: &str| err(&format!("[materials.m]\nbsdf = {bsdf}\n"));
+    assert!(m(r#"{ type = "lambart" }"#).contains("did you mean \"lambert\"?"));
+    assert!(m(r#"{ type = "phong", kd = 0.8, ks = 0.5 }"#).contains("kd + ks = 1.3 exceeds 1"));
+    assert!(
+        m(r#"{ type = "conductor", roughness = 0.2, distribution = "gaussian", shadowing = "smith" }"#)
+            .contains("Smith shadowing has no closed form")
+    );
+    assert!(m(r#"{ type = "dielectric", ior = 1.5, glass = "bk7" }"#).contains("give one of"));
+    assert!(m(r#"{ type = "dielectric", glass = "bk8" }"#).contains("did you mean \"bk7\"?"));
+    assert!(m(r#"{ type = "dielectric", cauchy = [1.5, -1] }"#).contains("index of refraction at 360 nm"));
+    assert!(m(r#"{ type = "conductor", metal = "gold", eta = [1, 1, 1] }"#).contains("either `metal` or `eta`"));
+    assert!(m(r#"{ type = "lambert", roughness = 0.1 }"#).contains("unknown key `roughness`"));
+    let env = err("[[light]]\ntype = \"environment\"\nfile = \"nowhere.hdr\"\n");
+    assert!(env.contains("s.toml:3:8") && env.contains("cannot load image"), "{env}");
+    assert!(err("[render]\nintegrator = \"bdpt\"\n").contains("expected one of"));
+}

@@ -1,0 +1,142 @@
+//! The path tracer end to end: white furnaces (nothing absorbs, so every pixel sees the
+//! environment), an environment map read from an EXR file, thread-count independence, and the
+//! dispersive prism showing a spectrum.
+
+use alhazen_math::Vec3;
+use alhazen_render::output::{Format, write_image};
+use alhazen_render::{Image, render};
+use alhazen_scene::parse_scene;
+use std::path::Path;
+
+fn mean(img: &Image) -> Vec3 {
+    let n = (img.width * img.height) as f64;
+    (0..img.height).flat_map(|y| (0..img.width).map(move |x| (x, y))).map(|(x, y)| img.get(x, y)).sum::<Vec3>() / n
+}
+
+fn furnace(material: &str, spp: u32) -> Image {
+    let text = format!(
+        r#"
+background = [1, 1, 1]
+[render]
+width = 48
+height = 48
+spp = {spp}
+max_depth = 64
+integrator = "path"
+[camera]
+eye = [0, 0, 4]
+fov = 35
+[materials.m]
+{material}
+[[object]]
+shape = "sphere"
+radius = 1
+material = "m"
+"#
+    );
+    render(&parse_scene("furnace.toml".as_ref(), &text).unwrap(), &|_, _| {})
+}
+
+#[test]
+fn white_lambert_sphere_vanishes_in_a_white_furnace() {
+    let img = furnace(r#"bsdf = { type = "lambert", color = [1, 1, 1] }"#, 64);
+    let m = mean(&img);
+    assert!((m - Vec3::ONE).abs().max_element() < 2e-3, "mean {m}");
+    // The centre pixel lies on the sphere: still the environment's radiance.
+    let c = img.get(24, 24);
+    assert!((c - Vec3::ONE).abs().max_element() < 0.05, "centre {c}");
+}
+
+#[test]
+fn smooth_and_rough_glass_conserve_energy_in_a_white_furnace() {
+    let smooth = mean(&furnace(r#"bsdf = { type = "dielectric", ior = 1.5 }"#, 64));
+    assert!((smooth - Vec3::ONE).abs().max_element() < 5e-3, "smooth glass: {smooth}");
+    // Single-scattering microfacets lose the energy of multiple bounces between facets (at
+    // every crossing, and light crosses a sphere at least twice): darker, never brighter, and
+    // the less the rougher.
+    let rough =
+        |a: f64| mean(&furnace(&format!(r#"bsdf = {{ type = "dielectric", ior = 1.5, roughness = {a} }}"#), 64));
+    let (slightly, very) = (rough(0.05), rough(0.3));
+    assert!(slightly.max_element() < 1.0 + 5e-3 && slightly.min_element() > 0.97, "α = 0.05: {slightly}");
+    assert!(very.max_element() < slightly.min_element() && very.min_element() > 0.8, "α = 0.3: {very}");
+}
+
+#[test]
+fn environment_map_from_an_exr_file_lights_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    // A uniform map of radiance 0.5 (scaled ×2 in the scene): a furnace of radiance 1.
+    let (w, h) = (32, 16);
+    let env = Image { width: w, height: h, pixels: vec![[0.5, 0.5, 0.5]; (w * h) as usize] };
+    write_image(&env, &dir.path().join("sky.exr"), Format::from_path(Path::new("x.exr"), false).unwrap()).unwrap();
+    let text = r#"
+[render]
+width = 32
+height = 32
+spp = 64
+integrator = "path"
+[camera]
+eye = [0, 0, 4]
+fov = 35
+[[light]]
+type = "environment"
+file = "sky.exr"
+scale = 2
+[materials.white]
+bsdf = { type = "lambert", color = [1, 1, 1] }
+[[object]]
+shape = "sphere"
+radius = 1
+material = "white"
+"#;
+    let scene = parse_scene(&dir.path().join("env.toml"), text).unwrap();
+    let m = mean(&render(&scene, &|_, _| {}));
+    assert!((m - Vec3::ONE).abs().max_element() < 3e-3, "mean {m}");
+}
+
+#[test]
+fn path_traced_images_do_not_depend_on_the_thread_count() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-rough.toml");
+    let mut scene = alhazen_scene::load_scene(&path).unwrap();
+    scene.render.width = 48;
+    scene.render.height = 48;
+    scene.render.spp = 8;
+    let at = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| render(&scene, &|_, _| {}))
+    };
+    let one = at(1);
+    assert_eq!(one, at(2));
+    assert_eq!(one, at(3));
+}
+
+#[test]
+fn the_prism_spreads_white_light_into_a_spectrum() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/prism.toml");
+    let mut scene = alhazen_scene::load_scene(&path).unwrap();
+    scene.render.width = 160;
+    scene.render.height = 120;
+    scene.render.spp = 16;
+    let img = render(&scene, &|_, _| {});
+    // Bright pixels whose colour is dominated by red, by green and by blue all appear, and
+    // along the band's rows red lies to the left of blue (the deviation grows with the index).
+    let (mut red, mut green, mut blue) = (vec![], vec![], vec![]);
+    for y in 0..img.height {
+        for x in 0..img.width {
+            let c = img.get(x, y);
+            if c.max_element() < 0.3 {
+                continue;
+            }
+            let s = c / c.element_sum();
+            if s.x > 0.6 {
+                red.push(x);
+            } else if s.y > 0.5 {
+                green.push(x);
+            } else if s.z > 0.6 {
+                blue.push(x);
+            }
+        }
+    }
+    assert!(red.len() > 20 && green.len() > 20 && blue.len() > 20, "{} {} {}", red.len(), green.len(), blue.len());
+    let avg = |v: &[u32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
+    assert!(avg(&red) < avg(&green) && avg(&green) < avg(&blue), "{} {} {}", avg(&red), avg(&green), avg(&blue));
+}
