@@ -35,6 +35,23 @@ fn renders_a_png() {
 }
 
 #[test]
+fn integrator_and_sampler_can_be_chosen_on_the_command_line() {
+    for extra in [
+        &["--integrator", "path"][..],
+        &["--integrator", "path", "--sampler", "independent"],
+        &["--integrator", "whitted"],
+    ] {
+        let (code, err, exists) = render(OK, extra);
+        assert_eq!(code, 0, "{extra:?}: {err}");
+        assert!(exists);
+    }
+    let (code, err, exists) = render(OK, &["--integrator", "bdpt"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("possible values: whitted, path"), "{err}");
+    assert!(!exists);
+}
+
+#[test]
 fn bad_toml_points_at_the_line() {
     let (code, err, exists) = render("[render]\nwidth = = 3\n", &[]);
     assert_eq!(code, 2);

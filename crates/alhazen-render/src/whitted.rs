@@ -140,6 +140,9 @@ impl<'a> Whitted<'a> {
         }
         let a = texture::eval(&m.color, h.uv, &self.scene.images) * m.diffuse;
         let mut color = a * self.scene.ambient + self.direct(m, a, h.p, n, ng, v);
+        if front {
+            color += m.emission; // emitters look lit (they light others only under the path tracer)
+        }
         if depth < self.max_depth {
             color += self.secondary(m, h.p, n, ng, v, front, depth, weight);
         }
