@@ -1,6 +1,6 @@
 //! Clipping (course, §"Line clipping", §"Liang-Barsky algorithm", §"Clipping polygons").
 
-use alhazen_math::Vec2;
+use alhazen_math::{Vec2, Vec4};
 
 /// An axis-aligned clipping window `[xmin, xmax] × [ymin, ymax]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,6 +88,31 @@ pub fn liang_barsky(w: &Window, a: Vec2, b: Vec2) -> Option<(Vec2, Vec2)> {
     (t0 <= t1).then(|| (a + d * t0, a + d * t1))
 }
 
+/// Liang–Barsky in homogeneous coordinates (course: "the algorithms may easily be modified to
+/// work using homogeneous coordinates"): the parameter interval `[t0, t1] ⊂ [0, 1]` of
+/// `a + t (b − a)` inside the clip volume `−w ≤ x, y, z ≤ w`, i.e. the six half-spaces
+/// `w ± x ≥ 0`, `w ± y ≥ 0`, `w ± z ≥ 0` — linear in `t`, so each is one Liang–Barsky test and no
+/// division by `w` happens before clipping. Points in the volume have `w ≥ 0`.
+pub fn liang_barsky_homogeneous(a: Vec4, b: Vec4) -> Option<(f64, f64)> {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for axis in 0..3 {
+        for sign in [1.0, -1.0] {
+            // d(t) = d0 + t (d1 − d0) ≥ 0 with d = w + sign·coordinate.
+            let (d0, d1) = (a.w + sign * a[axis], b.w + sign * b[axis]);
+            let (p, q) = (d0 - d1, d0);
+            if p == 0.0 {
+                if q < 0.0 {
+                    return None;
+                }
+            } else {
+                let r = q / p;
+                if p < 0.0 { t0 = t0.max(r) } else { t1 = t1.min(r) }
+            }
+        }
+    }
+    (t0 <= t1).then_some((t0, t1))
+}
+
 /// Sutherland–Hodgman: the polygon clipped by each half-plane of a convex, counter-clockwise
 /// `clipper` in turn. The result may have zero-length edges where the polygon touches a border;
 /// an empty result means no overlap.
@@ -136,7 +161,38 @@ mod tests {
         (-4.0..4.0f64, -4.0..4.0f64).prop_map(|(x, y)| Vec2::new(x, y))
     }
 
+    fn arb_homogeneous() -> impl Strategy<Value = Vec4> {
+        (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64, -0.5..2.5f64).prop_map(|(x, y, z, w)| Vec4::new(x, y, z, w))
+    }
+
     proptest! {
+        #[test]
+        fn homogeneous_clipping_agrees_with_brute_force(a in arb_homogeneous(), b in arb_homogeneous()) {
+            let inside = |t: f64| {
+                let p = a + (b - a) * t;
+                p.x.abs() <= p.w && p.y.abs() <= p.w && p.z.abs() <= p.w
+            };
+            let n = 4000;
+            let samples: Vec<f64> = (0..=n).map(|i| i as f64 / n as f64).filter(|t| inside(*t)).collect();
+            match liang_barsky_homogeneous(a, b) {
+                None => prop_assert!(samples.len() <= 1, "{} samples inside", samples.len()),
+                Some((t0, t1)) => {
+                    // The volume is convex: inside samples form exactly the interval.
+                    let h = 1.0 / n as f64;
+                    if let (Some(first), Some(last)) = (samples.first(), samples.last()) {
+                        prop_assert!((first - t0).abs() <= h + 1e-9 && (last - t1).abs() <= h + 1e-9, "[{t0}, {t1}] vs [{first}, {last}]");
+                    } else {
+                        prop_assert!(t1 - t0 <= h);
+                    }
+                    for t in [t0, (t0 + t1) / 2.0, t1] {
+                        let p = a + (b - a) * t;
+                        let tol = 1e-9 * (1.0 + p.abs().max_element());
+                        prop_assert!(p.x.abs() <= p.w + tol && p.y.abs() <= p.w + tol && p.z.abs() <= p.w + tol);
+                    }
+                }
+            }
+        }
+
         #[test]
         fn segment_clipping_agrees_with_brute_force(a in arb_point(), b in arb_point()) {
             let cs = cohen_sutherland(&W, a, b);

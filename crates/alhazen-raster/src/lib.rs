@@ -3,8 +3,11 @@
 //!
 //! * [`bresenham_line`] — integer-only lines in all octants;
 //! * [`midpoint_circle`] — integer-only circles (eight-way symmetry);
-//! * [`clip`] — Cohen–Sutherland and Liang–Barsky segment clipping, Sutherland–Hodgman polygon
-//!   clipping against a convex window;
+//! * [`ellipse`] — integer midpoint ellipses and the recursive conjugate-half-axes ellipse;
+//! * [`clip`] — Cohen–Sutherland and Liang–Barsky segment clipping (also in homogeneous
+//!   coordinates against the clip volume), Sutherland–Hodgman polygon clipping against a convex
+//!   window;
+//! * [`polygon_ops`] — Weiler–Atherton intersection, union and difference of polygons with holes;
 //! * [`fill`] — scanline filling with an active edge table and exact pixel ownership.
 //!
 //! ```
@@ -13,7 +16,9 @@
 //! ```
 
 pub mod clip;
+pub mod ellipse;
 pub mod fill;
+pub mod polygon_ops;
 
 /// The pixels of the segment between two pixel centres, by the course's Bresenham algorithm
 /// generalised to all octants (the roles of `x` and `y` swap when `|Δy| > |Δx|`; increments take
