@@ -1,4 +1,4 @@
-//! `alhazen`: the command-line front end (`render`, `mirror`). The only crate that reads argv and the environment,
+//! `alhazen`: the command-line front end (`render`, `raster`, `mirror`). The only crate that reads argv and the environment,
 //! writes to stdout/stderr and chooses exit codes:
 //! 0 success, 1 a failure while working (e.g. the output cannot be written), 2 bad input (usage,
 //! an unreadable or invalid scene file, impossible sizes).
@@ -12,6 +12,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 mod mirror;
+mod raster;
 
 #[derive(Parser)]
 #[command(name = "alhazen", version, about = "Mirrors, glass and line art: one scene, exact reflections.")]
@@ -27,6 +28,9 @@ enum Command {
         after_help = "Example:\n  alhazen render scenes/glass-balls.toml -o glass-balls.png --spp 16\n\nThe scene format is described in docs/scene-format.md."
     )]
     Render(RenderArgs),
+    /// Rasterise a scene (the fast preview): z-buffer, flat/Gouraud/Phong shading, no shadows.
+    #[command(after_help = "Example:\n  alhazen raster scenes/glass-balls.toml -o preview.png --shading gouraud")]
+    Raster(raster::RasterArgs),
     /// Exact reflexes on spheres and cylinders (Glaeser), catacaustics and their figures.
     #[command(subcommand)]
     Mirror(mirror::MirrorCommand),
@@ -108,6 +112,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => run_render(&args),
+        Command::Raster(args) => raster::run(&args),
         Command::Mirror(cmd) => mirror::run(&cmd),
     };
     match result {
@@ -147,7 +152,7 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
+pub(crate) fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
     let format = Format::from_path(path, half)
         .ok_or_else(|| Failure::input(format!("{}: unknown image format; use .png, .exr or .pfm", path.display())))?;
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));

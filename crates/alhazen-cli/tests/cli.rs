@@ -52,6 +52,31 @@ fn integrator_and_sampler_can_be_chosen_on_the_command_line() {
 }
 
 #[test]
+fn raster_preview_writes_an_image_and_refuses_unsupported_cameras() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), OK);
+    let out = dir.path().join("preview.png");
+    for shading in ["flat", "gouraud", "phong"] {
+        let o = alhazen(&[
+            "raster",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--shading",
+            shading,
+            "--wireframe",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(String::from_utf8_lossy(&o.stderr).contains("fps"));
+    }
+    assert!(out.exists());
+    let pano = scene_file(dir.path(), "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n");
+    let o = alhazen(&["raster", pano.to_str().unwrap(), "-o", dir.path().join("p.png").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("perspective and orthographic"));
+}
+
+#[test]
 fn bad_toml_points_at_the_line() {
     let (code, err, exists) = render("[render]\nwidth = = 3\n", &[]);
     assert_eq!(code, 2);

@@ -8,6 +8,8 @@
 //!   coordinates against the clip volume), Sutherland–Hodgman polygon clipping against a convex
 //!   window;
 //! * [`polygon_ops`] — Weiler–Atherton intersection, union and difference of polygons with holes;
+//! * [`pipeline`] — the 3D pipeline of `alhazen raster`: transforms, homogeneous clipping,
+//!   perspective-correct rasterisation with a z-buffer, flat/Gouraud/Phong shading;
 //! * [`fill`] — scanline filling with an active edge table and exact pixel ownership.
 //!
 //! ```
@@ -18,6 +20,7 @@
 pub mod clip;
 pub mod ellipse;
 pub mod fill;
+pub mod pipeline;
 pub mod polygon_ops;
 
 /// The pixels of the segment between two pixel centres, by the course's Bresenham algorithm

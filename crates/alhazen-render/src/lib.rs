@@ -40,7 +40,7 @@ pub mod path;
 pub mod sampler;
 pub mod shape;
 pub mod spectrum;
-pub mod texture;
+pub use alhazen_scene::texture;
 pub mod whitted;
 pub mod world;
 

@@ -23,6 +23,7 @@ pub mod model;
 mod parse;
 mod parse_bsdf;
 mod reader;
+pub mod texture;
 
 pub use diagnostic::{Diagnostic, did_you_mean};
 pub use model::*;

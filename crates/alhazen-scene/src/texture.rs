@@ -1,7 +1,7 @@
 //! Evaluation of surface colour textures: solid, checker, image (bilinear, repeating).
 
+use crate::{ImageData, Texture};
 use alhazen_math::{Vec2, Vec3};
-use alhazen_scene::{ImageData, Texture};
 
 /// The colour of `tex` at texture coordinates `uv`.
 pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Vec3 {

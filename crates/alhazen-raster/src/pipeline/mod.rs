@@ -1,0 +1,335 @@
+//! The raster pipeline of `alhazen raster` (course, §"Projections", §"Rasterisation",
+//! §"Clipping", §"Visibility", §"Shading methods"): scene objects become world-space triangles;
+//! vertices go model → world → view → clip by the course's matrices (`ViewFrame`, the
+//! perspective `P` or orthographic projection); triangles facing away are culled (closed surfaces
+//! only); polygons are clipped in homogeneous coordinates; the perspective division and the
+//! viewport transform give screen triangles, which are rasterised with a z-buffer, in parallel
+//! horizontal bands. Shading is flat (one colour per triangle), Gouraud (colours at the vertices,
+//! interpolated) or Phong (normals interpolated, lighting per pixel) with the course's local
+//! models. The camera and the sample position (pixel centres) match `alhazen render`'s.
+
+pub mod clip;
+pub mod geometry;
+pub mod raster;
+pub mod shade;
+
+use alhazen_math::viewing::{Frustum, ViewFrame};
+use alhazen_math::{Mat4, Vec2, Vec3, Vec4};
+use alhazen_scene::{CameraDesc, PerspectiveOpening, Scene};
+use clip::{ATTRIBUTES, ClipVertex, clip_polygon};
+use geometry::{Triangle, scene_triangles};
+use raster::{ScreenTriangle, rasterize};
+use rayon::prelude::*;
+
+/// How colours are computed over a triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shading {
+    /// One colour per triangle, from its face normal at its centroid.
+    Flat,
+    /// Lighting at the vertices, colours interpolated.
+    Gouraud,
+    /// Normals interpolated, lighting at every pixel.
+    Phong,
+}
+
+/// Options of a raster render.
+#[derive(Clone, Copy, Debug)]
+pub struct RasterOptions {
+    /// Shading method.
+    pub shading: Shading,
+    /// Cull triangles of closed surfaces that face away.
+    pub cull: bool,
+    /// Draw triangle edges on top (Bresenham).
+    pub wireframe: bool,
+}
+
+impl Default for RasterOptions {
+    fn default() -> Self {
+        Self { shading: Shading::Phong, cull: true, wireframe: false }
+    }
+}
+
+/// What the pipeline did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RasterStats {
+    /// Triangles in the scene.
+    pub triangles: usize,
+    /// Triangles culled as back faces.
+    pub culled: usize,
+    /// Triangles (after clipping and fan triangulation) rasterised.
+    pub drawn: usize,
+    /// Objects without a triangle form (CSG).
+    pub skipped_objects: usize,
+}
+
+/// A rendered frame: linear RGB and depth (`z/w`), rows top to bottom.
+#[derive(Clone, Debug)]
+pub struct Framebuffer {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Colours.
+    pub color: Vec<[f32; 3]>,
+    /// Depth per pixel (`+∞` where nothing was drawn).
+    pub depth: Vec<f64>,
+}
+
+/// Why a scene cannot be rasterised.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RasterError {
+    /// The camera type has no projection matrix here.
+    UnsupportedCamera(&'static str),
+}
+
+impl std::fmt::Display for RasterError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::UnsupportedCamera(k) => {
+                write!(f, "the raster preview supports perspective and orthographic cameras, not {k}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for RasterError {}
+
+/// The camera as matrices: world → clip, and what is needed to find the viewer direction.
+struct Projection {
+    world_to_clip: Mat4,
+    clip_to_world: Mat4,
+    frame: ViewFrame,
+    perspective: bool,
+}
+
+fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projection, RasterError> {
+    let aspect = width as f64 / height as f64;
+    let frame_of = |l: &alhazen_scene::LookAt| {
+        ViewFrame::look_at(l.eye, l.target, l.up).unwrap_or(ViewFrame {
+            eye: l.eye,
+            u: Vec3::X,
+            v: Vec3::Y,
+            w: Vec3::Z,
+        })
+    };
+    let (frame, p, perspective) = match desc {
+        CameraDesc::Perspective { look, opening } => {
+            let frustum = match *opening {
+                PerspectiveOpening::Fov { angle, horizontal } => {
+                    let fovy = if horizontal { 2.0 * ((angle / 2.0).tan() / aspect).atan() } else { angle };
+                    Frustum::symmetric(fovy, aspect, 1e-3, 1e6)
+                }
+                PerspectiveOpening::Frustum { lrbtn: [l, r, b, t, n] } => {
+                    // Same opening with a nearer near plane, so nothing close is clipped away.
+                    let k = 1e-3 / n;
+                    Frustum { l: l * k, r: r * k, b: b * k, t: t * k, n: 1e-3, f: 1e6 }
+                }
+            };
+            (frame_of(look), frustum.perspective(), true)
+        }
+        CameraDesc::Orthographic { look, width: w } => {
+            let (hw, hh) = (w / 2.0, w / aspect / 2.0);
+            let frustum = Frustum { l: -hw, r: hw, b: -hh, t: hh, n: 0.0, f: 1e6 };
+            (frame_of(look), frustum.orthographic(), false)
+        }
+        CameraDesc::Axonometric { .. } => return Err(RasterError::UnsupportedCamera("axonometric")),
+        CameraDesc::Stereo { .. } => return Err(RasterError::UnsupportedCamera("stereo")),
+        CameraDesc::Panorama { .. } => return Err(RasterError::UnsupportedCamera("panorama")),
+    };
+    let world_to_clip = p * frame.world_to_view();
+    Ok(Projection { world_to_clip, clip_to_world: world_to_clip.inverse(), frame, perspective })
+}
+
+impl Projection {
+    /// Unit direction from `p` towards the viewer.
+    fn to_viewer(&self, p: Vec3) -> Vec3 {
+        if self.perspective { (self.frame.eye - p).normalize_or_zero() } else { self.frame.w }
+    }
+
+    /// The world direction of the ray through NDC `(x, y)`.
+    fn ray_dir(&self, x: f64, y: f64) -> Vec3 {
+        let h = |z: f64| {
+            let q = self.clip_to_world * Vec4::new(x, y, z, 1.0);
+            q.truncate() / q.w
+        };
+        (h(1.0) - h(-1.0)).normalize_or_zero()
+    }
+}
+
+fn attributes(v: &geometry::Vertex, (d, s): (Vec3, Vec3)) -> [f64; ATTRIBUTES] {
+    [v.p.x, v.p.y, v.p.z, v.n.x, v.n.y, v.n.z, v.uv.x, v.uv.y, d.x, d.y, d.z, s.x, s.y, s.z]
+}
+
+/// Vertex processing of one triangle: shading at the vertices (Gouraud), culling, clipping,
+/// division, viewport.
+fn process(
+    scene: &Scene,
+    proj: &Projection,
+    t: &Triangle,
+    index: u32,
+    opts: &RasterOptions,
+    (w, h): (u32, u32),
+) -> (bool, Vec<ScreenTriangle>) {
+    let [a, b, c] = t.v;
+    let face = (b.p - a.p).cross(c.p - a.p);
+    let centroid = (a.p + b.p + c.p) / 3.0;
+    if opts.cull && t.closed && face.dot(proj.to_viewer(centroid)) < 0.0 {
+        return (true, vec![]);
+    }
+    let m = &scene.materials[t.material as usize];
+    let color = |v: &geometry::Vertex| match opts.shading {
+        Shading::Gouraud => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p)),
+        _ => (Vec3::ZERO, Vec3::ZERO),
+    };
+    let poly: Vec<ClipVertex> =
+        t.v.iter()
+            .map(|v| ClipVertex { pos: proj.world_to_clip * v.p.extend(1.0), attr: attributes(v, color(v)) })
+            .collect();
+    let clipped = clip_polygon(&poly);
+    let screen = |cv: &ClipVertex| {
+        let inv_w = 1.0 / cv.pos.w;
+        let (x, y, z) = (cv.pos.x * inv_w, cv.pos.y * inv_w, cv.pos.z * inv_w);
+        let attr_w = cv.attr.map(|a| a * inv_w);
+        ((x + 1.0) * 0.5 * w as f64, (1.0 - y) * 0.5 * h as f64, z, inv_w, attr_w)
+    };
+    let pts: Vec<_> = clipped.iter().map(screen).collect();
+    let tris = (1..pts.len().saturating_sub(1))
+        .map(|k| {
+            let c = [&pts[0], &pts[k], &pts[k + 1]];
+            ScreenTriangle {
+                x: c.map(|p| p.0),
+                y: c.map(|p| p.1),
+                z: c.map(|p| p.2),
+                inv_w: c.map(|p| p.3),
+                attr_w: c.map(|p| p.4),
+                source: index,
+            }
+        })
+        .collect();
+    (false, tris)
+}
+
+/// The colour of a fragment.
+fn fragment_color(
+    scene: &Scene,
+    proj: &Projection,
+    tris: &[Triangle],
+    src: u32,
+    attr: &[f64; ATTRIBUTES],
+    opts: &RasterOptions,
+) -> Vec3 {
+    let t = &tris[src as usize];
+    let m = &scene.materials[t.material as usize];
+    match opts.shading {
+        Shading::Gouraud => {
+            let p = Vec3::new(attr[0], attr[1], attr[2]);
+            let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
+            let light = (Vec3::new(attr[8], attr[9], attr[10]), Vec3::new(attr[11], attr[12], attr[13]));
+            shade::combine(scene, m, light, n, proj.to_viewer(p), Vec2::new(attr[6], attr[7]))
+        }
+        Shading::Flat => {
+            let [a, b, c] = t.v;
+            let centroid = (a.p + b.p + c.p) / 3.0;
+            let n = (b.p - a.p).cross(c.p - a.p).normalize_or_zero();
+            let uv = (a.uv + b.uv + c.uv) / 3.0;
+            shade::shade(scene, m, centroid, n, proj.to_viewer(centroid), uv)
+        }
+        Shading::Phong => {
+            let p = Vec3::new(attr[0], attr[1], attr[2]);
+            let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
+            shade::shade(scene, m, p, n, proj.to_viewer(p), Vec2::new(attr[6], attr[7]))
+        }
+    }
+}
+
+const BAND: u32 = 16;
+
+/// Renders `scene` at its `[render]` size with the camera of the scene file.
+pub fn render_scene(scene: &Scene, opts: &RasterOptions) -> Result<(Framebuffer, RasterStats), RasterError> {
+    render_triangles(scene, &scene_triangles(scene), opts)
+}
+
+/// Renders already tessellated geometry (built once by [`scene_triangles`], then drawn as often
+/// as the camera or options change).
+pub fn render_triangles(
+    scene: &Scene,
+    geometry: &geometry::SceneTriangles,
+    opts: &RasterOptions,
+) -> Result<(Framebuffer, RasterStats), RasterError> {
+    let (w, h) = (scene.render.width, scene.render.height);
+    let proj = projection(&scene.camera, w, h)?;
+    let tris = &geometry.triangles;
+    let processed: Vec<(bool, Vec<ScreenTriangle>)> =
+        tris.par_iter().enumerate().map(|(i, t)| process(scene, &proj, t, i as u32, opts, (w, h))).collect();
+    let culled = processed.iter().filter(|p| p.0).count();
+    let screen: Vec<ScreenTriangle> = processed.into_iter().flat_map(|p| p.1).collect();
+    let bands: Vec<(Vec<[f32; 3]>, Vec<f64>)> = (0..h.div_ceil(BAND))
+        .into_par_iter()
+        .map(|band| {
+            let (y0, y1) = (band * BAND, ((band + 1) * BAND).min(h));
+            let n = ((y1 - y0) * w) as usize;
+            let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; ATTRIBUTES]); n]);
+            for t in &screen {
+                let (lo, hi) = (
+                    t.y.iter().copied().fold(f64::INFINITY, f64::min),
+                    t.y.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                );
+                if hi < y0 as f64 || lo > y1 as f64 {
+                    continue;
+                }
+                rasterize(t, w, y0, y1, |f| {
+                    let k = ((f.y - y0) * w + f.x) as usize;
+                    if f.depth < depth[k] && f.depth >= -1.0 {
+                        depth[k] = f.depth;
+                        owner[k] = (t.source, f.attr);
+                    }
+                });
+            }
+            // Deferred: each visible pixel is shaded once.
+            let color = (0..n)
+                .map(|k| {
+                    let (src, attr) = &owner[k];
+                    let c = if *src == u32::MAX {
+                        let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
+                        shade::background(scene, proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
+                    } else {
+                        fragment_color(scene, &proj, tris, *src, attr, opts)
+                    };
+                    [c.x as f32, c.y as f32, c.z as f32]
+                })
+                .collect();
+            (color, depth)
+        })
+        .collect();
+    let mut fb = Framebuffer {
+        width: w,
+        height: h,
+        color: Vec::with_capacity((w * h) as usize),
+        depth: Vec::with_capacity((w * h) as usize),
+    };
+    for (c, d) in bands {
+        fb.color.extend(c);
+        fb.depth.extend(d);
+    }
+    if opts.wireframe {
+        draw_wireframe(&mut fb, &screen);
+    }
+    let stats = RasterStats { triangles: tris.len(), culled, drawn: screen.len(), skipped_objects: geometry.skipped };
+    Ok((fb, stats))
+}
+
+/// Triangle edges by Bresenham, in white, over the image.
+fn draw_wireframe(fb: &mut Framebuffer, screen: &[ScreenTriangle]) {
+    for t in screen {
+        for k in 0..3 {
+            let (a, b) = (k, (k + 1) % 3);
+            let pa = (t.x[a].floor() as i64, t.y[a].floor() as i64);
+            let pb = (t.x[b].floor() as i64, t.y[b].floor() as i64);
+            for (x, y) in crate::bresenham_line(pa, pb) {
+                if x >= 0 && y >= 0 && (x as u32) < fb.width && (y as u32) < fb.height {
+                    fb.color[(y as u32 * fb.width + x as u32) as usize] = [1.0, 1.0, 1.0];
+                }
+            }
+        }
+    }
+}

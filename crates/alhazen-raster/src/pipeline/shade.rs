@@ -1,0 +1,87 @@
+//! The course's local lighting models for the preview (§"Lighting models"): ambient, Lambert and
+//! the Phong or Blinn–Phong highlight (`⟨h, n⟩^{2m}`), for every light on the viewer's side of
+//! the surface (the factor ν), with the course's distance attenuation; no shadows.
+
+use alhazen_math::{Vec2, Vec3};
+use alhazen_scene::{Highlight, Light, Material, Scene};
+
+/// The light arriving at `p` (unit normal `n`, viewer direction `v`), split as the course's
+/// model is: the factor of the surface colour (`I^amb + Σ I^dir ⟨l, n⟩`) and the highlight
+/// (`Σ I^dir s W`). Gouraud shading interpolates these two, so textures stay per pixel.
+pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3) -> (Vec3, Vec3) {
+    // Two-sided: light the side the viewer sees.
+    let n = if n.dot(v) < 0.0 { -n } else { n };
+    let (mut diffuse, mut specular) = (scene.ambient, Vec3::ZERO);
+    for light in &scene.lights {
+        let Some((l, i)) = incoming(light, p) else { continue };
+        let cos = n.dot(l);
+        if cos <= 0.0 {
+            continue;
+        }
+        diffuse += i * cos;
+        if m.specular != Vec3::ZERO {
+            let spec = match m.highlight {
+                Highlight::Phong => (2.0 * l.dot(n) * n - l).dot(v).max(0.0).powf(m.shininess),
+                Highlight::BlinnPhong => (l + v).normalize_or_zero().dot(n).max(0.0).powf(2.0 * m.shininess),
+            };
+            specular += i * m.specular * spec;
+        }
+    }
+    (diffuse, specular)
+}
+
+/// Radiance towards the viewer from the light factors of [`lighting`] at texture coordinates
+/// `uv`: `a·diffuse + specular`, plus emission and, for mirrors and glass, the background in the
+/// reflected and the viewing direction (environment mapping; the preview traces no rays).
+pub fn combine(scene: &Scene, m: &Material, (diffuse, specular): (Vec3, Vec3), n: Vec3, v: Vec3, uv: Vec2) -> Vec3 {
+    let a = alhazen_scene::texture::eval(&m.color, uv, &scene.images) * m.diffuse;
+    let mut c = a * diffuse + specular + m.emission;
+    let n = if n.dot(v) < 0.0 { -n } else { n };
+    if m.mirror != Vec3::ZERO {
+        c += m.mirror * background(scene, 2.0 * v.dot(n) * n - v);
+    }
+    if m.transparency != Vec3::ZERO {
+        c += m.transparency * background(scene, -v);
+    }
+    c
+}
+
+/// Radiance towards the viewer at `p`, lit per point.
+pub fn shade(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, uv: Vec2) -> Vec3 {
+    combine(scene, m, lighting(scene, m, p, n, v), n, v, uv)
+}
+
+/// What a ray leaving the scene in direction `dir` sees.
+pub fn background(scene: &Scene, dir: Vec3) -> Vec3 {
+    match scene.background {
+        alhazen_scene::Background::Solid(c) => c,
+        alhazen_scene::Background::Gradient { zenith, horizon, ground } => {
+            if dir.y >= 0.0 {
+                horizon.lerp(zenith, dir.y.min(1.0))
+            } else {
+                ground
+            }
+        }
+    }
+}
+
+/// Direction towards the light and the intensity arriving, `I^em/(a d² + b d + c)`.
+fn incoming(light: &Light, p: Vec3) -> Option<(Vec3, Vec3)> {
+    let falloff = |abc: &[f64; 3], d: f64| abc[0] * d * d + abc[1] * d + abc[2];
+    match light {
+        Light::Point { position, intensity, attenuation } => {
+            let to = *position - p;
+            let d = to.length();
+            (d > 0.0).then(|| (to / d, *intensity / falloff(attenuation, d)))
+        }
+        Light::Directional { direction, intensity } => Some((-*direction, *intensity)),
+        Light::Spot { position, direction, cos_cutoff, falloff: e, intensity, attenuation } => {
+            let to = *position - p;
+            let d = to.length();
+            let l = to / d;
+            let cos = -l.dot(*direction);
+            (d > 0.0 && cos >= *cos_cutoff).then(|| (l, *intensity * cos.powf(*e) / falloff(attenuation, d)))
+        }
+        Light::Environment { .. } => None,
+    }
+}

@@ -1,0 +1,119 @@
+//! The raster pipeline against the ray tracer: same scene, same camera, same local lighting
+//! model, no reflections and no shadows in view — the images must agree up to tessellation.
+
+use alhazen_math::Vec3;
+use alhazen_raster::pipeline::{RasterError, RasterOptions, Shading, render_scene};
+use alhazen_scene::parse_scene;
+
+const SCENE: &str = r#"
+background = [0.1, 0.12, 0.2]
+ambient = 0.1
+[render]
+width = 160
+height = 120
+spp = 1
+[camera]
+eye = [0, 1.5, 6]
+target = [0, 0.5, 0]
+fov = 50
+[[light]]
+type = "point"
+position = [2, 6, 8]
+intensity = 0.9
+[[light]]
+type = "directional"
+direction = [-0.3, -0.4, -1]
+intensity = 0.3
+[materials.red]
+color = [0.8, 0.2, 0.15]
+specular = 0.5
+shininess = 40
+[materials.blue]
+color = [0.2, 0.3, 0.8]
+specular = 0.3
+shininess = 20
+highlight = "blinn-phong"
+[materials.checks]
+color = { checker = { even = 0.8, odd = 0.3, size = 0.5 } }
+[[object]]
+shape = "sphere"
+center = [-1.2, 0.8, 0]
+radius = 0.8
+material = "red"
+[[object]]
+shape = "box"
+min = [0.4, 0, -0.6]
+max = [1.8, 1.2, 0.6]
+material = "blue"
+transform = [{ rotate_y = 20 }]
+[[object]]
+shape = "disk"
+center = [0, 0, 0]
+normal = [0, 1, 0]
+radius = 3
+material = "checks"
+"#;
+
+fn mean_abs(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (0..3).map(|k| (x[k] - y[k]).abs() as f64).sum::<f64>() / 3.0).sum::<f64>()
+        / a.len() as f64
+}
+
+#[test]
+fn raster_preview_agrees_with_the_ray_tracer_without_shadows_or_reflections() {
+    let mut scene = parse_scene("agree.toml".as_ref(), SCENE).unwrap();
+    // The ray tracer's shadows would be the one difference: keep the lights where none show.
+    scene.lights.truncate(1);
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    let mean: f64 =
+        traced.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / traced.pixels.len() as f64;
+    for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
+        let (fb, stats) = render_scene(&scene, &RasterOptions { shading, ..Default::default() }).unwrap();
+        assert!(stats.culled > 0 && stats.drawn > 0);
+        let err = mean_abs(&fb.color, &traced.pixels) / mean;
+        eprintln!("{shading:?}: mean absolute difference {:.2} % of the mean brightness", err * 100.0);
+        let limit = match shading {
+            Shading::Phong => 0.02,
+            Shading::Gouraud => 0.03,
+            Shading::Flat => 0.05,
+        };
+        assert!(err < limit, "{shading:?}: mean error {:.2} % of the mean brightness", err * 100.0);
+    }
+}
+
+#[test]
+fn depth_buffer_keeps_the_nearest_surface() {
+    let scene = parse_scene("agree.toml".as_ref(), SCENE).unwrap();
+    let (fb, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    // Through the sphere's centre the disk lies behind the sphere: the sphere (red) must win,
+    // whatever order the triangles were drawn in.
+    let (x, y) = (50u32, 56u32);
+    let c = fb.color[(y * 160 + x) as usize];
+    assert!(c[0] > 2.0 * c[1] && c[0] > 2.0 * c[2], "{c:?}");
+    assert!(fb.depth[(y * 160 + x) as usize].is_finite());
+    // Background pixels keep an infinite depth and the background colour.
+    assert!(fb.depth[0].is_infinite());
+    assert!((fb.color[0][2] - 0.2).abs() < 1e-6);
+}
+
+#[test]
+fn unsupported_cameras_are_reported() {
+    let text = "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n";
+    let scene = parse_scene("p.toml".as_ref(), text).unwrap();
+    let err = render_scene(&scene, &RasterOptions::default()).unwrap_err();
+    assert_eq!(err, RasterError::UnsupportedCamera("panorama"));
+    assert!(err.to_string().contains("perspective and orthographic"));
+}
+
+#[test]
+fn orthographic_camera_and_wireframe_render() {
+    let text = SCENE
+        .replace("eye = [0, 1.5, 6]", "type = \"orthographic\"\nwidth = 6\neye = [0, 1.5, 6]")
+        .replace("fov = 50", "");
+    let scene = parse_scene("o.toml".as_ref(), &text).unwrap();
+    let (fb, _) = render_scene(&scene, &RasterOptions { wireframe: true, ..Default::default() }).unwrap();
+    let white = fb.color.iter().filter(|c| **c == [1.0, 1.0, 1.0]).count();
+    assert!(white > 100, "edges drawn: {white}");
+    let lit = fb.color.iter().filter(|c| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64).length() > 0.3).count();
+    assert!(lit > 1000);
+}
