@@ -36,19 +36,35 @@ enum Command {
     Mirror(mirror::MirrorCommand),
 }
 
+/// What every image-producing command takes: the scene, the output and its size.
 #[derive(Args)]
-struct RenderArgs {
+pub(crate) struct ImageArgs {
     /// The scene file (TOML).
-    scene: PathBuf,
-    /// Output image; the format follows the extension: .png, .exr, .pfm.
+    pub(crate) scene: PathBuf,
+    /// Output image: .png (8-bit sRGB), .exr or .pfm (linear floats).
     #[arg(short, long)]
-    output: PathBuf,
+    pub(crate) output: PathBuf,
     /// Image width in pixels (overrides the scene).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    width: Option<u32>,
+    pub(crate) width: Option<u32>,
     /// Image height in pixels (overrides the scene).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    height: Option<u32>,
+    pub(crate) height: Option<u32>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub(crate) threads: Option<u32>,
+    /// Write EXR as 16-bit half floats instead of 32-bit floats.
+    #[arg(long)]
+    pub(crate) half: bool,
+    /// No progress bar or summary.
+    #[arg(short, long)]
+    pub(crate) quiet: bool,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    image: ImageArgs,
     /// Samples per pixel (overrides the scene).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
     spp: Option<u32>,
@@ -64,15 +80,6 @@ struct RenderArgs {
     /// The path tracer's sampler (overrides the scene).
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
-    /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    threads: Option<u32>,
-    /// Write EXR as 16-bit half floats instead of 32-bit floats.
-    #[arg(long)]
-    half: bool,
-    /// No progress bar or summary.
-    #[arg(short, long)]
-    quiet: bool,
 }
 
 /// `--integrator`.
@@ -124,10 +131,8 @@ fn main() -> ExitCode {
     }
 }
 
-fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), Failure> {
+fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
     let r = &mut scene.render;
-    r.width = a.width.unwrap_or(r.width);
-    r.height = a.height.unwrap_or(r.height);
     r.spp = a.spp.unwrap_or(r.spp);
     r.max_depth = a.depth.unwrap_or(r.max_depth);
     r.seed = a.seed.unwrap_or(r.seed);
@@ -143,13 +148,29 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), Failure> {
             SamplerArg::Independent => alhazen_scene::SamplerKind::Independent,
         };
     }
+}
+
+/// Reads the scene and applies `--width`/`--height`, refusing sizes that cannot be allocated.
+pub(crate) fn load_sized(a: &ImageArgs) -> Result<Scene, Failure> {
+    let mut scene = load_scene(&a.scene).map_err(|e| match e {
+        SceneError::Io { .. } => Failure::input(e.to_string()),
+        SceneError::Syntax(d) => Failure::input(d.to_string()),
+    })?;
+    let r = &mut scene.render;
+    r.width = a.width.unwrap_or(r.width);
+    r.height = a.height.unwrap_or(r.height);
     if r.width as u64 * r.height as u64 > MAX_PIXELS {
         return Err(Failure::input(format!(
             "{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate",
             r.width, r.height
         )));
     }
-    Ok(())
+    Ok(scene)
+}
+
+/// Writes `image` atomically, or says why not.
+pub(crate) fn save(image: &alhazen_render::Image, path: &Path, format: Format) -> Result<(), Failure> {
+    write_image(image, path, format).map_err(|e| Failure::work(format!("cannot write {}: {e}", path.display())))
 }
 
 pub(crate) fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
@@ -163,16 +184,13 @@ pub(crate) fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
 }
 
 fn run_render(a: &RenderArgs) -> Result<(), Failure> {
-    let format = check_output(&a.output, a.half)?;
-    let mut scene = load_scene(&a.scene).map_err(|e| match e {
-        SceneError::Io { .. } => Failure::input(e.to_string()),
-        SceneError::Syntax(d) => Failure::input(d.to_string()),
-    })?;
-    apply_overrides(&mut scene, a)?;
-    let threads = a.threads.map_or(0, |t| t as usize);
+    let format = check_output(&a.image.output, a.image.half)?;
+    let mut scene = load_sized(&a.image)?;
+    apply_overrides(&mut scene, a);
+    let threads = a.image.threads.map_or(0, |t| t as usize);
     let pool =
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Failure::work(e.to_string()))?;
-    let bar = progress_bar(a.quiet);
+    let bar = progress_bar(a.image.quiet);
     let start = Instant::now();
     let image = pool.install(|| {
         alhazen_render::render(&scene, &|done, total| {
@@ -182,13 +200,12 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     });
     bar.finish_and_clear();
     let elapsed = start.elapsed();
-    write_image(&image, &a.output, format)
-        .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.output.display())))?;
-    if !a.quiet {
+    save(&image, &a.image.output, format)?;
+    if !a.image.quiet {
         let r = &scene.render;
         eprintln!(
             "rendered {} ({}×{}, {} spp, depth {}, {:?}) in {:.3} s on {} threads → {}",
-            a.scene.display(),
+            a.image.scene.display(),
             image.width,
             image.height,
             r.spp,
@@ -196,7 +213,7 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
             r.integrator,
             elapsed.as_secs_f64(),
             pool.current_num_threads(),
-            a.output.display()
+            a.image.output.display()
         );
     }
     Ok(())

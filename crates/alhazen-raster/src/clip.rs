@@ -76,16 +76,27 @@ pub fn liang_barsky(w: &Window, a: Vec2, b: Vec2) -> Option<(Vec2, Vec2)> {
     let d = b - a;
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     for (p, q) in [(-d.x, a.x - w.xmin), (d.x, w.xmax - a.x), (-d.y, a.y - w.ymin), (d.y, w.ymax - a.y)] {
-        if p == 0.0 {
-            if q < 0.0 {
-                return None;
-            }
-        } else {
-            let r = q / p;
-            if p < 0.0 { t0 = t0.max(r) } else { t1 = t1.min(r) }
+        if !lb_test(p, q, &mut t0, &mut t1) {
+            return None;
         }
     }
     (t0 <= t1).then(|| (a + d * t0, a + d * t1))
+}
+
+/// The course's `LBTest` for one inequality `t·p ≤ q`: narrows `[t0, t1]`; false when the
+/// segment lies wholly outside (parallel to the boundary and beyond it).
+#[inline]
+fn lb_test(p: f64, q: f64, t0: &mut f64, t1: &mut f64) -> bool {
+    if p == 0.0 {
+        return q >= 0.0;
+    }
+    let r = q / p;
+    if p < 0.0 {
+        *t0 = t0.max(r)
+    } else {
+        *t1 = t1.min(r)
+    }
+    true
 }
 
 /// Liang–Barsky in homogeneous coordinates (course: "the algorithms may easily be modified to
@@ -99,14 +110,8 @@ pub fn liang_barsky_homogeneous(a: Vec4, b: Vec4) -> Option<(f64, f64)> {
         for sign in [1.0, -1.0] {
             // d(t) = d0 + t (d1 − d0) ≥ 0 with d = w + sign·coordinate.
             let (d0, d1) = (a.w + sign * a[axis], b.w + sign * b[axis]);
-            let (p, q) = (d0 - d1, d0);
-            if p == 0.0 {
-                if q < 0.0 {
-                    return None;
-                }
-            } else {
-                let r = q / p;
-                if p < 0.0 { t0 = t0.max(r) } else { t1 = t1.min(r) }
+            if !lb_test(d0 - d1, d0, &mut t0, &mut t1) {
+                return None;
             }
         }
     }

@@ -118,19 +118,6 @@ pub struct Lights {
     sky: Option<u32>,
 }
 
-fn background_radiance(b: &Background, dir: Vec3) -> Vec3 {
-    match *b {
-        Background::Solid(c) => c,
-        Background::Gradient { zenith, horizon, ground } => {
-            if dir.y >= 0.0 {
-                horizon.lerp(zenith, dir.y.min(1.0))
-            } else {
-                ground
-            }
-        }
-    }
-}
-
 /// The world-space geometry of an emitting object, when it can be sampled.
 fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
     let t = &o.transform;
@@ -259,7 +246,7 @@ impl Lights {
     pub fn sky_radiance(&self, dir: Vec3) -> Vec3 {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => m.radiance(dir),
-            Some(PathLight::Background(b)) => background_radiance(b, dir),
+            Some(PathLight::Background(b)) => b.radiance(dir),
             _ => Vec3::ZERO,
         }
     }
@@ -333,7 +320,7 @@ impl Lights {
             }
             PathLight::Background(b) => {
                 let dir = uniform_sphere(u);
-                let radiance = background_radiance(b, dir);
+                let radiance = b.radiance(dir);
                 Some(LightSample { dir, dist: f64::INFINITY, radiance, pdf: 1.0 / (4.0 * PI), delta: false })
             }
             PathLight::Area { emitter, radiance } => sample_area(emitter, *radiance, p, u),

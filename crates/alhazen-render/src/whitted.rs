@@ -13,7 +13,7 @@ use crate::sampler::stratified_offset;
 use crate::texture;
 use crate::world::{ShadowHit, World, WorldHit};
 use alhazen_math::{Ray, Vec3};
-use alhazen_scene::{Background, FresnelMode, Highlight, Light, Material, Scene};
+use alhazen_scene::{FresnelMode, Highlight, Light, Material, Scene};
 
 /// Rays whose contribution to the pixel would fall below this are not traced (like POV-Ray's
 /// `adc_bailout` of 1/255, but finer).
@@ -116,16 +116,7 @@ impl<'a> Whitted<'a> {
         if let Some(env) = &self.environment {
             return env.radiance(dir);
         }
-        match self.scene.background {
-            Background::Solid(c) => c,
-            Background::Gradient { zenith, horizon, ground } => {
-                if dir.y >= 0.0 {
-                    horizon.lerp(zenith, dir.y.min(1.0))
-                } else {
-                    ground
-                }
-            }
-        }
+        self.scene.background.radiance(dir)
     }
 
     /// `RT_shade`.

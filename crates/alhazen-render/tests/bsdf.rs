@@ -21,14 +21,25 @@ fn catalogue() -> Vec<(String, Bsdf)> {
     let mut list: Vec<(String, Bsdf)> = vec![
         ("lambert".into(), Bsdf::Lambert(Lambert { albedo })),
         ("oren-nayar σ=0.5".into(), Bsdf::OrenNayar(OrenNayar { albedo, sigma: 0.5, interreflection: true })),
-        ("phong m=20".into(), Bsdf::Phong(Phong { diffuse: albedo * 0.5, ks: 0.5, exponent: 20.0 })),
+        (
+            "phong m=20".into(),
+            Bsdf::Phong(Phong { diffuse: albedo * 0.5, ks: 0.5, lobe: PhongLobe { exponent: 20.0 } }),
+        ),
         (
             "blinn-phong m=15".into(),
-            Bsdf::BlinnPhong(BlinnPhong { diffuse: albedo * 0.3, ks: 0.7, exponent: 15.0, anisotropy: 1.0 }),
+            Bsdf::BlinnPhong(BlinnPhong {
+                diffuse: albedo * 0.3,
+                ks: 0.7,
+                lobe: BlinnPhongLobe { exponent: 15.0, anisotropy: 1.0 },
+            }),
         ),
         (
             "anisotropic blinn-phong a=0.3".into(),
-            Bsdf::BlinnPhong(BlinnPhong { diffuse: albedo * 0.3, ks: 0.7, exponent: 15.0, anisotropy: 0.3 }),
+            Bsdf::BlinnPhong(BlinnPhong {
+                diffuse: albedo * 0.3,
+                ks: 0.7,
+                lobe: BlinnPhongLobe { exponent: 15.0, anisotropy: 0.3 },
+            }),
         ),
     ];
     for (d, name) in [
@@ -43,9 +54,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 Bsdf::CookTorrance(CookTorrance {
                     diffuse: albedo * 0.4,
                     ks: 0.6,
-                    facets: facets(d, a, a, g),
-                    ior: 1.5,
-                    schlick: false,
+                    lobe: CookTorranceLobe { facets: facets(d, a, a, g), ior: 1.5, schlick: false },
                 }),
             ));
             if d != Distribution::Gaussian {
@@ -324,7 +333,7 @@ fn the_course_phong_is_not_reciprocal_but_the_normalised_one_is() {
     let r = |l: Vec3| Vec3::new(-l.x, -l.y, l.z);
     let course = |v: Vec3, l: Vec3| r(l).dot(v).max(0.0).powf(10.0) / l.z;
     assert!((course(a, c) - course(c, a)).abs() > 0.1 * course(a, c));
-    let b = Bsdf::Phong(Phong { diffuse: Vec3::ZERO, ks: 1.0, exponent: 10.0 });
+    let b = Bsdf::Phong(Phong { diffuse: Vec3::ZERO, ks: 1.0, lobe: PhongLobe { exponent: 10.0 } });
     assert!((b.eval(a, c).x - b.eval(c, a).x).abs() < 1e-12);
 }
 

@@ -191,6 +191,22 @@ pub enum Background {
     },
 }
 
+impl Background {
+    /// What a ray leaving the scene in direction `dir` sees.
+    pub fn radiance(&self, dir: Vec3) -> Rgb {
+        match *self {
+            Background::Solid(c) => c,
+            Background::Gradient { zenith, horizon, ground } => {
+                if dir.y >= 0.0 {
+                    horizon.lerp(zenith, dir.y.min(1.0))
+                } else {
+                    ground
+                }
+            }
+        }
+    }
+}
+
 /// A light source with the course's distance attenuation `1/(a d² + b d + c)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {

@@ -291,7 +291,7 @@ pub fn render_triangles(
                     let (src, attr) = &owner[k];
                     let c = if *src == u32::MAX {
                         let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
-                        shade::background(scene, proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
+                        scene.background.radiance(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
                     } else {
                         fragment_color(scene, &proj, tris, *src, attr, opts)
                     };

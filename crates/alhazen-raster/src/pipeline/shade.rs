@@ -38,10 +38,10 @@ pub fn combine(scene: &Scene, m: &Material, (diffuse, specular): (Vec3, Vec3), n
     let mut c = a * diffuse + specular + m.emission;
     let n = if n.dot(v) < 0.0 { -n } else { n };
     if m.mirror != Vec3::ZERO {
-        c += m.mirror * background(scene, 2.0 * v.dot(n) * n - v);
+        c += m.mirror * scene.background.radiance(2.0 * v.dot(n) * n - v);
     }
     if m.transparency != Vec3::ZERO {
-        c += m.transparency * background(scene, -v);
+        c += m.transparency * scene.background.radiance(-v);
     }
     c
 }
@@ -49,20 +49,6 @@ pub fn combine(scene: &Scene, m: &Material, (diffuse, specular): (Vec3, Vec3), n
 /// Radiance towards the viewer at `p`, lit per point.
 pub fn shade(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, uv: Vec2) -> Vec3 {
     combine(scene, m, lighting(scene, m, p, n, v), n, v, uv)
-}
-
-/// What a ray leaving the scene in direction `dir` sees.
-pub fn background(scene: &Scene, dir: Vec3) -> Vec3 {
-    match scene.background {
-        alhazen_scene::Background::Solid(c) => c,
-        alhazen_scene::Background::Gradient { zenith, horizon, ground } => {
-            if dir.y >= 0.0 {
-                horizon.lerp(zenith, dir.y.min(1.0))
-            } else {
-                ground
-            }
-        }
-    }
 }
 
 /// Direction towards the light and the intensity arriving, `I^em/(a d² + b d + c)`.

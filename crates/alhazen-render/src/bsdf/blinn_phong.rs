@@ -10,24 +10,24 @@
 //! Parameters: `albedo`, `kd`, `ks`, exponent `m`, anisotropy `a ∈ (0, 1]`; the tangent frame's
 //! `s` axis is the scratch direction.
 
-use super::{BsdfSample, cosine_hemisphere, cosine_pdf, lobe_probability, reflect, same_side};
-use alhazen_math::{Vec2, Vec3, color::luminance};
-use std::f64::consts::{FRAC_1_PI, PI};
+use super::layered::{DiffuseSpecular, SpecularLobe};
+use super::{half_vector, reflect};
+use alhazen_math::{Vec2, Vec3};
+use std::f64::consts::PI;
 
-/// Normalised anisotropic Blinn–Phong.
+/// The stretched `⟨ĥ, n⟩^{2m}` lobe.
 #[derive(Clone, Copy, Debug)]
-pub struct BlinnPhong {
-    /// Diffuse colour times `kd`.
-    pub diffuse: Vec3,
-    /// `ks`.
-    pub ks: f64,
-    /// `m`.
+pub struct BlinnPhongLobe {
+    /// `m` (the lobe is `cos^{2m}`).
     pub exponent: f64,
     /// `a`.
     pub anisotropy: f64,
 }
 
-impl BlinnPhong {
+/// Normalised anisotropic Blinn–Phong.
+pub type BlinnPhong = DiffuseSpecular<BlinnPhongLobe>;
+
+impl BlinnPhongLobe {
     /// The half-vector density `D_a(h)`, `h` in the upper hemisphere.
     fn density(&self, h: Vec3) -> f64 {
         if h.z <= 0.0 {
@@ -39,49 +39,27 @@ impl BlinnPhong {
         let cos = h.z / len;
         (2.0 * self.exponent + 1.0) / (2.0 * PI) * cos.powf(2.0 * self.exponent) * a / (len * len * len)
     }
+}
 
-    fn half(v: Vec3, l: Vec3) -> Option<Vec3> {
-        let h = (v + l).normalize_or_zero();
-        (h != Vec3::ZERO).then(|| h * h.z.signum())
+impl SpecularLobe for BlinnPhongLobe {
+    fn value(&self, v: Vec3, l: Vec3) -> f64 {
+        let Some(h) = half_vector(v, l) else { return 0.0 };
+        self.density(h) / (4.0 * h.dot(l).abs() * l.z.abs().max(v.z.abs()))
     }
 
-    fn p_diffuse(&self) -> f64 {
-        lobe_probability(luminance(self.diffuse), self.ks)
+    /// The half-vector density mapped to `l` (Jacobian `1/(4⟨h,l⟩)`).
+    fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
+        let Some(h) = half_vector(v, l) else { return 0.0 };
+        self.density(h) / (4.0 * h.dot(l).abs())
     }
 
-    /// `ρ`.
-    pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
-        if !same_side(v, l) {
-            return Vec3::ZERO;
-        }
-        let Some(h) = Self::half(v, l) else { return Vec3::ZERO };
-        let spec = self.density(h) / (4.0 * h.dot(l).abs() * l.z.abs().max(v.z.abs()));
-        self.diffuse * FRAC_1_PI + Vec3::splat(self.ks * spec)
-    }
-
-    /// Cosine density mixed with the half-vector density mapped to `l` (Jacobian `1/(4⟨h,l⟩)`).
-    pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        if !same_side(v, l) {
-            return 0.0;
-        }
-        let Some(h) = Self::half(v, l) else { return 0.0 };
-        let pd = self.p_diffuse();
-        pd * cosine_pdf(v, l) + (1.0 - pd) * self.density(h) / (4.0 * h.dot(l).abs())
-    }
-
-    /// Diffuse, or a half vector from the stretched `cos^{2m}` lobe reflected about.
-    pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
-        let l = if uc < self.p_diffuse() {
-            cosine_hemisphere(u, v)
-        } else {
-            let cos = u.x.powf(1.0 / (2.0 * self.exponent + 1.0));
-            let sin = (1.0 - cos * cos).max(0.0).sqrt();
-            let phi = 2.0 * PI * u.y;
-            let hs = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
-            let h = Vec3::new(hs.x, hs.y / self.anisotropy, hs.z).normalize();
-            reflect(v, h * v.z.signum())
-        };
-        let pdf = self.pdf(v, l);
-        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+    /// A half vector from the stretched `cos^{2m}` lobe, `v` reflected about it.
+    fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
+        let cos = u.x.powf(1.0 / (2.0 * self.exponent + 1.0));
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y;
+        let hs = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+        let h = Vec3::new(hs.x, hs.y / self.anisotropy, hs.z).normalize();
+        Some(reflect(v, h * v.z.signum()))
     }
 }

@@ -76,20 +76,21 @@ fn from_desc(desc: &BsdfDesc, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mod
             Bsdf::OrenNayar(OrenNayar { albedo: tex(albedo), sigma: *sigma, interreflection: *interreflection })
         }
         BsdfDesc::Phong { albedo, kd, ks, exponent } => {
-            Bsdf::Phong(Phong { diffuse: tex(albedo) * *kd, ks: *ks, exponent: *exponent })
+            Bsdf::Phong(Phong { diffuse: tex(albedo) * *kd, ks: *ks, lobe: PhongLobe { exponent: *exponent } })
         }
         BsdfDesc::BlinnPhong { albedo, kd, ks, exponent, anisotropy, .. } => Bsdf::BlinnPhong(BlinnPhong {
             diffuse: tex(albedo) * *kd,
             ks: *ks,
-            exponent: *exponent,
-            anisotropy: *anisotropy,
+            lobe: BlinnPhongLobe { exponent: *exponent, anisotropy: *anisotropy },
         }),
         BsdfDesc::CookTorrance { albedo, kd, ks, facets, ior, fresnel } => Bsdf::CookTorrance(CookTorrance {
             diffuse: tex(albedo) * *kd,
             ks: *ks,
-            facets: Microfacet::new(facets),
-            ior: *ior,
-            schlick: *fresnel == FresnelMode::Schlick,
+            lobe: CookTorranceLobe {
+                facets: Microfacet::new(facets),
+                ior: *ior,
+                schlick: *fresnel == FresnelMode::Schlick,
+            },
         }),
         BsdfDesc::Conductor { facets, eta, k, tint, fresnel } => Bsdf::Conductor(Conductor {
             facets: facets.as_ref().map(Microfacet::new),

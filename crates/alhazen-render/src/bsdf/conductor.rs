@@ -7,7 +7,7 @@
 //! `tint` (a multiplier, 1 is physical), Fresnel mode. `η = κ = 0` is an ideal mirror (`F = tint`).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, reflect, same_side};
+use super::{BsdfSample, half_vector, reflect, same_side};
 use alhazen_math::{Vec2, Vec3};
 
 /// A conductor.
@@ -84,18 +84,13 @@ impl Conductor {
         Vec3::new(f(0), f(1), f(2)) * self.tint
     }
 
-    fn half(v: Vec3, l: Vec3) -> Option<Vec3> {
-        let h = (v + l).normalize_or_zero();
-        (h != Vec3::ZERO).then(|| h * h.z.signum())
-    }
-
     /// `D G F / (4⟨l,n⟩⟨v,n⟩)`; 0 for a smooth metal.
     pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
         let Some(f) = &self.facets else { return Vec3::ZERO };
         if !same_side(v, l) {
             return Vec3::ZERO;
         }
-        let Some(h) = Self::half(v, l) else { return Vec3::ZERO };
+        let Some(h) = half_vector(v, l) else { return Vec3::ZERO };
         self.fresnel(h.dot(l)) * (f.d(h) * f.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()))
     }
 
@@ -105,7 +100,7 @@ impl Conductor {
         if !same_side(v, l) {
             return 0.0;
         }
-        let Some(h) = Self::half(v, l) else { return 0.0 };
+        let Some(h) = half_vector(v, l) else { return 0.0 };
         f.pdf_h(h) / (4.0 * h.dot(v).abs())
     }
 

@@ -5,19 +5,16 @@
 //! Parameters: `albedo`, `kd`, `ks` (`k_d + k_s ≤ 1`), the microfacet distribution, roughness and
 //! shadowing, the coating's index `ior`, the Fresnel mode.
 
+use super::half_vector;
+use super::layered::{DiffuseSpecular, SpecularLobe};
 use super::microfacet::Microfacet;
-use super::{BsdfSample, cosine_hemisphere, cosine_pdf, lobe_probability, reflect, same_side};
+use super::reflect;
 use crate::optics::{fresnel_dielectric, fresnel_schlick};
-use alhazen_math::{Vec2, Vec3, color::luminance};
-use std::f64::consts::FRAC_1_PI;
+use alhazen_math::{Vec2, Vec3};
 
-/// Cook–Torrance.
+/// The microfacet lobe `D G F / (4⟨l,n⟩⟨v,n⟩)` of a dielectric coating.
 #[derive(Clone, Copy, Debug)]
-pub struct CookTorrance {
-    /// `k_d` times the albedo.
-    pub diffuse: Vec3,
-    /// `k_s`.
-    pub ks: f64,
+pub struct CookTorranceLobe {
     /// `D`, `G`.
     pub facets: Microfacet,
     /// Coating index.
@@ -26,50 +23,26 @@ pub struct CookTorrance {
     pub schlick: bool,
 }
 
-impl CookTorrance {
-    fn fresnel(&self, c: f64) -> f64 {
-        if self.schlick { fresnel_schlick(c, self.ior) } else { fresnel_dielectric(c, self.ior) }
+/// Cook–Torrance.
+pub type CookTorrance = DiffuseSpecular<CookTorranceLobe>;
+
+impl SpecularLobe for CookTorranceLobe {
+    fn value(&self, v: Vec3, l: Vec3) -> f64 {
+        let Some(h) = half_vector(v, l) else { return 0.0 };
+        let c = h.dot(l);
+        let f = if self.schlick { fresnel_schlick(c, self.ior) } else { fresnel_dielectric(c, self.ior) };
+        self.facets.d(h) * self.facets.g(v, l, h) * f / (4.0 * l.z.abs() * v.z.abs())
     }
 
-    fn half(v: Vec3, l: Vec3) -> Option<Vec3> {
-        let h = (v + l).normalize_or_zero();
-        (h != Vec3::ZERO).then(|| h * h.z.signum())
+    /// `D(h) cos ϑ_h / (4⟨h,v⟩)`.
+    fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
+        let Some(h) = half_vector(v, l) else { return 0.0 };
+        self.facets.pdf_h(h) / (4.0 * h.dot(v).abs())
     }
 
-    fn p_diffuse(&self) -> f64 {
-        lobe_probability(luminance(self.diffuse), self.ks)
-    }
-
-    /// `k_d ρ_d + k_s ρ_s`.
-    pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
-        if !same_side(v, l) {
-            return Vec3::ZERO;
-        }
-        let Some(h) = Self::half(v, l) else { return Vec3::ZERO };
-        let f = &self.facets;
-        let spec = f.d(h) * f.g(v, l, h) * self.fresnel(h.dot(l)) / (4.0 * l.z.abs() * v.z.abs());
-        self.diffuse * FRAC_1_PI + Vec3::splat(self.ks * spec)
-    }
-
-    /// Cosine density mixed with `D(h) cos ϑ_h / (4⟨h,v⟩)`.
-    pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        if !same_side(v, l) {
-            return 0.0;
-        }
-        let Some(h) = Self::half(v, l) else { return 0.0 };
-        let pd = self.p_diffuse();
-        pd * cosine_pdf(v, l) + (1.0 - pd) * self.facets.pdf_h(h) / (4.0 * h.dot(v).abs())
-    }
-
-    /// Diffuse by cosine, specular by reflecting `v` about a sampled facet normal.
-    pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
-        let l = if uc < self.p_diffuse() {
-            cosine_hemisphere(u, v)
-        } else {
-            let h = self.facets.sample_h(u)?;
-            reflect(v, h * v.z.signum())
-        };
-        let pdf = self.pdf(v, l);
-        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+    /// `v` reflected about a sampled facet normal.
+    fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
+        let h = self.facets.sample_h(u)?;
+        Some(reflect(v, h * v.z.signum()))
     }
 }

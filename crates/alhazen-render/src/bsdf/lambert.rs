@@ -3,7 +3,7 @@
 //!
 //! Parameters: `albedo` — the fraction of light reflected, per channel.
 
-use super::{BsdfSample, cosine_hemisphere, cosine_pdf, same_side};
+use super::{BsdfSample, cosine_pdf, same_side, sample_cosine};
 use alhazen_math::{Vec2, Vec3};
 use std::f64::consts::FRAC_1_PI;
 
@@ -27,8 +27,6 @@ impl Lambert {
 
     /// Cosine-weighted sampling.
     pub fn sample(&self, v: Vec3, _uc: f64, u: Vec2) -> Option<BsdfSample> {
-        let l = cosine_hemisphere(u, v);
-        let pdf = self.pdf(v, l);
-        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+        sample_cosine(v, u, |l| self.eval(v, l))
     }
 }

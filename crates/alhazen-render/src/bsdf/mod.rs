@@ -13,21 +13,22 @@ mod conductor;
 mod cook_torrance;
 mod dielectric;
 mod lambert;
+pub mod layered;
 pub mod microfacet;
 mod mix;
 mod oren_nayar;
 mod phong;
 
-pub use blinn_phong::BlinnPhong;
+pub use blinn_phong::{BlinnPhong, BlinnPhongLobe};
 pub use build::{ColorMode, bsdf_at, tangent_hint};
 pub use conductor::Conductor;
-pub use cook_torrance::CookTorrance;
+pub use cook_torrance::{CookTorrance, CookTorranceLobe};
 pub use dielectric::Dielectric;
 pub use lambert::Lambert;
 pub use microfacet::Microfacet;
 pub use mix::Mix;
 pub use oren_nayar::OrenNayar;
-pub use phong::Phong;
+pub use phong::{Phong, PhongLobe};
 
 use alhazen_math::{Vec2, Vec3};
 use std::f64::consts::PI;
@@ -194,6 +195,20 @@ pub(crate) fn refract(v: Vec3, mut n: Vec3, mut eta: f64) -> Option<(Vec3, f64)>
     }
     let cos_t = (1.0 - sin2_t).sqrt();
     Some((-v / eta + (cos_i / eta - cos_t) * n, eta))
+}
+
+/// The half vector of `v` and `l`, turned to the upper hemisphere; `None` when they are opposite.
+#[inline]
+pub(crate) fn half_vector(v: Vec3, l: Vec3) -> Option<Vec3> {
+    let h = (v + l).normalize_or_zero();
+    (h != Vec3::ZERO).then(|| h * h.z.signum())
+}
+
+/// A cosine-weighted sample of a diffuse lobe whose value is `eval(l)`.
+pub(crate) fn sample_cosine(v: Vec3, u: Vec2, eval: impl Fn(Vec3) -> Vec3) -> Option<BsdfSample> {
+    let l = cosine_hemisphere(u, v);
+    let pdf = cosine_pdf(v, l);
+    (pdf > 0.0).then(|| BsdfSample { l, f: eval(l), pdf, delta: false, eta: 1.0, dispersive: false })
 }
 
 /// Lobe choice probability proportional to two non-negative weights (0.5 each when both vanish).

@@ -8,7 +8,7 @@
 //! Note on the seed: the course prints `(1 − c β²/π²)` in `ρ_d,2`; Oren and Nayar's paper has
 //! `(2β/π)²`, which we use (the two differ by the factor 4 on β²).
 
-use super::{BsdfSample, cosine_hemisphere, cosine_pdf, same_side};
+use super::{BsdfSample, cosine_pdf, same_side, sample_cosine};
 use alhazen_math::{Vec2, Vec3};
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -61,8 +61,6 @@ impl OrenNayar {
 
     /// Cosine-weighted sampling.
     pub fn sample(&self, v: Vec3, _uc: f64, u: Vec2) -> Option<BsdfSample> {
-        let l = cosine_hemisphere(u, v);
-        let pdf = self.pdf(v, l);
-        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+        sample_cosine(v, u, |l| self.eval(v, l))
     }
 }

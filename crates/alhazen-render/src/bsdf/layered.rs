@@ -1,0 +1,59 @@
+//! The course's form of a physically based reflection model, `ρ_r = v(k_d ρ_d + k_s ρ_s)`:
+//! a Lambertian `ρ_d` plus a specular lobe `ρ_s`, zero unless `l` and `v` are on the same side
+//! (the factor `v`). Phong, Blinn–Phong and Cook–Torrance differ only in `ρ_s`; sampling picks the
+//! diffuse or the specular lobe in proportion to their weights and the density is the mixture.
+
+use super::{BsdfSample, cosine_hemisphere, cosine_pdf, lobe_probability, same_side};
+use alhazen_math::{Vec2, Vec3, color::luminance};
+use std::f64::consts::FRAC_1_PI;
+
+/// A specular lobe `ρ_s` with a way to sample it.
+pub trait SpecularLobe {
+    /// `ρ_s(l, v)` for `l`, `v` on the same side.
+    fn value(&self, v: Vec3, l: Vec3) -> f64;
+    /// Solid-angle density of [`SpecularLobe::sample`].
+    fn pdf(&self, v: Vec3, l: Vec3) -> f64;
+    /// A direction `l` from `u ∈ [0, 1)²`.
+    fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3>;
+}
+
+/// `k_d·albedo/π + k_s·ρ_s`.
+#[derive(Clone, Copy, Debug)]
+pub struct DiffuseSpecular<S> {
+    /// Diffuse colour times `k_d`.
+    pub diffuse: Vec3,
+    /// `k_s`.
+    pub ks: f64,
+    /// `ρ_s`.
+    pub lobe: S,
+}
+
+impl<S: SpecularLobe> DiffuseSpecular<S> {
+    fn p_diffuse(&self) -> f64 {
+        lobe_probability(luminance(self.diffuse), self.ks)
+    }
+
+    /// `ρ`.
+    pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
+        if !same_side(v, l) {
+            return Vec3::ZERO;
+        }
+        self.diffuse * FRAC_1_PI + Vec3::splat(self.ks * self.lobe.value(v, l))
+    }
+
+    /// The mixture of the cosine density and the lobe's.
+    pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
+        if !same_side(v, l) {
+            return 0.0;
+        }
+        let pd = self.p_diffuse();
+        pd * cosine_pdf(v, l) + (1.0 - pd) * self.lobe.pdf(v, l)
+    }
+
+    /// The diffuse or the specular lobe by `uc`, then a direction from it.
+    pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
+        let l = if uc < self.p_diffuse() { cosine_hemisphere(u, v) } else { self.lobe.sample(v, u)? };
+        let pdf = self.pdf(v, l);
+        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+}
