@@ -1,4 +1,4 @@
-//! `alhazen`: the command-line front end (`render`, `raster`, `mirror`). The only crate that reads argv and the environment,
+//! `alhazen`: the command-line front end (`render`, `raster`, `view`, `mirror`). The only crate that reads argv and the environment,
 //! writes to stdout/stderr and chooses exit codes:
 //! 0 success, 1 a failure while working (e.g. the output cannot be written), 2 bad input (usage,
 //! an unreadable or invalid scene file, impossible sizes).
@@ -13,6 +13,7 @@ use std::time::Instant;
 
 mod mirror;
 mod raster;
+mod view;
 
 #[derive(Parser)]
 #[command(name = "alhazen", version, about = "Mirrors, glass and line art: one scene, exact reflections.")]
@@ -31,6 +32,11 @@ enum Command {
     /// Rasterise a scene (the fast preview): z-buffer, flat/Gouraud/Phong shading, no shadows.
     #[command(after_help = "Example:\n  alhazen raster scenes/glass-balls.toml -o preview.png --shading gouraud")]
     Raster(raster::RasterArgs),
+    /// An interactive window on the raster preview: orbit, pan, zoom; R ray traces the view.
+    #[command(
+        after_help = "Controls: left drag or arrows orbit, right drag pans, wheel or +/- zooms,\n1/2/3 flat/Gouraud/Phong, W wireframe, C culling, R ray trace, Esc/Q quit.\n\nExample:\n  alhazen view scenes/glass-balls.toml"
+    )]
+    View(view::ViewArgs),
     /// Exact reflexes on spheres and cylinders (Glaeser), catacaustics and their figures.
     #[command(subcommand)]
     Mirror(mirror::MirrorCommand),
@@ -120,6 +126,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => run_render(&args),
         Command::Raster(args) => raster::run(&args),
+        Command::View(args) => view::run(&args),
         Command::Mirror(cmd) => mirror::run(&cmd),
     };
     match result {

@@ -77,6 +77,44 @@ fn raster_preview_writes_an_image_and_refuses_unsupported_cameras() {
 }
 
 #[test]
+fn view_needs_a_display_and_a_supported_camera() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), OK);
+    // Without an X server the window cannot open: a clear error, exit code 1.
+    let o = Command::new(env!("CARGO_BIN_EXE_alhazen"))
+        .args(["view", scene.to_str().unwrap(), "--screenshot", dir.path().join("s.png").to_str().unwrap()])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot open a window"));
+    let pano = scene_file(dir.path(), "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n");
+    let o = alhazen(&["view", pano.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn view_draws_frames_under_xvfb_when_it_is_installed() {
+    // `apt-get install xvfb` makes this run; the screenshot is the frame the window showed.
+    if Command::new("xvfb-run").arg("--help").output().is_err() {
+        eprintln!("xvfb-run not installed: the window test needs an X server");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), OK);
+    let shot = dir.path().join("shot.png");
+    let o = Command::new("xvfb-run")
+        .args(["-a", env!("CARGO_BIN_EXE_alhazen"), "view", scene.to_str().unwrap(), "--screenshot"])
+        .arg(&shot)
+        .args(["--frames", "3"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(shot.exists());
+}
+
+#[test]
 fn bad_toml_points_at_the_line() {
     let (code, err, exists) = render("[render]\nwidth = = 3\n", &[]);
     assert_eq!(code, 2);
