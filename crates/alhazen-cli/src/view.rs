@@ -121,8 +121,9 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
         .map_err(|e| Failure::work(format!("cannot open a window (is an X server running?): {e}")))?;
     window.set_target_fps(60);
     let mut opts = RasterOptions::default();
-    let (mut dirty, mut frame, mut last_mouse, mut traced): (bool, u32, Option<(f32, f32)>, Option<Vec<u32>>) =
-        (true, 0, None, None);
+    let (mut dirty, mut frame) = (true, 0u32);
+    let mut last_mouse: Option<(f32, f32)> = None;
+    let mut traced: Option<Vec<u32>> = None;
     let mut buffer = vec![0u32; w * h];
     while window.is_open() && !window.is_key_down(Key::Escape) && !window.is_key_down(Key::Q) {
         let before = (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull);
