@@ -29,12 +29,12 @@ enum Command {
         after_help = "Example:\n  alhazen render scenes/glass-balls.toml -o glass-balls.png --spp 16\n\nThe scene format is described in docs/scene-format.md."
     )]
     Render(RenderArgs),
-    /// Rasterise a scene (the fast preview): z-buffer, flat/Gouraud/Phong shading, no shadows.
+    /// Rasterise a scene (the fast preview): z-buffer, shadow maps, flat/Gouraud/Phong shading.
     #[command(after_help = "Example:\n  alhazen raster scenes/glass-balls.toml -o preview.png --shading gouraud")]
     Raster(raster::RasterArgs),
     /// An interactive window on the raster preview: orbit, pan, zoom; R ray traces the view.
     #[command(
-        after_help = "Controls: left drag or arrows orbit, right drag pans, wheel or +/- zooms,\n1/2/3 flat/Gouraud/Phong, W wireframe, C culling, R ray trace, Esc/Q quit.\n\nExample:\n  alhazen view scenes/glass-balls.toml"
+        after_help = "Controls: left drag or arrows orbit, right drag pans, wheel or +/- zooms,\n1/2/3 flat/Gouraud/Phong, S shadows, W wireframe, C culling, R ray trace, Esc/Q quit.\n\nExample:\n  alhazen view scenes/glass-balls.toml"
     )]
     View(view::ViewArgs),
     /// Exact reflexes on spheres and cylinders (Glaeser), catacaustics and their figures.

@@ -2,8 +2,7 @@
 //! preview of a scene before a long ray-traced render.
 
 use crate::{Failure, ImageArgs, check_output, load_sized, save};
-use alhazen_raster::pipeline::geometry::scene_triangles;
-use alhazen_raster::pipeline::{RasterOptions, Shading, render_triangles};
+use alhazen_raster::pipeline::{RasterOptions, Shading, prepare, render_prepared};
 use alhazen_render::Image;
 use clap::Args;
 use std::time::Instant;
@@ -32,6 +31,9 @@ pub(crate) struct RasterArgs {
     /// Draw triangle edges on top.
     #[arg(long)]
     wireframe: bool,
+    /// No shadow maps.
+    #[arg(long)]
+    no_shadows: bool,
     /// Render this many frames and report frames per second (the last one is written).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
     frames: u32,
@@ -48,19 +50,20 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         },
         cull: !a.no_cull,
         wireframe: a.wireframe,
+        shadows: !a.no_shadows,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.image.threads.map_or(0, |t| t as usize))
         .build()
         .map_err(|e| Failure::work(e.to_string()))?;
     let start = Instant::now();
-    let geometry = scene_triangles(&scene);
+    let prepared = pool.install(|| prepare(&scene, opts.shadows));
     let tessellation = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let mut last = None;
     for _ in 0..a.frames {
         last = Some(
-            pool.install(|| render_triangles(&scene, &geometry, &opts)).map_err(|e| Failure::input(e.to_string()))?,
+            pool.install(|| render_prepared(&scene, &prepared, &opts)).map_err(|e| Failure::input(e.to_string()))?,
         );
     }
     let elapsed = start.elapsed().as_secs_f64();
@@ -70,11 +73,12 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
     if !a.image.quiet {
         let per_frame = elapsed / a.frames as f64;
         eprintln!(
-            "rasterised {} ({}×{}, {} triangles tessellated in {:.3} s, {} culled, {} drawn{}) in {:.4} s per frame ({:.1} fps, {:.2} M triangles/s) on {} threads → {}",
+            "rasterised {} ({}×{}, {} triangles tessellated{} in {:.3} s, {} culled, {} drawn{}) in {:.4} s per frame ({:.1} fps, {:.2} M triangles/s) on {} threads → {}",
             a.image.scene.display(),
             image.width,
             image.height,
             stats.triangles,
+            if opts.shadows { " and shadow maps rendered" } else { "" },
             tessellation,
             stats.culled,
             stats.drawn,

@@ -4,13 +4,12 @@
 //! checks without a person at the keyboard).
 //!
 //! Controls: left drag or arrow keys orbit around the target; right drag pans; wheel or `+`/`-`
-//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `W` wireframe; `C` back-face culling; `R` ray
+//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `W` wireframe; `C` back-face culling; `R` ray
 //! traces the current view (Whitted, the scene's samples) and writes it to `--output`; `Esc` or
 //! `Q` quits.
 
 use crate::{Failure, check_output, save};
-use alhazen_raster::pipeline::geometry::scene_triangles;
-use alhazen_raster::pipeline::{RasterOptions, Shading, render_triangles};
+use alhazen_raster::pipeline::{RasterOptions, Shading, prepare, render_prepared};
 use alhazen_render::Image;
 use alhazen_render::output::to_srgb8;
 use alhazen_scene::{CameraDesc, LookAt, SceneError, load_scene};
@@ -116,7 +115,7 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
         CameraDesc::Orthographic { look, width } => Orbit { look: *look, ortho_width: Some(*width) },
         _ => return Err(Failure::input("alhazen view needs a perspective or orthographic camera")),
     };
-    let geometry = scene_triangles(&scene);
+    let prepared = prepare(&scene, true);
     let mut window = Window::new("alhazen view", w, h, WindowOptions::default())
         .map_err(|e| Failure::work(format!("cannot open a window (is an X server running?): {e}")))?;
     window.set_target_fps(60);
@@ -126,12 +125,12 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
     let mut traced: Option<Vec<u32>> = None;
     let mut buffer = vec![0u32; w * h];
     while window.is_open() && !window.is_key_down(Key::Escape) && !window.is_key_down(Key::Q) {
-        let before = (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull);
+        let before = (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull, opts.shadows);
         handle_input(&window, &mut orbit, &mut opts, &mut last_mouse);
         if a.screenshot.is_some() {
             orbit.rotate(1f64.to_radians(), 0.0);
         }
-        dirty |= before != (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull);
+        dirty |= before != (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull, opts.shadows);
         if window.is_key_pressed(Key::R, KeyRepeat::No) {
             window.set_title("alhazen view — ray tracing…");
             let image = alhazen_render::render(&scene, &|_, _| {});
@@ -143,12 +142,13 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
             traced = None;
             orbit.apply(&mut scene.camera);
             let start = Instant::now();
-            let (fb, stats) = render_triangles(&scene, &geometry, &opts).map_err(|e| Failure::input(e.to_string()))?;
+            let (fb, stats) = render_prepared(&scene, &prepared, &opts).map_err(|e| Failure::input(e.to_string()))?;
             buffer = to_pixels(&Image { width: fb.width, height: fb.height, pixels: fb.color });
             let ms = start.elapsed().as_secs_f64() * 1e3;
             window.set_title(&format!(
-                "alhazen view — {:?}{}{} — {} triangles, {:.1} ms",
+                "alhazen view — {:?}{}{}{} — {} triangles, {:.1} ms",
                 opts.shading,
+                if opts.shadows { ", shadows" } else { "" },
                 if opts.wireframe { ", wireframe" } else { "" },
                 if opts.cull { "" } else { ", no culling" },
                 stats.triangles,
@@ -205,6 +205,9 @@ fn handle_input(window: &Window, orbit: &mut Orbit, opts: &mut RasterOptions, la
     }
     if window.is_key_pressed(Key::C, KeyRepeat::No) {
         opts.cull = !opts.cull;
+    }
+    if window.is_key_pressed(Key::S, KeyRepeat::No) {
+        opts.shadows = !opts.shadows;
     }
     let pos = window.get_mouse_pos(MouseMode::Pass);
     let (left, right) = (window.get_mouse_down(MouseButton::Left), window.get_mouse_down(MouseButton::Right));

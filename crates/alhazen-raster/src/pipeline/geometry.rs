@@ -27,6 +27,8 @@ pub struct Triangle {
     pub material: u32,
     /// Part of a closed surface.
     pub closed: bool,
+    /// Part of an infinite plane (left out of shadow-map bounds).
+    pub unbounded: bool,
 }
 
 /// The triangles of a whole scene and the number of objects that could not be tessellated.
@@ -195,7 +197,8 @@ pub fn scene_triangles(scene: &Scene) -> SceneTriangles {
                 Some(&slot) => o.mesh_materials.get(slot as usize).copied().unwrap_or(o.material),
                 None => o.material,
             };
-            triangles.push(Triangle { v: place(t, &o.transform), material, closed: o.shape.is_closed() });
+            let unbounded = matches!(o.shape, Shape::Plane { .. });
+            triangles.push(Triangle { v: place(t, &o.transform), material, closed: o.shape.is_closed(), unbounded });
         }
     }
     SceneTriangles { triangles, skipped }

@@ -12,6 +12,7 @@ pub mod clip;
 pub mod geometry;
 pub mod raster;
 pub mod shade;
+pub mod shadow;
 
 use alhazen_math::viewing::{Frustum, ViewFrame};
 use alhazen_math::{Mat4, Vec2, Vec3, Vec4};
@@ -41,12 +42,32 @@ pub struct RasterOptions {
     pub cull: bool,
     /// Draw triangle edges on top (Bresenham).
     pub wireframe: bool,
+    /// Shadows from shadow maps (built once by [`prepare`]).
+    pub shadows: bool,
 }
 
 impl Default for RasterOptions {
     fn default() -> Self {
-        Self { shading: Shading::Phong, cull: true, wireframe: false }
+        Self { shading: Shading::Phong, cull: true, wireframe: false, shadows: true }
     }
+}
+
+/// Texels a side of each shadow map.
+pub const SHADOW_MAP_SIZE: u32 = 1024;
+
+/// What does not change when the camera moves: the triangles and the lights' shadow maps.
+pub struct Prepared {
+    /// World-space triangles.
+    pub geometry: geometry::SceneTriangles,
+    /// Shadow maps, when asked for.
+    pub shadows: Option<shadow::Shadows>,
+}
+
+/// Tessellates `scene` and, with `shadows`, renders its shadow maps.
+pub fn prepare(scene: &Scene, shadows: bool) -> Prepared {
+    let geometry = scene_triangles(scene);
+    let shadows = shadows.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
+    Prepared { geometry, shadows }
 }
 
 /// What the pipeline did.
@@ -168,6 +189,7 @@ fn process(
     t: &Triangle,
     index: u32,
     opts: &RasterOptions,
+    shadows: Option<&shadow::Shadows>,
     (w, h): (u32, u32),
 ) -> (bool, Vec<ScreenTriangle>) {
     let [a, b, c] = t.v;
@@ -178,7 +200,7 @@ fn process(
     }
     let m = &scene.materials[t.material as usize];
     let color = |v: &geometry::Vertex| match opts.shading {
-        Shading::Gouraud => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p)),
+        Shading::Gouraud => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), shadows),
         _ => (Vec3::ZERO, Vec3::ZERO),
     };
     let poly: Vec<ClipVertex> =
@@ -217,6 +239,7 @@ fn fragment_color(
     src: u32,
     attr: &[f64; ATTRIBUTES],
     opts: &RasterOptions,
+    shadows: Option<&shadow::Shadows>,
 ) -> Vec3 {
     let t = &tris[src as usize];
     let m = &scene.materials[t.material as usize];
@@ -232,12 +255,12 @@ fn fragment_color(
             let centroid = (a.p + b.p + c.p) / 3.0;
             let n = (b.p - a.p).cross(c.p - a.p).normalize_or_zero();
             let uv = (a.uv + b.uv + c.uv) / 3.0;
-            shade::shade(scene, m, centroid, n, proj.to_viewer(centroid), uv)
+            shade::shade(scene, m, centroid, n, proj.to_viewer(centroid), uv, shadows)
         }
         Shading::Phong => {
             let p = Vec3::new(attr[0], attr[1], attr[2]);
             let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
-            shade::shade(scene, m, p, n, proj.to_viewer(p), Vec2::new(attr[6], attr[7]))
+            shade::shade(scene, m, p, n, proj.to_viewer(p), Vec2::new(attr[6], attr[7]), shadows)
         }
     }
 }
@@ -246,21 +269,23 @@ const BAND: u32 = 16;
 
 /// Renders `scene` at its `[render]` size with the camera of the scene file.
 pub fn render_scene(scene: &Scene, opts: &RasterOptions) -> Result<(Framebuffer, RasterStats), RasterError> {
-    render_triangles(scene, &scene_triangles(scene), opts)
+    render_prepared(scene, &prepare(scene, opts.shadows), opts)
 }
 
-/// Renders already tessellated geometry (built once by [`scene_triangles`], then drawn as often
-/// as the camera or options change).
-pub fn render_triangles(
+/// Renders prepared geometry (built once by [`prepare`], then drawn as often as the camera or
+/// the options change).
+pub fn render_prepared(
     scene: &Scene,
-    geometry: &geometry::SceneTriangles,
+    prepared: &Prepared,
     opts: &RasterOptions,
 ) -> Result<(Framebuffer, RasterStats), RasterError> {
     let (w, h) = (scene.render.width, scene.render.height);
     let proj = projection(&scene.camera, w, h)?;
+    let geometry = &prepared.geometry;
+    let shadows = if opts.shadows { prepared.shadows.as_ref() } else { None };
     let tris = &geometry.triangles;
     let processed: Vec<(bool, Vec<ScreenTriangle>)> =
-        tris.par_iter().enumerate().map(|(i, t)| process(scene, &proj, t, i as u32, opts, (w, h))).collect();
+        tris.par_iter().enumerate().map(|(i, t)| process(scene, &proj, t, i as u32, opts, shadows, (w, h))).collect();
     let culled = processed.iter().filter(|p| p.0).count();
     let screen: Vec<ScreenTriangle> = processed.into_iter().flat_map(|p| p.1).collect();
     let bands: Vec<(Vec<[f32; 3]>, Vec<f64>)> = (0..h.div_ceil(BAND))
@@ -293,7 +318,7 @@ pub fn render_triangles(
                         let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
                         scene.background.radiance(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
                     } else {
-                        fragment_color(scene, &proj, tris, *src, attr, opts)
+                        fragment_color(scene, &proj, tris, *src, attr, opts, shadows)
                     };
                     [c.x as f32, c.y as f32, c.z as f32]
                 })
