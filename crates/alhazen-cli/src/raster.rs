@@ -34,6 +34,9 @@ pub(crate) struct RasterArgs {
     /// No shadow maps.
     #[arg(long)]
     no_shadows: bool,
+    /// Diffuse light from the environment map or background (nine-coefficient irradiance).
+    #[arg(long)]
+    ibl: bool,
     /// Render this many frames and report frames per second (the last one is written).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
     frames: u32,
@@ -51,6 +54,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         cull: !a.no_cull,
         wireframe: a.wireframe,
         shadows: !a.no_shadows,
+        ibl: a.ibl,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.image.threads.map_or(0, |t| t as usize))

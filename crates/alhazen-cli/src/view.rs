@@ -4,7 +4,7 @@
 //! checks without a person at the keyboard).
 //!
 //! Controls: left drag or arrow keys orbit around the target; right drag pans; wheel or `+`/`-`
-//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `W` wireframe; `C` back-face culling; `R` ray
+//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `I` environment light; `W` wireframe; `C` back-face culling; `R` ray
 //! traces the current view (Whitted, the scene's samples) and writes it to `--output`; `Esc` or
 //! `Q` quits.
 
@@ -125,12 +125,13 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
     let mut traced: Option<Vec<u32>> = None;
     let mut buffer = vec![0u32; w * h];
     while window.is_open() && !window.is_key_down(Key::Escape) && !window.is_key_down(Key::Q) {
-        let before = (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull, opts.shadows);
+        let before = (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull, opts.shadows, opts.ibl);
         handle_input(&window, &mut orbit, &mut opts, &mut last_mouse);
         if a.screenshot.is_some() {
             orbit.rotate(1f64.to_radians(), 0.0);
         }
-        dirty |= before != (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull, opts.shadows);
+        dirty |=
+            before != (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull, opts.shadows, opts.ibl);
         if window.is_key_pressed(Key::R, KeyRepeat::No) {
             window.set_title("alhazen view — ray tracing…");
             let image = alhazen_render::render(&scene, &|_, _| {});
@@ -208,6 +209,9 @@ fn handle_input(window: &Window, orbit: &mut Orbit, opts: &mut RasterOptions, la
     }
     if window.is_key_pressed(Key::S, KeyRepeat::No) {
         opts.shadows = !opts.shadows;
+    }
+    if window.is_key_pressed(Key::I, KeyRepeat::No) {
+        opts.ibl = !opts.ibl;
     }
     let pos = window.get_mouse_pos(MouseMode::Pass);
     let (left, right) = (window.get_mouse_down(MouseButton::Left), window.get_mouse_down(MouseButton::Right));

@@ -37,10 +37,7 @@ impl EnvMap {
     }
 
     fn to_uv(&self, dir: Vec3) -> Vec2 {
-        let phi = dir.x.atan2(-dir.z) + self.rotation;
-        let u = (phi / (2.0 * PI)).rem_euclid(1.0);
-        let v = dir.y.clamp(-1.0, 1.0).acos() / PI;
-        Vec2::new(u.min(1.0 - 1e-16), v.min(1.0 - 1e-16))
+        alhazen_scene::texture::equirect_uv(dir, self.rotation)
     }
 
     fn to_dir(&self, uv: Vec2) -> Vec3 {
@@ -51,11 +48,7 @@ impl EnvMap {
 
     /// Radiance arriving from direction `dir` (unit, pointing away from the scene).
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
-        let uv = self.to_uv(dir);
-        let (w, h) = (self.image.width as f64, self.image.height as f64);
-        let (x, y) = ((uv.x * w) as usize, (uv.y * h) as usize);
-        let p = self.image.pixels[y.min(h as usize - 1) * self.image.width as usize + x.min(w as usize - 1)];
-        Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64) * self.scale
+        alhazen_scene::texture::equirect_texel(&self.image, dir, self.rotation) * self.scale
     }
 
     /// A direction with density ∝ power, its radiance and solid-angle density.

@@ -15,6 +15,25 @@ pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Ve
     }
 }
 
+/// Equirectangular coordinates of direction `dir` (unit): `u` the azimuth from `−z` towards
+/// `+x` plus `rotation`, over 2π; `v` the angle from straight up (`+y`), over π.
+pub fn equirect_uv(dir: Vec3, rotation: f64) -> Vec2 {
+    use std::f64::consts::PI;
+    let phi = dir.x.atan2(-dir.z) + rotation;
+    let u = (phi / (2.0 * PI)).rem_euclid(1.0);
+    let v = dir.y.clamp(-1.0, 1.0).acos() / PI;
+    Vec2::new(u.min(1.0 - 1e-16), v.min(1.0 - 1e-16))
+}
+
+/// The texel of an equirectangular image seen in direction `dir` (nearest lookup).
+pub fn equirect_texel(img: &ImageData, dir: Vec3, rotation: f64) -> Vec3 {
+    let uv = equirect_uv(dir, rotation);
+    let (w, h) = (img.width as usize, img.height as usize);
+    let (x, y) = (((uv.x * w as f64) as usize).min(w - 1), ((uv.y * h as f64) as usize).min(h - 1));
+    let p = img.pixels[y * w + x];
+    Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+}
+
 fn bilinear(img: &ImageData, uv: Vec2) -> Vec3 {
     let (w, h) = (img.width as i64, img.height as i64);
     // v = 0 is the bottom row of the image.

@@ -10,6 +10,7 @@
 
 pub mod clip;
 pub mod geometry;
+pub mod ibl;
 pub mod raster;
 pub mod shade;
 pub mod shadow;
@@ -44,11 +45,14 @@ pub struct RasterOptions {
     pub wireframe: bool,
     /// Shadows from shadow maps (built once by [`prepare`]).
     pub shadows: bool,
+    /// Diffuse light from the environment (map or background) by its nine-coefficient
+    /// irradiance ([`ibl`]).
+    pub ibl: bool,
 }
 
 impl Default for RasterOptions {
     fn default() -> Self {
-        Self { shading: Shading::Phong, cull: true, wireframe: false, shadows: true }
+        Self { shading: Shading::Phong, cull: true, wireframe: false, shadows: true, ibl: false }
     }
 }
 
@@ -61,13 +65,29 @@ pub struct Prepared {
     pub geometry: geometry::SceneTriangles,
     /// Shadow maps, when asked for.
     pub shadows: Option<shadow::Shadows>,
+    /// The environment's irradiance.
+    pub irradiance: ibl::Sh9,
 }
 
-/// Tessellates `scene` and, with `shadows`, renders its shadow maps.
+/// The radiance of the environment: the environment map if the scene has one, else the background.
+fn environment(scene: &Scene) -> impl Fn(Vec3) -> Vec3 + '_ {
+    let map = scene.lights.iter().find_map(|l| match *l {
+        alhazen_scene::Light::Environment { image, scale, rotation } => Some((&scene.images[image], scale, rotation)),
+        _ => None,
+    });
+    move |dir| match map {
+        Some((img, scale, rotation)) => alhazen_scene::texture::equirect_texel(img, dir, rotation) * scale,
+        None => scene.background.radiance(dir),
+    }
+}
+
+/// Tessellates `scene`, computes its environment's irradiance and, with `shadows`, renders its
+/// shadow maps.
 pub fn prepare(scene: &Scene, shadows: bool) -> Prepared {
     let geometry = scene_triangles(scene);
     let shadows = shadows.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
-    Prepared { geometry, shadows }
+    let irradiance = ibl::Sh9::irradiance_of(&environment(scene), 8, 400);
+    Prepared { geometry, shadows, irradiance }
 }
 
 /// What the pipeline did.
@@ -189,7 +209,7 @@ fn process(
     t: &Triangle,
     index: u32,
     opts: &RasterOptions,
-    shadows: Option<&shadow::Shadows>,
+    shadows: &shade::Lighting,
     (w, h): (u32, u32),
 ) -> (bool, Vec<ScreenTriangle>) {
     let [a, b, c] = t.v;
@@ -239,7 +259,7 @@ fn fragment_color(
     src: u32,
     attr: &[f64; ATTRIBUTES],
     opts: &RasterOptions,
-    shadows: Option<&shadow::Shadows>,
+    shadows: &shade::Lighting,
 ) -> Vec3 {
     let t = &tris[src as usize];
     let m = &scene.materials[t.material as usize];
@@ -282,7 +302,11 @@ pub fn render_prepared(
     let (w, h) = (scene.render.width, scene.render.height);
     let proj = projection(&scene.camera, w, h)?;
     let geometry = &prepared.geometry;
-    let shadows = if opts.shadows { prepared.shadows.as_ref() } else { None };
+    let light = shade::Lighting {
+        shadows: if opts.shadows { prepared.shadows.as_ref() } else { None },
+        irradiance: opts.ibl.then_some(&prepared.irradiance),
+    };
+    let shadows = &light;
     let tris = &geometry.triangles;
     let processed: Vec<(bool, Vec<ScreenTriangle>)> =
         tris.par_iter().enumerate().map(|(i, t)| process(scene, &proj, t, i as u32, opts, shadows, (w, h))).collect();

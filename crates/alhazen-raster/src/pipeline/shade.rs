@@ -2,17 +2,33 @@
 //! the Phong or Blinn–Phong highlight (`⟨h, n⟩^{2m}`), for every light on the viewer's side of
 //! the surface (the factor ν), with the course's distance attenuation; no shadows.
 
+use super::ibl::Sh9;
 use super::shadow::Shadows;
+use std::f64::consts::FRAC_1_PI;
+
+/// What lights a point besides the scene's lights: shadow maps and the environment's irradiance.
+#[derive(Clone, Copy, Default)]
+pub struct Lighting<'a> {
+    /// Shadow maps (no shadows when `None`).
+    pub shadows: Option<&'a Shadows>,
+    /// The environment's irradiance (no image-based light when `None`).
+    pub irradiance: Option<&'a Sh9>,
+}
 use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::{Highlight, Light, Material, Scene};
 
 /// The light arriving at `p` (unit normal `n`, viewer direction `v`), split as the course's
 /// model is: the factor of the surface colour (`I^amb + Σ I^dir ⟨l, n⟩`) and the highlight
 /// (`Σ I^dir s W`). Gouraud shading interpolates these two, so textures stay per pixel.
-pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, shadows: Option<&Shadows>) -> (Vec3, Vec3) {
+pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &Lighting) -> (Vec3, Vec3) {
     // Two-sided: light the side the viewer sees.
     let n = if n.dot(v) < 0.0 { -n } else { n };
     let (mut diffuse, mut specular) = (scene.ambient, Vec3::ZERO);
+    // Lambertian reflection of the environment: ρ/π times its irradiance.
+    if let Some(sh) = extra.irradiance {
+        diffuse += sh.eval(n).max(Vec3::ZERO) * FRAC_1_PI;
+    }
+    let shadows = extra.shadows;
     for (k, light) in scene.lights.iter().enumerate() {
         let Some((l, i)) = incoming(light, p) else { continue };
         let cos = n.dot(l);
@@ -48,8 +64,8 @@ pub fn combine(scene: &Scene, m: &Material, (diffuse, specular): (Vec3, Vec3), n
 }
 
 /// Radiance towards the viewer at `p`, lit per point.
-pub fn shade(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, uv: Vec2, shadows: Option<&Shadows>) -> Vec3 {
-    combine(scene, m, lighting(scene, m, p, n, v, shadows), n, v, uv)
+pub fn shade(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, uv: Vec2, extra: &Lighting) -> Vec3 {
+    combine(scene, m, lighting(scene, m, p, n, v, extra), n, v, uv)
 }
 
 /// Direction towards the light and the intensity arriving, `I^em/(a d² + b d + c)`.
