@@ -37,9 +37,26 @@ pub(crate) struct RasterArgs {
     /// Diffuse light from the environment map or background (nine-coefficient irradiance).
     #[arg(long)]
     ibl: bool,
+    /// Keep only the world-space half-space `a x + b y + c z + d ≥ 0` (repeatable).
+    #[arg(long, value_name = "A,B,C,D", value_parser = parse_plane)]
+    clip_plane: Vec<alhazen_math::Vec4>,
+    /// Drop triangles wholly outside this half-space (repeatable).
+    #[arg(long, value_name = "A,B,C,D", value_parser = parse_plane)]
+    cull_plane: Vec<alhazen_math::Vec4>,
     /// Render this many frames and report frames per second (the last one is written).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
     frames: u32,
+}
+
+/// `a,b,c,d` with a non-zero normal `(a, b, c)`.
+fn parse_plane(s: &str) -> Result<alhazen_math::Vec4, String> {
+    let v: Vec<f64> =
+        s.split(',').map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}"))).collect::<Result<_, _>>()?;
+    let [a, b, c, d] = v[..] else { return Err(format!("expected 4 numbers a,b,c,d, found {}", v.len())) };
+    if !(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite()) || a * a + b * b + c * c == 0.0 {
+        return Err("the plane needs finite numbers and a non-zero normal (a, b, c)".into());
+    }
+    Ok(alhazen_math::Vec4::new(a, b, c, d))
 }
 
 pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
@@ -55,6 +72,8 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         wireframe: a.wireframe,
         shadows: !a.no_shadows,
         ibl: a.ibl,
+        clip_planes: a.clip_plane.clone(),
+        cull_planes: a.cull_plane.clone(),
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.image.threads.map_or(0, |t| t as usize))

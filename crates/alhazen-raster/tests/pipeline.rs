@@ -161,3 +161,22 @@ material = "white"
     eprintln!("IBL: mean absolute difference {:.2} % on the sphere", err * 100.0);
     assert!(err < 0.04, "{:.2} %", err * 100.0);
 }
+
+#[test]
+fn cull_planes_drop_whole_triangles_and_clip_planes_cut_them() {
+    let scene = parse_scene("agree.toml".as_ref(), SCENE).unwrap();
+    let (_, plain) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    // Everything with x < 0 (the red sphere) culled whole.
+    let cull = RasterOptions { cull_planes: vec![alhazen_math::Vec4::new(1.0, 0.0, 0.0, 0.0)], ..Default::default() };
+    let (fb, stats) = render_scene(&scene, &cull).unwrap();
+    assert!(stats.culled > plain.culled + 500, "{} vs {}", stats.culled, plain.culled);
+    let red = |fb: &alhazen_raster::pipeline::Framebuffer| {
+        fb.color.iter().filter(|c| c[0] > 2.0 * c[1] && c[0] > 0.2).count()
+    };
+    assert!(red(&fb) == 0, "the red sphere is gone");
+    // A clip plane through the sphere's centre keeps part of it.
+    let clip = RasterOptions { clip_planes: vec![alhazen_math::Vec4::new(0.0, 1.0, 0.0, -0.8)], ..Default::default() };
+    let (half, _) = render_scene(&scene, &clip).unwrap();
+    let (all, cut) = (red(&render_scene(&scene, &RasterOptions::default()).unwrap().0), red(&half));
+    assert!(cut > 0 && cut < all, "{cut} of {all}");
+}

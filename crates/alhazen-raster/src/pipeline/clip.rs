@@ -33,6 +33,26 @@ fn plane(p: Vec4, k: usize) -> f64 {
     if k.is_multiple_of(2) { p.w + c } else { p.w - c }
 }
 
+/// Sutherland–Hodgman against one half-space `f ≥ 0`, `f` affine along edges.
+fn clip_against(poly: &[ClipVertex], f: impl Fn(&ClipVertex) -> f64) -> Vec<ClipVertex> {
+    let Some(last) = poly.last() else { return vec![] };
+    let mut next = Vec::with_capacity(poly.len() + 2);
+    let (mut s, mut ds) = (*last, f(last));
+    for &p in poly {
+        let dp = f(&p);
+        if dp >= 0.0 {
+            if ds < 0.0 {
+                next.push(lerp(&s, &p, ds / (ds - dp)));
+            }
+            next.push(p);
+        } else if ds >= 0.0 {
+            next.push(lerp(&s, &p, ds / (ds - dp)));
+        }
+        (s, ds) = (p, dp);
+    }
+    next
+}
+
 /// The part of a convex polygon inside the view volume (empty when none).
 pub fn clip_polygon(poly: &[ClipVertex]) -> Vec<ClipVertex> {
     // Trivial accept: every vertex inside every plane.
@@ -41,27 +61,17 @@ pub fn clip_polygon(poly: &[ClipVertex]) -> Vec<ClipVertex> {
     }
     let mut cur = poly.to_vec();
     for k in 0..6 {
-        if cur.is_empty() {
-            break;
-        }
-        let mut next = Vec::with_capacity(cur.len() + 2);
-        let mut s = cur[cur.len() - 1];
-        let mut ds = plane(s.pos, k);
-        for &p in &cur {
-            let dp = plane(p.pos, k);
-            if dp >= 0.0 {
-                if ds < 0.0 {
-                    next.push(lerp(&s, &p, ds / (ds - dp)));
-                }
-                next.push(p);
-            } else if ds >= 0.0 {
-                next.push(lerp(&s, &p, ds / (ds - dp)));
-            }
-            (s, ds) = (p, dp);
-        }
-        cur = next;
+        cur = clip_against(&cur, |v| plane(v.pos, k));
     }
     cur
+}
+
+/// The course's user clip distances: the part of the polygon where every world-space plane
+/// `(n, d)` has `n·p + d ≥ 0` (`p` is the world position carried in the first attributes).
+pub fn clip_user_planes(poly: Vec<ClipVertex>, planes: &[Vec4]) -> Vec<ClipVertex> {
+    planes
+        .iter()
+        .fold(poly, |cur, pl| clip_against(&cur, |v| pl.x * v.attr[0] + pl.y * v.attr[1] + pl.z * v.attr[2] + pl.w))
 }
 
 #[cfg(test)]
@@ -74,6 +84,35 @@ mod tests {
     }
 
     proptest! {
+        #[test]
+        fn user_clip_planes_keep_exactly_the_positive_side(
+            c in prop::collection::vec((-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64), 3),
+            n in (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64), d in -1.0..1.0f64
+        ) {
+            prop_assume!(n.0 * n.0 + n.1 * n.1 + n.2 * n.2 > 0.01);
+            let plane = Vec4::new(n.0, n.1, n.2, d);
+            let f = |p: [f64; 3]| plane.x * p[0] + plane.y * p[1] + plane.z * p[2] + plane.w;
+            let tri: Vec<ClipVertex> = c
+                .iter()
+                .map(|&(x, y, z)| {
+                    let mut attr = [0.0; ATTRIBUTES];
+                    attr[..3].copy_from_slice(&[x, y, z]);
+                    ClipVertex { pos: Vec4::new(x, y, z, 1.0), attr }
+                })
+                .collect();
+            let out = clip_user_planes(tri.clone(), &[plane]);
+            for v in &out {
+                prop_assert!(f([v.attr[0], v.attr[1], v.attr[2]]) >= -1e-9);
+            }
+            let kept = tri.iter().filter(|v| f([v.attr[0], v.attr[1], v.attr[2]]) >= 0.0).count();
+            if kept == 3 {
+                prop_assert_eq!(out.len(), 3);
+            }
+            if kept == 0 {
+                prop_assert!(out.is_empty());
+            }
+        }
+
         #[test]
         fn clipped_triangles_stay_inside_and_keep_inside_points(
             c in prop::collection::vec((-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64, -0.5..2.5f64), 3)

@@ -35,7 +35,7 @@ pub enum Shading {
 }
 
 /// Options of a raster render.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct RasterOptions {
     /// Shading method.
     pub shading: Shading,
@@ -48,11 +48,25 @@ pub struct RasterOptions {
     /// Diffuse light from the environment (map or background) by its nine-coefficient
     /// irradiance ([`ibl`]).
     pub ibl: bool,
+    /// User clip planes `(n, d)` in world space: only `n·p + d ≥ 0` is drawn (the course's
+    /// clip distances).
+    pub clip_planes: Vec<Vec4>,
+    /// User culling planes: a triangle entirely on the negative side of one is dropped whole
+    /// (the course's culling distances).
+    pub cull_planes: Vec<Vec4>,
 }
 
 impl Default for RasterOptions {
     fn default() -> Self {
-        Self { shading: Shading::Phong, cull: true, wireframe: false, shadows: true, ibl: false }
+        Self {
+            shading: Shading::Phong,
+            cull: true,
+            wireframe: false,
+            shadows: true,
+            ibl: false,
+            clip_planes: vec![],
+            cull_planes: vec![],
+        }
     }
 }
 
@@ -218,6 +232,10 @@ fn process(
     if opts.cull && t.closed && face.dot(proj.to_viewer(centroid)) < 0.0 {
         return (true, vec![]);
     }
+    let below = |pl: &Vec4, p: Vec3| pl.truncate().dot(p) + pl.w < 0.0;
+    if opts.cull_planes.iter().any(|pl| t.v.iter().all(|v| below(pl, v.p))) {
+        return (true, vec![]);
+    }
     let m = &scene.materials[t.material as usize];
     let color = |v: &geometry::Vertex| match opts.shading {
         Shading::Gouraud => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), shadows),
@@ -227,7 +245,7 @@ fn process(
         t.v.iter()
             .map(|v| ClipVertex { pos: proj.world_to_clip * v.p.extend(1.0), attr: attributes(v, color(v)) })
             .collect();
-    let clipped = clip_polygon(&poly);
+    let clipped = clip::clip_user_planes(clip_polygon(&poly), &opts.clip_planes);
     let screen = |cv: &ClipVertex| {
         let inv_w = 1.0 / cv.pos.w;
         let (x, y, z) = (cv.pos.x * inv_w, cv.pos.y * inv_w, cv.pos.z * inv_w);
