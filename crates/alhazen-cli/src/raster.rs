@@ -2,7 +2,7 @@
 //! preview of a scene before a long ray-traced render.
 
 use crate::{Failure, ImageArgs, check_output, load_sized, save};
-use alhazen_raster::pipeline::{RasterOptions, Shading, prepare, render_prepared};
+use alhazen_raster::pipeline::{RasterOptions, Shading, Visibility, prepare, render_prepared};
 use alhazen_render::Image;
 use clap::Args;
 use std::time::Instant;
@@ -16,6 +16,15 @@ pub(crate) enum ShadingArg {
     Gouraud,
     /// Normals interpolated, lighting per pixel.
     Phong,
+}
+
+/// `--visibility`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub(crate) enum VisibilityArg {
+    /// A depth buffer.
+    Zbuffer,
+    /// The BSP-tree painter's algorithm.
+    Bsp,
 }
 
 #[derive(Args)]
@@ -37,6 +46,9 @@ pub(crate) struct RasterArgs {
     /// Diffuse light from the environment map or background (nine-coefficient irradiance).
     #[arg(long)]
     ibl: bool,
+    /// Hidden-surface removal: depth buffer, or the painter's algorithm over a BSP tree.
+    #[arg(long, value_enum, default_value = "zbuffer")]
+    visibility: VisibilityArg,
     /// Keep only the world-space half-space `a x + b y + c z + d ≥ 0` (repeatable).
     #[arg(long, value_name = "A,B,C,D", value_parser = parse_plane)]
     clip_plane: Vec<alhazen_math::Vec4>,
@@ -74,13 +86,17 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         ibl: a.ibl,
         clip_planes: a.clip_plane.clone(),
         cull_planes: a.cull_plane.clone(),
+        visibility: match a.visibility {
+            VisibilityArg::Zbuffer => Visibility::ZBuffer,
+            VisibilityArg::Bsp => Visibility::Bsp,
+        },
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.image.threads.map_or(0, |t| t as usize))
         .build()
         .map_err(|e| Failure::work(e.to_string()))?;
     let start = Instant::now();
-    let prepared = pool.install(|| prepare(&scene, opts.shadows));
+    let prepared = pool.install(|| prepare(&scene, &opts));
     let tessellation = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let mut last = None;
@@ -101,7 +117,12 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
             image.width,
             image.height,
             stats.triangles,
-            if opts.shadows { " and shadow maps rendered" } else { "" },
+            match (opts.shadows, opts.visibility) {
+                (true, Visibility::Bsp) => ", shadow maps and BSP tree built",
+                (true, Visibility::ZBuffer) => " and shadow maps rendered",
+                (false, Visibility::Bsp) => " and BSP tree built",
+                (false, Visibility::ZBuffer) => "",
+            },
             tessellation,
             stats.culled,
             stats.drawn,

@@ -4,12 +4,12 @@
 //! checks without a person at the keyboard).
 //!
 //! Controls: left drag or arrow keys orbit around the target; right drag pans; wheel or `+`/`-`
-//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `I` environment light; `W` wireframe; `C` back-face culling; `R` ray
+//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `I` environment light; `B` z-buffer/BSP painter; `W` wireframe; `C` back-face culling; `R` ray
 //! traces the current view (Whitted, the scene's samples) and writes it to `--output`; `Esc` or
 //! `Q` quits.
 
 use crate::{Failure, check_output, save};
-use alhazen_raster::pipeline::{RasterOptions, Shading, prepare, render_prepared};
+use alhazen_raster::pipeline::{RasterOptions, Shading, Visibility, prepare, render_prepared};
 use alhazen_render::Image;
 use alhazen_render::output::to_srgb8;
 use alhazen_scene::{CameraDesc, LookAt, SceneError, load_scene};
@@ -94,6 +94,12 @@ impl Orbit {
     }
 }
 
+/// What a redraw depends on.
+#[allow(clippy::type_complexity)]
+fn snapshot(o: &Orbit, p: &RasterOptions) -> (LookAt, Option<f64>, Shading, bool, bool, bool, bool, Visibility) {
+    (o.look, o.ortho_width, p.shading, p.wireframe, p.cull, p.shadows, p.ibl, p.visibility)
+}
+
 fn to_pixels(image: &Image) -> Vec<u32> {
     to_srgb8(image).chunks_exact(3).map(|c| (c[0] as u32) << 16 | (c[1] as u32) << 8 | c[2] as u32).collect()
 }
@@ -115,7 +121,7 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
         CameraDesc::Orthographic { look, width } => Orbit { look: *look, ortho_width: Some(*width) },
         _ => return Err(Failure::input("alhazen view needs a perspective or orthographic camera")),
     };
-    let prepared = prepare(&scene, true);
+    let mut prepared = prepare(&scene, &RasterOptions::default());
     let mut window = Window::new("alhazen view", w, h, WindowOptions::default())
         .map_err(|e| Failure::work(format!("cannot open a window (is an X server running?): {e}")))?;
     window.set_target_fps(60);
@@ -125,13 +131,12 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
     let mut traced: Option<Vec<u32>> = None;
     let mut buffer = vec![0u32; w * h];
     while window.is_open() && !window.is_key_down(Key::Escape) && !window.is_key_down(Key::Q) {
-        let before = (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull, opts.shadows, opts.ibl);
+        let before = snapshot(&orbit, &opts);
         handle_input(&window, &mut orbit, &mut opts, &mut last_mouse);
         if a.screenshot.is_some() {
             orbit.rotate(1f64.to_radians(), 0.0);
         }
-        dirty |=
-            before != (orbit.look, orbit.ortho_width, opts.shading, opts.wireframe, opts.cull, opts.shadows, opts.ibl);
+        dirty |= before != snapshot(&orbit, &opts);
         if window.is_key_pressed(Key::R, KeyRepeat::No) {
             window.set_title("alhazen view — ray tracing…");
             let image = alhazen_render::render(&scene, &|_, _| {});
@@ -141,13 +146,18 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
         }
         if dirty {
             traced = None;
+            if opts.visibility == Visibility::Bsp && prepared.bsp.is_none() {
+                window.set_title("alhazen view — building the BSP tree…");
+                prepared = prepare(&scene, &opts);
+            }
             orbit.apply(&mut scene.camera);
             let start = Instant::now();
             let (fb, stats) = render_prepared(&scene, &prepared, &opts).map_err(|e| Failure::input(e.to_string()))?;
             buffer = to_pixels(&Image { width: fb.width, height: fb.height, pixels: fb.color });
             let ms = start.elapsed().as_secs_f64() * 1e3;
             window.set_title(&format!(
-                "alhazen view — {:?}{}{}{} — {} triangles, {:.1} ms",
+                "alhazen view — {:?}, {:?}{}{}{} — {} triangles, {:.1} ms",
+                opts.visibility,
                 opts.shading,
                 if opts.shadows { ", shadows" } else { "" },
                 if opts.wireframe { ", wireframe" } else { "" },
@@ -212,6 +222,12 @@ fn handle_input(window: &Window, orbit: &mut Orbit, opts: &mut RasterOptions, la
     }
     if window.is_key_pressed(Key::I, KeyRepeat::No) {
         opts.ibl = !opts.ibl;
+    }
+    if window.is_key_pressed(Key::B, KeyRepeat::No) {
+        opts.visibility = match opts.visibility {
+            Visibility::ZBuffer => Visibility::Bsp,
+            Visibility::Bsp => Visibility::ZBuffer,
+        };
     }
     let pos = window.get_mouse_pos(MouseMode::Pass);
     let (left, right) = (window.get_mouse_down(MouseButton::Left), window.get_mouse_down(MouseButton::Right));

@@ -180,3 +180,35 @@ fn cull_planes_drop_whole_triangles_and_clip_planes_cut_them() {
     let (all, cut) = (red(&render_scene(&scene, &RasterOptions::default()).unwrap().0), red(&half));
     assert!(cut > 0 && cut < all, "{cut} of {all}");
 }
+
+#[test]
+fn bsp_painter_draws_what_the_z_buffer_draws() {
+    use alhazen_raster::pipeline::Visibility;
+    let scene = parse_scene("agree.toml".as_ref(), SCENE).unwrap();
+    let z = render_scene(&scene, &RasterOptions::default()).unwrap().0;
+    let opts = RasterOptions { visibility: Visibility::Bsp, ..Default::default() };
+    let (painted, _) = render_scene(&scene, &opts).unwrap();
+    let differ = z.color.iter().zip(&painted.color).filter(|(a, b)| (0..3).any(|k| (a[k] - b[k]).abs() > 1e-3)).count();
+    // Only pixels on silhouettes may differ (a split triangle's pieces cover them slightly
+    // differently from the whole).
+    assert!(differ * 200 < z.color.len(), "{differ} of {} pixels differ", z.color.len());
+}
+
+#[test]
+fn bsp_tree_partitions_the_scene() {
+    use alhazen_raster::pipeline::bsp::{BspTree, Viewer};
+    use alhazen_raster::pipeline::geometry::scene_triangles;
+    let scene = parse_scene("agree.toml".as_ref(), SCENE).unwrap();
+    let tris = scene_triangles(&scene).triangles;
+    let tree = BspTree::build(&tris, 1e-9);
+    assert!(tree.is_consistent(1e-7));
+    assert!(tree.len() >= tris.len() - tris.len() / 10, "{} of {}", tree.len(), tris.len());
+    // Every triangle is painted exactly once, from any viewpoint.
+    for eye in [Vec3::new(0.0, 1.5, 6.0), Vec3::new(-5.0, 0.2, -3.0), Vec3::new(0.0, 10.0, 0.1)] {
+        let mut order = tree.back_to_front(Viewer::At(eye));
+        assert_eq!(order.len(), tree.len());
+        order.sort();
+        order.dedup();
+        assert_eq!(order.len(), tree.len());
+    }
+}

@@ -8,6 +8,7 @@
 //! interpolated) or Phong (normals interpolated, lighting per pixel) with the course's local
 //! models. The camera and the sample position (pixel centres) match `alhazen render`'s.
 
+pub mod bsp;
 pub mod clip;
 pub mod geometry;
 pub mod ibl;
@@ -34,6 +35,15 @@ pub enum Shading {
     Phong,
 }
 
+/// How hidden surfaces are removed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Visibility {
+    /// A depth buffer.
+    ZBuffer,
+    /// The painter's algorithm over a BSP tree (built once by [`prepare`]).
+    Bsp,
+}
+
 /// Options of a raster render.
 #[derive(Clone, Debug)]
 pub struct RasterOptions {
@@ -54,6 +64,8 @@ pub struct RasterOptions {
     /// User culling planes: a triangle entirely on the negative side of one is dropped whole
     /// (the course's culling distances).
     pub cull_planes: Vec<Vec4>,
+    /// Hidden-surface removal.
+    pub visibility: Visibility,
 }
 
 impl Default for RasterOptions {
@@ -66,6 +78,7 @@ impl Default for RasterOptions {
             ibl: false,
             clip_planes: vec![],
             cull_planes: vec![],
+            visibility: Visibility::ZBuffer,
         }
     }
 }
@@ -81,6 +94,8 @@ pub struct Prepared {
     pub shadows: Option<shadow::Shadows>,
     /// The environment's irradiance.
     pub irradiance: ibl::Sh9,
+    /// The BSP tree, when the painter's algorithm is asked for.
+    pub bsp: Option<bsp::BspTree>,
 }
 
 /// The radiance of the environment: the environment map if the scene has one, else the background.
@@ -95,13 +110,18 @@ fn environment(scene: &Scene) -> impl Fn(Vec3) -> Vec3 + '_ {
     }
 }
 
-/// Tessellates `scene`, computes its environment's irradiance and, with `shadows`, renders its
-/// shadow maps.
-pub fn prepare(scene: &Scene, shadows: bool) -> Prepared {
+/// Tessellates `scene`, computes its environment's irradiance and, as `opts` ask, renders its
+/// shadow maps and builds its BSP tree.
+pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
     let geometry = scene_triangles(scene);
-    let shadows = shadows.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
+    let shadows = opts.shadows.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
     let irradiance = ibl::Sh9::irradiance_of(&environment(scene), 8, 400);
-    Prepared { geometry, shadows, irradiance }
+    let bsp = (opts.visibility == Visibility::Bsp).then(|| {
+        let b =
+            geometry.triangles.iter().fold(alhazen_math::Bounds3::EMPTY, |b, t| t.v.iter().fold(b, |b, v| b.grow(v.p)));
+        bsp::BspTree::build(&geometry.triangles, 1e-9 * (1.0 + b.extent().length()))
+    });
+    Prepared { geometry, shadows, irradiance, bsp }
 }
 
 /// What the pipeline did.
@@ -307,7 +327,7 @@ const BAND: u32 = 16;
 
 /// Renders `scene` at its `[render]` size with the camera of the scene file.
 pub fn render_scene(scene: &Scene, opts: &RasterOptions) -> Result<(Framebuffer, RasterStats), RasterError> {
-    render_prepared(scene, &prepare(scene, opts.shadows), opts)
+    render_prepared(scene, &prepare(scene, opts), opts)
 }
 
 /// Renders prepared geometry (built once by [`prepare`], then drawn as often as the camera or
@@ -325,9 +345,18 @@ pub fn render_prepared(
         irradiance: opts.ibl.then_some(&prepared.irradiance),
     };
     let shadows = &light;
-    let tris = &geometry.triangles;
+    // The painter's algorithm draws the BSP tree's triangles back to front; the z-buffer any order.
+    let (tris, order): (&[Triangle], Vec<u32>) = match (&prepared.bsp, opts.visibility) {
+        (Some(tree), Visibility::Bsp) => {
+            let viewer =
+                if proj.perspective { bsp::Viewer::At(proj.frame.eye) } else { bsp::Viewer::Towards(proj.frame.w) };
+            (&tree.triangles, tree.back_to_front(viewer))
+        }
+        _ => (&geometry.triangles, (0..geometry.triangles.len() as u32).collect()),
+    };
+    let painter = opts.visibility == Visibility::Bsp && prepared.bsp.is_some();
     let processed: Vec<(bool, Vec<ScreenTriangle>)> =
-        tris.par_iter().enumerate().map(|(i, t)| process(scene, &proj, t, i as u32, opts, shadows, (w, h))).collect();
+        order.par_iter().map(|&i| process(scene, &proj, &tris[i as usize], i, opts, shadows, (w, h))).collect();
     let culled = processed.iter().filter(|p| p.0).count();
     let screen: Vec<ScreenTriangle> = processed.into_iter().flat_map(|p| p.1).collect();
     let bands: Vec<(Vec<[f32; 3]>, Vec<f64>)> = (0..h.div_ceil(BAND))
@@ -346,7 +375,7 @@ pub fn render_prepared(
                 }
                 rasterize(t, w, y0, y1, |f| {
                     let k = ((f.y - y0) * w + f.x) as usize;
-                    if f.depth < depth[k] && f.depth >= -1.0 {
+                    if (painter || f.depth < depth[k]) && f.depth >= -1.0 {
                         depth[k] = f.depth;
                         owner[k] = (t.source, f.attr);
                     }
