@@ -17,6 +17,11 @@ struct Node {
     back: Option<u32>,
 }
 
+/// A parent node and whether a child hangs on its front side.
+type Attach = Option<(u32, bool)>;
+/// A half-space constraint `(n, d, front)` inherited from an ancestor.
+type Side = (Vec3, f64, bool);
+
 /// A BSP tree over triangles (split where needed).
 #[derive(Clone, Debug)]
 pub struct BspTree {
@@ -75,7 +80,7 @@ impl BspTree {
             return tree;
         }
         // Work items: (set of triangles, parent node and side to attach to).
-        let mut work: Vec<(Vec<u32>, Option<(u32, bool)>)> = vec![(all, None)];
+        let mut work: Vec<(Vec<u32>, Attach)> = vec![(all, None)];
         while let Some((mut set, parent)) = work.pop() {
             let best = tree.splitter(&set, eps);
             set.swap(0, best);
@@ -194,7 +199,7 @@ impl BspTree {
     /// Checks the partition: every triangle of a subtree lies on its side of each ancestor's
     /// plane (within `eps`). For tests.
     pub fn is_consistent(&self, eps: f64) -> bool {
-        let mut stack: Vec<(u32, Vec<(Vec3, f64, bool)>)> = vec![(0, vec![])];
+        let mut stack: Vec<(u32, Vec<Side>)> = vec![(0, vec![])];
         while let Some((k, constraints)) = stack.pop() {
             let Some(node) = self.nodes.get(k as usize) else { return true };
             for &i in &node.triangles {
