@@ -55,8 +55,8 @@ pub struct RasterOptions {
     pub wireframe: bool,
     /// Shadows from shadow maps (built once by [`prepare`]).
     pub shadows: bool,
-    /// Diffuse light from the environment (map or background) by its nine-coefficient
-    /// irradiance ([`ibl`]).
+    /// Light from the environment (map or background): diffuse by its nine-coefficient
+    /// irradiance, glossy by the prefiltered environment and the split sum ([`ibl`]).
     pub ibl: bool,
     /// User clip planes `(n, d)` in world space: only `n·p + d ≥ 0` is drawn (the course's
     /// clip distances).
@@ -94,12 +94,14 @@ pub struct Prepared {
     pub shadows: Option<shadow::Shadows>,
     /// The environment's irradiance.
     pub irradiance: ibl::Sh9,
+    /// The environment prefiltered for glossy reflection, with the split-sum table.
+    pub specular: ibl::SpecularIbl,
     /// The BSP tree, when the painter's algorithm is asked for.
     pub bsp: Option<bsp::BspTree>,
 }
 
 /// The radiance of the environment: the environment map if the scene has one, else the background.
-fn environment(scene: &Scene) -> impl Fn(Vec3) -> Vec3 + '_ {
+fn environment(scene: &Scene) -> impl Fn(Vec3) -> Vec3 + Sync + '_ {
     let map = scene.lights.iter().find_map(|l| match *l {
         alhazen_scene::Light::Environment { image, scale, rotation } => Some((&scene.images[image], scale, rotation)),
         _ => None,
@@ -116,12 +118,13 @@ pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
     let geometry = scene_triangles(scene);
     let shadows = opts.shadows.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
     let irradiance = ibl::Sh9::irradiance_of(&environment(scene), 8, 400);
+    let specular = ibl::SpecularIbl::build(&environment(scene), 32);
     let bsp = (opts.visibility == Visibility::Bsp).then(|| {
         let b =
             geometry.triangles.iter().fold(alhazen_math::Bounds3::EMPTY, |b, t| t.v.iter().fold(b, |b, v| b.grow(v.p)));
         bsp::BspTree::build(&geometry.triangles, 1e-9 * (1.0 + b.extent().length()))
     });
-    Prepared { geometry, shadows, irradiance, bsp }
+    Prepared { geometry, shadows, irradiance, specular, bsp }
 }
 
 /// What the pipeline did.
@@ -306,7 +309,7 @@ fn fragment_color(
             let p = Vec3::new(attr[0], attr[1], attr[2]);
             let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
             let light = (Vec3::new(attr[8], attr[9], attr[10]), Vec3::new(attr[11], attr[12], attr[13]));
-            shade::combine(scene, m, light, n, proj.to_viewer(p), Vec2::new(attr[6], attr[7]))
+            shade::combine(scene, m, light, n, proj.to_viewer(p), Vec2::new(attr[6], attr[7]), shadows)
         }
         Shading::Flat => {
             let [a, b, c] = t.v;
@@ -343,6 +346,7 @@ pub fn render_prepared(
     let light = shade::Lighting {
         shadows: if opts.shadows { prepared.shadows.as_ref() } else { None },
         irradiance: opts.ibl.then_some(&prepared.irradiance),
+        specular: opts.ibl.then_some(&prepared.specular),
     };
     let shadows = &light;
     // The painter's algorithm draws the BSP tree's triangles back to front; the z-buffer any order.

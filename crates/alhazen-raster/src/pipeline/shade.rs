@@ -2,7 +2,7 @@
 //! the Phong or Blinn–Phong highlight (`⟨h, n⟩^{2m}`), for every light on the viewer's side of
 //! the surface (the factor ν), with the course's distance attenuation; no shadows.
 
-use super::ibl::Sh9;
+use super::ibl::{Sh9, SpecularIbl};
 use super::shadow::Shadows;
 use std::f64::consts::FRAC_1_PI;
 
@@ -13,6 +13,8 @@ pub struct Lighting<'a> {
     pub shadows: Option<&'a Shadows>,
     /// The environment's irradiance (no image-based light when `None`).
     pub irradiance: Option<&'a Sh9>,
+    /// The prefiltered environment and split-sum table (no specular image-based light when `None`).
+    pub specular: Option<&'a SpecularIbl>,
 }
 use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::{Highlight, Light, Material, Scene};
@@ -50,10 +52,25 @@ pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &
 /// Radiance towards the viewer from the light factors of [`lighting`] at texture coordinates
 /// `uv`: `a·diffuse + specular`, plus emission and, for mirrors and glass, the background in the
 /// reflected and the viewing direction (environment mapping; the preview traces no rays).
-pub fn combine(scene: &Scene, m: &Material, (diffuse, specular): (Vec3, Vec3), n: Vec3, v: Vec3, uv: Vec2) -> Vec3 {
+pub fn combine(
+    scene: &Scene,
+    m: &Material,
+    (diffuse, specular): (Vec3, Vec3),
+    n: Vec3,
+    v: Vec3,
+    uv: Vec2,
+    extra: &Lighting,
+) -> Vec3 {
     let a = alhazen_scene::texture::eval(&m.color, uv, &scene.images) * m.diffuse;
     let mut c = a * diffuse + specular + m.emission;
     let n = if n.dot(v) < 0.0 { -n } else { n };
+    // Glossy reflection of the environment by the split sum, with the Beckmann roughness that
+    // matches the Phong exponent (m² = 2/(shininess + 2)) and a dielectric F₀ = 0.04.
+    if let (Some(ibl), true) = (extra.specular, m.specular != Vec3::ZERO) {
+        let r = 2.0 * v.dot(n) * n - v;
+        let rough = (2.0 / (m.shininess + 2.0)).sqrt();
+        c += m.specular * ibl.filtered(r, rough) * ibl.split_factor(v.dot(n), 0.04);
+    }
     if m.mirror != Vec3::ZERO {
         c += m.mirror * scene.background.radiance(2.0 * v.dot(n) * n - v);
     }
@@ -65,7 +82,7 @@ pub fn combine(scene: &Scene, m: &Material, (diffuse, specular): (Vec3, Vec3), n
 
 /// Radiance towards the viewer at `p`, lit per point.
 pub fn shade(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, uv: Vec2, extra: &Lighting) -> Vec3 {
-    combine(scene, m, lighting(scene, m, p, n, v, extra), n, v, uv)
+    combine(scene, m, lighting(scene, m, p, n, v, extra), n, v, uv, extra)
 }
 
 /// Direction towards the light and the intensity arriving, `I^em/(a d² + b d + c)`.
