@@ -2,7 +2,8 @@
 //! preview of a scene before a long ray-traced render.
 
 use crate::{Failure, ImageArgs, check_output, load_sized, save};
-use alhazen_raster::pipeline::{RasterOptions, Shading, Visibility, prepare, render_prepared};
+use alhazen_raster::pipeline::stencil::StencilMode;
+use alhazen_raster::pipeline::{RasterOptions, Shading, ShadowMethod, Visibility, prepare, render_prepared};
 use alhazen_render::Image;
 use clap::Args;
 use std::time::Instant;
@@ -16,6 +17,17 @@ pub(crate) enum ShadingArg {
     Gouraud,
     /// Normals interpolated, lighting per pixel.
     Phong,
+}
+
+/// `--shadow-method`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub(crate) enum ShadowMethodArg {
+    /// Shadow maps.
+    Maps,
+    /// Stencil shadow volumes, depth pass.
+    DepthPass,
+    /// Stencil shadow volumes, depth fail (Carmack's reverse).
+    DepthFail,
 }
 
 /// `--visibility`.
@@ -40,9 +52,13 @@ pub(crate) struct RasterArgs {
     /// Draw triangle edges on top.
     #[arg(long)]
     wireframe: bool,
-    /// No shadow maps.
+    /// No shadows.
     #[arg(long)]
     no_shadows: bool,
+    /// Shadow algorithm: shadow maps, or stencil shadow volumes counted in front of the surface
+    /// (depth pass) or behind it (depth fail).
+    #[arg(long, value_enum, default_value = "maps")]
+    shadow_method: ShadowMethodArg,
     /// Diffuse light from the environment map or background (nine-coefficient irradiance).
     #[arg(long)]
     ibl: bool,
@@ -86,6 +102,11 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         ibl: a.ibl,
         clip_planes: a.clip_plane.clone(),
         cull_planes: a.cull_plane.clone(),
+        shadow_method: match a.shadow_method {
+            ShadowMethodArg::Maps => ShadowMethod::Maps,
+            ShadowMethodArg::DepthPass => ShadowMethod::Volumes(StencilMode::DepthPass),
+            ShadowMethodArg::DepthFail => ShadowMethod::Volumes(StencilMode::DepthFail),
+        },
         visibility: match a.visibility {
             VisibilityArg::Zbuffer => Visibility::ZBuffer,
             VisibilityArg::Bsp => Visibility::Bsp,

@@ -4,12 +4,13 @@
 //! checks without a person at the keyboard).
 //!
 //! Controls: left drag or arrow keys orbit around the target; right drag pans; wheel or `+`/`-`
-//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `I` environment light; `B` z-buffer/BSP painter; `W` wireframe; `C` back-face culling; `R` ray
+//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `M` shadow maps / stencil depth pass / depth fail; `I` environment light; `B` z-buffer/BSP painter; `W` wireframe; `C` back-face culling; `R` ray
 //! traces the current view (Whitted, the scene's samples) and writes it to `--output`; `Esc` or
 //! `Q` quits.
 
 use crate::{Failure, check_output, save};
-use alhazen_raster::pipeline::{RasterOptions, Shading, Visibility, prepare, render_prepared};
+use alhazen_raster::pipeline::stencil::StencilMode;
+use alhazen_raster::pipeline::{RasterOptions, Shading, ShadowMethod, Visibility, prepare, render_prepared};
 use alhazen_render::Image;
 use alhazen_render::output::to_srgb8;
 use alhazen_scene::{CameraDesc, LookAt, SceneError, load_scene};
@@ -96,8 +97,11 @@ impl Orbit {
 
 /// What a redraw depends on.
 #[allow(clippy::type_complexity)]
-fn snapshot(o: &Orbit, p: &RasterOptions) -> (LookAt, Option<f64>, Shading, bool, bool, bool, bool, Visibility) {
-    (o.look, o.ortho_width, p.shading, p.wireframe, p.cull, p.shadows, p.ibl, p.visibility)
+fn snapshot(
+    o: &Orbit,
+    p: &RasterOptions,
+) -> (LookAt, Option<f64>, Shading, bool, bool, bool, bool, Visibility, ShadowMethod) {
+    (o.look, o.ortho_width, p.shading, p.wireframe, p.cull, p.shadows, p.ibl, p.visibility, p.shadow_method)
 }
 
 fn to_pixels(image: &Image) -> Vec<u32> {
@@ -159,7 +163,7 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
                 "alhazen view — {:?}, {:?}{}{}{} — {} triangles, {:.1} ms",
                 opts.visibility,
                 opts.shading,
-                if opts.shadows { ", shadows" } else { "" },
+                if opts.shadows { format!(", shadows by {:?}", opts.shadow_method) } else { String::new() },
                 if opts.wireframe { ", wireframe" } else { "" },
                 if opts.cull { "" } else { ", no culling" },
                 stats.triangles,
@@ -222,6 +226,13 @@ fn handle_input(window: &Window, orbit: &mut Orbit, opts: &mut RasterOptions, la
     }
     if window.is_key_pressed(Key::I, KeyRepeat::No) {
         opts.ibl = !opts.ibl;
+    }
+    if window.is_key_pressed(Key::M, KeyRepeat::No) {
+        opts.shadow_method = match opts.shadow_method {
+            ShadowMethod::Maps => ShadowMethod::Volumes(StencilMode::DepthPass),
+            ShadowMethod::Volumes(StencilMode::DepthPass) => ShadowMethod::Volumes(StencilMode::DepthFail),
+            ShadowMethod::Volumes(StencilMode::DepthFail) => ShadowMethod::Maps,
+        };
     }
     if window.is_key_pressed(Key::B, KeyRepeat::No) {
         opts.visibility = match opts.visibility {

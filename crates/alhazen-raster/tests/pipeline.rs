@@ -212,3 +212,61 @@ fn bsp_tree_partitions_the_scene() {
         assert_eq!(order.len(), tree.len());
     }
 }
+
+fn relative_error(fb: &alhazen_raster::pipeline::Framebuffer, traced: &alhazen_render::Image) -> f64 {
+    let mean: f64 =
+        traced.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / traced.pixels.len() as f64;
+    mean_abs(&fb.color, &traced.pixels) / mean
+}
+
+#[test]
+fn stencil_shadow_volumes_agree_with_the_ray_tracer() {
+    use alhazen_raster::pipeline::ShadowMethod;
+    use alhazen_raster::pipeline::stencil::StencilMode;
+    let scene = parse_scene("agree.toml".as_ref(), SCENE).unwrap();
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    for mode in [StencilMode::DepthPass, StencilMode::DepthFail] {
+        let opts = RasterOptions { shadow_method: ShadowMethod::Volumes(mode), ..Default::default() };
+        let err = relative_error(&render_scene(&scene, &opts).unwrap().0, &traced);
+        eprintln!("{mode:?}: {:.2} %", err * 100.0);
+        assert!(err < 0.01, "{mode:?}: {:.2} %", err * 100.0);
+    }
+}
+
+#[test]
+fn depth_fail_stays_right_when_the_eye_is_in_a_shadow() {
+    use alhazen_raster::pipeline::ShadowMethod;
+    use alhazen_raster::pipeline::stencil::StencilMode;
+    // The eye sits under a lit slab, inside its shadow volume, looking at the shadowed floor.
+    let text = r#"
+ambient = 0.1
+[render]
+width = 64
+height = 48
+spp = 1
+[camera]
+eye = [0, 1, 0.5]
+target = [0, 0, -1.5]
+fov = 60
+[[light]]
+type = "point"
+position = [0, 8, 0]
+[[object]]
+shape = "box"
+min = [-3, 2, -3]
+max = [3, 2.3, 3]
+[[object]]
+shape = "disk"
+radius = 20
+"#;
+    let scene = parse_scene("inside.toml".as_ref(), text).unwrap();
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    let err = |mode| {
+        let opts = RasterOptions { shadow_method: ShadowMethod::Volumes(mode), ..Default::default() };
+        relative_error(&render_scene(&scene, &opts).unwrap().0, &traced)
+    };
+    let (pass, fail) = (err(StencilMode::DepthPass), err(StencilMode::DepthFail));
+    eprintln!("eye in shadow: depth pass {:.1} %, depth fail {:.1} %", pass * 100.0, fail * 100.0);
+    assert!(fail < 0.01, "depth fail: {:.2} %", fail * 100.0);
+    assert!(pass > 10.0 * fail.max(1e-3), "depth pass should break here: {:.2} %", pass * 100.0);
+}

@@ -29,6 +29,8 @@ pub struct Triangle {
     pub closed: bool,
     /// Part of an infinite plane (left out of shadow-map bounds).
     pub unbounded: bool,
+    /// Index of the scene object.
+    pub object: u32,
 }
 
 /// The triangles of a whole scene and the number of objects that could not be tessellated.
@@ -70,15 +72,22 @@ fn basis(axis: Vec3) -> (Vec3, Vec3) {
 /// A disk of `radius` around `center` facing `normal`, as a fan.
 fn disk(center: Vec3, normal: Vec3, radius: f64) -> Vec<[Vertex; 3]> {
     let (s, t) = basis(normal);
+    disk_in(center, (s, t), normal, radius)
+}
+
+/// A disk in the plane of `s, t` facing `normal` (`±s × t`): the rim points are those of the
+/// side of a cylinder built on the same `s, t`, so caps and side share their edges exactly.
+fn disk_in(center: Vec3, (s, t): (Vec3, Vec3), normal: Vec3, radius: f64) -> Vec<[Vertex; 3]> {
     let c = Vertex { p: center, n: normal, uv: Vec2::splat(0.5) };
+    let facing_st = s.cross(t).dot(normal) > 0.0;
     (0..SEGMENTS)
         .map(|k| {
             let at = |k: usize| {
-                let a = 2.0 * PI * k as f64 / SEGMENTS as f64;
+                let a = 2.0 * PI * (k % SEGMENTS) as f64 / SEGMENTS as f64;
                 let d = s * a.cos() + t * a.sin();
                 Vertex { p: center + d * radius, n: normal, uv: Vec2::new(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin()) }
             };
-            [c, at(k), at(k + 1)]
+            if facing_st { [c, at(k), at(k + 1)] } else { [c, at(k + 1), at(k)] }
         })
         .collect()
 }
@@ -92,9 +101,10 @@ fn round_side(base: Vec3, top: Vec3, r0: f64, r1: f64) -> Vec<[Vertex; 3]> {
     // The normal tilts by the slope of the side.
     let slope = (r0 - r1) / h;
     grid(1, SEGMENTS, |u, v| {
-        let ang = 2.0 * PI * u;
+        let ang = 2.0 * PI * (u % 1.0);
         let d = s * ang.cos() + t * ang.sin();
-        let p = base + axis * v + d * (r0 + (r1 - r0) * v);
+        // The rims are exactly `base + d r0` and `top + d r1`, as the caps' (watertight meshes).
+        let p = if v == 1.0 { top + d * r1 } else { base + axis * v + d * (r0 + (r1 - r0) * v) };
         (p, (d + a * slope).normalize(), Vec2::new(u, v))
     })
 }
@@ -112,9 +122,10 @@ fn object_triangles(scene: &Scene, shape: &Shape) -> Option<Vec<[Vertex; 3]>> {
             let mut t = round_side(*base, *top, *radius, r1);
             if *capped {
                 let a = (*top - *base).normalize();
-                t.extend(disk(*base, -a, *radius));
+                let st = basis(a);
+                t.extend(disk_in(*base, st, -a, *radius));
                 if r1 > 0.0 {
-                    t.extend(disk(*top, a, r1));
+                    t.extend(disk_in(*top, st, a, r1));
                 }
             }
             t
@@ -183,7 +194,8 @@ fn place(tri: [Vertex; 3], tf: &Transform) -> [Vertex; 3] {
 /// Every object of `scene` as world-space triangles.
 pub fn scene_triangles(scene: &Scene) -> SceneTriangles {
     let (mut triangles, mut skipped) = (vec![], 0);
-    for o in &scene.objects {
+    for (object, o) in scene.objects.iter().enumerate() {
+        let object = object as u32;
         let Some(tris) = object_triangles(scene, &o.shape) else {
             skipped += 1;
             continue;
@@ -198,7 +210,15 @@ pub fn scene_triangles(scene: &Scene) -> SceneTriangles {
                 None => o.material,
             };
             let unbounded = matches!(o.shape, Shape::Plane { .. });
-            triangles.push(Triangle { v: place(t, &o.transform), material, closed: o.shape.is_closed(), unbounded });
+            let t = place(t, &o.transform);
+            // Degenerate triangles (sphere poles, cone apexes) draw nothing and would break the
+            // edge pairing of closed meshes.
+            let (e1, e2) = (t[1].p - t[0].p, t[2].p - t[0].p);
+            let longest = e1.length_squared().max(e2.length_squared()).max((t[2].p - t[1].p).length_squared());
+            if e1.cross(e2).length_squared() <= 1e-20 * longest * longest {
+                continue;
+            }
+            triangles.push(Triangle { v: t, material, closed: o.shape.is_closed(), unbounded, object });
         }
     }
     SceneTriangles { triangles, skipped }

@@ -15,6 +15,7 @@ pub mod ibl;
 pub mod raster;
 pub mod shade;
 pub mod shadow;
+pub mod stencil;
 
 use alhazen_math::viewing::{Frustum, ViewFrame};
 use alhazen_math::{Mat4, Vec2, Vec3, Vec4};
@@ -66,6 +67,18 @@ pub struct RasterOptions {
     pub cull_planes: Vec<Vec4>,
     /// Hidden-surface removal.
     pub visibility: Visibility,
+    /// How shadows are found when `shadows` is on: shadow maps, or stencil shadow volumes
+    /// (perspective cameras; Flat and Phong shading).
+    pub shadow_method: ShadowMethod,
+}
+
+/// Shadow algorithm.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadowMethod {
+    /// Depth images from the lights ([`shadow`]).
+    Maps,
+    /// Stencil shadow volumes ([`stencil`]) with the given counting rule.
+    Volumes(stencil::StencilMode),
 }
 
 impl Default for RasterOptions {
@@ -79,6 +92,7 @@ impl Default for RasterOptions {
             clip_planes: vec![],
             cull_planes: vec![],
             visibility: Visibility::ZBuffer,
+            shadow_method: ShadowMethod::Maps,
         }
     }
 }
@@ -116,7 +130,8 @@ fn environment(scene: &Scene) -> impl Fn(Vec3) -> Vec3 + Sync + '_ {
 /// shadow maps and builds its BSP tree.
 pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
     let geometry = scene_triangles(scene);
-    let shadows = opts.shadows.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
+    let maps = opts.shadows && opts.shadow_method == ShadowMethod::Maps;
+    let shadows = maps.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
     let irradiance = ibl::Sh9::irradiance_of(&environment(scene), 8, 400);
     let specular = ibl::SpecularIbl::build(&environment(scene), 32);
     let bsp = (opts.visibility == Visibility::Bsp).then(|| {
@@ -203,7 +218,12 @@ fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projection, 
                     Frustum { l: l * k, r: r * k, b: b * k, t: t * k, n: 1e-3, f: 1e6 }
                 }
             };
-            (frame_of(look), frustum.perspective(), true)
+            // The limit f → ∞ of the course's P: points at infinity (shadow volumes' far ends)
+            // land on the far plane instead of beyond it.
+            let mut p = frustum.perspective();
+            p.z_axis.z = -1.0;
+            p.w_axis.z = -2.0 * frustum.n;
+            (frame_of(look), p, true)
         }
         CameraDesc::Orthographic { look, width: w } => {
             let (hw, hh) = (w / 2.0, w / aspect / 2.0);
@@ -343,10 +363,15 @@ pub fn render_prepared(
     let (w, h) = (scene.render.width, scene.render.height);
     let proj = projection(&scene.camera, w, h)?;
     let geometry = &prepared.geometry;
+    let stencil_mode = match (opts.shadows, opts.shadow_method, proj.perspective) {
+        (true, ShadowMethod::Volumes(mode), true) => Some(mode),
+        _ => None,
+    };
     let light = shade::Lighting {
-        shadows: if opts.shadows { prepared.shadows.as_ref() } else { None },
+        shadows: if opts.shadows && stencil_mode.is_none() { prepared.shadows.as_ref() } else { None },
         irradiance: opts.ibl.then_some(&prepared.irradiance),
         specular: opts.ibl.then_some(&prepared.specular),
+        blocked: 0,
     };
     let shadows = &light;
     // The painter's algorithm draws the BSP tree's triangles back to front; the z-buffer any order.
@@ -359,6 +384,7 @@ pub fn render_prepared(
         _ => (&geometry.triangles, (0..geometry.triangles.len() as u32).collect()),
     };
     let painter = opts.visibility == Visibility::Bsp && prepared.bsp.is_some();
+    let volumes = stencil_mode.map(|_| stencil::volumes(scene, tris, proj.world_to_clip, (w, h))).unwrap_or_default();
     let processed: Vec<(bool, Vec<ScreenTriangle>)> =
         order.par_iter().map(|&i| process(scene, &proj, &tris[i as usize], i, opts, shadows, (w, h))).collect();
     let culled = processed.iter().filter(|p| p.0).count();
@@ -385,10 +411,23 @@ pub fn render_prepared(
                     }
                 });
             }
+            // Stencil shadow volumes: per light, a count per pixel of this band.
+            let mut blocked = vec![0u64; n];
+            if let Some(mode) = stencil_mode {
+                for (light, vol) in volumes.iter().enumerate().take(64) {
+                    let counts = stencil::count(vol, &depth, w, (y0, y1), mode);
+                    for (b, c) in blocked.iter_mut().zip(&counts) {
+                        if *c != 0 {
+                            *b |= 1 << light;
+                        }
+                    }
+                }
+            }
             // Deferred: each visible pixel is shaded once.
             let color = (0..n)
                 .map(|k| {
                     let (src, attr) = &owner[k];
+                    let shadows = &shade::Lighting { blocked: blocked[k], ..*shadows };
                     let c = if *src == u32::MAX {
                         let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
                         scene.background.radiance(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))

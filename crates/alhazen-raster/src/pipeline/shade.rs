@@ -15,6 +15,8 @@ pub struct Lighting<'a> {
     pub irradiance: Option<&'a Sh9>,
     /// The prefiltered environment and split-sum table (no specular image-based light when `None`).
     pub specular: Option<&'a SpecularIbl>,
+    /// Lights (bit `k` for light `k`) that a stencil shadow volume hides at this pixel.
+    pub blocked: u64,
 }
 use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::{Highlight, Light, Material, Scene};
@@ -34,7 +36,8 @@ pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &
     for (k, light) in scene.lights.iter().enumerate() {
         let Some((l, i)) = incoming(light, p) else { continue };
         let cos = n.dot(l);
-        if cos <= 0.0 || shadows.is_some_and(|s| !s.lit(k, p, n)) {
+        let stenciled = k < 64 && extra.blocked >> k & 1 == 1;
+        if cos <= 0.0 || stenciled || shadows.is_some_and(|s| !s.lit(k, p, n)) {
             continue;
         }
         diffuse += i * cos;
