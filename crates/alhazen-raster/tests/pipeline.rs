@@ -270,3 +270,20 @@ radius = 20
     assert!(fail < 0.01, "depth fail: {:.2} %", fail * 100.0);
     assert!(pass > 10.0 * fail.max(1e-3), "depth pass should break here: {:.2} %", pass * 100.0);
 }
+
+#[test]
+fn bump_mapping_agrees_with_the_ray_tracer() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/bumps.toml");
+    let mut scene = alhazen_scene::load_scene(&path).unwrap();
+    scene.render.width = 160;
+    scene.render.height = 108;
+    scene.render.spp = 1;
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    let err = relative_error(&render_scene(&scene, &RasterOptions::default()).unwrap().0, &traced);
+    // Without the bumps, the difference is far larger: the pattern is really there.
+    let mut flat = scene.clone();
+    flat.materials.iter_mut().for_each(|m| m.bump = None);
+    let flat_err = relative_error(&render_scene(&flat, &RasterOptions::default()).unwrap().0, &traced);
+    eprintln!("bumps: {:.2} % (against flat: {:.2} %)", err * 100.0, flat_err * 100.0);
+    assert!(err < 0.03 && flat_err > 2.0 * err, "{:.2} % vs {:.2} %", err * 100.0, flat_err * 100.0);
+}

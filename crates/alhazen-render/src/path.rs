@@ -144,7 +144,8 @@ impl<'a> PathTracer<'a> {
     /// The local frame (normal on the viewer's side for opaque surfaces — the course's two-sided
     /// reading of the same-side factor) and the geometric normal on the same side.
     fn shading_frame(&self, wh: &WorldHit, bsdf: &Bsdf, wo: Vec3, tangent: Vec3) -> (Frame, Vec3) {
-        let (mut ng, mut ns) = (wh.hit.n, wh.hit.ns);
+        let m = &self.scene.materials[wh.material as usize];
+        let (mut ng, mut ns) = (wh.hit.n, crate::world::shading_normal(&wh.hit, m, &self.scene.images));
         if !bsdf.transmits() && ng.dot(wo) < 0.0 {
             ng = -ng;
             ns = -ns;

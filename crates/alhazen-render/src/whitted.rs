@@ -125,7 +125,8 @@ impl<'a> Whitted<'a> {
         let h = &wh.hit;
         let v = -ray.dir;
         let front = h.n.dot(v) > 0.0;
-        let (ng, mut n) = if front { (h.n, h.ns) } else { (-h.n, -h.ns) };
+        let ns = crate::world::shading_normal(h, m, &self.scene.images);
+        let (ng, mut n) = if front { (h.n, ns) } else { (-h.n, -ns) };
         if n.dot(v) <= 0.0 {
             n = ng;
         }

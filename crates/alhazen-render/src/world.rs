@@ -253,3 +253,12 @@ impl World {
         best
     }
 }
+
+/// The shading normal at `hit` for material `m`: the surface's, bent by the material's bump map
+/// (course, bump mapping) when it has one.
+pub fn shading_normal(hit: &SurfaceHit, m: &scene::Material, images: &[Arc<scene::ImageData>]) -> Vec3 {
+    match &m.bump {
+        None => hit.ns,
+        Some(b) => scene::texture::bumped_normal(b, hit.uv, hit.ns, hit.dpduv[0], hit.dpduv[1], images),
+    }
+}

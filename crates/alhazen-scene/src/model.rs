@@ -325,6 +325,35 @@ pub struct Material {
     /// The scattering function for the path tracer; `None` derives one from the Whitted
     /// coefficients (see [`crate::bsdf`]).
     pub bsdf: Option<crate::bsdf::BsdfDesc>,
+    /// Bump mapping: small displacements along the normal, seen through the perturbed normal.
+    pub bump: Option<Bump>,
+}
+
+/// A displacement `d(q(u, v))` of a surface along its normal (course, §"Shading methods":
+/// bump mapping), applied to the normal only.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bump {
+    /// Displacement at the top of the pattern (world units).
+    pub height: f64,
+    /// The pattern, values in `[0, 1]`.
+    pub pattern: BumpPattern,
+}
+
+/// Where the displacement comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BumpPattern {
+    /// `½ + ½ sin(2πu/size) sin(2πv/size)`: an egg-crate of period `size` in texture units.
+    Waves {
+        /// Period.
+        size: f64,
+    },
+    /// The luminance of an image (bilinear), repeated `scale` times per texture unit.
+    Image {
+        /// Index into [`Scene::images`].
+        image: usize,
+        /// Repeats per texture unit.
+        scale: Vec2,
+    },
 }
 
 impl Default for Material {
@@ -343,6 +372,7 @@ impl Default for Material {
             fresnel: FresnelMode::Exact,
             emission: Vec3::ZERO,
             bsdf: None,
+            bump: None,
         }
     }
 }

@@ -126,6 +126,7 @@ impl Parser<'_> {
             "fresnel",
             "emission",
             "bsdf",
+            "bump",
         ];
         let t = n.table(KEYS)?;
         let d = Material::default();
@@ -161,7 +162,41 @@ impl Parser<'_> {
             },
             emission: t.opt_rgb("emission", d.emission)?,
             bsdf,
+            bump: t.get("bump").map(|b| self.bump(&b)).transpose()?,
         })
+    }
+
+    /// `{ file = "x.png", scale = s or [u, v] }`: a repeated image (its index and scale).
+    fn image_texture(&mut self, i: &Node) -> R<(usize, Vec2)> {
+        let i = i.table(&["file", "scale"])?;
+        let file = i.req("file")?;
+        let path = self.dir.join(file.str()?);
+        let data = import::load_image(&path).map_err(|e| file.err(e))?;
+        let scale = match i.get("scale") {
+            Some(s) if s.is_table() => return Err(s.err("`scale`: expected a number or [u, v]")),
+            Some(s) => match s.v {
+                toml::de::DeValue::Array(_) => Vec2::from_array(s.numbers::<2>()?),
+                _ => Vec2::splat(s.positive()?),
+            },
+            None => Vec2::ONE,
+        };
+        self.scene.images.push(Arc::new(data));
+        Ok((self.scene.images.len() - 1, scale))
+    }
+
+    /// `bump = { height = h, waves = size }` or `bump = { height = h, image = { file, scale } }`.
+    fn bump(&mut self, n: &Node) -> R<Bump> {
+        let t = n.table(&["height", "waves", "image"])?;
+        let height = t.req("height")?.f64()?;
+        let pattern = match (t.get("waves"), t.get("image")) {
+            (Some(w), None) => BumpPattern::Waves { size: w.positive()? },
+            (None, Some(i)) => {
+                let (image, scale) = self.image_texture(&i)?;
+                BumpPattern::Image { image, scale }
+            }
+            _ => return Err(n.err("a bump needs exactly one of `waves = size` or `image = { file = … }`")),
+        };
+        Ok(Bump { height, pattern })
     }
 
     pub(crate) fn texture(&mut self, n: &Node) -> R<Texture> {
@@ -178,20 +213,8 @@ impl Parser<'_> {
             });
         }
         if let Some(i) = t.get("image") {
-            let i = i.table(&["file", "scale"])?;
-            let file = i.req("file")?;
-            let path = self.dir.join(file.str()?);
-            let data = import::load_image(&path).map_err(|e| file.err(e))?;
-            let scale = match i.get("scale") {
-                Some(s) if s.is_table() => return Err(s.err("`scale`: expected a number or [u, v]")),
-                Some(s) => match s.v {
-                    toml::de::DeValue::Array(_) => Vec2::from_array(s.numbers::<2>()?),
-                    _ => Vec2::splat(s.positive()?),
-                },
-                None => Vec2::ONE,
-            };
-            self.scene.images.push(Arc::new(data));
-            return Ok(Texture::Image { image: self.scene.images.len() - 1, scale });
+            let (image, scale) = self.image_texture(&i)?;
+            return Ok(Texture::Image { image, scale });
         }
         Err(n.err("`color`: expected a colour, { checker = {...} } or { image = {...} }"))
     }

@@ -73,3 +73,73 @@ mod tests {
         assert_eq!(eval(&t, Vec2::new(0.75, 0.5), &imgs), Vec3::Z);
     }
 }
+
+/// The bump pattern's value in `[0, 1]` at `uv`.
+fn bump_value(b: &crate::BumpPattern, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> f64 {
+    match b {
+        crate::BumpPattern::Waves { size } => {
+            let k = 2.0 * std::f64::consts::PI / size;
+            0.5 + 0.5 * (k * uv.x).sin() * (k * uv.y).sin()
+        }
+        crate::BumpPattern::Image { image, scale } => {
+            alhazen_math::color::luminance(bilinear(&images[*image], uv * *scale)).clamp(0.0, 1.0)
+        }
+    }
+}
+
+/// The normal of the bumped surface `p̂ = p + d(u, v) n` by the course's approximation
+/// `Dp̂ ≈ Dp + (Dd) n` (the term `d Dn` neglected): `n̂ ∝ (p_u + d_u n) × (p_v + d_v n)`, turned
+/// to `n`'s side. `dpdu`, `dpdv` are the surface's partial derivatives (zero when unknown: then
+/// an orthonormal tangent frame of `n` stands in). The gradient of `d` is taken by central
+/// differences over a step that follows the pattern's detail. The caller keeps `n` where the
+/// viewer would see `n̂` from behind, as the course prescribes.
+pub fn bumped_normal(
+    bump: &crate::Bump,
+    uv: Vec2,
+    n: Vec3,
+    dpdu: Vec3,
+    dpdv: Vec3,
+    images: &[std::sync::Arc<ImageData>],
+) -> Vec3 {
+    let (pu, pv) = if dpdu.cross(dpdv).length_squared() > 0.0 {
+        (dpdu, dpdv)
+    } else {
+        let (s, t) = alhazen_math::orthonormal_basis(n);
+        if s.cross(t).dot(n) > 0.0 { (s, t) } else { (t, s) }
+    };
+    let step = match &bump.pattern {
+        crate::BumpPattern::Waves { size } => size * 1e-4,
+        crate::BumpPattern::Image { image, scale } => {
+            0.5 / (images[*image].width.max(images[*image].height) as f64 * scale.max_element())
+        }
+    };
+    let d = |du: f64, dv: f64| bump.height * bump_value(&bump.pattern, uv + Vec2::new(du, dv), images);
+    let (du, dv) = ((d(step, 0.0) - d(-step, 0.0)) / (2.0 * step), (d(0.0, step) - d(0.0, -step)) / (2.0 * step));
+    let m = (pu + n * du).cross(pv + n * dv);
+    let m = if m.dot(n) < 0.0 { -m } else { m };
+    m.try_normalize().unwrap_or(n)
+}
+
+#[cfg(test)]
+mod bump_tests {
+    use super::*;
+    use crate::{Bump, BumpPattern};
+
+    #[test]
+    fn bumped_plane_normal_is_the_displaced_surface_normal() {
+        // On a plane Dn = 0, so the course's approximation is exact: the normal of the surface
+        // z = h·w(x, y) (plane z = 0, u = x, v = y).
+        let (h, size) = (0.05, 0.7);
+        let bump = Bump { height: h, pattern: BumpPattern::Waves { size } };
+        for (x, y) in [(0.1, 0.2), (0.33, -0.4), (1.7, 0.05)] {
+            let got = bumped_normal(&bump, Vec2::new(x, y), Vec3::Z, Vec3::X, Vec3::Y, &[]);
+            let k = 2.0 * std::f64::consts::PI / size;
+            let (gx, gy) = (h * 0.5 * k * (k * x).cos() * (k * y).sin(), h * 0.5 * k * (k * x).sin() * (k * y).cos());
+            let want = Vec3::new(-gx, -gy, 1.0).normalize();
+            assert!((got - want).length() < 1e-7, "{got} vs {want}");
+        }
+        // Zero height leaves the normal alone.
+        let flat = Bump { height: 0.0, pattern: BumpPattern::Waves { size } };
+        assert_eq!(bumped_normal(&flat, Vec2::new(0.3, 0.3), Vec3::Z, Vec3::X, Vec3::Y, &[]), Vec3::Z);
+    }
+}

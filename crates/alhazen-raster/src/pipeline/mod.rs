@@ -312,6 +312,22 @@ fn process(
     (false, tris)
 }
 
+/// The normal bent by the material's bump map, with the triangle's `∂p/∂u`, `∂p/∂v` from its
+/// texture coordinates (Flat and Phong shading; Gouraud lights the vertices only).
+fn bumped(scene: &Scene, m: &alhazen_scene::Material, t: &Triangle, uv: Vec2, n: Vec3) -> Vec3 {
+    let Some(b) = &m.bump else { return n };
+    let [a, b1, c] = t.v;
+    let (d1, d2) = (b1.uv - a.uv, c.uv - a.uv);
+    let det = d1.x * d2.y - d1.y * d2.x;
+    let (e1, e2) = (b1.p - a.p, c.p - a.p);
+    let (pu, pv) = if det == 0.0 {
+        (Vec3::ZERO, Vec3::ZERO)
+    } else {
+        ((e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det)
+    };
+    alhazen_scene::texture::bumped_normal(b, uv, n, pu, pv, &scene.images)
+}
+
 /// The colour of a fragment.
 fn fragment_color(
     scene: &Scene,
@@ -336,12 +352,14 @@ fn fragment_color(
             let centroid = (a.p + b.p + c.p) / 3.0;
             let n = (b.p - a.p).cross(c.p - a.p).normalize_or_zero();
             let uv = (a.uv + b.uv + c.uv) / 3.0;
+            let n = bumped(scene, m, t, uv, n);
             shade::shade(scene, m, centroid, n, proj.to_viewer(centroid), uv, shadows)
         }
         Shading::Phong => {
             let p = Vec3::new(attr[0], attr[1], attr[2]);
-            let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
-            shade::shade(scene, m, p, n, proj.to_viewer(p), Vec2::new(attr[6], attr[7]), shadows)
+            let uv = Vec2::new(attr[6], attr[7]);
+            let n = bumped(scene, m, t, uv, Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero());
+            shade::shade(scene, m, p, n, proj.to_viewer(p), uv, shadows)
         }
     }
 }

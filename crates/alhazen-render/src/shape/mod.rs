@@ -35,12 +35,20 @@ pub struct SurfaceHit {
     pub uv: Vec2,
     /// Material slot of a mesh triangle (0 elsewhere).
     pub slot: u32,
+    /// `∂p/∂u` and `∂p/∂v` of the texture parametrisation (zero when the shape gives none), for
+    /// bump mapping.
+    pub dpduv: [Vec3; 2],
 }
 
 impl SurfaceHit {
     /// A hit whose shading normal is its geometric normal.
     pub fn flat(t: f64, p: Vec3, n: Vec3, uv: Vec2) -> Self {
-        Self { t, p, n, ns: n, uv, slot: 0 }
+        Self { t, p, n, ns: n, uv, slot: 0, dpduv: [Vec3::ZERO; 2] }
+    }
+
+    /// The same hit with the partial derivatives of its parametrisation.
+    pub fn with_tangents(self, dpdu: Vec3, dpdv: Vec3) -> Self {
+        Self { dpduv: [dpdu, dpdv], ..self }
     }
 }
 
@@ -232,7 +240,7 @@ impl Placed {
 fn to_world(tf: &Transform, h: SurfaceHit) -> SurfaceHit {
     let n = tf.normal(h.n).normalize();
     let ns = if h.ns == h.n { n } else { tf.normal(h.ns).normalize() };
-    SurfaceHit { p: tf.point(h.p), n, ns, ..h }
+    SurfaceHit { p: tf.point(h.p), n, ns, dpduv: h.dpduv.map(|d| tf.vector(d)), ..h }
 }
 
 #[cfg(test)]

@@ -32,7 +32,7 @@ impl Plane {
         let (t, p) = (c.t, ray.at(c.t));
         let (tu, tv) = orthonormal_basis(self.normal);
         let d = p - self.point;
-        SurfaceHit::flat(t, p, self.normal, Vec2::new(d.dot(tu), d.dot(tv)))
+        SurfaceHit::flat(t, p, self.normal, Vec2::new(d.dot(tu), d.dot(tv))).with_tangents(tu, tv)
     }
 }
 

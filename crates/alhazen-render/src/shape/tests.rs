@@ -172,3 +172,23 @@ fn open_cylinder_is_seen_from_inside() {
     let h = c.intersect(&ray, f64::INFINITY).unwrap();
     assert!((h.p.x - 1.0).abs() < 1e-12 && h.n.x > 0.0, "outward normal even when hit from inside");
 }
+
+#[test]
+fn tangents_are_the_derivatives_of_the_texture_parametrisation() {
+    // Two nearby hits: p₂ − p₁ ≈ ∂p/∂u Δu + ∂p/∂v Δv.
+    let sphere = Shape::Sphere(Sphere { center: Vec3::new(0.1, 0.2, -0.3), radius: 1.3 });
+    let plane = Shape::Plane(Plane { point: Vec3::new(0.0, -1.0, 0.0), normal: Vec3::new(0.2, 1.0, 0.1).normalize() });
+    let mesh = Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false });
+    for shape in [sphere, plane, mesh] {
+        let origin = Vec3::new(0.3, 4.0, 3.0);
+        let target = Vec3::new(0.2, -0.1, 0.15);
+        let d = 1e-5;
+        let a = shape.intersect(&Ray::new(origin, (target - origin).normalize()), f64::INFINITY).unwrap();
+        let b = shape
+            .intersect(&Ray::new(origin, (target + Vec3::new(d, 0.0, d) - origin).normalize()), f64::INFINITY)
+            .unwrap();
+        let predicted = a.dpduv[0] * (b.uv.x - a.uv.x) + a.dpduv[1] * (b.uv.y - a.uv.y);
+        let moved = b.p - a.p;
+        assert!((predicted - moved).length() < 1e-3 * moved.length(), "{shape:?}: {predicted} vs {moved}");
+    }
+}
