@@ -34,7 +34,7 @@ enum Command {
     Raster(raster::RasterArgs),
     /// An interactive window on the raster preview: orbit, pan, zoom; R ray traces the view.
     #[command(
-        after_help = "Controls: left drag or arrows orbit, right drag pans, wheel or +/- zooms,\n1/2/3 flat/Gouraud/Phong, S shadows, M maps/stencil, I environment light, B z-buffer/BSP,\nW wireframe, C culling, R ray trace, Esc/Q quit.\n\nExample:\n  alhazen view scenes/glass-balls.toml"
+        after_help = "Controls: left drag or arrows orbit, right drag pans, wheel or +/- zooms,\n1/2/3 flat/Gouraud/Phong, S shadows, M maps/stencil, I environment light, H hemispherical, B z-buffer/BSP,\nW wireframe, C culling, R ray trace, Esc/Q quit.\n\nExample:\n  alhazen view scenes/glass-balls.toml"
     )]
     View(view::ViewArgs),
     /// Exact reflexes on spheres and cylinders (Glaeser), catacaustics and their figures.

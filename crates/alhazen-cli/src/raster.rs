@@ -59,9 +59,13 @@ pub(crate) struct RasterArgs {
     /// (depth pass) or behind it (depth fail).
     #[arg(long, value_enum, default_value = "maps")]
     shadow_method: ShadowMethodArg,
-    /// Diffuse light from the environment map or background (nine-coefficient irradiance).
+    /// Light from the environment map or background: diffuse (nine-coefficient irradiance)
+    /// and glossy (prefiltered environment, split sum).
     #[arg(long)]
     ibl: bool,
+    /// The course's hemispherical lighting (background up and down) instead of the ambient term.
+    #[arg(long)]
+    hemispherical: bool,
     /// Hidden-surface removal: depth buffer, or the painter's algorithm over a BSP tree.
     #[arg(long, value_enum, default_value = "zbuffer")]
     visibility: VisibilityArg,
@@ -100,6 +104,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         wireframe: a.wireframe,
         shadows: !a.no_shadows,
         ibl: a.ibl,
+        hemispherical: a.hemispherical,
         clip_planes: a.clip_plane.clone(),
         cull_planes: a.cull_plane.clone(),
         shadow_method: match a.shadow_method {

@@ -4,7 +4,7 @@
 //! checks without a person at the keyboard).
 //!
 //! Controls: left drag or arrow keys orbit around the target; right drag pans; wheel or `+`/`-`
-//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `M` shadow maps / stencil depth pass / depth fail; `I` environment light; `B` z-buffer/BSP painter; `W` wireframe; `C` back-face culling; `R` ray
+//! zooms; `1`/`2`/`3` flat/Gouraud/Phong shading; `S` shadows; `M` shadow maps / stencil depth pass / depth fail; `I` environment light; `H` hemispherical lighting; `B` z-buffer/BSP painter; `W` wireframe; `C` back-face culling; `R` ray
 //! traces the current view (Whitted, the scene's samples) and writes it to `--output`; `Esc` or
 //! `Q` quits.
 
@@ -97,11 +97,15 @@ impl Orbit {
 
 /// What a redraw depends on.
 #[allow(clippy::type_complexity)]
-fn snapshot(
-    o: &Orbit,
-    p: &RasterOptions,
-) -> (LookAt, Option<f64>, Shading, bool, bool, bool, bool, Visibility, ShadowMethod) {
-    (o.look, o.ortho_width, p.shading, p.wireframe, p.cull, p.shadows, p.ibl, p.visibility, p.shadow_method)
+fn snapshot(o: &Orbit, p: &RasterOptions) -> (LookAt, Option<f64>, Shading, [bool; 5], Visibility, ShadowMethod) {
+    (
+        o.look,
+        o.ortho_width,
+        p.shading,
+        [p.wireframe, p.cull, p.shadows, p.ibl, p.hemispherical],
+        p.visibility,
+        p.shadow_method,
+    )
 }
 
 fn to_pixels(image: &Image) -> Vec<u32> {
@@ -226,6 +230,9 @@ fn handle_input(window: &Window, orbit: &mut Orbit, opts: &mut RasterOptions, la
     }
     if window.is_key_pressed(Key::I, KeyRepeat::No) {
         opts.ibl = !opts.ibl;
+    }
+    if window.is_key_pressed(Key::H, KeyRepeat::No) {
+        opts.hemispherical = !opts.hemispherical;
     }
     if window.is_key_pressed(Key::M, KeyRepeat::No) {
         opts.shadow_method = match opts.shadow_method {

@@ -287,3 +287,40 @@ fn bump_mapping_agrees_with_the_ray_tracer() {
     eprintln!("bumps: {:.2} % (against flat: {:.2} %)", err * 100.0, flat_err * 100.0);
     assert!(err < 0.03 && flat_err > 2.0 * err, "{:.2} % vs {:.2} %", err * 100.0, flat_err * 100.0);
 }
+
+#[test]
+fn hemispherical_lighting_blends_sky_and_ground_by_the_normal() {
+    use alhazen_raster::pipeline::shade::{Lighting, lighting};
+    let text = "background = { zenith = [0.2, 0.4, 1.0], horizon = [0.5, 0.5, 0.5], ground = [0.3, 0.2, 0.1] }\n";
+    let scene = parse_scene("h.toml".as_ref(), text).unwrap();
+    let (sky, ground) = (Vec3::new(0.2, 0.4, 1.0), Vec3::new(0.3, 0.2, 0.1));
+    let extra = Lighting { hemisphere: Some((sky, ground)), ..Default::default() };
+    let m = &scene.materials[0];
+    let at = |n: Vec3| lighting(&scene, m, Vec3::ZERO, n, n, &extra).0;
+    assert!((at(Vec3::Y) - sky).length() < 1e-12);
+    assert!((at(-Vec3::Y) - ground).length() < 1e-12);
+    assert!((at(Vec3::X) - (sky + ground) / 2.0).length() < 1e-12);
+}
+
+#[test]
+fn the_course_anisotropic_highlight() {
+    let scene = parse_scene("a.toml".as_ref(), "[materials.brushed]\nspecular = 1\nshininess = 20\nhighlight = \"blinn-phong\"\nanisotropy = 0.2\nscratches = [1, 0, 0]\n").unwrap();
+    let m = scene.materials.iter().find(|m| m.name == "brushed").unwrap();
+    let iso = alhazen_scene::Material { anisotropy: 1.0, ..m.clone() };
+    let (n, l) = (Vec3::Z, Vec3::new(0.0, 0.0, 1.0));
+    // With a = 1 the formula is Blinn–Phong's ⟨h, n⟩^{2m}.
+    let v = Vec3::new(0.3, 0.2, 1.0).normalize();
+    let h = (l + v).normalize();
+    assert!((iso.highlight(n, l, v) - h.z.powf(40.0)).abs() < 1e-12);
+    // a scales the half vector's component across the scratches: tilting v across them moves the
+    // highlight less than tilting it along them (the highlight is stretched across).
+    let along = m.highlight(n, l, Vec3::new(0.3, 0.0, 1.0).normalize());
+    let across = m.highlight(n, l, Vec3::new(0.0, 0.3, 1.0).normalize());
+    assert!(across > 1.3 * along, "{along} {across}");
+    assert!(
+        (iso.highlight(n, l, Vec3::new(0.3, 0.0, 1.0).normalize())
+            - iso.highlight(n, l, Vec3::new(0.0, 0.3, 1.0).normalize()))
+        .abs()
+            < 1e-12
+    );
+}

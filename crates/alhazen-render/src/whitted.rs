@@ -13,7 +13,7 @@ use crate::sampler::stratified_offset;
 use crate::texture;
 use crate::world::{ShadowHit, World, WorldHit};
 use alhazen_math::{Ray, Vec3};
-use alhazen_scene::{FresnelMode, Highlight, Light, Material, Scene};
+use alhazen_scene::{FresnelMode, Light, Material, Scene};
 
 /// Rays whose contribution to the pixel would fall below this are not traced (like POV-Ray's
 /// `adc_bailout` of 1/255, but finer).
@@ -161,11 +161,7 @@ impl<'a> Whitted<'a> {
             }
             let mut local = a * cos;
             if has_specular {
-                let spec = match m.highlight {
-                    Highlight::Phong => reflect(l, n).dot(v).max(0.0).powf(m.shininess),
-                    Highlight::BlinnPhong => (l + v).normalize().dot(n).max(0.0).powf(2.0 * m.shininess),
-                };
-                local += m.specular * spec;
+                local += m.specular * m.highlight(n, l, v);
             }
             sum += through * i_dir * local;
         }

@@ -191,6 +191,29 @@ pub enum Background {
     },
 }
 
+impl Material {
+    /// The course's highlight factor for light from `l` seen from `v` at normal `n` (all unit,
+    /// `n` on the viewer's side): Phong `max(0, ⟨r, v⟩)^m`, or Blinn–Phong `⟨ĥ, n⟩^{2m}` with the
+    /// course's anisotropic `ĥ ∝ P₀w + P₁w + a·P₂w`, `w = l + v` (projections on `n`, on the
+    /// scratch direction and across it; `a = 1` is plain Blinn–Phong).
+    pub fn highlight(&self, n: Vec3, l: Vec3, v: Vec3) -> f64 {
+        match self.highlight {
+            Highlight::Phong => (2.0 * l.dot(n) * n - l).dot(v).max(0.0).powf(self.shininess),
+            Highlight::BlinnPhong => {
+                let w = l + v;
+                let h = if self.anisotropy < 1.0 {
+                    let r = (self.scratches - n * n.dot(self.scratches)).normalize_or_zero();
+                    let b = n.cross(r);
+                    n * w.dot(n) + r * w.dot(r) + b * (self.anisotropy * w.dot(b))
+                } else {
+                    w
+                };
+                h.normalize_or_zero().dot(n).max(0.0).powf(2.0 * self.shininess)
+            }
+        }
+    }
+}
+
 impl Background {
     /// What a ray leaving the scene in direction `dir` sees.
     pub fn radiance(&self, dir: Vec3) -> Rgb {
@@ -310,6 +333,10 @@ pub struct Material {
     pub shininess: f64,
     /// Highlight formula.
     pub highlight: Highlight,
+    /// The course's anisotropy `a ∈ (0, 1]` of the Blinn–Phong highlight (1: isotropic).
+    pub anisotropy: f64,
+    /// Direction of the scratches for an anisotropic highlight (projected on the tangent plane).
+    pub scratches: Vec3,
     /// Mirror reflectance.
     pub mirror: Rgb,
     /// Transmission coefficient.
@@ -365,6 +392,8 @@ impl Default for Material {
             specular: Vec3::ZERO,
             shininess: 32.0,
             highlight: Highlight::Phong,
+            anisotropy: 1.0,
+            scratches: Vec3::X,
             mirror: Vec3::ZERO,
             transparency: Vec3::ZERO,
             ior: 1.5,

@@ -127,6 +127,8 @@ impl Parser<'_> {
             "emission",
             "bsdf",
             "bump",
+            "anisotropy",
+            "scratches",
         ];
         let t = n.table(KEYS)?;
         let d = Material::default();
@@ -160,6 +162,8 @@ impl Parser<'_> {
                 },
                 None => d.fresnel,
             },
+            anisotropy: t.get("anisotropy").map_or(Ok(d.anisotropy), |n| n.in_range(1e-3, 1.0))?,
+            scratches: t.get("scratches").map_or(Ok(d.scratches), |n| n.unit_vec3())?,
             emission: t.opt_rgb("emission", d.emission)?,
             bsdf,
             bump: t.get("bump").map(|b| self.bump(&b)).transpose()?,

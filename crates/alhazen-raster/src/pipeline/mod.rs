@@ -70,6 +70,9 @@ pub struct RasterOptions {
     /// How shadows are found when `shadows` is on: shadow maps, or stencil shadow volumes
     /// (perspective cameras; Flat and Phong shading).
     pub shadow_method: ShadowMethod,
+    /// Replace the ambient constant by the course's hemispherical lighting (sky and ground
+    /// colours from the background).
+    pub hemispherical: bool,
 }
 
 /// Shadow algorithm.
@@ -93,6 +96,7 @@ impl Default for RasterOptions {
             cull_planes: vec![],
             visibility: Visibility::ZBuffer,
             shadow_method: ShadowMethod::Maps,
+            hemispherical: false,
         }
     }
 }
@@ -390,6 +394,9 @@ pub fn render_prepared(
         irradiance: opts.ibl.then_some(&prepared.irradiance),
         specular: opts.ibl.then_some(&prepared.specular),
         blocked: 0,
+        hemisphere: opts
+            .hemispherical
+            .then(|| (scene.background.radiance(Vec3::Y), scene.background.radiance(Vec3::NEG_Y))),
     };
     let shadows = &light;
     // The painter's algorithm draws the BSP tree's triangles back to front; the z-buffer any order.

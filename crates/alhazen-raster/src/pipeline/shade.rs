@@ -17,9 +17,12 @@ pub struct Lighting<'a> {
     pub specular: Option<&'a SpecularIbl>,
     /// Lights (bit `k` for light `k`) that a stencil shadow volume hides at this pixel.
     pub blocked: u64,
+    /// The course's hemispherical lighting instead of the ambient constant: sky and ground
+    /// intensities (the background straight up and straight down).
+    pub hemisphere: Option<(Vec3, Vec3)>,
 }
 use alhazen_math::{Vec2, Vec3};
-use alhazen_scene::{Highlight, Light, Material, Scene};
+use alhazen_scene::{Light, Material, Scene};
 
 /// The light arriving at `p` (unit normal `n`, viewer direction `v`), split as the course's
 /// model is: the factor of the surface colour (`I^amb + Σ I^dir ⟨l, n⟩`) and the highlight
@@ -27,7 +30,16 @@ use alhazen_scene::{Highlight, Light, Material, Scene};
 pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &Lighting) -> (Vec3, Vec3) {
     // Two-sided: light the side the viewer sees.
     let n = if n.dot(v) < 0.0 { -n } else { n };
-    let (mut diffuse, mut specular) = (scene.ambient, Vec3::ZERO);
+    // The course's hemispherical lighting: sky and ground blended by t = (1 − ⟨z, n⟩)/2 (z = up),
+    // the share of the ground in the projected hemisphere the surface sees.
+    let ambient = match extra.hemisphere {
+        Some((sky, ground)) => {
+            let t = (1.0 - n.y) / 2.0;
+            sky * (1.0 - t) + ground * t
+        }
+        None => scene.ambient,
+    };
+    let (mut diffuse, mut specular) = (ambient, Vec3::ZERO);
     // Lambertian reflection of the environment: ρ/π times its irradiance.
     if let Some(sh) = extra.irradiance {
         diffuse += sh.eval(n).max(Vec3::ZERO) * FRAC_1_PI;
@@ -42,11 +54,7 @@ pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &
         }
         diffuse += i * cos;
         if m.specular != Vec3::ZERO {
-            let spec = match m.highlight {
-                Highlight::Phong => (2.0 * l.dot(n) * n - l).dot(v).max(0.0).powf(m.shininess),
-                Highlight::BlinnPhong => (l + v).normalize_or_zero().dot(n).max(0.0).powf(2.0 * m.shininess),
-            };
-            specular += i * m.specular * spec;
+            specular += i * m.specular * m.highlight(n, l, v);
         }
     }
     (diffuse, specular)
