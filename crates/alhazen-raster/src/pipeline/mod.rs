@@ -293,27 +293,7 @@ fn process(
             .map(|v| ClipVertex { pos: proj.world_to_clip * v.p.extend(1.0), attr: attributes(v, color(v)) })
             .collect();
     let clipped = clip::clip_user_planes(clip_polygon(&poly), &opts.clip_planes);
-    let screen = |cv: &ClipVertex| {
-        let inv_w = 1.0 / cv.pos.w;
-        let (x, y, z) = (cv.pos.x * inv_w, cv.pos.y * inv_w, cv.pos.z * inv_w);
-        let attr_w = cv.attr.map(|a| a * inv_w);
-        ((x + 1.0) * 0.5 * w as f64, (1.0 - y) * 0.5 * h as f64, z, inv_w, attr_w)
-    };
-    let pts: Vec<_> = clipped.iter().map(screen).collect();
-    let tris = (1..pts.len().saturating_sub(1))
-        .map(|k| {
-            let c = [&pts[0], &pts[k], &pts[k + 1]];
-            ScreenTriangle {
-                x: c.map(|p| p.0),
-                y: c.map(|p| p.1),
-                z: c.map(|p| p.2),
-                inv_w: c.map(|p| p.3),
-                attr_w: c.map(|p| p.4),
-                source: index,
-            }
-        })
-        .collect();
-    (false, tris)
+    (false, raster::to_screen(&clipped, (w, h), index))
 }
 
 /// The normal bent by the material's bump map, with the triangle's `∂p/∂u`, `∂p/∂v` from its

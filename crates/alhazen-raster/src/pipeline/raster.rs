@@ -24,6 +24,32 @@ pub struct ScreenTriangle {
     pub source: u32,
 }
 
+/// The perspective division and viewport transform of a clipped convex polygon (clip space,
+/// `w > 0`), fanned into screen triangles of a `w × h` image tagged with `source`.
+pub fn to_screen(clipped: &[super::clip::ClipVertex], (w, h): (u32, u32), source: u32) -> Vec<ScreenTriangle> {
+    let pts: Vec<_> = clipped
+        .iter()
+        .map(|cv| {
+            let inv_w = 1.0 / cv.pos.w;
+            let (x, y, z) = (cv.pos.x * inv_w, cv.pos.y * inv_w, cv.pos.z * inv_w);
+            ((x + 1.0) * 0.5 * w as f64, (1.0 - y) * 0.5 * h as f64, z, inv_w, cv.attr.map(|a| a * inv_w))
+        })
+        .collect();
+    (1..pts.len().saturating_sub(1))
+        .map(|k| {
+            let c = [&pts[0], &pts[k], &pts[k + 1]];
+            ScreenTriangle {
+                x: c.map(|p| p.0),
+                y: c.map(|p| p.1),
+                z: c.map(|p| p.2),
+                inv_w: c.map(|p| p.3),
+                attr_w: c.map(|p| p.4),
+                source,
+            }
+        })
+        .collect()
+}
+
 /// One covered pixel: position, depth and perspective-correct attributes.
 pub struct Fragment {
     /// Column.

@@ -8,7 +8,7 @@
 
 use super::clip::{ATTRIBUTES, ClipVertex, clip_polygon};
 use super::geometry::Triangle;
-use super::raster::{ScreenTriangle, rasterize};
+use super::raster::{rasterize, to_screen};
 use alhazen_math::viewing::{Frustum, ViewFrame};
 use alhazen_math::{Bounds3, Mat4, Vec3};
 use alhazen_scene::{Light, Scene};
@@ -68,29 +68,7 @@ fn face(tris: &[Triangle], frame: ViewFrame, projection: Mat4, size: u32, texel:
                     ClipVertex { pos: world_to_clip * v.p.extend(1.0), attr }
                 })
                 .collect();
-        let pts: Vec<_> = clip_polygon(&poly)
-            .iter()
-            .map(|c| {
-                let iw = 1.0 / c.pos.w;
-                (
-                    (c.pos.x * iw + 1.0) * 0.5 * size as f64,
-                    (1.0 - c.pos.y * iw) * 0.5 * size as f64,
-                    c.pos.z * iw,
-                    iw,
-                    c.attr.map(|a| a * iw),
-                )
-            })
-            .collect();
-        for k in 1..pts.len().saturating_sub(1) {
-            let c = [&pts[0], &pts[k], &pts[k + 1]];
-            let st = ScreenTriangle {
-                x: c.map(|p| p.0),
-                y: c.map(|p| p.1),
-                z: c.map(|p| p.2),
-                inv_w: c.map(|p| p.3),
-                attr_w: c.map(|p| p.4),
-                source: 0,
-            };
+        for st in to_screen(&clip_polygon(&poly), (size, size), 0) {
             rasterize(&st, size, 0, size, |f| {
                 let d = metric.of(Vec3::new(f.attr[0], f.attr[1], f.attr[2]));
                 let k = (f.y * size + f.x) as usize;
@@ -109,7 +87,7 @@ fn frame_towards(eye: Vec3, dir: Vec3) -> ViewFrame {
 }
 
 /// Bounds of the finite part of the scene (the huge quads of infinite planes left out).
-fn finite_bounds(tris: &[Triangle]) -> Bounds3 {
+pub(super) fn finite_bounds(tris: &[Triangle]) -> Bounds3 {
     tris.iter().filter(|t| !t.unbounded).fold(Bounds3::EMPTY, |b, t| t.v.iter().fold(b, |b, v| b.grow(v.p)))
 }
 

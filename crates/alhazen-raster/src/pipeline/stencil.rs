@@ -14,7 +14,7 @@
 
 use super::clip::{ATTRIBUTES, ClipVertex, clip_polygon};
 use super::geometry::Triangle;
-use super::raster::{ScreenTriangle, rasterize};
+use super::raster::{ScreenTriangle, rasterize, to_screen};
 use alhazen_math::{Mat4, Vec3, Vec4};
 use alhazen_scene::{Light, Scene};
 use std::collections::HashMap;
@@ -153,29 +153,12 @@ fn closed_objects(tris: &[Triangle]) -> Vec<Vec<&Triangle>> {
 fn project(q: &[Vec4; 4], world_to_clip: Mat4, (w, h): (u32, u32)) -> Vec<VolumeTriangle> {
     let poly: Vec<ClipVertex> =
         q.iter().map(|p| ClipVertex { pos: world_to_clip * *p, attr: [0.0; ATTRIBUTES] }).collect();
-    let pts: Vec<(f64, f64, f64, f64)> = clip_polygon(&poly)
-        .iter()
-        .map(|c| {
-            let iw = 1.0 / c.pos.w;
-            ((c.pos.x * iw + 1.0) * 0.5 * w as f64, (1.0 - c.pos.y * iw) * 0.5 * h as f64, c.pos.z * iw, iw)
-        })
-        .collect();
-    (1..pts.len().saturating_sub(1))
-        .filter_map(|k| {
-            let c = [pts[0], pts[k], pts[k + 1]];
+    to_screen(&clip_polygon(&poly), (w, h), 0)
+        .into_iter()
+        .filter_map(|tri| {
             // Counter-clockwise seen from outside = clockwise on a y-down screen when facing the eye.
-            let area = (c[1].0 - c[0].0) * (c[2].1 - c[0].1) - (c[1].1 - c[0].1) * (c[2].0 - c[0].0);
-            (area != 0.0).then(|| VolumeTriangle {
-                tri: ScreenTriangle {
-                    x: c.map(|p| p.0),
-                    y: c.map(|p| p.1),
-                    z: c.map(|p| p.2),
-                    inv_w: c.map(|p| p.3),
-                    attr_w: [[0.0; ATTRIBUTES]; 3],
-                    source: 0,
-                },
-                front: area < 0.0,
-            })
+            let area = (tri.x[1] - tri.x[0]) * (tri.y[2] - tri.y[0]) - (tri.y[1] - tri.y[0]) * (tri.x[2] - tri.x[0]);
+            (area != 0.0).then_some(VolumeTriangle { tri, front: area < 0.0 })
         })
         .collect()
 }
