@@ -3,10 +3,13 @@
 //! vertices go model → world → view → clip by the course's matrices (`ViewFrame`, the
 //! perspective `P` or orthographic projection); triangles facing away are culled (closed surfaces
 //! only); polygons are clipped in homogeneous coordinates; the perspective division and the
-//! viewport transform give screen triangles, which are rasterised with a z-buffer, in parallel
-//! horizontal bands. Shading is flat (one colour per triangle), Gouraud (colours at the vertices,
-//! interpolated) or Phong (normals interpolated, lighting per pixel) with the course's local
-//! models. The camera and the sample position (pixel centres) match `alhazen render`'s.
+//! viewport transform give screen triangles, which are rasterised with a z-buffer (or painted
+//! back to front over a BSP tree), in parallel horizontal bands. Visibility fills a G-buffer —
+//! per pixel the winning triangle and its interpolated world position, normal, texture
+//! coordinates and Gouraud light — and a deferred pass shades each visible pixel once. Shading is
+//! flat (one colour per triangle), Gouraud (light at the vertices, interpolated) or Phong
+//! (normals interpolated, lighting per pixel) with the course's local models, shadows (maps or
+//! stencil volumes), image-based and hemispherical light. The camera and the sample position (pixel centres) match `alhazen render`'s.
 
 pub mod bsp;
 pub mod clip;
