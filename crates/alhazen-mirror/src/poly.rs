@@ -67,9 +67,15 @@ pub fn real_roots_in(p: &Poly, lo: f64, hi: f64) -> Roots {
     for w in 0..nb - 1 {
         let (a, b) = (breaks[w], breaks[w + 1]);
         let (fa, fb) = (eval(p, a), eval(p, b));
-        // A critical point where p nearly vanishes: a double root (or a near miss).
+        // A critical point where p nearly vanishes without crossing zero on either side: a
+        // (near-)double root, which bracketing cannot see. Two close simple roots around it are
+        // bracketed instead (p changes sign in both neighbouring pieces).
         if w > 0 && fa.abs() <= 1e-9 * magnitude(p, a) {
-            out.push(a);
+            let before = eval(p, breaks[w - 1]);
+            let crossing = fa != 0.0 && (before.signum() != fa.signum() || fb.signum() != fa.signum());
+            if !crossing {
+                out.push(a);
+            }
         }
         if fa == 0.0 && w == 0 {
             out.push(a);

@@ -19,6 +19,8 @@ pub struct WorldObject {
     pub material: u32,
     /// Per-slot materials of a mesh (empty: `material` everywhere).
     pub slot_materials: Vec<u32>,
+    /// Some material of the object has a bump map: hits need `∂p/∂u`, `∂p/∂v`.
+    pub bumpy: bool,
 }
 
 /// What a leaf of the top-level BVH holds: a whole object, or one triangle of a small mesh
@@ -83,6 +85,17 @@ fn build_shape(s: &scene::Shape, meshes: &[Arc<MeshAccel>]) -> Shape {
     }
 }
 
+/// True when some material of the object looks at texture coordinates (a texture, a bump map,
+/// a textured BSDF).
+fn uses_uv(o: &scene::Object, s: &scene::Scene) -> bool {
+    std::iter::once(&o.material).chain(&o.mesh_materials).any(|&m| {
+        let m = &s.materials[m as usize];
+        !matches!(m.color, scene::Texture::Solid(_))
+            || m.bump.is_some()
+            || m.bsdf.as_ref().is_some_and(|b| b.is_textured())
+    })
+}
+
 /// Meshes up to this size are copied into world space when placed, so their rays need no
 /// transform; larger ones are shared between instances.
 const BAKE_TRIANGLES: usize = 256;
@@ -131,9 +144,12 @@ impl World {
             .objects
             .iter()
             .map(|o| WorldObject {
-                placed: place(o, &meshes, scene),
+                placed: Placed { uv: uses_uv(o, scene), ..place(o, &meshes, scene) },
                 material: o.material,
                 slot_materials: o.mesh_materials.clone(),
+                bumpy: std::iter::once(&o.material)
+                    .chain(&o.mesh_materials)
+                    .any(|&m| scene.materials[m as usize].bump.is_some()),
             })
             .collect();
         let (mut primitives, mut corners, mut prim_bounds, mut unbounded) = (vec![], vec![], vec![], vec![]);
@@ -197,7 +213,10 @@ impl World {
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<WorldHit> {
         let (c, i) = self.nearest(ray, t_max)?;
         let o = &self.objects[i as usize];
-        let hit = o.placed.surface(ray, c);
+        let mut hit = o.placed.surface(ray, c);
+        if o.bumpy {
+            hit.dpduv = o.placed.tangents(ray, c);
+        }
         let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
         Some(WorldHit { hit, material, object: i })
     }

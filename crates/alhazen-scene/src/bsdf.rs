@@ -181,6 +181,19 @@ pub enum BsdfDesc {
 }
 
 impl BsdfDesc {
+    /// True when some colour of it is a texture (so hits need texture coordinates).
+    pub fn is_textured(&self) -> bool {
+        let t = |x: &Texture| !matches!(x, Texture::Solid(_));
+        match self {
+            BsdfDesc::Lambert { albedo } | BsdfDesc::OrenNayar { albedo, .. } => t(albedo),
+            BsdfDesc::Phong { albedo, .. }
+            | BsdfDesc::BlinnPhong { albedo, .. }
+            | BsdfDesc::CookTorrance { albedo, .. } => t(albedo),
+            BsdfDesc::Mix { a, b, .. } => a.is_textured() || b.is_textured(),
+            BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } => false,
+        }
+    }
+
     /// True when some part of it refracts with a wavelength-dependent index.
     pub fn is_dispersive(&self) -> bool {
         match self {

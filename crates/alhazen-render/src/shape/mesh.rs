@@ -75,21 +75,26 @@ impl MeshShape {
             m.uvs[idx[0]] * b0 + m.uvs[idx[1]] * b1 + m.uvs[idx[2]] * b2
         };
         let slot = m.material_slots.get(tri).copied().unwrap_or(0);
-        // ∂p/∂u, ∂p/∂v of the triangle from its texture coordinates.
-        let dpduv = if m.uvs.is_empty() {
-            [p1 - p0, p2 - p0]
-        } else {
-            let [t0, t1, t2] = idx.map(|i| m.uvs[i]);
-            let (d1, d2) = (t1 - t0, t2 - t0);
-            let det = d1.x * d2.y - d1.y * d2.x;
-            if det == 0.0 {
-                [Vec3::ZERO; 2]
-            } else {
-                let (e1, e2) = (p1 - p0, p2 - p0);
-                [(e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det]
-            }
-        };
-        SurfaceHit { t, p: ray.at(t), n, ns, uv, slot, dpduv }
+        SurfaceHit { t, p: ray.at(t), n, ns, uv, slot, dpduv: [Vec3::ZERO; 2] }
+    }
+
+    /// `∂p/∂u`, `∂p/∂v` of triangle `tri` from its texture coordinates (its barycentric
+    /// parametrisation when the mesh has none).
+    pub fn tangents(&self, tri: usize) -> [Vec3; 2] {
+        let m = &self.accel.mesh;
+        let idx = m.triangles[tri].map(|i| i as usize);
+        let [p0, p1, p2] = idx.map(|i| m.positions[i]);
+        if m.uvs.is_empty() {
+            return [p1 - p0, p2 - p0];
+        }
+        let [t0, t1, t2] = idx.map(|i| m.uvs[i]);
+        let (d1, d2) = (t1 - t0, t2 - t0);
+        let det = d1.x * d2.y - d1.y * d2.x;
+        if det == 0.0 {
+            return [Vec3::ZERO; 2];
+        }
+        let (e1, e2) = (p1 - p0, p2 - p0);
+        [(e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det]
     }
 
     /// Nearest hit in `(0, t_max)`; `aux` is the triangle.

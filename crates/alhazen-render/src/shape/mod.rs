@@ -35,8 +35,9 @@ pub struct SurfaceHit {
     pub uv: Vec2,
     /// Material slot of a mesh triangle (0 elsewhere).
     pub slot: u32,
-    /// `∂p/∂u` and `∂p/∂v` of the texture parametrisation (zero when the shape gives none), for
-    /// bump mapping.
+    /// `∂p/∂u` and `∂p/∂v` of the texture parametrisation, for bump mapping: filled in by
+    /// [`crate::World`] for objects whose material has a bump map (zero otherwise, and for shapes
+    /// without them).
     pub dpduv: [Vec3; 2],
 }
 
@@ -44,11 +45,6 @@ impl SurfaceHit {
     /// A hit whose shading normal is its geometric normal.
     pub fn flat(t: f64, p: Vec3, n: Vec3, uv: Vec2) -> Self {
         Self { t, p, n, ns: n, uv, slot: 0, dpduv: [Vec3::ZERO; 2] }
-    }
-
-    /// The same hit with the partial derivatives of its parametrisation.
-    pub fn with_tangents(self, dpdu: Vec3, dpdv: Vec3) -> Self {
-        Self { dpduv: [dpdu, dpdv], ..self }
     }
 }
 
@@ -113,7 +109,14 @@ impl Shape {
 
     /// The surface at a hit found by [`Shape::hit`] on the same ray.
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        self.surface_with(ray, c, true)
+    }
+
+    /// [`Shape::surface`], leaving a sphere's texture coordinates at zero unless `uv`.
+    #[inline]
+    pub fn surface_with(&self, ray: &Ray, c: Candidate, uv: bool) -> SurfaceHit {
         match self {
+            Shape::Sphere(s) if !uv => s.hit_at_without_uv(ray, c.t),
             Shape::Sphere(s) => s.hit_at(ray, c.t),
             Shape::Cylinder(s) => s.surface(ray, c),
             Shape::Cone(s) => s.surface(ray, c),
@@ -180,12 +183,38 @@ pub struct Placed {
     pub shape: Shape,
     /// Object → world; `None` for the identity (saves two matrix products per ray).
     pub to_world: Option<Transform>,
+    /// Compute texture coordinates at hits (a sphere's cost two inverse trigonometric functions;
+    /// the world turns them off for objects whose materials use none).
+    pub uv: bool,
+}
+
+impl Shape {
+    /// `∂p/∂u`, `∂p/∂v` at `hit` (object space), found by `c`; zero where the shape has none.
+    pub fn tangents(&self, hit: &SurfaceHit, c: Candidate) -> [Vec3; 2] {
+        match self {
+            Shape::Sphere(s) => s.tangents(hit),
+            Shape::Plane(p) => p.tangents(),
+            Shape::Mesh(m) => m.tangents(c.aux as usize),
+            _ => [Vec3::ZERO; 2],
+        }
+    }
 }
 
 impl Placed {
+    /// `∂p/∂u`, `∂p/∂v` in world space at the hit of `ray` found by `c`.
+    pub fn tangents(&self, ray: &Ray, c: Candidate) -> [Vec3; 2] {
+        match &self.to_world {
+            None => self.shape.tangents(&self.shape.surface(ray, c), c),
+            Some(tf) => {
+                let local = tf.inverse().ray(ray);
+                self.shape.tangents(&self.shape.surface(&local, c), c).map(|d| tf.vector(d))
+            }
+        }
+    }
+
     /// Places `shape` with `to_world` (dropped when it is the identity).
     pub fn new(shape: Shape, to_world: Transform) -> Self {
-        Self { shape, to_world: (!to_world.is_identity()).then_some(to_world) }
+        Self { shape, to_world: (!to_world.is_identity()).then_some(to_world), uv: true }
     }
 
     /// The nearest hit of a world-space ray, without surface details.
@@ -200,8 +229,8 @@ impl Placed {
     /// The world-space surface at a hit found by [`Placed::hit`].
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
         match &self.to_world {
-            None => self.shape.surface(ray, c),
-            Some(tf) => to_world(tf, self.shape.surface(&tf.inverse().ray(ray), c)),
+            None => self.shape.surface_with(ray, c, self.uv),
+            Some(tf) => to_world(tf, self.shape.surface_with(&tf.inverse().ray(ray), c, self.uv)),
         }
     }
 
@@ -240,7 +269,7 @@ impl Placed {
 fn to_world(tf: &Transform, h: SurfaceHit) -> SurfaceHit {
     let n = tf.normal(h.n).normalize();
     let ns = if h.ns == h.n { n } else { tf.normal(h.ns).normalize() };
-    SurfaceHit { p: tf.point(h.p), n, ns, dpduv: h.dpduv.map(|d| tf.vector(d)), ..h }
+    SurfaceHit { p: tf.point(h.p), n, ns, ..h }
 }
 
 #[cfg(test)]

@@ -32,7 +32,13 @@ impl Plane {
         let (t, p) = (c.t, ray.at(c.t));
         let (tu, tv) = orthonormal_basis(self.normal);
         let d = p - self.point;
-        SurfaceHit::flat(t, p, self.normal, Vec2::new(d.dot(tu), d.dot(tv))).with_tangents(tu, tv)
+        SurfaceHit::flat(t, p, self.normal, Vec2::new(d.dot(tu), d.dot(tv)))
+    }
+
+    /// `∂p/∂u`, `∂p/∂v`: the tangent frame the texture coordinates are measured along.
+    pub fn tangents(&self) -> [Vec3; 2] {
+        let (tu, tv) = orthonormal_basis(self.normal);
+        [tu, tv]
     }
 }
 

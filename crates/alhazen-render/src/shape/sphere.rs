@@ -35,12 +35,23 @@ impl Sphere {
         // Texture coordinates: longitude around +y, latitude from the north pole.
         let u = (n.z.atan2(-n.x) + PI) / TAU;
         let v = n.y.clamp(-1.0, 1.0).acos() / PI;
-        // ∂p/∂u around +y (longitude), ∂p/∂v towards the south (latitude).
-        let r = self.radius;
+        SurfaceHit::flat(t, p, n.normalize(), Vec2::new(u, v))
+    }
+
+    /// The surface at parameter `t` without texture coordinates.
+    #[inline]
+    pub fn hit_at_without_uv(&self, ray: &Ray, t: f64) -> SurfaceHit {
+        let p = ray.at(t);
+        SurfaceHit::flat(t, p, ((p - self.center) / self.radius).normalize(), Vec2::ZERO)
+    }
+
+    /// `∂p/∂u` around +y (longitude) and `∂p/∂v` towards the south (latitude) at a hit.
+    pub fn tangents(&self, hit: &SurfaceHit) -> [Vec3; 2] {
+        let (n, r) = (hit.n, self.radius);
         let dpdu = Vec3::new(n.z, 0.0, -n.x) * (TAU * r);
         let rho = (n.x * n.x + n.z * n.z).sqrt();
         let dpdv = if rho > 0.0 { Vec3::new(n.x * n.y / rho, -rho, n.z * n.y / rho) * (PI * r) } else { Vec3::ZERO };
-        SurfaceHit::flat(t, p, n.normalize(), Vec2::new(u, v)).with_tangents(dpdu, dpdv)
+        [dpdu, dpdv]
     }
 
     /// Nearest hit in `(0, t_max)`.
