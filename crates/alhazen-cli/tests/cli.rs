@@ -73,7 +73,7 @@ fn raster_preview_writes_an_image_and_refuses_unsupported_cameras() {
     let pano = scene_file(dir.path(), "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n");
     let o = alhazen(&["raster", pano.to_str().unwrap(), "-o", dir.path().join("p.png").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("perspective and orthographic"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("perspective, orthographic and axonometric"));
 }
 
 #[test]

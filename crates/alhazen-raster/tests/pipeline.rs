@@ -101,7 +101,7 @@ fn unsupported_cameras_are_reported() {
     let scene = parse_scene("p.toml".as_ref(), text).unwrap();
     let err = render_scene(&scene, &RasterOptions::default()).unwrap_err();
     assert_eq!(err, RasterError::UnsupportedCamera("panorama"));
-    assert!(err.to_string().contains("perspective and orthographic"));
+    assert!(err.to_string().contains("perspective, orthographic and axonometric"));
 }
 
 #[test]
@@ -323,4 +323,19 @@ fn the_course_anisotropic_highlight() {
         .abs()
             < 1e-12
     );
+}
+
+#[test]
+fn axonometric_views_agree_with_the_ray_tracer() {
+    for style in ["isometric", "cavalier", "cabinet", "military"] {
+        let camera =
+            format!("[camera]\ntype = \"axonometric\"\nstyle = \"{style}\"\ntarget = [0, 0.5, 0]\nwidth = 7\n");
+        let start = SCENE.find("[camera]").unwrap();
+        let end = SCENE.find("[[light]]").unwrap();
+        let text = format!("{}{}{}", &SCENE[..start], camera, &SCENE[end..]);
+        let scene = parse_scene("axo.toml".as_ref(), &text).unwrap();
+        let traced = alhazen_render::render(&scene, &|_, _| {});
+        let err = relative_error(&render_scene(&scene, &RasterOptions::default()).unwrap().0, &traced);
+        assert!(err < 0.01, "{style}: {:.2} %", err * 100.0);
+    }
 }

@@ -13,7 +13,7 @@
 
 use alhazen_math::viewing::{Frustum, ViewFrame, homogenize, stereo_frusta};
 use alhazen_math::{Mat3, Mat4, Ray, Vec3, Vec4};
-use alhazen_scene::{Axonometry, CameraDesc, PerspectiveOpening};
+use alhazen_scene::{CameraDesc, PerspectiveOpening};
 
 /// A camera ready to generate rays for a film of `film_width × film_height` pixels.
 #[derive(Clone, Debug)]
@@ -85,8 +85,8 @@ impl Camera {
                 (parallel(f.u, f.v, -f.w, look.eye, *w, (width, height), 0.0), width)
             }
             CameraDesc::Axonometric { style, target, width: w, azimuth } => {
-                let (a, b) = axonometric_axes(*style, *azimuth);
-                let dir = kernel_direction(a, b);
+                let (a, b) = style.axes(*azimuth);
+                let dir = alhazen_scene::Axonometry::direction(a, b);
                 (parallel(a, b, dir, *target, *w, (width, height), 1e4), width)
             }
             CameraDesc::Stereo { look, eye_distance, screen_distance, screen_width } => {
@@ -122,35 +122,6 @@ impl Camera {
     }
 }
 
-/// The image axes `a, b` of an axonometry: a point `p` lands at `(a·p, b·p)`.
-fn axonometric_axes(style: Axonometry, azimuth: f64) -> (Vec3, Vec3) {
-    let (s, c) = azimuth.sin_cos();
-    // Rotated ground axes: x' (right) and the receding direction r' (away from the viewer).
-    let (x, away) = (Vec3::new(c, 0.0, -s), Vec3::new(-s, 0.0, -c));
-    match style {
-        Axonometry::Isometric => {
-            let w = (Vec3::new(1.0, 1.0, 1.0)).normalize();
-            let w = Vec3::new(c * w.x + s * w.z, w.y, -s * w.x + c * w.z);
-            let u = Vec3::Y.cross(w).normalize();
-            (u, w.cross(u))
-        }
-        Axonometry::Cavalier | Axonometry::Cabinet => {
-            let k = if style == Axonometry::Cavalier { 1.0 } else { 0.5 };
-            let q = std::f64::consts::FRAC_PI_4;
-            // Depth along `away` is drawn up and to the right at 45°, length k.
-            (x + away * (k * q.cos()), Vec3::Y + away * (k * q.sin()))
-        }
-        // The rotated ground plan is undistorted; verticals keep their length.
-        Axonometry::Military => (x, away + Vec3::Y),
-    }
-}
-
-/// The projection direction: the kernel of `p ↦ (a·p, b·p)`, pointing down or away.
-fn kernel_direction(a: Vec3, b: Vec3) -> Vec3 {
-    let d = a.cross(b).normalize();
-    if d.y < 0.0 || (d.y == 0.0 && d.z < 0.0) { d } else { -d }
-}
-
 /// A parallel projection with image axes `a, b` (their dual basis spans the film), rays along
 /// `dir`, centred on `center`, `view_width` world units across a film of `px_w × px_h`;
 /// origins backed off by `back`.
@@ -168,7 +139,7 @@ fn parallel(a: Vec3, b: Vec3, dir: Vec3, center: Vec3, view_width: f64, (px_w, p
 #[cfg(test)]
 mod tests {
     use super::*;
-    use alhazen_scene::LookAt;
+    use alhazen_scene::{Axonometry, LookAt};
 
     const LOOK: LookAt = LookAt { eye: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y };
 

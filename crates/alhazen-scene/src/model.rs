@@ -127,6 +127,38 @@ pub enum Axonometry {
     Military,
 }
 
+impl Axonometry {
+    /// The image axes `a`, `b` of the projection `p ↦ (a·p, b·p)` for the scene turned by
+    /// `azimuth` about the vertical.
+    pub fn axes(self, azimuth: f64) -> (Vec3, Vec3) {
+        let (s, c) = azimuth.sin_cos();
+        // Rotated ground axes: x' (right) and the receding direction r' (away from the viewer).
+        let (x, away) = (Vec3::new(c, 0.0, -s), Vec3::new(-s, 0.0, -c));
+        match self {
+            Axonometry::Isometric => {
+                let w = Vec3::new(1.0, 1.0, 1.0).normalize();
+                let w = Vec3::new(c * w.x + s * w.z, w.y, -s * w.x + c * w.z);
+                let u = Vec3::Y.cross(w).normalize();
+                (u, w.cross(u))
+            }
+            Axonometry::Cavalier | Axonometry::Cabinet => {
+                let k = if self == Axonometry::Cavalier { 1.0 } else { 0.5 };
+                let q = std::f64::consts::FRAC_PI_4;
+                // Depth along `away` is drawn up and to the right at 45°, length k.
+                (x + away * (k * q.cos()), Vec3::Y + away * (k * q.sin()))
+            }
+            // The rotated ground plan is undistorted; verticals keep their length.
+            Axonometry::Military => (x, away + Vec3::Y),
+        }
+    }
+
+    /// The projection direction: the kernel of `p ↦ (a·p, b·p)`, pointing down or away.
+    pub fn direction(a: Vec3, b: Vec3) -> Vec3 {
+        let d = a.cross(b).normalize();
+        if d.y < 0.0 || (d.y == 0.0 && d.z < 0.0) { d } else { -d }
+    }
+}
+
 /// A camera description.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CameraDesc {

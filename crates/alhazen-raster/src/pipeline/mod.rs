@@ -186,7 +186,7 @@ impl std::fmt::Display for RasterError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Self::UnsupportedCamera(k) => {
-                write!(f, "the raster preview supports perspective and orthographic cameras, not {k}")
+                write!(f, "the raster preview supports perspective, orthographic and axonometric cameras, not {k}")
             }
         }
     }
@@ -237,7 +237,28 @@ fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projection, 
             let frustum = Frustum { l: -hw, r: hw, b: -hh, t: hh, n: 0.0, f: 1e6 };
             (frame_of(look), frustum.orthographic(), false)
         }
-        CameraDesc::Axonometric { .. } => return Err(RasterError::UnsupportedCamera("axonometric")),
+        CameraDesc::Axonometric { style, target, width, azimuth } => {
+            // The course's parallel projection p ↦ (a·p, b·p), depth along the kernel direction,
+            // scaled to the standard cube; the view starts 10⁴ units before the target, as the
+            // ray tracer's rays do.
+            let (a, b) = style.axes(*azimuth);
+            let dir = alhazen_scene::Axonometry::direction(a, b);
+            let (hw, hh) = (width / 2.0, width / aspect / 2.0);
+            let (near, far) = (-1e4, 1e6);
+            let row = |v: Vec3, scale: f64, shift: f64| (v * scale).extend(-v.dot(*target) * scale + shift);
+            let depth = 2.0 / (far - near);
+            let m = Mat4::from_cols_array_2d(&[
+                row(a, 1.0 / hw, 0.0).to_array(),
+                row(b, 1.0 / hh, 0.0).to_array(),
+                row(dir, depth, -near * depth - 1.0).to_array(),
+                [0.0, 0.0, 0.0, 1.0],
+            ])
+            .transpose();
+            let w = -dir;
+            let u = b.cross(w).normalize_or_zero();
+            let frame = ViewFrame { eye: *target - dir * 1e4, u, v: w.cross(u), w };
+            return Ok(Projection { world_to_clip: m, clip_to_world: m.inverse(), frame, perspective: false });
+        }
         CameraDesc::Stereo { .. } => return Err(RasterError::UnsupportedCamera("stereo")),
         CameraDesc::Panorama { .. } => return Err(RasterError::UnsupportedCamera("panorama")),
     };

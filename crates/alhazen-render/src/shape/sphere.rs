@@ -1,7 +1,6 @@
 //! Sphere `|p − c| = r`: the quadratic `|o + t d − c|² = r²`.
 
 use super::{Candidate, Crossing, SurfaceHit, convex_crossings};
-use alhazen_math::poly::solve_quadratic;
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
 use std::f64::consts::{PI, TAU};
 
@@ -15,17 +14,23 @@ pub struct Sphere {
 }
 
 impl Sphere {
+    /// Both roots of `a t² − 2βt + c = 0` (`f = o − c`, `β = −f·d`), ascending. The
+    /// discriminant is taken as `a (r² − |f − (f·d/a) d|²)` — from the ray's closest approach to
+    /// the centre — instead of `β² − ac`, which cancels catastrophically for rays from far away
+    /// (Haines et al., "Precision Improvements for Ray/Sphere Intersection", 2019).
     fn roots(&self, ray: &Ray) -> [f64; 2] {
-        let oc = ray.origin - self.center;
-        let r = solve_quadratic(
-            ray.dir.length_squared(),
-            2.0 * oc.dot(ray.dir),
-            oc.length_squared() - self.radius * self.radius,
-        );
-        match r.as_slice() {
-            [a, b] => [*a, *b],
-            _ => [f64::NAN; 2],
+        let (d, f) = (ray.dir, ray.origin - self.center);
+        let a = d.length_squared();
+        let beta = -f.dot(d);
+        let perp = f + d * (beta / a);
+        let disc = a * (self.radius * self.radius - perp.length_squared());
+        if disc < 0.0 || disc.is_nan() || a == 0.0 {
+            return [f64::NAN; 2];
         }
+        let c = f.length_squared() - self.radius * self.radius;
+        let q = beta + disc.sqrt().copysign(beta);
+        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q / a) };
+        [t0.min(t1), t0.max(t1)]
     }
 
     /// The surface at parameter `t`.

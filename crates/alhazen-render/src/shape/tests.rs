@@ -195,3 +195,20 @@ fn tangents_are_the_derivatives_of_the_texture_parametrisation() {
         assert!((predicted - moved).length() < 1e-3 * moved.length(), "{shape:?}: {predicted} vs {moved}");
     }
 }
+
+#[test]
+fn spheres_seen_from_far_away_are_hit_on_their_surface() {
+    // β² − ac would cancel: rays from 10⁴–10⁶ away used to land 10⁻⁸ off the surface (shadow
+    // acne in axonometric views, whose rays start 10⁴ units back).
+    let s = Sphere { center: Vec3::new(0.3, 0.8, -0.2), radius: 0.8 };
+    for dist in [1e4, 1e5, 1e6] {
+        for k in 0..50 {
+            let off = Vec3::new((k as f64 * 0.37).sin(), (k as f64 * 0.71).cos(), (k as f64 * 0.13).sin()) * 0.5;
+            let origin = s.center + Vec3::new(1.0, 0.7, 0.4).normalize() * dist;
+            let ray = Ray::new(origin, (s.center + off - origin).normalize());
+            let h = Shape::Sphere(s).intersect(&ray, f64::INFINITY).unwrap();
+            let miss = ((h.p - s.center).length() - s.radius).abs();
+            assert!(miss < 1e-14 * dist, "{dist}: {miss}");
+        }
+    }
+}
