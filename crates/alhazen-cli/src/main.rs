@@ -157,12 +157,17 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
     }
 }
 
-/// Reads the scene and applies `--width`/`--height`, refusing sizes that cannot be allocated.
-pub(crate) fn load_sized(a: &ImageArgs) -> Result<Scene, Failure> {
-    let mut scene = load_scene(&a.scene).map_err(|e| match e {
+/// Reads a scene file; every problem with it is bad input (exit code 2).
+pub(crate) fn load(path: &Path) -> Result<Scene, Failure> {
+    load_scene(path).map_err(|e| match e {
         SceneError::Io { .. } => Failure::input(e.to_string()),
         SceneError::Syntax(d) => Failure::input(d.to_string()),
-    })?;
+    })
+}
+
+/// Reads the scene and applies `--width`/`--height`, refusing sizes that cannot be allocated.
+pub(crate) fn load_sized(a: &ImageArgs) -> Result<Scene, Failure> {
+    let mut scene = load(&a.scene)?;
     let r = &mut scene.render;
     r.width = a.width.unwrap_or(r.width);
     r.height = a.height.unwrap_or(r.height);

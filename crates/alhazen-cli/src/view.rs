@@ -8,12 +8,12 @@
 //! traces the current view (Whitted, the scene's samples) and writes it to `--output`; `Esc` or
 //! `Q` quits.
 
-use crate::{Failure, check_output, save};
+use crate::{Failure, check_output, load, save};
 use alhazen_raster::pipeline::stencil::StencilMode;
 use alhazen_raster::pipeline::{RasterOptions, Shading, ShadowMethod, Visibility, prepare, render_prepared};
 use alhazen_render::Image;
 use alhazen_render::output::to_srgb8;
-use alhazen_scene::{CameraDesc, LookAt, SceneError, load_scene};
+use alhazen_scene::{CameraDesc, LookAt};
 use clap::Args;
 use minifb::{Key, KeyRepeat, MouseButton, MouseMode, Window, WindowOptions};
 use std::path::PathBuf;
@@ -117,10 +117,7 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
     if let Some(s) = &a.screenshot {
         check_output(s, false)?;
     }
-    let mut scene = load_scene(&a.scene).map_err(|e| match e {
-        SceneError::Io { .. } => Failure::input(e.to_string()),
-        SceneError::Syntax(d) => Failure::input(d.to_string()),
-    })?;
+    let mut scene = load(&a.scene)?;
     scene.render.width = a.width.unwrap_or(scene.render.width).clamp(16, 8192);
     scene.render.height = a.height.unwrap_or(scene.render.height).clamp(16, 8192);
     let (w, h) = (scene.render.width as usize, scene.render.height as usize);

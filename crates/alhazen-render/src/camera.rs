@@ -13,7 +13,7 @@
 
 use alhazen_math::viewing::{Frustum, ViewFrame, homogenize, stereo_frusta};
 use alhazen_math::{Mat3, Mat4, Ray, Vec3, Vec4};
-use alhazen_scene::{CameraDesc, PerspectiveOpening};
+use alhazen_scene::CameraDesc;
 
 /// A camera ready to generate rays for a film of `film_width × film_height` pixels.
 #[derive(Clone, Debug)]
@@ -71,13 +71,7 @@ impl Camera {
         let aspect = width as f64 / height as f64;
         let (kind, film_width) = match desc {
             CameraDesc::Perspective { look, opening } => {
-                let frustum = match *opening {
-                    PerspectiveOpening::Fov { angle, horizontal } => {
-                        let fovy = if horizontal { 2.0 * ((angle / 2.0).tan() / aspect).atan() } else { angle };
-                        Frustum::symmetric(fovy, aspect, 1.0, 1000.0)
-                    }
-                    PerspectiveOpening::Frustum { lrbtn: [l, r, b, t, n] } => Frustum { l, r, b, t, n, f: n * 1000.0 },
-                };
+                let frustum = opening.frustum(aspect, None);
                 (Kind::Perspective(Pinhole::new(frame(look), frustum)), width)
             }
             CameraDesc::Orthographic { look, width: w } => {
@@ -139,7 +133,7 @@ fn parallel(a: Vec3, b: Vec3, dir: Vec3, center: Vec3, view_width: f64, (px_w, p
 #[cfg(test)]
 mod tests {
     use super::*;
-    use alhazen_scene::{Axonometry, LookAt};
+    use alhazen_scene::{Axonometry, LookAt, PerspectiveOpening};
 
     const LOOK: LookAt = LookAt { eye: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y };
 

@@ -6,14 +6,13 @@
 //! decays by Beer's law `exp(−σ d)`.
 
 use crate::camera::Camera;
-use crate::envmap::EnvMap;
 use crate::film::PixelEstimator;
 use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use crate::sampler::stratified_offset;
 use crate::texture;
 use crate::world::{ShadowHit, World, WorldHit};
 use alhazen_math::{Ray, Vec3};
-use alhazen_scene::{FresnelMode, Light, Material, Scene};
+use alhazen_scene::{FresnelMode, Material, Scene};
 
 /// Rays whose contribution to the pixel would fall below this are not traced (like POV-Ray's
 /// `adc_bailout` of 1/255, but finer).
@@ -26,36 +25,12 @@ pub struct Whitted<'a> {
     scene: &'a Scene,
     world: &'a World,
     max_depth: u32,
-    environment: Option<EnvMap>,
 }
 
 /// A self-intersection guard scaled to the magnitude of the coordinates.
 #[inline]
 fn epsilon(p: Vec3) -> f64 {
     1e-9 * (1.0 + p.abs().max_element())
-}
-
-/// The lights' contribution to a point: direction towards the light, distance and the
-/// intensity `I^dir` arriving there.
-fn light_at(light: &Light, p: Vec3) -> Option<(Vec3, f64, Vec3)> {
-    let falloff = |abc: &[f64; 3], d: f64| abc[0] * d * d + abc[1] * d + abc[2];
-    match light {
-        Light::Point { position, intensity, attenuation } => {
-            let to = *position - p;
-            let d = to.length();
-            (d > 0.0).then(|| (to / d, d, *intensity / falloff(attenuation, d)))
-        }
-        Light::Directional { direction, intensity } => Some((-*direction, f64::INFINITY, *intensity)),
-        Light::Spot { position, direction, cos_cutoff, falloff: e, intensity, attenuation } => {
-            let to = *position - p;
-            let d = to.length();
-            let l = to / d;
-            let cos = -l.dot(*direction);
-            (d > 0.0 && cos >= *cos_cutoff).then(|| (l, d, *intensity * cos.powf(*e) / falloff(attenuation, d)))
-        }
-        // The environment is seen by rays that leave the scene (see `background`).
-        Light::Environment { .. } => None,
-    }
 }
 
 /// Fresnel reflectance for `cos` at a boundary with relative index `eta = η_T/η_I`.
@@ -94,13 +69,7 @@ impl PixelEstimator for WhittedEstimator<'_> {
 impl<'a> Whitted<'a> {
     /// The integrator for `scene` over `world`.
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
-        let environment = scene.lights.iter().find_map(|l| match *l {
-            Light::Environment { image, scale, rotation } => {
-                Some(EnvMap::new(scene.images[image].clone(), scale, rotation))
-            }
-            _ => None,
-        });
-        Self { scene, world, max_depth: scene.render.max_depth.max(1), environment }
+        Self { scene, world, max_depth: scene.render.max_depth.max(1) }
     }
 
     /// `RT_trace`: radiance along `ray` (unit direction); `depth` starts at 1 for camera rays,
@@ -113,10 +82,7 @@ impl<'a> Whitted<'a> {
     }
 
     fn background(&self, dir: Vec3) -> Vec3 {
-        if let Some(env) = &self.environment {
-            return env.radiance(dir);
-        }
-        self.scene.background.radiance(dir)
+        self.scene.sky(dir)
     }
 
     /// `RT_shade`.
@@ -150,7 +116,7 @@ impl<'a> Whitted<'a> {
         let has_specular = m.specular != Vec3::ZERO;
         let mut sum = Vec3::ZERO;
         for light in &self.scene.lights {
-            let Some((l, dist, i_dir)) = light_at(light, p) else { continue };
+            let Some((l, dist, i_dir)) = light.arriving(p) else { continue };
             let cos = n.dot(l);
             if cos <= 0.0 || ng.dot(l) <= 0.0 {
                 continue;

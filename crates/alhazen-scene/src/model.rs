@@ -307,6 +307,66 @@ pub enum Light {
     },
 }
 
+impl Light {
+    /// The course's local-model view of the light at `p`: the unit direction towards it, its
+    /// distance (infinite for directional light) and the intensity `I^dir = I^em/(a d² + b d + c)`
+    /// arriving there (times `cos^e` inside a spot's cone); `None` outside a spot's cone, at the
+    /// light itself, and for the environment (which rays see when they leave the scene).
+    pub fn arriving(&self, p: Vec3) -> Option<(Vec3, f64, Rgb)> {
+        let falloff = |abc: &[f64; 3], d: f64| abc[0] * d * d + abc[1] * d + abc[2];
+        match self {
+            Light::Point { position, intensity, attenuation } => {
+                let to = *position - p;
+                let d = to.length();
+                (d > 0.0).then(|| (to / d, d, *intensity / falloff(attenuation, d)))
+            }
+            Light::Directional { direction, intensity } => Some((-*direction, f64::INFINITY, *intensity)),
+            Light::Spot { position, direction, cos_cutoff, falloff: e, intensity, attenuation } => {
+                let to = *position - p;
+                let d = to.length();
+                let l = to / d;
+                let cos = -l.dot(*direction);
+                (d > 0.0 && cos >= *cos_cutoff).then(|| (l, d, *intensity * cos.powf(*e) / falloff(attenuation, d)))
+            }
+            Light::Environment { .. } => None,
+        }
+    }
+}
+
+impl Scene {
+    /// What a ray leaving the scene in direction `dir` sees: the environment map if the scene
+    /// has one (nearest texel), else the background.
+    pub fn sky(&self, dir: Vec3) -> Rgb {
+        for l in &self.lights {
+            if let Light::Environment { image, scale, rotation } = *l {
+                return crate::texture::equirect_texel(&self.images[image], dir, rotation) * scale;
+            }
+        }
+        self.background.radiance(dir)
+    }
+}
+
+impl PerspectiveOpening {
+    /// The frustum for an image of aspect `width/height` with its near plane at `near` (the
+    /// file's own `near` for an explicit frustum when `None`, else 1), far at 1000 × near. A
+    /// horizontal field of view is converted to the vertical one of the course's `P`.
+    pub fn frustum(&self, aspect: f64, near: Option<f64>) -> alhazen_math::viewing::Frustum {
+        use alhazen_math::viewing::Frustum;
+        match *self {
+            PerspectiveOpening::Fov { angle, horizontal } => {
+                let fovy = if horizontal { 2.0 * ((angle / 2.0).tan() / aspect).atan() } else { angle };
+                let n = near.unwrap_or(1.0);
+                Frustum::symmetric(fovy, aspect, n, 1000.0 * n)
+            }
+            PerspectiveOpening::Frustum { lrbtn: [l, r, b, t, n0] } => {
+                let n = near.unwrap_or(n0);
+                let k = n / n0;
+                Frustum { l: l * k, r: r * k, b: b * k, t: t * k, n, f: 1000.0 * n }
+            }
+        }
+    }
+}
+
 /// A colour that may vary over a surface.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Texture {

@@ -74,6 +74,18 @@ mod tests {
     }
 }
 
+/// `∂p/∂u`, `∂p/∂v` of the linear map taking a triangle's texture coordinates `uv` to its
+/// corners `p`; zero when the texture coordinates are degenerate.
+pub fn uv_tangents(p: [Vec3; 3], uv: [Vec2; 3]) -> [Vec3; 2] {
+    let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+    let det = d1.x * d2.y - d1.y * d2.x;
+    if det == 0.0 {
+        return [Vec3::ZERO; 2];
+    }
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    [(e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det]
+}
+
 /// The bump pattern's value in `[0, 1]` at `uv`.
 fn bump_value(b: &crate::BumpPattern, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> f64 {
     match b {

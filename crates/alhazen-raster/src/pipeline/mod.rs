@@ -22,7 +22,7 @@ pub mod stencil;
 
 use alhazen_math::viewing::{Frustum, ViewFrame};
 use alhazen_math::{Mat4, Vec2, Vec3, Vec4};
-use alhazen_scene::{CameraDesc, PerspectiveOpening, Scene};
+use alhazen_scene::{CameraDesc, Scene};
 use clip::{ATTRIBUTES, ClipVertex, clip_polygon};
 use geometry::{Triangle, scene_triangles};
 use raster::{ScreenTriangle, rasterize};
@@ -121,26 +121,14 @@ pub struct Prepared {
     pub bsp: Option<bsp::BspTree>,
 }
 
-/// The radiance of the environment: the environment map if the scene has one, else the background.
-fn environment(scene: &Scene) -> impl Fn(Vec3) -> Vec3 + Sync + '_ {
-    let map = scene.lights.iter().find_map(|l| match *l {
-        alhazen_scene::Light::Environment { image, scale, rotation } => Some((&scene.images[image], scale, rotation)),
-        _ => None,
-    });
-    move |dir| match map {
-        Some((img, scale, rotation)) => alhazen_scene::texture::equirect_texel(img, dir, rotation) * scale,
-        None => scene.background.radiance(dir),
-    }
-}
-
 /// Tessellates `scene`, computes its environment's irradiance and, as `opts` ask, renders its
 /// shadow maps and builds its BSP tree.
 pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
     let geometry = scene_triangles(scene);
     let maps = opts.shadows && opts.shadow_method == ShadowMethod::Maps;
     let shadows = maps.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
-    let irradiance = ibl::Sh9::irradiance_of(&environment(scene), 8, 400);
-    let specular = ibl::SpecularIbl::build(&environment(scene), 32);
+    let irradiance = ibl::Sh9::irradiance_of(&|d| scene.sky(d), 8, 400);
+    let specular = ibl::SpecularIbl::build(&|d| scene.sky(d), 32);
     let bsp = (opts.visibility == Visibility::Bsp).then(|| {
         let b =
             geometry.triangles.iter().fold(alhazen_math::Bounds3::EMPTY, |b, t| t.v.iter().fold(b, |b, v| b.grow(v.p)));
@@ -214,17 +202,8 @@ fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projection, 
     };
     let (frame, p, perspective) = match desc {
         CameraDesc::Perspective { look, opening } => {
-            let frustum = match *opening {
-                PerspectiveOpening::Fov { angle, horizontal } => {
-                    let fovy = if horizontal { 2.0 * ((angle / 2.0).tan() / aspect).atan() } else { angle };
-                    Frustum::symmetric(fovy, aspect, 1e-3, 1e6)
-                }
-                PerspectiveOpening::Frustum { lrbtn: [l, r, b, t, n] } => {
-                    // Same opening with a nearer near plane, so nothing close is clipped away.
-                    let k = 1e-3 / n;
-                    Frustum { l: l * k, r: r * k, b: b * k, t: t * k, n: 1e-3, f: 1e6 }
-                }
-            };
+            // A near plane close enough that nothing near the eye is clipped away.
+            let frustum = opening.frustum(aspect, Some(1e-3));
             // The limit f → ∞ of the course's P: points at infinity (shadow volumes' far ends)
             // land on the far plane instead of beyond it.
             let mut p = frustum.perspective();
@@ -324,15 +303,7 @@ fn process(
 /// texture coordinates (Flat and Phong shading; Gouraud lights the vertices only).
 fn bumped(scene: &Scene, m: &alhazen_scene::Material, t: &Triangle, uv: Vec2, n: Vec3) -> Vec3 {
     let Some(b) = &m.bump else { return n };
-    let [a, b1, c] = t.v;
-    let (d1, d2) = (b1.uv - a.uv, c.uv - a.uv);
-    let det = d1.x * d2.y - d1.y * d2.x;
-    let (e1, e2) = (b1.p - a.p, c.p - a.p);
-    let (pu, pv) = if det == 0.0 {
-        (Vec3::ZERO, Vec3::ZERO)
-    } else {
-        ((e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det)
-    };
+    let [pu, pv] = alhazen_scene::texture::uv_tangents(t.v.map(|v| v.p), t.v.map(|v| v.uv));
     alhazen_scene::texture::bumped_normal(b, uv, n, pu, pv, &scene.images)
 }
 

@@ -22,7 +22,7 @@ pub struct Lighting<'a> {
     pub hemisphere: Option<(Vec3, Vec3)>,
 }
 use alhazen_math::{Vec2, Vec3};
-use alhazen_scene::{Light, Material, Scene};
+use alhazen_scene::{Material, Scene};
 
 /// The light arriving at `p` (unit normal `n`, viewer direction `v`), split as the course's
 /// model is: the factor of the surface colour (`I^amb + Σ I^dir ⟨l, n⟩`) and the highlight
@@ -46,7 +46,7 @@ pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &
     }
     let shadows = extra.shadows;
     for (k, light) in scene.lights.iter().enumerate() {
-        let Some((l, i)) = incoming(light, p) else { continue };
+        let Some((l, _, i)) = light.arriving(p) else { continue };
         let cos = n.dot(l);
         let stenciled = k < 64 && extra.blocked >> k & 1 == 1;
         if cos <= 0.0 || stenciled || shadows.is_some_and(|s| !s.lit(k, p, n)) {
@@ -94,25 +94,4 @@ pub fn combine(
 /// Radiance towards the viewer at `p`, lit per point.
 pub fn shade(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, uv: Vec2, extra: &Lighting) -> Vec3 {
     combine(scene, m, lighting(scene, m, p, n, v, extra), n, v, uv, extra)
-}
-
-/// Direction towards the light and the intensity arriving, `I^em/(a d² + b d + c)`.
-fn incoming(light: &Light, p: Vec3) -> Option<(Vec3, Vec3)> {
-    let falloff = |abc: &[f64; 3], d: f64| abc[0] * d * d + abc[1] * d + abc[2];
-    match light {
-        Light::Point { position, intensity, attenuation } => {
-            let to = *position - p;
-            let d = to.length();
-            (d > 0.0).then(|| (to / d, *intensity / falloff(attenuation, d)))
-        }
-        Light::Directional { direction, intensity } => Some((-*direction, *intensity)),
-        Light::Spot { position, direction, cos_cutoff, falloff: e, intensity, attenuation } => {
-            let to = *position - p;
-            let d = to.length();
-            let l = to / d;
-            let cos = -l.dot(*direction);
-            (d > 0.0 && cos >= *cos_cutoff).then(|| (l, *intensity * cos.powf(*e) / falloff(attenuation, d)))
-        }
-        Light::Environment { .. } => None,
-    }
 }

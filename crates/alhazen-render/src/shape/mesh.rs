@@ -87,14 +87,7 @@ impl MeshShape {
         if m.uvs.is_empty() {
             return [p1 - p0, p2 - p0];
         }
-        let [t0, t1, t2] = idx.map(|i| m.uvs[i]);
-        let (d1, d2) = (t1 - t0, t2 - t0);
-        let det = d1.x * d2.y - d1.y * d2.x;
-        if det == 0.0 {
-            return [Vec3::ZERO; 2];
-        }
-        let (e1, e2) = (p1 - p0, p2 - p0);
-        [(e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det]
+        alhazen_scene::texture::uv_tangents([p0, p1, p2], idx.map(|i| m.uvs[i]))
     }
 
     /// Nearest hit in `(0, t_max)`; `aux` is the triangle.
