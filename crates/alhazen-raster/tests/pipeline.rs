@@ -59,17 +59,22 @@ fn mean_abs(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
         / a.len() as f64
 }
 
+/// Mean absolute difference per channel, relative to the ray tracer's mean brightness.
+fn relative_error(fb: &alhazen_raster::pipeline::Framebuffer, traced: &alhazen_render::Image) -> f64 {
+    let mean: f64 =
+        traced.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / traced.pixels.len() as f64;
+    mean_abs(&fb.color, &traced.pixels) / mean
+}
+
 #[test]
 fn raster_preview_agrees_with_the_ray_tracer_with_shadow_maps() {
     // Both lights cast shadows on the disk: shadow maps against shadow rays.
     let scene = parse_scene("agree.toml".as_ref(), SCENE).unwrap();
     let traced = alhazen_render::render(&scene, &|_, _| {});
-    let mean: f64 =
-        traced.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / traced.pixels.len() as f64;
     for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
         let (fb, stats) = render_scene(&scene, &RasterOptions { shading, ..Default::default() }).unwrap();
         assert!(stats.culled > 0 && stats.drawn > 0);
-        let err = mean_abs(&fb.color, &traced.pixels) / mean;
+        let err = relative_error(&fb, &traced);
         eprintln!("{shading:?}: mean absolute difference {:.2} % of the mean brightness", err * 100.0);
         let limit = match shading {
             Shading::Phong => 0.01,
@@ -211,12 +216,6 @@ fn bsp_tree_partitions_the_scene() {
         order.dedup();
         assert_eq!(order.len(), tree.len());
     }
-}
-
-fn relative_error(fb: &alhazen_raster::pipeline::Framebuffer, traced: &alhazen_render::Image) -> f64 {
-    let mean: f64 =
-        traced.pixels.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / traced.pixels.len() as f64;
-    mean_abs(&fb.color, &traced.pixels) / mean
 }
 
 #[test]
