@@ -227,6 +227,7 @@ impl Canonical {
     /// `[max(0, σ − α_S), min(σ, α_E)]` (between the two directions and on the arcs both can
     /// see), where the balance changes sign from + to −. Returns the unit normal
     /// `(cos φ, sin φ)`; `None` in the forbidden region.
+    #[inline]
     pub fn visible(&self) -> Option<Vec2> {
         if let (Site2::At(e), Site2::At(s)) = (self.eye, self.source)
             && let Some(n) = crate::batch::fast_visible(self.r, e.x, s.x, s.y)

@@ -68,6 +68,7 @@ fn finite_site(s: Site) -> Result<Site, MirrorError> {
 
 /// Builds the canonical problem in the plane through `origin` with eye and source given relative
 /// to it (already projected for a cylinder). `None` for `ŷ` means the source is on the axis.
+#[inline(always)]
 fn frame(
     origin: Vec3,
     r: f64,
@@ -86,38 +87,44 @@ fn frame(
             if (e - r).abs() <= 1e-12 * scale {
                 return Err(MirrorError::EyeOnMirror);
             }
-            (d / e, Some(e))
+            (d * (1.0 / e), Some(e))
         }
         Site::Toward(d) => (d, None),
     };
-    let (rel, finite_source) = match source {
+    let (rel, rel_len, finite_source) = match source {
         Site::At(p) => {
-            if let Site::At(e) = eye
-                && (p - e).length() <= 1e-12 * scale.max(e.length())
-            {
-                return Err(MirrorError::SourceAtEye);
+            if let Site::At(e) = eye {
+                let near = 1e-12 * scale.max(e.abs().max_element());
+                if (p - e).length_squared() <= near * near {
+                    return Err(MirrorError::SourceAtEye);
+                }
             }
             let rel = p - origin;
-            if (rel.length() - r).abs() <= 1e-12 * scale {
+            let rel_len = rel.length();
+            if (rel_len - r).abs() <= 1e-12 * scale {
                 return Err(MirrorError::SourceOnMirror);
             }
-            (rel, true)
+            (rel, rel_len, true)
         }
-        Site::Toward(d) => (d, false),
+        Site::Toward(d) => (d, 1.0, false),
     };
     let sx = rel.dot(x);
     let perp = rel - x * sx;
-    let on_axis = perp.length() <= 1e-12 * rel.length().max(scale);
-    let y = match plane_normal {
+    let perp_len = perp.length();
+    let on_axis = perp_len <= 1e-12 * rel_len.max(scale);
+    let (y, sy) = match plane_normal {
         // A cylinder's plane is known exactly: ŷ = a × x̂, turned towards the source.
         Some(a) => {
             let y = a.cross(x).normalize();
-            if perp.dot(y) < 0.0 { -y } else { y }
+            let y = if perp.dot(y) < 0.0 { -y } else { y };
+            (y, rel.dot(y).max(0.0))
         }
-        None if on_axis => orthonormal_basis(x).0,
-        None => perp.normalize(),
+        None if on_axis => (orthonormal_basis(x).0, 0.0),
+        // |perp|, not rel·ŷ: the rounding of ŷ along x̂ (ε|rel|/|perp|) times rel's large
+        // component along x̂ would cost 10 ulps of the source's distance from the axis.
+        None => (perp * (1.0 / perp_len), perp_len),
     };
-    let s2 = Vec2::new(sx, if on_axis { 0.0 } else { rel.dot(y).max(0.0) });
+    let s2 = Vec2::new(sx, if on_axis { 0.0 } else { sy });
     let problem = Canonical {
         r,
         eye: match e_dist {
@@ -233,6 +240,7 @@ impl Circle {
 }
 
 impl Sphere {
+    #[inline(always)]
     fn frame(&self, eye: Site, source: Site) -> Result<(Frame, bool), MirrorError> {
         check_radius(self.radius)?;
         if !self.center.is_finite() {
