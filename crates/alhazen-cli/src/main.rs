@@ -1,4 +1,4 @@
-//! `alhazen`: the command-line front end (`render`, `raster`, `view`, `mirror`). The only crate that reads argv and the environment,
+//! `alhazen`: the command-line front end (`render`, `raster`, `view`, `mirror`, `lines`). The only crate that reads argv and the environment,
 //! writes to stdout/stderr and chooses exit codes:
 //! 0 success, 1 a failure while working (e.g. the output cannot be written), 2 bad input (usage,
 //! an unreadable or invalid scene file, impossible sizes).
@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+mod lines;
 mod mirror;
 mod raster;
 mod view;
@@ -40,6 +41,12 @@ enum Command {
     /// Exact reflexes on spheres and cylinders (Glaeser), catacaustics and their figures.
     #[command(subcommand)]
     Mirror(mirror::MirrorCommand),
+    /// Exact hidden-line drawing (SVG, PDF, PNG) with the reflections in spherical and
+    /// cylindrical mirrors.
+    #[command(
+        after_help = "Examples:\n  alhazen lines scenes/lines/fig21-cylinder-in-sphere.toml -o fig21.svg\n  alhazen lines scenes/lines/fig1-town-in-cylinder.toml -o fig1.pdf --hidden\n  alhazen lines --graph ripple -o ripple.svg"
+    )]
+    Lines(lines::LinesArgs),
 }
 
 /// What every image-producing command takes: the scene, the output and its size.
@@ -128,6 +135,7 @@ fn main() -> ExitCode {
         Command::Raster(args) => raster::run(&args),
         Command::View(args) => view::run(&args),
         Command::Mirror(cmd) => mirror::run(&cmd),
+        Command::Lines(args) => lines::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -191,6 +191,11 @@ fn place(tri: [Vertex; 3], tf: &Transform) -> [Vertex; 3] {
     t
 }
 
+/// One object's tessellation in world space (`None` for CSG), before material assignment.
+pub fn world_triangles(scene: &Scene, object: &alhazen_scene::Object) -> Option<Vec<[Vertex; 3]>> {
+    Some(object_triangles(scene, &object.shape)?.into_iter().map(|t| place(t, &object.transform)).collect())
+}
+
 /// Every object of `scene` as world-space triangles.
 pub fn scene_triangles(scene: &Scene) -> SceneTriangles {
     let (mut triangles, mut skipped) = (vec![], 0);

@@ -183,14 +183,21 @@ impl std::fmt::Display for RasterError {
 impl std::error::Error for RasterError {}
 
 /// The camera as matrices: world → clip, and what is needed to find the viewer direction.
-struct Projection {
-    world_to_clip: Mat4,
-    clip_to_world: Mat4,
-    frame: ViewFrame,
-    perspective: bool,
+#[derive(Clone, Copy, Debug)]
+pub struct Projection {
+    /// The course's viewing transformation followed by its projection matrix.
+    pub world_to_clip: Mat4,
+    /// Its inverse.
+    pub clip_to_world: Mat4,
+    /// The view frame (for parallel views: an eye 10⁴ units before the target).
+    pub frame: ViewFrame,
+    /// Central (true) or parallel projection.
+    pub perspective: bool,
 }
 
-fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projection, RasterError> {
+/// The camera of a scene as a [`Projection`] for a film of `width × height` pixels; stereo and
+/// panorama cameras have none.
+pub fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projection, RasterError> {
     let aspect = width as f64 / height as f64;
     let frame_of = |l: &alhazen_scene::LookAt| {
         ViewFrame::look_at(l.eye, l.target, l.up).unwrap_or(ViewFrame {
@@ -247,7 +254,7 @@ fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projection, 
 
 impl Projection {
     /// Unit direction from `p` towards the viewer.
-    fn to_viewer(&self, p: Vec3) -> Vec3 {
+    pub fn to_viewer(&self, p: Vec3) -> Vec3 {
         if self.perspective { (self.frame.eye - p).normalize_or_zero() } else { self.frame.w }
     }
 

@@ -1,0 +1,176 @@
+//! `alhazen lines`: exact hidden-line drawings of a scene with its reflections in spherical and
+//! cylindrical mirrors, as SVG, PDF or a PNG preview; `--graph` draws a function graph with
+//! the floating-horizon algorithm instead.
+
+use crate::{Failure, load};
+use alhazen_lines::drawing::{Drawing, Layer, Stroke, default_stroke};
+use alhazen_lines::horizon::{Graph, Layout, floating_horizon};
+use alhazen_lines::{Options, draw};
+use alhazen_math::Vec2;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Args)]
+pub struct LinesArgs {
+    /// The scene file (TOML); not needed with --graph.
+    #[arg(required_unless_present = "graph")]
+    scene: Option<PathBuf>,
+    /// Output: .svg, .pdf or .png (an antialiased preview).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Paper width in millimetres (the height follows the scene's image aspect).
+    #[arg(long, default_value_t = 200.0, value_parser = positive)]
+    width_mm: f64,
+    /// Also draw hidden lines (dashed, on their own layer).
+    #[arg(long)]
+    hidden: bool,
+    /// Leave out the reflections in mirrors.
+    #[arg(long)]
+    no_reflections: bool,
+    /// Mesh edges whose faces meet at more than this angle (degrees) are drawn.
+    #[arg(long, default_value_t = 30.0)]
+    feature_angle: f64,
+    /// Stroke width of visible lines in millimetres (hidden and reflected lines are thinner).
+    #[arg(long, default_value_t = 0.35, value_parser = positive)]
+    stroke: f64,
+    /// Width of a PNG preview in pixels.
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(16..=20000))]
+    png_width: u32,
+    /// Draw the graph of a built-in function with the floating-horizon algorithm.
+    #[arg(long, value_enum)]
+    graph: Option<GraphFunction>,
+    /// Net lines per direction of a graph.
+    #[arg(long, default_value_t = 41, value_parser = clap::value_parser!(u32).range(2..=2000))]
+    net: u32,
+    /// Worker threads (default: all cores). The drawing does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    /// No summary.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Functions for `--graph`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum GraphFunction {
+    /// cos(r)·e^(−r/6) over [−10, 10]², r = √(x² + y²).
+    Ripple,
+    /// x² − y² over [−1, 1]².
+    Saddle,
+    /// The MATLAB "peaks" surface over [−3, 3]².
+    Peaks,
+}
+
+fn positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("expected a positive number, got {s:?}")),
+    }
+}
+
+/// Output kinds by extension.
+enum Kind {
+    Svg,
+    Pdf,
+    Png,
+}
+
+fn output_kind(path: &Path) -> Result<Kind, Failure> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let kind = match ext.as_deref() {
+        Some("svg") => Kind::Svg,
+        Some("pdf") => Kind::Pdf,
+        Some("png") => Kind::Png,
+        _ => return Err(Failure::input(format!("{}: unknown drawing format; use .svg, .pdf or .png", path.display()))),
+    };
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        return Err(Failure::input(format!("{}: the directory {} does not exist", path.display(), dir.display())));
+    }
+    Ok(kind)
+}
+
+pub fn run(a: &LinesArgs) -> Result<(), Failure> {
+    let kind = output_kind(&a.output)?;
+    let threads = a.threads.map_or(0, |t| t as usize);
+    let pool =
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Failure::work(e.to_string()))?;
+    let start = Instant::now();
+    let (drawing, summary) = match (a.graph, &a.scene) {
+        (Some(g), _) => graph_drawing(g, a),
+        (None, Some(path)) => {
+            let scene = load(path)?;
+            let opts = Options {
+                width_mm: a.width_mm,
+                feature_angle_deg: a.feature_angle,
+                hidden: a.hidden,
+                reflections: !a.no_reflections,
+                ..Options::default()
+            };
+            let (d, s) =
+                pool.install(|| draw(&scene, &opts)).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+            let mut summary = format!(
+                "{} scene lines → {} visible, {} hidden, {} reflected polylines ({} mirrors)",
+                s.scene_lines, s.visible, s.hidden, s.reflected, s.mirrors
+            );
+            if s.tessellated > 0 {
+                summary += &format!("; {} distorted round objects drawn from their tessellation", s.tessellated);
+            }
+            if s.skipped > 0 {
+                summary += &format!("; {} planes/CSG objects have no lines", s.skipped);
+            }
+            (d, summary)
+        }
+        (None, None) => return Err(Failure::input("give a scene file or --graph")),
+    };
+    let stroke = |l: Layer| {
+        let s = default_stroke(l);
+        Stroke { width: s.width * a.stroke / default_stroke(Layer::Visible).width, ..s }
+    };
+    let bytes = match kind {
+        Kind::Svg => drawing.to_svg(stroke).into_bytes(),
+        Kind::Pdf => drawing.to_pdf(stroke),
+        Kind::Png => drawing.to_png(a.png_width, stroke).map_err(|e| Failure::work(e.to_string()))?,
+    };
+    alhazen_render::output::write_atomically(&a.output, |f| std::io::Write::write_all(f, &bytes))
+        .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.output.display())))?;
+    if !a.quiet {
+        eprintln!("{summary} in {:.3} s → {}", start.elapsed().as_secs_f64(), a.output.display());
+    }
+    Ok(())
+}
+
+/// A floating-horizon drawing of a built-in function on paper `width_mm` wide.
+fn graph_drawing(g: GraphFunction, a: &LinesArgs) -> (Drawing, String) {
+    let (f, range): (&(dyn Fn(f64, f64) -> f64 + Sync), f64) = match g {
+        GraphFunction::Ripple => (
+            &|x: f64, y: f64| {
+                let r = (x * x + y * y).sqrt();
+                r.cos() * (-r / 6.0).exp()
+            },
+            10.0,
+        ),
+        GraphFunction::Saddle => (&|x: f64, y: f64| x * x - y * y, 1.0),
+        GraphFunction::Peaks => (
+            &|x: f64, y: f64| {
+                3.0 * (1.0 - x).powi(2) * (-(x * x) - (y + 1.0).powi(2)).exp()
+                    - 10.0 * (x / 5.0 - x.powi(3) - y.powi(5)) * (-x * x - y * y).exp()
+                    - (-(x + 1.0).powi(2) - y * y).exp() / 3.0
+            },
+            3.0,
+        ),
+    };
+    let n = a.net as usize;
+    let graph = Graph { f, x: (-range, range), y: (-range, range), lines: (n, n) };
+    // One pixel column per 0.05 mm.
+    let w = a.width_mm / 0.05;
+    let layout = Layout { w, h: 0.75 * w, wx: 0.4 * w, hx: 0.18 * w, hz: 0.3 * w };
+    let lines = floating_horizon(&graph, &layout);
+    let count = lines.len();
+    let drawing = Drawing {
+        size: Vec2::new(a.width_mm, 0.75 * a.width_mm),
+        lines: lines.into_iter().map(|l| (Layer::Visible, l.into_iter().map(|p| p * 0.05).collect())).collect(),
+    };
+    (drawing, format!("{g:?} graph, {n}×{n} net → {count} visible polylines"))
+}

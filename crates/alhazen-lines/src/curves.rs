@@ -1,0 +1,300 @@
+//! The lines of a scene in space, exactly: edges of polyhedra and meshes (boundary edges,
+//! feature edges by dihedral angle, silhouettes seen from the eye), the contours of spheres,
+//! cylinders and cones (the course's and Glaeser's §1: a sphere's contour from `E` is a small
+//! circle; a cylinder's and a cone's are generating lines through the tangents from the eye's
+//! projection), and the rims of cylinders, cones and disks.
+
+use crate::view::View;
+use alhazen_math::{Transform, Vec3, orthonormal_basis};
+use alhazen_raster::pipeline::geometry::world_triangles;
+use alhazen_scene::{Scene, Shape};
+use std::collections::HashMap;
+use std::f64::consts::TAU;
+
+/// A curve in space: a segment or an arc of a circle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Curve {
+    /// The segment from `a` to `b`.
+    Segment {
+        /// Start.
+        a: Vec3,
+        /// End.
+        b: Vec3,
+    },
+    /// `center + radius (u cos θ + v sin θ)` for θ from `start` to `end` (`u`, `v` orthonormal).
+    Arc {
+        /// Centre.
+        center: Vec3,
+        /// First axis of the circle's plane (unit).
+        u: Vec3,
+        /// Second axis (unit, ⟂ `u`).
+        v: Vec3,
+        /// Radius.
+        radius: f64,
+        /// Start angle.
+        start: f64,
+        /// End angle.
+        end: f64,
+    },
+}
+
+impl Curve {
+    /// The point at parameter `s ∈ [0, 1]`.
+    pub fn point(&self, s: f64) -> Vec3 {
+        match *self {
+            Curve::Segment { a, b } => a + (b - a) * s,
+            Curve::Arc { center, u, v, radius, start, end } => {
+                let th = start + (end - start) * s;
+                center + (u * th.cos() + v * th.sin()) * radius
+            }
+        }
+    }
+
+    /// A full circle.
+    pub fn circle(center: Vec3, axis: Vec3, radius: f64) -> Curve {
+        let (u, v) = orthonormal_basis(axis.normalize());
+        Curve::Arc { center, u, v, radius, start: 0.0, end: TAU }
+    }
+
+    /// Parameters of the chords that approximate the curve on paper within `tol_mm`.
+    pub fn knots(&self, view: &View, tol_mm: f64) -> Vec<f64> {
+        match *self {
+            Curve::Segment { .. } => vec![0.0, 1.0],
+            Curve::Arc { center, radius, start, end, .. } => {
+                // Radius on paper at the circle's depth bounds the chord error r(1 − cos(Δ/2)).
+                let mm = radius * view.mm_per_px * view_px_per_unit(view, center);
+                let step = if mm > 0.0 { (8.0 * tol_mm / mm).sqrt().min(0.5) } else { 0.5 };
+                let n = (((end - start).abs() / step).ceil() as usize).clamp(8, 20_000);
+                (0..=n).map(|k| k as f64 / n as f64).collect()
+            }
+        }
+    }
+}
+
+/// Film pixels per world unit near `p` (the projection's local scale).
+fn view_px_per_unit(view: &View, p: Vec3) -> f64 {
+    let (ray, _) = view.eye_ray(p);
+    let (u, _) = orthonormal_basis(ray.dir);
+    let h = 1e-3 * view.scale;
+    let (a, b) = (p - u * h, p + u * h);
+    if !view.in_front(a) || !view.in_front(b) {
+        return 1.0;
+    }
+    (view.to_film(b) - view.to_film(a)).length() / (2.0 * h)
+}
+
+/// What a line is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LineKind {
+    /// Edge between faces meeting at an angle, or a face's free boundary.
+    Edge,
+    /// Silhouette of a mesh or contour of a curved surface.
+    Contour,
+    /// Rim of a cylinder, cone or disk.
+    Rim,
+}
+
+/// A line of the scene: a curve on an object.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneLine {
+    /// The curve.
+    pub curve: Curve,
+    /// Index of the scene object it lies on.
+    pub object: u32,
+    /// What it is.
+    pub kind: LineKind,
+}
+
+/// How lines are picked.
+#[derive(Clone, Copy, Debug)]
+pub struct EdgeOptions {
+    /// Mesh edges whose faces meet at more than this angle (radians) are drawn.
+    pub feature_angle: f64,
+}
+
+/// Every line of the scene for this view; the count of objects drawn from their tessellation
+/// because their transform distorts a round shape, and of objects with no lines (CSG, planes).
+pub fn scene_lines(scene: &Scene, view: &View, opts: &EdgeOptions) -> (Vec<SceneLine>, usize, usize) {
+    let (mut lines, mut tessellated, mut skipped) = (vec![], 0, 0);
+    for (i, o) in scene.objects.iter().enumerate() {
+        let object = i as u32;
+        let exact = similarity(&o.transform).and_then(|s| round_lines(&o.shape, &o.transform, s, view, object));
+        match (exact, &o.shape) {
+            (Some(l), _) => lines.extend(l),
+            (None, Shape::Plane { .. } | Shape::Csg { .. }) => skipped += 1,
+            (None, shape) => {
+                if matches!(
+                    shape,
+                    Shape::Sphere { .. } | Shape::Cylinder { .. } | Shape::Cone { .. } | Shape::Disk { .. }
+                ) {
+                    tessellated += 1;
+                }
+                if let Some(tris) = world_triangles(scene, o) {
+                    lines.extend(mesh_lines(
+                        &tris.iter().map(|t| t.map(|v| v.p)).collect::<Vec<_>>(),
+                        view,
+                        opts,
+                        object,
+                    ));
+                }
+            }
+        }
+    }
+    (lines, tessellated, skipped)
+}
+
+/// The uniform scale of a similarity transform (rotation, uniform scale, translation).
+fn similarity(t: &Transform) -> Option<f64> {
+    let (x, y, z) = (t.vector(Vec3::X), t.vector(Vec3::Y), t.vector(Vec3::Z));
+    let s = x.length();
+    let tol = 1e-9 * s;
+    let ok = (y.length() - s).abs() < tol
+        && (z.length() - s).abs() < tol
+        && x.dot(y).abs() < tol * s
+        && y.dot(z).abs() < tol * s
+        && x.dot(z).abs() < tol * s;
+    ok.then_some(s)
+}
+
+/// Exact lines of spheres, cylinders, cones and disks; `None` for other shapes.
+fn round_lines(shape: &Shape, t: &Transform, scale: f64, view: &View, object: u32) -> Option<Vec<SceneLine>> {
+    let line = |curve, kind| SceneLine { curve, object, kind };
+    let mut out = vec![];
+    match *shape {
+        Shape::Sphere { center, radius } => {
+            if let Some(c) = sphere_contour(t.point(center), radius * scale, view) {
+                out.push(line(c, LineKind::Contour));
+            }
+        }
+        Shape::Cylinder { base, top, radius, .. } => {
+            let (b, tp, r) = (t.point(base), t.point(top), radius * scale);
+            let axis = tp - b;
+            out.push(line(Curve::circle(b, axis, r), LineKind::Rim));
+            out.push(line(Curve::circle(tp, axis, r), LineKind::Rim));
+            for p in cylinder_contour_feet(b, axis, r, view) {
+                out.push(line(Curve::Segment { a: p, b: p + axis }, LineKind::Contour));
+            }
+        }
+        Shape::Cone { base, apex, radius, .. } => {
+            let (b, a, r) = (t.point(base), t.point(apex), radius * scale);
+            out.push(line(Curve::circle(b, a - b, r), LineKind::Rim));
+            for p in cone_contour_feet(b, a, r, view) {
+                out.push(line(Curve::Segment { a: p, b: a }, LineKind::Contour));
+            }
+        }
+        Shape::Disk { center, normal, radius } => {
+            out.push(line(Curve::circle(t.point(center), t.normal(normal), radius * scale), LineKind::Rim));
+        }
+        _ => return None,
+    }
+    Some(out)
+}
+
+/// The contour of a sphere: from an eye at distance `d > r`, the small circle of the touching
+/// cone (centre `M + (E − M) r²/d²`, radius `r √(1 − r²/d²)`); for parallel views the great
+/// circle across the viewing direction.
+fn sphere_contour(m: Vec3, r: f64, view: &View) -> Option<Curve> {
+    match view.eye {
+        Some(e) => {
+            let d = e - m;
+            let dd = d.length_squared();
+            (dd > r * r * (1.0 + 1e-12)).then(|| Curve::circle(m + d * (r * r / dd), d, r * (1.0 - r * r / dd).sqrt()))
+        }
+        None => Some(Curve::circle(m, view.dir, r)),
+    }
+}
+
+/// Feet on the base circle of the tangents from the eye's projection along the axis (the two
+/// contour generators of a cylinder).
+fn cylinder_contour_feet(base: Vec3, axis: Vec3, r: f64, view: &View) -> Vec<Vec3> {
+    let a = axis.normalize();
+    let toward = match view.eye {
+        Some(e) => {
+            let q = (e - base) - a * (e - base).dot(a);
+            return tangent_feet(base, a, r, q);
+        }
+        None => a.cross(view.dir),
+    };
+    let Some(n) = toward.try_normalize() else { return vec![] };
+    vec![base + n * r, base - n * r]
+}
+
+/// Points of contact of the tangents from `q` (relative to `center`, in the circle's plane ⟂
+/// `a`) to the circle of radius `r`.
+fn tangent_feet(center: Vec3, a: Vec3, r: f64, q: Vec3) -> Vec<Vec3> {
+    let d = q.length();
+    if d <= r * (1.0 + 1e-12) {
+        return vec![];
+    }
+    let x = q / d;
+    let y = a.cross(x);
+    let (c, s) = (r / d, (1.0 - (r / d) * (r / d)).sqrt());
+    vec![center + (x * c + y * s) * r, center + (x * c - y * s) * r]
+}
+
+/// A cone's contour generators touch the base circle where the tangents from `P` do, `P` the
+/// point where the line from the apex through the eye (or along the view) meets the base plane.
+fn cone_contour_feet(base: Vec3, apex: Vec3, r: f64, view: &View) -> Vec<Vec3> {
+    let a = (apex - base).normalize();
+    let through = match view.eye {
+        Some(e) => e - apex,
+        None => view.dir,
+    };
+    let den = through.dot(a);
+    if den.abs() < 1e-12 * through.length() {
+        // The line is parallel to the base plane: the feet are across its direction.
+        let Some(x) = (through - a * den).try_normalize() else { return vec![] };
+        let y = a.cross(x);
+        return vec![base + y * r, base - y * r];
+    }
+    let p = apex + through * ((base - apex).dot(a) / den);
+    tangent_feet(base, a, r, p - base)
+}
+
+/// An undirected edge by the bits of its corners.
+type EdgeKey = ([u64; 3], [u64; 3]);
+
+/// Boundary, feature and silhouette edges of a triangle soup whose shared corners are equal.
+pub fn mesh_lines(tris: &[[Vec3; 3]], view: &View, opts: &EdgeOptions, object: u32) -> Vec<SceneLine> {
+    let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    let mut edges: HashMap<EdgeKey, (Vec3, Vec3, Vec<Vec3>)> = HashMap::new();
+    let mut order = vec![];
+    for t in tris {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        let Some(n) = n.try_normalize() else { continue };
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let (ka, kb) = (key(a), key(b));
+            let id = if ka < kb { (ka, kb) } else { (kb, ka) };
+            let e = edges.entry(id).or_insert_with(|| {
+                order.push(id);
+                (a, b, vec![])
+            });
+            e.2.push(n);
+        }
+    }
+    let cos_feature = opts.feature_angle.cos();
+    let mut out = vec![];
+    for id in order {
+        let (a, b, normals) = &edges[&id];
+        let mid = (*a + *b) * 0.5;
+        let facing = |n: Vec3| {
+            let to_eye = match view.eye {
+                Some(e) => e - mid,
+                None => -view.dir,
+            };
+            n.dot(to_eye) > 0.0
+        };
+        let kind = match normals.as_slice() {
+            [_] => Some(LineKind::Edge),
+            [n1, n2] if n1.dot(*n2) < cos_feature => Some(LineKind::Edge),
+            [n1, n2] if facing(*n1) != facing(*n2) => Some(LineKind::Contour),
+            [_, _] => None,
+            _ => Some(LineKind::Edge),
+        };
+        if let Some(kind) = kind {
+            out.push(SceneLine { curve: Curve::Segment { a: *a, b: *b }, object, kind });
+        }
+    }
+    out
+}

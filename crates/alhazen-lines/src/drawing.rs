@@ -1,0 +1,316 @@
+//! A drawing on paper — polylines in millimetres on layers — and its three outputs: SVG (a
+//! group per layer), PDF (an optional-content layer per layer, written by hand: the format's
+//! few objects need no library) and an antialiased PNG preview (coverage from the exact
+//! distance of each pixel centre to each segment).
+
+use alhazen_math::Vec2;
+use std::fmt::Write;
+
+/// The layers of a line drawing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Layer {
+    /// Lines seen directly.
+    Visible,
+    /// Lines hidden by surfaces (drawn dashed when asked for).
+    Hidden,
+    /// Lines seen in a mirror.
+    Reflected,
+}
+
+impl Layer {
+    /// All layers, bottom to top.
+    pub const ALL: [Layer; 3] = [Layer::Hidden, Layer::Reflected, Layer::Visible];
+
+    /// The layer's name in SVG ids and PDF layer lists.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layer::Visible => "visible",
+            Layer::Hidden => "hidden",
+            Layer::Reflected => "reflected",
+        }
+    }
+}
+
+/// Stroke of a layer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stroke {
+    /// Width in millimetres.
+    pub width: f64,
+    /// Grey level 0 (black) … 1 (white).
+    pub grey: f64,
+    /// Dash length in millimetres (0: solid).
+    pub dash: f64,
+}
+
+/// Polylines on paper, in millimetres, origin top left, `y` down.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Drawing {
+    /// Paper size in millimetres.
+    pub size: Vec2,
+    /// `(layer, points)` in drawing order.
+    pub lines: Vec<(Layer, Vec<Vec2>)>,
+}
+
+/// Default strokes: visible 0.35 mm black, hidden 0.18 mm grey dashed, reflected 0.25 mm.
+pub fn default_stroke(layer: Layer) -> Stroke {
+    match layer {
+        Layer::Visible => Stroke { width: 0.35, grey: 0.0, dash: 0.0 },
+        Layer::Hidden => Stroke { width: 0.18, grey: 0.45, dash: 1.0 },
+        Layer::Reflected => Stroke { width: 0.25, grey: 0.1, dash: 0.0 },
+    }
+}
+
+impl Drawing {
+    /// Number of polylines on a layer.
+    pub fn count(&self, layer: Layer) -> usize {
+        self.lines.iter().filter(|(l, _)| *l == layer).count()
+    }
+
+    /// Total length of the lines of a layer in millimetres.
+    pub fn length(&self, layer: Layer) -> f64 {
+        self.lines
+            .iter()
+            .filter(|(l, _)| *l == layer)
+            .map(|(_, p)| p.windows(2).map(|w| (w[1] - w[0]).length()).sum::<f64>())
+            .sum()
+    }
+
+    /// The drawing cut to its paper by the course's Liang–Barsky clipping: polylines leaving
+    /// the paper are split.
+    pub fn clipped(self) -> Drawing {
+        let win = alhazen_raster::clip::Window { xmin: 0.0, ymin: 0.0, xmax: self.size.x, ymax: self.size.y };
+        let mut lines = vec![];
+        for (layer, pts) in self.lines {
+            let mut cur: Vec<Vec2> = vec![];
+            for s in pts.windows(2) {
+                match alhazen_raster::clip::liang_barsky(&win, s[0], s[1]) {
+                    Some((a, b)) => {
+                        if cur.last().is_none_or(|l| (*l - a).length() > 1e-12) {
+                            if cur.len() > 1 {
+                                lines.push((layer, std::mem::take(&mut cur)));
+                            }
+                            cur = vec![a];
+                        }
+                        cur.push(b);
+                    }
+                    None => {
+                        if cur.len() > 1 {
+                            lines.push((layer, std::mem::take(&mut cur)));
+                        }
+                        cur.clear();
+                    }
+                }
+            }
+            if cur.len() > 1 {
+                lines.push((layer, cur));
+            }
+        }
+        Drawing { size: self.size, lines }
+    }
+
+    /// SVG in millimetres, a group per layer, coordinates to 0.001 mm.
+    pub fn to_svg(&self, stroke: impl Fn(Layer) -> Stroke) -> String {
+        let mut s = String::new();
+        let (w, h) = (self.size.x, self.size.y);
+        let _ = writeln!(
+            s,
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w:.3}mm\" height=\"{h:.3}mm\" viewBox=\"0 0 {w:.3} {h:.3}\">"
+        );
+        let _ = writeln!(s, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
+        for layer in Layer::ALL {
+            let st = stroke(layer);
+            let grey = (st.grey.clamp(0.0, 1.0) * 255.0).round() as u8;
+            let dash = if st.dash > 0.0 {
+                format!(" stroke-dasharray=\"{:.3} {:.3}\"", st.dash, st.dash)
+            } else {
+                String::new()
+            };
+            let _ = writeln!(
+                s,
+                "<g id=\"{}\" fill=\"none\" stroke=\"rgb({grey},{grey},{grey})\" stroke-width=\"{:.3}\" stroke-linecap=\"round\" stroke-linejoin=\"round\"{dash}>",
+                layer.name(),
+                st.width
+            );
+            for (_, pts) in self.lines.iter().filter(|(l, _)| *l == layer) {
+                s.push_str("<polyline points=\"");
+                for (i, p) in pts.iter().enumerate() {
+                    let _ = write!(s, "{}{:.3},{:.3}", if i > 0 { " " } else { "" }, p.x, p.y);
+                }
+                s.push_str("\"/>\n");
+            }
+            s.push_str("</g>\n");
+        }
+        s.push_str("</svg>\n");
+        s
+    }
+
+    /// A one-page PDF of the paper's size with one optional-content layer per layer.
+    pub fn to_pdf(&self, stroke: impl Fn(Layer) -> Stroke) -> Vec<u8> {
+        const PT: f64 = 72.0 / 25.4;
+        let (w, h) = (self.size.x * PT, self.size.y * PT);
+        let mut content = String::new();
+        for (k, layer) in Layer::ALL.iter().enumerate() {
+            let st = stroke(*layer);
+            let _ = writeln!(content, "/OC /L{k} BDC");
+            let dash =
+                if st.dash > 0.0 { format!("[{:.3} {:.3}] 0 d", st.dash * PT, st.dash * PT) } else { "[] 0 d".into() };
+            let _ = writeln!(content, "{:.3} G {:.3} w 1 J 1 j {dash}", st.grey.clamp(0.0, 1.0), st.width * PT);
+            for (_, pts) in self.lines.iter().filter(|(l, _)| l == layer) {
+                for (i, p) in pts.iter().enumerate() {
+                    let _ = write!(content, "{:.3} {:.3} {} ", p.x * PT, h - p.y * PT, if i == 0 { "m" } else { "l" });
+                }
+                content.push_str("S\n");
+            }
+            content.push_str("EMC\n");
+        }
+        let n = Layer::ALL.len();
+        let ocgs: Vec<String> = (0..n).map(|k| format!("{} 0 R", 6 + k)).collect();
+        let props: Vec<String> = (0..n).map(|k| format!("/L{k} {} 0 R", 6 + k)).collect();
+        let mut objects = vec![
+            format!(
+                "<< /Type /Catalog /Pages 2 0 R /OCProperties << /OCGs [{0}] /D << /Order [{0}] >> >> >>",
+                ocgs.join(" ")
+            ),
+            "<< /Type /Pages /Kids [3 0 R] /Count 1 >>".to_string(),
+            format!(
+                "<< /Type /Page /Parent 2 0 R /MediaBox [0 0 {w:.3} {h:.3}] /Contents 4 0 R /Resources << /Properties << {} >> >> >>",
+                props.join(" ")
+            ),
+            format!("<< /Length {} >>\nstream\n{content}endstream", content.len()),
+            "<< /Producer (alhazen lines) >>".to_string(),
+        ];
+        for layer in Layer::ALL {
+            objects.push(format!("<< /Type /OCG /Name ({}) >>", layer.name()));
+        }
+        let mut out = b"%PDF-1.5\n%\xe2\xe3\xcf\xd3\n".to_vec();
+        let mut offsets = vec![];
+        for (i, o) in objects.iter().enumerate() {
+            offsets.push(out.len());
+            out.extend_from_slice(format!("{} 0 obj\n{o}\nendobj\n", i + 1).as_bytes());
+        }
+        let xref = out.len();
+        let mut tail = format!("xref\n0 {}\n0000000000 65535 f \n", objects.len() + 1);
+        for off in offsets {
+            let _ = writeln!(tail, "{off:010} 00000 n ");
+        }
+        let _ = write!(
+            tail,
+            "trailer\n<< /Size {} /Root 1 0 R /Info 5 0 R >>\nstartxref\n{xref}\n%%EOF\n",
+            objects.len() + 1
+        );
+        out.extend_from_slice(tail.as_bytes());
+        out
+    }
+
+    /// An antialiased greyscale preview `px` pixels wide: each pixel's coverage by each stroke
+    /// from the exact distance of its centre to the segment (round caps), darkest wins.
+    pub fn to_pixels(&self, px: u32, stroke: impl Fn(Layer) -> Stroke) -> (u32, u32, Vec<u8>) {
+        let scale = px as f64 / self.size.x.max(1e-9);
+        let (w, h) = (px, ((self.size.y * scale).round() as u32).max(1));
+        let mut ink = vec![0.0f32; (w * h) as usize];
+        for (layer, pts) in &self.lines {
+            let st = stroke(*layer);
+            let half = (0.5 * st.width * scale).max(0.5);
+            let darkness = (1.0 - st.grey.clamp(0.0, 1.0)) as f32;
+            let mut walked = 0.0;
+            for seg in pts.windows(2) {
+                let (a, b) = (seg[0] * scale, seg[1] * scale);
+                let len = (b - a).length();
+                if st.dash > 0.0 {
+                    let period = 2.0 * st.dash * scale;
+                    // Draw the dashes of this segment as sub-segments.
+                    let mut t = 0.0;
+                    while t < len {
+                        let phase = (walked + t) % period;
+                        let run = if phase < period / 2.0 { period / 2.0 - phase } else { period - phase };
+                        let end = (t + run).min(len);
+                        if phase < period / 2.0 {
+                            let d = (b - a) / len.max(1e-12);
+                            stamp(&mut ink, (w, h), a + d * t, a + d * end, half, darkness);
+                        }
+                        t = end;
+                    }
+                } else {
+                    stamp(&mut ink, (w, h), a, b, half, darkness);
+                }
+                walked += len;
+            }
+        }
+        let pixels = ink.iter().map(|&k| (255.0 * (1.0 - k.clamp(0.0, 1.0))).round() as u8).collect();
+        (w, h, pixels)
+    }
+}
+
+impl Drawing {
+    /// The preview encoded as an 8-bit greyscale PNG.
+    pub fn to_png(&self, px: u32, stroke: impl Fn(Layer) -> Stroke) -> Result<Vec<u8>, image::ImageError> {
+        use image::ImageEncoder;
+        let (w, h, pixels) = self.to_pixels(px, stroke);
+        let mut out = vec![];
+        image::codecs::png::PngEncoder::new(&mut out).write_image(&pixels, w, h, image::ExtendedColorType::L8)?;
+        Ok(out)
+    }
+}
+
+/// Darkens the pixels near segment `a b` by their coverage (1 inside, a one-pixel ramp at
+/// distance `half`).
+fn stamp(ink: &mut [f32], (w, h): (u32, u32), a: Vec2, b: Vec2, half: f64, darkness: f32) {
+    let lo = (a.min(b) - Vec2::splat(half + 1.0)).max(Vec2::ZERO);
+    let hi = (a.max(b) + Vec2::splat(half + 1.0)).min(Vec2::new(w as f64 - 1.0, h as f64 - 1.0));
+    if lo.x > hi.x || lo.y > hi.y {
+        return;
+    }
+    let d = b - a;
+    let l2 = d.length_squared();
+    for y in lo.y as u32..=hi.y as u32 {
+        for x in lo.x as u32..=hi.x as u32 {
+            let p = Vec2::new(x as f64 + 0.5, y as f64 + 0.5);
+            let t = if l2 > 0.0 { ((p - a).dot(d) / l2).clamp(0.0, 1.0) } else { 0.0 };
+            let dist = (p - (a + d * t)).length();
+            let cover = (half + 0.5 - dist).clamp(0.0, 1.0) as f32 * darkness;
+            let k = &mut ink[(y * w + x) as usize];
+            *k = k.max(cover);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Drawing {
+        let p = |x, y| Vec2::new(x, y);
+        Drawing { size: p(20.0, 10.0), lines: vec![(Layer::Visible, vec![p(2.0, 2.0), p(18.0, 2.0), p(18.0, 8.0)])] }
+    }
+
+    #[test]
+    fn svg_has_a_group_per_layer_and_exact_coordinates() {
+        let s = square().to_svg(default_stroke);
+        assert!(s.contains("width=\"20.000mm\""));
+        assert!(s.contains("<g id=\"visible\"") && s.contains("<g id=\"hidden\"") && s.contains("<g id=\"reflected\""));
+        assert!(s.contains("2.000,2.000 18.000,2.000 18.000,8.000"));
+    }
+
+    #[test]
+    fn pdf_cross_reference_points_at_its_objects() {
+        let pdf = square().to_pdf(default_stroke);
+        let at = |off: usize, what: &str| pdf[off..].starts_with(what.as_bytes());
+        let text = String::from_utf8_lossy(&pdf[20..]).into_owned();
+        let xref: usize = text.rsplit("startxref\n").next().unwrap().lines().next().unwrap().parse().unwrap();
+        assert!(at(xref, "xref"));
+        let table = String::from_utf8_lossy(&pdf[xref..]).into_owned();
+        for (k, line) in table.lines().skip(3).take(8).enumerate() {
+            let off: usize = line[..10].parse().unwrap();
+            assert!(at(off, &format!("{} 0 obj", k + 1)), "object {}", k + 1);
+        }
+        assert!(text.contains("/OCG /Name (visible)"));
+    }
+
+    #[test]
+    fn preview_inks_the_line_and_nothing_far_from_it() {
+        let (w, h, px) = square().to_pixels(200, default_stroke);
+        assert_eq!((w, h), (200, 100));
+        assert!(px[(20 * w + 100) as usize] < 60, "on the line");
+        assert_eq!(px[(60 * w + 60) as usize], 255, "far from it");
+    }
+}

@@ -1,0 +1,163 @@
+//! `alhazen-lines`: exact line drawings of a scene with its reflections in spherical and
+//! cylindrical mirrors — Glaeser, *Reflections on spheres and cylinders of revolution*, §3–4,
+//! and the course's visibility algorithms for line drawings.
+//!
+//! The pipeline, one module each:
+//! * [`curves`] — the lines in space: mesh edges (boundary, feature by dihedral angle,
+//!   silhouettes), exact contours of spheres, cylinders and cones, rims;
+//! * [`visibility`] — hidden-line removal: lines are cut where their images cross (segment
+//!   against segment with robust orientation tests) or where they pierce a surface, and each
+//!   piece is decided by one exact ray test;
+//! * [`reflect`] — every line reflected in every mirror by the exact reflex solver, knots as in
+//!   the paper's Fig. 16, drawn where the eye sees the mirror point and the reflected ray
+//!   reaches the line;
+//! * [`drawing`] — millimetres on paper: SVG, PDF (layers), antialiased PNG preview;
+//! * [`horizon`] — the floating-horizon algorithm for graphs `z = f(x, y)`.
+//!
+//! ```no_run
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let scene = alhazen_scene::load_scene(std::path::Path::new("scenes/lines/fig21-cylinder-in-sphere.toml"))?;
+//! let (drawing, stats) = alhazen_lines::draw(&scene, &alhazen_lines::Options::default())?;
+//! std::fs::write("fig21.svg", drawing.to_svg(alhazen_lines::drawing::default_stroke))?;
+//! println!("{} visible polylines", stats.visible);
+//! # Ok(()) }
+//! ```
+
+pub mod contour;
+pub mod curves;
+pub mod drawing;
+pub mod horizon;
+pub mod reflect;
+pub mod view;
+pub mod visibility;
+
+use alhazen_math::Vec3;
+use alhazen_raster::pipeline::RasterError;
+use alhazen_render::World;
+use alhazen_scene::Scene;
+use drawing::{Drawing, Layer};
+use rayon::prelude::*;
+
+/// What to draw and how finely.
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    /// Paper width in millimetres (the height follows the scene's aspect ratio).
+    pub width_mm: f64,
+    /// Largest distance on paper between a drawn chord and the true curve, millimetres.
+    pub tol_mm: f64,
+    /// Mesh edges whose faces meet at more than this angle (degrees) are drawn.
+    pub feature_angle_deg: f64,
+    /// Keep hidden lines (on their own layer).
+    pub hidden: bool,
+    /// Draw reflections in spherical and cylindrical mirrors.
+    pub reflections: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options { width_mm: 200.0, tol_mm: 0.005, feature_angle_deg: 30.0, hidden: false, reflections: true }
+    }
+}
+
+/// What a drawing holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Lines found in the scene (edges, contours, rims).
+    pub scene_lines: usize,
+    /// Visible polylines.
+    pub visible: usize,
+    /// Hidden polylines.
+    pub hidden: usize,
+    /// Reflected polylines.
+    pub reflected: usize,
+    /// Mirrors found.
+    pub mirrors: usize,
+    /// Round objects drawn from their tessellation (their transform is not a similarity).
+    pub tessellated: usize,
+    /// Objects without lines (planes, CSG).
+    pub skipped: usize,
+}
+
+/// Draws `scene` from its camera.
+pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterError> {
+    let world = World::build(scene);
+    let view = view::View::new(scene, &world, opts.width_mm)?;
+    let edge_opts = curves::EdgeOptions { feature_angle: opts.feature_angle_deg.to_radians() };
+    let (lines, tessellated, skipped) = curves::scene_lines(scene, &view, &edge_opts);
+    let chords = visibility::chords(&lines, &view, opts.tol_mm);
+    let pieces = visibility::pieces(&lines, &chords, &view, &world);
+    let mut drawing = Drawing { size: view.paper(), lines: vec![] };
+    for p in &pieces {
+        if !p.visible && !opts.hidden {
+            continue;
+        }
+        let layer = if p.visible { Layer::Visible } else { Layer::Hidden };
+        drawing.lines.push((layer, polyline(&lines[p.line].curve, p.s, &view, opts.tol_mm)));
+    }
+    let mirrors = if opts.reflections { reflect::mirrors(scene) } else { vec![] };
+    let tol_px = opts.tol_mm / view.mm_per_px;
+    let ropts = reflect::ReflectOptions { tol_px, knots: 16 };
+    let jobs: Vec<(usize, usize)> = (0..mirrors.len()).flat_map(|m| (0..lines.len()).map(move |l| (m, l))).collect();
+    let reflected: Vec<Vec<Vec<Vec3>>> =
+        jobs.par_iter().map(|&(m, l)| reflect::reflect_line(&mirrors[m], &lines[l], &view, &world, &ropts)).collect();
+    let mut reflected = reflected;
+    reflected.extend(reflex_contours(scene, &mirrors, &view, &world, tol_px));
+    for run in reflected.into_iter().flatten() {
+        drawing.lines.push((Layer::Reflected, run.iter().map(|p| view.to_paper(*p)).collect()));
+    }
+    let drawing = drawing.clipped();
+    let stats = Stats {
+        scene_lines: lines.len(),
+        visible: drawing.count(Layer::Visible),
+        hidden: drawing.count(Layer::Hidden),
+        reflected: drawing.count(Layer::Reflected),
+        mirrors: mirrors.len(),
+        tessellated,
+        skipped,
+    };
+    Ok((drawing, stats))
+}
+
+/// The reflex contours (Theorem 10) of every sphere, cylinder and cone in every mirror.
+fn reflex_contours(
+    scene: &Scene,
+    mirrors: &[reflect::Mirror],
+    view: &view::View,
+    world: &World,
+    tol_px: f64,
+) -> Vec<Vec<Vec<Vec3>>> {
+    let jobs: Vec<(usize, usize)> =
+        (0..mirrors.len()).flat_map(|m| (0..scene.objects.len()).map(move |o| (m, o))).collect();
+    jobs.par_iter()
+        .filter(|&&(m, o)| mirrors[m].object() != o as u32)
+        .filter_map(|&(m, o)| {
+            let obj = &scene.objects[o];
+            let surface = contour::Surface::of(&obj.shape, &obj.transform, mirrors[m].center())?;
+            let curves = contour::reflex_contour(&surface, &mirrors[m], view);
+            let runs = curves.iter().flat_map(|c| {
+                let knots = reflect::uniform(c.len() - 1);
+                reflect::reflect_path(
+                    &mirrors[m],
+                    reflect::polyline_path(c),
+                    &knots,
+                    Some(o as u32),
+                    view,
+                    world,
+                    tol_px,
+                )
+            });
+            Some(runs.collect::<Vec<_>>())
+        })
+        .collect()
+}
+
+/// The piece `s` of a curve as a polyline on paper within `tol_mm`.
+fn polyline(curve: &curves::Curve, s: (f64, f64), view: &view::View, tol_mm: f64) -> Vec<alhazen_math::Vec2> {
+    let knots = curve.knots(view, tol_mm);
+    let mut pts = vec![view.to_paper(curve.point(s.0))];
+    for &k in knots.iter().filter(|&&k| k > s.0 && k < s.1) {
+        pts.push(view.to_paper(curve.point(k)));
+    }
+    pts.push(view.to_paper(curve.point(s.1)));
+    pts
+}

@@ -1,0 +1,115 @@
+//! The drawing's camera: the scene camera as the course's viewing and projection matrices
+//! (shared with the raster preview), film pixels → millimetres on paper, and the one exact
+//! visibility question every line asks: does the ray from the eye reach this point?
+
+use alhazen_math::{Mat4, Ray, Vec2, Vec3, Vec4};
+use alhazen_mirror::Site;
+use alhazen_raster::pipeline::{Projection, RasterError, projection};
+use alhazen_render::World;
+use alhazen_scene::Scene;
+
+/// Clip-space `w` below which a point counts as behind the eye (relative to the view's scale).
+const NEAR_W: f64 = 1e-6;
+
+/// A camera that maps world points to the paper and answers visibility by ray casting.
+pub struct View {
+    world_to_clip: Mat4,
+    /// Film size in pixels (the scene's image size).
+    pub film: (u32, u32),
+    /// Millimetres per film pixel.
+    pub mm_per_px: f64,
+    /// The eye, or `None` for parallel projections.
+    pub eye: Option<Vec3>,
+    /// Viewing direction (from the eye into the scene), unit.
+    pub dir: Vec3,
+    /// A length larger than the scene, for parallel rays' origins and tolerances.
+    pub scale: f64,
+    near_w: f64,
+}
+
+impl View {
+    /// The scene camera on paper `width_mm` wide.
+    pub fn new(scene: &Scene, world: &World, width_mm: f64) -> Result<View, RasterError> {
+        let (w, h) = (scene.render.width, scene.render.height);
+        let Projection { world_to_clip, frame, perspective, .. } = projection(&scene.camera, w, h)?;
+        let b = world.bounds();
+        let scale = if b.is_empty() { 1.0 } else { (b.max - b.min).length().max(1e-9) + frame.eye.length() };
+        let near_w = if perspective { NEAR_W * scale } else { f64::NEG_INFINITY };
+        Ok(View {
+            world_to_clip,
+            film: (w, h),
+            mm_per_px: width_mm / w as f64,
+            eye: perspective.then_some(frame.eye),
+            dir: -frame.w,
+            scale,
+            near_w,
+        })
+    }
+
+    /// Clip-space `w` of a point: positive in front of the eye (1 for parallel views).
+    pub fn depth(&self, p: Vec3) -> f64 {
+        (self.world_to_clip * p.extend(1.0)).w
+    }
+
+    /// True when `p` is in front of the eye (far enough not to blow up the projection).
+    pub fn in_front(&self, p: Vec3) -> bool {
+        self.depth(p) > self.near_w
+    }
+
+    /// Film position in pixels (`y` down) of a point in front of the eye.
+    pub fn to_film(&self, p: Vec3) -> Vec2 {
+        let c: Vec4 = self.world_to_clip * p.extend(1.0);
+        let (x, y) = (c.x / c.w, c.y / c.w);
+        let (w, h) = (self.film.0 as f64, self.film.1 as f64);
+        Vec2::new((x + 1.0) * 0.5 * w, (1.0 - y) * 0.5 * h)
+    }
+
+    /// Paper position in millimetres (`y` down, origin top left).
+    pub fn to_paper(&self, p: Vec3) -> Vec2 {
+        self.to_film(p) * self.mm_per_px
+    }
+
+    /// Paper size in millimetres.
+    pub fn paper(&self) -> Vec2 {
+        Vec2::new(self.film.0 as f64, self.film.1 as f64) * self.mm_per_px
+    }
+
+    /// The eye for the mirror solver: a point, or the direction towards the viewer.
+    pub fn viewer(&self) -> Site {
+        match self.eye {
+            Some(e) => Site::At(e),
+            None => Site::Toward(-self.dir),
+        }
+    }
+
+    /// The parameter along a 3D chord `a → b` of the point at parameter `t` of its projection:
+    /// central projection is projective on a line, so equal steps on paper are not equal steps
+    /// in space.
+    pub fn chord_param(&self, a: Vec3, b: Vec3, t: f64) -> f64 {
+        let (wa, wb) = (self.depth(a), self.depth(b));
+        let den = (1.0 - t) * wb + t * wa;
+        if den.abs() < 1e-300 { t } else { t * wa / den }
+    }
+
+    /// The ray from the eye towards `p` and the distance to `p`.
+    pub fn eye_ray(&self, p: Vec3) -> (Ray, f64) {
+        match self.eye {
+            Some(e) => {
+                let d = p - e;
+                let dist = d.length();
+                (Ray::new(e, d / dist.max(1e-300)), dist)
+            }
+            None => {
+                let back = 4.0 * self.scale;
+                (Ray::new(p - self.dir * back, self.dir), back)
+            }
+        }
+    }
+
+    /// Exact visibility of a point on (or near) a surface: nothing is hit before it, allowing
+    /// for the surface the point itself lies on (a relative 1e-6 of the distance).
+    pub fn sees(&self, world: &World, p: Vec3) -> bool {
+        let (ray, dist) = self.eye_ray(p);
+        world.intersect(&ray, dist * (1.0 - 1e-6)).is_none()
+    }
+}
