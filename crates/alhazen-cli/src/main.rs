@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+mod anamorph;
 mod lines;
 mod mirror;
 mod raster;

@@ -35,6 +35,12 @@ and processing continues; the exit code is 2 if any line was bad."#)]
     /// (the paper's Fig. 12) as SVG.
     #[command(after_help = "Example:\n  alhazen mirror conics --radius 1 --eye 3,0 --point 1.2,1.8 -o conics.svg")]
     Conics(ConicsArgs),
+    /// The print to lay around a mirror cylinder so that a picture appears undistorted in it
+    /// from the eye (the paper's anamorphoses, §2.4).
+    #[command(
+        after_help = "Examples:\n  alhazen mirror anamorph picture.png --radius 40 --height 150 --eye 0,300,400 --paper A3 --dpi 300 -o print.pdf\n  alhazen mirror anamorph drawing.svg --radius 40 --height 150 --eye 0,300,400 -o print.svg\n\nUnits are millimetres, y up, the cylinder stands on the paper with its axis on the y axis."
+    )]
+    Anamorph(crate::anamorph::AnamorphArgs),
 }
 
 #[derive(Args)]
@@ -101,6 +107,7 @@ pub fn run(cmd: &MirrorCommand) -> Result<(), Failure> {
             let svg = figures::conics_svg(a.radius, a.eye, a.point).map_err(|e| Failure::input(e.to_string()))?;
             write_text(&a.output, &svg)
         }
+        MirrorCommand::Anamorph(a) => crate::anamorph::run(a),
     }
 }
 

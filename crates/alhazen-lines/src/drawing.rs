@@ -146,9 +146,18 @@ impl Drawing {
 
     /// A one-page PDF of the paper's size with one optional-content layer per layer.
     pub fn to_pdf(&self, stroke: impl Fn(Layer) -> Stroke) -> Vec<u8> {
+        self.to_pdf_over(stroke, None)
+    }
+
+    /// The PDF with an RGB raster (`width × height`, 8 bits, row-major) filling the page under
+    /// the lines, compressed with Flate.
+    pub fn to_pdf_over(&self, stroke: impl Fn(Layer) -> Stroke, backdrop: Option<&Backdrop>) -> Vec<u8> {
         const PT: f64 = 72.0 / 25.4;
         let (w, h) = (self.size.x * PT, self.size.y * PT);
         let mut content = String::new();
+        if backdrop.is_some() {
+            let _ = writeln!(content, "q {w:.3} 0 0 {h:.3} 0 0 cm /Im0 Do Q");
+        }
         for (k, layer) in Layer::ALL.iter().enumerate() {
             let st = stroke(*layer);
             let _ = writeln!(content, "/OC /L{k} BDC");
@@ -164,6 +173,8 @@ impl Drawing {
             content.push_str("EMC\n");
         }
         let n = Layer::ALL.len();
+        let image_obj = 6 + n;
+        let xobject = if backdrop.is_some() { format!(" /XObject << /Im0 {image_obj} 0 R >>") } else { String::new() };
         let ocgs: Vec<String> = (0..n).map(|k| format!("{} 0 R", 6 + k)).collect();
         let props: Vec<String> = (0..n).map(|k| format!("/L{k} {} 0 R", 6 + k)).collect();
         let mut objects = vec![
@@ -173,7 +184,7 @@ impl Drawing {
             ),
             "<< /Type /Pages /Kids [3 0 R] /Count 1 >>".to_string(),
             format!(
-                "<< /Type /Page /Parent 2 0 R /MediaBox [0 0 {w:.3} {h:.3}] /Contents 4 0 R /Resources << /Properties << {} >> >> >>",
+                "<< /Type /Page /Parent 2 0 R /MediaBox [0 0 {w:.3} {h:.3}] /Contents 4 0 R /Resources << /Properties << {} >>{xobject} >> >>",
                 props.join(" ")
             ),
             format!("<< /Length {} >>\nstream\n{content}endstream", content.len()),
@@ -188,8 +199,27 @@ impl Drawing {
             offsets.push(out.len());
             out.extend_from_slice(format!("{} 0 obj\n{o}\nendobj\n", i + 1).as_bytes());
         }
+        if let Some(b) = backdrop {
+            use std::io::Write as _;
+            let mut z = flate2::write::ZlibEncoder::new(vec![], flate2::Compression::default());
+            let _ = z.write_all(&b.rgb);
+            let data = z.finish().unwrap_or_default();
+            offsets.push(out.len());
+            out.extend_from_slice(
+                format!(
+                    "{image_obj} 0 obj\n<< /Type /XObject /Subtype /Image /Width {} /Height {} /ColorSpace /DeviceRGB /BitsPerComponent 8 /Filter /FlateDecode /Length {} >>\nstream\n",
+                    b.width,
+                    b.height,
+                    data.len()
+                )
+                .as_bytes(),
+            );
+            out.extend_from_slice(&data);
+            out.extend_from_slice(b"\nendstream\nendobj\n");
+        }
+        let count = offsets.len();
         let xref = out.len();
-        let mut tail = format!("xref\n0 {}\n0000000000 65535 f \n", objects.len() + 1);
+        let mut tail = format!("xref\n0 {}\n0000000000 65535 f \n", count + 1);
         for off in offsets {
             let _ = writeln!(tail, "{off:010} 00000 n ");
         }
@@ -250,6 +280,17 @@ impl Drawing {
         image::codecs::png::PngEncoder::new(&mut out).write_image(&pixels, w, h, image::ExtendedColorType::L8)?;
         Ok(out)
     }
+}
+
+/// An 8-bit RGB raster to put under a PDF's lines.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Backdrop {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width × height × 3` bytes, rows top to bottom.
+    pub rgb: Vec<u8>,
 }
 
 /// Darkens the pixels near segment `a b` by their coverage (1 inside, a one-pixel ramp at

@@ -38,6 +38,7 @@
 //! assert!((to_eye.dot(n) - to_light.dot(n)).abs() < 1e-12);
 //! ```
 
+pub mod anamorph;
 pub mod batch;
 pub mod caustic;
 pub mod circle;
