@@ -37,6 +37,10 @@ pub struct LinesArgs {
     /// Width of a PNG preview in pixels.
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(16..=20000))]
     png_width: u32,
+    /// Decide visibility by ray tests every STEP film pixels instead of exactly (the
+    /// benchmark's baseline, as fogleman/ln draws).
+    #[arg(long, value_name = "STEP", value_parser = positive)]
+    sampled: Option<f64>,
     /// Draw the graph of a built-in function with the floating-horizon algorithm.
     #[arg(long, value_enum)]
     graph: Option<GraphFunction>,
@@ -106,6 +110,7 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
                 feature_angle_deg: a.feature_angle,
                 hidden: a.hidden,
                 reflections: !a.no_reflections,
+                sampled: a.sampled,
                 ..Options::default()
             };
             let (d, s) =

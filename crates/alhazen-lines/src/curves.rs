@@ -36,6 +36,20 @@ pub enum Curve {
         /// End angle.
         end: f64,
     },
+    /// `center + u cos θ + v sin θ` for θ from `start` to `end` (`u`, `v` conjugate
+    /// semi-diameters): a cylinder's plane section.
+    Ellipse {
+        /// Centre.
+        center: Vec3,
+        /// Semi-diameter at θ = 0.
+        u: Vec3,
+        /// Conjugate semi-diameter at θ = π/2.
+        v: Vec3,
+        /// Start angle.
+        start: f64,
+        /// End angle.
+        end: f64,
+    },
 }
 
 impl Curve {
@@ -46,6 +60,10 @@ impl Curve {
             Curve::Arc { center, u, v, radius, start, end } => {
                 let th = start + (end - start) * s;
                 center + (u * th.cos() + v * th.sin()) * radius
+            }
+            Curve::Ellipse { center, u, v, start, end } => {
+                let th = start + (end - start) * s;
+                center + u * th.cos() + v * th.sin()
             }
         }
     }
@@ -60,15 +78,21 @@ impl Curve {
     pub fn knots(&self, view: &View, tol_mm: f64) -> Vec<f64> {
         match *self {
             Curve::Segment { .. } => vec![0.0, 1.0],
-            Curve::Arc { center, radius, start, end, .. } => {
-                // Radius on paper at the circle's depth bounds the chord error r(1 − cos(Δ/2)).
-                let mm = radius * view.mm_per_px * view_px_per_unit(view, center);
-                let step = if mm > 0.0 { (8.0 * tol_mm / mm).sqrt().min(0.5) } else { 0.5 };
-                let n = (((end - start).abs() / step).ceil() as usize).clamp(8, 20_000);
-                (0..=n).map(|k| k as f64 / n as f64).collect()
+            Curve::Arc { center, radius, start, end, .. } => round_knots(view, tol_mm, center, radius, end - start),
+            Curve::Ellipse { center, u, v, start, end } => {
+                round_knots(view, tol_mm, center, u.length().max(v.length()), end - start)
             }
         }
     }
+}
+
+/// Knots of an arc of radius (at most) `radius` spanning `angle`, chords within `tol_mm`.
+fn round_knots(view: &View, tol_mm: f64, center: Vec3, radius: f64, angle: f64) -> Vec<f64> {
+    // Radius on paper at the circle's depth bounds the chord error r(1 − cos(Δ/2)).
+    let mm = radius * view.mm_per_px * view_px_per_unit(view, center);
+    let step = if mm > 0.0 { (8.0 * tol_mm / mm).sqrt().min(0.5) } else { 0.5 };
+    let n = ((angle.abs() / step).ceil() as usize).clamp(8, 20_000);
+    (0..=n).map(|k| k as f64 / n as f64).collect()
 }
 
 /// Film pixels per world unit near `p` (the projection's local scale).

@@ -72,7 +72,7 @@ impl Drawing {
             .iter()
             .filter(|(l, _)| *l == layer)
             .map(|(_, p)| p.windows(2).map(|w| (w[1] - w[0]).length()).sum::<f64>())
-            .sum()
+            .fold(0.0, |a, b| a + b)
     }
 
     /// The drawing cut to its paper by the course's Liang–Barsky clipping: polylines leaving

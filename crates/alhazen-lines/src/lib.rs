@@ -8,6 +8,8 @@
 //! * [`visibility`] — hidden-line removal: lines are cut where their images cross (segment
 //!   against segment with robust orientation tests) or where they pierce a surface, and each
 //!   piece is decided by one exact ray test;
+//! * [`intersect`] — intersection curves where objects meet (plane sections of spheres and
+//!   cylinders, sphere pairs, face pairs), exactly;
 //! * [`reflect`] — every line reflected in every mirror by the exact reflex solver, knots as in
 //!   the paper's Fig. 16, drawn where the eye sees the mirror point and the reflected ray
 //!   reaches the line;
@@ -27,6 +29,7 @@ pub mod contour;
 pub mod curves;
 pub mod drawing;
 pub mod horizon;
+pub mod intersect;
 pub mod reflect;
 pub mod view;
 pub mod visibility;
@@ -49,13 +52,23 @@ pub struct Options {
     pub feature_angle_deg: f64,
     /// Keep hidden lines (on their own layer).
     pub hidden: bool,
-    /// Draw reflections in spherical and cylindrical mirrors.
+    /// Draw reflections in spherical, cylindrical and plane mirrors.
     pub reflections: bool,
+    /// Decide visibility by sampling every this many film pixels instead of exactly (the
+    /// baseline of the benchmark, as fogleman/ln does).
+    pub sampled: Option<f64>,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { width_mm: 200.0, tol_mm: 0.005, feature_angle_deg: 30.0, hidden: false, reflections: true }
+        Options {
+            width_mm: 200.0,
+            tol_mm: 0.005,
+            feature_angle_deg: 30.0,
+            hidden: false,
+            reflections: true,
+            sampled: None,
+        }
     }
 }
 
@@ -83,9 +96,13 @@ pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterErr
     let world = World::build(scene);
     let view = view::View::new(scene, &world, opts.width_mm)?;
     let edge_opts = curves::EdgeOptions { feature_angle: opts.feature_angle_deg.to_radians() };
-    let (lines, tessellated, skipped) = curves::scene_lines(scene, &view, &edge_opts);
+    let (mut lines, tessellated, skipped) = curves::scene_lines(scene, &view, &edge_opts);
+    lines.extend(intersect::intersection_lines(scene));
     let chords = visibility::chords(&lines, &view, opts.tol_mm);
-    let pieces = visibility::pieces(&lines, &chords, &view, &world);
+    let pieces = match opts.sampled {
+        Some(step) => visibility::pieces_sampled(&lines, &chords, &view, &world, step),
+        None => visibility::pieces(&lines, &chords, &view, &world),
+    };
     let mut drawing = Drawing { size: view.paper(), lines: vec![] };
     for p in &pieces {
         if !p.visible && !opts.hidden {

@@ -14,8 +14,19 @@ use alhazen_render::World;
 use alhazen_scene::{Scene, Shape};
 
 /// A mirror of the scene.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum Mirror {
+    /// A plane mirror (Glaeser's Fig. 3): a disk or a flat mesh such as a `rectangle`.
+    Plane {
+        /// A point of the plane.
+        point: Vec3,
+        /// Unit normal on the mirroring side.
+        normal: Vec3,
+        /// Its outline.
+        extent: Extent,
+        /// Scene object index.
+        object: u32,
+    },
     /// A spherical mirror.
     Sphere {
         /// The sphere.
@@ -32,7 +43,47 @@ pub enum Mirror {
     },
 }
 
-/// The spheres and cylinders of the scene with a mirror reflectance, placed by a similarity.
+/// The outline of a plane mirror.
+#[derive(Clone, Debug)]
+pub enum Extent {
+    /// A disk of this radius about the plane's point.
+    Disk(f64),
+    /// Triangles (in the plane).
+    Triangles(std::sync::Arc<Vec<[Vec3; 3]>>),
+}
+
+impl Extent {
+    fn contains(&self, center: Vec3, normal: Vec3, p: Vec3) -> bool {
+        match self {
+            Extent::Disk(r) => (p - center).length_squared() <= r * r,
+            Extent::Triangles(tris) => tris.iter().any(|t| {
+                let side = |a: Vec3, b: Vec3| (b - a).cross(p - a).dot(normal) >= 0.0;
+                side(t[0], t[1]) && side(t[1], t[2]) && side(t[2], t[0])
+            }),
+        }
+    }
+}
+
+/// A flat mesh as a plane mirror: all its triangles in one plane, wound alike.
+fn flat_mirror(scene: &Scene, o: &alhazen_scene::Object, object: u32) -> Option<Mirror> {
+    let tris: Vec<[Vec3; 3]> =
+        alhazen_raster::pipeline::geometry::world_triangles(scene, o)?.iter().map(|t| t.map(|v| v.p)).collect();
+    let first = tris.first()?;
+    let normal = (first[1] - first[0]).cross(first[2] - first[0]).try_normalize()?;
+    let point = first[0];
+    let size = tris.iter().flatten().map(|p| (*p - point).length()).fold(0.0, f64::max);
+    let flat = tris.iter().flatten().all(|p| (*p - point).dot(normal).abs() <= 1e-9 * size.max(1.0));
+    let alike = tris.iter().all(|t| (t[1] - t[0]).cross(t[2] - t[0]).dot(normal) > 0.0);
+    (flat && alike).then(|| Mirror::Plane {
+        point,
+        normal,
+        extent: Extent::Triangles(std::sync::Arc::new(tris)),
+        object,
+    })
+}
+
+/// The spheres, cylinders and plane mirrors (disks, flat meshes) of the scene with a mirror
+/// reflectance; round ones placed by a similarity.
 pub fn mirrors(scene: &Scene) -> Vec<Mirror> {
     let mut out = vec![];
     for (i, o) in scene.objects.iter().enumerate() {
@@ -41,13 +92,25 @@ pub fn mirrors(scene: &Scene) -> Vec<Mirror> {
             continue;
         }
         let t = &o.transform;
+        let object = i as u32;
+        if let Shape::Mesh { .. } = o.shape {
+            out.extend(flat_mirror(scene, o, object));
+            continue;
+        }
+        if let Shape::Disk { center, normal, radius } = o.shape {
+            let (c, n) = (t.point(center), t.normal(normal).normalize());
+            // A disk stays round only under a similarity; its rim's radius is measured.
+            let (u, _) = alhazen_math::orthonormal_basis(normal);
+            let r = (t.point(center + u * radius) - c).length();
+            out.push(Mirror::Plane { point: c, normal: n, extent: Extent::Disk(r), object });
+            continue;
+        }
         let scale = t.vector(Vec3::X).length();
         let uniform = (t.vector(Vec3::Y).length() - scale).abs() < 1e-9 * scale
             && (t.vector(Vec3::Z).length() - scale).abs() < 1e-9 * scale;
         if !uniform {
             continue;
         }
-        let object = i as u32;
         match o.shape {
             Shape::Sphere { center, radius } => {
                 out.push(Mirror::Sphere { sphere: Sphere { center: t.point(center), radius: radius * scale }, object })
@@ -97,7 +160,7 @@ impl Mirror {
     /// Scene object index.
     pub fn object(&self) -> u32 {
         match *self {
-            Mirror::Sphere { object, .. } | Mirror::Cylinder { object, .. } => object,
+            Mirror::Sphere { object, .. } | Mirror::Cylinder { object, .. } | Mirror::Plane { object, .. } => object,
         }
     }
 
@@ -106,12 +169,35 @@ impl Mirror {
         match self {
             Mirror::Sphere { sphere, .. } => sphere.center,
             Mirror::Cylinder { cylinder, .. } => cylinder.center + cylinder.axis * 0.5,
+            Mirror::Plane { point, .. } => *point,
         }
     }
 
     /// The visible reflex of `s` on the mirror seen from `viewer`.
     pub fn reflex(&self, viewer: Site, s: Vec3) -> Option<Vec3> {
         match self {
+            Mirror::Plane { point, normal, extent, .. } => {
+                let ds = (s - *point).dot(*normal);
+                let r = match viewer {
+                    Site::At(e) => {
+                        let de = (e - *point).dot(*normal);
+                        if ds <= 0.0 || de <= 0.0 {
+                            return None;
+                        }
+                        // The eye's ray to the mirror image of s meets the plane at R.
+                        let image = s - *normal * (2.0 * ds);
+                        e + (image - e) * (de / (de + ds))
+                    }
+                    Site::Toward(d) => {
+                        let dn = d.dot(*normal);
+                        if ds <= 0.0 || dn <= 0.0 {
+                            return None;
+                        }
+                        s + (d - *normal * (2.0 * dn)) * (ds / dn)
+                    }
+                };
+                extent.contains(*point, *normal, r).then_some(r)
+            }
             Mirror::Sphere { sphere, .. } => sphere.visible_reflex(viewer, Site::At(s)).ok().flatten().map(|r| r.point),
             Mirror::Cylinder { cylinder, .. } => {
                 let r = cylinder.visible_reflex(viewer, Site::At(s)).ok().flatten()?.point;
@@ -138,6 +224,8 @@ impl Mirror {
         let (m, r, axis) = match *self {
             Mirror::Sphere { sphere, .. } => (sphere.center, sphere.radius, None),
             Mirror::Cylinder { cylinder, .. } => (cylinder.center, cylinder.radius, Some(cylinder.axis.normalize())),
+            // The reflex of a line in a plane is a line: uniform knots do.
+            Mirror::Plane { .. } => return None,
         };
         let flat = |v: Vec3| axis.map_or(v, |a| v - a * v.dot(a));
         let (x, e) = match view.eye {

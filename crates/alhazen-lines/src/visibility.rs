@@ -197,6 +197,31 @@ pub fn pieces(lines: &[SceneLine], chords: &[Chord], view: &View, world: &World)
     merge(per_chord.into_iter().flatten())
 }
 
+/// The baseline the exact method is measured against (fogleman/ln's approach): visibility
+/// tested by a ray at sample points every `step_px` pixels along each chord, pieces cut halfway
+/// between samples that disagree. Its answer depends on the step.
+pub fn pieces_sampled(lines: &[SceneLine], chords: &[Chord], view: &View, world: &World, step_px: f64) -> Vec<Piece> {
+    let per_chord: Vec<Vec<Piece>> = chords
+        .par_iter()
+        .map(|c| {
+            let n = ((c.q.1 - c.q.0).length() / step_px).ceil().max(1.0) as usize;
+            let curve = lines[c.line].curve;
+            let s = |t: f64| c.s.0 + (c.s.1 - c.s.0) * t;
+            let vis: Vec<bool> =
+                (0..n).map(|k| view.sees(world, curve.point(s((k as f64 + 0.5) / n as f64)))).collect();
+            vis.iter()
+                .enumerate()
+                .map(|(k, &v)| Piece {
+                    line: c.line,
+                    s: (s(k as f64 / n as f64), s((k + 1) as f64 / n as f64)),
+                    visible: v,
+                })
+                .collect()
+        })
+        .collect();
+    merge(per_chord.into_iter().flatten())
+}
+
 /// Where the chord, as a ray, passes through the surface of another object.
 fn piercings(c: &Chord, own: u32, world: &World, ts: &mut Vec<f64>) {
     let d = c.p.1 - c.p.0;

@@ -135,3 +135,31 @@ fn fig21_drawing_agrees_with_the_ray_tracer() {
     assert!(lines_on_edges > 0.99, "{lines_on_edges}");
     assert!(edges_drawn > 0.99, "{edges_drawn}");
 }
+
+#[test]
+fn fig3_plane_mirror_agrees_with_the_ray_tracer() {
+    let (on, drawn) = agreement("scenes/lines/fig3-plane-mirror.toml");
+    eprintln!("fig3: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
+    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+}
+
+#[test]
+fn fig1_town_in_a_cylinder_agrees_with_the_ray_tracer() {
+    let (on, drawn) = agreement("scenes/lines/fig1-town-in-cylinder.toml");
+    eprintln!("fig1: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
+    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+}
+
+#[test]
+fn fig16_reflexes_of_lines_agree_with_the_ray_tracer() {
+    let (on, drawn) = agreement("scenes/lines/fig16-reflexes-of-lines.toml");
+    eprintln!("fig16: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
+    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+}
+
+#[test]
+fn fig17_polygon_through_a_cylinder_agrees_with_the_ray_tracer() {
+    let (on, drawn) = agreement("scenes/lines/fig17-polygon-overlap.toml");
+    eprintln!("fig17: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
+    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+}
