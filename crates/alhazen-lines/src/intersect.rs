@@ -362,26 +362,42 @@ fn pair(p: &Piece, q: &Piece) -> Vec<Curve> {
 /// Lower and upper corners of a box.
 type Aabb = (Vec3, Vec3);
 
-/// World bounds of an object for the pair test (`None`: unbounded).
-fn bounds(scene: &Scene, o: &alhazen_scene::Object) -> Option<Aabb> {
-    if matches!(o.shape, Shape::Plane { .. }) {
-        return None;
+/// Bounds of an object's pieces (`None`: unbounded), padded a little.
+fn bounds(pieces: &[Piece]) -> Option<Aabb> {
+    let (mut lo, mut hi) = (Vec3::splat(f64::INFINITY), Vec3::splat(f64::NEG_INFINITY));
+    let mut grow = |p: Vec3, r: f64| {
+        lo = lo.min(p - Vec3::splat(r));
+        hi = hi.max(p + Vec3::splat(r));
+    };
+    for p in pieces {
+        match p {
+            Piece::Sphere { center, radius } => grow(*center, *radius),
+            Piece::Side { base, axis, radius } => {
+                grow(*base, *radius);
+                grow(*base + *axis, *radius);
+            }
+            Piece::Flat(f) => match &f.outline {
+                Outline::Unbounded => return None,
+                Outline::Disk(r) => grow(f.point, *r),
+                Outline::Polygon(poly) => poly.iter().for_each(|q| grow(*q, 0.0)),
+            },
+        }
     }
-    let tris = world_triangles(scene, o)?;
-    let mut lo = Vec3::splat(f64::INFINITY);
-    let mut hi = Vec3::splat(f64::NEG_INFINITY);
-    for p in tris.iter().flatten().map(|v| v.p) {
-        (lo, hi) = (lo.min(p), hi.max(p));
-    }
-    // The tessellation lies inside round shapes: pad by a little.
-    let pad = (hi - lo).length() * 0.02;
-    Some((lo - Vec3::splat(pad), hi + Vec3::splat(pad)))
+    let pad = 1e-9 * (hi - lo).length();
+    (lo.x <= hi.x).then(|| (lo - Vec3::splat(pad), hi + Vec3::splat(pad)))
 }
 
 /// The intersection curves of every pair of objects whose bounds overlap.
 pub fn intersection_lines(scene: &Scene) -> Vec<SceneLine> {
-    let objs: Vec<(Vec<Piece>, Option<Aabb>)> =
-        scene.objects.iter().map(|o| (pieces(scene, o), bounds(scene, o))).collect();
+    let objs: Vec<(Vec<Piece>, Option<Aabb>)> = scene
+        .objects
+        .iter()
+        .map(|o| pieces(scene, o))
+        .map(|p| {
+            let b = bounds(&p);
+            (p, b)
+        })
+        .collect();
     let mut out = vec![];
     for i in 0..objs.len() {
         for j in i + 1..objs.len() {

@@ -163,3 +163,10 @@ fn fig17_polygon_through_a_cylinder_agrees_with_the_ray_tracer() {
     eprintln!("fig17: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
     assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
 }
+
+#[test]
+fn a_military_axonometry_with_a_mirror_agrees_with_the_ray_tracer() {
+    let (on, drawn) = agreement("scenes/lines/axonometric-mirror.toml");
+    eprintln!("axonometric: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
+    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+}

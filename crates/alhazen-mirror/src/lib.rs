@@ -17,6 +17,7 @@
 //!   visible reflex only.
 //! * [`caustic`] gives the catacaustic (12), (13), its rational form (15), kernel points (16),
 //!   double points (17) and the catacaustic surfaces as triangle meshes.
+//! * [`anamorph`] prints cylinder anamorphoses (§2.4, Theorem 4).
 //!
 //! All solutions satisfy the law of reflection to about 1e-13 rad (tests check 1e-12 against a
 //! brute-force search), and no input makes the solver panic: degenerate input is a
