@@ -37,12 +37,7 @@ pub struct AnamorphArgs {
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
-    let parts: Vec<f64> =
-        s.split(',').map(|p| p.trim().parse::<f64>().map_err(|e| format!("`{p}`: {e}"))).collect::<Result<_, _>>()?;
-    match parts.as_slice() {
-        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
-        _ => Err("expected three finite numbers: x,y,z".into()),
-    }
+    crate::mirror::parse_numbers::<3>(s).map(Vec3::from_array)
 }
 
 fn ext(p: &Path) -> String {

@@ -31,9 +31,15 @@ pub struct LinesArgs {
     /// Mesh edges whose faces meet at more than this angle (degrees) are drawn.
     #[arg(long, default_value_t = 30.0)]
     feature_angle: f64,
-    /// Stroke width of visible lines in millimetres (hidden and reflected lines are thinner).
+    /// Stroke width of visible lines in millimetres.
     #[arg(long, default_value_t = 0.35, value_parser = positive)]
     stroke: f64,
+    /// Stroke width of hidden lines in millimetres.
+    #[arg(long, default_value_t = 0.18, value_parser = positive)]
+    stroke_hidden: f64,
+    /// Stroke width of reflected lines in millimetres.
+    #[arg(long, default_value_t = 0.25, value_parser = positive)]
+    stroke_reflected: f64,
     /// Width of a PNG preview in pixels.
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(16..=20000))]
     png_width: u32,
@@ -130,8 +136,12 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
         (None, None) => return Err(Failure::input("give a scene file or --graph")),
     };
     let stroke = |l: Layer| {
-        let s = default_stroke(l);
-        Stroke { width: s.width * a.stroke / default_stroke(Layer::Visible).width, ..s }
+        let width = match l {
+            Layer::Visible => a.stroke,
+            Layer::Hidden => a.stroke_hidden,
+            Layer::Reflected => a.stroke_reflected,
+        };
+        Stroke { width, ..default_stroke(l) }
     };
     let bytes = match kind {
         Kind::Svg => drawing.to_svg(stroke).into_bytes(),

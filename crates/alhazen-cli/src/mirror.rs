@@ -79,11 +79,16 @@ pub struct ConicsArgs {
 }
 
 fn parse_vec2(s: &str) -> Result<Vec2, String> {
+    parse_numbers::<2>(s).map(|[x, y]| Vec2::new(x, y))
+}
+
+/// `N` finite numbers separated by commas (`x,y` or `x,y,z` arguments).
+pub(crate) fn parse_numbers<const N: usize>(s: &str) -> Result<[f64; N], String> {
     let parts: Vec<f64> =
         s.split(',').map(|p| p.trim().parse::<f64>().map_err(|e| format!("`{p}`: {e}"))).collect::<Result<_, _>>()?;
-    match parts.as_slice() {
-        [x, y] if x.is_finite() && y.is_finite() => Ok(Vec2::new(*x, *y)),
-        _ => Err("expected two finite numbers: x,y".into()),
+    match <[f64; N]>::try_from(parts) {
+        Ok(v) if v.iter().all(|x| x.is_finite()) => Ok(v),
+        _ => Err(format!("expected {N} finite numbers separated by commas")),
     }
 }
 

@@ -293,3 +293,61 @@ mod mirror {
         assert_eq!(o.status.code(), Some(2));
     }
 }
+
+#[test]
+fn lines_writes_svg_pdf_and_png_and_refuses_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(
+        dir.path(),
+        "[render]\nwidth = 200\nheight = 150\n[camera]\neye = [4, 3, 5]\n[[object]]\nshape = \"box\"\n\
+         [[object]]\nshape = \"sphere\"\ncenter = [2.2, 0, 0]\nradius = 0.8\nmaterial = { mirror = 1 }\n",
+    );
+    for ext in ["svg", "pdf", "png"] {
+        let out = dir.path().join(format!("d.{ext}"));
+        let o = alhazen(&["lines", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--hidden"]);
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        let bytes = std::fs::read(&out).unwrap();
+        match ext {
+            "svg" => {
+                let s = String::from_utf8(bytes).unwrap();
+                assert!(s.contains("<g id=\"visible\"") && s.matches("<polyline").count() >= 9, "{s}");
+                assert!(s.contains("<g id=\"reflected\""));
+            }
+            "pdf" => assert!(bytes.starts_with(b"%PDF-1.5") && bytes.ends_with(b"%%EOF\n")),
+            _ => assert!(bytes.starts_with(b"\x89PNG")),
+        }
+    }
+    let bad_ext = alhazen(&["lines", scene.to_str().unwrap(), "-o", dir.path().join("d.jpg").to_str().unwrap()]);
+    assert_eq!(bad_ext.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad_ext.stderr).contains(".svg, .pdf or .png"));
+    let graph = alhazen(&["lines", "--graph", "saddle", "-o", dir.path().join("g.svg").to_str().unwrap(), "-q"]);
+    assert_eq!(graph.status.code(), Some(0));
+    let stereo = scene_file(dir.path(), "[camera]\ntype = \"stereo\"\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
+    let o = alhazen(&["lines", stereo.to_str().unwrap(), "-o", dir.path().join("s.svg").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn anamorph_prints_and_says_when_the_paper_is_too_small() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("pic.svg");
+    std::fs::write(&svg, "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 40 30\"><polyline points=\"2,2 38,2 38,28 2,28 2,2\"/><line x1=\"2\" y1=\"2\" x2=\"38\" y2=\"28\"/></svg>").unwrap();
+    let out = dir.path().join("print.svg");
+    let args = ["--radius", "40", "--height", "120", "--eye", "0,500,350"];
+    let mut ok = vec!["mirror", "anamorph", svg.to_str().unwrap()];
+    ok.extend(args);
+    ok.extend(["-o", out.to_str().unwrap()]);
+    let o = alhazen(&ok);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read_to_string(&out).unwrap().matches("<polyline").count() >= 4);
+    let mut small = ok.clone();
+    small.extend(["--paper", "A5"]);
+    let o = alhazen(&small);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs"), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut inside = vec!["mirror", "anamorph", svg.to_str().unwrap(), "--radius", "40", "--height", "120"];
+    inside.extend(["--eye", "0,100,10", "-o", out.to_str().unwrap()]);
+    let o = alhazen(&inside);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("outside the cylinder"));
+}

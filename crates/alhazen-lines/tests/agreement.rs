@@ -128,45 +128,39 @@ fn agreement(path: &str) -> (f64, f64) {
     (within(&lines, &edges, 1.0), within(&edges, &lines, 1.0))
 }
 
+/// Asserts that 99 % of the drawn line samples lie on ID edges and 99 % of ID edges are drawn.
+fn assert_agrees(path: &str) {
+    let (on, drawn) = agreement(path);
+    eprintln!("{path}: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
+    assert!(on > 0.99 && drawn > 0.99, "{path}: {on} {drawn}");
+}
+
 #[test]
 fn fig21_drawing_agrees_with_the_ray_tracer() {
-    let (lines_on_edges, edges_drawn) = agreement("scenes/lines/fig21-cylinder-in-sphere.toml");
-    eprintln!("lines on ID edges {lines_on_edges:.4}, ID edges drawn {edges_drawn:.4}");
-    assert!(lines_on_edges > 0.99, "{lines_on_edges}");
-    assert!(edges_drawn > 0.99, "{edges_drawn}");
+    assert_agrees("scenes/lines/fig21-cylinder-in-sphere.toml");
 }
 
 #[test]
 fn fig3_plane_mirror_agrees_with_the_ray_tracer() {
-    let (on, drawn) = agreement("scenes/lines/fig3-plane-mirror.toml");
-    eprintln!("fig3: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
-    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+    assert_agrees("scenes/lines/fig3-plane-mirror.toml");
 }
 
 #[test]
 fn fig1_town_in_a_cylinder_agrees_with_the_ray_tracer() {
-    let (on, drawn) = agreement("scenes/lines/fig1-town-in-cylinder.toml");
-    eprintln!("fig1: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
-    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+    assert_agrees("scenes/lines/fig1-town-in-cylinder.toml");
 }
 
 #[test]
 fn fig16_reflexes_of_lines_agree_with_the_ray_tracer() {
-    let (on, drawn) = agreement("scenes/lines/fig16-reflexes-of-lines.toml");
-    eprintln!("fig16: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
-    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+    assert_agrees("scenes/lines/fig16-reflexes-of-lines.toml");
 }
 
 #[test]
 fn fig17_polygon_through_a_cylinder_agrees_with_the_ray_tracer() {
-    let (on, drawn) = agreement("scenes/lines/fig17-polygon-overlap.toml");
-    eprintln!("fig17: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
-    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+    assert_agrees("scenes/lines/fig17-polygon-overlap.toml");
 }
 
 #[test]
 fn a_military_axonometry_with_a_mirror_agrees_with_the_ray_tracer() {
-    let (on, drawn) = agreement("scenes/lines/axonometric-mirror.toml");
-    eprintln!("axonometric: lines on ID edges {on:.4}, ID edges drawn {drawn:.4}");
-    assert!(on > 0.99 && drawn > 0.99, "{on} {drawn}");
+    assert_agrees("scenes/lines/axonometric-mirror.toml");
 }
