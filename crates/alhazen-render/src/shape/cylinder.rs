@@ -126,14 +126,21 @@ impl Cylinder {
         let ax = &self.axis;
         let sp = ax.split(ray);
         let mut parts = Parts::default();
-        let roots = solve_quadratic(
-            sp.dp.length_squared(),
-            2.0 * sp.op.dot(sp.dp),
-            sp.op.length_squared() - self.radius * self.radius,
-        );
-        for &t in roots.as_slice() {
-            if (0.0..=ax.height).contains(&(sp.od + t * sp.dd)) {
-                parts.push(t, SIDE);
+        // From the ray's closest approach to the axis, as for the sphere: |op + t dp|² = r²
+        // solved about t_c, so origins far away (axonometric views start 10⁴ back) keep the
+        // roots' precision instead of losing it to c = |op|² − r².
+        let dp2 = sp.dp.length_squared();
+        if dp2 > 0.0 {
+            let tc = -sp.op.dot(sp.dp) / dp2;
+            let q = sp.op + sp.dp * tc;
+            let disc = self.radius * self.radius - q.length_squared();
+            if disc >= 0.0 {
+                let half = (disc / dp2).sqrt();
+                for t in [tc - half, tc + half] {
+                    if (0.0..=ax.height).contains(&(sp.od + t * sp.dd)) {
+                        parts.push(t, SIDE);
+                    }
+                }
             }
         }
         if self.capped {
@@ -196,19 +203,23 @@ impl Cone {
 
     fn parts(&self, ray: &Ray) -> Parts {
         let ax = &self.axis;
-        let sp = ax.split(ray);
+        // The side's quadratic is solved from the ray's point nearest the base centre, so that
+        // far origins (axonometric views start 10⁴ back) do not cancel its constant term.
+        let shift = (ax.base - ray.origin).dot(ray.dir) / ray.dir.length_squared();
+        let near = ax.split(&Ray::new(ray.origin + ray.dir * shift, ray.dir));
         let k2 = (self.radius / ax.height).powi(2);
-        let h0 = ax.height - sp.od;
+        let h0 = ax.height - near.od;
         // |op + t dp|² = k² (h − s)², s = od + t dd.
-        let a = sp.dp.length_squared() - k2 * sp.dd * sp.dd;
-        let b = 2.0 * (sp.op.dot(sp.dp) + k2 * h0 * sp.dd);
-        let c = sp.op.length_squared() - k2 * h0 * h0;
+        let a = near.dp.length_squared() - k2 * near.dd * near.dd;
+        let b = 2.0 * (near.op.dot(near.dp) + k2 * h0 * near.dd);
+        let c = near.op.length_squared() - k2 * h0 * h0;
         let mut parts = Parts::default();
         for &t in solve_quadratic(a, b, c).as_slice() {
-            if (0.0..ax.height).contains(&(sp.od + t * sp.dd)) {
-                parts.push(t, SIDE);
+            if (0.0..ax.height).contains(&(near.od + t * near.dd)) {
+                parts.push(t + shift, SIDE);
             }
         }
+        let sp = ax.split(ray);
         if self.capped
             && let Some(t) = ax.cap_t(&sp, 0.0, self.radius)
         {

@@ -212,3 +212,27 @@ fn spheres_seen_from_far_away_are_hit_on_their_surface() {
         }
     }
 }
+
+#[test]
+fn cylinders_and_cones_seen_from_far_away_are_hit_on_their_surface() {
+    // As for spheres: |op|² − r² cancelled for far origins (noisy self-shadowing of cylinders in
+    // a military axonometry before session 3).
+    let (base, top, r) = (Vec3::new(0.2, 0.0, -0.1), Vec3::new(0.2, 2.0, -0.1), 0.6);
+    let cyl = Shape::Cylinder(Cylinder::new(base, top, r, false));
+    let cone = Shape::Cone(Cone::new(base, top, r, false));
+    let on_cylinder = |p: Vec3| (Vec2::new(p.x - base.x, p.z - base.z).length() - r).abs();
+    let on_cone = |p: Vec3| (Vec2::new(p.x - base.x, p.z - base.z).length() - r * (1.0 - (p.y - base.y) / 2.0)).abs();
+    for dist in [1e4, 1e5] {
+        for k in 0..50 {
+            let aim =
+                base + Vec3::new(0.25 * (k as f64 * 0.37).sin(), 0.2 + 0.02 * k as f64, 0.1 * (k as f64 * 0.13).cos());
+            let origin = aim + Vec3::new(1.0, 0.7, 0.4).normalize() * dist;
+            let ray = Ray::new(origin, (aim - origin).normalize());
+            for (shape, miss) in [(&cyl, &on_cylinder as &dyn Fn(Vec3) -> f64), (&cone, &on_cone)] {
+                if let Some(h) = shape.intersect(&ray, f64::INFINITY) {
+                    assert!(miss(h.p) < 1e-14 * dist, "{shape:?} {dist}: {}", miss(h.p));
+                }
+            }
+        }
+    }
+}
