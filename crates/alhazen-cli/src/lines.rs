@@ -119,8 +119,9 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
                 sampled: a.sampled,
                 ..Options::default()
             };
-            let (d, s) =
-                pool.install(|| draw(&scene, &opts)).map_err(|e| Failure::input(format!("{}: {e}", path.display())))?;
+            let (d, s) = pool
+                .install(|| draw(&scene, &opts))
+                .map_err(|e| Failure::input(format!("{}: {}", path.display(), camera_error(e))))?;
             let mut summary = format!(
                 "{} scene lines → {} visible, {} hidden, {} reflected polylines ({} mirrors)",
                 s.scene_lines, s.visible, s.hidden, s.reflected, s.mirrors
@@ -154,6 +155,12 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
         eprintln!("{summary} in {:.3} s → {}", start.elapsed().as_secs_f64(), a.output.display());
     }
     Ok(())
+}
+
+/// The drawing's own words for a camera it cannot use.
+fn camera_error(e: alhazen_raster::pipeline::RasterError) -> String {
+    let alhazen_raster::pipeline::RasterError::UnsupportedCamera(kind) = e;
+    format!("line drawings support perspective, orthographic and axonometric cameras, not {kind}")
 }
 
 /// A floating-horizon drawing of a built-in function on paper `width_mm` wide.

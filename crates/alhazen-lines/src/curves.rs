@@ -278,11 +278,22 @@ fn cone_contour_feet(base: Vec3, apex: Vec3, r: f64, view: &View) -> Vec<Vec3> {
 /// An undirected edge by the bits of its corners.
 type EdgeKey = ([u64; 3], [u64; 3]);
 
-/// Boundary, feature and silhouette edges of a triangle soup whose shared corners are equal.
-pub fn mesh_lines(tris: &[[Vec3; 3]], view: &View, opts: &EdgeOptions, object: u32) -> Vec<SceneLine> {
+/// An edge of a triangle soup with the unit normals of the faces that share it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshEdge {
+    /// One end.
+    pub a: Vec3,
+    /// The other end.
+    pub b: Vec3,
+    /// Normals of the faces on it (one for a boundary edge).
+    pub normals: Vec<Vec3>,
+}
+
+/// The edges of a triangle soup whose shared corners are equal, in first-seen order.
+pub fn mesh_edges(tris: &[[Vec3; 3]]) -> Vec<MeshEdge> {
     let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-    let mut edges: HashMap<EdgeKey, (Vec3, Vec3, Vec<Vec3>)> = HashMap::new();
-    let mut order = vec![];
+    let mut index: HashMap<EdgeKey, usize> = HashMap::new();
+    let mut edges: Vec<MeshEdge> = vec![];
     for t in tris {
         let n = (t[1] - t[0]).cross(t[2] - t[0]);
         let Some(n) = n.try_normalize() else { continue };
@@ -290,35 +301,54 @@ pub fn mesh_lines(tris: &[[Vec3; 3]], view: &View, opts: &EdgeOptions, object: u
             let (a, b) = (t[k], t[(k + 1) % 3]);
             let (ka, kb) = (key(a), key(b));
             let id = if ka < kb { (ka, kb) } else { (kb, ka) };
-            let e = edges.entry(id).or_insert_with(|| {
-                order.push(id);
-                (a, b, vec![])
+            let i = *index.entry(id).or_insert_with(|| {
+                edges.push(MeshEdge { a, b, normals: vec![] });
+                edges.len() - 1
             });
-            e.2.push(n);
+            edges[i].normals.push(n);
         }
     }
+    edges
+}
+
+/// Whether an edge is always drawn (a boundary, a crease beyond `cos_feature`, non-manifold).
+pub fn is_feature(e: &MeshEdge, cos_feature: f64) -> bool {
+    match e.normals.as_slice() {
+        [n1, n2] => n1.dot(*n2) < cos_feature,
+        _ => true,
+    }
+}
+
+/// Whether a smooth edge is on the silhouette seen from `toward(mid)` (a direction from the
+/// edge's midpoint to the viewer): one face turned to it, the other away.
+pub fn is_silhouette(e: &MeshEdge, toward: impl Fn(Vec3) -> Option<Vec3>) -> bool {
+    let Some(to) = toward((e.a + e.b) * 0.5) else { return false };
+    match e.normals.as_slice() {
+        [n1, n2] => (n1.dot(to) > 0.0) != (n2.dot(to) > 0.0),
+        _ => false,
+    }
+}
+
+/// Boundary, feature and silhouette edges of a triangle soup whose shared corners are equal.
+pub fn mesh_lines(tris: &[[Vec3; 3]], view: &View, opts: &EdgeOptions, object: u32) -> Vec<SceneLine> {
     let cos_feature = opts.feature_angle.cos();
-    let mut out = vec![];
-    for id in order {
-        let (a, b, normals) = &edges[&id];
-        let mid = (*a + *b) * 0.5;
-        let facing = |n: Vec3| {
-            let to_eye = match view.eye {
-                Some(e) => e - mid,
-                None => -view.dir,
+    let to_eye = |mid: Vec3| {
+        Some(match view.eye {
+            Some(e) => e - mid,
+            None => -view.dir,
+        })
+    };
+    mesh_edges(tris)
+        .into_iter()
+        .filter_map(|e| {
+            let kind = if is_feature(&e, cos_feature) {
+                LineKind::Edge
+            } else if is_silhouette(&e, to_eye) {
+                LineKind::Contour
+            } else {
+                return None;
             };
-            n.dot(to_eye) > 0.0
-        };
-        let kind = match normals.as_slice() {
-            [_] => Some(LineKind::Edge),
-            [n1, n2] if n1.dot(*n2) < cos_feature => Some(LineKind::Edge),
-            [n1, n2] if facing(*n1) != facing(*n2) => Some(LineKind::Contour),
-            [_, _] => None,
-            _ => Some(LineKind::Edge),
-        };
-        if let Some(kind) = kind {
-            out.push(SceneLine { curve: Curve::Segment { a: *a, b: *b }, object, kind });
-        }
-    }
-    out
+            Some(SceneLine { curve: Curve::Segment { a: e.a, b: e.b }, object, kind })
+        })
+        .collect()
 }

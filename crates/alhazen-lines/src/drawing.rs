@@ -75,6 +75,59 @@ impl Drawing {
             .fold(0.0, |a, b| a + b)
     }
 
+    /// Polylines of a layer that meet end to end (within 1 µm) chained into one, so a plotter
+    /// lifts its pen less and files shrink; order otherwise kept.
+    pub fn joined(self) -> Drawing {
+        use std::collections::HashMap;
+        let key = |p: Vec2| ((p.x * 1e3).round() as i64, (p.y * 1e3).round() as i64);
+        let n = self.lines.len();
+        let mut ends: HashMap<(Layer, (i64, i64)), Vec<usize>> = HashMap::new();
+        for (i, (layer, pts)) in self.lines.iter().enumerate() {
+            ends.entry((*layer, key(pts[0]))).or_default().push(i);
+            ends.entry((*layer, key(pts[pts.len() - 1]))).or_default().push(i);
+        }
+        let mut used = vec![false; n];
+        let mut take = |layer: Layer, at: Vec2, used: &mut Vec<bool>| -> Option<usize> {
+            let list = ends.get_mut(&(layer, key(at)))?;
+            let pos = list.iter().position(|&j| !used[j])?;
+            let j = list.swap_remove(pos);
+            used[j] = true;
+            Some(j)
+        };
+        let mut lines = vec![];
+        for i in 0..n {
+            if used[i] {
+                continue;
+            }
+            used[i] = true;
+            let layer = self.lines[i].0;
+            let mut chain = self.lines[i].1.clone();
+            // Forward from the end, then backward from the start.
+            for forward in [true, false] {
+                loop {
+                    let at = if forward { chain[chain.len() - 1] } else { chain[0] };
+                    let Some(j) = take(layer, at, &mut used) else { break };
+                    let mut next = self.lines[j].1.clone();
+                    if forward {
+                        if key(next[0]) != key(at) {
+                            next.reverse();
+                        }
+                        chain.extend_from_slice(&next[1..]);
+                    } else {
+                        if key(next[next.len() - 1]) != key(at) {
+                            next.reverse();
+                        }
+                        next.pop();
+                        next.extend_from_slice(&chain);
+                        chain = next;
+                    }
+                }
+            }
+            lines.push((layer, chain));
+        }
+        Drawing { size: self.size, lines }
+    }
+
     /// The drawing cut to its paper by the course's Liang–Barsky clipping: polylines leaving
     /// the paper are split.
     pub fn clipped(self) -> Drawing {
@@ -345,6 +398,26 @@ mod tests {
             assert!(at(off, &format!("{} 0 obj", k + 1)), "object {}", k + 1);
         }
         assert!(text.contains("/OCG /Name (visible)"));
+    }
+
+    #[test]
+    fn touching_polylines_are_chained_and_nothing_is_lost() {
+        let p = |x, y| Vec2::new(x, y);
+        let d = Drawing {
+            size: p(10.0, 10.0),
+            lines: vec![
+                (Layer::Visible, vec![p(0.0, 0.0), p(1.0, 0.0)]),
+                (Layer::Visible, vec![p(2.0, 0.0), p(1.0, 0.0)]),
+                (Layer::Visible, vec![p(3.0, 3.0), p(0.0, 0.0)]),
+                (Layer::Reflected, vec![p(2.0, 0.0), p(5.0, 5.0)]),
+            ],
+        };
+        let length = d.length(Layer::Visible);
+        let j = d.joined();
+        assert_eq!(j.count(Layer::Visible), 1);
+        assert_eq!(j.count(Layer::Reflected), 1, "layers are not mixed");
+        assert!((j.length(Layer::Visible) - length).abs() < 1e-12);
+        assert_eq!(j.lines[0].1.len(), 4);
     }
 
     #[test]

@@ -119,10 +119,11 @@ pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterErr
         jobs.par_iter().map(|&(m, l)| reflect::reflect_line(&mirrors[m], &lines[l], &view, &world, &ropts)).collect();
     let mut reflected = reflected;
     reflected.extend(reflex_contours(scene, &mirrors, &view, &world, tol_px));
+    reflected.extend(mesh_reflex_silhouettes(scene, &mirrors, &view, &world, &edge_opts, tol_px));
     for run in reflected.into_iter().flatten() {
         drawing.lines.push((Layer::Reflected, run.iter().map(|p| view.to_paper(*p)).collect()));
     }
-    let drawing = drawing.clipped();
+    let drawing = drawing.clipped().joined();
     let stats = Stats {
         scene_lines: lines.len(),
         visible: drawing.count(Layer::Visible),
@@ -164,6 +165,51 @@ fn reflex_contours(
                 )
             });
             Some(runs.collect::<Vec<_>>())
+        })
+        .collect()
+}
+
+/// The silhouettes of meshes as seen in each mirror: smooth edges whose faces turn one to, one
+/// away from the reflected ray at the edge's midpoint (the polyhedral reflex contour).
+fn mesh_reflex_silhouettes(
+    scene: &Scene,
+    mirrors: &[reflect::Mirror],
+    view: &view::View,
+    world: &World,
+    opts: &curves::EdgeOptions,
+    tol_px: f64,
+) -> Vec<Vec<Vec<Vec3>>> {
+    if mirrors.is_empty() {
+        return vec![];
+    }
+    let cos_feature = opts.feature_angle.cos();
+    let meshes: Vec<(u32, Vec<curves::MeshEdge>)> = scene
+        .objects
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| matches!(o.shape, alhazen_scene::Shape::Mesh { .. }))
+        .filter_map(|(i, o)| {
+            let tris = alhazen_raster::pipeline::geometry::world_triangles(scene, o)?;
+            let tris: Vec<[Vec3; 3]> = tris.iter().map(|t| t.map(|v| v.p)).collect();
+            Some((i as u32, curves::mesh_edges(&tris)))
+        })
+        .collect();
+    let jobs: Vec<(usize, usize)> = (0..mirrors.len()).flat_map(|m| (0..meshes.len()).map(move |k| (m, k))).collect();
+    jobs.par_iter()
+        .filter(|&&(m, k)| mirrors[m].object() != meshes[k].0)
+        .map(|&(m, k)| {
+            let mirror = &mirrors[m];
+            let toward = |mid: Vec3| mirror.reflex(view.viewer(), mid).map(|r| r - mid);
+            let knots = reflect::uniform(4);
+            meshes[k]
+                .1
+                .iter()
+                .filter(|e| !curves::is_feature(e, cos_feature) && curves::is_silhouette(e, toward))
+                .flat_map(|e| {
+                    let (a, b) = (e.a, e.b);
+                    reflect::reflect_path(mirror, move |s| a + (b - a) * s, &knots, None, view, world, tol_px)
+                })
+                .collect()
         })
         .collect()
 }
