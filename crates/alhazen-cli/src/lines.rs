@@ -130,7 +130,7 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
                 summary += &format!("; {} distorted round objects drawn from their tessellation", s.tessellated);
             }
             if s.skipped > 0 {
-                summary += &format!("; {} planes/CSG objects have no lines", s.skipped);
+                summary += &format!("; {} CSG objects have no lines", s.skipped);
             }
             (d, summary)
         }

@@ -116,6 +116,8 @@ pub enum LineKind {
     Contour,
     /// Rim of a cylinder, cone or disk.
     Rim,
+    /// The horizon of an infinite plane: its line at infinity (a circle far away).
+    Horizon,
 }
 
 /// A line of the scene: a curve on an object.
@@ -145,7 +147,10 @@ pub fn scene_lines(scene: &Scene, view: &View, opts: &EdgeOptions) -> (Vec<Scene
         let exact = similarity(&o.transform).and_then(|s| round_lines(&o.shape, &o.transform, s, view, object));
         match (exact, &o.shape) {
             (Some(l), _) => lines.extend(l),
-            (None, Shape::Plane { .. } | Shape::Csg { .. }) => skipped += 1,
+            (None, Shape::Plane { point, normal }) => {
+                lines.extend(horizon(o.transform.point(*point), o.transform.normal(*normal), view, object))
+            }
+            (None, Shape::Csg { .. }) => skipped += 1,
             (None, shape) => {
                 if matches!(
                     shape,
@@ -165,6 +170,18 @@ pub fn scene_lines(scene: &Scene, view: &View, opts: &EdgeOptions) -> (Vec<Scene
         }
     }
     (lines, tessellated, skipped)
+}
+
+/// Seen from an eye, an infinite plane ends at its horizon, the image of its line at infinity:
+/// drawn as a circle in the plane a million scene sizes away (the image is off the true line by
+/// less than 1e-6 of the eye's height over that distance). In parallel views it lies off the
+/// paper, but mirrors still show it.
+fn horizon(point: Vec3, normal: Vec3, view: &View, object: u32) -> Option<SceneLine> {
+    let n = normal.try_normalize()?;
+    let center = view.eye.unwrap_or(point);
+    let foot = center - n * (center - point).dot(n);
+    let curve = Curve::circle(foot, n, 1e6 * view.scale);
+    Some(SceneLine { curve, object, kind: LineKind::Horizon })
 }
 
 /// The uniform scale of a similarity transform (rotation, uniform scale, translation).

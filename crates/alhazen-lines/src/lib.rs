@@ -87,7 +87,7 @@ pub struct Stats {
     pub mirrors: usize,
     /// Round objects drawn from their tessellation (their transform is not a similarity).
     pub tessellated: usize,
-    /// Objects without lines (planes, CSG).
+    /// Objects without lines (CSG; planes in parallel views).
     pub skipped: usize,
 }
 

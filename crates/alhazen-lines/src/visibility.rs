@@ -62,7 +62,24 @@ pub fn chords(lines: &[SceneLine], view: &View, tol_mm: f64) -> Vec<Chord> {
                     continue;
                 }
             }
-            out.push(Chord { line: i, s: (s0, s1), p: (a, b), q: (view.to_film(a), view.to_film(b)) });
+            // Only what lies on the film (and a margin) is drawn, and only crossings there can
+            // change it: cut the chord to that window on paper (projective on the chord).
+            let (qa, qb) = (view.to_film(a), view.to_film(b));
+            let margin = 2.0;
+            let window = alhazen_raster::clip::Window {
+                xmin: -margin,
+                ymin: -margin,
+                xmax: view.film.0 as f64 + margin,
+                ymax: view.film.1 as f64 + margin,
+            };
+            let Some((ca, cb)) = alhazen_raster::clip::liang_barsky(&window, qa, qb) else { continue };
+            let d = qb - qa;
+            let l2 = d.length_squared();
+            let film_t = |q: Vec2| if l2 > 0.0 { ((q - qa).dot(d) / l2).clamp(0.0, 1.0) } else { 0.0 };
+            let (t0, t1) = (view.chord_param(a, b, film_t(ca)), view.chord_param(a, b, film_t(cb)));
+            let s_at = |t: f64| s0 + (s1 - s0) * t;
+            let (p0, p1) = (a + (b - a) * t0, a + (b - a) * t1);
+            out.push(Chord { line: i, s: (s_at(t0), s_at(t1)), p: (p0, p1), q: (ca, cb) });
         }
     }
     out

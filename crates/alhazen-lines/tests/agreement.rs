@@ -1,13 +1,13 @@
 //! The drawing agrees with the ray tracer: an edge/ID render of the same scene and camera
-//! (object and normal seen directly and, on a mirror, after one reflection; planes count as
-//! background because they carry no lines) has its edges where the drawing has lines, within
-//! about a pixel at 1000 pixels across.
+//! (object and normal seen directly and, on a mirror, after one reflection) has its edges where
+//! the drawing has lines — the horizon of the floor included — within about a pixel at 1000
+//! pixels across.
 
 use alhazen_lines::drawing::Layer;
 use alhazen_lines::{Options, draw};
 use alhazen_math::{Ray, Vec2, Vec3};
 use alhazen_render::{Camera, World};
-use alhazen_scene::{Scene, Shape, load_scene};
+use alhazen_scene::{Scene, load_scene};
 use std::path::Path;
 
 const WIDTH: u32 = 1000;
@@ -30,9 +30,6 @@ fn scene_at(path: &str) -> Scene {
 
 fn seen(scene: &Scene, world: &World, ray: &Ray) -> Option<(u32, Vec3, Vec3, Vec3)> {
     let h = world.intersect(ray, f64::INFINITY)?;
-    if matches!(scene.objects[h.object as usize].shape, Shape::Plane { .. }) {
-        return None;
-    }
     Some((h.object, h.hit.n, h.hit.p, scene.materials[h.material as usize].mirror))
 }
 
