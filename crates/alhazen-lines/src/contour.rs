@@ -63,10 +63,10 @@ impl Surface {
     }
 }
 
-/// Rows of `a`, scan steps of `b`, bisection steps.
+/// Rows of `a`, scan steps of `b`, root-refinement steps at most.
 const ROWS: usize = 96;
 const SCAN: usize = 128;
-const BISECT: usize = 48;
+const REFINE: usize = 60;
 
 /// The reflex contour of `surface` in `mirror`, as curves of points on the surface (closed
 /// curves repeat their first point).
@@ -81,33 +81,58 @@ pub fn reflex_contour(surface: &Surface, mirror: &Mirror, view: &View) -> Vec<Ve
     for k in 0..=ROWS {
         // Keep off the poles of a sphere and the apex of a cone.
         let a = 1e-4 + (1.0 - 2e-4) * k as f64 / ROWS as f64;
+        // The scan of a row goes through the batch solver.
+        let bs: Vec<f64> = (0..=SCAN).map(|j| j as f64 / SCAN as f64).collect();
+        let (pts, normals): (Vec<Vec3>, Vec<Vec3>) = bs.iter().map(|&b| (surface.eval)(a, b)).unzip();
+        let values: Vec<Option<f64>> = mirror
+            .reflexes(viewer, &pts)
+            .iter()
+            .zip(pts.iter().zip(&normals))
+            .map(|(r, (s, n))| r.map(|r| n.dot((*s - r).normalize_or_zero())))
+            .collect();
         let mut roots = vec![];
-        let mut prev = (0.0, f(a, 0.0));
-        for j in 1..=SCAN {
-            let b = j as f64 / SCAN as f64;
-            let cur = (b, f(a, b));
-            if let (Some(f0), Some(f1)) = (prev.1, cur.1)
+        for j in 0..SCAN {
+            if let (Some(f0), Some(f1)) = (values[j], values[j + 1])
                 && (f0 > 0.0) != (f1 > 0.0)
             {
-                roots.push(bisect(&f, a, prev.0, cur.0, f0));
+                roots.push(refine_root(&f, a, (bs[j], f0), (bs[j + 1], f1)));
             }
-            prev = cur;
         }
         rows.push(roots);
     }
     link(&rows, surface)
 }
 
-fn bisect(f: &impl Fn(f64, f64) -> Option<f64>, a: f64, mut lo: f64, mut hi: f64, f_lo: f64) -> f64 {
-    for _ in 0..BISECT {
-        let m = 0.5 * (lo + hi);
-        match f(a, m) {
-            Some(v) if (v > 0.0) == (f_lo > 0.0) => lo = m,
-            Some(_) => hi = m,
-            None => break,
+/// A sign change of `f(a, ·)` between `lo` and `hi` narrowed by the Illinois variant of false
+/// position (superlinear, and never leaves the bracket) until the bracket is below 1e-13.
+fn refine_root(f: &impl Fn(f64, f64) -> Option<f64>, a: f64, mut lo: (f64, f64), mut hi: (f64, f64)) -> f64 {
+    let mut side = 0;
+    for _ in 0..REFINE {
+        if hi.0 - lo.0 < 1e-13 {
+            break;
+        }
+        let x = (lo.0 * hi.1 - hi.0 * lo.1) / (hi.1 - lo.1);
+        let x = if x > lo.0 && x < hi.0 { x } else { 0.5 * (lo.0 + hi.0) };
+        let Some(fx) = f(a, x) else { break };
+        if fx == 0.0 {
+            return x;
+        }
+        if (fx > 0.0) == (lo.1 > 0.0) {
+            lo = (x, fx);
+            if side == -1 {
+                hi.1 *= 0.5;
+            }
+            side = -1;
+        } else {
+            hi = (x, fx);
+            if side == 1 {
+                lo.1 *= 0.5;
+            }
+            side = 1;
         }
     }
-    0.5 * (lo + hi)
+    let (x0, x1) = (lo.0, hi.0);
+    if x1 - x0 < 1e-9 { 0.5 * (x0 + x1) } else { (lo.0 * hi.1 - hi.0 * lo.1) / (hi.1 - lo.1) }
 }
 
 /// Links the roots of consecutive rows by nearest `b` (periodic) into polylines.

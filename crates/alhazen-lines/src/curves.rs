@@ -78,18 +78,20 @@ impl Curve {
     pub fn knots(&self, view: &View, tol_mm: f64) -> Vec<f64> {
         match *self {
             Curve::Segment { .. } => vec![0.0, 1.0],
-            Curve::Arc { center, radius, start, end, .. } => round_knots(view, tol_mm, center, radius, end - start),
-            Curve::Ellipse { center, u, v, start, end } => {
-                round_knots(view, tol_mm, center, u.length().max(v.length()), end - start)
+            Curve::Arc { radius, start, end, .. } => round_knots(view, tol_mm, self, radius, end - start),
+            Curve::Ellipse { u, v, start, end, .. } => {
+                round_knots(view, tol_mm, self, u.length().max(v.length()), end - start)
             }
         }
     }
 }
 
-/// Knots of an arc of radius (at most) `radius` spanning `angle`, chords within `tol_mm`.
-fn round_knots(view: &View, tol_mm: f64, center: Vec3, radius: f64, angle: f64) -> Vec<f64> {
-    // Radius on paper at the circle's depth bounds the chord error r(1 − cos(Δ/2)).
-    let mm = radius * view.mm_per_px * view_px_per_unit(view, center);
+/// Knots of an arc of radius (at most) `radius` spanning `angle`, chords within `tol_mm`: the
+/// chord error `r(1 − cos(Δ/2))` on paper, with the projection's scale taken at the largest of
+/// eight points of the arc (not at its centre: a horizon's centre is under the eye).
+fn round_knots(view: &View, tol_mm: f64, curve: &Curve, radius: f64, angle: f64) -> Vec<f64> {
+    let px_per_unit = (0..8).map(|k| view_px_per_unit(view, curve.point(k as f64 / 8.0))).fold(0.0, f64::max);
+    let mm = radius * view.mm_per_px * px_per_unit;
     let step = if mm > 0.0 { (8.0 * tol_mm / mm).sqrt().min(0.5) } else { 0.5 };
     let n = ((angle.abs() / step).ceil() as usize).clamp(8, 20_000);
     (0..=n).map(|k| k as f64 / n as f64).collect()

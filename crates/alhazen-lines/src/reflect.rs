@@ -207,6 +207,40 @@ impl Mirror {
         }
     }
 
+    /// The visible reflexes of many points at once: spheres and cylinders seen from a finite
+    /// eye go through the batch kernel of `alhazen-mirror` (33 M/s on one core).
+    pub fn reflexes(&self, viewer: Site, pts: &[Vec3]) -> Vec<Option<Vec3>> {
+        let eye = match viewer {
+            Site::At(e) => e,
+            Site::Toward(_) => return pts.iter().map(|p| self.reflex(viewer, *p)).collect(),
+        };
+        let (x, y, z): (Vec<f64>, Vec<f64>, Vec<f64>) =
+            (pts.iter().map(|p| p.x).collect(), pts.iter().map(|p| p.y).collect(), pts.iter().map(|p| p.z).collect());
+        let soa = alhazen_mirror::batch::PointsSoA { x: &x, y: &y, z: &z };
+        let mut out = alhazen_mirror::batch::ReflexesSoA::default();
+        let ok = match self {
+            Mirror::Sphere { sphere, .. } => sphere.visible_reflexes_batch(eye, soa, &mut out),
+            Mirror::Cylinder { cylinder, .. } => cylinder.visible_reflexes_batch(eye, soa, &mut out),
+            Mirror::Plane { .. } => return pts.iter().map(|p| self.reflex(viewer, *p)).collect(),
+        };
+        if ok.is_err() {
+            return vec![None; pts.len()];
+        }
+        (0..pts.len())
+            .map(|i| {
+                let r = Vec3::new(out.x[i], out.y[i], out.z[i]);
+                let on_mirror = match self {
+                    Mirror::Cylinder { cylinder, .. } => {
+                        let h = (r - cylinder.center).dot(cylinder.axis) / cylinder.axis.length_squared();
+                        (0.0..=1.0).contains(&h)
+                    }
+                    _ => true,
+                };
+                (out.visible[i] && on_mirror).then_some(r)
+            })
+            .collect()
+    }
+
     /// What the eye sees of `s` in the mirror; the reflected ray may pass through the object
     /// `convex` (a convex object `s` lies on the contour of: it cannot hide its own contour).
     fn seen(&self, view: &View, world: &World, s: Vec3, convex: Option<u32>) -> Seen {
