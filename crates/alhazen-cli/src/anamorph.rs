@@ -108,13 +108,18 @@ fn raster_print(a: &AnamorphArgs, paper: Vec2, out: &str) -> Result<Vec<u8>, Fai
     let img = alhazen_scene::import::load_image(&a.image)
         .map_err(|e| Failure::input(format!("{}: {e}", a.image.display())))?;
     let (an, at) = setup(a, img.width as f64 / img.height as f64, paper)?;
-    let (w, h, uvs) = an.print_raster(&at, a.dpi);
     let srgb = |v: f32| (255.0 * alhazen_math::color::srgb_encode(v.clamp(0.0, 1.0) as f64)).round() as u8;
-    let mut rgb = Vec::with_capacity(uvs.len() * 3);
-    for uv in &uvs {
-        let c = uv.map_or([1.0f32; 3], |uv| bilinear(&img, uv));
-        rgb.extend(c.map(srgb));
-    }
+    let mut rgb = vec![];
+    let bar = crate::progress_bar(false);
+    let rows = (at.paper.y / 25.4 * a.dpi).round().max(1.0) as u64;
+    bar.set_length(rows);
+    let (w, h) = an.print_raster(&at, a.dpi, |y, row| {
+        for uv in row {
+            rgb.extend(uv.map_or([1.0f32; 3], |uv| bilinear(&img, uv)).map(srgb));
+        }
+        bar.set_position(y as u64 + 1);
+    });
+    bar.finish_and_clear();
     let guides =
         Drawing { size: at.paper, lines: footprint(&an, &at).into_iter().map(|p| (Layer::Hidden, p)).collect() };
     match out {

@@ -240,7 +240,7 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-fn progress_bar(quiet: bool) -> ProgressBar {
+pub(crate) fn progress_bar(quiet: bool) -> ProgressBar {
     if quiet {
         return ProgressBar::hidden();
     }

@@ -42,8 +42,8 @@ fn the_printed_anamorphosis_looks_like_the_picture_in_the_mirror() {
     let an = Anamorphosis::new(radius, height, eye, 4.0 / 3.0).unwrap();
     let at = an.place(paper_size("A3").unwrap()).unwrap();
     let dpi = 150.0;
-    let (pw, ph, print) = an.print_raster(&at, dpi);
-    let ink: Vec<f64> = print.iter().map(|uv| uv.map_or(1.0, picture)).collect();
+    let mut ink: Vec<f64> = vec![];
+    let (pw, ph) = an.print_raster(&at, dpi, |_, row| ink.extend(row.iter().map(|uv| uv.map_or(1.0, picture))));
     let px_mm = 25.4 / dpi;
     let print_at = |paper: Vec2| {
         // Bilinear lookup of the printed raster (paper millimetres).

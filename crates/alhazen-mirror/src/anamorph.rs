@@ -282,31 +282,32 @@ impl Anamorphosis {
         Err(need)
     }
 
-    /// The picture coordinates printed at each pixel of a `dpi` raster of the paper (row-major,
-    /// top row first), by the batch solver a row at a time; `None` where the paper stays blank.
-    pub fn print_raster(&self, at: &Placement, dpi: f64) -> (u32, u32, Vec<Option<Vec2>>) {
+    /// The picture coordinates printed at each pixel of a `dpi` raster of the paper, handed to
+    /// `row(y, coordinates)` a row at a time, top first (`None` where the paper stays blank),
+    /// computed by the batch solver; returns the raster's size.
+    pub fn print_raster(&self, at: &Placement, dpi: f64, mut row: impl FnMut(u32, &[Option<Vec2>])) -> (u32, u32) {
         let px_mm = 25.4 / dpi;
         let (w, h) = ((at.paper.x / px_mm).round().max(1.0) as u32, (at.paper.y / px_mm).round().max(1.0) as u32);
-        let mut out = Vec::with_capacity((w * h) as usize);
         let mut reflexes = crate::batch::ReflexesSoA::default();
-        let (ys, xs): (Vec<f64>, Vec<f64>) =
-            (vec![0.0; w as usize], (0..w).map(|i| (i as f64 + 0.5) * px_mm).collect());
-        for row in 0..h {
-            let fz = (row as f64 + 0.5) * px_mm - at.axis.y;
-            let fx: Vec<f64> = xs.iter().map(|x| x - at.axis.x).collect();
-            let fzs = vec![fz; w as usize];
+        let ys = vec![0.0; w as usize];
+        let fx: Vec<f64> = (0..w).map(|i| (i as f64 + 0.5) * px_mm - at.axis.x).collect();
+        let mut uvs = Vec::with_capacity(w as usize);
+        for y in 0..h {
+            let fzs = vec![(y as f64 + 0.5) * px_mm - at.axis.y; w as usize];
             let pts = crate::batch::PointsSoA { x: &fx, y: &ys, z: &fzs };
+            uvs.clear();
             if self.cylinder.visible_reflexes_batch(self.eye, pts, &mut reflexes).is_err() {
-                out.extend(std::iter::repeat_n(None, w as usize));
-                continue;
+                uvs.resize(w as usize, None);
+            } else {
+                for i in 0..w as usize {
+                    let r = Vec3::new(reflexes.x[i], reflexes.y[i], reflexes.z[i]);
+                    let seen = reflexes.visible[i] && (0.0..=self.height).contains(&r.y);
+                    uvs.push(if seen { self.picture_coords(r) } else { None });
+                }
             }
-            for i in 0..w as usize {
-                let r = Vec3::new(reflexes.x[i], reflexes.y[i], reflexes.z[i]);
-                let seen = reflexes.visible[i] && (0.0..=self.height).contains(&r.y);
-                out.push(if seen { self.picture_coords(r) } else { None });
-            }
+            row(y, &uvs);
         }
-        (w, h, out)
+        (w, h)
     }
 
     /// A polyline of the picture (picture coordinates) as printed: floor polylines in
