@@ -120,6 +120,23 @@ pub enum LineKind {
     Rim,
     /// The horizon of an infinite plane: its line at infinity (a circle far away).
     Horizon,
+    /// Where the object meets `other`.
+    Intersection {
+        /// The other object.
+        other: u32,
+    },
+}
+
+impl SceneLine {
+    /// How close to the line's own objects a visibility ray may pass: chords of intersection
+    /// curves run just inside both objects (1e-3 of the distance is ample and far below any
+    /// real occlusion by them).
+    pub fn leeway(&self) -> (Vec<u32>, f64) {
+        match self.kind {
+            LineKind::Intersection { other } => (vec![self.object, other], 1e-3),
+            _ => (vec![], 0.0),
+        }
+    }
 }
 
 /// A line of the scene: a curve on an object.

@@ -1,9 +1,12 @@
-//! Intersection curves where objects meet, exactly: plane sections of spheres (circles) and of
-//! cylinders (ellipses, or generating lines when the plane is parallel to the axis), two
-//! spheres (the circle in their radical plane), and flat faces against flat faces (segments) —
-//! each cut to the faces and the finite cylinder it belongs to by exact angular intervals
-//! (`A cos θ + B sin θ + C ≥ 0` per bounding half-plane). Lines a face shares with the other
-//! object's own edges (a box standing on the floor, a cylinder's base on it) are not repeated.
+//! Intersection curves where objects meet: plane sections of spheres (circles) and of cylinders
+//! (ellipses, or generating lines when the plane is parallel to the axis), two spheres (the
+//! circle in their radical plane), and flat faces against flat faces (segments) — exact curves,
+//! cut to the faces and the finite cylinder by exact angular intervals (`A cos θ + B sin θ + C ≥
+//! 0` per bounding half-plane). Cylinders and cones against spheres, cylinders, cones and
+//! planes (quartics and conics) are traced generator by generator: each generator meets the
+//! other surface exactly (a quadratic), 720 generators around, linked into polylines. Lines a
+//! face shares with the other object's own edges (a box standing on the floor, a cylinder's
+//! base on it) are not repeated.
 
 use crate::curves::{Curve, LineKind, SceneLine};
 use alhazen_math::{Transform, Vec3, orthonormal_basis};
@@ -43,6 +46,12 @@ enum Piece {
         axis: Vec3,
         radius: f64,
     },
+    /// The side of a finite cone from its base circle to `apex`.
+    ConeSide {
+        base: Vec3,
+        apex: Vec3,
+        radius: f64,
+    },
 }
 
 /// Meshes with more triangles are left out of intersections (their pairs grow as the product).
@@ -75,6 +84,14 @@ fn pieces(scene: &Scene, o: &alhazen_scene::Object) -> Vec<Piece> {
                 let a = (tp - b).normalize();
                 v.push(flat_disk(b, -a, radius * s));
                 v.push(flat_disk(tp, a, radius * s));
+            }
+            v
+        }
+        (Shape::Cone { base, apex, radius, capped }, Some(s)) => {
+            let (b, ap) = (t.point(*base), t.point(*apex));
+            let mut v = vec![Piece::ConeSide { base: b, apex: ap, radius: radius * s }];
+            if *capped {
+                v.push(flat_disk(b, (b - ap).normalize(), radius * s));
             }
             v
         }
@@ -354,9 +371,126 @@ fn pair(p: &Piece, q: &Piece) -> Vec<Curve> {
         (Piece::Sphere { center: c1, radius: r1 }, Piece::Sphere { center: c2, radius: r2 }) => {
             sphere_sphere(*c1, *r1, *c2, *r2)
         }
-        // Other quadric pairs meet in quartic curves: not drawn.
-        _ => vec![],
+        // The rest meet in quartics (or conics on a cone): traced generator by generator.
+        (Piece::Side { .. } | Piece::ConeSide { .. }, _) => ruled_section(p, q),
+        (_, Piece::Side { .. } | Piece::ConeSide { .. }) => ruled_section(q, p),
     }
+}
+
+/// Generators traced around a cylinder's or cone's side.
+const GENERATORS: usize = 720;
+
+/// The intersection of a ruled side (cylinder or cone) with another piece, exact on every one
+/// of `GENERATORS` generators — each meets a quadric in at most two points (a quadratic in
+/// the height) and a plane in one — and linked from generator to generator into polylines.
+fn ruled_section(ruled: &Piece, other: &Piece) -> Vec<Curve> {
+    let (base, axis, r, cone) = match *ruled {
+        Piece::Side { base, axis, radius } => (base, axis, radius, false),
+        Piece::ConeSide { base, apex, radius } => (base, apex - base, radius, true),
+        _ => return vec![],
+    };
+    let (x, y) = orthonormal_basis(axis.normalize());
+    let generator = |th: f64| {
+        let foot = base + (x * th.cos() + y * th.sin()) * r;
+        // h ∈ [0, 1] from the base circle to the top circle (or the apex).
+        (foot, if cone { base + axis - foot } else { axis })
+    };
+    let mut rows = vec![];
+    for k in 0..GENERATORS {
+        let th = TAU * k as f64 / GENERATORS as f64;
+        let (o, d) = generator(th);
+        // Hits on the rims (or the apex) are rims, drawn already: a cone standing on the floor.
+        let hs: Vec<f64> = line_hits(other, o, d).into_iter().filter(|h| *h > 1e-9 && *h < 1.0 - 1e-9).collect();
+        rows.push(hs.into_iter().map(|h| o + d * h).collect::<Vec<Vec3>>());
+    }
+    link_rows(&rows, (axis.length() + r) * 0.05)
+}
+
+/// Parameters `h` where the line `o + h d` meets a piece (within its extent).
+fn line_hits(piece: &Piece, o: Vec3, d: Vec3) -> Vec<f64> {
+    let roots = |a: f64, b: f64, c: f64| -> Vec<f64> {
+        if a.abs() < 1e-300 {
+            return if b != 0.0 { vec![-c / b] } else { vec![] };
+        }
+        let disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            return vec![];
+        }
+        let q = -0.5 * (b + disc.sqrt().copysign(b));
+        if q == 0.0 { vec![0.0] } else { vec![q / a, c / q] }
+    };
+    match *piece {
+        Piece::Sphere { center, radius } => {
+            let m = o - center;
+            roots(d.length_squared(), 2.0 * m.dot(d), m.length_squared() - radius * radius)
+        }
+        Piece::Side { base, axis, radius } => {
+            let a = axis.normalize();
+            let perp = |v: Vec3| v - a * v.dot(a);
+            let (m, dp) = (perp(o - base), perp(d));
+            roots(dp.length_squared(), 2.0 * m.dot(dp), m.length_squared() - radius * radius)
+                .into_iter()
+                .filter(|h| (0.0..=axis.length()).contains(&(o + d * *h - base).dot(a)))
+                .collect()
+        }
+        Piece::ConeSide { base, apex, radius } => {
+            let axis = apex - base;
+            let height = axis.length();
+            let a = axis / height;
+            let k2 = (radius / height).powi(2);
+            let (m, s0, ds) = (o - base, (o - base).dot(a), d.dot(a));
+            let (mp, dp) = (m - a * s0, d - a * ds);
+            // |mp + h dp|² = k² (H − s0 − h ds)²
+            let h0 = height - s0;
+            roots(
+                dp.length_squared() - k2 * ds * ds,
+                2.0 * (mp.dot(dp) + k2 * h0 * ds),
+                mp.length_squared() - k2 * h0 * h0,
+            )
+            .into_iter()
+            .filter(|h| (0.0..=height).contains(&(s0 + ds * *h)))
+            .collect()
+        }
+        Piece::Flat(ref f) => {
+            let den = d.dot(f.normal);
+            if den.abs() < 1e-300 {
+                return vec![];
+            }
+            let h = (f.point - o).dot(f.normal) / den;
+            let p = o + d * h;
+            let inside = match &f.outline {
+                Outline::Unbounded => true,
+                Outline::Disk(r) => (p - f.point).length_squared() <= r * r,
+                Outline::Polygon(poly) => (0..poly.len()).all(|k| {
+                    let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                    f.normal.cross(b - a).dot(p - a) >= 0.0
+                }),
+            };
+            if inside { vec![h] } else { vec![] }
+        }
+    }
+}
+
+/// Links points of consecutive (cyclic) rows by nearest distance, below `gap`, into segments.
+fn link_rows(rows: &[Vec<Vec3>], gap: f64) -> Vec<Curve> {
+    let mut out = vec![];
+    let n = rows.len();
+    for k in 0..n {
+        let (cur, next) = (&rows[k], &rows[(k + 1) % n]);
+        let mut taken = vec![false; next.len()];
+        for p in cur {
+            let best = (0..next.len())
+                .filter(|&j| !taken[j])
+                .min_by(|&i, &j| (next[i] - *p).length_squared().total_cmp(&(next[j] - *p).length_squared()));
+            if let Some(j) = best
+                && (next[j] - *p).length() < gap
+            {
+                taken[j] = true;
+                out.push(Curve::Segment { a: *p, b: next[j] });
+            }
+        }
+    }
+    out
 }
 
 /// Lower and upper corners of a box.
@@ -375,6 +509,10 @@ fn bounds(pieces: &[Piece]) -> Option<Aabb> {
             Piece::Side { base, axis, radius } => {
                 grow(*base, *radius);
                 grow(*base + *axis, *radius);
+            }
+            Piece::ConeSide { base, apex, radius } => {
+                grow(*base, *radius);
+                grow(*apex, 0.0);
             }
             Piece::Flat(f) => match &f.outline {
                 Outline::Unbounded => return None,
@@ -411,7 +549,11 @@ pub fn intersection_lines(scene: &Scene) -> Vec<SceneLine> {
             for p in &objs[i].0 {
                 for q in &objs[j].0 {
                     for curve in pair(p, q) {
-                        out.push(SceneLine { curve, object: i as u32, kind: LineKind::Edge });
+                        out.push(SceneLine {
+                            curve,
+                            object: i as u32,
+                            kind: LineKind::Intersection { other: j as u32 },
+                        });
                     }
                 }
             }

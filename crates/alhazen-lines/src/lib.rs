@@ -152,17 +152,12 @@ fn reflex_contours(
             let obj = &scene.objects[o];
             let surface = contour::Surface::of(&obj.shape, &obj.transform, mirrors[m].center())?;
             let curves = contour::reflex_contour(&surface, &mirrors[m], view);
+            let own = [o as u32];
             let runs = curves.iter().flat_map(|c| {
                 let knots = reflect::uniform(c.len() - 1);
-                reflect::reflect_path(
-                    &mirrors[m],
-                    reflect::polyline_path(c),
-                    &knots,
-                    Some(o as u32),
-                    view,
-                    world,
-                    tol_px,
-                )
+                // A convex object cannot hide its own contour.
+                let leeway = view::Leeway { objects: &own, near: 1.0 };
+                reflect::reflect_path(&mirrors[m], reflect::polyline_path(c), &knots, &leeway, view, world, tol_px)
             });
             Some(runs.collect::<Vec<_>>())
         })
@@ -207,7 +202,8 @@ fn mesh_reflex_silhouettes(
                 .filter(|e| !curves::is_feature(e, cos_feature) && curves::is_silhouette(e, toward))
                 .flat_map(|e| {
                     let (a, b) = (e.a, e.b);
-                    reflect::reflect_path(mirror, move |s| a + (b - a) * s, &knots, None, view, world, tol_px)
+                    let own = view::Leeway::NONE;
+                    reflect::reflect_path(mirror, move |s| a + (b - a) * s, &knots, &own, view, world, tol_px)
                 })
                 .collect()
         })

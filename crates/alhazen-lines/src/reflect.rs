@@ -7,7 +7,7 @@
 //! forbidden region (§2.2) and of blocked stretches are found by bisection.
 
 use crate::curves::{Curve, SceneLine};
-use crate::view::View;
+use crate::view::{Leeway, View, clear_path};
 use alhazen_math::{Ray, Vec2, Vec3};
 use alhazen_mirror::{Cylinder, Site, Sphere};
 use alhazen_render::World;
@@ -241,14 +241,14 @@ impl Mirror {
             .collect()
     }
 
-    /// What the eye sees of `s` in the mirror; the reflected ray may pass through the object
-    /// `convex` (a convex object `s` lies on the contour of: it cannot hide its own contour).
-    fn seen(&self, view: &View, world: &World, s: Vec3, convex: Option<u32>) -> Seen {
+    /// What the eye sees of `s` in the mirror; the reflected ray may pass near the objects `s`
+    /// lies on as `own` allows.
+    fn seen(&self, view: &View, world: &World, s: Vec3, own: &Leeway) -> Seen {
         let Some(r) = self.reflex(view.viewer(), s) else { return Seen::Nothing };
         if !view.in_front(r) {
             return Seen::Nothing;
         }
-        if view.sees(world, r) && reaches(world, r, s, convex) { Seen::Visible(r) } else { Seen::Hidden(r) }
+        if view.sees(world, r) && reaches(world, r, s, own) { Seen::Visible(r) } else { Seen::Hidden(r) }
     }
 
     /// The two-dimensional problem of a point: its coordinates in the plane `MES` (sphere) or
@@ -367,27 +367,17 @@ fn quadratic(a: f64, b: f64, c: f64) -> Vec<f64> {
     v
 }
 
-/// True when the reflected ray from the mirror point `r` reaches `s` unblocked (passing
-/// through the object `skip`, if given).
-fn reaches(world: &World, r: Vec3, s: Vec3, skip: Option<u32>) -> bool {
+/// True when the reflected ray from the mirror point `r` reaches `s` unblocked (but for what
+/// `own` allows near `s`).
+fn reaches(world: &World, r: Vec3, s: Vec3, own: &Leeway) -> bool {
     let d = s - r;
     let dist = d.length();
     if dist <= 0.0 {
         return false;
     }
     let dir = d / dist;
-    let (mut t, end) = (1e-6 * dist, dist * (1.0 - 2e-6));
-    for _ in 0..8 {
-        match world.intersect(&Ray::new(r + dir * t, dir), end - t) {
-            None => return true,
-            Some(h) if Some(h.object) == skip => t += h.hit.t + 1e-9 * dist,
-            Some(_) => return false,
-        }
-        if t >= end {
-            return true;
-        }
-    }
-    false
+    let start = 1e-6 * dist;
+    clear_path(world, Ray::new(r + dir * start, dir), dist - start, own)
 }
 
 /// How finely reflected curves are followed.
@@ -422,21 +412,23 @@ pub fn reflect_line(
         }
         _ => uniform(opts.knots * 4),
     };
-    reflect_path(mirror, |s| curve.point(s), &knots, None, view, world, opts.tol_px)
+    let (own, near) = line.leeway();
+    reflect_path(mirror, |s| curve.point(s), &knots, &Leeway { objects: &own, near }, view, world, opts.tol_px)
 }
 
 /// The visible reflexes of the path `s ↦ point(s)`, `s ∈ [0, 1]`, starting from `knots`
-/// (sorted, from 0 to 1); `convex`: the convex object whose contour the path is.
+/// (sorted, from 0 to 1); `own`: the objects the path lies on and how near to it their hits
+/// are ignored.
 pub fn reflect_path(
     mirror: &Mirror,
     point: impl Fn(f64) -> Vec3,
     knots: &[f64],
-    convex: Option<u32>,
+    own: &Leeway,
     view: &View,
     world: &World,
     tol_px: f64,
 ) -> Vec<Vec<Vec3>> {
-    let seen = |s: f64| mirror.seen(view, world, point(s), convex);
+    let seen = |s: f64| mirror.seen(view, world, point(s), own);
     let states: Vec<(f64, Seen)> = knots.iter().map(|&s| (s, seen(s))).collect();
     let Some(&first) = states.first() else { return vec![] };
     let mut pts = vec![first];

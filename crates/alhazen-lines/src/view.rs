@@ -112,4 +112,48 @@ impl View {
         let (ray, dist) = self.eye_ray(p);
         world.intersect(&ray, dist * (1.0 - 1e-6)).is_none()
     }
+
+    /// Visibility of a point allowed `own`: hits on those objects closer to the point than
+    /// its leeway (a fraction of the distance) do not count — for points on chords of curves
+    /// that lie on those objects (an intersection curve's chords run just inside both).
+    pub fn sees_with(&self, world: &World, p: Vec3, own: &Leeway) -> bool {
+        let (ray, dist) = self.eye_ray(p);
+        clear_path(world, ray, dist, own)
+    }
+}
+
+/// Objects a visibility ray may pass near its end point: hits on them beyond `(1 − near)` of
+/// the way are ignored (`near = 1` ignores them entirely: a convex object cannot hide its own
+/// contour).
+#[derive(Clone, Copy, Debug)]
+pub struct Leeway<'a> {
+    /// The objects.
+    pub objects: &'a [u32],
+    /// The fraction of the distance.
+    pub near: f64,
+}
+
+impl Leeway<'_> {
+    /// No leeway.
+    pub const NONE: Leeway<'static> = Leeway { objects: &[], near: 0.0 };
+}
+
+/// True when the ray reaches `dist` with no hit except those `own` allows.
+pub fn clear_path(world: &World, ray: Ray, dist: f64, own: &Leeway) -> bool {
+    let end = dist * (1.0 - 1e-6);
+    let mut t = 0.0;
+    for _ in 0..16 {
+        let from = Ray::new(ray.origin + ray.dir * t, ray.dir);
+        match world.intersect(&from, end - t) {
+            None => return true,
+            Some(h) if own.objects.contains(&h.object) && t + h.hit.t >= dist * (1.0 - own.near) => {
+                t += h.hit.t + 1e-9 * dist;
+            }
+            Some(_) => return false,
+        }
+        if t >= end {
+            return true;
+        }
+    }
+    false
 }

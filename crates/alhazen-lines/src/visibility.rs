@@ -7,7 +7,7 @@
 //! to find crossings, within the drawing tolerance.
 
 use crate::curves::SceneLine;
-use crate::view::View;
+use crate::view::{Leeway, View};
 use alhazen_math::{Ray, Vec2, Vec3};
 use alhazen_render::World;
 use rayon::prelude::*;
@@ -201,12 +201,14 @@ pub fn pieces(lines: &[SceneLine], chords: &[Chord], view: &View, world: &World)
             ts.sort_by(f64::total_cmp);
             ts.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
             let curve = lines[c.line].curve;
+            let (own, near) = lines[c.line].leeway();
+            let leeway = Leeway { objects: &own, near };
             ts.windows(2)
                 .filter(|w| w[1] > w[0])
                 .map(|w| {
                     let s = |t: f64| c.s.0 + (c.s.1 - c.s.0) * t;
                     let mid = curve.point(s(0.5 * (w[0] + w[1])));
-                    Piece { line: c.line, s: (s(w[0]), s(w[1])), visible: view.sees(world, mid) }
+                    Piece { line: c.line, s: (s(w[0]), s(w[1])), visible: view.sees_with(world, mid, &leeway) }
                 })
                 .collect()
         })

@@ -161,3 +161,8 @@ fn fig17_polygon_through_a_cylinder_agrees_with_the_ray_tracer() {
 fn a_military_axonometry_with_a_mirror_agrees_with_the_ray_tracer() {
     assert_agrees("scenes/lines/axonometric-mirror.toml");
 }
+
+#[test]
+fn intersection_curves_agree_with_the_ray_tracer() {
+    assert_agrees("scenes/lines/intersections.toml");
+}
