@@ -31,6 +31,10 @@ pub struct AnamorphArgs {
     /// Resolution of a raster print.
     #[arg(long, default_value_t = 300.0)]
     dpi: f64,
+    /// Samples per pixel along each axis of a raster print, averaged (the print squeezes parts
+    /// of the picture hard: without them they alias).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=8))]
+    supersample: u32,
     /// Output: .png or .pdf (raster picture); .svg or .pdf (line drawing); .png too.
     #[arg(short, long)]
     output: PathBuf,
@@ -109,17 +113,30 @@ fn raster_print(a: &AnamorphArgs, paper: Vec2, out: &str) -> Result<Vec<u8>, Fai
         .map_err(|e| Failure::input(format!("{}: {e}", a.image.display())))?;
     let (an, at) = setup(a, img.width as f64 / img.height as f64, paper)?;
     let srgb = |v: f32| (255.0 * alhazen_math::color::srgb_encode(v.clamp(0.0, 1.0) as f64)).round() as u8;
-    let mut rgb = vec![];
+    // The print at `n`× the resolution, averaged over n × n blocks in linear light.
+    let n = a.supersample as usize;
+    let fine_rows = (at.paper.y / 25.4 * a.dpi * n as f64).round().max(1.0) as u64;
+    let (mut rgb, mut sums, mut w) = (vec![], vec![], 0usize);
     let bar = crate::progress_bar(false);
-    let rows = (at.paper.y / 25.4 * a.dpi).round().max(1.0) as u64;
-    bar.set_length(rows);
-    let (w, h) = an.print_raster(&at, a.dpi, |y, row| {
-        for uv in row {
-            rgb.extend(uv.map_or([1.0f32; 3], |uv| bilinear(&img, uv)).map(srgb));
+    bar.set_length(fine_rows);
+    let (_, fine_h) = an.print_raster(&at, a.dpi * n as f64, |y, row| {
+        w = row.len() / n;
+        sums.resize(w * 3, 0.0f32);
+        for (x, uv) in row.iter().take(w * n).enumerate() {
+            let c = uv.map_or([1.0f32; 3], |uv| bilinear(&img, uv));
+            for k in 0..3 {
+                sums[(x / n) * 3 + k] += c[k];
+            }
+        }
+        if (y as usize + 1).is_multiple_of(n) {
+            let scale = 1.0 / (n * n) as f32;
+            rgb.extend(sums.iter().map(|v| srgb(v * scale)));
+            sums.iter_mut().for_each(|v| *v = 0.0);
         }
         bar.set_position(y as u64 + 1);
     });
     bar.finish_and_clear();
+    let (w, h) = (w as u32, fine_h / n as u32);
     let guides =
         Drawing { size: at.paper, lines: footprint(&an, &at).into_iter().map(|p| (Layer::Hidden, p)).collect() };
     match out {
