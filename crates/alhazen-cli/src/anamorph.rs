@@ -59,6 +59,16 @@ pub fn run(a: &AnamorphArgs) -> Result<(), Failure> {
     if !dir.is_dir() {
         return Err(Failure::input(format!("{}: the directory {} does not exist", a.output.display(), dir.display())));
     }
+    let fits = match ext(&a.image).as_str() {
+        "png" => ["png", "pdf"].contains(&out_ext.as_str()),
+        _ => ["svg", "pdf", "png"].contains(&out_ext.as_str()),
+    };
+    if !fits {
+        return Err(Failure::input(format!(
+            "{}: a raster picture prints to .png or .pdf, a line drawing to .svg, .pdf or .png",
+            a.output.display()
+        )));
+    }
     let bytes = match ext(&a.image).as_str() {
         "png" => raster_print(a, paper, &out_ext)?,
         "svg" => vector_print(a, paper, &out_ext)?,
