@@ -225,9 +225,11 @@ pub fn pieces_sampled(lines: &[SceneLine], chords: &[Chord], view: &View, world:
         .map(|c| {
             let n = ((c.q.1 - c.q.0).length() / step_px).ceil().max(1.0) as usize;
             let curve = lines[c.line].curve;
+            let (own, near) = lines[c.line].leeway();
+            let leeway = Leeway { objects: &own, near };
             let s = |t: f64| c.s.0 + (c.s.1 - c.s.0) * t;
             let vis: Vec<bool> =
-                (0..n).map(|k| view.sees(world, curve.point(s((k as f64 + 0.5) / n as f64)))).collect();
+                (0..n).map(|k| view.sees_with(world, curve.point(s((k as f64 + 0.5) / n as f64)), &leeway)).collect();
             vis.iter()
                 .enumerate()
                 .map(|(k, &v)| Piece {
