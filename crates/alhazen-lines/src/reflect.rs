@@ -255,20 +255,27 @@ impl Mirror {
     /// the normal projection along the axis (cylinder), `x̂` towards the eye, with the eye's own
     /// (finite `e`, or `None` at infinity).
     fn plane(&self, view: &View) -> Option<Plane> {
-        let (m, r, axis) = match *self {
+        Plane::new(self, view.eye, view.dir)
+    }
+}
+
+impl Plane {
+    /// The frame of `mirror` for an eye at `eye` (or at infinity opposite `dir`).
+    fn new(mirror: &Mirror, eye: Option<Vec3>, dir: Vec3) -> Option<Plane> {
+        let (m, r, axis) = match *mirror {
             Mirror::Sphere { sphere, .. } => (sphere.center, sphere.radius, None),
             Mirror::Cylinder { cylinder, .. } => (cylinder.center, cylinder.radius, Some(cylinder.axis.normalize())),
             // The reflex of a line in a plane is a line: uniform knots do.
             Mirror::Plane { .. } => return None,
         };
         let flat = |v: Vec3| axis.map_or(v, |a| v - a * v.dot(a));
-        let (x, e) = match view.eye {
+        let (x, e) = match eye {
             Some(eye) => {
                 let d = flat(eye - m);
                 let e = d.length();
                 (d / e, Some(e))
             }
-            None => (flat(-view.dir).normalize(), None),
+            None => (flat(-dir).normalize(), None),
         };
         x.is_finite().then(|| Plane { m, r, x, y: axis.map(|a| a.cross(x)), e })
     }
@@ -510,6 +517,35 @@ fn runs(pts: &[(f64, Seen)]) -> Vec<Vec<Vec3>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Fig. 16: the knots' reflexes divide the arc between the ends' reflexes into equal polar
+    /// angles about the axis ME (sphere) or in the projection along the axis (cylinder).
+    #[test]
+    fn knots_give_equal_steps_of_the_reflex_angle() {
+        let eye = Vec3::new(0.3, 0.8, 6.0);
+        let (a, b) = (Vec3::new(-2.5, 0.4, 1.0), Vec3::new(2.0, -0.3, 1.8));
+        let mirrors = [
+            Mirror::Sphere { sphere: Sphere { center: Vec3::ZERO, radius: 1.0 }, object: 0 },
+            Mirror::Cylinder {
+                cylinder: Cylinder { center: Vec3::new(0.0, -5.0, 0.0), axis: Vec3::Y * 10.0, radius: 1.0 },
+                object: 0,
+            },
+        ];
+        for mirror in mirrors {
+            let plane = Plane::new(&mirror, Some(eye), Vec3::NEG_Z).unwrap();
+            let reflex = |p: Vec3| mirror.reflex(Site::At(eye), p).unwrap();
+            let knots = plane.knots(reflex(a), reflex(b), a, b, 8);
+            assert_eq!(knots.len(), 9, "{mirror:?}");
+            let angle = |l: f64| {
+                let c = plane.coords(reflex(a + (b - a) * l));
+                c.y.atan2(c.x)
+            };
+            let steps: Vec<f64> = knots.windows(2).map(|w| angle(w[1]) - angle(w[0])).collect();
+            for s in &steps {
+                assert!((s - steps[0]).abs() < 1e-9, "{mirror:?}: {steps:?}");
+            }
+        }
+    }
 
     #[test]
     fn quadratic_roots_are_accurate() {
