@@ -77,8 +77,9 @@ impl Drawing {
 
     /// Polylines of a layer that meet end to end (within 1 µm) chained into one, so a plotter
     /// lifts its pen less and files shrink; order otherwise kept.
-    pub fn joined(self) -> Drawing {
+    pub fn joined(mut self) -> Drawing {
         use std::collections::HashMap;
+        self.lines.retain(|(_, p)| !p.is_empty());
         let key = |p: Vec2| ((p.x * 1e3).round() as i64, (p.y * 1e3).round() as i64);
         let n = self.lines.len();
         let mut ends: HashMap<(Layer, (i64, i64)), Vec<usize>> = HashMap::new();
