@@ -496,6 +496,9 @@ fn link_rows(rows: &[Vec<Vec3>], gap: f64) -> Vec<Curve> {
 /// Lower and upper corners of a box.
 type Aabb = (Vec3, Vec3);
 
+/// A piece with its bounds (`None`: unbounded).
+type Bounded = (Piece, Option<Aabb>);
+
 /// Bounds of an object's pieces (`None`: unbounded), padded a little.
 fn bounds(pieces: &[Piece]) -> Option<Aabb> {
     let (mut lo, mut hi) = (Vec3::splat(f64::INFINITY), Vec3::splat(f64::NEG_INFINITY));
@@ -527,27 +530,31 @@ fn bounds(pieces: &[Piece]) -> Option<Aabb> {
 
 /// The intersection curves of every pair of objects whose bounds overlap.
 pub fn intersection_lines(scene: &Scene) -> Vec<SceneLine> {
-    let objs: Vec<(Vec<Piece>, Option<Aabb>)> = scene
+    // Each piece with its bounds (`None`: unbounded), and each object's.
+    let objs: Vec<(Vec<Bounded>, Option<Aabb>)> = scene
         .objects
         .iter()
-        .map(|o| pieces(scene, o))
-        .map(|p| {
-            let b = bounds(&p);
-            (p, b)
+        .map(|o| {
+            let ps = pieces(scene, o);
+            let whole = bounds(&ps);
+            (ps.into_iter().map(|p| (p.clone(), bounds(std::slice::from_ref(&p)))).collect(), whole)
         })
         .collect();
+    let overlap = |a: Option<Aabb>, b: Option<Aabb>| match (a, b) {
+        (Some((a0, a1)), Some((b0, b1))) => a0.cmple(b1).all() && b0.cmple(a1).all(),
+        _ => true,
+    };
     let mut out = vec![];
     for i in 0..objs.len() {
         for j in i + 1..objs.len() {
-            let overlap = match (objs[i].1, objs[j].1) {
-                (Some((a0, a1)), Some((b0, b1))) => a0.cmple(b1).all() && b0.cmple(a1).all(),
-                _ => true,
-            };
-            if !overlap {
+            if !overlap(objs[i].1, objs[j].1) {
                 continue;
             }
-            for p in &objs[i].0 {
-                for q in &objs[j].0 {
+            for (p, pb) in &objs[i].0 {
+                for (q, qb) in &objs[j].0 {
+                    if !overlap(*pb, *qb) {
+                        continue;
+                    }
                     for curve in pair(p, q) {
                         out.push(SceneLine {
                             curve,
