@@ -325,22 +325,10 @@ impl Sphere {
         out: &mut ReflexesSoA,
     ) -> Result<(), MirrorError> {
         self.check_eye(eye)?;
-        let n = points.len();
-        out.reset(n);
         let (m, r) = (self.center, self.radius);
         let e = (eye - m).length();
-        let xh = (eye - m) / e;
-        let mut cn = Canon::with_len(n);
-        with_widest_vectors(SphereLoop { m, r, e, xh, points, cn: &mut cn, out: &mut *out });
-        for i in 0..n {
-            out.visible[i] = cn.ok[i];
-            if !cn.ok[i] {
-                out.set_none(i);
-                if !forbidden(r, e, cn.sx[i], cn.sy[i]) {
-                    out.set_from_scalar(i, self.visible_reflex(crate::Site::At(eye), crate::Site::At(points.get(i))));
-                }
-            }
-        }
+        let frame = SphereFrame { m, r, xh: (eye - m) / e };
+        run_batch(frame, r, e, points, out, |p| self.visible_reflex(crate::Site::At(eye), crate::Site::At(p)));
         Ok(())
     }
 }
@@ -354,74 +342,111 @@ impl Cylinder {
         out: &mut ReflexesSoA,
     ) -> Result<(), MirrorError> {
         self.check_eye(eye)?;
-        let n = points.len();
-        out.reset(n);
         let a = self.axis.normalize();
         let (m, r) = (self.center, self.radius);
         let he = (eye - m).dot(a);
         let d = (eye - m) - a * he;
         let e = d.length();
         let xh = d / e;
-        let yh = a.cross(xh);
-        let mut cn = Canon::with_len(n);
-        let frame = CylinderFrame { m, a, xh, yh, he };
-        with_widest_vectors(CylinderLoop { frame, r, e, points, cn: &mut cn, out: &mut *out });
-        for i in 0..n {
-            out.visible[i] = cn.ok[i];
-            if !cn.ok[i] {
-                out.set_none(i);
-                if !forbidden(r, e, cn.sx[i], cn.sy[i]) {
-                    out.set_from_scalar(i, self.visible_reflex(crate::Site::At(eye), crate::Site::At(points.get(i))));
-                }
-            }
-        }
+        let frame = CylinderFrame { m, a, xh, yh: a.cross(xh), he, r, e };
+        run_batch(frame, r, e, points, out, |p| self.visible_reflex(crate::Site::At(eye), crate::Site::At(p)));
         Ok(())
     }
 }
 
-/// The sphere's batch: canonical coordinates in the plane MES (x̂ towards the eye, the source
-/// at distance |perp| from the axis), the kernel, and the reflexes back in 3D.
-struct SphereLoop<'a> {
-    m: Vec3,
+/// How a mirror turns a point into its canonical problem `(x, y ≥ 0)` and the solution `t` of
+/// that problem back into the reflex in space.
+trait CanonicalFrame: Copy {
+    fn canonical(&self, p: Vec3) -> (f64, f64);
+    fn lift(&self, p: Vec3, t: f64, sy: f64) -> Vec3;
+}
+
+/// The kernel over a batch with the widest vectors, then the scalar solver (which also decides
+/// the forbidden region) for the points it left undecided.
+fn run_batch<F: CanonicalFrame>(
+    frame: F,
     r: f64,
     e: f64,
-    xh: Vec3,
+    points: PointsSoA,
+    out: &mut ReflexesSoA,
+    scalar: impl Fn(Vec3) -> Result<Option<crate::Reflex>, MirrorError>,
+) {
+    let n = points.len();
+    out.reset(n);
+    let mut cn = Canon::with_len(n);
+    with_widest_vectors(BatchLoop { frame, r, e, points, cn: &mut cn, out: &mut *out });
+    for i in 0..n {
+        out.visible[i] = cn.ok[i];
+        if !cn.ok[i] {
+            out.set_none(i);
+            if !forbidden(r, e, cn.sx[i], cn.sy[i]) {
+                out.set_from_scalar(i, scalar(points.get(i)));
+            }
+        }
+    }
+}
+
+/// A batch: canonical coordinates, the kernel, and the reflexes back in space, in one loop
+/// each that the compiler vectorises.
+struct BatchLoop<'a, F> {
+    frame: F,
+    r: f64,
+    e: f64,
     points: PointsSoA<'a>,
     cn: &'a mut Canon,
     out: &'a mut ReflexesSoA,
 }
 
-impl SphereLoop<'_> {
-    #[inline(always)]
-    fn perp(&self, i: usize) -> (f64, Vec3) {
-        let rel = self.points.get(i) - self.m;
-        let sx = rel.dot(self.xh);
-        (sx, rel - self.xh * sx)
-    }
-}
-
-impl VectorLoop for SphereLoop<'_> {
+impl<F: CanonicalFrame> VectorLoop for BatchLoop<'_, F> {
     #[inline(always)]
     fn run(self) {
         let n = self.cn.sx.len();
         for i in 0..n {
-            let (sx, perp) = self.perp(i);
-            (self.cn.sx[i], self.cn.sy[i]) = (sx, perp.length());
+            (self.cn.sx[i], self.cn.sy[i]) = self.frame.canonical(self.points.get(i));
         }
         self.cn.solve(self.r, self.e);
         for i in 0..n {
-            // The normal (c, s) of (14) and ŷ = perp/|perp|, with one division.
-            let (t, sy) = (self.cn.t[i], self.cn.sy[i]);
-            let inv = 1.0 / ((1.0 + t * t) * sy);
-            let (c, s_over_sy) = ((1.0 - t * t) * sy * inv, 2.0 * t * inv);
-            let p = self.m + (self.xh * c + self.perp(i).1 * s_over_sy) * self.r;
+            let p = self.frame.lift(self.points.get(i), self.cn.t[i], self.cn.sy[i]);
             (self.out.x[i], self.out.y[i], self.out.z[i]) = (p.x, p.y, p.z);
         }
     }
 }
 
-/// A cylinder's frame: centre, unit axis, x̂ towards the eye's projection, ŷ = a × x̂, and the
-/// eye's height.
+/// The sphere's plane MES: x̂ towards the eye, the source at distance |perp| from the axis.
+#[derive(Clone, Copy)]
+struct SphereFrame {
+    m: Vec3,
+    r: f64,
+    xh: Vec3,
+}
+
+impl SphereFrame {
+    #[inline(always)]
+    fn perp(&self, p: Vec3) -> (f64, Vec3) {
+        let rel = p - self.m;
+        let sx = rel.dot(self.xh);
+        (sx, rel - self.xh * sx)
+    }
+}
+
+impl CanonicalFrame for SphereFrame {
+    #[inline(always)]
+    fn canonical(&self, p: Vec3) -> (f64, f64) {
+        let (sx, perp) = self.perp(p);
+        (sx, perp.length())
+    }
+
+    #[inline(always)]
+    fn lift(&self, p: Vec3, t: f64, sy: f64) -> Vec3 {
+        // The normal (c, s) of (14) and ŷ = perp/|perp|, with one division.
+        let inv = 1.0 / ((1.0 + t * t) * sy);
+        let (c, s_over_sy) = ((1.0 - t * t) * sy * inv, 2.0 * t * inv);
+        self.m + (self.xh * c + self.perp(p).1 * s_over_sy) * self.r
+    }
+}
+
+/// A cylinder's frame: centre, unit axis, x̂ towards the eye's projection, ŷ = a × x̂, the
+/// eye's height, the radius and the eye's distance from the axis.
 #[derive(Clone, Copy)]
 struct CylinderFrame {
     m: Vec3,
@@ -429,6 +454,8 @@ struct CylinderFrame {
     xh: Vec3,
     yh: Vec3,
     he: f64,
+    r: f64,
+    e: f64,
 }
 
 impl CylinderFrame {
@@ -440,39 +467,24 @@ impl CylinderFrame {
     }
 }
 
-/// The cylinder's batch: the normal projection along the axis, the kernel, and the height of
-/// each reflex by (10).
-struct CylinderLoop<'a> {
-    frame: CylinderFrame,
-    r: f64,
-    e: f64,
-    points: PointsSoA<'a>,
-    cn: &'a mut Canon,
-    out: &'a mut ReflexesSoA,
-}
-
-impl VectorLoop for CylinderLoop<'_> {
+impl CanonicalFrame for CylinderFrame {
     #[inline(always)]
-    fn run(self) {
-        let (f, r, e) = (self.frame, self.r, self.e);
-        let n = self.cn.sx.len();
-        for i in 0..n {
-            let (sx, sy, _) = f.project(self.points.get(i));
-            (self.cn.sx[i], self.cn.sy[i]) = (sx, sy.abs());
-        }
-        self.cn.solve(r, e);
-        for i in 0..n {
-            let (sx, sy, hs) = f.project(self.points.get(i));
-            let (c, s) = normal_of(self.cn.t[i]);
-            let s = s.copysign(sy);
-            // (10): the unfolded path E → R → S is straight.
-            let (fx, fy) = (c * r, s * r);
-            let le = ((e - fx) * (e - fx) + fy * fy).sqrt();
-            let ls = ((sx - fx) * (sx - fx) + (sy - fy) * (sy - fy)).sqrt();
-            let h = f.he + (hs - f.he) * le / (le + ls);
-            let p = f.m + (f.xh * c + f.yh * s) * r + f.a * h;
-            (self.out.x[i], self.out.y[i], self.out.z[i]) = (p.x, p.y, p.z);
-        }
+    fn canonical(&self, p: Vec3) -> (f64, f64) {
+        let (sx, sy, _) = self.project(p);
+        (sx, sy.abs())
+    }
+
+    #[inline(always)]
+    fn lift(&self, p: Vec3, t: f64, _: f64) -> Vec3 {
+        let (sx, sy, hs) = self.project(p);
+        let (c, s) = normal_of(t);
+        let s = s.copysign(sy);
+        // (10): the unfolded path E → R → S is straight.
+        let (fx, fy) = (c * self.r, s * self.r);
+        let le = ((self.e - fx) * (self.e - fx) + fy * fy).sqrt();
+        let ls = ((sx - fx) * (sx - fx) + (sy - fy) * (sy - fy)).sqrt();
+        let h = self.he + (hs - self.he) * le / (le + ls);
+        self.m + (self.xh * c + self.yh * s) * self.r + self.a * h
     }
 }
 
