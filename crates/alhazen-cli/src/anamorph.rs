@@ -55,10 +55,7 @@ pub fn run(a: &AnamorphArgs) -> Result<(), Failure> {
         return Err(Failure::input("--dpi must be between 10 and 2400"));
     }
     let out_ext = ext(&a.output);
-    let dir = a.output.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        return Err(Failure::input(format!("{}: the directory {} does not exist", a.output.display(), dir.display())));
-    }
+    crate::check_output_dir(&a.output)?;
     let fits = match ext(&a.image).as_str() {
         "png" => ["png", "pdf"].contains(&out_ext.as_str()),
         _ => ["svg", "pdf", "png"].contains(&out_ext.as_str()),

@@ -94,10 +94,7 @@ fn output_kind(path: &Path) -> Result<Kind, Failure> {
         Some("png") => Kind::Png,
         _ => return Err(Failure::input(format!("{}: unknown drawing format; use .svg, .pdf or .png", path.display()))),
     };
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        return Err(Failure::input(format!("{}: the directory {} does not exist", path.display(), dir.display())));
-    }
+    crate::check_output_dir(path)?;
     Ok(kind)
 }
 

@@ -197,11 +197,17 @@ pub(crate) fn save(image: &alhazen_render::Image, path: &Path, format: Format) -
 pub(crate) fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
     let format = Format::from_path(path, half)
         .ok_or_else(|| Failure::input(format!("{}: unknown image format; use .png, .exr or .pfm", path.display())))?;
+    check_output_dir(path)?;
+    Ok(format)
+}
+
+/// Refuses an output path whose directory does not exist, before any work is done.
+pub(crate) fn check_output_dir(path: &Path) -> Result<(), Failure> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {
         return Err(Failure::input(format!("{}: the directory {} does not exist", path.display(), dir.display())));
     }
-    Ok(format)
+    Ok(())
 }
 
 fn run_render(a: &RenderArgs) -> Result<(), Failure> {

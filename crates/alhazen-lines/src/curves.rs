@@ -203,8 +203,9 @@ fn horizon(point: Vec3, normal: Vec3, view: &View, object: u32) -> Option<SceneL
     Some(SceneLine { curve, object, kind: LineKind::Horizon })
 }
 
-/// The uniform scale of a similarity transform (rotation, uniform scale, translation).
-fn similarity(t: &Transform) -> Option<f64> {
+/// The uniform scale of a similarity transform (rotation, uniform scale, translation): the
+/// transforms under which spheres, cylinders and cones keep their exact form.
+pub(crate) fn similarity(t: &Transform) -> Option<f64> {
     let (x, y, z) = (t.vector(Vec3::X), t.vector(Vec3::Y), t.vector(Vec3::Z));
     let s = x.length();
     let tol = 1e-9 * s;

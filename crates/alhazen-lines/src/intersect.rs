@@ -9,7 +9,7 @@
 //! base on it) are not repeated.
 
 use crate::curves::{Curve, LineKind, SceneLine};
-use alhazen_math::{Transform, Vec3, orthonormal_basis};
+use alhazen_math::{Vec3, orthonormal_basis};
 use alhazen_raster::pipeline::geometry::world_triangles;
 use alhazen_scene::{Scene, Shape};
 use std::f64::consts::TAU;
@@ -57,16 +57,10 @@ enum Piece {
 /// Meshes with more triangles are left out of intersections (their pairs grow as the product).
 const MAX_TRIANGLES: usize = 4096;
 
-fn uniform_scale(t: &Transform) -> Option<f64> {
-    let s = t.vector(Vec3::X).length();
-    let ok = (t.vector(Vec3::Y).length() - s).abs() < 1e-9 * s && (t.vector(Vec3::Z).length() - s).abs() < 1e-9 * s;
-    ok.then_some(s)
-}
-
 fn pieces(scene: &Scene, o: &alhazen_scene::Object) -> Vec<Piece> {
     let t = &o.transform;
     let flat_disk = |c: Vec3, n: Vec3, r: f64| Piece::Flat(Flat { point: c, normal: n, outline: Outline::Disk(r) });
-    match (&o.shape, uniform_scale(t)) {
+    match (&o.shape, crate::curves::similarity(t)) {
         (Shape::Plane { point, normal }, _) => {
             vec![Piece::Flat(Flat {
                 point: t.point(*point),

@@ -105,12 +105,7 @@ pub fn mirrors(scene: &Scene) -> Vec<Mirror> {
             out.push(Mirror::Plane { point: c, normal: n, extent: Extent::Disk(r), object });
             continue;
         }
-        let scale = t.vector(Vec3::X).length();
-        let uniform = (t.vector(Vec3::Y).length() - scale).abs() < 1e-9 * scale
-            && (t.vector(Vec3::Z).length() - scale).abs() < 1e-9 * scale;
-        if !uniform {
-            continue;
-        }
+        let Some(scale) = crate::curves::similarity(t) else { continue };
         match o.shape {
             Shape::Sphere { center, radius } => {
                 out.push(Mirror::Sphere { sphere: Sphere { center: t.point(center), radius: radius * scale }, object })

@@ -109,8 +109,7 @@ impl View {
     /// Exact visibility of a point on (or near) a surface: nothing is hit before it, allowing
     /// for the surface the point itself lies on (a relative 1e-6 of the distance).
     pub fn sees(&self, world: &World, p: Vec3) -> bool {
-        let (ray, dist) = self.eye_ray(p);
-        world.intersect(&ray, dist * (1.0 - 1e-6)).is_none()
+        self.sees_with(world, p, &Leeway::NONE)
     }
 
     /// Visibility of a point allowed `own`: hits on those objects closer to the point than
