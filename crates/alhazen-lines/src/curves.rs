@@ -157,9 +157,27 @@ pub struct EdgeOptions {
     pub feature_angle: f64,
 }
 
-/// Every line of the scene for this view; the count of objects drawn from their tessellation
-/// because their transform distorts a round shape, and of objects with no lines (CSG, planes).
-pub fn scene_lines(scene: &Scene, view: &View, opts: &EdgeOptions) -> (Vec<SceneLine>, usize, usize) {
+/// Corners of the world triangles of every box and mesh (`None` for other shapes), computed
+/// once per drawing for the lines, the intersections, the plane mirrors and the silhouettes
+/// seen in mirrors.
+pub fn polyhedra(scene: &Scene) -> Vec<Option<Vec<[Vec3; 3]>>> {
+    let corners = |o| world_triangles(scene, o).map(|t| t.iter().map(|t| t.map(|v| v.p)).collect());
+    scene
+        .objects
+        .iter()
+        .map(|o| if matches!(o.shape, Shape::Box { .. } | Shape::Mesh { .. }) { corners(o) } else { None })
+        .collect()
+}
+
+/// Every line of the scene for this view (boxes and meshes from `polyhedra`); the count of
+/// objects drawn from their tessellation because their transform distorts a round shape, and of
+/// objects with no lines (CSG).
+pub fn scene_lines(
+    scene: &Scene,
+    polyhedra: &[Option<Vec<[Vec3; 3]>>],
+    view: &View,
+    opts: &EdgeOptions,
+) -> (Vec<SceneLine>, usize, usize) {
     let (mut lines, mut tessellated, mut skipped) = (vec![], 0, 0);
     for (i, o) in scene.objects.iter().enumerate() {
         let object = i as u32;
@@ -177,13 +195,15 @@ pub fn scene_lines(scene: &Scene, view: &View, opts: &EdgeOptions) -> (Vec<Scene
                 ) {
                     tessellated += 1;
                 }
-                if let Some(tris) = world_triangles(scene, o) {
-                    lines.extend(mesh_lines(
-                        &tris.iter().map(|t| t.map(|v| v.p)).collect::<Vec<_>>(),
-                        view,
-                        opts,
-                        object,
-                    ));
+                match &polyhedra[i] {
+                    Some(tris) => lines.extend(mesh_lines(tris, view, opts, object)),
+                    None => {
+                        // A round object under a distorting transform: its tessellation.
+                        if let Some(tris) = world_triangles(scene, o) {
+                            let corners: Vec<[Vec3; 3]> = tris.iter().map(|t| t.map(|v| v.p)).collect();
+                            lines.extend(mesh_lines(&corners, view, opts, object));
+                        }
+                    }
                 }
             }
         }

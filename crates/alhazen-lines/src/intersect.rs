@@ -10,7 +10,6 @@
 
 use crate::curves::{Curve, LineKind, SceneLine};
 use alhazen_math::{Vec3, orthonormal_basis};
-use alhazen_raster::pipeline::geometry::world_triangles;
 use alhazen_scene::{Scene, Shape};
 use std::f64::consts::TAU;
 
@@ -57,7 +56,7 @@ enum Piece {
 /// Meshes with more triangles are left out of intersections (their pairs grow as the product).
 const MAX_TRIANGLES: usize = 4096;
 
-fn pieces(scene: &Scene, o: &alhazen_scene::Object) -> Vec<Piece> {
+fn pieces(o: &alhazen_scene::Object, polyhedron: Option<&[[Vec3; 3]]>) -> Vec<Piece> {
     let t = &o.transform;
     let flat_disk = |c: Vec3, n: Vec3, r: f64| Piece::Flat(Flat { point: c, normal: n, outline: Outline::Disk(r) });
     match (&o.shape, crate::curves::similarity(t)) {
@@ -93,13 +92,12 @@ fn pieces(scene: &Scene, o: &alhazen_scene::Object) -> Vec<Piece> {
             vec![flat_disk(t.point(*center), t.normal(*normal).normalize(), radius * s)]
         }
         (Shape::Box { .. } | Shape::Mesh { .. }, _) => {
-            let Some(tris) = world_triangles(scene, o) else { return vec![] };
+            let Some(tris) = polyhedron else { return vec![] };
             if tris.len() > MAX_TRIANGLES {
                 return vec![];
             }
             tris.iter()
-                .filter_map(|t| {
-                    let p = t.map(|v| v.p);
+                .filter_map(|&p| {
                     let n = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()?;
                     Some(Piece::Flat(Flat { point: p[0], normal: n, outline: Outline::Polygon(p.to_vec()) }))
                 })
@@ -523,13 +521,14 @@ fn bounds(pieces: &[Piece]) -> Option<Aabb> {
 }
 
 /// The intersection curves of every pair of objects whose bounds overlap.
-pub fn intersection_lines(scene: &Scene) -> Vec<SceneLine> {
+pub fn intersection_lines(scene: &Scene, polyhedra: &[Option<Vec<[Vec3; 3]>>]) -> Vec<SceneLine> {
     // Each piece with its bounds (`None`: unbounded), and each object's.
     let objs: Vec<(Vec<Bounded>, Option<Aabb>)> = scene
         .objects
         .iter()
-        .map(|o| {
-            let ps = pieces(scene, o);
+        .zip(polyhedra)
+        .map(|(o, poly)| {
+            let ps = pieces(o, poly.as_deref());
             let whole = bounds(&ps);
             (ps.into_iter().map(|p| (p.clone(), bounds(std::slice::from_ref(&p)))).collect(), whole)
         })

@@ -96,8 +96,9 @@ pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterErr
     let world = World::build(scene);
     let view = view::View::new(scene, &world, opts.width_mm)?;
     let edge_opts = curves::EdgeOptions { feature_angle: opts.feature_angle_deg.to_radians() };
-    let (mut lines, tessellated, skipped) = curves::scene_lines(scene, &view, &edge_opts);
-    lines.extend(intersect::intersection_lines(scene));
+    let polyhedra = curves::polyhedra(scene);
+    let (mut lines, tessellated, skipped) = curves::scene_lines(scene, &polyhedra, &view, &edge_opts);
+    lines.extend(intersect::intersection_lines(scene, &polyhedra));
     let chords = visibility::chords(&lines, &view, opts.tol_mm);
     let pieces = match opts.sampled {
         Some(step) => visibility::pieces_sampled(&lines, &chords, &view, &world, step),
@@ -111,7 +112,7 @@ pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterErr
         let layer = if p.visible { Layer::Visible } else { Layer::Hidden };
         drawing.lines.push((layer, polyline(&lines[p.line].curve, p.s, &view, opts.tol_mm)));
     }
-    let mirrors = if opts.reflections { reflect::mirrors(scene) } else { vec![] };
+    let mirrors = if opts.reflections { reflect::mirrors(scene, &polyhedra) } else { vec![] };
     let tol_px = opts.tol_mm / view.mm_per_px;
     let ropts = reflect::ReflectOptions { tol_px, knots: 16 };
     let jobs: Vec<(usize, usize)> = (0..mirrors.len()).flat_map(|m| (0..lines.len()).map(move |l| (m, l))).collect();
@@ -119,7 +120,7 @@ pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterErr
         jobs.par_iter().map(|&(m, l)| reflect::reflect_line(&mirrors[m], &lines[l], &view, &world, &ropts)).collect();
     let mut reflected = reflected;
     reflected.extend(reflex_contours(scene, &mirrors, &view, &world, tol_px));
-    reflected.extend(mesh_reflex_silhouettes(scene, &mirrors, &view, &world, &edge_opts, tol_px));
+    reflected.extend(mesh_reflex_silhouettes(scene, &polyhedra, &mirrors, &view, &world, &edge_opts, tol_px));
     for run in reflected.into_iter().flatten() {
         drawing.lines.push((Layer::Reflected, run.iter().map(|p| view.to_paper(*p)).collect()));
     }
@@ -168,6 +169,7 @@ fn reflex_contours(
 /// away from the reflected ray at the edge's midpoint (the polyhedral reflex contour).
 fn mesh_reflex_silhouettes(
     scene: &Scene,
+    polyhedra: &[Option<Vec<[Vec3; 3]>>],
     mirrors: &[reflect::Mirror],
     view: &view::View,
     world: &World,
@@ -183,11 +185,7 @@ fn mesh_reflex_silhouettes(
         .iter()
         .enumerate()
         .filter(|(_, o)| matches!(o.shape, alhazen_scene::Shape::Mesh { .. }))
-        .filter_map(|(i, o)| {
-            let tris = alhazen_raster::pipeline::geometry::world_triangles(scene, o)?;
-            let tris: Vec<[Vec3; 3]> = tris.iter().map(|t| t.map(|v| v.p)).collect();
-            Some((i as u32, curves::mesh_edges(&tris)))
-        })
+        .filter_map(|(i, _)| Some((i as u32, curves::mesh_edges(polyhedra[i].as_deref()?))))
         .collect();
     let jobs: Vec<(usize, usize)> = (0..mirrors.len()).flat_map(|m| (0..meshes.len()).map(move |k| (m, k))).collect();
     jobs.par_iter()

@@ -65,9 +65,7 @@ impl Extent {
 }
 
 /// A flat mesh as a plane mirror: all its triangles in one plane, wound alike.
-fn flat_mirror(scene: &Scene, o: &alhazen_scene::Object, object: u32) -> Option<Mirror> {
-    let tris: Vec<[Vec3; 3]> =
-        alhazen_raster::pipeline::geometry::world_triangles(scene, o)?.iter().map(|t| t.map(|v| v.p)).collect();
+fn flat_mirror(tris: &[[Vec3; 3]], object: u32) -> Option<Mirror> {
     let first = tris.first()?;
     let normal = (first[1] - first[0]).cross(first[2] - first[0]).try_normalize()?;
     let point = first[0];
@@ -77,14 +75,14 @@ fn flat_mirror(scene: &Scene, o: &alhazen_scene::Object, object: u32) -> Option<
     (flat && alike).then(|| Mirror::Plane {
         point,
         normal,
-        extent: Extent::Triangles(std::sync::Arc::new(tris)),
+        extent: Extent::Triangles(std::sync::Arc::new(tris.to_vec())),
         object,
     })
 }
 
 /// The spheres, cylinders and plane mirrors (disks, flat meshes) of the scene with a mirror
 /// reflectance; round ones placed by a similarity.
-pub fn mirrors(scene: &Scene) -> Vec<Mirror> {
+pub fn mirrors(scene: &Scene, polyhedra: &[Option<Vec<[Vec3; 3]>>]) -> Vec<Mirror> {
     let mut out = vec![];
     for (i, o) in scene.objects.iter().enumerate() {
         let m = &scene.materials[o.material as usize];
@@ -94,7 +92,7 @@ pub fn mirrors(scene: &Scene) -> Vec<Mirror> {
         let t = &o.transform;
         let object = i as u32;
         if let Shape::Mesh { .. } = o.shape {
-            out.extend(flat_mirror(scene, o, object));
+            out.extend(polyhedra[i].as_deref().and_then(|t| flat_mirror(t, object)));
             continue;
         }
         if let Shape::Disk { center, normal, radius } = o.shape {
