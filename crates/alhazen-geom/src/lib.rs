@@ -111,6 +111,22 @@ impl TriangleMesh {
         Ok(())
     }
 
+    /// The solid box `[min, max]` as twelve triangles, two per face, counter-clockwise seen
+    /// from outside.
+    pub fn cuboid(min: Vec3, max: Vec3) -> Self {
+        let positions = (0..8)
+            .map(|i| {
+                let pick = |bit: usize, lo: f64, hi: f64| if i & bit == 0 { lo } else { hi };
+                Vec3::new(pick(1, min.x, max.x), pick(2, min.y, max.y), pick(4, min.z, max.z))
+            })
+            .collect();
+        // Faces as corner quads (bit 0: x, bit 1: y, bit 2: z high), outward winding.
+        const FACES: [[u32; 4]; 6] =
+            [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let triangles = FACES.iter().flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]]).collect();
+        Self { positions, triangles, ..Self::default() }
+    }
+
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
@@ -144,6 +160,22 @@ impl TriangleMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cuboid_faces_point_outwards_and_cover_the_surface() {
+        let (min, max) = (Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 0.5, 4.0));
+        let m = TriangleMesh::cuboid(min, max);
+        let centre = (min + max) * 0.5;
+        let mut area = 0.0;
+        for i in 0..m.triangle_count() {
+            let [a, b, c] = m.corners(i);
+            let n = (b - a).cross(c - a);
+            assert!(n.dot((a + b + c) / 3.0 - centre) > 0.0, "triangle {i} faces inwards");
+            area += 0.5 * n.length();
+        }
+        let e = max - min;
+        assert!((area - 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)).abs() < 1e-12);
+    }
 
     #[test]
     fn validation_catches_bad_indices_and_nan() {

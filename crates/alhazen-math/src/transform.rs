@@ -125,6 +125,12 @@ impl Transform {
         Ray::new(self.point(r.origin), self.vector(r.dir))
     }
 
+    /// `self.inverse().ray(r)` without copying the matrices.
+    #[inline]
+    pub fn inverse_ray(&self, r: &Ray) -> Ray {
+        Ray::new(self.inv.transform_point3(r.origin), self.inv.transform_vector3(r.dir))
+    }
+
     /// A box containing the image of `b` (the eight corners transformed).
     pub fn bounds(&self, b: &Bounds3) -> Bounds3 {
         if b.is_empty() {

@@ -150,36 +150,18 @@ fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
             parallelogram(&m.triangles, &tris).or_else(|| triangles(tris))
         }
         Shape::Box { min, max } => {
-            let corner = |i: usize| {
-                t.point(Vec3::new(
-                    if i & 1 == 0 { min.x } else { max.x },
-                    if i & 2 == 0 { min.y } else { max.y },
-                    if i & 4 == 0 { min.z } else { max.z },
-                ))
-            };
-            // Faces as corner quads, counter-clockwise seen from outside.
-            const FACES: [[usize; 4]; 6] =
-                [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-            let tris = FACES
-                .iter()
-                .flat_map(|f| [[corner(f[0]), corner(f[1]), corner(f[2])], [corner(f[0]), corner(f[2]), corner(f[3])]])
-                .collect();
-            triangles(tris)
+            let m = alhazen_geom::TriangleMesh::cuboid(*min, *max);
+            triangles((0..m.triangle_count()).map(|i| m.corners(i).map(|p| t.point(p))).collect())
         }
         _ => None,
     }
 }
 
-/// Two triangles `[a, b, c], [a, c, d]` with `c = b + d − a` form a parallelogram.
+/// A mesh of two triangles forming a parallelogram.
 fn parallelogram(indices: &[[u32; 3]], corners: &[[Vec3; 3]]) -> Option<Emitter> {
-    let ([i, j], [[a, b, c], [_, _, d]]) = (indices, corners) else { return None };
-    if i[0] != j[0] || i[2] != j[1] {
-        return None;
-    }
-    let (e1, e2) = (*b - *a, *d - *a);
-    let scale = e1.length() + e2.length();
-    let flat = (*b + *d - *a - *c).length() <= 1e-12 * scale;
-    (flat && e1.cross(e2).length() > 0.0).then_some(Emitter::Parallelogram { origin: *a, e1, e2 })
+    let ([i, j], [first, [_, _, d]]) = (indices, corners) else { return None };
+    let [origin, e1, e2] = crate::shape::parallelogram_of(*i, *j, *first, *d)?;
+    Some(Emitter::Parallelogram { origin, e1, e2 })
 }
 
 fn uniform_sphere(u: Vec2) -> Vec3 {

@@ -3,9 +3,10 @@
 
 use crate::bvh::Bvh;
 use crate::shape::{
-    AaBox, Candidate, Cone, Csg, Cylinder, Disk, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit,
-    triangle_hit,
+    AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit,
+    parallelogram_of, parallelogram_to_triangle,
 };
+use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
 use alhazen_scene as scene;
 use std::sync::Arc;
@@ -24,11 +25,17 @@ pub struct WorldObject {
 }
 
 /// What a leaf of the top-level BVH holds: a whole object, or one triangle of a small mesh
-/// placed in world space (flattened so its rays skip the nested mesh BVH).
+/// placed in world space, or a parallelogram of two (flattened so their rays skip the nested
+/// mesh BVH).
 #[derive(Clone, Copy, Debug)]
 enum Primitive {
     Object(u32),
-    Triangle { object: u32, triangle: u32 },
+    /// `flats[flat]`; for a parallelogram, `triangle` is the first of its pair.
+    Flat {
+        object: u32,
+        triangle: u32,
+        flat: u32,
+    },
 }
 
 /// All objects with their acceleration structure.
@@ -37,8 +44,8 @@ pub struct World {
     objects: Vec<WorldObject>,
     bvh: Bvh,
     primitives: Vec<Primitive>,
-    /// Corners of the flattened triangles, parallel to `primitives`.
-    corners: Vec<[Vec3; 3]>,
+    /// The flattened triangles and parallelograms.
+    flats: Vec<Flat>,
     unbounded: Vec<u32>,
 }
 
@@ -101,7 +108,7 @@ fn uses_uv(o: &scene::Object, s: &scene::Scene) -> bool {
 const BAKE_TRIANGLES: usize = 256;
 
 /// A small mesh with `tf` applied to its positions and normals.
-fn baked(mesh: &alhazen_geom::TriangleMesh, tf: &alhazen_math::Transform) -> alhazen_geom::TriangleMesh {
+fn baked(mesh: &TriangleMesh, tf: &alhazen_math::Transform) -> TriangleMesh {
     let mut m = mesh.clone();
     m.positions.iter_mut().for_each(|p| *p = tf.point(*p));
     m.normals.iter_mut().for_each(|n| *n = tf.normal(*n).normalize_or_zero());
@@ -121,11 +128,37 @@ fn flattenable(p: &Placed) -> Option<&alhazen_geom::TriangleMesh> {
     }
 }
 
+/// The triangles of a flattened mesh as top-level primitives `(first triangle, test, bounds)`:
+/// consecutive pairs that form a parallelogram become one; triangles without area are dropped.
+fn flat_primitives(mesh: &TriangleMesh) -> Vec<(u32, Flat, Bounds3)> {
+    let mut out = vec![];
+    let mut t = 0;
+    while t < mesh.triangle_count() {
+        let corners = mesh.corners(t);
+        let pair = (t + 1 < mesh.triangle_count()).then(|| {
+            let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
+            parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])
+        });
+        if let Some([o, e1, e2]) = pair.flatten()
+            && let Some(f) = Flat::new(o, e1, e2, true)
+        {
+            out.push((t as u32, f, Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])));
+            t += 2;
+            continue;
+        }
+        if let Some(f) = Flat::triangle(corners) {
+            out.push((t as u32, f, Bounds3::from_points(corners)));
+        }
+        t += 1;
+    }
+    out
+}
+
 fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene) -> Placed {
     let small = match &o.shape {
         scene::Shape::Mesh { mesh, smooth } if !o.transform.is_identity() => {
             let m = &scene.meshes[*mesh];
-            (m.triangle_count() <= BAKE_TRIANGLES).then(|| (m.clone(), *smooth))
+            (m.triangle_count() <= BAKE_TRIANGLES).then(|| (TriangleMesh::clone(m), *smooth))
         }
         _ => None,
     };
@@ -152,29 +185,27 @@ impl World {
                     .any(|&m| scene.materials[m as usize].bump.is_some()),
             })
             .collect();
-        let (mut primitives, mut corners, mut prim_bounds, mut unbounded) = (vec![], vec![], vec![], vec![]);
+        let (mut primitives, mut flats, mut prim_bounds, mut unbounded) = (vec![], vec![], vec![], vec![]);
         for (i, o) in objects.iter().enumerate() {
-            let i = i as u32;
+            let object = i as u32;
             if let Some(mesh) = flattenable(&o.placed) {
-                for t in 0..mesh.triangle_count() {
-                    let c = mesh.corners(t);
-                    primitives.push(Primitive::Triangle { object: i, triangle: t as u32 });
-                    corners.push(c);
-                    prim_bounds.push(Bounds3::from_points(c));
+                for (triangle, flat, bounds) in flat_primitives(mesh) {
+                    primitives.push(Primitive::Flat { object, triangle, flat: flats.len() as u32 });
+                    flats.push(flat);
+                    prim_bounds.push(bounds);
                 }
                 continue;
             }
             let b = o.placed.bounds();
             if b.is_finite() {
-                primitives.push(Primitive::Object(i));
-                corners.push([Vec3::ZERO; 3]);
+                primitives.push(Primitive::Object(object));
                 prim_bounds.push(b);
             } else {
-                unbounded.push(i);
+                unbounded.push(object);
             }
         }
         let bvh = Bvh::build(&prim_bounds);
-        Self { objects, bvh, primitives, corners, unbounded }
+        Self { objects, bvh, primitives, flats, unbounded }
     }
 
     /// Bounds of the bounded objects.
@@ -199,9 +230,12 @@ impl World {
                 best = Some((c, i));
                 Some(c.t)
             }
-            Primitive::Triangle { object, triangle } => {
-                let (t, b1, b2) = triangle_hit(ray, self.corners[k as usize]).filter(|h| h.0 > 0.0 && h.0 < t_max)?;
-                best = Some((Candidate { t, aux: triangle, bary: [b1, b2] }, object));
+            Primitive::Flat { object, triangle, flat } => {
+                let f = &self.flats[flat as usize];
+                let (t, b1, b2) = f.hit(ray, t_max)?;
+                let (second, b1, b2) =
+                    if f.is_parallelogram() { parallelogram_to_triangle(b1, b2) } else { (0, b1, b2) };
+                best = Some((Candidate { t, aux: triangle + second, bary: [b1, b2] }, object));
                 Some(t)
             }
         });
@@ -250,9 +284,7 @@ impl World {
         self.bvh.traverse(&ray, dist, |k, t_max| {
             let hit = match self.primitives[k as usize] {
                 Primitive::Object(i) => self.objects[i as usize].placed.hit(&ray, t_max).is_some(),
-                Primitive::Triangle { .. } => {
-                    triangle_hit(&ray, self.corners[k as usize]).is_some_and(|h| h.0 > 0.0 && h.0 < t_max)
-                }
+                Primitive::Flat { flat, .. } => self.flats[flat as usize].hit(&ray, t_max).is_some(),
             };
             blocked |= hit;
             hit.then_some(0.0)

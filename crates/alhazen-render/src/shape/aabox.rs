@@ -14,27 +14,32 @@ pub struct AaBox {
 
 impl AaBox {
     /// Entry and exit parameters along the whole line with their face axes, if it meets the box.
+    #[inline]
     fn slab(&self, ray: &Ray) -> Option<((f64, usize), (f64, usize))> {
-        let (mut near, mut far) = ((f64::NEG_INFINITY, 0), (f64::INFINITY, 0));
-        for a in 0..3 {
-            let inv = 1.0 / ray.dir[a];
-            let mut t0 = (self.min[a] - ray.origin[a]) * inv;
-            let mut t1 = (self.max[a] - ray.origin[a]) * inv;
-            if t0.is_nan() || t1.is_nan() {
-                // Parallel and in a face plane: treat as outside.
-                return None;
-            }
-            if t0 > t1 {
-                std::mem::swap(&mut t0, &mut t1);
-            }
-            if t0 > near.0 {
-                near = (t0, a);
-            }
-            if t1 < far.0 {
-                far = (t1, a);
-            }
+        let inv = 1.0 / ray.dir;
+        let (t0, t1) = ((self.min - ray.origin) * inv, (self.max - ray.origin) * inv);
+        if t0.is_nan() || t1.is_nan() {
+            // Parallel and in a face plane: treat as outside.
+            return None;
         }
-        (near.0 <= far.0 && near.0.is_finite() && far.0.is_finite()).then_some((near, far))
+        let (lo, hi) = (t0.min(t1), t0.max(t1));
+        // Ties go to the lowest axis.
+        let near_axis = if lo.x >= lo.y && lo.x >= lo.z {
+            0
+        } else if lo.y >= lo.z {
+            1
+        } else {
+            2
+        };
+        let far_axis = if hi.x <= hi.y && hi.x <= hi.z {
+            0
+        } else if hi.y <= hi.z {
+            1
+        } else {
+            2
+        };
+        let (near, far) = (lo[near_axis], hi[far_axis]);
+        (near <= far && near.is_finite() && far.is_finite()).then_some(((near, near_axis), (far, far_axis)))
     }
 
     fn hit_at(&self, ray: &Ray, t: f64, axis: usize) -> SurfaceHit {

@@ -7,6 +7,7 @@
 mod aabox;
 mod csg;
 mod cylinder;
+mod flat;
 mod mesh;
 mod plane;
 mod sphere;
@@ -14,6 +15,7 @@ mod sphere;
 pub use aabox::AaBox;
 pub use csg::Csg;
 pub use cylinder::{Cone, Cylinder};
+pub use flat::{Flat, parallelogram_of, parallelogram_to_triangle};
 pub use mesh::{MeshAccel, MeshShape, triangle_hit};
 pub use plane::{Disk, Plane};
 pub use sphere::Sphere;
@@ -206,7 +208,7 @@ impl Placed {
         match &self.to_world {
             None => self.shape.tangents(&self.shape.surface(ray, c), c),
             Some(tf) => {
-                let local = tf.inverse().ray(ray);
+                let local = tf.inverse_ray(ray);
                 self.shape.tangents(&self.shape.surface(&local, c), c).map(|d| tf.vector(d))
             }
         }
@@ -222,7 +224,7 @@ impl Placed {
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         match &self.to_world {
             None => self.shape.hit(ray, t_max),
-            Some(tf) => self.shape.hit(&tf.inverse().ray(ray), t_max),
+            Some(tf) => self.shape.hit(&tf.inverse_ray(ray), t_max),
         }
     }
 
@@ -230,7 +232,7 @@ impl Placed {
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
         match &self.to_world {
             None => self.shape.surface_with(ray, c, self.uv),
-            Some(tf) => to_world(tf, self.shape.surface_with(&tf.inverse().ray(ray), c, self.uv)),
+            Some(tf) => to_world(tf, self.shape.surface_with(&tf.inverse_ray(ray), c, self.uv)),
         }
     }
 
@@ -246,7 +248,7 @@ impl Placed {
             None => self.shape.crossings(ray, out),
             Some(tf) => {
                 let start = out.len();
-                self.shape.crossings(&tf.inverse().ray(ray), out);
+                self.shape.crossings(&tf.inverse_ray(ray), out);
                 for c in &mut out[start..] {
                     c.hit = to_world(tf, c.hit);
                 }

@@ -1,0 +1,124 @@
+//! Planar primitives of the top-level BVH: the triangles of small meshes and the parallelograms
+//! that pairs of them form (rectangles, box faces), each with its plane and its two barycentric
+//! axes precomputed. The test is a projection: one division for the plane, then two dot
+//! products (Wald 2004, "Realtime Ray Tracing and Interactive Global Illumination", §7.1).
+
+use alhazen_math::{Ray, Vec3};
+
+/// A triangle `origin + b1·e1 + b2·e2` (`b1, b2 ≥ 0`, `b1 + b2 ≤ 1`) or a parallelogram
+/// (`b1, b2 ∈ [0, 1]`), ready for ray tests.
+#[derive(Clone, Copy, Debug)]
+pub struct Flat {
+    origin: Vec3,
+    /// `e1 × e2`.
+    normal: Vec3,
+    /// `(e2 × N) / |N|²`: `(p − origin)·u = b1`.
+    u: Vec3,
+    /// `(N × e1) / |N|²`: `(p − origin)·v = b2`.
+    v: Vec3,
+    parallelogram: bool,
+}
+
+impl Flat {
+    /// The primitive spanned by `e1`, `e2` from `origin`; `None` when they span no area.
+    pub fn new(origin: Vec3, e1: Vec3, e2: Vec3, parallelogram: bool) -> Option<Self> {
+        let normal = e1.cross(e2);
+        let n2 = normal.length_squared();
+        (n2 > 0.0 && n2.is_finite()).then(|| Self {
+            origin,
+            normal,
+            u: e2.cross(normal) / n2,
+            v: normal.cross(e1) / n2,
+            parallelogram,
+        })
+    }
+
+    /// The triangle with these corners.
+    pub fn triangle([a, b, c]: [Vec3; 3]) -> Option<Self> {
+        Self::new(a, b - a, c - a, false)
+    }
+
+    /// True for a parallelogram.
+    pub fn is_parallelogram(&self) -> bool {
+        self.parallelogram
+    }
+
+    /// The hit `(t, b1, b2)` with `0 < t < t_max`.
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, f64)> {
+        let t = self.normal.dot(self.origin - ray.origin) / self.normal.dot(ray.dir);
+        // Also rejects NaN and ±∞ (rays in or parallel to the plane).
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let p = ray.origin + ray.dir * t - self.origin;
+        let b1 = p.dot(self.u);
+        if !(0.0..=1.0).contains(&b1) {
+            return None;
+        }
+        let b2 = p.dot(self.v);
+        let outside = if self.parallelogram { b2 > 1.0 } else { b1 + b2 > 1.0 };
+        (b2 >= 0.0 && !outside).then_some((t, b1, b2))
+    }
+}
+
+/// Triangles `[a, b, c]`, `[a, c, d]` of a mesh that form the parallelogram
+/// `a + s·(b − a) + t·(d − a)`: its corner and edges.
+pub fn parallelogram_of(first: [u32; 3], second: [u32; 3], [a, b, c]: [Vec3; 3], d: Vec3) -> Option<[Vec3; 3]> {
+    if first[0] != second[0] || first[2] != second[1] {
+        return None;
+    }
+    let (e1, e2) = (b - a, d - a);
+    let flat = (b + d - a - c).length() <= 1e-12 * (e1.length() + e2.length());
+    (flat && e1.cross(e2).length_squared() > 0.0).then_some([a, e1, e2])
+}
+
+/// The triangle of the pair and its barycentric coordinates at parallelogram coordinates
+/// `(s, t)`: the first triangle `[a, b, c]` where `s ≥ t`, else the second `[a, c, d]`.
+#[inline]
+pub fn parallelogram_to_triangle(s: f64, t: f64) -> (u32, f64, f64) {
+    if s >= t { (0, s - t, t) } else { (1, s, t - s) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_barycentrics_reproduce_the_hit_point() {
+        let corners = [Vec3::new(0.0, 0.0, 1.0), Vec3::new(2.0, 0.1, 1.2), Vec3::new(0.3, 1.5, 0.9)];
+        let f = Flat::triangle(corners).unwrap();
+        let target = corners[0] * 0.2 + corners[1] * 0.5 + corners[2] * 0.3;
+        let ray = Ray::new(Vec3::new(0.1, -0.2, -3.0), (target - Vec3::new(0.1, -0.2, -3.0)).normalize());
+        let (t, b1, b2) = f.hit(&ray, f64::INFINITY).unwrap();
+        assert!((ray.at(t) - target).length() < 1e-12);
+        assert!((b1 - 0.5).abs() < 1e-12 && (b2 - 0.3).abs() < 1e-12);
+        assert!(f.hit(&ray, t * 0.999).is_none(), "beyond t_max");
+        let away = Ray::new(ray.origin, -ray.dir);
+        assert!(f.hit(&away, f64::INFINITY).is_none(), "behind the origin");
+    }
+
+    #[test]
+    fn parallelogram_covers_both_triangles_and_maps_back() {
+        let (a, b, d) = (Vec3::ZERO, Vec3::X * 2.0, Vec3::Y);
+        let c = b + d - a;
+        let [o, e1, e2] = parallelogram_of([0, 1, 2], [0, 2, 3], [a, b, c], d).unwrap();
+        let quad = Flat::new(o, e1, e2, true).unwrap();
+        let (tri1, tri2) = (Flat::triangle([a, b, c]).unwrap(), Flat::triangle([a, c, d]).unwrap());
+        for (x, y) in [(0.3, 0.2), (1.5, 0.9), (0.2, 0.8), (1.9, 0.05), (2.1, 0.5), (0.5, -0.1)] {
+            let ray = Ray::new(Vec3::new(x, y, 5.0), -Vec3::Z);
+            let direct = tri1.hit(&ray, 10.0).map(|h| (0, h)).or(tri2.hit(&ray, 10.0).map(|h| (1, h)));
+            match (quad.hit(&ray, 10.0), direct) {
+                (Some((t, s, u)), Some((which, (t2, b1, b2)))) => {
+                    let (k, c1, c2) = parallelogram_to_triangle(s, u);
+                    assert!((t - t2).abs() < 1e-12 && k == which, "({x}, {y})");
+                    assert!((c1 - b1).abs() < 1e-12 && (c2 - b2).abs() < 1e-12, "({x}, {y})");
+                }
+                (None, None) => {}
+                (q, t) => panic!("({x}, {y}): parallelogram {q:?}, triangles {t:?}"),
+            }
+        }
+        assert!(parallelogram_of([0, 1, 2], [0, 3, 2], [a, b, c], d).is_none(), "not a shared diagonal");
+        assert!(parallelogram_of([0, 1, 2], [0, 2, 3], [a, b, c + Vec3::Z], d).is_none(), "not flat");
+    }
+}
