@@ -13,13 +13,32 @@ pub struct MeshAccel {
     /// The mesh.
     pub mesh: Arc<TriangleMesh>,
     bvh: Bvh,
+    /// Unit geometric normal per triangle (zero for triangles without area).
+    face_normals: Vec<Vec3>,
+    /// Per triangle: its vertex normals all equal its face normal (smooth shading would only
+    /// interpolate it back).
+    flat: Vec<bool>,
 }
 
 impl MeshAccel {
     /// Builds the triangle BVH.
     pub fn new(mesh: Arc<TriangleMesh>) -> Self {
         let bounds: Vec<Bounds3> = (0..mesh.triangle_count()).map(|i| Bounds3::from_points(mesh.corners(i))).collect();
-        Self { bvh: Bvh::build(&bounds), mesh }
+        let face_normals: Vec<Vec3> = (0..mesh.triangle_count())
+            .map(|i| {
+                let [a, b, c] = mesh.corners(i);
+                (b - a).cross(c - a).normalize_or_zero()
+            })
+            .collect();
+        let flat = mesh
+            .triangles
+            .iter()
+            .zip(&face_normals)
+            .map(|(t, n): (&[u32; 3], &Vec3)| {
+                mesh.normals.is_empty() || t.iter().all(|&i| (mesh.normals[i as usize] - *n).length() < 1e-12)
+            })
+            .collect();
+        Self { bvh: Bvh::build(&bounds), mesh, face_normals, flat }
     }
 }
 
@@ -59,10 +78,9 @@ impl MeshShape {
     fn surface(&self, ray: &Ray, tri: usize, (t, b1, b2): (f64, f64, f64)) -> SurfaceHit {
         let m = &self.accel.mesh;
         let idx = m.triangles[tri].map(|i| i as usize);
-        let [p0, p1, p2] = idx.map(|i| m.positions[i]);
-        let n = (p1 - p0).cross(p2 - p0).normalize();
+        let n = self.accel.face_normals[tri];
         let b0 = 1.0 - b1 - b2;
-        let ns = if self.smooth && !m.normals.is_empty() {
+        let ns = if self.smooth && !self.accel.flat[tri] {
             let s = m.normals[idx[0]] * b0 + m.normals[idx[1]] * b1 + m.normals[idx[2]] * b2;
             // Keep the shading normal on the geometric normal's side.
             s.try_normalize().map_or(n, |s| if s.dot(n) < 0.0 { -s } else { s })
