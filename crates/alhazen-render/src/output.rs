@@ -95,13 +95,13 @@ fn encode_exr(img: &Image, out: &mut std::fs::File, half: bool) -> io::Result<()
             let c = px(p.x(), p.y());
             (f16::from_f32(c[0]), f16::from_f32(c[1]), f16::from_f32(c[2]))
         });
-        Image::from_channels((w, h), channels).write().to_buffered(BufWriter::new(out))
+        Image::from_channels((w, h), channels).write().non_parallel().to_buffered(BufWriter::new(out))
     } else {
         let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
             let c = px(p.x(), p.y());
             (c[0], c[1], c[2])
         });
-        Image::from_channels((w, h), channels).write().to_buffered(BufWriter::new(out))
+        Image::from_channels((w, h), channels).write().non_parallel().to_buffered(BufWriter::new(out))
     };
     result.map_err(io::Error::other)
 }

@@ -151,3 +151,23 @@ fn output_formats_round_trip() {
     // Only the finished files remain: no temporary files are left behind.
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
 }
+
+#[test]
+fn exr_files_are_the_same_bytes_every_time() {
+    // Large enough for many compressed chunks, which a parallel writer emitted in the order its
+    // threads finished.
+    let (w, h) = (256u32, 256u32);
+    let pixels = (0..w * h).map(|i| [(i % 97) as f32 * 0.37, (i % 31) as f32 * 1.9, (i / w) as f32]).collect();
+    let img = alhazen_render::Image { width: w, height: h, pixels };
+    let dir = tempfile::tempdir().unwrap();
+    for f in [output::Format::ExrFloat, output::Format::ExrHalf] {
+        let bytes: Vec<Vec<u8>> = (0..4)
+            .map(|k| {
+                let p = dir.path().join(format!("{k}.exr"));
+                output::write_image(&img, &p, f).unwrap();
+                std::fs::read(&p).unwrap()
+            })
+            .collect();
+        assert!(bytes.iter().all(|b| *b == bytes[0]), "{f:?}");
+    }
+}
