@@ -38,6 +38,10 @@ pub enum Emitter {
         e1: Vec3,
         /// Second edge.
         e2: Vec3,
+        /// Unit normal `e1 × e2 / |e1 × e2|`.
+        normal: Vec3,
+        /// `|e1 × e2|`.
+        area: f64,
     },
     /// A disk.
     Disk {
@@ -161,7 +165,8 @@ fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
 fn parallelogram(indices: &[[u32; 3]], corners: &[[Vec3; 3]]) -> Option<Emitter> {
     let ([i, j], [first, [_, _, d]]) = (indices, corners) else { return None };
     let [origin, e1, e2] = crate::shape::parallelogram_of(*i, *j, *first, *d)?;
-    Some(Emitter::Parallelogram { origin, e1, e2 })
+    let n = e1.cross(e2);
+    Some(Emitter::Parallelogram { origin, e1, e2, normal: n / n.length(), area: n.length() })
 }
 
 fn uniform_sphere(u: Vec2) -> Vec3 {
@@ -257,7 +262,7 @@ impl Lights {
                 None => area_to_solid(1.0 / (4.0 * PI * radius * radius)),
             },
             Emitter::Triangles { area, .. } => area_to_solid(1.0 / area),
-            Emitter::Parallelogram { e1, e2, .. } => area_to_solid(1.0 / e1.cross(*e2).length()),
+            Emitter::Parallelogram { area, .. } => area_to_solid(1.0 / area),
             Emitter::Disk { radius, .. } => area_to_solid(1.0 / (PI * radius * radius)),
         };
         pdf * self.choice_pdf()
@@ -351,10 +356,8 @@ fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<Li
             let q = a * b0 + b * b1 + c * (1.0 - b0 - b1);
             (q, (b - a).cross(c - a).normalize_or_zero(), 1.0 / area)
         }
-        Emitter::Parallelogram { origin, e1, e2 } => {
-            let n = e1.cross(*e2);
-            let area = n.length();
-            (*origin + *e1 * u.x + *e2 * u.y, n / area, 1.0 / area)
+        Emitter::Parallelogram { origin, e1, e2, normal, area } => {
+            (*origin + *e1 * u.x + *e2 * u.y, *normal, 1.0 / area)
         }
         Emitter::Disk { center, normal, radius } => {
             let (s, t) = orthonormal_basis(*normal);

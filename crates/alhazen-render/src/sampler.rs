@@ -56,7 +56,8 @@ pub enum Sequence {
 pub struct SampleStream {
     sequence: Sequence,
     pixel_seed: u64,
-    index: u32,
+    /// The sample index with its bits reversed (the form Owen scrambling works on).
+    index_reversed: u32,
     dimension: u32,
     rng: Rng,
 }
@@ -73,8 +74,8 @@ fn scramble_reversed(mut x: u32, seed: u32) -> u32 {
     x
 }
 
-/// Owen scrambling of `x`.
-#[inline]
+/// Owen scrambling of `x` (the stream does the first reversal once per sample).
+#[cfg(test)]
 fn owen_scramble(x: u32, seed: u32) -> u32 {
     scramble_reversed(x.reverse_bits(), seed).reverse_bits()
 }
@@ -142,7 +143,8 @@ impl SampleStream {
     /// The stream of sample `index` of pixel `(x, y)`.
     pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, index: u32) -> Self {
         let pixel_seed = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d) ^ ((x as u64) << 32 | y as u64));
-        Self { sequence, pixel_seed, index, dimension: 0, rng: Rng::for_sample(seed, x, y, index) }
+        let index_reversed = index.reverse_bits();
+        Self { sequence, pixel_seed, index_reversed, dimension: 0, rng: Rng::for_sample(seed, x, y, index) }
     }
 
     /// The next pair of numbers in `[0, 1)²`.
@@ -153,7 +155,8 @@ impl SampleStream {
             Sequence::Sobol => {
                 let h = mix(self.pixel_seed ^ self.dimension as u64);
                 self.dimension += 1;
-                let shuffled = owen_scramble(self.index, h as u32);
+                // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal done once).
+                let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
                 let (sa, sb) = ((h >> 32) as u32, (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32);
                 // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
                 let a = scramble_reversed(shuffled, sa).reverse_bits();
