@@ -1,5 +1,7 @@
-//! Criterion benchmarks: the glass-balls scene at reduced size (whole pipeline) and rays per
-//! second against the BVH. The full-size comparison with POV-Ray is `bench/povray-compare.sh`.
+//! Criterion benchmarks: the glass-balls scene at reduced size (whole pipeline), rays per
+//! second against the BVH, and the Cornell box's world with rays like a path tracer's (from
+//! inside the room, in every direction). The full-size comparisons are
+//! `bench/povray-compare.sh` and `bench/mitsuba/compare.py`.
 
 use alhazen_math::{Ray, Vec3};
 use alhazen_render::World;
@@ -7,9 +9,13 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;
 
-fn glass_balls() -> alhazen_scene::Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/glass-balls.toml");
+fn example(name: &str) -> alhazen_scene::Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
     alhazen_scene::load_scene(&path).expect("scene loads")
+}
+
+fn glass_balls() -> alhazen_scene::Scene {
+    example("glass-balls.toml")
 }
 
 fn bench_render(c: &mut Criterion) {
@@ -42,5 +48,29 @@ fn bench_intersect(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_render, bench_intersect);
+fn bench_cornell_rays(c: &mut Criterion) {
+    let world = World::build(&example("cornell-box.toml"));
+    let mut state = 12345u64;
+    let mut uniform = || {
+        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let rays: Vec<Ray> = (0..4096)
+        .map(|_| {
+            let o = Vec3::new(uniform() * 1.8 - 0.9, uniform() * 1.8 - 0.9, uniform() * 1.8 - 0.9);
+            Ray::new(o, Vec3::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5).normalize())
+        })
+        .collect();
+    let mut g = c.benchmark_group("cornell-box world");
+    g.throughput(Throughput::Elements(rays.len() as u64));
+    g.bench_function("nearest hit (rays/s)", |b| {
+        b.iter(|| rays.iter().filter(|r| world.intersect(black_box(r), f64::INFINITY).is_some()).count())
+    });
+    g.bench_function("shadow rays of length 0.5 (rays/s)", |b| {
+        b.iter(|| rays.iter().filter(|r| world.unoccluded(black_box(r.origin), r.dir, 0.5)).count())
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_render, bench_intersect, bench_cornell_rays);
 criterion_main!(benches);

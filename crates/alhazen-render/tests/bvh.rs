@@ -1,4 +1,5 @@
-//! The BVH must return the same nearest hit as testing every object.
+//! The BVH must return the same nearest hit as testing every object (and the world's planar
+//! primitives the same hits as the mesh triangles they stand for).
 
 use alhazen_math::{Ray, Vec3};
 use alhazen_render::World;
@@ -7,6 +8,16 @@ use proptest::prelude::*;
 
 fn random_scene(spheres: &[(f64, f64, f64, f64)], boxes: &[(f64, f64, f64)]) -> String {
     let mut s = String::from("[[object]]\nshape = \"plane\"\npoint = [0, -3, 0]\n");
+    // Rectangles: small meshes the world flattens into parallelograms.
+    for (k, (x, y, z, r)) in spheres.iter().enumerate().filter(|(k, _)| k % 3 == 0) {
+        s += &format!(
+            "[[object]]\nshape = \"rectangle\"\ntransform = [{{ scale = [{}, {r}, 1] }}, {{ rotate_x = {} }}, \
+             {{ rotate_y = {} }}, {{ translate = [{x}, {y}, {z}] }}]\n",
+            2.0 * r,
+            17 * k,
+            40 + 29 * k
+        );
+    }
     for (x, y, z, r) in spheres {
         s += &format!("[[object]]\nshape = \"sphere\"\ncenter = [{x}, {y}, {z}]\nradius = {r}\n");
     }
@@ -40,9 +51,15 @@ proptest! {
         for ((dx, dy, dz), (ox, oy, oz)) in rays {
             let Some(d) = Vec3::new(dx, dy, dz).try_normalize() else { continue };
             let ray = Ray::new(Vec3::new(ox, oy, oz), d);
-            let fast = world.intersect(&ray, f64::INFINITY).map(|h| h.hit.t);
-            let slow = world.intersect_brute_force(&ray, f64::INFINITY).map(|h| h.t);
-            prop_assert_eq!(fast, slow);
+            let fast = world.intersect(&ray, f64::INFINITY).map(|h| (h.hit.t, h.hit.n));
+            let slow = world.intersect_brute_force(&ray, f64::INFINITY).map(|h| (h.t, h.n));
+            match (fast, slow) {
+                (Some((t1, n1)), Some((t2, n2))) => {
+                    prop_assert!((t1 - t2).abs() <= 1e-9 * (1.0 + t2), "t {} vs {}", t1, t2);
+                    prop_assert!((n1 - n2).length() < 1e-9, "n {} vs {}", n1, n2);
+                }
+                (a, b) => prop_assert_eq!(a.is_some(), b.is_some(), "{:?} vs {:?}", a, b),
+            }
         }
     }
 }
