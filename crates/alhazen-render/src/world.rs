@@ -158,7 +158,7 @@ fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene) -> 
     let small = match &o.shape {
         scene::Shape::Mesh { mesh, smooth } if !o.transform.is_identity() => {
             let m = &scene.meshes[*mesh];
-            (m.triangle_count() <= BAKE_TRIANGLES).then(|| (TriangleMesh::clone(m), *smooth))
+            (m.triangle_count() <= BAKE_TRIANGLES).then(|| (m.clone(), *smooth))
         }
         _ => None,
     };
