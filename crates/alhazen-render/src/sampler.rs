@@ -153,23 +153,38 @@ impl SampleStream {
         match self.sequence {
             Sequence::Independent => alhazen_math::Vec2::new(self.rng.uniform(), self.rng.uniform()),
             Sequence::Sobol => {
-                let h = mix(self.pixel_seed ^ self.dimension as u64);
-                self.dimension += 1;
-                // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal done once).
-                let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
-                let (sa, sb) = ((h >> 32) as u32, (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32);
-                // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
-                let a = scramble_reversed(shuffled, sa).reverse_bits();
+                let (h, shuffled, a) = self.next_sobol_first();
+                let sb = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
                 let b = scramble_reversed(sobol1_reversed(shuffled), sb).reverse_bits();
-                alhazen_math::Vec2::new(to_unit(a), to_unit(b))
+                alhazen_math::Vec2::new(a, to_unit(b))
             }
         }
     }
 
-    /// The next number in `[0, 1)`.
+    /// The next number in `[0, 1)`: the first of the pair [`Self::next_2d`] would give, without
+    /// computing the second.
     #[inline]
     pub fn next_1d(&mut self) -> f64 {
-        self.next_2d().x
+        match self.sequence {
+            Sequence::Independent => {
+                let u = self.rng.uniform();
+                self.rng.uniform();
+                u
+            }
+            Sequence::Sobol => self.next_sobol_first().2,
+        }
+    }
+
+    /// Advances one dimension pair: its hash, the Owen-shuffled index and the first coordinate.
+    #[inline]
+    fn next_sobol_first(&mut self) -> (u64, u32, f64) {
+        let h = mix(self.pixel_seed ^ self.dimension as u64);
+        self.dimension += 1;
+        // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal done once).
+        let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
+        // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
+        let a = scramble_reversed(shuffled, (h >> 32) as u32).reverse_bits();
+        (h, shuffled, to_unit(a))
     }
 }
 
@@ -287,6 +302,17 @@ mod tests {
                 cells.sort();
                 assert_eq!(cells, (0..64).collect::<Vec<_>>(), "dimension pair {dim}, {nx}×{ny}");
             }
+        }
+    }
+
+    #[test]
+    fn next_1d_is_the_first_of_the_pair_and_advances_alike() {
+        for sequence in [Sequence::Sobol, Sequence::Independent] {
+            let (mut one, mut two) = (SampleStream::new(sequence, 2, 3, 4, 5), SampleStream::new(sequence, 2, 3, 4, 5));
+            for _ in 0..6 {
+                assert_eq!(one.next_1d(), two.next_2d().x, "{sequence:?}");
+            }
+            assert_eq!(one.next_2d(), two.next_2d(), "{sequence:?}");
         }
     }
 
