@@ -26,7 +26,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene to an image (PNG, EXR or PFM) with the Whitted ray tracer.
+    /// Render a scene to an image (PNG, EXR or PFM) by recursive (Whitted) ray tracing or path tracing.
     #[command(
         after_help = "Example:\n  alhazen render scenes/glass-balls.toml -o glass-balls.png --spp 16\n\nThe scene format is described in docs/scene-format.md."
     )]
