@@ -143,7 +143,7 @@ impl<'a> PathTracer<'a> {
 
     /// The local frame (normal on the viewer's side for opaque surfaces — the course's two-sided
     /// reading of the same-side factor) and the geometric normal on the same side.
-    fn shading_frame(&self, wh: &WorldHit, bsdf: &Bsdf, wo: Vec3, tangent: Vec3) -> (Frame, Vec3) {
+    fn shading_frame(&self, wh: &WorldHit, bsdf: &Bsdf, wo: Vec3, tangent: Option<Vec3>) -> (Frame, Vec3) {
         let m = &self.scene.materials[wh.material as usize];
         let (mut ng, mut ns) = (wh.hit.n, crate::world::shading_normal(&wh.hit, m, &self.scene.images));
         if !bsdf.transmits() && ng.dot(wo) < 0.0 {
@@ -154,7 +154,7 @@ impl<'a> PathTracer<'a> {
         if ns.dot(wo) * ng.dot(wo) <= 0.0 {
             ns = ng;
         }
-        (Frame::new(ns, tangent), ng)
+        (tangent.map_or_else(|| Frame::around(ns), |t| Frame::new(ns, t)), ng)
     }
 
     /// One light sample, weighted by the power heuristic against the BSDF's density.

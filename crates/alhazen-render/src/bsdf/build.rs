@@ -111,10 +111,11 @@ fn from_desc(desc: &BsdfDesc, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mod
     }
 }
 
-/// The tangent direction that anisotropic lobes align with (world space).
-pub fn tangent_hint(m: &Material) -> Vec3 {
+/// The world-space tangent that anisotropic lobes align with; `None` for isotropic BSDFs, whose
+/// frame may turn freely about the normal.
+pub fn tangent_hint(m: &Material) -> Option<Vec3> {
     match &m.bsdf {
-        Some(BsdfDesc::BlinnPhong { scratches, .. }) => *scratches,
-        _ => Vec3::X,
+        Some(BsdfDesc::BlinnPhong { scratches, .. }) => Some(*scratches),
+        _ => None,
     }
 }

@@ -142,6 +142,13 @@ impl Frame {
         Self { s, t: n.cross(s), n }
     }
 
+    /// Any frame around unit `n` (Duff et al. 2017, "Building an Orthonormal Basis, Revisited"):
+    /// for isotropic BSDFs, which do not care how the tangent turns about the normal.
+    pub fn around(n: Vec3) -> Self {
+        let (s, t) = alhazen_math::orthonormal_basis(n);
+        Self { s, t, n }
+    }
+
     /// World → local.
     pub fn to_local(&self, w: Vec3) -> Vec3 {
         Vec3::new(w.dot(self.s), w.dot(self.t), w.dot(self.n))

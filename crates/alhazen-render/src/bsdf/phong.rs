@@ -40,6 +40,6 @@ impl SpecularLobe for PhongLobe {
         let cos = u.x.powf(1.0 / (self.exponent + 1.0));
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let phi = 2.0 * PI * u.y;
-        Some(Frame::new(mirror(v), Vec3::X).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)))
+        Some(Frame::around(mirror(v)).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)))
     }
 }
