@@ -50,6 +50,17 @@ pub struct Bezier<P> {
     points: Vec<P>,
 }
 
+/// The de Casteljau algorithm on `p` (overwritten): the point at `t` of the Bézier curve with
+/// control points `p`, which must not be empty.
+pub fn de_casteljau<P: ControlPoint>(p: &mut [P], t: f64) -> P {
+    for j in 1..p.len() {
+        for i in 0..p.len() - j {
+            p[i] = p[i] * (1.0 - t) + p[i + 1] * t;
+        }
+    }
+    p[0]
+}
+
 /// The Bernstein polynomial `Bⁿᵢ(t) = C(n, i) tⁱ (1−t)ⁿ⁻ⁱ`.
 pub fn bernstein(n: usize, i: usize, t: f64) -> f64 {
     if i > n {
@@ -80,13 +91,7 @@ impl<P: ControlPoint> Bezier<P> {
 
     /// `p(t)` by the de Casteljau algorithm (O(n²), numerically the most stable).
     pub fn eval(&self, t: f64) -> P {
-        let mut p = self.points.clone();
-        for j in 1..p.len() {
-            for i in 0..p.len() - j {
-                p[i] = p[i] * (1.0 - t) + p[i + 1] * t;
-            }
-        }
-        p[0]
+        de_casteljau(&mut self.points.clone(), t)
     }
 
     /// `p(t)` by the course's Horner scheme in `s = 1 − t` (O(n)), with its binomial update

@@ -94,33 +94,13 @@ impl<P: ControlPoint> BSpline<P> {
         (self.knots[self.degree], self.knots[self.knots.len() - 1 - self.degree])
     }
 
-    /// The `k` with `t ∈ [u_k, u_{k+1})`, `n ≤ k < N − n` (the last span for the right end).
     fn span(&self, t: f64) -> usize {
-        let n = self.degree;
-        let last = self.knots.len() - 2 - n;
-        let mut k = n;
-        while k < last && t >= self.knots[k + 1] {
-            k += 1;
-        }
-        k
+        span(&self.knots, self.degree, t)
     }
 
     /// `s(t)` by de Boor's algorithm (`t` is clamped to the domain).
     pub fn eval(&self, t: f64) -> P {
-        let (a, b) = self.domain();
-        let t = t.clamp(a, b);
-        let (n, k) = (self.degree, self.span(t));
-        let u = &self.knots;
-        let mut d: Vec<P> = self.points[k - n..=k].to_vec();
-        for j in 1..=n {
-            for i in (j..=n).rev() {
-                let idx = k - n + i;
-                let denom = u[idx + n + 1 - j] - u[idx];
-                let alpha = if denom > 0.0 { (t - u[idx]) / denom } else { 0.0 };
-                d[i] = d[i - 1] * (1.0 - alpha) + d[i] * alpha;
-            }
-        }
-        d[n]
+        de_boor(&self.knots, self.degree, &self.points, t, &mut Vec::new())
     }
 
     /// The basis function `Nⁿᵢ(t)` by the Mansfield–de Boor–Cox recursion (0/0 taken as 0).
@@ -151,12 +131,8 @@ impl<P: ControlPoint> BSpline<P> {
             return None;
         }
         let u = &self.knots;
-        let pts = (0..self.points.len() - 1)
-            .map(|i| {
-                let h = u[i + n + 1] - u[i + 1];
-                if h > 0.0 { (self.points[i + 1] - self.points[i]) * (n as f64 / h) } else { self.points[i] * 0.0 }
-            })
-            .collect();
+        let mut pts = Vec::with_capacity(self.points.len() - 1);
+        hodograph(u, n, &self.points, &mut pts);
         BSpline::new(n - 1, u[1..u.len() - 1].to_vec(), pts).ok()
     }
 
@@ -208,6 +184,46 @@ impl<P: ControlPoint> BSpline<P> {
             })
             .collect()
     }
+}
+
+/// The `k` with `t ∈ [u_k, u_{k+1})`, `n ≤ k < N − n` (the last span for the right end).
+pub(crate) fn span(knots: &[f64], n: usize, t: f64) -> usize {
+    let last = knots.len() - 2 - n;
+    let mut k = n;
+    while k < last && t >= knots[k + 1] {
+        k += 1;
+    }
+    k
+}
+
+/// De Boor's algorithm: the point at `t` (clamped to the domain) of the B-spline of degree `n`
+/// on valid `knots` (as [`BSpline::new`] checks them) with control points `points`. Only
+/// `points[k − n ..= k]` of the span `k` of `t` are read; `scratch` is working space.
+pub(crate) fn de_boor<P: ControlPoint>(knots: &[f64], n: usize, points: &[P], t: f64, scratch: &mut Vec<P>) -> P {
+    let t = t.clamp(knots[n], knots[knots.len() - 1 - n]);
+    let k = span(knots, n, t);
+    scratch.clear();
+    scratch.extend_from_slice(&points[k - n..=k]);
+    let d = scratch;
+    for j in 1..=n {
+        for i in (j..=n).rev() {
+            let idx = k - n + i;
+            let denom = knots[idx + n + 1 - j] - knots[idx];
+            let alpha = if denom > 0.0 { (t - knots[idx]) / denom } else { 0.0 };
+            d[i] = d[i - 1] * (1.0 - alpha) + d[i] * alpha;
+        }
+    }
+    d[n]
+}
+
+/// The control points of the hodograph of a spline of degree `n ≥ 1` (see
+/// [`BSpline::derivative`]), written to `out`.
+pub(crate) fn hodograph<P: ControlPoint>(knots: &[f64], n: usize, points: &[P], out: &mut Vec<P>) {
+    out.clear();
+    out.extend(points.windows(2).enumerate().map(|(i, w)| {
+        let h = knots[i + n + 1] - knots[i + 1];
+        if h > 0.0 { (w[1] - w[0]) * (n as f64 / h) } else { w[0] * 0.0 }
+    }));
 }
 
 /// One Lane–Riesenfeld step for a uniform B-spline of degree `n` with control points `c`:

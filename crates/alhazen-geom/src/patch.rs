@@ -1,13 +1,14 @@
 //! Tensor-product patches (course, §"Tensor product Bézier and B-spline patches", §"Rational
-//! Bézier and B-spline patches"): points by evaluating curves of curves, first partial
-//! derivatives from the curves' hodographs, knot insertion per direction, and the normal of a
-//! rational patch as the 4D vector product `N = P ∧ P_v ∧ P_u` of the homogeneous point and its
-//! derivatives.
+//! Bézier and B-spline patches"): points by evaluating curves of curves (de Casteljau or de
+//! Boor along the rows, then along the column, reading only the rows whose basis functions do
+//! not vanish), first partial derivatives from the curves' hodographs, knot insertion per
+//! direction, and the normal of a rational patch as the 4D vector product `N = P ∧ P_v ∧ P_u`
+//! of the homogeneous point and its derivatives.
 //!
 //! The control net is stored row-major: `points[i * cols + j]` is `p_ij`, `i` along `u`.
 
-use crate::bezier::{Bezier, ControlPoint};
-use crate::bspline::{BSpline, SplineError};
+use crate::bezier::{ControlPoint, de_casteljau};
+use crate::bspline::{BSpline, SplineError, de_boor, hodograph, span};
 use alhazen_math::{Mat3, Vec3, Vec4};
 
 /// A control net of `rows × cols` points.
@@ -40,33 +41,49 @@ pub struct BezierPatch<P> {
 }
 
 impl<P: ControlPoint> BezierPatch<P> {
-    /// The points `q_i = Σ_j p_ij B_j(v)`, then a Bézier curve in `u`.
-    fn column(&self, v: f64) -> Bezier<P> {
-        Bezier::new((0..self.net.rows).map(|i| Bezier::new(self.net.row(i)).expect("cols > 0").eval(v)).collect())
-            .expect("rows > 0")
+    /// `(p, ∂p/∂u, ∂p/∂v)` at `(u, v)`: de Casteljau along every row at `v` gives the points
+    /// `q_i` of a Bézier curve in `u` (the derivative along a degree-0 direction is zero).
+    pub fn partials(&self, u: f64, v: f64) -> (P, P, P) {
+        let (rows, cols) = (self.net.rows, self.net.cols);
+        let zero = self.net.points[0] * 0.0;
+        let hodograph = |points: &[P], out: &mut Vec<P>| {
+            out.clear();
+            out.extend(points.windows(2).map(|w| (w[1] - w[0]) * (points.len() - 1) as f64));
+        };
+        let (mut q, mut qv, mut scratch) = (Vec::with_capacity(rows), Vec::with_capacity(rows), Vec::new());
+        for row in self.net.points.chunks_exact(cols) {
+            scratch.clear();
+            scratch.extend_from_slice(row);
+            q.push(de_casteljau(&mut scratch, v));
+            qv.push(if cols > 1 {
+                hodograph(row, &mut scratch);
+                de_casteljau(&mut scratch, v)
+            } else {
+                zero
+            });
+        }
+        let du = if rows > 1 {
+            hodograph(&q, &mut scratch);
+            de_casteljau(&mut scratch, u)
+        } else {
+            zero
+        };
+        (de_casteljau(&mut q, u), du, de_casteljau(&mut qv, u))
     }
 
     /// `p(u, v)`.
     pub fn eval(&self, u: f64, v: f64) -> P {
-        self.column(v).eval(u)
+        self.partials(u, v).0
     }
 
     /// `∂p/∂u` (zero for degree 0 in `u`).
     pub fn du(&self, u: f64, v: f64) -> P {
-        self.column(v).derivative().map_or(self.net.points[0] * 0.0, |d| d.eval(u))
+        self.partials(u, v).1
     }
 
     /// `∂p/∂v`.
     pub fn dv(&self, u: f64, v: f64) -> P {
-        let q: Vec<P> = (0..self.net.rows)
-            .map(|i| {
-                Bezier::new(self.net.row(i))
-                    .expect("cols > 0")
-                    .derivative()
-                    .map_or(self.net.points[0] * 0.0, |d| d.eval(v))
-            })
-            .collect();
-        Bezier::new(q).expect("rows > 0").eval(u)
+        self.partials(u, v).2
     }
 }
 
@@ -97,34 +114,60 @@ impl<P: ControlPoint> BSplinePatch<P> {
         BSpline::new(self.m, self.v_knots.clone(), self.net.row(i)).expect("checked in new")
     }
 
-    fn column(&self, v: f64, derive_v: bool) -> BSpline<P> {
-        let q = (0..self.net.rows)
-            .map(|i| {
-                let c = self.row_curve(i);
-                if derive_v { c.derivative().map_or(self.net.points[0] * 0.0, |d| d.eval(v)) } else { c.eval(v) }
-            })
-            .collect();
-        BSpline::new(self.n, self.u_knots.clone(), q).expect("checked in new")
-    }
-
     /// The parameter domain `([u_n, u_{N−n}], [v_m, v_{M−m}])`.
     pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
-        (self.column(self.v_knots[self.m], false).domain(), self.row_curve(0).domain())
+        let (u, v) = (&self.u_knots, &self.v_knots);
+        ((u[self.n], u[u.len() - 1 - self.n]), (v[self.m], v[v.len() - 1 - self.m]))
+    }
+
+    /// `(s, ∂s/∂u, ∂s/∂v)` at `(u, v)` (clamped to the domain): de Boor along the rows at `v`
+    /// gives the points `q_i` of a B-spline in `u`; only the rows its spans at `u` read (for
+    /// the point and for the hodograph) are evaluated.
+    pub fn partials(&self, u: f64, v: f64) -> (P, P, P) {
+        let (n, m, cols) = (self.n, self.m, self.net.cols);
+        let (uk, vk) = (&self.u_knots[..], &self.v_knots[..]);
+        let (uk1, vk1) = (&uk[1..uk.len() - 1], &vk[1..vk.len() - 1]);
+        let zero = self.net.points[0] * 0.0;
+        let uc = u.clamp(uk[n], uk[uk.len() - 1 - n]);
+        let k = span(uk, n, uc);
+        let (lo, hi) = if n > 0 {
+            let kd = span(uk1, n - 1, uc);
+            ((k - n).min(kd + 1 - n), k.max(kd + 1))
+        } else {
+            (k, k)
+        };
+        let (mut q, mut qv) = (vec![zero; self.net.rows], vec![zero; self.net.rows]);
+        let (mut scratch, mut hod) = (Vec::new(), Vec::new());
+        for i in lo..=hi {
+            let row = &self.net.points[i * cols..(i + 1) * cols];
+            q[i] = de_boor(vk, m, row, v, &mut scratch);
+            if m > 0 {
+                hodograph(vk, m, row, &mut hod);
+                qv[i] = de_boor(vk1, m - 1, &hod, v, &mut scratch);
+            }
+        }
+        let du = if n > 0 {
+            hodograph(uk, n, &q, &mut hod);
+            de_boor(uk1, n - 1, &hod, u, &mut scratch)
+        } else {
+            zero
+        };
+        (de_boor(uk, n, &q, u, &mut scratch), du, de_boor(uk, n, &qv, u, &mut scratch))
     }
 
     /// `s(u, v)`.
     pub fn eval(&self, u: f64, v: f64) -> P {
-        self.column(v, false).eval(u)
+        self.partials(u, v).0
     }
 
     /// `∂s/∂u`.
     pub fn du(&self, u: f64, v: f64) -> P {
-        self.column(v, false).derivative().map_or(self.net.points[0] * 0.0, |d| d.eval(u))
+        self.partials(u, v).1
     }
 
     /// `∂s/∂v`.
     pub fn dv(&self, u: f64, v: f64) -> P {
-        self.column(v, true).eval(u)
+        self.partials(u, v).2
     }
 
     /// Boehm's insertion of `t` into the `v` knots of every row.
@@ -202,7 +245,7 @@ pub fn rational_normal(p: Vec4, pu: Vec4, pv: Vec4) -> Option<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bezier::bernstein;
+    use crate::bezier::{Bezier, bernstein};
     use proptest::prelude::*;
 
     fn arb_net(rows: usize, cols: usize) -> impl Strategy<Value = Net<Vec3>> {
@@ -244,6 +287,51 @@ mod tests {
             let fu = (s.eval(uu + h, vv) - s.eval(uu - h, vv)) / (2.0 * h);
             let fv = (s.eval(uu, vv + h) - s.eval(uu, vv - h)) / (2.0 * h);
             prop_assert!(close(s.du(uu, vv), fu, 1e-5) && close(s.dv(uu, vv), fv, 1e-5));
+        }
+
+        #[test]
+        fn b_spline_patch_partials_are_curves_of_curves(net in arb_net(4, 6), u in 0.0..=1.0f64, v in 0.0..=1.0f64) {
+            // Degrees (2, 3) on clamped, non-uniform knots with a double knot along v.
+            let (uk, vk) = (vec![0.0, 0.0, 0.0, 0.4, 1.0, 1.0, 1.0], vec![0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 2.0, 2.0, 2.0, 2.0]);
+            let s = BSplinePatch::new(2, 3, uk.clone(), vk.clone(), net.clone()).unwrap();
+            let (uu, vv) = (u, 2.0 * v);
+            // The course's way: de Boor along every row at v, then along the column at u.
+            let rows: Vec<BSpline<Vec3>> = (0..4).map(|i| BSpline::new(3, vk.clone(), net.row(i)).unwrap()).collect();
+            let column = BSpline::new(2, uk.clone(), rows.iter().map(|r| r.eval(vv)).collect()).unwrap();
+            let column_v = BSpline::new(2, uk, rows.iter().map(|r| r.derivative().unwrap().eval(vv)).collect()).unwrap();
+            // Bit for bit: meshes of neighbouring patches are welded by exact positions.
+            let (p, pu, pv) = s.partials(uu, vv);
+            prop_assert_eq!(p, column.eval(uu));
+            prop_assert_eq!(pu, column.derivative().unwrap().eval(uu));
+            prop_assert_eq!(pv, column_v.eval(uu));
+            prop_assert_eq!(s.domain(), ((0.0, 1.0), (0.0, 2.0)));
+        }
+
+        #[test]
+        fn bezier_patch_partials_are_curves_of_curves(net in arb_net(4, 3), u in -0.1..1.1f64, v in -0.1..1.1f64) {
+            let p = BezierPatch { net: net.clone() };
+            let rows: Vec<Bezier<Vec3>> = (0..4).map(|i| Bezier::new(net.row(i)).unwrap()).collect();
+            let column = Bezier::new(rows.iter().map(|r| r.eval(v)).collect()).unwrap();
+            let column_v = Bezier::new(rows.iter().map(|r| r.derivative().unwrap().eval(v)).collect()).unwrap();
+            let (s, su, sv) = p.partials(u, v);
+            prop_assert_eq!(s, column.eval(u));
+            prop_assert_eq!(su, column.derivative().unwrap().eval(u));
+            prop_assert_eq!(sv, column_v.eval(u));
+        }
+
+        #[test]
+        fn bezier_patches_sharing_an_edge_agree_bit_for_bit(a in arb_net(4, 4), b in arb_net(3, 4), j in 0..=16u32) {
+            // `b` starts with the last row of `a`, once as it is and once reversed along v; at the
+            // tessellator's dyadic parameters the shared edge must give the same bits.
+            let t = j as f64 / 16.0;
+            let edge = a.row(3);
+            let mut same = b.points.clone();
+            same[..4].copy_from_slice(&edge);
+            let mut reversed = same.clone();
+            reversed[..4].reverse();
+            let (a, same, reversed) = (BezierPatch { net: a }, Net::new(3, 4, same).unwrap(), Net::new(3, 4, reversed).unwrap());
+            prop_assert_eq!(a.eval(1.0, t), BezierPatch { net: same }.eval(0.0, t));
+            prop_assert_eq!(a.eval(1.0, t), BezierPatch { net: reversed }.eval(0.0, 1.0 - t));
         }
 
         #[test]

@@ -28,35 +28,31 @@ pub trait Surface {
 
 impl Surface for BezierPatch<Vec3> {
     fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3) {
-        let n = self.du(u, v).cross(self.dv(u, v)).try_normalize().unwrap_or(Vec3::Z);
-        (self.eval(u, v), n)
+        let (p, pu, pv) = self.partials(u, v);
+        (p, pu.cross(pv).try_normalize().unwrap_or(Vec3::Z))
     }
 }
 
 impl Surface for BezierPatch<Vec4> {
     fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3) {
-        let h = self.eval(u, v);
-        let n = rational_normal(h, self.du(u, v), self.dv(u, v)).unwrap_or(Vec3::Z);
-        (h.truncate() / h.w, n)
+        let (h, hu, hv) = self.partials(u, v);
+        (h.truncate() / h.w, rational_normal(h, hu, hv).unwrap_or(Vec3::Z))
     }
 }
 
 impl Surface for BSplinePatch<Vec3> {
     fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3) {
         let ((u0, u1), (v0, v1)) = self.domain();
-        let (uu, vv) = (u0 + (u1 - u0) * u, v0 + (v1 - v0) * v);
-        let n = self.du(uu, vv).cross(self.dv(uu, vv)).try_normalize().unwrap_or(Vec3::Z);
-        (self.eval(uu, vv), n)
+        let (p, pu, pv) = self.partials(u0 + (u1 - u0) * u, v0 + (v1 - v0) * v);
+        (p, pu.cross(pv).try_normalize().unwrap_or(Vec3::Z))
     }
 }
 
 impl Surface for BSplinePatch<Vec4> {
     fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3) {
         let ((u0, u1), (v0, v1)) = self.domain();
-        let (uu, vv) = (u0 + (u1 - u0) * u, v0 + (v1 - v0) * v);
-        let h = self.eval(uu, vv);
-        let n = rational_normal(h, self.du(uu, vv), self.dv(uu, vv)).unwrap_or(Vec3::Z);
-        (h.truncate() / h.w, n)
+        let (h, hu, hv) = self.partials(u0 + (u1 - u0) * u, v0 + (v1 - v0) * v);
+        (h.truncate() / h.w, rational_normal(h, hu, hv).unwrap_or(Vec3::Z))
     }
 }
 
