@@ -71,9 +71,20 @@ impl<P: ControlPoint> BezierPatch<P> {
         (de_casteljau(&mut q, u), du, de_casteljau(&mut qv, u))
     }
 
-    /// `p(u, v)`.
+    /// `p(u, v)` (the first of [`Self::partials`], without the derivatives).
     pub fn eval(&self, u: f64, v: f64) -> P {
-        self.partials(u, v).0
+        let mut scratch = Vec::with_capacity(self.net.cols);
+        let mut q: Vec<P> = self
+            .net
+            .points
+            .chunks_exact(self.net.cols)
+            .map(|row| {
+                scratch.clear();
+                scratch.extend_from_slice(row);
+                de_casteljau(&mut scratch, v)
+            })
+            .collect();
+        de_casteljau(&mut q, u)
     }
 
     /// `∂p/∂u` (zero for degree 0 in `u`).
@@ -155,9 +166,17 @@ impl<P: ControlPoint> BSplinePatch<P> {
         (de_boor(uk, n, &q, u, &mut scratch), du, de_boor(uk, n, &qv, u, &mut scratch))
     }
 
-    /// `s(u, v)`.
+    /// `s(u, v)` (the first of [`Self::partials`], without the derivatives).
     pub fn eval(&self, u: f64, v: f64) -> P {
-        self.partials(u, v).0
+        let (n, uk) = (self.n, &self.u_knots[..]);
+        let k = span(uk, n, u.clamp(uk[n], uk[uk.len() - 1 - n]));
+        let mut q = vec![self.net.points[0] * 0.0; self.net.rows];
+        let mut scratch = Vec::new();
+        for (i, q) in q.iter_mut().enumerate().take(k + 1).skip(k - n) {
+            let row = &self.net.points[i * self.net.cols..(i + 1) * self.net.cols];
+            *q = de_boor(&self.v_knots, self.m, row, v, &mut scratch);
+        }
+        de_boor(uk, n, &q, u, &mut scratch)
     }
 
     /// `∂s/∂u`.
@@ -302,6 +321,7 @@ mod tests {
             // Bit for bit: meshes of neighbouring patches are welded by exact positions.
             let (p, pu, pv) = s.partials(uu, vv);
             prop_assert_eq!(p, column.eval(uu));
+            prop_assert_eq!(s.eval(uu, vv), p);
             prop_assert_eq!(pu, column.derivative().unwrap().eval(uu));
             prop_assert_eq!(pv, column_v.eval(uu));
             prop_assert_eq!(s.domain(), ((0.0, 1.0), (0.0, 2.0)));
@@ -315,6 +335,7 @@ mod tests {
             let column_v = Bezier::new(rows.iter().map(|r| r.derivative().unwrap().eval(v)).collect()).unwrap();
             let (s, su, sv) = p.partials(u, v);
             prop_assert_eq!(s, column.eval(u));
+            prop_assert_eq!(p.eval(u, v), s);
             prop_assert_eq!(su, column.derivative().unwrap().eval(u));
             prop_assert_eq!(sv, column_v.eval(u));
         }

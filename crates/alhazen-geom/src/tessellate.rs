@@ -24,12 +24,21 @@ pub fn polygons_to_triangles(m: &HalfedgeMesh) -> TriangleMesh {
 pub trait Surface {
     /// Point and unit normal at `(u, v)` in the unit square.
     fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3);
+
+    /// The point alone (the same as `sample(u, v).0`, possibly cheaper).
+    fn point(&self, u: f64, v: f64) -> Vec3 {
+        self.sample(u, v).0
+    }
 }
 
 impl Surface for BezierPatch<Vec3> {
     fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3) {
         let (p, pu, pv) = self.partials(u, v);
         (p, pu.cross(pv).try_normalize().unwrap_or(Vec3::Z))
+    }
+
+    fn point(&self, u: f64, v: f64) -> Vec3 {
+        self.eval(u, v)
     }
 }
 
@@ -38,21 +47,43 @@ impl Surface for BezierPatch<Vec4> {
         let (h, hu, hv) = self.partials(u, v);
         (h.truncate() / h.w, rational_normal(h, hu, hv).unwrap_or(Vec3::Z))
     }
+
+    fn point(&self, u: f64, v: f64) -> Vec3 {
+        let h = self.eval(u, v);
+        h.truncate() / h.w
+    }
+}
+
+/// The parameters of `s` at `(u, v)` in the unit square.
+fn in_domain<P: ControlPoint>(s: &BSplinePatch<P>, u: f64, v: f64) -> (f64, f64) {
+    let ((u0, u1), (v0, v1)) = s.domain();
+    (u0 + (u1 - u0) * u, v0 + (v1 - v0) * v)
 }
 
 impl Surface for BSplinePatch<Vec3> {
     fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3) {
-        let ((u0, u1), (v0, v1)) = self.domain();
-        let (p, pu, pv) = self.partials(u0 + (u1 - u0) * u, v0 + (v1 - v0) * v);
+        let (uu, vv) = in_domain(self, u, v);
+        let (p, pu, pv) = self.partials(uu, vv);
         (p, pu.cross(pv).try_normalize().unwrap_or(Vec3::Z))
+    }
+
+    fn point(&self, u: f64, v: f64) -> Vec3 {
+        let (uu, vv) = in_domain(self, u, v);
+        self.eval(uu, vv)
     }
 }
 
 impl Surface for BSplinePatch<Vec4> {
     fn sample(&self, u: f64, v: f64) -> (Vec3, Vec3) {
-        let ((u0, u1), (v0, v1)) = self.domain();
-        let (h, hu, hv) = self.partials(u0 + (u1 - u0) * u, v0 + (v1 - v0) * v);
+        let (uu, vv) = in_domain(self, u, v);
+        let (h, hu, hv) = self.partials(uu, vv);
         (h.truncate() / h.w, rational_normal(h, hu, hv).unwrap_or(Vec3::Z))
+    }
+
+    fn point(&self, u: f64, v: f64) -> Vec3 {
+        let (uu, vv) = in_domain(self, u, v);
+        let h = self.eval(uu, vv);
+        h.truncate() / h.w
     }
 }
 
@@ -60,16 +91,18 @@ impl Surface for BSplinePatch<Vec4> {
 /// triangles of a `k × k` grid.
 fn chordal_error<S: Surface>(s: &S, k: usize) -> f64 {
     let h = 1.0 / k as f64;
+    let corners: Vec<Vec3> =
+        (0..=k).flat_map(|i| (0..=k).map(move |j| (i, j))).map(|(i, j)| s.point(i as f64 * h, j as f64 * h)).collect();
+    let corner = |i: usize, j: usize| corners[i * (k + 1) + j];
     let mut worst = 0.0f64;
     for i in 0..k {
         for j in 0..k {
             let (u, v) = (i as f64 * h, j as f64 * h);
-            let c = |a: f64, b: f64| s.sample(a, b).0;
-            let (p00, p10, p01, p11) = (c(u, v), c(u + h, v), c(u, v + h), c(u + h, v + h));
+            let (p00, p10, p01, p11) = (corner(i, j), corner(i + 1, j), corner(i, j + 1), corner(i + 1, j + 1));
             for (su, sv, approx) in
                 [(0.5, 0.5, (p00 + p11) * 0.5), (0.5, 0.0, (p00 + p10) * 0.5), (0.0, 0.5, (p00 + p01) * 0.5)]
             {
-                worst = worst.max((c(u + su * h, v + sv * h) - approx).length());
+                worst = worst.max((s.point(u + su * h, v + sv * h) - approx).length());
             }
         }
     }
