@@ -126,7 +126,8 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
         CameraDesc::Orthographic { look, width } => Orbit { look: *look, ortho_width: Some(*width) },
         _ => return Err(Failure::input("alhazen view needs a perspective or orthographic camera")),
     };
-    let mut prepared = prepare(&scene, &RasterOptions::default());
+    let mut prepared_for = RasterOptions::default();
+    let mut prepared = prepare(&scene, &prepared_for);
     let mut window = Window::new("alhazen view", w, h, WindowOptions::default())
         .map_err(|e| Failure::work(format!("cannot open a window (is an X server running?): {e}")))?;
     window.set_target_fps(60);
@@ -151,9 +152,10 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
         }
         if dirty {
             traced = None;
-            if opts.visibility == Visibility::Bsp && prepared.bsp.is_none() {
-                window.set_title("alhazen view — building the BSP tree…");
-                prepared = prepare(&scene, &opts);
+            if !prepared.serves(&opts) {
+                window.set_title("alhazen view — preparing…");
+                prepared_for.prepare_also(&opts);
+                prepared = prepare(&scene, &prepared_for);
             }
             orbit.apply(&mut scene.camera);
             let start = Instant::now();

@@ -338,3 +338,28 @@ fn axonometric_views_agree_with_the_ray_tracer() {
         assert!(err < 0.01, "{style}: {:.2} %", err * 100.0);
     }
 }
+
+#[test]
+fn preparation_builds_only_what_is_asked_and_widens_to_serve_more() {
+    use alhazen_raster::pipeline::{ShadowMethod, Visibility, prepare, render_prepared, stencil::StencilMode};
+    let scene = parse_scene("s.toml".as_ref(), SCENE).unwrap();
+    let plain = RasterOptions { shadows: false, ..Default::default() };
+    let prepared = prepare(&scene, &plain);
+    assert!(prepared.shadows.is_none() && prepared.ibl.is_none() && prepared.bsp.is_none());
+    let ibl = RasterOptions { ibl: true, ..Default::default() };
+    let bsp = RasterOptions { visibility: Visibility::Bsp, ..plain.clone() };
+    let volumes = RasterOptions { shadow_method: ShadowMethod::Volumes(StencilMode::DepthPass), ..Default::default() };
+    assert!(!prepared.serves(&ibl) && !prepared.serves(&bsp) && prepared.serves(&volumes));
+    let mut wide = plain.clone();
+    for o in [&ibl, &bsp, &volumes] {
+        wide.prepare_also(o);
+    }
+    let widened = prepare(&scene, &wide);
+    for o in [&plain, &ibl, &bsp, &volumes] {
+        assert!(widened.serves(o));
+        // What was prepared beyond the options does not change the frame.
+        let (a, _) = render_prepared(&scene, &widened, o).unwrap();
+        let (b, _) = render_scene(&scene, o).unwrap();
+        assert_eq!(a.color, b.color);
+    }
+}

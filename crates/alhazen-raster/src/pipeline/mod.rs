@@ -107,34 +107,69 @@ impl Default for RasterOptions {
 /// Texels a side of each shadow map.
 pub const SHADOW_MAP_SIZE: u32 = 1024;
 
-/// What does not change when the camera moves: the triangles and the lights' shadow maps.
+/// What does not change when the camera moves: the triangles, the lights' shadow maps, the
+/// environment's lighting and the BSP tree — each, but the triangles, only when asked for.
 pub struct Prepared {
     /// World-space triangles.
     pub geometry: geometry::SceneTriangles,
     /// Shadow maps, when asked for.
     pub shadows: Option<shadow::Shadows>,
-    /// The environment's irradiance.
-    pub irradiance: ibl::Sh9,
-    /// The environment prefiltered for glossy reflection, with the split-sum table.
-    pub specular: ibl::SpecularIbl,
+    /// The environment's irradiance and its prefiltered radiance, when image-based light is
+    /// asked for.
+    pub ibl: Option<Ibl>,
     /// The BSP tree, when the painter's algorithm is asked for.
     pub bsp: Option<bsp::BspTree>,
 }
 
-/// Tessellates `scene`, computes its environment's irradiance and, as `opts` ask, renders its
-/// shadow maps and builds its BSP tree.
+/// Image-based light: the environment's irradiance, and the environment prefiltered for glossy
+/// reflection with the split-sum table.
+pub struct Ibl {
+    /// Nine spherical-harmonic coefficients of the irradiance.
+    pub irradiance: ibl::Sh9,
+    /// The prefiltered environment.
+    pub specular: ibl::SpecularIbl,
+}
+
+impl RasterOptions {
+    /// Widens these options (as given to [`prepare`]) so that what `also` needs is prepared
+    /// too: shadow maps, image-based light, the BSP tree.
+    pub fn prepare_also(&mut self, also: &RasterOptions) {
+        if also.shadows && also.shadow_method == ShadowMethod::Maps {
+            (self.shadows, self.shadow_method) = (true, ShadowMethod::Maps);
+        }
+        self.ibl |= also.ibl;
+        if also.visibility == Visibility::Bsp {
+            self.visibility = Visibility::Bsp;
+        }
+    }
+}
+
+impl Prepared {
+    /// True when everything `opts` asks for was prepared.
+    pub fn serves(&self, opts: &RasterOptions) -> bool {
+        let maps = opts.shadows && opts.shadow_method == ShadowMethod::Maps;
+        (!maps || self.shadows.is_some())
+            && (!opts.ibl || self.ibl.is_some())
+            && (opts.visibility != Visibility::Bsp || self.bsp.is_some())
+    }
+}
+
+/// Tessellates `scene` and, as `opts` ask, renders its shadow maps, computes its environment's
+/// lighting and builds its BSP tree.
 pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
     let geometry = scene_triangles(scene);
     let maps = opts.shadows && opts.shadow_method == ShadowMethod::Maps;
     let shadows = maps.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
-    let irradiance = ibl::Sh9::irradiance_of(&|d| scene.sky(d), 8, 400);
-    let specular = ibl::SpecularIbl::build(&|d| scene.sky(d), 32);
+    let ibl = opts.ibl.then(|| Ibl {
+        irradiance: ibl::Sh9::irradiance_of(&|d| scene.sky(d), 8, 400),
+        specular: ibl::SpecularIbl::build(&|d| scene.sky(d), 32),
+    });
     let bsp = (opts.visibility == Visibility::Bsp).then(|| {
         let b =
             geometry.triangles.iter().fold(alhazen_math::Bounds3::EMPTY, |b, t| t.v.iter().fold(b, |b, v| b.grow(v.p)));
         bsp::BspTree::build(&geometry.triangles, 1e-9 * (1.0 + b.extent().length()))
     });
-    Prepared { geometry, shadows, irradiance, specular, bsp }
+    Prepared { geometry, shadows, ibl, bsp }
 }
 
 /// What the pipeline did.
@@ -358,7 +393,8 @@ pub fn render_scene(scene: &Scene, opts: &RasterOptions) -> Result<(Framebuffer,
 }
 
 /// Renders prepared geometry (built once by [`prepare`], then drawn as often as the camera or
-/// the options change).
+/// the options change). What `opts` asks for but was not prepared (see [`Prepared::serves`])
+/// is left out: no shadow maps, no image-based light, the z-buffer instead of the BSP tree.
 pub fn render_prepared(
     scene: &Scene,
     prepared: &Prepared,
@@ -373,8 +409,8 @@ pub fn render_prepared(
     };
     let light = shade::Lighting {
         shadows: if opts.shadows && stencil_mode.is_none() { prepared.shadows.as_ref() } else { None },
-        irradiance: opts.ibl.then_some(&prepared.irradiance),
-        specular: opts.ibl.then_some(&prepared.specular),
+        irradiance: prepared.ibl.as_ref().filter(|_| opts.ibl).map(|i| &i.irradiance),
+        specular: prepared.ibl.as_ref().filter(|_| opts.ibl).map(|i| &i.specular),
         blocked: 0,
         hemisphere: opts
             .hemispherical
