@@ -70,6 +70,28 @@ fn owns_edge(dx: f64, dy: f64) -> bool {
     dy > 0.0 || (dy == 0.0 && dx < 0.0)
 }
 
+/// Columns `[x0, x1)` of row centre `cy` that may be inside all edges: each edge not parallel
+/// to the row bounds the centres `cx` where its function is non-negative; a pixel of margin
+/// absorbs the rounding of the division, and the exact per-pixel test decides (thin triangles
+/// such as shadow-volume sides no longer cost their whole bounding box).
+#[inline]
+fn row_span(edges: &[(f64, f64, f64, f64); 3], cy: f64, min_x: u32, max_x: u32) -> (u32, u32) {
+    let (mut lo, mut hi) = (min_x as f64, max_x as f64);
+    for &(ax, ay, dx, dy) in edges {
+        // e = dx (cy − ay) − dy (cx − ax) ≥ 0.
+        let cross = ax + dx * (cy - ay) / dy;
+        if dy > 0.0 {
+            hi = hi.min(cross + 1.0);
+        } else if dy < 0.0 {
+            lo = lo.max(cross - 1.5);
+        }
+    }
+    if lo >= hi {
+        return (0, 0);
+    }
+    (lo.max(min_x as f64) as u32, hi.min(max_x as f64).ceil() as u32)
+}
+
 /// Calls `emit` for every pixel centre of rows `[y0, y1)` and columns `[0, width)` covered by `t`.
 pub fn rasterize(t: &ScreenTriangle, width: u32, y0: u32, y1: u32, mut emit: impl FnMut(Fragment)) {
     let (mut x, mut y, mut idx) = (t.x, t.y, [0usize, 1, 2]);
@@ -94,7 +116,8 @@ pub fn rasterize(t: &ScreenTriangle, width: u32, y0: u32, y1: u32, mut emit: imp
     });
     for py in min_y..max_y {
         let cy = py as f64 + 0.5;
-        for px in min_x..max_x {
+        let (x0, x1) = row_span(&edges, cy, min_x, max_x);
+        for px in x0..x1 {
             let cx = px as f64 + 0.5;
             let mut w = [0.0; 3];
             let mut inside = true;
