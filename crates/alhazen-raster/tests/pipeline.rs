@@ -219,6 +219,26 @@ fn bsp_tree_partitions_the_scene() {
 }
 
 #[test]
+fn bsp_tree_of_a_convex_mesh_is_not_a_chain() {
+    use alhazen_raster::pipeline::bsp::{BspTree, Viewer};
+    use alhazen_raster::pipeline::geometry::scene_triangles;
+    // Every face of a tessellated sphere lies behind every other face's plane: with triangle
+    // planes alone the tree is a chain as deep as the mesh (and quadratic to build).
+    let text = "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n[[object]]\nshape = \"sphere\"\nradius = 1\n";
+    let scene = parse_scene("sphere.toml".as_ref(), text).unwrap();
+    let tris = scene_triangles(&scene).triangles;
+    assert!(tris.len() > 2000);
+    let tree = BspTree::build(&tris, 1e-9);
+    assert!(tree.is_consistent(1e-7));
+    assert!(tree.depth() < tris.len() / 4, "depth {} for {} triangles", tree.depth(), tris.len());
+    assert!(tree.len() < tris.len() * 3 / 2, "{} pieces of {} triangles", tree.len(), tris.len());
+    let mut order = tree.back_to_front(Viewer::At(Vec3::new(0.3, 0.2, 5.0)));
+    order.sort();
+    order.dedup();
+    assert_eq!(order.len(), tree.len());
+}
+
+#[test]
 fn stencil_shadow_volumes_agree_with_the_ray_tracer() {
     use alhazen_raster::pipeline::ShadowMethod;
     use alhazen_raster::pipeline::stencil::StencilMode;

@@ -3,6 +3,10 @@
 //! straddle it are split — and for every view the tree is walked back to front (the subtree on
 //! the viewer's far side of the plane first, then the node's own triangles, then the near side),
 //! so painting in that order needs no depth buffer.
+//!
+//! Where no triangle's plane divides a large set (the faces of a convex mesh all lie behind one
+//! another's planes, which would make the tree a chain and its construction quadratic), the
+//! node takes a free plane instead: axis-aligned through the median of the triangles' centroids.
 
 use super::geometry::{Triangle, Vertex};
 use alhazen_math::Vec3;
@@ -79,14 +83,12 @@ impl BspTree {
         if all.is_empty() {
             return tree;
         }
-        // Work items: (set of triangles, parent node and side to attach to).
-        let mut work: Vec<(Vec<u32>, Attach)> = vec![(all, None)];
-        while let Some((mut set, parent)) = work.pop() {
-            let best = tree.splitter(&set, eps);
-            set.swap(0, best);
-            let (n, d) = plane_of(&tree.triangles[set[0] as usize]).expect("degenerate triangles filtered");
-            let (mut on, mut front, mut back) = (vec![set[0]], vec![], vec![]);
-            for &i in &set[1..] {
+        // Work items: (set of triangles, parent node and side to attach to, depth).
+        let mut work: Vec<(Vec<u32>, Attach, usize)> = vec![(all, None, 0)];
+        while let Some((set, parent, depth)) = work.pop() {
+            let (n, d) = tree.splitter(&set, eps, depth);
+            let (mut on, mut front, mut back) = (vec![], vec![], vec![]);
+            for &i in &set {
                 let t = tree.triangles[i as usize];
                 let dist = t.v.map(|v| n.dot(v.p) - d);
                 let dist = dist.map(|x| if x.abs() <= eps { 0.0 } else { x });
@@ -115,44 +117,64 @@ impl BspTree {
                 if is_front { node.front = Some(me) } else { node.back = Some(me) }
             }
             if !front.is_empty() {
-                work.push((front, Some((me, true))));
+                work.push((front, Some((me, true)), depth + 1));
             }
             if !back.is_empty() {
-                work.push((back, Some((me, false))));
+                work.push((back, Some((me, false)), depth + 1));
             }
         }
         tree
     }
 
-    /// The position in `set` of the candidate plane that splits the fewest triangles of a sample
-    /// and divides it most evenly (eight candidates against up to 64 triangles), so that the tree
-    /// stays small and shallow. (A convex mesh has every other face behind each face's plane,
-    /// so its tree is a chain and building it is quadratic: the painter's mode is for moderate
-    /// triangle counts.)
-    fn splitter(&self, set: &[u32], eps: f64) -> usize {
+    /// The plane of a node over `set`: of eight candidate triangles' planes, the one that splits
+    /// the fewest triangles of a sample and divides it most evenly (eight candidates against up
+    /// to 64 triangles), so that the tree stays small and shallow; a free plane when the set is
+    /// large and even the best leaves one side of the sample empty (a chain step) and a free
+    /// plane divides it better.
+    fn splitter(&self, set: &[u32], eps: f64, depth: usize) -> (Vec3, f64) {
+        let plane = |i: usize| plane_of(&self.triangles[set[i] as usize]).expect("degenerate triangles filtered");
         if set.len() <= 8 {
-            return 0;
+            return plane(0);
         }
-        let sample: Vec<&Triangle> =
-            (0..64.min(set.len())).map(|k| &self.triangles[set[k * set.len() / 64.min(set.len())] as usize]).collect();
-        (0..8)
-            .map(|c| c * set.len() / 8)
-            .min_by_key(|&c| {
-                let Some((n, d)) = plane_of(&self.triangles[set[c] as usize]) else { return usize::MAX };
-                // Few splits first, then balance.
-                let (mut splits, mut front, mut back) = (0usize, 0usize, 0usize);
-                for t in &sample {
-                    let s = t.v.map(|v| n.dot(v.p) - d);
-                    match (s.iter().any(|x| *x > eps), s.iter().any(|x| *x < -eps)) {
-                        (true, true) => splits += 1,
-                        (true, false) => front += 1,
-                        (false, true) => back += 1,
-                        _ => {}
-                    }
-                }
-                8 * splits + front.abs_diff(back)
+        let m = 64.min(set.len());
+        let sample: Vec<&Triangle> = (0..m).map(|k| &self.triangles[set[k * set.len() / m] as usize]).collect();
+        let (score, (n, d)) = (0..8)
+            .map(|c| {
+                let (n, d) = plane(c * set.len() / 8);
+                (sides(&sample, n, d, eps), (n, d))
             })
-            .unwrap_or(0)
+            .min_by_key(|((splits, front, back), _)| 8 * splits + front.abs_diff(*back))
+            .expect("eight candidates");
+        let (_, front, back) = score;
+        if front.min(back) > 0 || set.len() < FREE_PLANE_SET || depth >= FREE_PLANE_DEPTH {
+            return (n, d);
+        }
+        self.median_plane(set)
+            .filter(|&(n, d)| {
+                // Both sides non-empty and few splits, so that the children are smaller.
+                let (splits, f, b) = sides(&sample, n, d, eps);
+                f > 0 && b > 0 && splits <= f.min(b)
+            })
+            .unwrap_or((n, d))
+    }
+
+    /// The plane across the longest extent of the centroids of `set`, through their median.
+    fn median_plane(&self, set: &[u32]) -> Option<(Vec3, f64)> {
+        let centroid = |i: &u32| {
+            let v = &self.triangles[*i as usize].v;
+            (v[0].p + v[1].p + v[2].p) / 3.0
+        };
+        let bounds = set.iter().map(centroid).fold(alhazen_math::Bounds3::EMPTY, |b, c| b.grow(c));
+        let axis = bounds.extent().max_position();
+        if bounds.extent()[axis] <= 0.0 {
+            return None;
+        }
+        let mut coords: Vec<f64> = set.iter().map(|i| centroid(i)[axis]).collect();
+        let mid = coords.len() / 2;
+        let (_, median, _) = coords.select_nth_unstable_by(mid, f64::total_cmp);
+        let mut n = Vec3::ZERO;
+        n[axis] = 1.0;
+        Some((n, *median))
     }
 
     /// The triangles from the farthest to the nearest as seen by `viewer`.
@@ -191,6 +213,18 @@ impl BspTree {
         self.nodes.iter().map(|n| n.triangles.len()).sum()
     }
 
+    /// The number of nodes on the longest path from the root.
+    pub fn depth(&self) -> usize {
+        let mut deepest = 0;
+        let mut stack: Vec<(u32, usize)> = if self.nodes.is_empty() { vec![] } else { vec![(0, 1)] };
+        while let Some((k, d)) = stack.pop() {
+            deepest = deepest.max(d);
+            let node = &self.nodes[k as usize];
+            stack.extend([node.front, node.back].into_iter().flatten().map(|c| (c, d + 1)));
+        }
+        deepest
+    }
+
     /// True when there is nothing to draw.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
@@ -222,6 +256,28 @@ impl BspTree {
         }
         true
     }
+}
+
+/// Depth below which a node may take a free plane (bounds the splitting of long triangles).
+const FREE_PLANE_DEPTH: usize = 48;
+/// Sets smaller than this always take a triangle's plane: a chain over them costs less than the
+/// triangles a free plane would split.
+const FREE_PLANE_SET: usize = 1024;
+
+/// How many triangles of `sample` the plane `n·p = d` splits, and how many lie wholly in front
+/// and wholly behind.
+fn sides(sample: &[&Triangle], n: Vec3, d: f64, eps: f64) -> (usize, usize, usize) {
+    let (mut splits, mut front, mut back) = (0usize, 0usize, 0usize);
+    for t in sample {
+        let s = t.v.map(|v| n.dot(v.p) - d);
+        match (s.iter().any(|x| *x > eps), s.iter().any(|x| *x < -eps)) {
+            (true, true) => splits += 1,
+            (true, false) => front += 1,
+            (false, true) => back += 1,
+            _ => {}
+        }
+    }
+    (splits, front, back)
 }
 
 /// The plane `n·p = d` of a triangle (unit `n`), `None` when it is degenerate.
