@@ -230,14 +230,17 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     save(&image, &a.image.output, format)?;
     if !a.image.quiet {
         let r = &scene.render;
+        let integrator = match r.integrator {
+            alhazen_scene::IntegratorKind::Whitted => "Whitted ray tracing".to_string(),
+            alhazen_scene::IntegratorKind::Path => format!("path tracing, {:?} sampler", r.sampler).to_lowercase(),
+        };
         eprintln!(
-            "rendered {} ({}×{}, {} spp, depth {}, {:?}) in {:.3} s on {} threads → {}",
+            "rendered {} ({}×{}, {} spp, depth {}, {integrator}) in {:.3} s on {} threads → {}",
             a.image.scene.display(),
             image.width,
             image.height,
             r.spp,
             r.max_depth,
-            r.integrator,
             elapsed.as_secs_f64(),
             pool.current_num_threads(),
             a.image.output.display()
