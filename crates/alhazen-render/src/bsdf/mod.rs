@@ -169,9 +169,9 @@ pub(crate) fn same_side(v: Vec3, l: Vec3) -> bool {
 /// Cosine-weighted direction in the hemisphere of `v` (Malley's method), density `|cos|/π`.
 pub(crate) fn cosine_hemisphere(u: Vec2, v: Vec3) -> Vec3 {
     let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
+    let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
     let z = (1.0 - u.x).max(0.0).sqrt();
-    Vec3::new(r * phi.cos(), r * phi.sin(), if v.z < 0.0 { -z } else { z })
+    Vec3::new(r * cos, r * sin, if v.z < 0.0 { -z } else { z })
 }
 
 /// Density of [`cosine_hemisphere`].
