@@ -18,8 +18,9 @@ use crate::lights::Lights;
 use crate::sampler::{SampleStream, Sequence};
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::world::{World, WorldHit};
-use alhazen_math::{Ray, Vec3};
+use alhazen_math::{Ray, Vec2, Vec3};
 use alhazen_scene::{SamplerKind, Scene};
+use std::borrow::Cow;
 
 /// Depth from which Russian roulette may end paths (Mitsuba's `rr_depth`).
 const RR_DEPTH: u32 = 5;
@@ -32,6 +33,8 @@ pub struct PathTracer<'a> {
     lights: Lights,
     spectral: bool,
     sequence: Sequence,
+    /// Each material's BSDF in RGB when it does not vary over the surface (no texture).
+    uniform_bsdfs: Vec<Option<Bsdf>>,
 }
 
 /// Power heuristic with β = 2.
@@ -69,7 +72,16 @@ impl<'a> PathTracer<'a> {
             SamplerKind::Sobol => Sequence::Sobol,
             SamplerKind::Independent => Sequence::Independent,
         };
-        Self { scene, world, camera, lights: Lights::build(scene), spectral, sequence }
+        let uniform_bsdfs = scene
+            .materials
+            .iter()
+            .map(|m| {
+                let untextured = matches!(m.color, alhazen_scene::Texture::Solid(_))
+                    && m.bsdf.as_ref().is_none_or(|b| !b.is_textured());
+                untextured.then(|| bsdf_at(m, Vec2::ZERO, &scene.images, ColorMode::Rgb))
+            })
+            .collect();
+        Self { scene, world, camera, lights: Lights::build(scene), spectral, sequence, uniform_bsdfs }
     }
 
     /// Radiance along `ray` in the channels of `mode`.
@@ -92,7 +104,10 @@ impl<'a> PathTracer<'a> {
                 break;
             }
             let m = &self.scene.materials[wh.material as usize];
-            let bsdf = bsdf_at(m, wh.hit.uv, &self.scene.images, mode);
+            let bsdf = match (&self.uniform_bsdfs[wh.material as usize], mode) {
+                (Some(b), ColorMode::Rgb) => Cow::Borrowed(b),
+                _ => Cow::Owned(bsdf_at(m, wh.hit.uv, &self.scene.images, mode)),
+            };
             if self.spectral && !hero_only && is_dispersive(&bsdf) {
                 // Wavelength-dependent paths: only the hero survives (×3 keeps it unbiased).
                 beta *= Vec3::new(3.0, 0.0, 0.0);
