@@ -53,17 +53,35 @@ impl AaBox {
         SurfaceHit::flat(t, p, n, uv)
     }
 
-    /// Nearest hit in `(0, t_max)`; `aux` is the axis of the face.
+    /// Nearest hit in `(0, t_max)`. The face is found again by [`Self::surface`], so this
+    /// test (also every shadow ray's) has no data-dependent branches.
     #[inline]
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
-        let ((t0, a0), (t1, a1)) = self.slab(ray)?;
-        let (t, a) = if t0 > 0.0 { (t0, a0) } else { (t1, a1) };
-        (t > 0.0 && t < t_max).then_some(Candidate { t, aux: a as u32, bary: [0.0; 2] })
+        let inv = 1.0 / ray.dir;
+        let (t0, t1) = ((self.min - ray.origin) * inv, (self.max - ray.origin) * inv);
+        if t0.is_nan() || t1.is_nan() {
+            return None;
+        }
+        // The same values as `slab`'s entry and exit.
+        let (near, far) = (t0.min(t1).max_element(), t0.max(t1).min_element());
+        let t = if near > 0.0 { near } else { far };
+        let inside = near <= far && near.is_finite() && far.is_finite();
+        (inside && t > 0.0 && t < t_max).then_some(Candidate { t, aux: 0, bary: [0.0; 2] })
     }
 
     /// The surface at a hit.
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
-        self.hit_at(ray, c.t, c.aux as usize)
+        let face = match self.slab(ray) {
+            Some(((t0, a0), (_, a1))) => {
+                if t0 == c.t {
+                    a0
+                } else {
+                    a1
+                }
+            }
+            None => 0,
+        };
+        self.hit_at(ray, c.t, face)
     }
 
     /// Entry and exit of the line.
