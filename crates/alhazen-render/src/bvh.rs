@@ -1,11 +1,16 @@
 //! A bounding volume hierarchy built with the surface area heuristic (binned SAH, 12 bins),
 //! flattened depth-first so that a node's first child follows it. Used twice: over the objects
-//! of a scene and over the triangles of each mesh.
+//! of a scene and over the triangles of each mesh. The world's tree charges one test per
+//! started group of four packed primitives ([`Bvh::build_packed`]), so a room of walls and
+//! boxes becomes one leaf of packets rather than a tree of overlapping boxes.
 
 use alhazen_math::{Bounds3, Ray, Vec3};
 
 const BINS: usize = 12;
+/// Leaves that cost at most this many tests are not split.
 const MAX_LEAF: usize = 4;
+/// Primitives per packet (`crate::shape::LANES`).
+pub const PACK: usize = 4;
 /// Deeper subtrees become leaves, so traversal's fixed stack never overflows.
 const MAX_DEPTH: usize = 48;
 
@@ -32,28 +37,67 @@ struct Item {
     bounds: Bounds3,
     centroid: Vec3,
     index: u32,
+    /// Tested [`PACK`] at a time.
+    packed: bool,
+}
+
+/// How many primitives of each kind a set holds, for the cost of testing it as one leaf.
+#[derive(Clone, Copy, Default)]
+struct Tests {
+    packed: usize,
+    single: usize,
+}
+
+impl Tests {
+    fn of(items: &[Item]) -> Self {
+        items.iter().fold(Self::default(), |t, it| t.add(it))
+    }
+
+    fn add(self, it: &Item) -> Self {
+        Self { packed: self.packed + usize::from(it.packed), single: self.single + usize::from(!it.packed) }
+    }
+
+    fn merge(self, o: Self) -> Self {
+        Self { packed: self.packed + o.packed, single: self.single + o.single }
+    }
+
+    /// Tests a ray makes in the leaf, in units of one primitive test.
+    fn cost(self) -> f64 {
+        (self.packed.div_ceil(PACK) + self.single) as f64
+    }
 }
 
 impl Bvh {
     /// Builds over `bounds[i]` for every primitive `i`.
     pub fn build(bounds: &[Bounds3]) -> Self {
+        Self::build_packed(bounds, |_| false)
+    }
+
+    /// [`Self::build`] for primitives some of which (`packed(i)`) are tested [`PACK`] at a time
+    /// in a leaf: the surface area heuristic charges a leaf one test per started group of
+    /// them plus one per other primitive, so leaves of such primitives grow large.
+    pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool) -> Self {
         let mut items: Vec<Item> = bounds
             .iter()
             .enumerate()
-            .map(|(i, b)| Item { bounds: *b, centroid: b.centroid(), index: i as u32 })
+            .map(|(i, b)| Item { bounds: *b, centroid: b.centroid(), index: i as u32, packed: packed(i) })
             .collect();
         let mut bvh = Bvh { nodes: Vec::with_capacity(2 * bounds.len()), order: Vec::with_capacity(bounds.len()) };
         if !items.is_empty() {
-            bvh.build_node(&mut items, 0);
+            // A node's slab test costs about what a packet's test does, an eighth of a
+            // triangle's (pbrt's ratio).
+            let packets = items.iter().any(|it| it.packed);
+            bvh.build_node(&mut items, 0, if packets { 1.0 } else { 0.125 });
         }
         bvh
     }
 
-    fn build_node(&mut self, items: &mut [Item], depth: usize) -> usize {
+    fn build_node(&mut self, items: &mut [Item], depth: usize, traversal: f64) -> usize {
         let bounds = items.iter().fold(Bounds3::EMPTY, |b, it| b.union(it.bounds));
         let me = self.nodes.len();
         self.nodes.push(Node { bounds, offset: 0, count: 0, axis: 0 });
-        let split = if items.len() <= MAX_LEAF || depth >= MAX_DEPTH { None } else { sah_split(items, &bounds) };
+        let small = items.len() == 1 || Tests::of(items).cost() <= MAX_LEAF as f64;
+        let split = if small || depth >= MAX_DEPTH { None } else { sah_split(items, &bounds, traversal) };
         match split {
             None => {
                 self.nodes[me].offset = self.order.len() as u32;
@@ -62,8 +106,8 @@ impl Bvh {
             }
             Some((axis, mid)) => {
                 let (left, right) = items.split_at_mut(mid);
-                self.build_node(left, depth + 1);
-                let second = self.build_node(right, depth + 1);
+                self.build_node(left, depth + 1, traversal);
+                let second = self.build_node(right, depth + 1, traversal);
                 self.nodes[me].offset = second as u32;
                 self.nodes[me].axis = axis as u8;
             }
@@ -75,7 +119,31 @@ impl Bvh {
     /// distance, which prunes the rest of the traversal; `Some(0.0)` ends it at once (for
     /// any-hit queries such as shadow rays).
     #[inline]
-    pub fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
+    pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
+        self.traverse_leaves(ray, t_max, |leaf, mut t_max| {
+            let mut closer = None;
+            for &prim in &self.order[leaf] {
+                if let Some(t) = visit(prim, t_max) {
+                    if t <= 0.0 {
+                        return Some(0.0);
+                    }
+                    t_max = t_max.min(t);
+                    closer = Some(t_max);
+                }
+            }
+            closer
+        })
+    }
+
+    /// Visits candidate leaves front to back: `visit(range, t_max)` gets the leaf's positions
+    /// in [`Self::leaf_order`] and returns a closer hit distance, or `Some(0.0)` to stop.
+    #[inline]
+    pub fn traverse_leaves(
+        &self,
+        ray: &Ray,
+        mut t_max: f64,
+        mut visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
+    ) -> f64 {
         if self.nodes.is_empty() {
             return t_max;
         }
@@ -89,13 +157,11 @@ impl Bvh {
             if node.bounds.hit_interval(ray, inv, t_max).is_some() {
                 if node.count > 0 {
                     let first = node.offset as usize;
-                    for &prim in &self.order[first..first + node.count as usize] {
-                        if let Some(t) = visit(prim, t_max) {
-                            if t <= 0.0 {
-                                return 0.0;
-                            }
-                            t_max = t_max.min(t);
+                    if let Some(t) = visit(first..first + node.count as usize, t_max) {
+                        if t <= 0.0 {
+                            return 0.0;
                         }
+                        t_max = t_max.min(t);
                     }
                 } else {
                     // Near child first.
@@ -118,6 +184,17 @@ impl Bvh {
         }
     }
 
+    /// Primitive indices in leaf order: leaf `k`'s primitives are `leaf_order()[range]` for
+    /// the ranges [`Self::leaves`] lists and [`Self::traverse_leaves`] visits.
+    pub fn leaf_order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// Every leaf's range in [`Self::leaf_order`].
+    pub fn leaves(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        self.nodes.iter().filter(|n| n.count > 0).map(|n| n.offset as usize..(n.offset + n.count) as usize)
+    }
+
     /// The bounds of everything (empty for an empty BVH).
     pub fn bounds(&self) -> Bounds3 {
         self.nodes.first().map_or(Bounds3::EMPTY, |n| n.bounds)
@@ -125,7 +202,7 @@ impl Bvh {
 }
 
 /// The best binned SAH split `(axis, position in items)`, or `None` when a leaf is cheaper.
-fn sah_split(items: &mut [Item], bounds: &Bounds3) -> Option<(usize, usize)> {
+fn sah_split(items: &mut [Item], bounds: &Bounds3, traversal: f64) -> Option<(usize, usize)> {
     let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.grow(it.centroid));
     let extent = cb.extent();
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
@@ -143,31 +220,30 @@ fn sah_split(items: &mut [Item], bounds: &Bounds3) -> Option<(usize, usize)> {
         return None;
     }
     let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) / extent[axis] * BINS as f64) as usize).min(BINS - 1);
-    let mut bins = [(Bounds3::EMPTY, 0usize); BINS];
+    let mut bins = [(Bounds3::EMPTY, Tests::default()); BINS];
     for it in items.iter() {
         let b = &mut bins[bin_of(it.centroid)];
-        b.0 = b.0.union(it.bounds);
-        b.1 += 1;
+        *b = (b.0.union(it.bounds), b.1.add(it));
     }
     // Sweep from the right to get suffix areas, then from the left.
     let mut right_area = [0.0; BINS];
-    let mut acc = (Bounds3::EMPTY, 0);
+    let mut acc = (Bounds3::EMPTY, Tests::default());
     for i in (1..BINS).rev() {
-        acc = (acc.0.union(bins[i].0), acc.1 + bins[i].1);
-        right_area[i] = acc.0.surface_area() * acc.1 as f64;
+        acc = (acc.0.union(bins[i].0), acc.1.merge(bins[i].1));
+        right_area[i] = acc.0.surface_area() * acc.1.cost();
     }
     let (mut best, mut best_cost) = (0, f64::INFINITY);
-    let mut left = (Bounds3::EMPTY, 0);
+    let mut left = (Bounds3::EMPTY, Tests::default());
     for i in 0..BINS - 1 {
-        left = (left.0.union(bins[i].0), left.1 + bins[i].1);
-        let cost = left.0.surface_area() * left.1 as f64 + right_area[i + 1];
+        left = (left.0.union(bins[i].0), left.1.merge(bins[i].1));
+        let cost = left.0.surface_area() * left.1.cost() + right_area[i + 1];
         if cost < best_cost {
             best_cost = cost;
             best = i;
         }
     }
-    let leaf_cost = items.len() as f64 * bounds.surface_area();
-    let split_cost = 0.125 * bounds.surface_area() + best_cost;
+    let leaf_cost = Tests::of(items).cost() * bounds.surface_area();
+    let split_cost = traversal * bounds.surface_area() + best_cost;
     if split_cost >= leaf_cost && items.len() <= 255 {
         return None;
     }
