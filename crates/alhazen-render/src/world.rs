@@ -1,10 +1,12 @@
 //! The renderable world: every object of the scene placed, with a top-level BVH over the
-//! bounded ones and a plain list of unbounded ones (planes).
+//! bounded ones and a plain list of unbounded ones (planes). Small meshes, rectangles and
+//! untextured boxes are flattened into world-space triangles and parallelograms, which the
+//! BVH's leaves test four at a time ([`FlatPacket`]); other objects are tested one by one.
 
 use crate::bvh::Bvh;
 use crate::shape::{
-    AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, MeshAccel, MeshShape, Placed, Plane, Shape, Sphere, SurfaceHit,
-    parallelogram_of, parallelogram_to_triangle,
+    AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, FlatPacket, LANES, MeshAccel, MeshShape, Placed, Plane, Shape,
+    Sphere, SurfaceHit, has_vector_unit, parallelogram_of, parallelogram_to_triangle,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -24,18 +26,36 @@ pub struct WorldObject {
     pub bumpy: bool,
 }
 
-/// What a leaf of the top-level BVH holds: a whole object, or one triangle of a small mesh
-/// placed in world space, or a parallelogram of two (flattened so their rays skip the nested
-/// mesh BVH).
+/// A primitive of the top-level BVH: a whole object, or one triangle of a small mesh placed
+/// in world space, or a parallelogram of two (flattened so their rays skip the nested mesh
+/// BVH).
 #[derive(Clone, Copy, Debug)]
 enum Primitive {
     Object(u32),
-    /// `flats[flat]`; for a parallelogram, `triangle` is the first of its pair.
+    /// For a parallelogram, `triangle` is the first of its pair.
     Flat {
         object: u32,
         triangle: u32,
-        flat: u32,
+        flat: Flat,
     },
+}
+
+/// Whose triangle a lane of a [`FlatPacket`] is.
+#[derive(Clone, Copy, Debug, Default)]
+struct Lane {
+    object: u32,
+    /// The triangle, or the first of a parallelogram's pair.
+    triangle: u32,
+    parallelogram: bool,
+}
+
+/// What one leaf of the top-level BVH tests: its flats in packets, then its other objects.
+#[derive(Clone, Debug)]
+struct Leaf {
+    /// Range in `World::packets` (and `World::lanes`).
+    packets: std::ops::Range<usize>,
+    /// Range in `World::leaf_objects`.
+    objects: std::ops::Range<usize>,
 }
 
 /// All objects with their acceleration structure.
@@ -43,10 +63,15 @@ enum Primitive {
 pub struct World {
     objects: Vec<WorldObject>,
     bvh: Bvh,
-    primitives: Vec<Primitive>,
-    /// The flattened triangles and parallelograms.
-    flats: Vec<Flat>,
+    /// Leaf of the BVH by the start of its range in the BVH's leaf order.
+    leaf_at: Vec<u32>,
+    leaves: Vec<Leaf>,
+    packets: Vec<FlatPacket>,
+    lanes: Vec<[Lane; LANES]>,
+    leaf_objects: Vec<u32>,
     unbounded: Vec<u32>,
+    /// The packets may use the processor's AVX2 unit.
+    vectors: bool,
 }
 
 /// The first thing a shadow ray meets.
@@ -160,6 +185,10 @@ fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene) -> 
             let m = &scene.meshes[*mesh];
             (m.triangle_count() <= BAKE_TRIANGLES).then(|| (m.clone(), *smooth))
         }
+        // A box without texture coordinates becomes its six faces, tested in packets.
+        scene::Shape::Box { min, max } if !uses_uv(o, scene) => {
+            Some((Arc::new(TriangleMesh::cuboid(*min, *max)), false))
+        }
         _ => None,
     };
     if let Some((m, smooth)) = small {
@@ -185,13 +214,12 @@ impl World {
                     .any(|&m| scene.materials[m as usize].bump.is_some()),
             })
             .collect();
-        let (mut primitives, mut flats, mut prim_bounds, mut unbounded) = (vec![], vec![], vec![], vec![]);
+        let (mut primitives, mut prim_bounds, mut unbounded) = (vec![], vec![], vec![]);
         for (i, o) in objects.iter().enumerate() {
             let object = i as u32;
             if let Some(mesh) = flattenable(&o.placed) {
                 for (triangle, flat, bounds) in flat_primitives(mesh) {
-                    primitives.push(Primitive::Flat { object, triangle, flat: flats.len() as u32 });
-                    flats.push(flat);
+                    primitives.push(Primitive::Flat { object, triangle, flat });
                     prim_bounds.push(bounds);
                 }
                 continue;
@@ -204,8 +232,38 @@ impl World {
                 unbounded.push(object);
             }
         }
-        let bvh = Bvh::build(&prim_bounds);
-        Self { objects, bvh, primitives, flats, unbounded }
+        let bvh = Bvh::build_packed(&prim_bounds, |k| matches!(primitives[k], Primitive::Flat { .. }));
+        let mut world = Self { objects, unbounded, vectors: has_vector_unit(), ..Self::default() };
+        world.fill_leaves(&bvh, &primitives);
+        world.bvh = bvh;
+        world
+    }
+
+    /// Sorts each leaf's primitives into packets of flats and a list of objects.
+    fn fill_leaves(&mut self, bvh: &Bvh, primitives: &[Primitive]) {
+        self.leaf_at = vec![0; bvh.leaf_order().len()];
+        for range in bvh.leaves() {
+            self.leaf_at[range.start] = self.leaves.len() as u32;
+            let (first_packet, first_object) = (self.packets.len(), self.leaf_objects.len());
+            let mut flats: Vec<(Lane, Flat)> = vec![];
+            for &k in &bvh.leaf_order()[range] {
+                match primitives[k as usize] {
+                    Primitive::Object(i) => self.leaf_objects.push(i),
+                    Primitive::Flat { object, triangle, flat } => {
+                        flats.push((Lane { object, triangle, parallelogram: flat.is_parallelogram() }, flat))
+                    }
+                }
+            }
+            for chunk in flats.chunks(LANES) {
+                let flats: Vec<Flat> = chunk.iter().map(|(_, f)| *f).collect();
+                self.packets.push(FlatPacket::new(&flats));
+                let mut lanes = [Lane::default(); LANES];
+                chunk.iter().zip(&mut lanes).for_each(|((lane, _), slot)| *slot = *lane);
+                self.lanes.push(lanes);
+            }
+            let (packets, objects) = (first_packet..self.packets.len(), first_object..self.leaf_objects.len());
+            self.leaves.push(Leaf { packets, objects });
+        }
     }
 
     /// Bounds of the bounded objects.
@@ -224,20 +282,25 @@ impl World {
                 best = Some((c, i));
             }
         }
-        self.bvh.traverse(ray, t_best, |k, t_max| match self.primitives[k as usize] {
-            Primitive::Object(i) => {
-                let c = self.objects[i as usize].placed.hit(ray, t_max)?;
-                best = Some((c, i));
-                Some(c.t)
+        self.bvh.traverse_leaves(ray, t_best, |range, mut t_max| {
+            let leaf = &self.leaves[self.leaf_at[range.start] as usize];
+            let mut closer = None;
+            for k in leaf.packets.clone() {
+                if let Some(h) = self.packets[k].hit(ray, t_max, self.vectors) {
+                    let lane = self.lanes[k][h.lane];
+                    let (second, b1, b2) =
+                        if lane.parallelogram { parallelogram_to_triangle(h.b1, h.b2) } else { (0, h.b1, h.b2) };
+                    best = Some((Candidate { t: h.t, aux: lane.triangle + second, bary: [b1, b2] }, lane.object));
+                    (t_max, closer) = (h.t, Some(h.t));
+                }
             }
-            Primitive::Flat { object, triangle, flat } => {
-                let f = &self.flats[flat as usize];
-                let (t, b1, b2) = f.hit(ray, t_max)?;
-                let (second, b1, b2) =
-                    if f.is_parallelogram() { parallelogram_to_triangle(b1, b2) } else { (0, b1, b2) };
-                best = Some((Candidate { t, aux: triangle + second, bary: [b1, b2] }, object));
-                Some(t)
+            for &i in &self.leaf_objects[leaf.objects.clone()] {
+                if let Some(c) = self.objects[i as usize].placed.hit(ray, t_max) {
+                    best = Some((c, i));
+                    (t_max, closer) = (c.t, Some(c.t));
+                }
             }
+            closer
         });
         best
     }
@@ -281,13 +344,13 @@ impl World {
             return false;
         }
         let mut blocked = false;
-        self.bvh.traverse(&ray, dist, |k, t_max| {
-            let hit = match self.primitives[k as usize] {
-                Primitive::Object(i) => self.objects[i as usize].placed.hit(&ray, t_max).is_some(),
-                Primitive::Flat { flat, .. } => self.flats[flat as usize].hit(&ray, t_max).is_some(),
-            };
-            blocked |= hit;
-            hit.then_some(0.0)
+        self.bvh.traverse_leaves(&ray, dist, |range, t_max| {
+            let leaf = &self.leaves[self.leaf_at[range.start] as usize];
+            blocked = self.packets[leaf.packets.clone()].iter().any(|p| p.hit(&ray, t_max, self.vectors).is_some())
+                || self.leaf_objects[leaf.objects.clone()]
+                    .iter()
+                    .any(|&i| self.objects[i as usize].placed.hit(&ray, t_max).is_some());
+            blocked.then_some(0.0)
         });
         !blocked
     }

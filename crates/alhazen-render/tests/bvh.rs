@@ -1,5 +1,6 @@
 //! The BVH must return the same nearest hit as testing every object (and the world's planar
-//! primitives the same hits as the mesh triangles they stand for).
+//! primitives, tested four at a time, the same hits as the mesh triangles they stand for);
+//! shadow rays must be blocked exactly when a hit is nearer than the light.
 
 use alhazen_math::{Ray, Vec3};
 use alhazen_render::World;
@@ -53,6 +54,12 @@ proptest! {
             let ray = Ray::new(Vec3::new(ox, oy, oz), d);
             let fast = world.intersect(&ray, f64::INFINITY).map(|h| (h.hit.t, h.hit.n));
             let slow = world.intersect_brute_force(&ray, f64::INFINITY).map(|h| (h.t, h.n));
+            // A shadow ray of length 4 is blocked exactly when something is nearer.
+            let dist = 4.0;
+            if slow.is_none_or(|(t, _)| (t - dist).abs() > 1e-6) {
+                let blocked = slow.is_some_and(|(t, _)| t < dist);
+                prop_assert_eq!(world.unoccluded(ray.origin, d, dist), !blocked);
+            }
             match (fast, slow) {
                 (Some((t1, n1)), Some((t2, n2))) => {
                     prop_assert!((t1 - t2).abs() <= 1e-9 * (1.0 + t2), "t {} vs {}", t1, t2);

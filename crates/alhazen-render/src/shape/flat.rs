@@ -9,13 +9,13 @@ use alhazen_math::{Ray, Vec3};
 /// (`b1, b2 ∈ [0, 1]`), ready for ray tests.
 #[derive(Clone, Copy, Debug)]
 pub struct Flat {
-    origin: Vec3,
+    pub(super) origin: Vec3,
     /// `e1 × e2`.
-    normal: Vec3,
+    pub(super) normal: Vec3,
     /// `(e2 × N) / |N|²`: `(p − origin)·u = b1`.
-    u: Vec3,
+    pub(super) u: Vec3,
     /// `(N × e1) / |N|²`: `(p − origin)·v = b2`.
-    v: Vec3,
+    pub(super) v: Vec3,
     parallelogram: bool,
 }
 
