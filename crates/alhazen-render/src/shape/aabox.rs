@@ -13,16 +13,19 @@ pub struct AaBox {
 }
 
 impl AaBox {
+    /// Per axis, the parameters where the line enters and leaves that axis's slab; `None` for
+    /// a line parallel to a slab and in one of its planes (treated as outside).
+    #[inline]
+    fn slab_times(&self, ray: &Ray) -> Option<(Vec3, Vec3)> {
+        let inv = 1.0 / ray.dir;
+        let (t0, t1) = ((self.min - ray.origin) * inv, (self.max - ray.origin) * inv);
+        (!t0.is_nan() && !t1.is_nan()).then(|| (t0.min(t1), t0.max(t1)))
+    }
+
     /// Entry and exit parameters along the whole line with their face axes, if it meets the box.
     #[inline]
     fn slab(&self, ray: &Ray) -> Option<((f64, usize), (f64, usize))> {
-        let inv = 1.0 / ray.dir;
-        let (t0, t1) = ((self.min - ray.origin) * inv, (self.max - ray.origin) * inv);
-        if t0.is_nan() || t1.is_nan() {
-            // Parallel and in a face plane: treat as outside.
-            return None;
-        }
-        let (lo, hi) = (t0.min(t1), t0.max(t1));
+        let (lo, hi) = self.slab_times(ray)?;
         // Ties go to the lowest axis.
         let near_axis = if lo.x >= lo.y && lo.x >= lo.z {
             0
@@ -57,13 +60,9 @@ impl AaBox {
     /// test (also every shadow ray's) has no data-dependent branches.
     #[inline]
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
-        let inv = 1.0 / ray.dir;
-        let (t0, t1) = ((self.min - ray.origin) * inv, (self.max - ray.origin) * inv);
-        if t0.is_nan() || t1.is_nan() {
-            return None;
-        }
+        let (lo, hi) = self.slab_times(ray)?;
         // The same values as `slab`'s entry and exit.
-        let (near, far) = (t0.min(t1).max_element(), t0.max(t1).min_element());
+        let (near, far) = (lo.max_element(), hi.min_element());
         let t = if near > 0.0 { near } else { far };
         let inside = near <= far && near.is_finite() && far.is_finite();
         (inside && t > 0.0 && t < t_max).then_some(Candidate { t, aux: 0, bary: [0.0; 2] })
@@ -71,16 +70,7 @@ impl AaBox {
 
     /// The surface at a hit.
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
-        let face = match self.slab(ray) {
-            Some(((t0, a0), (_, a1))) => {
-                if t0 == c.t {
-                    a0
-                } else {
-                    a1
-                }
-            }
-            None => 0,
-        };
+        let face = self.slab(ray).map_or(0, |((t0, a0), (_, a1))| if t0 == c.t { a0 } else { a1 });
         self.hit_at(ray, c.t, face)
     }
 

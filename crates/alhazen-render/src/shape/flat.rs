@@ -16,7 +16,7 @@ pub struct Flat {
     pub(super) u: Vec3,
     /// `(N × e1) / |N|²`: `(p − origin)·v = b2`.
     pub(super) v: Vec3,
-    parallelogram: bool,
+    pub(super) parallelogram: bool,
 }
 
 impl Flat {

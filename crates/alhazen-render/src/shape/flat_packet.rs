@@ -70,19 +70,19 @@ impl FlatPacket {
         if vectors { self.hit_vector(ray, t_max) } else { self.hit_portable(ray, t_max) }
     }
 
-    /// [`Self::hit`] one lane after the other.
-    fn hit_portable(&self, ray: &Ray, t_max: f64) -> Option<LaneHit> {
-        let mut best: Option<LaneHit> = None;
+    /// Lane `lane` as a [`Flat`] (an unused lane: one with a zero normal, which no ray hits).
+    fn lane(&self, lane: usize) -> Flat {
+        let at = |a: &[[f64; LANES]; 3]| Vec3::new(a[0][lane], a[1][lane], a[2][lane]);
+        let (origin, normal, u, v) = (at(&self.origin), at(&self.normal), at(&self.u), at(&self.v));
+        Flat { origin, normal, u, v, parallelogram: self.triangle[lane] == 0.0 }
+    }
+
+    /// [`Self::hit`] one lane after the other, each by [`Flat::hit`].
+    fn hit_portable(&self, ray: &Ray, mut t_max: f64) -> Option<LaneHit> {
+        let mut best = None;
         for lane in 0..LANES {
-            let at = |a: &[[f64; LANES]; 3]| Vec3::new(a[0][lane], a[1][lane], a[2][lane]);
-            let (o, n, u, v) = (at(&self.origin), at(&self.normal), at(&self.u), at(&self.v));
-            // Flat::hit's operations, in its order.
-            let t = n.dot(o - ray.origin) / n.dot(ray.dir);
-            let p = ray.origin + ray.dir * t - o;
-            let (b1, b2) = (p.dot(u), p.dot(v));
-            let far = b2 + self.triangle[lane] * b1;
-            let inside = t > 0.0 && t < t_max && (0.0..=1.0).contains(&b1) && b2 >= 0.0 && far <= 1.0;
-            if inside && best.is_none_or(|b| t < b.t) {
+            if let Some((t, b1, b2)) = self.lane(lane).hit(ray, t_max) {
+                t_max = t;
                 best = Some(LaneHit { lane, t, b1, b2 });
             }
         }
@@ -144,7 +144,8 @@ mod avx2 {
         [load(&a[0]), load(&a[1]), load(&a[2])]
     }
 
-    /// [`FlatPacket::hit_portable`] in AVX2 registers.
+    /// [`FlatPacket::hit_portable`] in AVX2 registers: [`super::Flat::hit`]'s operations lane by
+    /// lane, in its order, combined without its early exits.
     #[target_feature(enable = "avx2")]
     pub(super) fn hit(p: &FlatPacket, ray: &Ray, t_max: f64) -> Option<LaneHit> {
         let ro = [_mm256_set1_pd(ray.origin.x), _mm256_set1_pd(ray.origin.y), _mm256_set1_pd(ray.origin.z)];
