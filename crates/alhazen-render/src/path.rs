@@ -116,8 +116,10 @@ impl<'a> PathTracer<'a> {
             let wo = -ray.dir;
             let (frame, ng) = self.shading_frame(&wh, &bsdf, wo, tangent_hint(m));
             let v = frame.to_local(wo);
-            // One pair picks the light and the BSDF lobe; one pair each places the points.
-            let choices = s.next_2d();
+            // One pair picks the light and the BSDF lobe, drawn only when there is a choice;
+            // one pair each places the points.
+            let choices =
+                if self.lights.len() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
             if !bsdf.is_delta() {
                 l += beta * self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, choices.x, s);
             }

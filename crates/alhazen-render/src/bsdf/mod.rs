@@ -102,6 +102,11 @@ impl Bsdf {
         dispatch!(self, b => b.sample(v, uc, u))
     }
 
+    /// True when `sample` uses its lobe choice `uc` (several lobes to pick from).
+    pub fn chooses_lobe(&self) -> bool {
+        !matches!(self, Bsdf::Lambert(_) | Bsdf::OrenNayar(_) | Bsdf::Conductor(_))
+    }
+
     /// True when every lobe is a delta (no light sampling helps).
     pub fn is_delta(&self) -> bool {
         match self {
