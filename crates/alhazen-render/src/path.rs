@@ -118,8 +118,7 @@ impl<'a> PathTracer<'a> {
             let v = frame.to_local(wo);
             // One pair picks the light and the BSDF lobe, drawn only when there is a choice;
             // one pair each places the points.
-            let choices =
-                if self.lights.len() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
+            let choices = if self.lights.len() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
             if !bsdf.is_delta() {
                 l += beta * self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, choices.x, s);
             }

@@ -46,17 +46,18 @@ impl Flat {
     /// The hit `(t, b1, b2)` with `0 < t < t_max`.
     #[inline]
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, f64)> {
-        let t = self.normal.dot(self.origin - ray.origin) / self.normal.dot(ray.dir);
+        let to_flat = self.origin - ray.origin;
+        let t = self.normal.dot(to_flat) / self.normal.dot(ray.dir);
         // Also rejects NaN and ±∞ (rays in or parallel to the plane).
         if !(t > 0.0 && t < t_max) {
             return None;
         }
-        let p = ray.origin + ray.dir * t - self.origin;
-        let b1 = p.dot(self.u);
+        // `(ray(t) − origin)·u`, split so that only a product and a difference wait for `t`.
+        let b1 = t * ray.dir.dot(self.u) - to_flat.dot(self.u);
         if !(0.0..=1.0).contains(&b1) {
             return None;
         }
-        let b2 = p.dot(self.v);
+        let b2 = t * ray.dir.dot(self.v) - to_flat.dot(self.v);
         let outside = if self.parallelogram { b2 > 1.0 } else { b1 + b2 > 1.0 };
         (b2 >= 0.0 && !outside).then_some((t, b1, b2))
     }

@@ -154,9 +154,10 @@ mod avx2 {
         let to_flat = [_mm256_sub_pd(o[0], ro[0]), _mm256_sub_pd(o[1], ro[1]), _mm256_sub_pd(o[2], ro[2])];
         let n = load3(&p.normal);
         let t = _mm256_div_pd(dot(n, to_flat), dot(n, rd));
-        let along = |k: usize| _mm256_sub_pd(_mm256_add_pd(ro[k], _mm256_mul_pd(rd[k], t)), o[k]);
-        let q = [along(0), along(1), along(2)];
-        let (b1, b2) = (dot(q, load3(&p.u)), dot(q, load3(&p.v)));
+        // As `Flat::hit`: `t·(d·u) − (o − r)·u`, the dot products independent of the division.
+        let (u, v) = (load3(&p.u), load3(&p.v));
+        let b1 = _mm256_sub_pd(_mm256_mul_pd(t, dot(rd, u)), dot(to_flat, u));
+        let b2 = _mm256_sub_pd(_mm256_mul_pd(t, dot(rd, v)), dot(to_flat, v));
         let far = _mm256_add_pd(b2, _mm256_mul_pd(load(&p.triangle), b1));
         let (zero, one) = (_mm256_setzero_pd(), _mm256_set1_pd(1.0));
         let in_t =
