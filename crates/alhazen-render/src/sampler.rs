@@ -8,6 +8,8 @@
 //! with the sample index shuffled and the digits scrambled by hashes of
 //! `(seed, pixel, dimension)`, so strata stay intact at power-of-two sample counts.
 
+use alhazen_math::Vec2;
+
 /// A small, fast generator (SplitMix64 sequence), adequate for jitter and stratification.
 #[derive(Clone, Debug)]
 pub struct Rng(u64);
@@ -60,6 +62,8 @@ pub struct SampleStream {
     index_reversed: u32,
     dimension: u32,
     rng: Rng,
+    /// The pair of dimension `dimension`, computed one call ahead.
+    ahead: Vec2,
 }
 
 /// Laine–Karras style hash of bit-reversed values: every output bit depends only on the same
@@ -144,47 +148,46 @@ impl SampleStream {
     pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, index: u32) -> Self {
         let pixel_seed = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d) ^ ((x as u64) << 32 | y as u64));
         let index_reversed = index.reverse_bits();
-        Self { sequence, pixel_seed, index_reversed, dimension: 0, rng: Rng::for_sample(seed, x, y, index) }
+        let rng = Rng::for_sample(seed, x, y, index);
+        let mut s = Self { sequence, pixel_seed, index_reversed, dimension: 0, rng, ahead: Vec2::ZERO };
+        s.ahead = s.pair();
+        s
     }
 
     /// The next pair of numbers in `[0, 1)²`.
     #[inline]
-    pub fn next_2d(&mut self) -> alhazen_math::Vec2 {
-        match self.sequence {
-            Sequence::Independent => alhazen_math::Vec2::new(self.rng.uniform(), self.rng.uniform()),
-            Sequence::Sobol => {
-                let (h, shuffled, a) = self.next_sobol_first();
-                let sb = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
-                let b = scramble_reversed(sobol1_reversed(shuffled), sb).reverse_bits();
-                alhazen_math::Vec2::new(a, to_unit(b))
-            }
-        }
+    pub fn next_2d(&mut self) -> Vec2 {
+        let current = self.ahead;
+        self.dimension += 1;
+        // Computed now, used at the next call: the hashing runs while the caller works on
+        // `current` instead of stalling it (a path is one long chain of dependent operations).
+        self.ahead = self.pair();
+        current
     }
 
-    /// The next number in `[0, 1)`: the first of the pair [`Self::next_2d`] would give, without
-    /// computing the second.
+    /// The next number in `[0, 1)`: the first of the pair [`Self::next_2d`] would give.
     #[inline]
     pub fn next_1d(&mut self) -> f64 {
-        match self.sequence {
-            Sequence::Independent => {
-                let u = self.rng.uniform();
-                self.rng.uniform();
-                u
-            }
-            Sequence::Sobol => self.next_sobol_first().2,
-        }
+        self.next_2d().x
     }
 
-    /// Advances one dimension pair: its hash, the Owen-shuffled index and the first coordinate.
+    /// The pair of the current dimension (for independent numbers: the generator's next two).
     #[inline]
-    fn next_sobol_first(&mut self) -> (u64, u32, f64) {
-        let h = mix(self.pixel_seed ^ self.dimension as u64);
-        self.dimension += 1;
-        // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal done once).
-        let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
-        // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
-        let a = scramble_reversed(shuffled, (h >> 32) as u32).reverse_bits();
-        (h, shuffled, to_unit(a))
+    fn pair(&mut self) -> Vec2 {
+        match self.sequence {
+            Sequence::Independent => Vec2::new(self.rng.uniform(), self.rng.uniform()),
+            Sequence::Sobol => {
+                let h = mix(self.pixel_seed ^ self.dimension as u64);
+                // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal
+                // done once).
+                let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
+                // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
+                let a = scramble_reversed(shuffled, (h >> 32) as u32).reverse_bits();
+                let sb = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+                let b = scramble_reversed(sobol1_reversed(shuffled), sb).reverse_bits();
+                Vec2::new(to_unit(a), to_unit(b))
+            }
+        }
     }
 }
 
