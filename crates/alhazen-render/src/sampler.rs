@@ -148,7 +148,8 @@ impl SampleStream {
     pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, index: u32) -> Self {
         let pixel_seed = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d) ^ ((x as u64) << 32 | y as u64));
         let index_reversed = index.reverse_bits();
-        let rng = Rng::for_sample(seed, x, y, index);
+        // Sobol streams never draw from the generator: leave it unseeded.
+        let rng = if sequence == Sequence::Independent { Rng::for_sample(seed, x, y, index) } else { Rng(0) };
         let mut s = Self { sequence, pixel_seed, index_reversed, dimension: 0, rng, ahead: Vec2::ZERO };
         s.ahead = s.pair();
         s
