@@ -5,8 +5,8 @@
 
 use crate::bvh::Bvh;
 use crate::shape::{
-    AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, FlatPacket, LANES, MeshAccel, MeshShape, Placed, Plane, Shape,
-    Sphere, SurfaceHit, has_vector_unit, parallelogram_of, parallelogram_to_triangle,
+    AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, FlatPacket, LANES, LaneHit, MeshAccel, MeshShape, Placed, Plane,
+    Shape, Sphere, SurfaceHit, has_vector_unit, parallelogram_of, parallelogram_to_triangle,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -282,27 +282,34 @@ impl World {
                 best = Some((c, i));
             }
         }
+        // The nearest flat's packet and lane; made a candidate once, after the traversal.
+        let mut best_flat: Option<(usize, LaneHit)> = None;
         self.bvh.traverse_leaves(ray, t_best, |range, mut t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
             let mut closer = None;
             for k in leaf.packets.clone() {
                 if let Some(h) = self.packets[k].hit(ray, t_max, self.vectors) {
-                    let lane = self.lanes[k][h.lane];
-                    let (second, b1, b2) =
-                        if lane.parallelogram { parallelogram_to_triangle(h.b1, h.b2) } else { (0, h.b1, h.b2) };
-                    best = Some((Candidate { t: h.t, aux: lane.triangle + second, bary: [b1, b2] }, lane.object));
+                    best_flat = Some((k, h));
                     (t_max, closer) = (h.t, Some(h.t));
                 }
             }
             for &i in &self.leaf_objects[leaf.objects.clone()] {
                 if let Some(c) = self.objects[i as usize].placed.hit(ray, t_max) {
-                    best = Some((c, i));
+                    (best, best_flat) = (Some((c, i)), None);
                     (t_max, closer) = (c.t, Some(c.t));
                 }
             }
             closer
         });
-        best
+        best_flat.map(|(k, h)| self.flat_candidate(k, h)).or(best)
+    }
+
+    /// The candidate of lane hit `h` of packet `k`.
+    #[inline]
+    fn flat_candidate(&self, k: usize, h: LaneHit) -> (Candidate, u32) {
+        let lane = self.lanes[k][h.lane];
+        let (second, b1, b2) = if lane.parallelogram { parallelogram_to_triangle(h.b1, h.b2) } else { (0, h.b1, h.b2) };
+        (Candidate { t: h.t, aux: lane.triangle + second, bary: [b1, b2] }, lane.object)
     }
 
     /// The nearest hit in `(0, t_max)` with its surface and material.
