@@ -183,10 +183,12 @@ impl SampleStream {
                 // done once).
                 let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
                 // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
-                let a = scramble_reversed(shuffled, (h >> 32) as u32).reverse_bits();
+                let a = scramble_reversed(shuffled, (h >> 32) as u32);
                 let sb = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
-                let b = scramble_reversed(sobol1_reversed(shuffled), sb).reverse_bits();
-                Vec2::new(to_unit(a), to_unit(b))
+                let b = scramble_reversed(sobol1_reversed(shuffled), sb);
+                // Both reversed by one 64-bit reversal, which also swaps the halves.
+                let ab = ((b as u64) << 32 | a as u64).reverse_bits();
+                Vec2::new(to_unit((ab >> 32) as u32), to_unit(ab as u32))
             }
         }
     }
