@@ -6,8 +6,10 @@ depth 8, on this machine's cores, in one run.
 
 1. Equal samples: median wall time of `alhazen render scenes/cornell-box.toml` (whole process:
    parse, build, render, write EXR) against Mitsuba `llvm_ad_rgb` and `scalar_rgb` renders timed
-   after one warm-up render (so LLVM's JIT compilation is excluded).
-2. Equal time: alhazen re-renders with the sample count that fits in Mitsuba llvm's time, and
+   after one warm-up render (so LLVM's JIT compilation is excluded); alhazen and llvm runs
+   alternate, so a drift in the machine's speed affects both alike.
+2. Equal time: alhazen re-renders with the largest sample count whose render (median of 3) fits
+   in Mitsuba llvm's time, and
    both images are compared with the 16384-spp Mitsuba reference committed in
    crates/alhazen-render/tests/data/mitsuba/cornell-box.exr (RMSE and mean relative error).
 
@@ -37,31 +39,44 @@ def errors(img, ref):
     return rmse, rel
 
 
-def time_alhazen(spp, out, runs):
+def alhazen_run(spp, out):
+    """Wall time of one whole `alhazen render` process."""
     exe = os.path.join(ROOT, "target/release/alhazen")
-    times = []
-    for _ in range(runs):
-        t0 = time.perf_counter()
-        subprocess.run([exe, "render", os.path.join(ROOT, "scenes/cornell-box.toml"), "-o", out,
-                        "--spp", str(spp), "--quiet"], check=True)
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
+    t0 = time.perf_counter()
+    subprocess.run([exe, "render", os.path.join(ROOT, "scenes/cornell-box.toml"), "-o", out,
+                    "--spp", str(spp), "--quiet"], check=True)
+    return time.perf_counter() - t0
 
 
-def time_mitsuba(variant, spp, out, runs):
+def time_alhazen(spp, out, runs):
+    return float(np.median([alhazen_run(spp, out) for _ in range(runs)]))
+
+
+def mitsuba_renderer(variant, spp, out):
+    """A function timing one Mitsuba render of a scene loaded and warmed up (JIT) beforehand;
+    it writes the last image to `out`."""
     mi.set_variant(variant)
     import drjit as dr
     scene = mi.load_dict(cornell.scene_dict("cornell", spp))
     dr.eval(mi.render(scene, spp=spp))  # warm-up (JIT)
-    times, img = [], None
-    for i in range(runs):
+    count = [0]
+
+    def run():
+        mi.set_variant(variant)
+        count[0] += 1
         t0 = time.perf_counter()
-        img = mi.render(scene, spp=spp, seed=i + 1)
+        img = mi.render(scene, spp=spp, seed=count[0])
         dr.eval(img)
         np.array(img)  # make sure the image is computed and on the host
-        times.append(time.perf_counter() - t0)
-    mi.Bitmap(img).write(out)
-    return float(np.median(times))
+        elapsed = time.perf_counter() - t0
+        mi.Bitmap(img).write(out)
+        return elapsed
+    return run
+
+
+def time_mitsuba(variant, spp, out, runs):
+    run = mitsuba_renderer(variant, spp, out)
+    return float(np.median([run() for _ in range(runs)]))
 
 
 def main():
@@ -72,17 +87,30 @@ def main():
     subprocess.run(["cargo", "build", "--release", "-q"], cwd=ROOT, check=True)
     tmp = tempfile.mkdtemp()
     ref = None
-    t_ours = time_alhazen(a.spp, f"{tmp}/ours.exr", a.runs)
-    t_llvm = time_mitsuba("llvm_ad_rgb", a.spp, f"{tmp}/llvm.exr", a.runs)
+    # alhazen and Mitsuba llvm alternate, so a drift of this VM's speed hits both alike.
+    llvm = mitsuba_renderer("llvm_ad_rgb", a.spp, f"{tmp}/llvm.exr")
+    pairs = [(alhazen_run(a.spp, f"{tmp}/ours.exr"), llvm()) for _ in range(a.runs)]
+    t_ours, t_llvm = (float(np.median(ts)) for ts in zip(*pairs))
     t_scalar = time_mitsuba("scalar_rgb", a.spp, f"{tmp}/scalar.exr", max(1, a.runs // 2))
     ref = load(REF)
     print(f"Cornell box 256x256, {a.spp} spp, max depth 8, {os.cpu_count()} cores")
     print(f"  alhazen (sobol)        {t_ours:7.3f} s")
     print(f"  mitsuba llvm_ad_rgb    {t_llvm:7.3f} s   ratio alhazen/llvm   = {t_ours / t_llvm:.2f}")
     print(f"  mitsuba scalar_rgb     {t_scalar:7.3f} s   ratio alhazen/scalar = {t_ours / t_scalar:.2f}")
-    # Equal time: as many samples as fit in llvm's time (per-sample cost measured above).
+    # Equal time: the most samples whose render (median of 3) fits in llvm's time, searched from
+    # the estimate the 64-spp time gives.
     spp_eq = max(1, int(a.spp * t_llvm / t_ours))
-    t_eq = time_alhazen(spp_eq, f"{tmp}/ours_eq.exr", 1)
+    t_eq = time_alhazen(spp_eq, f"{tmp}/ours_eq.exr", 3)
+    while t_eq > t_llvm and spp_eq > 1:
+        spp_eq -= 1
+        t_eq = time_alhazen(spp_eq, f"{tmp}/ours_eq.exr", 3)
+    while True:
+        t_next = time_alhazen(spp_eq + 1, f"{tmp}/ours_next.exr", 3)
+        print(f"  equal-time search: {spp_eq} spp {t_eq:.3f} s, {spp_eq + 1} spp {t_next:.3f} s")
+        if t_next > t_llvm:
+            break
+        spp_eq, t_eq = spp_eq + 1, t_next
+        os.replace(f"{tmp}/ours_next.exr", f"{tmp}/ours_eq.exr")
     for name, path in [(f"alhazen {a.spp} spp", f"{tmp}/ours.exr"), (f"alhazen {spp_eq} spp ({t_eq:.2f} s)", f"{tmp}/ours_eq.exr"),
                        (f"mitsuba llvm {a.spp} spp ({t_llvm:.2f} s)", f"{tmp}/llvm.exr")]:
         rmse, rel = errors(load(path), ref)
