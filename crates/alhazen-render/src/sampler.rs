@@ -16,7 +16,7 @@ use alhazen_math::Vec2;
 /// Dimension pairs drawn from the Sobol sequence: the pixel position and, in the common case of
 /// one light and one-lobe BSDFs, the light and BSDF samples of a path's first two vertices. On
 /// the Cornell box, its rough variant and the prism (6–8 seeds at 32 spp, against 1024-spp
-/// renders) the error is the same as with Sobol points in every pair, and renders are 2–5 %
+/// renders) the error is the same as with Sobol points in every pair, and renders are 4–7 %
 /// faster (BENCHMARKS.md).
 pub const SOBOL_PAIRS: u32 = 5;
 
