@@ -1,12 +1,12 @@
 //! The renderable world: every object of the scene placed, with a top-level BVH over the
 //! bounded ones and a plain list of unbounded ones (planes). Small meshes, rectangles and
 //! untextured boxes are flattened into world-space triangles and parallelograms, which the
-//! BVH's leaves test four at a time ([`FlatPacket`]); other objects are tested one by one.
+//! BVH's leaves test four or eight at a time ([`FlatPacket`]); other objects are tested one by one.
 
 use crate::bvh::Bvh;
 use crate::shape::{
     AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, FlatPacket, LANES, LaneHit, MeshAccel, MeshShape, Placed, Plane,
-    Shape, Sphere, SurfaceHit, has_vector_unit, parallelogram_of, parallelogram_to_triangle,
+    Shape, Sphere, SurfaceHit, VectorUnit, parallelogram_of, parallelogram_to_triangle,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -70,8 +70,8 @@ pub struct World {
     lanes: Vec<[Lane; LANES]>,
     leaf_objects: Vec<u32>,
     unbounded: Vec<u32>,
-    /// The packets may use the processor's AVX2 unit.
-    vectors: bool,
+    /// The packets' kernel for this processor.
+    vectors: VectorUnit,
 }
 
 /// The first thing a shadow ray meets.
@@ -232,8 +232,10 @@ impl World {
                 unbounded.push(object);
             }
         }
+        // The tree does not depend on the processor (its SAH charges packets of four), so
+        // neither do the order of tests nor the hit chosen on a tie.
         let bvh = Bvh::build_packed(&prim_bounds, |k| matches!(primitives[k], Primitive::Flat { .. }));
-        let mut world = Self { objects, unbounded, vectors: has_vector_unit(), ..Self::default() };
+        let mut world = Self { objects, unbounded, vectors: VectorUnit::detect(), ..Self::default() };
         world.fill_leaves(&bvh, &primitives);
         world.bvh = bvh;
         world
@@ -254,7 +256,7 @@ impl World {
                     }
                 }
             }
-            for chunk in flats.chunks(LANES) {
+            for chunk in flats.chunks(self.vectors.lanes()) {
                 let flats: Vec<Flat> = chunk.iter().map(|(_, f)| *f).collect();
                 self.packets.push(FlatPacket::new(&flats));
                 let mut lanes = [Lane::default(); LANES];
@@ -287,11 +289,10 @@ impl World {
         self.bvh.traverse_leaves(ray, t_best, |range, mut t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
             let mut closer = None;
-            for k in leaf.packets.clone() {
-                if let Some(h) = self.packets[k].hit(ray, t_max, self.vectors) {
-                    best_flat = Some((k, h));
-                    (t_max, closer) = (h.t, Some(h.t));
-                }
+            let packets = &self.packets[leaf.packets.clone()];
+            if let Some((k, h)) = FlatPacket::nearest_of(packets, ray, t_max, self.vectors) {
+                best_flat = Some((leaf.packets.start + k, h));
+                (t_max, closer) = (h.t, Some(h.t));
             }
             for &i in &self.leaf_objects[leaf.objects.clone()] {
                 if let Some(c) = self.objects[i as usize].placed.hit(ray, t_max) {
@@ -353,7 +354,7 @@ impl World {
         let mut blocked = false;
         self.bvh.traverse_leaves(&ray, dist, |range, t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
-            blocked = self.packets[leaf.packets.clone()].iter().any(|p| p.hit(&ray, t_max, self.vectors).is_some())
+            blocked = FlatPacket::any_of(&self.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
                 || self.leaf_objects[leaf.objects.clone()]
                     .iter()
                     .any(|&i| self.objects[i as usize].placed.hit(&ray, t_max).is_some());

@@ -1,20 +1,24 @@
-//! Four planar primitives ([`Flat`]s) tested against one ray at once: the top-level BVH's
-//! leaves keep their triangles and parallelograms in such packets, structure of arrays
+//! Up to eight planar primitives ([`Flat`]s) tested against one ray at once: the top-level
+//! BVH's leaves keep their triangles and parallelograms in such packets, structure of arrays
 //! (Wald et al. 2008, "Getting Rid of Packets", multi-primitive leaves; Embree's `Triangle4`).
 //!
 //! Each lane does exactly [`Flat::hit`]'s arithmetic in the same order (no fused multiply–add),
-//! so the AVX2 kernel, used where the processor has it, and the portable loop give the same
-//! bits as each other and as the one-primitive test: images do not depend on the machine.
-//! The ray is tested against all four lanes without branches, which is what makes the packet
-//! pay: a scalar test's early exits are unpredictable for rays in all directions.
+//! so the AVX-512 and AVX2 kernels, used where the processor has them, and the portable loop
+//! give the same bits as each other and as the one-primitive test. Packets hold eight flats for
+//! the AVX-512 kernel and four elsewhere ([`VectorUnit::lanes`]). The ray is tested against
+//! all lanes without branches, which is what makes the packet pay: a scalar test's early exits
+//! are unpredictable for rays in all directions. With AVX-512, a leaf's packets are tested in
+//! one call that keeps each lane's nearest hit in registers and compares lanes once at the end.
 
 use super::Flat;
 use alhazen_math::{Ray, Vec3};
 
 /// Primitives per packet.
-pub const LANES: usize = 4;
+pub const LANES: usize = 8;
+/// Lanes per AVX2 register.
+const HALF: usize = 4;
 
-/// Up to four flats, lane by lane; unused lanes never report a hit.
+/// Up to eight flats, lane by lane; unused lanes never report a hit.
 #[derive(Clone, Debug)]
 #[repr(C, align(32))]
 pub struct FlatPacket {
@@ -24,6 +28,8 @@ pub struct FlatPacket {
     v: [[f64; LANES]; 3],
     /// 1 for a triangle (`b1 + b2 ≤ 1`), 0 for a parallelogram (`b2 ≤ 1`).
     triangle: [f64; LANES],
+    /// Lanes in use (the first ones).
+    used: usize,
 }
 
 /// A packet's nearest hit: its lane and [`Flat::hit`]'s `(t, b1, b2)`.
@@ -50,6 +56,7 @@ impl FlatPacket {
             u: [[0.0; LANES]; 3],
             v: [[0.0; LANES]; 3],
             triangle: [0.0; LANES],
+            used: flats.len(),
         };
         for (lane, f) in flats.iter().enumerate() {
             for axis in 0..3 {
@@ -63,11 +70,52 @@ impl FlatPacket {
         p
     }
 
-    /// The nearest hit with `0 < t < t_max` among the lanes (the first lane on a tie).
-    /// `vectors` says whether the processor has AVX2 ([`has_vector_unit`]).
+    /// The nearest hit with `0 < t < t_max` among the lanes (the first lane on a tie), by the
+    /// kernel of `unit` (from [`VectorUnit::detect`] or [`VectorUnit::None`]).
     #[inline]
-    pub fn hit(&self, ray: &Ray, t_max: f64, vectors: bool) -> Option<LaneHit> {
-        if vectors { self.hit_vector(ray, t_max) } else { self.hit_portable(ray, t_max) }
+    #[allow(unsafe_code)]
+    pub fn hit(&self, ray: &Ray, t_max: f64, unit: VectorUnit) -> Option<LaneHit> {
+        match unit {
+            VectorUnit::None => self.hit_portable(ray, t_max),
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `detect` returns `Avx2` only when this processor has AVX2.
+            VectorUnit::Avx2 => unsafe { avx2::hit(self, ray, t_max) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `detect` returns `Avx512` only when this processor has AVX-512F.
+            VectorUnit::Avx512 => unsafe { avx512::nearest(std::slice::from_ref(self), ray, t_max) }.map(|(_, h)| h),
+        }
+    }
+
+    /// The nearest hit with `0 < t < t_max` in `packets`: the packet's index and its lane's hit
+    /// (on a tie, the first packet, then the first lane). Same bits from every `unit`.
+    #[inline]
+    #[allow(unsafe_code)]
+    pub fn nearest_of(packets: &[Self], ray: &Ray, t_max: f64, unit: VectorUnit) -> Option<(usize, LaneHit)> {
+        #[cfg(target_arch = "x86_64")]
+        if unit == VectorUnit::Avx512 {
+            // SAFETY: `detect` returns `Avx512` only when this processor has AVX-512F.
+            return unsafe { avx512::nearest(packets, ray, t_max) };
+        }
+        let mut best = None;
+        let mut t_max = t_max;
+        for (k, p) in packets.iter().enumerate() {
+            if let Some(h) = p.hit(ray, t_max, unit) {
+                (t_max, best) = (h.t, Some((k, h)));
+            }
+        }
+        best
+    }
+
+    /// True when some lane of `packets` is hit with `0 < t < t_max`.
+    #[inline]
+    #[allow(unsafe_code)]
+    pub fn any_of(packets: &[Self], ray: &Ray, t_max: f64, unit: VectorUnit) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if unit == VectorUnit::Avx512 {
+            // SAFETY: `detect` returns `Avx512` only when this processor has AVX-512F.
+            return unsafe { avx512::any(packets, ray, t_max) };
+        }
+        packets.iter().any(|p| p.hit(ray, t_max, unit).is_some())
     }
 
     /// Lane `lane` as a [`Flat`] (an unused lane: one with a zero normal, which no ray hits).
@@ -80,7 +128,7 @@ impl FlatPacket {
     /// [`Self::hit`] one lane after the other, each by [`Flat::hit`].
     fn hit_portable(&self, ray: &Ray, mut t_max: f64) -> Option<LaneHit> {
         let mut best = None;
-        for lane in 0..LANES {
+        for lane in 0..self.used {
             if let Some((t, b1, b2)) = self.lane(lane).hit(ray, t_max) {
                 t_max = t;
                 best = Some(LaneHit { lane, t, b1, b2 });
@@ -88,47 +136,77 @@ impl FlatPacket {
         }
         best
     }
-
-    #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)]
-    #[inline]
-    fn hit_vector(&self, ray: &Ray, t_max: f64) -> Option<LaneHit> {
-        // SAFETY: `vectors` is true only when `has_vector_unit` found AVX2 on this processor.
-        unsafe { avx2::hit(self, ray, t_max) }
-    }
-
-    #[cfg(not(target_arch = "x86_64"))]
-    #[inline]
-    fn hit_vector(&self, ray: &Ray, t_max: f64) -> Option<LaneHit> {
-        self.hit_portable(ray, t_max)
-    }
 }
 
-/// True when [`FlatPacket::hit`] may use its AVX2 kernel on this processor.
-pub fn has_vector_unit() -> bool {
+/// Which of [`FlatPacket::hit`]'s kernels runs: all give the same bits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VectorUnit {
+    /// One lane after the other (any processor).
+    #[default]
+    None,
+    /// Two halves of four lanes in AVX2 registers.
     #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
+    Avx2,
+    /// All eight lanes in one AVX-512 register.
+    #[cfg(target_arch = "x86_64")]
+    Avx512,
+}
+
+impl VectorUnit {
+    /// The widest kernel this processor runs.
+    pub fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                return Self::Avx512;
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                return Self::Avx2;
+            }
+        }
+        Self::None
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
+
+    /// Flats per packet for this kernel: eight fill an AVX-512 register; four an AVX2 one, and
+    /// a packet of eight would mostly test empty lanes there.
+    pub fn lanes(self) -> usize {
+        match self {
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx512 => LANES,
+            _ => HALF,
+        }
+    }
+
+    /// Every kernel this processor runs (for tests).
+    pub fn available() -> Vec<Self> {
+        let mut units = vec![Self::None];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                units.push(Self::Avx2);
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                units.push(Self::Avx512);
+            }
+        }
+        units
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod avx2 {
-    use super::{FlatPacket, LANES, LaneHit};
+    use super::{FlatPacket, HALF, LANES, LaneHit};
     use alhazen_math::Ray;
     use std::arch::x86_64::*;
 
-    /// Lane `i` of every register is lane `i` of the packet.
+    /// Lanes `half·4 ..` of `a`, lane `i` of the register being lane `half·4 + i`.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn load(a: &[f64; LANES]) -> __m256d {
-        // SAFETY: `a` is four readable f64s; `loadu` needs no alignment.
-        unsafe { _mm256_loadu_pd(a.as_ptr()) }
+    fn load(a: &[f64; LANES], half: usize) -> __m256d {
+        // SAFETY: `half` is 0 or 1, so four f64s from `half·4` are in `a`; `loadu` needs no
+        // alignment.
+        unsafe { _mm256_loadu_pd(a[half * HALF..].as_ptr()) }
     }
 
     /// `(a·b)` lane by lane, summed as glam's `dot`: `(x·x + y·y) + z·z`.
@@ -140,25 +218,36 @@ mod avx2 {
 
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn load3(a: &[[f64; LANES]; 3]) -> [__m256d; 3] {
-        [load(&a[0]), load(&a[1]), load(&a[2])]
+    fn load3(a: &[[f64; LANES]; 3], half: usize) -> [__m256d; 3] {
+        [load(&a[0], half), load(&a[1], half), load(&a[2], half)]
     }
 
-    /// [`FlatPacket::hit_portable`] in AVX2 registers: [`super::Flat::hit`]'s operations lane by
-    /// lane, in its order, combined without its early exits.
+    /// [`FlatPacket::hit_portable`] in AVX2 registers, four lanes at a time.
     #[target_feature(enable = "avx2")]
     pub(super) fn hit(p: &FlatPacket, ray: &Ray, t_max: f64) -> Option<LaneHit> {
+        let first = hit_half(p, ray, t_max, 0);
+        if p.used <= HALF {
+            return first;
+        }
+        hit_half(p, ray, first.map_or(t_max, |h| h.t), 1).or(first)
+    }
+
+    /// [`super::Flat::hit`]'s operations on four lanes, in its order, combined without its
+    /// early exits.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn hit_half(p: &FlatPacket, ray: &Ray, t_max: f64, half: usize) -> Option<LaneHit> {
         let ro = [_mm256_set1_pd(ray.origin.x), _mm256_set1_pd(ray.origin.y), _mm256_set1_pd(ray.origin.z)];
         let rd = [_mm256_set1_pd(ray.dir.x), _mm256_set1_pd(ray.dir.y), _mm256_set1_pd(ray.dir.z)];
-        let o = load3(&p.origin);
+        let o = load3(&p.origin, half);
         let to_flat = [_mm256_sub_pd(o[0], ro[0]), _mm256_sub_pd(o[1], ro[1]), _mm256_sub_pd(o[2], ro[2])];
-        let n = load3(&p.normal);
+        let n = load3(&p.normal, half);
         let t = _mm256_div_pd(dot(n, to_flat), dot(n, rd));
         // As `Flat::hit`: `t·(d·u) − (o − r)·u`, the dot products independent of the division.
-        let (u, v) = (load3(&p.u), load3(&p.v));
+        let (u, v) = (load3(&p.u, half), load3(&p.v, half));
         let b1 = _mm256_sub_pd(_mm256_mul_pd(t, dot(rd, u)), dot(to_flat, u));
         let b2 = _mm256_sub_pd(_mm256_mul_pd(t, dot(rd, v)), dot(to_flat, v));
-        let far = _mm256_add_pd(b2, _mm256_mul_pd(load(&p.triangle), b1));
+        let far = _mm256_add_pd(b2, _mm256_mul_pd(load(&p.triangle, half), b1));
         let (zero, one) = (_mm256_setzero_pd(), _mm256_set1_pd(1.0));
         let in_t =
             _mm256_and_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(t, zero), _mm256_cmp_pd::<_CMP_LT_OQ>(t, _mm256_set1_pd(t_max)));
@@ -173,12 +262,125 @@ mod avx2 {
         let min = _mm256_min_pd(t, _mm256_permute4x64_pd::<0b01_00_11_10>(t));
         let min = _mm256_min_pd(min, _mm256_permute_pd::<0b0101>(min));
         let lane = _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(t, min)).trailing_zeros() as usize;
-        let mut lanes = [[0.0; LANES]; 3];
+        let mut lanes = [[0.0; HALF]; 3];
         for (dst, src) in lanes.iter_mut().zip([t, b1, b2]) {
             // SAFETY: `dst` is four writable f64s; `storeu` needs no alignment.
             unsafe { _mm256_storeu_pd(dst.as_mut_ptr(), src) };
         }
-        Some(LaneHit { lane, t: lanes[0][lane], b1: lanes[1][lane], b2: lanes[2][lane] })
+        Some(LaneHit { lane: half * HALF + lane, t: lanes[0][lane], b1: lanes[1][lane], b2: lanes[2][lane] })
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx512 {
+    use super::{FlatPacket, LANES, LaneHit};
+    use alhazen_math::Ray;
+    use std::arch::x86_64::*;
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn load(a: &[f64; LANES]) -> __m512d {
+        // SAFETY: `a` is eight readable f64s; `loadu` needs no alignment.
+        unsafe { _mm512_loadu_pd(a.as_ptr()) }
+    }
+
+    /// `(a·b)` lane by lane, summed as glam's `dot`: `(x·x + y·y) + z·z`.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn dot(a: [__m512d; 3], b: [__m512d; 3]) -> __m512d {
+        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a[0], b[0]), _mm512_mul_pd(a[1], b[1])), _mm512_mul_pd(a[2], b[2]))
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn load3(a: &[[f64; LANES]; 3]) -> [__m512d; 3] {
+        [load(&a[0]), load(&a[1]), load(&a[2])]
+    }
+
+    /// The ray's origin and direction, each coordinate in all lanes.
+    struct RayLanes {
+        origin: [__m512d; 3],
+        dir: [__m512d; 3],
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn ray_lanes(ray: &Ray) -> RayLanes {
+        let (o, d) = (ray.origin, ray.dir);
+        RayLanes {
+            origin: [_mm512_set1_pd(o.x), _mm512_set1_pd(o.y), _mm512_set1_pd(o.z)],
+            dir: [_mm512_set1_pd(d.x), _mm512_set1_pd(d.y), _mm512_set1_pd(d.z)],
+        }
+    }
+
+    /// [`super::Flat::hit`]'s operations on all eight lanes, in its order, without its early
+    /// exits: `(t, b1, b2)` and the lanes hit with `0 < t < t_max`.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn lanes(p: &FlatPacket, r: &RayLanes, t_max: __m512d) -> (__m512d, __m512d, __m512d, __mmask8) {
+        let (ro, rd) = (&r.origin, r.dir);
+        let o = load3(&p.origin);
+        let to_flat = [_mm512_sub_pd(o[0], ro[0]), _mm512_sub_pd(o[1], ro[1]), _mm512_sub_pd(o[2], ro[2])];
+        let n = load3(&p.normal);
+        let t = _mm512_div_pd(dot(n, to_flat), dot(n, rd));
+        let (u, v) = (load3(&p.u), load3(&p.v));
+        let b1 = _mm512_sub_pd(_mm512_mul_pd(t, dot(rd, u)), dot(to_flat, u));
+        let b2 = _mm512_sub_pd(_mm512_mul_pd(t, dot(rd, v)), dot(to_flat, v));
+        let far = _mm512_add_pd(b2, _mm512_mul_pd(load(&p.triangle), b1));
+        let (zero, one) = (_mm512_setzero_pd(), _mm512_set1_pd(1.0));
+        let in_t = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(t, zero) & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, t_max);
+        let in_b1 = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(b1, zero) & _mm512_cmp_pd_mask::<_CMP_LE_OQ>(b1, one);
+        let in_b2 = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(b2, zero) & _mm512_cmp_pd_mask::<_CMP_LE_OQ>(far, one);
+        (t, b1, b2, in_t & in_b1 & in_b2)
+    }
+
+    /// [`FlatPacket::nearest_of`] without a branch per packet: each lane keeps the nearest hit
+    /// it has seen (strictly nearer replaces, so earlier packets win ties), and the lanes are
+    /// compared once at the end.
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn nearest(packets: &[FlatPacket], ray: &Ray, t_max: f64) -> Option<(usize, LaneHit)> {
+        let r = ray_lanes(ray);
+        let limit = _mm512_set1_pd(t_max);
+        let (mut best_t, mut best_b1, mut best_b2) = (limit, _mm512_setzero_pd(), _mm512_setzero_pd());
+        let (mut best_k, mut any) = (_mm512_setzero_si512(), 0);
+        for (k, p) in packets.iter().enumerate() {
+            let (t, b1, b2, inside) = lanes(p, &r, limit);
+            let closer = inside & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, best_t);
+            best_t = _mm512_mask_blend_pd(closer, best_t, t);
+            best_b1 = _mm512_mask_blend_pd(closer, best_b1, b1);
+            best_b2 = _mm512_mask_blend_pd(closer, best_b2, b2);
+            best_k = _mm512_mask_blend_epi64(closer, best_k, _mm512_set1_epi64(k as i64));
+            any |= closer;
+        }
+        if any == 0 {
+            return None;
+        }
+        let min = _mm512_reduce_min_pd(_mm512_mask_blend_pd(any, _mm512_set1_pd(f64::INFINITY), best_t));
+        let ties = any & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(best_t, _mm512_set1_pd(min));
+        let lane = if ties.is_power_of_two() { ties.trailing_zeros() as usize } else { first_packet(ties, best_k) };
+        let at = |v: __m512d| _mm512_cvtsd_f64(_mm512_permutexvar_pd(_mm512_set1_epi64(lane as i64), v));
+        let k =
+            _mm_cvtsi128_si64(_mm512_castsi512_si128(_mm512_permutexvar_epi64(_mm512_set1_epi64(lane as i64), best_k)));
+        Some((k as usize, LaneHit { lane, t: min, b1: at(best_b1), b2: at(best_b2) }))
+    }
+
+    /// Of the lanes in `ties`, the one whose packet (`k`) came first, then the first lane.
+    #[cold]
+    #[target_feature(enable = "avx512f")]
+    fn first_packet(ties: __mmask8, k: __m512i) -> usize {
+        let mut ks = [0i64; LANES];
+        // SAFETY: `ks` is eight writable i64s; `storeu` needs no alignment.
+        unsafe { _mm512_storeu_si512(ks.as_mut_ptr().cast(), k) };
+        (0..LANES).filter(|&l| ties & (1 << l) != 0).min_by_key(|&l| ks[l]).unwrap_or(0)
+    }
+
+    /// [`FlatPacket::any_of`]: the lanes hit, gathered over every packet.
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn any(packets: &[FlatPacket], ray: &Ray, t_max: f64) -> bool {
+        let r = ray_lanes(ray);
+        let limit = _mm512_set1_pd(t_max);
+        packets.iter().fold(0, |hit, p| hit | lanes(p, &r, limit).3) != 0
     }
 }
 
@@ -196,10 +398,12 @@ mod tests {
     }
 
     proptest! {
-        /// Both kernels agree bit for bit with testing the flats one by one.
+        /// Every kernel agrees bit for bit with testing the flats one by one, in order, over
+        /// packets of any fill.
         #[test]
-        fn packet_equals_flat_by_flat(
-            flats in prop::collection::vec(flat(), 1..=LANES),
+        fn packets_equal_flat_by_flat(
+            flats in prop::collection::vec(flat(), 1..=3 * LANES),
+            fill in 1..=LANES,
             origin in vec3(),
             dir in vec3(),
             t_max in prop_oneof![Just(f64::INFINITY), 0.1..5.0f64],
@@ -209,16 +413,36 @@ mod tests {
             let ray = Ray::new(origin, dir.normalize());
             let mut expected = None;
             let mut limit = t_max;
-            for (lane, f) in flats.iter().enumerate() {
+            for (i, f) in flats.iter().enumerate() {
                 if let Some((t, b1, b2)) = f.hit(&ray, limit) {
                     limit = t;
-                    expected = Some(LaneHit { lane, t, b1, b2 });
+                    expected = Some((i / fill, LaneHit { lane: i % fill, t, b1, b2 }));
                 }
             }
-            let packet = FlatPacket::new(&flats);
-            prop_assert_eq!(packet.hit(&ray, t_max, false), expected);
-            if has_vector_unit() {
-                prop_assert_eq!(packet.hit(&ray, t_max, true), expected);
+            let packets: Vec<FlatPacket> = flats.chunks(fill).map(FlatPacket::new).collect();
+            for unit in VectorUnit::available() {
+                prop_assert_eq!(FlatPacket::nearest_of(&packets, &ray, t_max, unit), expected, "{:?}", unit);
+                prop_assert_eq!(FlatPacket::any_of(&packets, &ray, t_max, unit), expected.is_some(), "{:?}", unit);
+            }
+        }
+    }
+
+    /// Two flats in one plane: the first packet's wins, whatever lane the other is in.
+    #[test]
+    fn ties_go_to_the_first_packet_then_the_first_lane() {
+        let f = Flat::new(Vec3::ZERO, Vec3::X, Vec3::Y, true).unwrap();
+        let g = Flat::new(Vec3::new(-1.0, -1.0, 0.0), Vec3::X * 3.0, Vec3::Y * 3.0, true).unwrap();
+        let far = Flat::new(Vec3::new(0.0, 0.0, -1.0), Vec3::X, Vec3::Y, true).unwrap();
+        let down = Ray::new(Vec3::new(0.5, 0.5, 1.0), -Vec3::Z);
+        // (packets, the winner's packet and lane): a tie within a lane, then across lanes.
+        let cases = [
+            (vec![FlatPacket::new(&[f, far, far]), FlatPacket::new(&[g, f])], (0, 0)),
+            (vec![FlatPacket::new(&[far, f]), FlatPacket::new(&[g])], (0, 1)),
+        ];
+        for (packets, winner) in cases {
+            for unit in VectorUnit::available() {
+                let (k, h) = FlatPacket::nearest_of(&packets, &down, f64::INFINITY, unit).unwrap();
+                assert_eq!(((k, h.lane), h.t), (winner, 1.0), "{unit:?}");
             }
         }
     }
@@ -227,12 +451,12 @@ mod tests {
     fn unused_lanes_and_rays_in_the_plane_never_hit() {
         let f = Flat::new(Vec3::ZERO, Vec3::X, Vec3::Y, true).unwrap();
         let packet = FlatPacket::new(&[f]);
-        for vectors in [false, has_vector_unit()] {
+        for unit in VectorUnit::available() {
             let down = Ray::new(Vec3::new(0.5, 0.5, 1.0), -Vec3::Z);
-            assert_eq!(packet.hit(&down, f64::INFINITY, vectors).map(|h| (h.lane, h.t)), Some((0, 1.0)));
+            assert_eq!(packet.hit(&down, f64::INFINITY, unit).map(|h| (h.lane, h.t)), Some((0, 1.0)));
             let grazing = Ray::new(Vec3::new(-1.0, 0.5, 0.0), Vec3::X);
-            assert_eq!(packet.hit(&grazing, f64::INFINITY, vectors), None);
-            assert_eq!(FlatPacket::new(&[]).hit(&down, f64::INFINITY, vectors), None);
+            assert_eq!(packet.hit(&grazing, f64::INFINITY, unit), None);
+            assert_eq!(FlatPacket::new(&[]).hit(&down, f64::INFINITY, unit), None);
         }
     }
 }

@@ -17,7 +17,7 @@ pub use aabox::AaBox;
 pub use csg::Csg;
 pub use cylinder::{Cone, Cylinder};
 pub use flat::{Flat, parallelogram_of, parallelogram_to_triangle};
-pub use flat_packet::{FlatPacket, LANES, LaneHit, has_vector_unit};
+pub use flat_packet::{FlatPacket, LANES, LaneHit, VectorUnit};
 pub use mesh::{MeshAccel, MeshShape, triangle_hit};
 pub use plane::{Disk, Plane};
 pub use sphere::Sphere;
