@@ -146,8 +146,15 @@ impl Bvh {
         mut t_max: f64,
         mut visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
     ) -> f64 {
-        if self.nodes.is_empty() {
-            return t_max;
+        match self.nodes.as_slice() {
+            [] => return t_max,
+            // A lone leaf is tested whole: its box test would only cost a division.
+            [leaf] => {
+                let first = leaf.offset as usize;
+                let t = visit(first..first + leaf.count as usize, t_max);
+                return t.map_or(t_max, |t| t_max.min(t.max(0.0)));
+            }
+            _ => {}
         }
         let inv = 1.0 / ray.dir;
         let neg = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
