@@ -5,8 +5,8 @@
 
 use crate::bvh::Bvh;
 use crate::shape::{
-    AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, FlatPacket, LANES, LaneHit, MeshAccel, MeshShape, Placed, Plane,
-    Shape, Sphere, SurfaceHit, VectorUnit, parallelogram_of, parallelogram_to_triangle,
+    AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, FlatLane, FlatPacket, LaneHit, MeshAccel, MeshShape,
+    PackedFlats, Placed, Plane, Shape, Sphere, SurfaceHit, VectorUnit, flat_primitives,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -32,27 +32,20 @@ pub struct WorldObject {
 #[derive(Clone, Copy, Debug)]
 enum Primitive {
     Object(u32),
-    /// For a parallelogram, `triangle` is the first of its pair.
-    Flat {
-        object: u32,
-        triangle: u32,
-        flat: Flat,
-    },
+    Flat { object: u32, lane: FlatLane, flat: Flat },
 }
 
 /// Whose triangle a lane of a [`FlatPacket`] is.
 #[derive(Clone, Copy, Debug, Default)]
 struct Lane {
     object: u32,
-    /// The triangle, or the first of a parallelogram's pair.
-    triangle: u32,
-    parallelogram: bool,
+    flat: FlatLane,
 }
 
 /// What one leaf of the top-level BVH tests: its flats in packets, then its other objects.
 #[derive(Clone, Debug)]
 struct Leaf {
-    /// Range in `World::packets` (and `World::lanes`).
+    /// Range in `World::flats`.
     packets: std::ops::Range<usize>,
     /// Range in `World::leaf_objects`.
     objects: std::ops::Range<usize>,
@@ -66,8 +59,7 @@ pub struct World {
     /// Leaf of the BVH by the start of its range in the BVH's leaf order.
     leaf_at: Vec<u32>,
     leaves: Vec<Leaf>,
-    packets: Vec<FlatPacket>,
-    lanes: Vec<[Lane; LANES]>,
+    flats: PackedFlats<Lane>,
     leaf_objects: Vec<u32>,
     unbounded: Vec<u32>,
     /// The packets' kernel for this processor.
@@ -153,32 +145,6 @@ fn flattenable(p: &Placed) -> Option<&alhazen_geom::TriangleMesh> {
     }
 }
 
-/// The triangles of a flattened mesh as top-level primitives `(first triangle, test, bounds)`:
-/// consecutive pairs that form a parallelogram become one; triangles without area are dropped.
-fn flat_primitives(mesh: &TriangleMesh) -> Vec<(u32, Flat, Bounds3)> {
-    let mut out = vec![];
-    let mut t = 0;
-    while t < mesh.triangle_count() {
-        let corners = mesh.corners(t);
-        let pair = (t + 1 < mesh.triangle_count()).then(|| {
-            let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
-            parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])
-        });
-        if let Some([o, e1, e2]) = pair.flatten()
-            && let Some(f) = Flat::new(o, e1, e2, true)
-        {
-            out.push((t as u32, f, Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])));
-            t += 2;
-            continue;
-        }
-        if let Some(f) = Flat::triangle(corners) {
-            out.push((t as u32, f, Bounds3::from_points(corners)));
-        }
-        t += 1;
-    }
-    out
-}
-
 fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene) -> Placed {
     let small = match &o.shape {
         scene::Shape::Mesh { mesh, smooth } if !o.transform.is_identity() => {
@@ -218,8 +184,8 @@ impl World {
         for (i, o) in objects.iter().enumerate() {
             let object = i as u32;
             if let Some(mesh) = flattenable(&o.placed) {
-                for (triangle, flat, bounds) in flat_primitives(mesh) {
-                    primitives.push(Primitive::Flat { object, triangle, flat });
+                for (lane, flat, bounds) in flat_primitives(mesh) {
+                    primitives.push(Primitive::Flat { object, lane, flat });
                     prim_bounds.push(bounds);
                 }
                 continue;
@@ -246,25 +212,16 @@ impl World {
         self.leaf_at = vec![0; bvh.leaf_order().len()];
         for range in bvh.leaves() {
             self.leaf_at[range.start] = self.leaves.len() as u32;
-            let (first_packet, first_object) = (self.packets.len(), self.leaf_objects.len());
+            let first_object = self.leaf_objects.len();
             let mut flats: Vec<(Lane, Flat)> = vec![];
             for &k in &bvh.leaf_order()[range] {
                 match primitives[k as usize] {
                     Primitive::Object(i) => self.leaf_objects.push(i),
-                    Primitive::Flat { object, triangle, flat } => {
-                        flats.push((Lane { object, triangle, parallelogram: flat.is_parallelogram() }, flat))
-                    }
+                    Primitive::Flat { object, lane, flat } => flats.push((Lane { object, flat: lane }, flat)),
                 }
             }
-            for chunk in flats.chunks(self.vectors.lanes()) {
-                let flats: Vec<Flat> = chunk.iter().map(|(_, f)| *f).collect();
-                self.packets.push(FlatPacket::new(&flats));
-                let mut lanes = [Lane::default(); LANES];
-                chunk.iter().zip(&mut lanes).for_each(|((lane, _), slot)| *slot = *lane);
-                self.lanes.push(lanes);
-            }
-            let (packets, objects) = (first_packet..self.packets.len(), first_object..self.leaf_objects.len());
-            self.leaves.push(Leaf { packets, objects });
+            let packets = self.flats.push_leaf(&flats, self.vectors.lanes());
+            self.leaves.push(Leaf { packets, objects: first_object..self.leaf_objects.len() });
         }
     }
 
@@ -285,13 +242,12 @@ impl World {
             }
         }
         // The nearest flat's packet and lane; made a candidate once, after the traversal.
-        let mut best_flat: Option<(usize, LaneHit)> = None;
+        let mut best_flat: Option<(Lane, LaneHit)> = None;
         self.bvh.traverse_leaves(ray, t_best, |range, mut t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
             let mut closer = None;
-            let packets = &self.packets[leaf.packets.clone()];
-            if let Some((k, h)) = FlatPacket::nearest_of(packets, ray, t_max, self.vectors) {
-                best_flat = Some((leaf.packets.start + k, h));
+            if let Some((lane, h)) = self.flats.nearest(leaf.packets.clone(), ray, t_max, self.vectors) {
+                best_flat = Some((lane, h));
                 (t_max, closer) = (h.t, Some(h.t));
             }
             for &i in &self.leaf_objects[leaf.objects.clone()] {
@@ -302,15 +258,7 @@ impl World {
             }
             closer
         });
-        best_flat.map(|(k, h)| self.flat_candidate(k, h)).or(best)
-    }
-
-    /// The candidate of lane hit `h` of packet `k`.
-    #[inline]
-    fn flat_candidate(&self, k: usize, h: LaneHit) -> (Candidate, u32) {
-        let lane = self.lanes[k][h.lane];
-        let (second, b1, b2) = if lane.parallelogram { parallelogram_to_triangle(h.b1, h.b2) } else { (0, h.b1, h.b2) };
-        (Candidate { t: h.t, aux: lane.triangle + second, bary: [b1, b2] }, lane.object)
+        best_flat.map(|(lane, h)| (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)).or(best)
     }
 
     /// The nearest hit in `(0, t_max)` with its surface and material.
@@ -354,7 +302,7 @@ impl World {
         let mut blocked = false;
         self.bvh.traverse_leaves(&ray, dist, |range, t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
-            blocked = FlatPacket::any_of(&self.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
+            blocked = FlatPacket::any_of(&self.flats.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
                 || self.leaf_objects[leaf.objects.clone()]
                     .iter()
                     .any(|&i| self.objects[i as usize].placed.hit(&ray, t_max).is_some());

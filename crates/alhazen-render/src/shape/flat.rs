@@ -3,7 +3,9 @@
 //! axes precomputed. The test is a projection: one division for the plane, then two dot
 //! products (Wald 2004, "Realtime Ray Tracing and Interactive Global Illumination", §7.1).
 
-use alhazen_math::{Ray, Vec3};
+use super::Candidate;
+use alhazen_geom::TriangleMesh;
+use alhazen_math::{Bounds3, Ray, Vec3};
 
 /// A triangle `origin + b1·e1 + b2·e2` (`b1, b2 ≥ 0`, `b1 + b2 ≤ 1`) or a parallelogram
 /// (`b1, b2 ∈ [0, 1]`), ready for ray tests.
@@ -79,6 +81,57 @@ pub fn parallelogram_of(first: [u32; 3], second: [u32; 3], [a, b, c]: [Vec3; 3],
 #[inline]
 pub fn parallelogram_to_triangle(s: f64, t: f64) -> (u32, f64, f64) {
     if s >= t { (0, s - t, t) } else { (1, s, t - s) }
+}
+
+/// Which mesh triangle a flat is: the triangle, or the first of a parallelogram's pair.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FlatLane {
+    /// The triangle (the first of the pair for a parallelogram).
+    pub triangle: u32,
+    /// The flat is the parallelogram of `triangle` and the next one.
+    pub parallelogram: bool,
+}
+
+impl FlatLane {
+    /// The mesh triangle hit and its barycentrics, for the flat's hit `(t, b1, b2)`.
+    #[inline]
+    pub fn candidate(self, t: f64, b1: f64, b2: f64) -> Candidate {
+        let (second, b1, b2) = if self.parallelogram { parallelogram_to_triangle(b1, b2) } else { (0, b1, b2) };
+        Candidate { t, aux: self.triangle + second, bary: [b1, b2] }
+    }
+
+    /// The mesh triangles the flat covers.
+    pub fn triangles(self) -> std::ops::Range<usize> {
+        let first = self.triangle as usize;
+        first..first + 1 + usize::from(self.parallelogram)
+    }
+}
+
+/// The triangles of `mesh` as flats with their bounds: consecutive pairs that form a
+/// parallelogram become one; triangles without area are dropped.
+pub fn flat_primitives(mesh: &TriangleMesh) -> Vec<(FlatLane, Flat, Bounds3)> {
+    let mut out = vec![];
+    let mut t = 0;
+    while t < mesh.triangle_count() {
+        let corners = mesh.corners(t);
+        let pair = (t + 1 < mesh.triangle_count()).then(|| {
+            let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
+            parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])
+        });
+        let lane = FlatLane { triangle: t as u32, parallelogram: true };
+        if let Some([o, e1, e2]) = pair.flatten()
+            && let Some(f) = Flat::new(o, e1, e2, true)
+        {
+            out.push((lane, f, Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])));
+            t += 2;
+            continue;
+        }
+        if let Some(f) = Flat::triangle(corners) {
+            out.push((FlatLane { parallelogram: false, ..lane }, f, Bounds3::from_points(corners)));
+        }
+        t += 1;
+    }
+    out
 }
 
 #[cfg(test)]

@@ -138,6 +138,46 @@ impl FlatPacket {
     }
 }
 
+/// Packets of flats with what each lane stands for (`L`), filled leaf by leaf.
+#[derive(Clone, Debug, Default)]
+pub struct PackedFlats<L> {
+    /// The packets, the leaves' one after the other.
+    pub packets: Vec<FlatPacket>,
+    /// Lane by lane, what packet `k`'s flats are.
+    pub lanes: Vec<[L; LANES]>,
+}
+
+impl<L: Copy + Default> PackedFlats<L> {
+    /// Appends `flats`, in order, as packets of `width` ([`VectorUnit::lanes`]); returns the
+    /// range of their packets.
+    pub fn push_leaf(&mut self, flats: &[(L, Flat)], width: usize) -> std::ops::Range<usize> {
+        let first = self.packets.len();
+        for chunk in flats.chunks(width) {
+            let packet: Vec<Flat> = chunk.iter().map(|(_, f)| *f).collect();
+            self.packets.push(FlatPacket::new(&packet));
+            let mut lanes = [L::default(); LANES];
+            chunk.iter().zip(&mut lanes).for_each(|((lane, _), slot)| *slot = *lane);
+            self.lanes.push(lanes);
+        }
+        first..self.packets.len()
+    }
+
+    /// The nearest hit in packets `range` (see [`FlatPacket::nearest_of`]): what its lane
+    /// stands for and its hit.
+    #[inline]
+    pub fn nearest(
+        &self,
+        range: std::ops::Range<usize>,
+        ray: &Ray,
+        t_max: f64,
+        unit: VectorUnit,
+    ) -> Option<(L, LaneHit)> {
+        let first = range.start;
+        let (k, h) = FlatPacket::nearest_of(&self.packets[range], ray, t_max, unit)?;
+        Some((self.lanes[first + k][h.lane], h))
+    }
+}
+
 /// Which of [`FlatPacket::hit`]'s kernels runs: all give the same bits.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum VectorUnit {

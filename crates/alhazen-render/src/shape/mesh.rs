@@ -1,7 +1,9 @@
-//! Triangle meshes: Möller–Trumbore intersection over a per-mesh BVH. One [`MeshAccel`] is
-//! shared by every instance of the mesh (instancing = one mesh, many transforms).
+//! Triangle meshes over a per-mesh BVH whose leaves hold the triangles (and the parallelograms
+//! pairs of them form) as packets of [`super::Flat`]s, tested several at once; CSG's crossings
+//! use Möller–Trumbore. One [`MeshAccel`] is shared by every instance of the mesh (instancing =
+//! one mesh, many transforms).
 
-use super::{Candidate, Crossing, SurfaceHit};
+use super::{Candidate, Crossing, FlatLane, PackedFlats, SurfaceHit, VectorUnit, flat_primitives};
 use crate::bvh::Bvh;
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
@@ -12,7 +14,14 @@ use std::sync::Arc;
 pub struct MeshAccel {
     /// The mesh.
     pub mesh: Arc<TriangleMesh>,
+    /// Over `prims`, the flats of the mesh.
     bvh: Bvh,
+    prims: Vec<FlatLane>,
+    /// Each leaf's flats, tested in packets: a leaf starting at `s` in the BVH's leaf order
+    /// has packets `leaf_packets[s]`.
+    packets: PackedFlats<FlatLane>,
+    leaf_packets: Vec<std::ops::Range<u32>>,
+    vectors: VectorUnit,
     /// Unit geometric normal per triangle (zero for triangles without area).
     face_normals: Vec<Vec3>,
     /// Per triangle: its vertex normals all equal its face normal (smooth shading would only
@@ -21,9 +30,20 @@ pub struct MeshAccel {
 }
 
 impl MeshAccel {
-    /// Builds the triangle BVH.
+    /// Builds the BVH over the mesh's flats and packs its leaves.
     pub fn new(mesh: Arc<TriangleMesh>) -> Self {
-        let bounds: Vec<Bounds3> = (0..mesh.triangle_count()).map(|i| Bounds3::from_points(mesh.corners(i))).collect();
+        let flats = flat_primitives(&mesh);
+        let bounds: Vec<Bounds3> = flats.iter().map(|f| f.2).collect();
+        let bvh = Bvh::build_packed(&bounds, |_| true);
+        let vectors = VectorUnit::detect();
+        let (mut packets, mut leaf_packets) = (PackedFlats::default(), vec![0..0; bvh.leaf_order().len()]);
+        for range in bvh.leaves() {
+            let leaf: Vec<_> =
+                bvh.leaf_order()[range.clone()].iter().map(|&k| (flats[k as usize].0, flats[k as usize].1)).collect();
+            let r = packets.push_leaf(&leaf, vectors.lanes());
+            leaf_packets[range.start] = r.start as u32..r.end as u32;
+        }
+        let prims = flats.iter().map(|f| f.0).collect();
         let face_normals: Vec<Vec3> = (0..mesh.triangle_count())
             .map(|i| {
                 let [a, b, c] = mesh.corners(i);
@@ -38,7 +58,7 @@ impl MeshAccel {
                 mesh.normals.is_empty() || t.iter().all(|&i| (mesh.normals[i as usize] - *n).length() < 1e-12)
             })
             .collect();
-        Self { bvh: Bvh::build(&bounds), mesh, face_normals, flat }
+        Self { mesh, bvh, prims, packets, leaf_packets, vectors, face_normals, flat }
     }
 }
 
@@ -110,14 +130,15 @@ impl MeshShape {
 
     /// Nearest hit in `(0, t_max)`; `aux` is the triangle.
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
-        let m = &self.accel.mesh;
+        let a = &*self.accel;
         let mut best = None;
-        self.accel.bvh.traverse(ray, t_max, |i, t_max| {
-            let h = triangle_hit(ray, m.corners(i as usize)).filter(|h| h.0 > 0.0 && h.0 < t_max)?;
-            best = Some(Candidate { t: h.0, aux: i, bary: [h.1, h.2] });
-            Some(h.0)
+        a.bvh.traverse_leaves(ray, t_max, |leaf, t_max| {
+            let r = a.leaf_packets[leaf.start].clone();
+            let (lane, h) = a.packets.nearest(r.start as usize..r.end as usize, ray, t_max, a.vectors)?;
+            best = Some((lane, h));
+            Some(h.t)
         });
-        best
+        best.map(|(lane, h)| lane.candidate(h.t, h.b1, h.b2))
     }
 
     /// The surface at a hit found by [`MeshShape::hit`].
@@ -135,10 +156,12 @@ impl MeshShape {
         let back = back.min(0.0);
         let shifted = Ray::new(ray.at(back), ray.dir);
         let m = &self.accel.mesh;
-        self.accel.bvh.traverse(&shifted, f64::INFINITY, |i, _| {
-            if let Some((t, b1, b2)) = triangle_hit(&shifted, m.corners(i as usize)).filter(|h| h.0 > 0.0) {
-                let hit = self.surface(ray, i as usize, (t + back, b1, b2));
-                out.push(Crossing { hit, entering: hit.n.dot(ray.dir) < 0.0 });
+        self.accel.bvh.traverse(&shifted, f64::INFINITY, |k, _| {
+            for i in self.accel.prims[k as usize].triangles() {
+                if let Some((t, b1, b2)) = triangle_hit(&shifted, m.corners(i)).filter(|h| h.0 > 0.0) {
+                    let hit = self.surface(ray, i, (t + back, b1, b2));
+                    out.push(Crossing { hit, entering: hit.n.dot(ray.dir) < 0.0 });
+                }
             }
             None
         });

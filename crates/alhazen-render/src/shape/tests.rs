@@ -75,6 +75,25 @@ fn shapes_with_implicit() -> Vec<(Shape, Implicit)> {
     ]
 }
 
+/// A soup of `n` triangles in the unit cube; every third pair of triangles a parallelogram.
+fn arb_soup(n: usize) -> impl Strategy<Value = alhazen_geom::TriangleMesh> {
+    prop::collection::vec(arb_point(1.0), 3 * n).prop_map(|mut positions| {
+        let mut triangles = vec![];
+        for k in (0..positions.len()).step_by(6) {
+            let k = k as u32;
+            if k.is_multiple_of(18) {
+                // Corners a, b, d and c = b + d − a: triangles [a, b, c], [a, c, d] tile a parallelogram.
+                let (a, b, d) = (positions[k as usize], positions[k as usize + 1], positions[k as usize + 2]);
+                positions[k as usize + 3] = b + d - a;
+                triangles.extend([[k, k + 1, k + 3], [k, k + 3, k + 2]]);
+            } else {
+                triangles.extend([[k, k + 1, k + 2], [k + 3, k + 4, k + 5]]);
+            }
+        }
+        alhazen_geom::TriangleMesh { positions, triangles, ..Default::default() }
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 
@@ -114,6 +133,28 @@ proptest! {
         if let (Some(a), Some(b)) = (a, b) {
             prop_assert!((a.t - b.t).abs() < 1e-9);
             prop_assert!((a.n - b.n).length() < 1e-9);
+        }
+    }
+
+    /// The mesh's packets of flats find what Möller–Trumbore over every triangle finds.
+    #[test]
+    fn mesh_packets_agree_with_every_triangle(mesh in arb_soup(150), ray in arb_ray()) {
+        let mesh = Arc::new(mesh);
+        let shape = MeshShape { accel: Arc::new(MeshAccel::new(mesh.clone())), smooth: false };
+        let brute = (0..mesh.triangle_count())
+            .filter_map(|i| mesh::triangle_hit(&ray, mesh.corners(i)).filter(|h| h.0 > 0.0).map(|h| (h.0, i)))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let hit = shape.hit(&ray, f64::INFINITY);
+        prop_assert_eq!(hit.is_some(), brute.is_some());
+        if let (Some(c), Some((t, i))) = (hit, brute) {
+            prop_assert!((c.t - t).abs() <= 1e-9 * (1.0 + t), "t {} vs {}", c.t, t);
+            let s = shape.surface_at(&ray, c);
+            prop_assert!((s.p - ray.at(t)).length() < 1e-8);
+            // The same triangle unless another lies (almost) as near.
+            let near: Vec<usize> = (0..mesh.triangle_count())
+                .filter(|&j| mesh::triangle_hit(&ray, mesh.corners(j)).is_some_and(|h| (h.0 - t).abs() < 1e-9))
+                .collect();
+            prop_assert!(c.aux as usize == i || near.contains(&(c.aux as usize)));
         }
     }
 
