@@ -6,7 +6,7 @@
 use crate::bvh::Bvh;
 use crate::shape::{
     AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, FlatLane, FlatPacket, LaneHit, MeshAccel, MeshShape,
-    PackedFlats, Placed, Plane, Shape, Sphere, SurfaceHit, VectorUnit, flat_primitives,
+    PackedFlats, Placed, Plane, SPHERE_LANES, Shape, Sphere, SpherePacket, SurfaceHit, VectorUnit, flat_primitives,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -28,11 +28,12 @@ pub struct WorldObject {
 
 /// A primitive of the top-level BVH: a whole object, or one triangle of a small mesh placed
 /// in world space, or a parallelogram of two (flattened so their rays skip the nested mesh
-/// BVH).
+/// BVH), or an untransformed sphere (the last two tested in packets).
 #[derive(Clone, Copy, Debug)]
 enum Primitive {
     Object(u32),
     Flat { object: u32, lane: FlatLane, flat: Flat },
+    Sphere { object: u32, sphere: Sphere },
 }
 
 /// Whose triangle a lane of a [`FlatPacket`] is.
@@ -42,11 +43,14 @@ struct Lane {
     flat: FlatLane,
 }
 
-/// What one leaf of the top-level BVH tests: its flats in packets, then its other objects.
+/// What one leaf of the top-level BVH tests: its flats and spheres in packets, then its other
+/// objects.
 #[derive(Clone, Debug)]
 struct Leaf {
     /// Range in `World::flats`.
     packets: std::ops::Range<usize>,
+    /// Range in `World::spheres` (and `World::sphere_objects`).
+    spheres: std::ops::Range<usize>,
     /// Range in `World::leaf_objects`.
     objects: std::ops::Range<usize>,
 }
@@ -60,6 +64,9 @@ pub struct World {
     leaf_at: Vec<u32>,
     leaves: Vec<Leaf>,
     flats: PackedFlats<Lane>,
+    spheres: Vec<SpherePacket>,
+    /// Lane by lane, whose sphere packet `k`'s spheres are.
+    sphere_objects: Vec<[u32; SPHERE_LANES]>,
     leaf_objects: Vec<u32>,
     unbounded: Vec<u32>,
     /// The packets' kernel for this processor.
@@ -119,6 +126,10 @@ fn uses_uv(o: &scene::Object, s: &scene::Scene) -> bool {
             || m.bsdf.as_ref().is_some_and(|b| b.is_textured())
     })
 }
+
+/// Leaves with fewer spheres test them one by one: a lone sphere's scalar test, with its
+/// early exits, beats the packet's (measured on `bubble.toml`, two spheres).
+const MIN_SPHERE_PACKET: usize = 3;
 
 /// Meshes up to this size are copied into world space when placed, so their rays need no
 /// transform; larger ones are shared between instances.
@@ -191,7 +202,10 @@ impl World {
                 continue;
             }
             let b = o.placed.bounds();
-            if b.is_finite() {
+            if let (Shape::Sphere(sphere), None) = (&o.placed.shape, &o.placed.to_world) {
+                primitives.push(Primitive::Sphere { object, sphere: *sphere });
+                prim_bounds.push(b);
+            } else if b.is_finite() {
                 primitives.push(Primitive::Object(object));
                 prim_bounds.push(b);
             } else {
@@ -207,21 +221,35 @@ impl World {
         world
     }
 
-    /// Sorts each leaf's primitives into packets of flats and a list of objects.
+    /// Sorts each leaf's primitives into packets of flats, packets of spheres and a list of
+    /// objects.
     fn fill_leaves(&mut self, bvh: &Bvh, primitives: &[Primitive]) {
         self.leaf_at = vec![0; bvh.leaf_order().len()];
         for range in bvh.leaves() {
             self.leaf_at[range.start] = self.leaves.len() as u32;
             let first_object = self.leaf_objects.len();
             let mut flats: Vec<(Lane, Flat)> = vec![];
+            let mut spheres: Vec<(u32, Sphere)> = vec![];
             for &k in &bvh.leaf_order()[range] {
                 match primitives[k as usize] {
                     Primitive::Object(i) => self.leaf_objects.push(i),
                     Primitive::Flat { object, lane, flat } => flats.push((Lane { object, flat: lane }, flat)),
+                    Primitive::Sphere { object, sphere } => spheres.push((object, sphere)),
                 }
             }
             let packets = self.flats.push_leaf(&flats, self.vectors.lanes());
-            self.leaves.push(Leaf { packets, objects: first_object..self.leaf_objects.len() });
+            if spheres.len() < MIN_SPHERE_PACKET {
+                self.leaf_objects.extend(spheres.drain(..).map(|s| s.0));
+            }
+            let first_sphere = self.spheres.len();
+            for chunk in spheres.chunks(SPHERE_LANES) {
+                self.spheres.push(SpherePacket::new(&chunk.iter().map(|s| s.1).collect::<Vec<_>>()));
+                let mut objects = [0; SPHERE_LANES];
+                chunk.iter().zip(&mut objects).for_each(|(s, slot)| *slot = s.0);
+                self.sphere_objects.push(objects);
+            }
+            let (spheres, objects) = (first_sphere..self.spheres.len(), first_object..self.leaf_objects.len());
+            self.leaves.push(Leaf { packets, spheres, objects });
         }
     }
 
@@ -249,6 +277,12 @@ impl World {
             if let Some((lane, h)) = self.flats.nearest(leaf.packets.clone(), ray, t_max, self.vectors) {
                 best_flat = Some((lane, h));
                 (t_max, closer) = (h.t, Some(h.t));
+            }
+            let spheres = &self.spheres[leaf.spheres.clone()];
+            if let Some((k, lane, t)) = SpherePacket::nearest_of(spheres, ray, t_max, self.vectors) {
+                let object = self.sphere_objects[leaf.spheres.start + k][lane];
+                (best, best_flat) = (Some((Candidate { t, aux: 0, bary: [0.0; 2] }, object)), None);
+                (t_max, closer) = (t, Some(t));
             }
             for &i in &self.leaf_objects[leaf.objects.clone()] {
                 if let Some(c) = self.objects[i as usize].placed.hit(ray, t_max) {
@@ -303,6 +337,7 @@ impl World {
         self.bvh.traverse_leaves(&ray, dist, |range, t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
             blocked = FlatPacket::any_of(&self.flats.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
+                || SpherePacket::nearest_of(&self.spheres[leaf.spheres.clone()], &ray, t_max, self.vectors).is_some()
                 || self.leaf_objects[leaf.objects.clone()]
                     .iter()
                     .any(|&i| self.objects[i as usize].placed.hit(&ray, t_max).is_some());

@@ -12,6 +12,7 @@ mod flat_packet;
 mod mesh;
 mod plane;
 mod sphere;
+mod sphere_packet;
 
 pub use aabox::AaBox;
 pub use csg::Csg;
@@ -21,6 +22,7 @@ pub use flat_packet::{FlatPacket, LaneHit, PackedFlats, VectorUnit};
 pub use mesh::{MeshAccel, MeshShape, triangle_hit};
 pub use plane::{Disk, Plane};
 pub use sphere::Sphere;
+pub use sphere_packet::{SPHERE_LANES, SpherePacket};
 
 use alhazen_math::{Bounds3, Ray, Transform, Vec2, Vec3};
 

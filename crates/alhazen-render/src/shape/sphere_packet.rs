@@ -1,0 +1,248 @@
+//! Up to eight spheres tested against one ray at once: the top-level BVH's leaves keep their
+//! untransformed spheres in such packets, structure of arrays (mirror and glass balls are what
+//! Glaeser's scenes are made of).
+//!
+//! Each lane does exactly [`Sphere::hit`]'s arithmetic in the same order (Haines et al.'s
+//! discriminant, no fused multiply–add; `sqrt` and division are exact in IEEE arithmetic), so
+//! the AVX-512 kernel and the portable loop give the same bits as the one-sphere test.
+
+use super::{Sphere, VectorUnit};
+use alhazen_math::Ray;
+
+/// Spheres per packet.
+pub const SPHERE_LANES: usize = 8;
+
+/// Up to eight spheres, lane by lane; unused lanes never report a hit.
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+pub struct SpherePacket {
+    center: [[f64; SPHERE_LANES]; 3],
+    radius: [f64; SPHERE_LANES],
+    /// Lanes in use (the first ones).
+    used: usize,
+}
+
+impl SpherePacket {
+    /// The packet of `spheres` (at most [`SPHERE_LANES`]); lane `i` is `spheres[i]`.
+    pub fn new(spheres: &[Sphere]) -> Self {
+        assert!(spheres.len() <= SPHERE_LANES, "a packet holds at most {SPHERE_LANES} spheres");
+        // An unused lane has radius NaN: its discriminant is NaN, which is no hit.
+        let mut p = Self { center: [[0.0; SPHERE_LANES]; 3], radius: [f64::NAN; SPHERE_LANES], used: spheres.len() };
+        for (lane, s) in spheres.iter().enumerate() {
+            for axis in 0..3 {
+                p.center[axis][lane] = s.center[axis];
+            }
+            p.radius[lane] = s.radius;
+        }
+        p
+    }
+
+    fn lane(&self, lane: usize) -> Sphere {
+        let c = &self.center;
+        Sphere { center: alhazen_math::Vec3::new(c[0][lane], c[1][lane], c[2][lane]), radius: self.radius[lane] }
+    }
+
+    /// The nearest hit with `0 < t < t_max` among `packets`: the packet, its lane and `t` (on a
+    /// tie, the first packet, then the first lane). Same bits from every `unit`.
+    #[inline]
+    #[allow(unsafe_code)]
+    pub fn nearest_of(packets: &[Self], ray: &Ray, t_max: f64, unit: VectorUnit) -> Option<(usize, usize, f64)> {
+        #[cfg(target_arch = "x86_64")]
+        if unit == VectorUnit::Avx512 {
+            // SAFETY: `detect` returns `Avx512` only when this processor has AVX-512F.
+            return unsafe { avx512::nearest(packets, ray, t_max) };
+        }
+        let _ = unit;
+        let (mut best, mut t_max) = (None, t_max);
+        for (k, p) in packets.iter().enumerate() {
+            for lane in 0..p.used {
+                if let Some(c) = p.lane(lane).hit(ray, t_max) {
+                    (t_max, best) = (c.t, Some((k, lane, c.t)));
+                }
+            }
+        }
+        best
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx512 {
+    use super::{SPHERE_LANES, SpherePacket};
+    use alhazen_math::Ray;
+    use std::arch::x86_64::*;
+
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn load(a: &[f64; SPHERE_LANES]) -> __m512d {
+        // SAFETY: `a` is eight readable f64s; `loadu` needs no alignment.
+        unsafe { _mm512_loadu_pd(a.as_ptr()) }
+    }
+
+    /// `(a·b)` lane by lane, summed as glam's `dot`: `(x·x + y·y) + z·z`.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn dot(a: [__m512d; 3], b: [__m512d; 3]) -> __m512d {
+        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a[0], b[0]), _mm512_mul_pd(a[1], b[1])), _mm512_mul_pd(a[2], b[2]))
+    }
+
+    /// [`super::Sphere::hit`]'s operations on all lanes, in its order, without its branches:
+    /// the nearer root in front of the origin and the lanes hit before `t_max`.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn lanes(p: &SpherePacket, o: [__m512d; 3], d: [__m512d; 3], t_max: __m512d) -> (__m512d, __mmask8) {
+        let f = [0, 1, 2].map(|i| _mm512_sub_pd(o[i], load(&p.center[i])));
+        let a = dot(d, d);
+        let sign = _mm512_set1_pd(-0.0);
+        // `−(f·d)` by flipping the sign bit (`0 − x` would turn −0 into +0).
+        let beta = bits(dot(f, d), sign, _mm512_xor_si512);
+        let s = _mm512_div_pd(beta, a);
+        let perp = [0, 1, 2].map(|i| _mm512_add_pd(f[i], _mm512_mul_pd(d[i], s)));
+        let r = load(&p.radius);
+        let r2 = _mm512_mul_pd(r, r);
+        let disc = _mm512_mul_pd(a, _mm512_sub_pd(r2, dot(perp, perp)));
+        let zero = _mm512_setzero_pd();
+        // `!(disc < 0 || disc is NaN || a == 0)`.
+        let real = _mm512_cmp_pd_mask::<_CMP_NLT_UQ>(disc, zero)
+            & _mm512_cmp_pd_mask::<_CMP_ORD_Q>(disc, disc)
+            & _mm512_cmp_pd_mask::<_CMP_NEQ_UQ>(a, zero);
+        // Most rays pass every sphere of a packet: skip the square root and two divisions.
+        if real == 0 {
+            return (zero, 0);
+        }
+        let c = _mm512_sub_pd(dot(f, f), r2);
+        // `sqrt(disc).copysign(beta)`.
+        let magnitude = bits(sign, _mm512_sqrt_pd(disc), _mm512_andnot_si512);
+        let root = bits(magnitude, bits(sign, beta, _mm512_and_si512), _mm512_or_si512);
+        let q = _mm512_add_pd(beta, root);
+        let q_zero = _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(q, zero);
+        let t0 = _mm512_mask_blend_pd(q_zero, _mm512_div_pd(c, q), zero);
+        let t1 = _mm512_mask_blend_pd(q_zero, _mm512_div_pd(q, a), zero);
+        let (lo, hi) = (min(t0, t1), max(t0, t1));
+        let t = _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_GT_OQ>(lo, zero), hi, lo);
+        let inside = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(t, zero) & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, t_max);
+        (t, real & inside)
+    }
+
+    /// A bitwise operation of AVX-512F on the lanes' bits.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn bits(a: __m512d, b: __m512d, op: unsafe fn(__m512i, __m512i) -> __m512i) -> __m512d {
+        // SAFETY: `op` is one of AVX-512F's bitwise intrinsics, which this function enables.
+        _mm512_castsi512_pd(unsafe { op(_mm512_castpd_si512(a), _mm512_castpd_si512(b)) })
+    }
+
+    /// `f64::min` lane by lane (the other operand where one is NaN).
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn min(a: __m512d, b: __m512d) -> __m512d {
+        _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_LT_OQ>(b, a) | _mm512_cmp_pd_mask::<_CMP_UNORD_Q>(a, a), a, b)
+    }
+
+    /// `f64::max` lane by lane (the other operand where one is NaN).
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn max(a: __m512d, b: __m512d) -> __m512d {
+        _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_GT_OQ>(b, a) | _mm512_cmp_pd_mask::<_CMP_UNORD_Q>(a, a), a, b)
+    }
+
+    /// [`SpherePacket::nearest_of`]: each lane keeps the nearest hit it has seen (strictly
+    /// nearer replaces), compared once at the end.
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn nearest(packets: &[SpherePacket], ray: &Ray, t_max: f64) -> Option<(usize, usize, f64)> {
+        let (ro, rd) = (ray.origin, ray.dir);
+        let o = [_mm512_set1_pd(ro.x), _mm512_set1_pd(ro.y), _mm512_set1_pd(ro.z)];
+        let d = [_mm512_set1_pd(rd.x), _mm512_set1_pd(rd.y), _mm512_set1_pd(rd.z)];
+        let limit = _mm512_set1_pd(t_max);
+        let (mut best_t, mut best_k, mut any) = (limit, _mm512_setzero_si512(), 0);
+        for (k, p) in packets.iter().enumerate() {
+            let (t, inside) = lanes(p, o, d, limit);
+            let closer = inside & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, best_t);
+            best_t = _mm512_mask_blend_pd(closer, best_t, t);
+            best_k = _mm512_mask_blend_epi64(closer, best_k, _mm512_set1_epi64(k as i64));
+            any |= closer;
+        }
+        if any == 0 {
+            return None;
+        }
+        let min = _mm512_reduce_min_pd(_mm512_mask_blend_pd(any, _mm512_set1_pd(f64::INFINITY), best_t));
+        let ties = any & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(best_t, _mm512_set1_pd(min));
+        let mut ks = [0i64; SPHERE_LANES];
+        // SAFETY: `ks` is eight writable i64s; `storeu` needs no alignment.
+        unsafe { _mm512_storeu_si512(ks.as_mut_ptr().cast(), best_k) };
+        let lane = (0..SPHERE_LANES).filter(|&l| ties & (1 << l) != 0).min_by_key(|&l| ks[l])?;
+        Some((ks[lane] as usize, lane, min))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alhazen_math::Vec3;
+    use proptest::prelude::*;
+
+    fn vec3(r: f64) -> impl Strategy<Value = Vec3> {
+        (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+
+    fn sphere() -> impl Strategy<Value = Sphere> {
+        (vec3(3.0), 0.05..1.5f64).prop_map(|(center, radius)| Sphere { center, radius })
+    }
+
+    proptest! {
+        /// Every kernel agrees bit for bit with testing the spheres one by one, in order.
+        #[test]
+        fn packets_equal_sphere_by_sphere(
+            spheres in prop::collection::vec(sphere(), 1..=2 * SPHERE_LANES + 3),
+            fill in 1..=SPHERE_LANES,
+            origin in vec3(4.0),
+            dir in vec3(1.0),
+            t_max in prop_oneof![Just(f64::INFINITY), 0.1..8.0f64],
+        ) {
+            prop_assume!(dir.length() > 1e-3);
+            let ray = Ray::new(origin, dir.normalize());
+            let mut expected = None;
+            let mut limit = t_max;
+            for (i, s) in spheres.iter().enumerate() {
+                if let Some(c) = s.hit(&ray, limit) {
+                    limit = c.t;
+                    expected = Some((i / fill, i % fill, c.t));
+                }
+            }
+            let packets: Vec<SpherePacket> = spheres.chunks(fill).map(SpherePacket::new).collect();
+            for unit in VectorUnit::available() {
+                prop_assert_eq!(SpherePacket::nearest_of(&packets, &ray, t_max, unit), expected, "{:?}", unit);
+            }
+        }
+    }
+
+    /// Rays from inside, tangent rays and a sphere seen from far away take the same roots.
+    #[test]
+    fn inside_tangent_and_far_rays_agree() {
+        let spheres = [
+            Sphere { center: Vec3::ZERO, radius: 1.0 },
+            Sphere { center: Vec3::new(0.0, 1.0, 5.0), radius: 1.0 },
+            Sphere { center: Vec3::new(0.0, 0.0, -1e6), radius: 2.0 },
+        ];
+        let packet = [SpherePacket::new(&spheres)];
+        let rays = [
+            Ray::new(Vec3::new(0.1, 0.2, 0.0), Vec3::Z),
+            Ray::new(Vec3::new(0.0, 0.0, 2.0), Vec3::Z),
+            Ray::new(Vec3::new(0.5, 0.0, 1e3), -Vec3::Z),
+        ];
+        for ray in rays {
+            let expected = spheres
+                .iter()
+                .enumerate()
+                .fold((None, f64::INFINITY), |(best, lim), (i, s)| match s.hit(&ray, lim) {
+                    Some(c) => (Some((0, i, c.t)), c.t),
+                    None => (best, lim),
+                })
+                .0;
+            assert!(expected.is_some());
+            for unit in VectorUnit::available() {
+                assert_eq!(SpherePacket::nearest_of(&packet, &ray, f64::INFINITY, unit), expected, "{unit:?}");
+            }
+        }
+    }
+}
