@@ -56,7 +56,13 @@ use whitted::WhittedEstimator;
 /// Renders `scene` with its own settings (`scene.render`); `progress(done, total)` reports
 /// finished tiles. Runs on the current rayon pool.
 pub fn render(scene: &Scene, progress: &(dyn Fn(usize, usize) + Sync)) -> Image {
-    let world = World::build(scene);
+    render_with(scene, shape::VectorUnit::detect(), progress)
+}
+
+/// [`render`] with the packets tested by `unit`'s kernel (one of [`shape::VectorUnit::available`]):
+/// the same image from every kernel.
+pub fn render_with(scene: &Scene, unit: shape::VectorUnit, progress: &(dyn Fn(usize, usize) + Sync)) -> Image {
+    let world = World::build_with(scene, unit);
     let s = &scene.render;
     let camera = Camera::new(&scene.camera, s.width, s.height);
     let (w, h) = (camera.film_width, camera.film_height);

@@ -156,7 +156,7 @@ fn flattenable(p: &Placed) -> Option<&alhazen_geom::TriangleMesh> {
     }
 }
 
-fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene) -> Placed {
+fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene, unit: VectorUnit) -> Placed {
     let small = match &o.shape {
         scene::Shape::Mesh { mesh, smooth } if !o.transform.is_identity() => {
             let m = &scene.meshes[*mesh];
@@ -169,21 +169,28 @@ fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene) -> 
         _ => None,
     };
     if let Some((m, smooth)) = small {
-        let accel = Arc::new(MeshAccel::new(Arc::new(baked(&m, &o.transform))));
+        let accel = Arc::new(MeshAccel::with_unit(Arc::new(baked(&m, &o.transform)), unit));
         return Placed::new(Shape::Mesh(MeshShape { accel, smooth }), alhazen_math::Transform::IDENTITY);
     }
     Placed::new(build_shape(&o.shape, meshes), o.transform)
 }
 
 impl World {
-    /// Places every object of `scene` and builds the BVH.
+    /// Places every object of `scene` and builds the BVH, for this processor's widest kernel.
     pub fn build(scene: &scene::Scene) -> Self {
-        let meshes: Vec<Arc<MeshAccel>> = scene.meshes.iter().map(|m| Arc::new(MeshAccel::new(m.clone()))).collect();
+        Self::build_with(scene, VectorUnit::detect())
+    }
+
+    /// [`Self::build`] testing packets with `unit`'s kernel (one this processor runs: see
+    /// [`VectorUnit::available`]). Every kernel gives the same hits.
+    pub fn build_with(scene: &scene::Scene, unit: VectorUnit) -> Self {
+        let meshes: Vec<Arc<MeshAccel>> =
+            scene.meshes.iter().map(|m| Arc::new(MeshAccel::with_unit(m.clone(), unit))).collect();
         let objects: Vec<WorldObject> = scene
             .objects
             .iter()
             .map(|o| WorldObject {
-                placed: Placed { uv: uses_uv(o, scene), ..place(o, &meshes, scene) },
+                placed: Placed { uv: uses_uv(o, scene), ..place(o, &meshes, scene, unit) },
                 material: o.material,
                 slot_materials: o.mesh_materials.clone(),
                 bumpy: std::iter::once(&o.material)
@@ -215,7 +222,7 @@ impl World {
         // The tree does not depend on the processor (its SAH charges packets of four), so
         // neither do the order of tests nor the hit chosen on a tie.
         let bvh = Bvh::build_packed(&prim_bounds, |k| matches!(primitives[k], Primitive::Flat { .. }));
-        let mut world = Self { objects, unbounded, vectors: VectorUnit::detect(), ..Self::default() };
+        let mut world = Self { objects, unbounded, vectors: unit, ..Self::default() };
         world.fill_leaves(&bvh, &primitives);
         world.bvh = bvh;
         world

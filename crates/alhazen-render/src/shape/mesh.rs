@@ -30,12 +30,17 @@ pub struct MeshAccel {
 }
 
 impl MeshAccel {
-    /// Builds the BVH over the mesh's flats and packs its leaves.
+    /// Builds the BVH over the mesh's flats and packs its leaves for this processor's widest
+    /// kernel.
     pub fn new(mesh: Arc<TriangleMesh>) -> Self {
+        Self::with_unit(mesh, VectorUnit::detect())
+    }
+
+    /// [`Self::new`] for `vectors`' kernel.
+    pub fn with_unit(mesh: Arc<TriangleMesh>, vectors: VectorUnit) -> Self {
         let flats = flat_primitives(&mesh);
         let bounds: Vec<Bounds3> = flats.iter().map(|f| f.2).collect();
         let bvh = Bvh::build_packed(&bounds, |_| true);
-        let vectors = VectorUnit::detect();
         let (mut packets, mut leaf_packets) = (PackedFlats::default(), vec![0..0; bvh.leaf_order().len()]);
         for range in bvh.leaves() {
             let leaf: Vec<_> =
