@@ -314,45 +314,10 @@ mod avx2 {
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod avx512 {
-    use super::{FlatPacket, LANES, LaneHit};
+    use super::super::avx512::{NearestLanes, RayLanes, dot, lane_of, load, load3, ray_lanes};
+    use super::{FlatPacket, LaneHit};
     use alhazen_math::Ray;
     use std::arch::x86_64::*;
-
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn load(a: &[f64; LANES]) -> __m512d {
-        // SAFETY: `a` is eight readable f64s; `loadu` needs no alignment.
-        unsafe { _mm512_loadu_pd(a.as_ptr()) }
-    }
-
-    /// `(a·b)` lane by lane, summed as glam's `dot`: `(x·x + y·y) + z·z`.
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn dot(a: [__m512d; 3], b: [__m512d; 3]) -> __m512d {
-        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a[0], b[0]), _mm512_mul_pd(a[1], b[1])), _mm512_mul_pd(a[2], b[2]))
-    }
-
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn load3(a: &[[f64; LANES]; 3]) -> [__m512d; 3] {
-        [load(&a[0]), load(&a[1]), load(&a[2])]
-    }
-
-    /// The ray's origin and direction, each coordinate in all lanes.
-    struct RayLanes {
-        origin: [__m512d; 3],
-        dir: [__m512d; 3],
-    }
-
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn ray_lanes(ray: &Ray) -> RayLanes {
-        let (o, d) = (ray.origin, ray.dir);
-        RayLanes {
-            origin: [_mm512_set1_pd(o.x), _mm512_set1_pd(o.y), _mm512_set1_pd(o.z)],
-            dir: [_mm512_set1_pd(d.x), _mm512_set1_pd(d.y), _mm512_set1_pd(d.z)],
-        }
-    }
 
     /// [`super::Flat::hit`]'s operations on all eight lanes, in its order, without its early
     /// exits: `(t, b1, b2)` and the lanes hit with `0 < t < t_max`.
@@ -382,37 +347,15 @@ mod avx512 {
     pub(super) fn nearest(packets: &[FlatPacket], ray: &Ray, t_max: f64) -> Option<(usize, LaneHit)> {
         let r = ray_lanes(ray);
         let limit = _mm512_set1_pd(t_max);
-        let (mut best_t, mut best_b1, mut best_b2) = (limit, _mm512_setzero_pd(), _mm512_setzero_pd());
-        let (mut best_k, mut any) = (_mm512_setzero_si512(), 0);
+        let (mut best, mut best_b1, mut best_b2) = (NearestLanes::new(limit), _mm512_setzero_pd(), _mm512_setzero_pd());
         for (k, p) in packets.iter().enumerate() {
             let (t, b1, b2, inside) = lanes(p, &r, limit);
-            let closer = inside & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, best_t);
-            best_t = _mm512_mask_blend_pd(closer, best_t, t);
+            let closer = best.update(k, t, inside);
             best_b1 = _mm512_mask_blend_pd(closer, best_b1, b1);
             best_b2 = _mm512_mask_blend_pd(closer, best_b2, b2);
-            best_k = _mm512_mask_blend_epi64(closer, best_k, _mm512_set1_epi64(k as i64));
-            any |= closer;
         }
-        if any == 0 {
-            return None;
-        }
-        let min = _mm512_reduce_min_pd(_mm512_mask_blend_pd(any, _mm512_set1_pd(f64::INFINITY), best_t));
-        let ties = any & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(best_t, _mm512_set1_pd(min));
-        let lane = if ties.is_power_of_two() { ties.trailing_zeros() as usize } else { first_packet(ties, best_k) };
-        let at = |v: __m512d| _mm512_cvtsd_f64(_mm512_permutexvar_pd(_mm512_set1_epi64(lane as i64), v));
-        let k =
-            _mm_cvtsi128_si64(_mm512_castsi512_si128(_mm512_permutexvar_epi64(_mm512_set1_epi64(lane as i64), best_k)));
-        Some((k as usize, LaneHit { lane, t: min, b1: at(best_b1), b2: at(best_b2) }))
-    }
-
-    /// Of the lanes in `ties`, the one whose packet (`k`) came first, then the first lane.
-    #[cold]
-    #[target_feature(enable = "avx512f")]
-    fn first_packet(ties: __mmask8, k: __m512i) -> usize {
-        let mut ks = [0i64; LANES];
-        // SAFETY: `ks` is eight writable i64s; `storeu` needs no alignment.
-        unsafe { _mm512_storeu_si512(ks.as_mut_ptr().cast(), k) };
-        (0..LANES).filter(|&l| ties & (1 << l) != 0).min_by_key(|&l| ks[l]).unwrap_or(0)
+        let (lane, k, t) = best.nearest()?;
+        Some((k, LaneHit { lane, t, b1: lane_of(best_b1, lane), b2: lane_of(best_b2, lane) }))
     }
 
     /// [`FlatPacket::any_of`]: the lanes hit, gathered over every packet.

@@ -5,6 +5,9 @@
 //! Rays need not have unit directions here: transformed rays keep the world parameter `t`.
 
 mod aabox;
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx512;
 mod csg;
 mod cylinder;
 mod flat;

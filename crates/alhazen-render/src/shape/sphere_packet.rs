@@ -68,23 +68,10 @@ impl SpherePacket {
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod avx512 {
-    use super::{SPHERE_LANES, SpherePacket};
+    use super::super::avx512::{NearestLanes, dot, load, ray_lanes};
+    use super::SpherePacket;
     use alhazen_math::Ray;
     use std::arch::x86_64::*;
-
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn load(a: &[f64; SPHERE_LANES]) -> __m512d {
-        // SAFETY: `a` is eight readable f64s; `loadu` needs no alignment.
-        unsafe { _mm512_loadu_pd(a.as_ptr()) }
-    }
-
-    /// `(a·b)` lane by lane, summed as glam's `dot`: `(x·x + y·y) + z·z`.
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn dot(a: [__m512d; 3], b: [__m512d; 3]) -> __m512d {
-        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(a[0], b[0]), _mm512_mul_pd(a[1], b[1])), _mm512_mul_pd(a[2], b[2]))
-    }
 
     /// [`super::Sphere::hit`]'s operations on all lanes, in its order, without its branches:
     /// the nearer root in front of the origin and the lanes hit before `t_max`.
@@ -150,28 +137,15 @@ mod avx512 {
     /// nearer replaces), compared once at the end.
     #[target_feature(enable = "avx512f")]
     pub(super) fn nearest(packets: &[SpherePacket], ray: &Ray, t_max: f64) -> Option<(usize, usize, f64)> {
-        let (ro, rd) = (ray.origin, ray.dir);
-        let o = [_mm512_set1_pd(ro.x), _mm512_set1_pd(ro.y), _mm512_set1_pd(ro.z)];
-        let d = [_mm512_set1_pd(rd.x), _mm512_set1_pd(rd.y), _mm512_set1_pd(rd.z)];
+        let r = ray_lanes(ray);
         let limit = _mm512_set1_pd(t_max);
-        let (mut best_t, mut best_k, mut any) = (limit, _mm512_setzero_si512(), 0);
+        let mut best = NearestLanes::new(limit);
         for (k, p) in packets.iter().enumerate() {
-            let (t, inside) = lanes(p, o, d, limit);
-            let closer = inside & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, best_t);
-            best_t = _mm512_mask_blend_pd(closer, best_t, t);
-            best_k = _mm512_mask_blend_epi64(closer, best_k, _mm512_set1_epi64(k as i64));
-            any |= closer;
+            let (t, inside) = lanes(p, r.origin, r.dir, limit);
+            best.update(k, t, inside);
         }
-        if any == 0 {
-            return None;
-        }
-        let min = _mm512_reduce_min_pd(_mm512_mask_blend_pd(any, _mm512_set1_pd(f64::INFINITY), best_t));
-        let ties = any & _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(best_t, _mm512_set1_pd(min));
-        let mut ks = [0i64; SPHERE_LANES];
-        // SAFETY: `ks` is eight writable i64s; `storeu` needs no alignment.
-        unsafe { _mm512_storeu_si512(ks.as_mut_ptr().cast(), best_k) };
-        let lane = (0..SPHERE_LANES).filter(|&l| ties & (1 << l) != 0).min_by_key(|&l| ks[l])?;
-        Some((ks[lane] as usize, lane, min))
+        let (lane, k, t) = best.nearest()?;
+        Some((k, lane, t))
     }
 }
 
