@@ -71,18 +71,18 @@ impl FlatPacket {
     }
 
     /// The nearest hit with `0 < t < t_max` among the lanes (the first lane on a tie), by the
-    /// kernel of `unit` (from [`VectorUnit::detect`] or [`VectorUnit::None`]).
+    /// kernel of `unit`.
     #[inline]
     #[allow(unsafe_code)]
     pub fn hit(&self, ray: &Ray, t_max: f64, unit: VectorUnit) -> Option<LaneHit> {
-        match unit {
-            VectorUnit::None => self.hit_portable(ray, t_max),
+        match unit.0 {
+            Unit::Portable => self.hit_portable(ray, t_max),
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `detect` returns `Avx2` only when this processor has AVX2.
-            VectorUnit::Avx2 => unsafe { avx2::hit(self, ray, t_max) },
+            // SAFETY: a `VectorUnit` says AVX2 only where the processor has it (`available`).
+            Unit::Avx2 => unsafe { avx2::hit(self, ray, t_max) },
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `detect` returns `Avx512` only when this processor has AVX-512F.
-            VectorUnit::Avx512 => unsafe { avx512::nearest(std::slice::from_ref(self), ray, t_max) }.map(|(_, h)| h),
+            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+            Unit::Avx512 => unsafe { avx512::nearest(std::slice::from_ref(self), ray, t_max) }.map(|(_, h)| h),
         }
     }
 
@@ -92,8 +92,8 @@ impl FlatPacket {
     #[allow(unsafe_code)]
     pub fn nearest_of(packets: &[Self], ray: &Ray, t_max: f64, unit: VectorUnit) -> Option<(usize, LaneHit)> {
         #[cfg(target_arch = "x86_64")]
-        if unit == VectorUnit::Avx512 {
-            // SAFETY: `detect` returns `Avx512` only when this processor has AVX-512F.
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
             return unsafe { avx512::nearest(packets, ray, t_max) };
         }
         let mut best = None;
@@ -111,8 +111,8 @@ impl FlatPacket {
     #[allow(unsafe_code)]
     pub fn any_of(packets: &[Self], ray: &Ray, t_max: f64, unit: VectorUnit) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if unit == VectorUnit::Avx512 {
-            // SAFETY: `detect` returns `Avx512` only when this processor has AVX-512F.
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
             return unsafe { avx512::any(packets, ray, t_max) };
         }
         packets.iter().any(|p| p.hit(ray, t_max, unit).is_some())
@@ -178,12 +178,17 @@ impl<L: Copy + Default> PackedFlats<L> {
     }
 }
 
-/// Which of [`FlatPacket::hit`]'s kernels runs: all give the same bits.
+/// Which of the packet kernels runs: all give the same bits. A value can only come from
+/// [`VectorUnit::detect`], [`VectorUnit::available`] or [`VectorUnit::PORTABLE`], so it never
+/// names an instruction set this processor lacks (the kernels rely on that).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum VectorUnit {
+pub struct VectorUnit(Unit);
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Unit {
     /// One lane after the other (any processor).
     #[default]
-    None,
+    Portable,
     /// Two halves of four lanes in AVX2 registers.
     #[cfg(target_arch = "x86_64")]
     Avx2,
@@ -193,43 +198,46 @@ pub enum VectorUnit {
 }
 
 impl VectorUnit {
+    /// The portable loop, on any processor.
+    pub const PORTABLE: Self = Self(Unit::Portable);
+
     /// The widest kernel this processor runs.
     pub fn detect() -> Self {
+        Self::available().pop().unwrap_or(Self::PORTABLE)
+    }
+
+    /// Every kernel this processor runs, narrowest first.
+    pub fn available() -> Vec<Self> {
+        let mut units = vec![Self::PORTABLE];
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                return Self::Avx512;
-            }
             if std::arch::is_x86_feature_detected!("avx2") {
-                return Self::Avx2;
+                units.push(Self(Unit::Avx2));
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                units.push(Self(Unit::Avx512));
             }
         }
-        Self::None
+        units
     }
 
     /// Flats per packet for this kernel: eight fill an AVX-512 register; four an AVX2 one, and
     /// a packet of eight would mostly test empty lanes there.
     pub fn lanes(self) -> usize {
-        match self {
-            #[cfg(target_arch = "x86_64")]
-            Self::Avx512 => LANES,
-            _ => HALF,
-        }
+        if self.is_avx512() { LANES } else { HALF }
     }
 
-    /// Every kernel this processor runs (for tests).
-    pub fn available() -> Vec<Self> {
-        let mut units = vec![Self::None];
+    /// The AVX-512 kernels run.
+    #[inline]
+    pub fn is_avx512(self) -> bool {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                units.push(Self::Avx2);
-            }
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                units.push(Self::Avx512);
-            }
+            self.0 == Unit::Avx512
         }
-        units
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            false
+        }
     }
 }
 

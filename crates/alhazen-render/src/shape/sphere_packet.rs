@@ -48,8 +48,8 @@ impl SpherePacket {
     #[allow(unsafe_code)]
     pub fn nearest_of(packets: &[Self], ray: &Ray, t_max: f64, unit: VectorUnit) -> Option<(usize, usize, f64)> {
         #[cfg(target_arch = "x86_64")]
-        if unit == VectorUnit::Avx512 {
-            // SAFETY: `detect` returns `Avx512` only when this processor has AVX-512F.
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
             return unsafe { avx512::nearest(packets, ray, t_max) };
         }
         let _ = unit;
