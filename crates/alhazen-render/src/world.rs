@@ -1,7 +1,8 @@
 //! The renderable world: every object of the scene placed, with a top-level BVH over the
 //! bounded ones and a plain list of unbounded ones (planes). Small meshes, rectangles and
 //! untextured boxes are flattened into world-space triangles and parallelograms, which the
-//! BVH's leaves test four or eight at a time ([`FlatPacket`]); other objects are tested one by one.
+//! BVH's leaves test four or eight at a time ([`FlatPacket`]); a leaf's untransformed spheres,
+//! three or more, are one [`SpherePacket`]; other objects are tested one by one.
 
 use crate::bvh::Bvh;
 use crate::shape::{
