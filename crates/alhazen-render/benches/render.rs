@@ -1,10 +1,13 @@
 //! Criterion benchmarks: the glass-balls scene at reduced size (whole pipeline), rays per
 //! second against the BVH, and the Cornell box's world with rays like a path tracer's (from
-//! inside the room, in every direction). The full-size comparisons are
+//! inside the room, in every direction), each world once per packet kernel the processor runs
+//! (`portable`, `avx2`, `avx512`: the same hits, so only the speed differs). The full-size
+//! comparisons are
 //! `bench/povray-compare.sh` and `bench/mitsuba/compare.py`.
 
 use alhazen_math::{Ray, Vec3};
 use alhazen_render::World;
+use alhazen_render::shape::VectorUnit;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;
@@ -33,7 +36,6 @@ fn bench_render(c: &mut Criterion) {
 
 fn bench_intersect(c: &mut Criterion) {
     let scene = glass_balls();
-    let world = World::build(&scene);
     let rays: Vec<Ray> = (0..1024)
         .map(|i| {
             let (x, y) = ((i % 32) as f64 / 32.0 - 0.5, (i / 32) as f64 / 32.0 - 0.3);
@@ -42,14 +44,17 @@ fn bench_intersect(c: &mut Criterion) {
         .collect();
     let mut g = c.benchmark_group("intersect");
     g.throughput(Throughput::Elements(rays.len() as u64));
-    g.bench_function("glass-balls world (rays/s)", |b| {
-        b.iter(|| rays.iter().filter(|r| world.intersect(black_box(r), f64::INFINITY).is_some()).count())
-    });
+    for unit in VectorUnit::available() {
+        let world = World::build_with(&scene, unit);
+        g.bench_function(format!("glass-balls world, {} (rays/s)", unit.name()), |b| {
+            b.iter(|| rays.iter().filter(|r| world.intersect(black_box(r), f64::INFINITY).is_some()).count())
+        });
+    }
     g.finish();
 }
 
 fn bench_cornell_rays(c: &mut Criterion) {
-    let world = World::build(&example("cornell-box.toml"));
+    let scene = example("cornell-box.toml");
     let mut state = 12345u64;
     let mut uniform = || {
         state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
@@ -63,12 +68,15 @@ fn bench_cornell_rays(c: &mut Criterion) {
         .collect();
     let mut g = c.benchmark_group("cornell-box world");
     g.throughput(Throughput::Elements(rays.len() as u64));
-    g.bench_function("nearest hit (rays/s)", |b| {
-        b.iter(|| rays.iter().filter(|r| world.intersect(black_box(r), f64::INFINITY).is_some()).count())
-    });
-    g.bench_function("shadow rays of length 0.5 (rays/s)", |b| {
-        b.iter(|| rays.iter().filter(|r| world.unoccluded(black_box(r.origin), r.dir, 0.5)).count())
-    });
+    for unit in VectorUnit::available() {
+        let world = World::build_with(&scene, unit);
+        g.bench_function(format!("nearest hit, {} (rays/s)", unit.name()), |b| {
+            b.iter(|| rays.iter().filter(|r| world.intersect(black_box(r), f64::INFINITY).is_some()).count())
+        });
+        g.bench_function(format!("shadow rays of length 0.5, {} (rays/s)", unit.name()), |b| {
+            b.iter(|| rays.iter().filter(|r| world.unoccluded(black_box(r.origin), r.dir, 0.5)).count())
+        });
+    }
     g.finish();
 }
 

@@ -227,6 +227,17 @@ impl VectorUnit {
         if self.is_avx512() { LANES } else { HALF }
     }
 
+    /// `portable`, `avx2` or `avx512`.
+    pub fn name(self) -> &'static str {
+        match self.0 {
+            Unit::Portable => "portable",
+            #[cfg(target_arch = "x86_64")]
+            Unit::Avx2 => "avx2",
+            #[cfg(target_arch = "x86_64")]
+            Unit::Avx512 => "avx512",
+        }
+    }
+
     /// The AVX-512 kernels run.
     #[inline]
     pub fn is_avx512(self) -> bool {
