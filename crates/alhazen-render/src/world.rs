@@ -287,7 +287,10 @@ impl World {
                 (t_max, closer) = (h.t, Some(h.t));
             }
             let spheres = &self.spheres[leaf.spheres.clone()];
-            if let Some((k, lane, t)) = SpherePacket::nearest_of(spheres, ray, t_max, self.vectors) {
+            // Most leaves hold no sphere packet: skip the kernel's call.
+            if !spheres.is_empty()
+                && let Some((k, lane, t)) = SpherePacket::nearest_of(spheres, ray, t_max, self.vectors)
+            {
                 let object = self.sphere_objects[leaf.spheres.start + k][lane];
                 (best, best_flat) = (Some((Candidate { t, aux: 0, bary: [0.0; 2] }, object)), None);
                 (t_max, closer) = (t, Some(t));
@@ -345,7 +348,9 @@ impl World {
         self.bvh.traverse_leaves(&ray, dist, |range, t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
             blocked = FlatPacket::any_of(&self.flats.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
-                || SpherePacket::nearest_of(&self.spheres[leaf.spheres.clone()], &ray, t_max, self.vectors).is_some()
+                || !leaf.spheres.is_empty()
+                    && SpherePacket::nearest_of(&self.spheres[leaf.spheres.clone()], &ray, t_max, self.vectors)
+                        .is_some()
                 || self.leaf_objects[leaf.objects.clone()]
                     .iter()
                     .any(|&i| self.objects[i as usize].placed.hit(&ray, t_max).is_some());
