@@ -31,6 +31,12 @@ impl Image {
 pub trait PixelEstimator: Sync {
     /// Linear RGB of sample `index` of pixel `(x, y)`: a pure function of its arguments.
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3;
+
+    /// Every sample of pixel `(x, y)`: `out[i] = self.sample(x, y, i)`, in whatever order
+    /// the estimator computes them fastest.
+    fn samples(&self, x: u32, y: u32, out: &mut [Vec3]) {
+        out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample(x, y, i as u32));
+    }
 }
 
 /// Renders a `w × h` image with `spp` samples per pixel, averaged with a box filter;
@@ -49,9 +55,11 @@ pub fn render_image(
         .par_iter()
         .map(|&(x0, y0)| {
             let mut out = Vec::with_capacity((TILE * TILE) as usize);
+            let mut samples = vec![Vec3::ZERO; spp as usize];
             for y in y0..(y0 + TILE).min(h) {
                 for x in x0..(x0 + TILE).min(w) {
-                    out.push(pixel(estimator, x, y, spp));
+                    estimator.samples(x, y, &mut samples);
+                    out.push(average(&samples));
                 }
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, tiles.len());
@@ -69,13 +77,13 @@ pub fn render_image(
     Image { width: w, height: h, pixels }
 }
 
-fn pixel(estimator: &dyn PixelEstimator, x: u32, y: u32, spp: u32) -> [f32; 3] {
+/// The box-filtered pixel of its samples, summed in index order.
+fn average(samples: &[Vec3]) -> [f32; 3] {
     let mut sum = Vec3::ZERO;
-    for s in 0..spp {
-        let c = estimator.sample(x, y, s);
+    for &c in samples {
         // A NaN or infinity from a degenerate input must not poison the pixel.
         sum += if c.is_finite() { c } else { Vec3::ZERO };
     }
-    let c = sum / spp as f64;
+    let c = sum / samples.len() as f64;
     [c.x as f32, c.y as f32, c.z as f32]
 }

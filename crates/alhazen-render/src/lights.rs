@@ -225,8 +225,24 @@ impl Lights {
         self.lights.is_empty()
     }
 
-    fn choice_pdf(&self) -> f64 {
+    /// Probability of choosing any one light.
+    pub fn choice_pdf(&self) -> f64 {
         1.0 / self.lights.len() as f64
+    }
+
+    /// The light `u_choice` chooses (uniformly); there must be one.
+    #[inline]
+    pub fn choose(&self, u_choice: f64) -> usize {
+        ((u_choice * self.lights.len() as f64) as usize).min(self.lights.len() - 1)
+    }
+
+    /// Every light, when all are parallelograms (one or more): `(emitter, radiance)`.
+    pub fn parallelograms(&self) -> Option<Vec<(Emitter, Vec3)>> {
+        let all = self.lights.iter().map(|l| match l {
+            PathLight::Area { emitter: e @ Emitter::Parallelogram { .. }, radiance } => Some((e.clone(), *radiance)),
+            _ => None,
+        });
+        all.collect::<Option<Vec<_>>>().filter(|v| !v.is_empty())
     }
 
     /// Radiance of the sky (environment or background) in direction `dir`.
@@ -273,8 +289,7 @@ impl Lights {
         if self.lights.is_empty() {
             return None;
         }
-        let i = ((u_choice * self.lights.len() as f64) as usize).min(self.lights.len() - 1);
-        let mut s = self.sample_one(&self.lights[i], p, u)?;
+        let mut s = self.sample_one(&self.lights[self.choose(u_choice)], p, u)?;
         s.pdf *= self.choice_pdf();
         Some(s)
     }

@@ -22,6 +22,8 @@ use alhazen_math::{Ray, Vec2, Vec3};
 use alhazen_scene::{SamplerKind, Scene};
 use std::borrow::Cow;
 
+mod lanes;
+
 /// Depth from which Russian roulette may end paths (Mitsuba's `rr_depth`).
 const RR_DEPTH: u32 = 5;
 
@@ -35,6 +37,10 @@ pub struct PathTracer<'a> {
     sequence: Sequence,
     /// Each material's BSDF in RGB when it does not vary over the surface (no texture).
     uniform_bsdfs: Vec<Option<Bsdf>>,
+    /// Pixels are traced eight samples at a time ([`lanes`]); same image.
+    pub in_lanes: bool,
+    /// The lights, when every one is a parallelogram, for the lanes to sample.
+    lane_lights: Option<Vec<lanes::LaneLight>>,
 }
 
 /// Power heuristic with β = 2.
@@ -81,7 +87,12 @@ impl<'a> PathTracer<'a> {
                 untextured.then(|| bsdf_at(m, Vec2::ZERO, &scene.images, ColorMode::Rgb))
             })
             .collect();
-        Self { scene, world, camera, lights: Lights::build(scene), spectral, sequence, uniform_bsdfs }
+        let lights = Lights::build(scene);
+        let lane_lights = lanes::lane_lights(&lights);
+        let mut tracer =
+            Self { scene, world, camera, lights, spectral, sequence, uniform_bsdfs, in_lanes: false, lane_lights };
+        tracer.in_lanes = tracer.lanes_apply();
+        tracer
     }
 
     /// Radiance along `ray` in the channels of `mode`.
@@ -92,10 +103,8 @@ impl<'a> PathTracer<'a> {
         let mut prev = Previous { p: ray.origin, pdf: 1.0, delta: true };
         for depth in 1..=max_depth {
             let Some(wh) = self.world.intersect(&ray, f64::INFINITY) else {
-                let le = self.lights.sky_radiance(ray.dir);
-                if le != Vec3::ZERO {
-                    let w = if prev.delta { 1.0 } else { power_heuristic(prev.pdf, self.lights.sky_pdf(ray.dir)) };
-                    l += beta * mode.color(le) * w;
+                if let Some(sky) = self.escaped(&ray, &prev, beta, mode) {
+                    l += sky;
                 }
                 break;
             };
@@ -141,6 +150,17 @@ impl<'a> PathTracer<'a> {
             ray = Ray::new(offset(wh.hit.p, ng, dir), dir);
         }
         l
+    }
+
+    /// What a path carrying `beta` gathers from the sky when `ray` leaves the scene, weighted
+    /// against light sampling; `None` where the sky is black.
+    fn escaped(&self, ray: &Ray, prev: &Previous, beta: Vec3, mode: ColorMode) -> Option<Vec3> {
+        let le = self.lights.sky_radiance(ray.dir);
+        if le == Vec3::ZERO {
+            return None;
+        }
+        let w = if prev.delta { 1.0 } else { power_heuristic(prev.pdf, self.lights.sky_pdf(ray.dir)) };
+        Some(beta * mode.color(le) * w)
     }
 
     /// Emission of the surface hit, weighted against light sampling.
@@ -216,6 +236,14 @@ fn is_dispersive(b: &Bsdf) -> bool {
 }
 
 impl PixelEstimator for PathTracer<'_> {
+    fn samples(&self, x: u32, y: u32, out: &mut [Vec3]) {
+        if self.in_lanes {
+            self.pixel_in_lanes(x, y, out);
+        } else {
+            out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample(x, y, i as u32));
+        }
+    }
+
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
         let mut s = SampleStream::new(self.sequence, self.scene.render.seed, x, y, index);
         let film = s.next_2d();

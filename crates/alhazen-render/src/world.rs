@@ -261,6 +261,11 @@ impl World {
         }
     }
 
+    /// The kernel its packets are tested with.
+    pub fn vector_unit(&self) -> VectorUnit {
+        self.vectors
+    }
+
     /// Bounds of the bounded objects.
     pub fn bounds(&self) -> Bounds3 {
         self.bvh.bounds()

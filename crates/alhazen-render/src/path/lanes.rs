@@ -1,0 +1,584 @@
+//! The path tracer's common case in lanes: eight samples of one pixel traced side by side, so
+//! their shading runs in the processor's vector units (a small wavefront: Laine, Karras and
+//! Aila 2013, "Megakernels Considered Harmful", split a path tracer into stages over many
+//! paths). It applies when every material is an untextured Lambert BSDF in RGB.
+//!
+//! One bounce is three stages. Per path: the nearest hit, emission, the light sample and every
+//! random number of the vertex ([`PathTracer::prepare_vertex`]). Over all lanes at once: the
+//! shading frame, the next-event weights, the cosine-weighted continuation and Russian
+//! roulette ([`shade`], one loop the compiler turns into AVX-512 or AVX2 code). Per path again:
+//! the shadow ray and the step to the next vertex. A lane whose path ends starts the pixel's
+//! next sample, so lanes stay busy until the pixel's samples run out.
+//!
+//! Every lane performs exactly the floating-point operations of [`PathTracer::radiance`], in
+//! the same order (no fused multiply–adds, no reassociation), so the image is bit-identical to
+//! the per-path tracer's on every processor (test `lanes_match_the_per_path_tracer`).
+
+use super::{PathTracer, Previous, RR_DEPTH, power_heuristic};
+use crate::bsdf::{Bsdf, ColorMode};
+use crate::lights::{Emitter, Lights};
+use crate::sampler::SampleStream;
+use crate::shape::VectorUnit;
+use alhazen_math::{Ray, Vec2, Vec3, sin_cos_turns};
+use std::f64::consts::{FRAC_1_PI, PI};
+
+/// Paths traced side by side: one AVX-512 register of `f64`.
+const LANES: usize = 8;
+
+/// One number per lane.
+type Lanes = [f64; LANES];
+
+/// One vector per lane, component by component.
+#[derive(Clone, Copy, Debug, Default)]
+struct Lanes3 {
+    x: Lanes,
+    y: Lanes,
+    z: Lanes,
+}
+
+impl Lanes3 {
+    #[inline(always)]
+    fn get(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x[i], self.y[i], self.z[i])
+    }
+
+    #[inline(always)]
+    fn set(&mut self, i: usize, v: Vec3) {
+        (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
+    }
+}
+
+/// What the per-path stage leaves for [`shade`], lane by lane.
+#[derive(Clone, Debug, Default)]
+struct Vertices {
+    /// Towards the viewer (`−ray.dir`).
+    wo: Lanes3,
+    p: Lanes3,
+    /// Geometric and shading normals as the surface reports them.
+    ng: Lanes3,
+    ns: Lanes3,
+    albedo: Lanes3,
+    beta: Lanes3,
+    /// The light sample, valid where `light` is set (it exists, has radiance and density).
+    light: [bool; LANES],
+    light_dir: Lanes3,
+    light_dist: Lanes,
+    light_radiance: Lanes3,
+    light_pdf: Lanes,
+    light_delta: [bool; LANES],
+    /// The continuation's two numbers, and roulette's where `roulette` is set.
+    u_bsdf: [Lanes; 2],
+    roulette: [bool; LANES],
+    u_roulette: Lanes,
+}
+
+/// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LaneLight {
+    corner: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    normal: Vec3,
+    /// `1 / area`.
+    pdf_area: f64,
+    radiance: Vec3,
+}
+
+/// The lights in lane form when every one is a parallelogram (the lanes then sample them too).
+pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
+    let lights = lights.parallelograms()?.into_iter().map(|(e, radiance)| match e {
+        Emitter::Parallelogram { origin, e1, e2, normal, area } => {
+            Some(LaneLight { corner: origin, e1, e2, normal, pdf_area: 1.0 / area, radiance })
+        }
+        _ => None,
+    });
+    lights.collect()
+}
+
+/// Where the lanes sample parallelogram lights: each lane's light and its two numbers.
+#[derive(Clone, Debug, Default)]
+struct LightLanes {
+    corner: Lanes3,
+    e1: Lanes3,
+    e2: Lanes3,
+    normal: Lanes3,
+    pdf_area: Lanes,
+    u: [Lanes; 2],
+}
+
+/// What [`shade`] returns, lane by lane.
+#[derive(Clone, Debug, Default)]
+struct Shaded {
+    /// Next-event contribution (before `beta`) if the shadow ray is clear; zero when there is
+    /// no light to test (`shadow` unset).
+    light: Lanes3,
+    shadow: [bool; LANES],
+    shadow_origin: Lanes3,
+    shadow_dist: Lanes,
+    /// The path goes on (`alive`) from `origin` along `dir`, sampled with density `pdf`,
+    /// carrying `beta`.
+    alive: [bool; LANES],
+    origin: Lanes3,
+    dir: Lanes3,
+    pdf: Lanes,
+    beta: Lanes3,
+}
+
+/// One sample's path in flight.
+struct Path {
+    index: u32,
+    stream: SampleStream,
+    ray: Ray,
+    depth: u32,
+    l: Vec3,
+    beta: Vec3,
+    prev: Previous,
+}
+
+impl PathTracer<'_> {
+    /// True when every material is an untextured Lambert BSDF and colours are RGB: the case
+    /// [`Self::pixel_in_lanes`] traces.
+    pub(super) fn lanes_apply(&self) -> bool {
+        !self.spectral
+            && self.scene.materials.iter().zip(&self.uniform_bsdfs).all(|(m, b)| {
+                matches!(b, Some(Bsdf::Lambert(_))) && m.bump.is_none() && crate::bsdf::tangent_hint(m).is_none()
+            })
+    }
+
+    /// Every sample of pixel `(x, y)`, `out[i]` being sample `i`, traced in lanes.
+    pub(super) fn pixel_in_lanes(&self, x: u32, y: u32, out: &mut [Vec3]) {
+        let mut paths: [Option<Path>; LANES] = Default::default();
+        let mut next = 0u32;
+        let (mut vertices, mut shaded) = (Vertices::default(), Shaded::default());
+        let mut lights = LightLanes::default();
+        loop {
+            let mut any = false;
+            for (i, slot) in paths.iter_mut().enumerate() {
+                any |= self.prepare_lane(slot, i, (&mut vertices, &mut lights), x, y, &mut next, out);
+            }
+            if !any {
+                return;
+            }
+            let unit = self.world.vector_unit();
+            if self.lane_lights.is_some() {
+                sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
+            }
+            shade(&vertices, &mut shaded, unit);
+            for (i, slot) in paths.iter_mut().enumerate() {
+                if let Some(path) = slot {
+                    self.finish_vertex(path, &vertices, &shaded, i);
+                    if !shaded.alive[i] {
+                        out[path.index as usize] = path.l;
+                        *slot = None;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Brings lane `i` to a vertex to shade, starting the pixel's next samples as paths end;
+    /// false when the pixel has no sample left for it.
+    fn prepare_lane(
+        &self,
+        slot: &mut Option<Path>,
+        i: usize,
+        (v, lights): (&mut Vertices, &mut LightLanes),
+        x: u32,
+        y: u32,
+        next: &mut u32,
+        out: &mut [Vec3],
+    ) -> bool {
+        loop {
+            let path = match slot {
+                Some(path) => path,
+                None if (*next as usize) < out.len() => {
+                    slot.insert(self.start_path(x, y, std::mem::replace(next, *next + 1)))
+                }
+                None => return false,
+            };
+            if self.prepare_vertex(path, v, lights, i) {
+                return true;
+            }
+            out[path.index as usize] = path.l;
+            *slot = None;
+        }
+    }
+
+    fn start_path(&self, x: u32, y: u32, index: u32) -> Path {
+        let mut stream = SampleStream::new(self.sequence, self.scene.render.seed, x, y, index);
+        let film = stream.next_2d();
+        let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
+        let prev = Previous { p: ray.origin, pdf: 1.0, delta: true };
+        Path { index, stream, ray, depth: 1, l: Vec3::ZERO, beta: Vec3::ONE, prev }
+    }
+
+    /// The per-path half of a vertex, as in [`Self::radiance`]: the hit, its emission, the light
+    /// sample and the vertex's random numbers, written to lane `i`; false when the path ends.
+    fn prepare_vertex(&self, path: &mut Path, v: &mut Vertices, lights: &mut LightLanes, i: usize) -> bool {
+        let max_depth = self.scene.render.max_depth;
+        if path.depth > max_depth {
+            return false;
+        }
+        let Some(wh) = self.world.intersect(&path.ray, f64::INFINITY) else {
+            if let Some(sky) = self.escaped(&path.ray, &path.prev, path.beta, ColorMode::Rgb) {
+                path.l += sky;
+            }
+            return false;
+        };
+        path.l += path.beta * self.emitted(&wh, &path.ray, &path.prev, ColorMode::Rgb);
+        if path.depth == max_depth {
+            return false;
+        }
+        let Some(Bsdf::Lambert(lambert)) = &self.uniform_bsdfs[wh.material as usize] else {
+            unreachable!("lanes apply only when every material is Lambert (`lanes_apply`)")
+        };
+        let s = &mut path.stream;
+        let choice = if self.lights.len() > 1 { s.next_2d() } else { Vec2::ZERO };
+        let u_light = s.next_2d();
+        match &self.lane_lights {
+            Some(all) => {
+                let k = &all[self.lights.choose(choice.x)];
+                lights.corner.set(i, k.corner);
+                lights.e1.set(i, k.e1);
+                lights.e2.set(i, k.e2);
+                lights.normal.set(i, k.normal);
+                (lights.pdf_area[i], lights.u[0][i], lights.u[1][i]) = (k.pdf_area, u_light.x, u_light.y);
+                v.light_radiance.set(i, k.radiance);
+                (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
+            }
+            None => {
+                let light = self.lights.sample(wh.hit.p, choice.x, u_light);
+                let light = light.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
+                v.light[i] = light.is_some();
+                if let Some(ls) = light {
+                    v.light_dir.set(i, ls.dir);
+                    v.light_radiance.set(i, ls.radiance);
+                    (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
+                }
+            }
+        }
+        let u_bsdf = s.next_2d();
+        let roulette = path.depth >= RR_DEPTH;
+        // Drawn before it is known whether the path survives the continuation; a path that
+        // does not never draws again, so the stream is the per-path tracer's.
+        v.u_roulette[i] = if roulette { s.next_1d() } else { 0.0 };
+        (v.roulette[i], v.u_bsdf[0][i], v.u_bsdf[1][i]) = (roulette, u_bsdf.x, u_bsdf.y);
+        v.wo.set(i, -path.ray.dir);
+        v.p.set(i, wh.hit.p);
+        v.ng.set(i, wh.hit.n);
+        v.ns.set(i, wh.hit.ns);
+        v.albedo.set(i, lambert.albedo);
+        v.beta.set(i, path.beta);
+        path.prev.p = wh.hit.p;
+        true
+    }
+
+    /// The per-path half after [`shade`]: the shadow ray, then the step to the next vertex.
+    fn finish_vertex(&self, path: &mut Path, v: &Vertices, s: &Shaded, i: usize) {
+        let clear = !s.shadow[i] || self.world.unoccluded(s.shadow_origin.get(i), v.light_dir.get(i), s.shadow_dist[i]);
+        let light = if clear { s.light.get(i) } else { Vec3::ZERO };
+        path.l += path.beta * light;
+        if s.alive[i] {
+            path.beta = s.beta.get(i);
+            path.prev.pdf = s.pdf[i];
+            path.prev.delta = false;
+            path.ray = Ray::new(s.origin.get(i), s.dir.get(i));
+            path.depth += 1;
+        }
+    }
+}
+
+/// Every lane's point on its parallelogram light, as `Lights::sample` computes it.
+#[allow(unsafe_code)]
+fn sample_lights(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
+    #[cfg(target_arch = "x86_64")]
+    if unit.is_avx512() {
+        // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+        return unsafe { sample_lights_avx512(k, v, choice_pdf) };
+    }
+    let _ = unit;
+    (0..LANES).for_each(|i| sample_light(k, v, choice_pdf, i));
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[allow(unsafe_code)]
+unsafe fn sample_lights_avx512(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
+    (0..LANES).for_each(|i| sample_light(k, v, choice_pdf, i));
+}
+
+#[inline(always)]
+fn sample_light(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
+    let (ux, uy) = (k.u[0][i], k.u[1][i]);
+    let (o, e1, e2, p) = (lane(&k.corner, i), lane(&k.e1, i), lane(&k.e2, i), lane(&v.p, i));
+    let q = (o.0 + e1.0 * ux + e2.0 * uy, o.1 + e1.1 * ux + e2.1 * uy, o.2 + e1.2 * ux + e2.2 * uy);
+    let to = (q.0 - p.0, q.1 - p.1, q.2 - p.2);
+    let d2 = dot(to, to);
+    let dist = d2.sqrt();
+    let dir = (to.0 / dist, to.1 / dist, to.2 / dist);
+    let cos = -dot(lane(&k.normal, i), dir);
+    let pdf = k.pdf_area[i] * d2 / cos * choice_pdf;
+    v.light[i] &= dist != 0.0 && not_at_most_zero(cos) && not_at_most_zero(pdf);
+    put(&mut v.light_dir, i, dir);
+    (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
+}
+
+/// The Lambertian vertex of every lane at once, with the per-path tracer's arithmetic.
+#[allow(unsafe_code)]
+fn shade(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
+    #[cfg(target_arch = "x86_64")]
+    if unit.is_avx512() {
+        // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+        return unsafe { shade_avx512(v, out) };
+    }
+    let _ = unit;
+    shade_lanes(v, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[allow(unsafe_code)]
+unsafe fn shade_avx512(v: &Vertices, out: &mut Shaded) {
+    shade_lanes(v, out)
+}
+
+#[inline(always)]
+fn shade_lanes(v: &Vertices, out: &mut Shaded) {
+    for i in 0..LANES {
+        shade_lane(v, out, i);
+    }
+}
+
+#[inline(always)]
+fn dot(a: (f64, f64, f64), b: (f64, f64, f64)) -> f64 {
+    (a.0 * b.0) + (a.1 * b.1) + (a.2 * b.2)
+}
+
+#[inline(always)]
+fn lane(v: &Lanes3, i: usize) -> (f64, f64, f64) {
+    (v.x[i], v.y[i], v.z[i])
+}
+
+#[inline(always)]
+fn put(v: &mut Lanes3, i: usize, (x, y, z): (f64, f64, f64)) {
+    (v.x[i], v.y[i], v.z[i]) = (x, y, z);
+}
+
+/// `p` moved off its surface towards the side of `dir` ([`super::offset`]).
+#[inline(always)]
+fn offset(p: (f64, f64, f64), ng: (f64, f64, f64), dir: (f64, f64, f64)) -> (f64, f64, f64) {
+    let eps = lane_epsilon(p);
+    let e = if dot(ng, dir) >= 0.0 { eps } else { -eps };
+    (p.0 + ng.0 * e, p.1 + ng.1 * e, p.2 + ng.2 * e)
+}
+
+/// [`super::epsilon`], with glam's `max_element`.
+#[inline(always)]
+fn lane_epsilon(p: (f64, f64, f64)) -> f64 {
+    let max = |a: f64, b: f64| if a > b { a } else { b };
+    1e-9 * (1.0 + max(p.0.abs(), max(p.1.abs(), p.2.abs())))
+}
+
+#[inline(always)]
+fn shade_lane(v: &Vertices, out: &mut Shaded, i: usize) {
+    let wo = lane(&v.wo, i);
+    let p = lane(&v.p, i);
+    // The shading frame (`PathTracer::shading_frame`, Lambert does not transmit).
+    let (mut ng, mut ns) = (lane(&v.ng, i), lane(&v.ns, i));
+    let ng_wo = dot(ng, wo);
+    if ng_wo < 0.0 {
+        ng = (-ng.0, -ng.1, -ng.2);
+        ns = (-ns.0, -ns.1, -ns.2);
+    }
+    if dot(ns, wo) * dot(ng, wo) <= 0.0 {
+        ns = ng;
+    }
+    let (fs, ft) = orthonormal_basis(ns);
+    let local = |w| (dot(w, fs), dot(w, ft), dot(w, ns));
+    let wv = local(wo);
+    let albedo = lane(&v.albedo, i);
+    let rho = (albedo.0 * FRAC_1_PI, albedo.1 * FRAC_1_PI, albedo.2 * FRAC_1_PI);
+    // Next event (`PathTracer::next_event`).
+    let dir = lane(&v.light_dir, i);
+    let l = local(dir);
+    let same = wv.2 * l.2 > 0.0;
+    let lz = l.2.abs();
+    let f = if same { (rho.0 * lz, rho.1 * lz, rho.2 * lz) } else { (0.0, 0.0, 0.0) };
+    let zero = f.0 == 0.0 && f.1 == 0.0 && f.2 == 0.0;
+    let shadow = v.light[i] && !(zero || (dot(ng, dir) > 0.0) != (l.2 > 0.0));
+    let pdf_light = v.light_pdf[i];
+    let bsdf_pdf = if same { lz / PI } else { 0.0 };
+    let w = if v.light_delta[i] { 1.0 } else { power_heuristic(pdf_light, bsdf_pdf) };
+    let rad = lane(&v.light_radiance, i);
+    let k = w / pdf_light;
+    let c = if shadow { (f.0 * rad.0 * k, f.1 * rad.1 * k, f.2 * rad.2 * k) } else { (0.0, 0.0, 0.0) };
+    put(&mut out.light, i, c);
+    out.shadow[i] = shadow;
+    put(&mut out.shadow_origin, i, offset(p, ng, dir));
+    let d = v.light_dist[i];
+    out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * lane_epsilon(p) } else { f64::INFINITY };
+    // The continuation (`sample_cosine`, Malley's method).
+    let (ux, uy) = (v.u_bsdf[0][i], v.u_bsdf[1][i]);
+    let r = ux.sqrt();
+    let (sin, cos) = sin_cos_turns(uy);
+    let z = (1.0 - ux).max(0.0).sqrt();
+    let l = (r * cos, r * sin, if wv.2 < 0.0 { -z } else { z });
+    let pdf = if wv.2 * l.2 > 0.0 { l.2.abs() / PI } else { 0.0 };
+    let dir = (
+        fs.0 * l.0 + ft.0 * l.1 + ns.0 * l.2,
+        fs.1 * l.0 + ft.1 * l.1 + ns.1 * l.2,
+        fs.2 * l.0 + ft.2 * l.1 + ns.2 * l.2,
+    );
+    let lz = l.2.abs();
+    let weight = ((rho.0 * lz) / pdf, (rho.1 * lz) / pdf, (rho.2 * lz) / pdf);
+    let finite = weight.0.is_finite() && weight.1.is_finite() && weight.2.is_finite();
+    let nonzero = !(weight.0 == 0.0 && weight.1 == 0.0 && weight.2 == 0.0);
+    let beta = lane(&v.beta, i);
+    let mut beta = (beta.0 * weight.0, beta.1 * weight.1, beta.2 * weight.2);
+    let mut alive = pdf > 0.0 && finite && nonzero;
+    if v.roulette[i] {
+        let max = |a: f64, b: f64| if a > b { a } else { b };
+        let q = (max(beta.0, max(beta.1, beta.2)) * 1.0).min(0.95);
+        // `u ≥ q` ends the path (u is never NaN; a NaN q does not end it).
+        alive &= v.u_roulette[i] < q || q.is_nan();
+        beta = (beta.0 / q, beta.1 / q, beta.2 / q);
+    }
+    out.alive[i] = alive;
+    out.pdf[i] = pdf;
+    put(&mut out.beta, i, beta);
+    put(&mut out.dir, i, dir);
+    put(&mut out.origin, i, offset(p, ng, dir));
+}
+
+/// `!(x <= 0)`, as the per-path tracer's rejections read (NaN passes).
+#[inline(always)]
+fn not_at_most_zero(x: f64) -> bool {
+    x > 0.0 || x.is_nan()
+}
+
+/// [`alhazen_math::orthonormal_basis`] on a tuple, same operations.
+#[inline(always)]
+fn orthonormal_basis(n: (f64, f64, f64)) -> ((f64, f64, f64), (f64, f64, f64)) {
+    let sign = 1f64.copysign(n.2);
+    let a = -1.0 / (sign + n.2);
+    let b = n.0 * n.1 * a;
+    ((1.0 + sign * n.0 * n.0 * a, sign * b, -sign * n.0), (b, sign + n.1 * n.1 * a, -n.1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::film::PixelEstimator;
+    use crate::{Camera, World};
+
+    /// A Lambertian scene the lanes trace with per-path light sampling: spheres, a box and a
+    /// plane, an emitting box (triangles) and sphere, point and spot lights, a gradient sky.
+    const MIXED: &str = r#"
+background = { zenith = [0.3, 0.4, 0.9], horizon = [0.8, 0.8, 0.7], ground = [0.2, 0.15, 0.1] }
+[render]
+width = 24
+height = 18
+spp = 13
+max_depth = 6
+integrator = "path"
+[camera]
+eye = [0, 1.5, 6]
+target = [0, 0.5, 0]
+[[light]]
+type = "point"
+position = [2, 4, 3]
+intensity = 6
+[[light]]
+type = "spot"
+position = [-3, 4, 2]
+direction = [0.5, -1, -0.3]
+angle = 30
+intensity = 8
+[materials.glow]
+color = [0.5, 0.5, 0.5]
+emission = [4, 3, 2]
+[[object]]
+shape = "plane"
+normal = [0, 1, 0]
+material = { color = [0.6, 0.6, 0.5] }
+[[object]]
+shape = "sphere"
+center = [-1, 1, 0]
+radius = 1
+material = { color = [0.8, 0.2, 0.2] }
+[[object]]
+shape = "box"
+min = [0.5, 0, -1]
+max = [1.5, 1.2, 0]
+material = { color = [0.2, 0.7, 0.3] }
+[[object]]
+shape = "box"
+min = [-0.3, 2.5, -0.3]
+max = [0.3, 2.7, 0.3]
+material = "glow"
+[[object]]
+shape = "sphere"
+center = [2, 0.4, 1]
+radius = 0.4
+material = "glow"
+"#;
+
+    /// Every sample of every pixel, `(in lanes, per path)`, in full precision, with `unit`'s
+    /// kernels.
+    fn samples(scene: &alhazen_scene::Scene, unit: VectorUnit) -> (Vec<Vec3>, Vec<Vec3>) {
+        let world = World::build_with(scene, unit);
+        let camera = Camera::new(&scene.camera, scene.render.width, scene.render.height);
+        let mut tracer = PathTracer::new(scene, &world, &camera);
+        assert!(tracer.in_lanes, "the scene is Lambertian: lanes apply");
+        let mut all = [vec![], vec![]];
+        for (in_lanes, out) in [true, false].into_iter().zip(&mut all) {
+            tracer.in_lanes = in_lanes;
+            for (x, y) in (0..camera.film_height).flat_map(|y| (0..camera.film_width).map(move |x| (x, y))) {
+                let mut pixel = vec![Vec3::NAN; scene.render.spp as usize];
+                tracer.samples(x, y, &mut pixel);
+                out.extend(pixel);
+            }
+        }
+        let [lanes, per_path] = all;
+        (lanes, per_path)
+    }
+
+    /// The lanes trace the same bits as the per-path tracer: lights sampled in lanes (the
+    /// Cornell box's parallelogram) and per path (everything else), every depth from 0, a sky,
+    /// sample counts that leave lanes idle; with every vector unit this processor has.
+    #[test]
+    fn lanes_match_the_per_path_tracer() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        let mut cornell = alhazen_scene::load_scene(&root.join("cornell-box.toml")).unwrap();
+        (cornell.render.width, cornell.render.height, cornell.render.spp) = (20, 20, 11);
+        let mixed = alhazen_scene::parse_scene("mixed.toml".as_ref(), MIXED).unwrap();
+        for (name, base) in [("cornell-box", cornell), ("mixed", mixed)] {
+            for depth in [0, 1, 2, 3, 8] {
+                let mut scene = base.clone();
+                scene.render.max_depth = depth;
+                for unit in VectorUnit::available() {
+                    let (lanes, per_path) = samples(&scene, unit);
+                    let same = lanes
+                        .iter()
+                        .zip(&per_path)
+                        .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits));
+                    assert!(same, "{name}, max_depth {depth}, {}: the lanes' samples differ", unit.name());
+                    if depth > 2 {
+                        assert!(lanes.iter().filter(|c| c.x > 0.0).count() > lanes.len() / 4, "{name}: lit");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn lanes_apply_only_to_lambertian_rgb_scenes() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        for (name, lambertian) in [("cornell-box", true), ("cornell-rough", false), ("prism", false)] {
+            let scene = alhazen_scene::load_scene(&root.join(format!("{name}.toml"))).unwrap();
+            let world = World::build(&scene);
+            let camera = Camera::new(&scene.camera, 8, 8);
+            assert_eq!(PathTracer::new(&scene, &world, &camera).in_lanes, lambertian, "{name}");
+        }
+    }
+}
