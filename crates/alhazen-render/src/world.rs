@@ -6,8 +6,9 @@
 
 use crate::bvh::Bvh;
 use crate::shape::{
-    AaBox, Candidate, Cone, Csg, Cylinder, Disk, Flat, FlatLane, FlatPacket, LaneHit, MeshAccel, MeshShape,
-    PackedFlats, Placed, Plane, SPHERE_LANES, Shape, Sphere, SpherePacket, SurfaceHit, VectorUnit, flat_primitives,
+    AaBox, Candidate, Cone, Csg, Cylinder, Disk, FLAT_LANES as LANES, Flat, FlatLane, FlatPacket, LaneHit, MeshAccel,
+    MeshShape, PackedFlats, Placed, Plane, SPHERE_LANES, Shape, Sphere, SpherePacket, SurfaceHit, VectorUnit,
+    flat_primitives,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -72,6 +73,8 @@ pub struct World {
     unbounded: Vec<u32>,
     /// The packets' kernel for this processor.
     vectors: VectorUnit,
+    /// Everything is flats in one leaf: eight rays are tested at once, ray by lane.
+    flats_only: bool,
 }
 
 /// The first thing a shadow ray meets.
@@ -225,6 +228,9 @@ impl World {
         let bvh = Bvh::build_packed(&prim_bounds, |k| matches!(primitives[k], Primitive::Flat { .. }));
         let mut world = Self { objects, unbounded, vectors: unit, ..Self::default() };
         world.fill_leaves(&bvh, &primitives);
+        world.flats_only = world.unbounded.is_empty()
+            && matches!(world.leaves.as_slice(), [leaf] if leaf.spheres.is_empty() && leaf.objects.is_empty())
+            && bvh.leaves().count() == 1;
         world.bvh = bvh;
         world
     }
@@ -315,13 +321,44 @@ impl World {
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<WorldHit> {
         let (c, i) = self.nearest(ray, t_max)?;
+        Some(self.surface_of(ray, c, i))
+    }
+
+    /// [`Self::intersect`] for eight rays without a limit, into `out` (`None` where not
+    /// `live`): the same hits, several rays' tests in flight at once.
+    pub fn intersect_rays(&self, rays: &[Ray; LANES], live: [bool; LANES], out: &mut [Option<WorldHit>; LANES]) {
+        if self.flats_only {
+            out.iter_mut().for_each(|slot| *slot = None);
+            FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
+                let lane = self.flats.lanes[k][h.lane];
+                out[r] = Some(self.surface_of(&rays[r], lane.flat.candidate(h.t, h.b1, h.b2), lane.object));
+            });
+        } else {
+            for ((slot, ray), live) in out.iter_mut().zip(rays).zip(live) {
+                *slot = if live { self.intersect(ray, f64::INFINITY) } else { None };
+            }
+        }
+    }
+
+    /// [`Self::unoccluded`] for eight segments, `rays[r]` over `dist[r]` (false where not `live`).
+    pub fn unoccluded_rays(&self, rays: &[Ray; LANES], dist: &[f64; LANES], live: [bool; LANES]) -> [bool; LANES] {
+        if self.flats_only {
+            let blocked = FlatPacket::any_of_rays(&self.flats.packets, rays, dist, live, self.vectors);
+            return std::array::from_fn(|r| live[r] && !blocked[r]);
+        }
+        std::array::from_fn(|r| live[r] && self.unoccluded(rays[r].origin, rays[r].dir, dist[r]))
+    }
+
+    /// The hit of object `i` whose candidate is `c`, with its surface and material.
+    #[inline]
+    fn surface_of(&self, ray: &Ray, c: Candidate, i: u32) -> WorldHit {
         let o = &self.objects[i as usize];
         let mut hit = o.placed.surface(ray, c);
         if o.bumpy {
             hit.dpduv = o.placed.tangents(ray, c);
         }
         let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
-        Some(WorldHit { hit, material, object: i })
+        WorldHit { hit, material, object: i }
     }
 
     /// What a shadow ray meets first: asks `is_opaque(material)` before computing the

@@ -70,3 +70,49 @@ proptest! {
         }
     }
 }
+
+/// A room of rectangles and untransformed boxes: all flats in one leaf, which the world tests
+/// eight rays at a time, ray by lane.
+fn flats_scene(boxes: &[(f64, f64, f64)]) -> String {
+    let mut s = String::new();
+    for (k, (x, y, z)) in boxes.iter().enumerate() {
+        s += &format!(
+            "[[object]]\nshape = \"box\"\nmin = [{x}, {y}, {z}]\nmax = [{}, {}, {}]\n",
+            x + 0.7,
+            y + 0.4,
+            z + 0.9
+        );
+        s += &format!(
+            "[[object]]\nshape = \"rectangle\"\ntransform = [{{ scale = 2 }}, {{ rotate_x = {} }}, {{ translate = [{z}, {x}, {y}] }}]\n",
+            23 * k
+        );
+    }
+    s
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+    /// Eight rays at once meet what each meets alone, in a world of flats in one leaf and in a
+    /// general one; shadow rays likewise; rays not live meet nothing.
+    #[test]
+    fn eight_rays_meet_what_each_meets_alone(
+        spheres in prop::collection::vec((-5.0..5.0f64, -2.0..5.0f64, -5.0..5.0f64, 0.1..1.0f64), 1..10),
+        boxes in prop::collection::vec((-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64), 1..4),
+        rays in prop::collection::vec(((-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64), (-4.0..4.0f64, -4.0..4.0f64, -4.0..4.0f64), 0.5..8.0f64, any::<bool>()), 8),
+    ) {
+        for text in [flats_scene(&boxes), random_scene(&spheres, &boxes)] {
+            let world = World::build(&parse_scene("rays.toml".as_ref(), &text).unwrap());
+            let dir = |i: usize| Vec3::new(rays[i].0.0, rays[i].0.1, rays[i].0.2).try_normalize().unwrap_or(Vec3::Z);
+            let all: [Ray; 8] = std::array::from_fn(|i| Ray::new(Vec3::new(rays[i].1.0, rays[i].1.1, rays[i].1.2), dir(i)));
+            let (dist, live): ([f64; 8], [bool; 8]) = (std::array::from_fn(|i| rays[i].2), std::array::from_fn(|i| rays[i].3));
+            let mut hits = [None; 8];
+            world.intersect_rays(&all, live, &mut hits);
+            let clear = world.unoccluded_rays(&all, &dist, live);
+            for (i, ray) in all.iter().enumerate() {
+                let alone = world.intersect(ray, f64::INFINITY).filter(|_| live[i]);
+                prop_assert_eq!(hits[i].map(|h| (h.hit, h.material, h.object)), alone.map(|h| (h.hit, h.material, h.object)));
+                prop_assert_eq!(clear[i], live[i] && world.unoccluded(ray.origin, ray.dir, dist[i]));
+            }
+        }
+    }
+}

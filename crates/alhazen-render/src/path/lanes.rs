@@ -19,6 +19,7 @@ use crate::bsdf::{Bsdf, ColorMode};
 use crate::lights::{Emitter, Lights};
 use crate::sampler::SampleStream;
 use crate::shape::VectorUnit;
+use crate::world::WorldHit;
 use alhazen_math::{Ray, Vec2, Vec3, sin_cos_turns};
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -148,59 +149,50 @@ impl PathTracer<'_> {
     /// Every sample of pixel `(x, y)`, `out[i]` being sample `i`, traced in lanes.
     pub(super) fn pixel_in_lanes(&self, x: u32, y: u32, out: &mut [Vec3]) {
         let mut paths: [Option<Path>; LANES] = Default::default();
-        let mut next = 0u32;
+        let mut next = 0..out.len() as u32;
         let (mut vertices, mut shaded) = (Vertices::default(), Shaded::default());
         let mut lights = LightLanes::default();
+        let unit = self.world.vector_unit();
+        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
+        let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
         loop {
-            let mut any = false;
-            for (i, slot) in paths.iter_mut().enumerate() {
-                any |= self.prepare_lane(slot, i, (&mut vertices, &mut lights), x, y, &mut next, out);
+            // Idle lanes start the pixel's next samples; all lanes' rays are traced together.
+            for slot in paths.iter_mut().filter(|p| p.is_none()) {
+                *slot = next.next().map(|index| self.start_path(x, y, index));
             }
-            if !any {
+            if paths.iter().all(Option::is_none) {
                 return;
             }
-            let unit = self.world.vector_unit();
+            for (ray, path) in rays.iter_mut().zip(&paths) {
+                if let Some(p) = path {
+                    *ray = p.ray;
+                }
+            }
+            self.world.intersect_rays(&rays, paths.each_ref().map(|p| p.is_some()), &mut hits);
+            let mut shading = [false; LANES];
+            for (i, (slot, hit)) in paths.iter_mut().zip(&hits).enumerate() {
+                let Some(path) = slot else { continue };
+                shading[i] = self.prepare_vertex(path, hit, (&mut vertices, &mut lights), i);
+                if !shading[i] {
+                    out[path.index as usize] = path.l;
+                    *slot = None;
+                }
+            }
             if self.lane_lights.is_some() {
                 sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
             }
             shade(&vertices, &mut shaded, unit);
+            let shadow_rays = std::array::from_fn(|i| Ray::new(shaded.shadow_origin.get(i), vertices.light_dir.get(i)));
+            let tested = std::array::from_fn(|i| shading[i] && shaded.shadow[i]);
+            let clear = self.world.unoccluded_rays(&shadow_rays, &shaded.shadow_dist, tested);
             for (i, slot) in paths.iter_mut().enumerate() {
-                if let Some(path) = slot {
-                    self.finish_vertex(path, &vertices, &shaded, i);
-                    if !shaded.alive[i] {
-                        out[path.index as usize] = path.l;
-                        *slot = None;
-                    }
+                let Some(path) = slot.as_mut().filter(|_| shading[i]) else { continue };
+                self.finish_vertex(path, &shaded, clear[i], i);
+                if !shaded.alive[i] {
+                    out[path.index as usize] = path.l;
+                    *slot = None;
                 }
             }
-        }
-    }
-
-    /// Brings lane `i` to a vertex to shade, starting the pixel's next samples as paths end;
-    /// false when the pixel has no sample left for it.
-    fn prepare_lane(
-        &self,
-        slot: &mut Option<Path>,
-        i: usize,
-        (v, lights): (&mut Vertices, &mut LightLanes),
-        x: u32,
-        y: u32,
-        next: &mut u32,
-        out: &mut [Vec3],
-    ) -> bool {
-        loop {
-            let path = match slot {
-                Some(path) => path,
-                None if (*next as usize) < out.len() => {
-                    slot.insert(self.start_path(x, y, std::mem::replace(next, *next + 1)))
-                }
-                None => return false,
-            };
-            if self.prepare_vertex(path, v, lights, i) {
-                return true;
-            }
-            out[path.index as usize] = path.l;
-            *slot = None;
         }
     }
 
@@ -212,20 +204,27 @@ impl PathTracer<'_> {
         Path { index, stream, ray, depth: 1, l: Vec3::ZERO, beta: Vec3::ONE, prev }
     }
 
-    /// The per-path half of a vertex, as in [`Self::radiance`]: the hit, its emission, the light
-    /// sample and the vertex's random numbers, written to lane `i`; false when the path ends.
-    fn prepare_vertex(&self, path: &mut Path, v: &mut Vertices, lights: &mut LightLanes, i: usize) -> bool {
+    /// The per-path half of a vertex, as in [`Self::radiance`]: the ray's `hit`, its emission,
+    /// the light sample and the vertex's random numbers, written to lane `i`; false when the
+    /// path ends.
+    fn prepare_vertex(
+        &self,
+        path: &mut Path,
+        hit: &Option<WorldHit>,
+        (v, lights): (&mut Vertices, &mut LightLanes),
+        i: usize,
+    ) -> bool {
         let max_depth = self.scene.render.max_depth;
         if path.depth > max_depth {
             return false;
         }
-        let Some(wh) = self.world.intersect(&path.ray, f64::INFINITY) else {
+        let Some(wh) = hit else {
             if let Some(sky) = self.escaped(&path.ray, &path.prev, path.beta, ColorMode::Rgb) {
                 path.l += sky;
             }
             return false;
         };
-        path.l += path.beta * self.emitted(&wh, &path.ray, &path.prev, ColorMode::Rgb);
+        path.l += path.beta * self.emitted(wh, &path.ray, &path.prev, ColorMode::Rgb);
         if path.depth == max_depth {
             return false;
         }
@@ -273,9 +272,10 @@ impl PathTracer<'_> {
         true
     }
 
-    /// The per-path half after [`shade`]: the shadow ray, then the step to the next vertex.
-    fn finish_vertex(&self, path: &mut Path, v: &Vertices, s: &Shaded, i: usize) {
-        let clear = !s.shadow[i] || self.world.unoccluded(s.shadow_origin.get(i), v.light_dir.get(i), s.shadow_dist[i]);
+    /// The per-path half after [`shade`] and the shadow ray (`unoccluded` when it was traced and
+    /// met nothing): the light gathered, then the step to the next vertex.
+    fn finish_vertex(&self, path: &mut Path, s: &Shaded, unoccluded: bool, i: usize) {
+        let clear = !s.shadow[i] || unoccluded;
         let light = if clear { s.light.get(i) } else { Vec3::ZERO };
         path.l += path.beta * light;
         if s.alive[i] {

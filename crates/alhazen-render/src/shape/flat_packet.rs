@@ -118,6 +118,54 @@ impl FlatPacket {
         packets.iter().any(|p| p.hit(ray, t_max, unit).is_some())
     }
 
+    /// [`Self::nearest_of`] for eight rays at once: `found(r, k, hit)` for each `live` ray `r`
+    /// that hits, with the same hit. With AVX-512 the rays are the lanes and each flat is
+    /// broadcast against all eight, which needs no reduction across lanes and keeps eight
+    /// independent tests in flight.
+    #[allow(unsafe_code)]
+    pub fn nearest_of_rays(
+        packets: &[Self],
+        rays: &[Ray; LANES],
+        live: [bool; LANES],
+        unit: VectorUnit,
+        mut found: impl FnMut(usize, usize, LaneHit),
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+            let hits = unsafe { avx512::nearest_rays(packets, rays) };
+            for r in (0..LANES).filter(|&r| live[r] && hits.hit & (1 << r) != 0) {
+                let at = hits.at[r] as usize;
+                found(r, at / LANES, LaneHit { lane: at % LANES, t: hits.t[r], b1: hits.b1[r], b2: hits.b2[r] });
+            }
+            return;
+        }
+        for r in (0..LANES).filter(|&r| live[r]) {
+            if let Some((k, h)) = Self::nearest_of(packets, &rays[r], f64::INFINITY, unit) {
+                found(r, k, h);
+            }
+        }
+    }
+
+    /// [`Self::any_of`] for eight rays at once, each with its own `t_max` (false where not
+    /// `live`).
+    #[allow(unsafe_code)]
+    pub fn any_of_rays(
+        packets: &[Self],
+        rays: &[Ray; LANES],
+        t_max: &[f64; LANES],
+        live: [bool; LANES],
+        unit: VectorUnit,
+    ) -> [bool; LANES] {
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+            let hit = unsafe { avx512::any_rays(packets, rays, t_max) };
+            return std::array::from_fn(|r| live[r] && hit & (1 << r) != 0);
+        }
+        std::array::from_fn(|r| live[r] && Self::any_of(packets, &rays[r], t_max[r], unit))
+    }
+
     /// Lane `lane` as a [`Flat`] (an unused lane: one with a zero normal, which no ray hits).
     fn lane(&self, lane: usize) -> Flat {
         let at = |a: &[[f64; LANES]; 3]| Vec3::new(a[0][lane], a[1][lane], a[2][lane]);
@@ -334,7 +382,7 @@ mod avx2 {
 #[allow(unsafe_code)]
 mod avx512 {
     use super::super::avx512::{NearestLanes, RayLanes, dot, lane_of, load, load3, ray_lanes};
-    use super::{FlatPacket, LaneHit};
+    use super::{FlatPacket, LANES, LaneHit};
     use alhazen_math::Ray;
     use std::arch::x86_64::*;
 
@@ -343,15 +391,37 @@ mod avx512 {
     #[inline]
     #[target_feature(enable = "avx512f")]
     fn lanes(p: &FlatPacket, r: &RayLanes, t_max: __m512d) -> (__m512d, __m512d, __m512d, __mmask8) {
-        let (ro, rd) = (&r.origin, r.dir);
-        let o = load3(&p.origin);
+        let flat = FlatLanes {
+            origin: load3(&p.origin),
+            normal: load3(&p.normal),
+            u: load3(&p.u),
+            v: load3(&p.v),
+            triangle: load(&p.triangle),
+        };
+        flat_lanes(&flat, r, t_max)
+    }
+
+    /// A flat per lane (eight of a packet, or one in all lanes).
+    struct FlatLanes {
+        origin: [__m512d; 3],
+        normal: [__m512d; 3],
+        u: [__m512d; 3],
+        v: [__m512d; 3],
+        triangle: __m512d,
+    }
+
+    /// [`lanes`] for a flat and a ray per lane.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn flat_lanes(p: &FlatLanes, r: &RayLanes, t_max: __m512d) -> (__m512d, __m512d, __m512d, __mmask8) {
+        let (ro, rd, o) = (&r.origin, r.dir, p.origin);
         let to_flat = [_mm512_sub_pd(o[0], ro[0]), _mm512_sub_pd(o[1], ro[1]), _mm512_sub_pd(o[2], ro[2])];
-        let n = load3(&p.normal);
+        let n = p.normal;
         let t = _mm512_div_pd(dot(n, to_flat), dot(n, rd));
-        let (u, v) = (load3(&p.u), load3(&p.v));
+        let (u, v) = (p.u, p.v);
         let b1 = _mm512_sub_pd(_mm512_mul_pd(t, dot(rd, u)), dot(to_flat, u));
         let b2 = _mm512_sub_pd(_mm512_mul_pd(t, dot(rd, v)), dot(to_flat, v));
-        let far = _mm512_add_pd(b2, _mm512_mul_pd(load(&p.triangle), b1));
+        let far = _mm512_add_pd(b2, _mm512_mul_pd(p.triangle, b1));
         let (zero, one) = (_mm512_setzero_pd(), _mm512_set1_pd(1.0));
         let in_t = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(t, zero) & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, t_max);
         let in_b1 = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(b1, zero) & _mm512_cmp_pd_mask::<_CMP_LE_OQ>(b1, one);
@@ -375,6 +445,85 @@ mod avx512 {
         }
         let (lane, k, t) = best.nearest()?;
         Some((k, LaneHit { lane, t, b1: lane_of(best_b1, lane), b2: lane_of(best_b2, lane) }))
+    }
+
+    /// Eight rays, one per lane.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn rays_in_lanes(rays: &[Ray; LANES]) -> RayLanes {
+        let axis = |f: fn(&Ray) -> f64| load(&std::array::from_fn(|r| f(&rays[r])));
+        RayLanes {
+            origin: [axis(|r| r.origin.x), axis(|r| r.origin.y), axis(|r| r.origin.z)],
+            dir: [axis(|r| r.dir.x), axis(|r| r.dir.y), axis(|r| r.dir.z)],
+        }
+    }
+
+    /// Flat `lane` of `p` in every lane (against eight rays).
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn broadcast(p: &FlatPacket, lane: usize) -> FlatLanes {
+        let row = |a: &[[f64; LANES]; 3]| [0, 1, 2].map(|axis| _mm512_set1_pd(a[axis][lane]));
+        FlatLanes {
+            origin: row(&p.origin),
+            normal: row(&p.normal),
+            u: row(&p.u),
+            v: row(&p.v),
+            triangle: _mm512_set1_pd(p.triangle[lane]),
+        }
+    }
+
+    /// Eight rays' nearest hits, ray by lane: `hit` has bit `r` set when ray `r` hits flat
+    /// `at[r]` (packet × [`LANES`] + lane) at `t[r]`, `b1[r]`, `b2[r]`.
+    pub(super) struct RaysHits {
+        pub hit: u8,
+        pub at: [i64; LANES],
+        pub t: [f64; LANES],
+        pub b1: [f64; LANES],
+        pub b2: [f64; LANES],
+    }
+
+    /// [`FlatPacket::nearest_of_rays`]: every flat in order against the eight rays; strictly
+    /// nearer replaces, so ties keep the first packet, then the first lane, as
+    /// [`nearest`] does.
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn nearest_rays(packets: &[FlatPacket], rays: &[Ray; LANES]) -> RaysHits {
+        let r = rays_in_lanes(rays);
+        let limit = _mm512_set1_pd(f64::INFINITY);
+        let (mut best_t, mut best_at) = (limit, _mm512_setzero_si512());
+        let (mut best_b1, mut best_b2, mut hit) = (_mm512_setzero_pd(), _mm512_setzero_pd(), 0u8);
+        for (k, p) in packets.iter().enumerate() {
+            for lane in 0..p.used {
+                let (t, b1, b2, inside) = flat_lanes(&broadcast(p, lane), &r, limit);
+                let closer = inside & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, best_t);
+                best_t = _mm512_mask_blend_pd(closer, best_t, t);
+                best_at = _mm512_mask_blend_epi64(closer, best_at, _mm512_set1_epi64((k * LANES + lane) as i64));
+                best_b1 = _mm512_mask_blend_pd(closer, best_b1, b1);
+                best_b2 = _mm512_mask_blend_pd(closer, best_b2, b2);
+                hit |= closer;
+            }
+        }
+        let mut out = RaysHits { hit, at: [0; LANES], t: [0.0; LANES], b1: [0.0; LANES], b2: [0.0; LANES] };
+        // SAFETY: each destination is eight writable f64s or i64s; `storeu` needs no alignment.
+        unsafe {
+            _mm512_storeu_pd(out.t.as_mut_ptr(), best_t);
+            _mm512_storeu_pd(out.b1.as_mut_ptr(), best_b1);
+            _mm512_storeu_pd(out.b2.as_mut_ptr(), best_b2);
+            _mm512_storeu_si512(out.at.as_mut_ptr().cast(), best_at);
+        }
+        out
+    }
+
+    /// [`FlatPacket::any_of_rays`]: the rays blocked by some flat, one bit per ray.
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn any_rays(packets: &[FlatPacket], rays: &[Ray; LANES], t_max: &[f64; LANES]) -> u8 {
+        let (r, limit) = (rays_in_lanes(rays), load(t_max));
+        let mut blocked = 0u8;
+        for p in packets {
+            for lane in 0..p.used {
+                blocked |= flat_lanes(&broadcast(p, lane), &r, limit).3;
+            }
+        }
+        blocked
     }
 
     /// [`FlatPacket::any_of`]: the lanes hit, gathered over every packet.
@@ -425,6 +574,33 @@ mod tests {
             for unit in VectorUnit::available() {
                 prop_assert_eq!(FlatPacket::nearest_of(&packets, &ray, t_max, unit), expected, "{:?}", unit);
                 prop_assert_eq!(FlatPacket::any_of(&packets, &ray, t_max, unit), expected.is_some(), "{:?}", unit);
+            }
+        }
+
+        /// Eight rays at once find what each finds alone (nearest without a limit; any-hit
+        /// with each ray's own), and nothing for rays not live.
+        #[test]
+        fn eight_rays_equal_one_by_one(
+            flats in prop::collection::vec(flat(), 1..=3 * LANES),
+            fill in 1..=LANES,
+            rays in prop::collection::vec((vec3(), vec3(), 0.1..5.0f64, any::<bool>()), LANES),
+        ) {
+            let flats: Vec<Flat> = flats.into_iter().flatten().collect();
+            prop_assume!(!flats.is_empty() && rays.iter().all(|r| r.1.length() > 1e-3));
+            let packets: Vec<FlatPacket> = flats.chunks(fill).map(FlatPacket::new).collect();
+            let ray_of = |r: &(Vec3, Vec3, f64, bool)| Ray::new(r.0, r.1.normalize());
+            let (all, t_max) = (std::array::from_fn(|i| ray_of(&rays[i])), std::array::from_fn(|i| rays[i].2));
+            let live = std::array::from_fn(|i| rays[i].3);
+            for unit in VectorUnit::available() {
+                let mut found = [None; LANES];
+                FlatPacket::nearest_of_rays(&packets, &all, live, unit, |r, k, h| found[r] = Some((k, h)));
+                let blocked = FlatPacket::any_of_rays(&packets, &all, &t_max, live, unit);
+                for r in 0..LANES {
+                    let alone = FlatPacket::nearest_of(&packets, &all[r], f64::INFINITY, unit);
+                    prop_assert_eq!(found[r], alone.filter(|_| live[r]), "{:?}", unit);
+                    let any = FlatPacket::any_of(&packets, &all[r], t_max[r], unit);
+                    prop_assert_eq!(blocked[r], any && live[r], "{:?}", unit);
+                }
             }
         }
     }
