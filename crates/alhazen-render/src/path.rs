@@ -15,7 +15,7 @@ use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_hint};
 use crate::camera::Camera;
 use crate::film::PixelEstimator;
 use crate::lights::Lights;
-use crate::sampler::{SampleStream, Sequence};
+use crate::sampler::{PixelSeeds, SampleStream, Sequence};
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::world::{World, WorldHit};
 use alhazen_math::{Ray, Vec2, Vec3};
@@ -237,15 +237,22 @@ fn is_dispersive(b: &Bsdf) -> bool {
 
 impl PixelEstimator for PathTracer<'_> {
     fn samples(&self, x: u32, y: u32, out: &mut [Vec3]) {
+        let seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
         if self.in_lanes {
-            self.pixel_in_lanes(x, y, out);
+            self.pixel_in_lanes(&seeds, x, y, out);
         } else {
-            out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample(x, y, i as u32));
+            out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample_of(seeds.stream(i as u32), x, y));
         }
     }
 
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
-        let mut s = SampleStream::new(self.sequence, self.scene.render.seed, x, y, index);
+        self.sample_of(SampleStream::new(self.sequence, self.scene.render.seed, x, y, index), x, y)
+    }
+}
+
+impl PathTracer<'_> {
+    /// The sample of pixel `(x, y)` whose numbers `s` gives.
+    fn sample_of(&self, mut s: SampleStream, x: u32, y: u32) -> Vec3 {
         let film = s.next_2d();
         let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
         if self.spectral {

@@ -31,13 +31,17 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The hash of `(seed, pixel)` that [`Rng::for_sample`] finishes with the sample index.
+#[inline]
+fn rng_pixel_hash(seed: u64, x: u32, y: u32) -> u64 {
+    mix(mix(seed ^ 0x9e37_79b9_7f4a_7c15) ^ ((x as u64) << 32 | y as u64))
+}
+
 impl Rng {
     /// The generator for one sample.
     #[inline]
     pub fn for_sample(seed: u64, x: u32, y: u32, sample: u32) -> Self {
-        let h = mix(seed ^ 0x9e37_79b9_7f4a_7c15);
-        let h = mix(h ^ ((x as u64) << 32 | y as u64));
-        Self(mix(h ^ sample as u64))
+        Self(mix(rng_pixel_hash(seed, x, y) ^ sample as u64))
     }
 
     /// Next 64 random bits.
@@ -63,11 +67,47 @@ pub enum Sequence {
     Sobol,
 }
 
+/// What every sample of one pixel shares: the hashes of `(seed, pixel)` and of each Sobol
+/// dimension pair, computed once for all the pixel's [`SampleStream`]s.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelSeeds {
+    sequence: Sequence,
+    /// `mix(pixel seed ⊕ d)` for each Sobol pair `d`.
+    dimensions: [u64; SOBOL_PAIRS as usize],
+    rng: u64,
+}
+
+impl PixelSeeds {
+    /// The seeds of pixel `(x, y)`.
+    pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32) -> Self {
+        let pixel_seed = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d) ^ ((x as u64) << 32 | y as u64));
+        let dimensions = std::array::from_fn(|d| mix(pixel_seed ^ d as u64));
+        Self { sequence, dimensions, rng: rng_pixel_hash(seed, x, y) }
+    }
+
+    /// The stream of sample `index` of this pixel.
+    #[inline]
+    pub fn stream(&self, index: u32) -> SampleStream {
+        let rng = Rng(mix(self.rng ^ index as u64));
+        let mut s = SampleStream {
+            sequence: self.sequence,
+            dimensions: self.dimensions,
+            index_reversed: index.reverse_bits(),
+            dimension: 0,
+            rng,
+            ahead: Vec2::ZERO,
+        };
+        s.ahead = s.pair();
+        s
+    }
+}
+
 /// The numbers of one sample of one pixel, dimension after dimension.
 #[derive(Clone, Debug)]
 pub struct SampleStream {
     sequence: Sequence,
-    pixel_seed: u64,
+    /// The pixel's hash of each Sobol pair ([`PixelSeeds`]).
+    dimensions: [u64; SOBOL_PAIRS as usize],
     /// The sample index with its bits reversed (the form Owen scrambling works on).
     index_reversed: u32,
     dimension: u32,
@@ -154,14 +194,10 @@ fn to_unit(x: u32) -> f64 {
 }
 
 impl SampleStream {
-    /// The stream of sample `index` of pixel `(x, y)`.
+    /// The stream of sample `index` of pixel `(x, y)` (for many samples of one pixel,
+    /// [`PixelSeeds::stream`] hashes the pixel once).
     pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, index: u32) -> Self {
-        let pixel_seed = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d) ^ ((x as u64) << 32 | y as u64));
-        let index_reversed = index.reverse_bits();
-        let rng = Rng::for_sample(seed, x, y, index);
-        let mut s = Self { sequence, pixel_seed, index_reversed, dimension: 0, rng, ahead: Vec2::ZERO };
-        s.ahead = s.pair();
-        s
+        PixelSeeds::new(sequence, seed, x, y).stream(index)
     }
 
     /// The next pair of numbers in `[0, 1)²`.
@@ -186,7 +222,7 @@ impl SampleStream {
     fn pair(&mut self) -> Vec2 {
         match self.sequence {
             Sequence::Sobol if self.dimension < SOBOL_PAIRS => {
-                let h = mix(self.pixel_seed ^ self.dimension as u64);
+                let h = self.dimensions[self.dimension as usize];
                 // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal
                 // done once).
                 let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();

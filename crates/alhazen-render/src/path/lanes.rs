@@ -17,7 +17,7 @@
 use super::{PathTracer, Previous, RR_DEPTH, power_heuristic};
 use crate::bsdf::{Bsdf, ColorMode};
 use crate::lights::{Emitter, Lights};
-use crate::sampler::SampleStream;
+use crate::sampler::{PixelSeeds, SampleStream};
 use crate::shape::VectorUnit;
 use crate::world::WorldHit;
 use alhazen_math::{Ray, Vec2, Vec3, sin_cos_turns};
@@ -147,7 +147,7 @@ impl PathTracer<'_> {
     }
 
     /// Every sample of pixel `(x, y)`, `out[i]` being sample `i`, traced in lanes.
-    pub(super) fn pixel_in_lanes(&self, x: u32, y: u32, out: &mut [Vec3]) {
+    pub(super) fn pixel_in_lanes(&self, seeds: &PixelSeeds, x: u32, y: u32, out: &mut [Vec3]) {
         let mut paths: [Option<Path>; LANES] = Default::default();
         let mut next = 0..out.len() as u32;
         let (mut vertices, mut shaded) = (Vertices::default(), Shaded::default());
@@ -158,7 +158,7 @@ impl PathTracer<'_> {
         loop {
             // Idle lanes start the pixel's next samples; all lanes' rays are traced together.
             for slot in paths.iter_mut().filter(|p| p.is_none()) {
-                *slot = next.next().map(|index| self.start_path(x, y, index));
+                *slot = next.next().map(|index| self.start_path(seeds, x, y, index));
             }
             if paths.iter().all(Option::is_none) {
                 return;
@@ -196,8 +196,8 @@ impl PathTracer<'_> {
         }
     }
 
-    fn start_path(&self, x: u32, y: u32, index: u32) -> Path {
-        let mut stream = SampleStream::new(self.sequence, self.scene.render.seed, x, y, index);
+    fn start_path(&self, seeds: &PixelSeeds, x: u32, y: u32, index: u32) -> Path {
+        let mut stream = seeds.stream(index);
         let film = stream.next_2d();
         let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
         let prev = Previous { p: ray.origin, pdf: 1.0, delta: true };
