@@ -37,6 +37,15 @@ pub trait PixelEstimator: Sync {
     fn samples(&self, x: u32, y: u32, out: &mut [Vec3]) {
         out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample(x, y, i as u32));
     }
+
+    /// [`Self::samples`] of several pixels: `out` holds each pixel's in turn (`out.len()` is a
+    /// multiple of `pixels.len()`, the sample count).
+    fn pixels_samples(&self, pixels: &[(u32, u32)], out: &mut [Vec3]) {
+        let spp = out.len() / pixels.len().max(1);
+        for (&(x, y), samples) in pixels.iter().zip(out.chunks_exact_mut(spp.max(1))) {
+            self.samples(x, y, samples);
+        }
+    }
 }
 
 /// Renders a `w × h` image with `spp` samples per pixel, averaged with a box filter;
@@ -55,12 +64,13 @@ pub fn render_image(
         .par_iter()
         .map(|&(x0, y0)| {
             let mut out = Vec::with_capacity((TILE * TILE) as usize);
-            let mut samples = vec![Vec3::ZERO; spp as usize];
+            let row_end = (x0 + TILE).min(w);
+            // A tile row at a time: the estimator may trace several pixels' samples together.
+            let mut samples = vec![Vec3::ZERO; spp as usize * (row_end - x0) as usize];
             for y in y0..(y0 + TILE).min(h) {
-                for x in x0..(x0 + TILE).min(w) {
-                    estimator.samples(x, y, &mut samples);
-                    out.push(average(&samples));
-                }
+                let row: Vec<(u32, u32)> = (x0..row_end).map(|x| (x, y)).collect();
+                estimator.pixels_samples(&row, &mut samples);
+                out.extend(row.iter().enumerate().map(|(i, _)| average(&samples[i * spp as usize..][..spp as usize])));
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, tiles.len());
             out

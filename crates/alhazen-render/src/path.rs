@@ -237,11 +237,22 @@ fn is_dispersive(b: &Bsdf) -> bool {
 
 impl PixelEstimator for PathTracer<'_> {
     fn samples(&self, x: u32, y: u32, out: &mut [Vec3]) {
-        let seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
         if self.in_lanes {
-            self.pixel_in_lanes(&seeds, x, y, out);
+            self.pixels_in_lanes(&[(x, y)], out);
         } else {
+            let seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
             out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample_of(seeds.stream(i as u32), x, y));
+        }
+    }
+
+    fn pixels_samples(&self, pixels: &[(u32, u32)], out: &mut [Vec3]) {
+        if self.in_lanes {
+            self.pixels_in_lanes(pixels, out);
+        } else {
+            let spp = out.len() / pixels.len().max(1);
+            for (&(x, y), samples) in pixels.iter().zip(out.chunks_exact_mut(spp.max(1))) {
+                self.samples(x, y, samples);
+            }
         }
     }
 

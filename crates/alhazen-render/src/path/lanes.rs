@@ -127,7 +127,8 @@ struct Shaded {
 
 /// One sample's path in flight.
 struct Path {
-    index: u32,
+    /// Where its result goes.
+    job: usize,
     stream: SampleStream,
     ray: Ray,
     depth: u32,
@@ -146,10 +147,13 @@ impl PathTracer<'_> {
             })
     }
 
-    /// Every sample of pixel `(x, y)`, `out[i]` being sample `i`, traced in lanes.
-    pub(super) fn pixel_in_lanes(&self, seeds: &PixelSeeds, x: u32, y: u32, out: &mut [Vec3]) {
+    /// Every sample of `pixels`, traced in lanes: `out` holds each pixel's samples in turn,
+    /// sample `i` of pixel `p` at `out[p × spp + i]`.
+    pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], out: &mut [Vec3]) {
         let mut paths: [Option<Path>; LANES] = Default::default();
-        let mut next = 0..out.len() as u32;
+        let spp = out.len() / pixels.len().max(1);
+        let mut next = 0..out.len();
+        let mut seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, 0, 0);
         let (mut vertices, mut shaded) = (Vertices::default(), Shaded::default());
         let mut lights = LightLanes::default();
         let unit = self.world.vector_unit();
@@ -158,7 +162,13 @@ impl PathTracer<'_> {
         loop {
             // Idle lanes start the pixel's next samples; all lanes' rays are traced together.
             for slot in paths.iter_mut().filter(|p| p.is_none()) {
-                *slot = next.next().map(|index| self.start_path(seeds, x, y, index));
+                *slot = next.next().map(|job| {
+                    let ((x, y), index) = (pixels[job / spp], (job % spp) as u32);
+                    if index == 0 {
+                        seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
+                    }
+                    self.start_path(&seeds, (x, y), index, job)
+                });
             }
             if paths.iter().all(Option::is_none) {
                 return;
@@ -174,7 +184,7 @@ impl PathTracer<'_> {
                 let Some(path) = slot else { continue };
                 shading[i] = self.prepare_vertex(path, hit, (&mut vertices, &mut lights), i);
                 if !shading[i] {
-                    out[path.index as usize] = path.l;
+                    out[path.job] = path.l;
                     *slot = None;
                 }
             }
@@ -189,19 +199,20 @@ impl PathTracer<'_> {
                 let Some(path) = slot.as_mut().filter(|_| shading[i]) else { continue };
                 self.finish_vertex(path, &shaded, clear[i], i);
                 if !shaded.alive[i] {
-                    out[path.index as usize] = path.l;
+                    out[path.job] = path.l;
                     *slot = None;
                 }
             }
         }
     }
 
-    fn start_path(&self, seeds: &PixelSeeds, x: u32, y: u32, index: u32) -> Path {
+    /// Sample `index` of pixel `(x, y)`, whose result goes to `out[job]`.
+    fn start_path(&self, seeds: &PixelSeeds, (x, y): (u32, u32), index: u32, job: usize) -> Path {
         let mut stream = seeds.stream(index);
         let film = stream.next_2d();
         let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
         let prev = Previous { p: ray.origin, pdf: 1.0, delta: true };
-        Path { index, stream, ray, depth: 1, l: Vec3::ZERO, beta: Vec3::ONE, prev }
+        Path { job, stream, ray, depth: 1, l: Vec3::ZERO, beta: Vec3::ONE, prev }
     }
 
     /// The per-path half of a vertex, as in [`Self::radiance`]: the ray's `hit`, its emission,
@@ -533,10 +544,17 @@ material = "glow"
         let mut all = [vec![], vec![]];
         for (in_lanes, out) in [true, false].into_iter().zip(&mut all) {
             tracer.in_lanes = in_lanes;
-            for (x, y) in (0..camera.film_height).flat_map(|y| (0..camera.film_width).map(move |x| (x, y))) {
-                let mut pixel = vec![Vec3::NAN; scene.render.spp as usize];
-                tracer.samples(x, y, &mut pixel);
-                out.extend(pixel);
+            // Rows of pixels traced together, and single pixels.
+            let (w, h, spp) = (camera.film_width, camera.film_height, scene.render.spp as usize);
+            for y in 0..h {
+                let row: Vec<(u32, u32)> = (0..w).map(|x| (x, y)).collect();
+                let mut samples = vec![Vec3::NAN; spp * row.len()];
+                if y % 2 == 0 {
+                    tracer.pixels_samples(&row, &mut samples);
+                } else {
+                    samples.chunks_mut(spp).zip(&row).for_each(|(s, &(x, y))| tracer.samples(x, y, s));
+                }
+                out.extend(samples);
             }
         }
         let [lanes, per_path] = all;
