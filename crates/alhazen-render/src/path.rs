@@ -17,7 +17,7 @@ use crate::film::PixelEstimator;
 use crate::lights::Lights;
 use crate::sampler::{PixelSeeds, SampleStream, Sequence};
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
-use crate::world::{World, WorldHit};
+use crate::world::{HitPoint, World, WorldHit};
 use alhazen_math::{Ray, Vec2, Vec3};
 use alhazen_scene::{SamplerKind, Scene};
 use std::borrow::Cow;
@@ -108,7 +108,7 @@ impl<'a> PathTracer<'a> {
                 }
                 break;
             };
-            l += beta * self.emitted(&wh, &ray, &prev, mode);
+            l += beta * self.emitted(&HitPoint::from(wh), &ray, &prev, mode);
             if depth == max_depth {
                 break;
             }
@@ -164,16 +164,13 @@ impl<'a> PathTracer<'a> {
     }
 
     /// Emission of the surface hit, weighted against light sampling.
-    fn emitted(&self, wh: &WorldHit, ray: &Ray, prev: &Previous, mode: ColorMode) -> Vec3 {
-        let le = self.scene.materials[wh.material as usize].emission;
-        if le == Vec3::ZERO || wh.hit.n.dot(ray.dir) >= 0.0 {
+    fn emitted(&self, h: &HitPoint, ray: &Ray, prev: &Previous, mode: ColorMode) -> Vec3 {
+        let le = self.scene.materials[h.material as usize].emission;
+        if le == Vec3::ZERO || h.n.dot(ray.dir) >= 0.0 {
             return Vec3::ZERO;
         }
-        let w = if prev.delta {
-            1.0
-        } else {
-            power_heuristic(prev.pdf, self.lights.area_pdf(wh.object, prev.p, wh.hit.p, wh.hit.n))
-        };
+        let w =
+            if prev.delta { 1.0 } else { power_heuristic(prev.pdf, self.lights.area_pdf(h.object, prev.p, h.p, h.n)) };
         mode.color(le) * w
     }
 

@@ -77,6 +77,28 @@ pub struct World {
     flats_only: bool,
 }
 
+/// Where a ray meets the world, without texture coordinates or bump-map tangents (enough to
+/// shade untextured materials).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HitPoint {
+    /// The point.
+    pub p: Vec3,
+    /// Geometric normal (out of the solid or to the shape's front).
+    pub n: Vec3,
+    /// Shading normal, on the side of `n`.
+    pub ns: Vec3,
+    /// Material index.
+    pub material: u32,
+    /// Index of the scene object.
+    pub object: u32,
+}
+
+impl From<WorldHit> for HitPoint {
+    fn from(h: WorldHit) -> Self {
+        Self { p: h.hit.p, n: h.hit.n, ns: h.hit.ns, material: h.material, object: h.object }
+    }
+}
+
 /// The first thing a shadow ray meets.
 #[derive(Clone, Copy, Debug)]
 pub enum ShadowHit {
@@ -325,19 +347,30 @@ impl World {
     }
 
     /// [`Self::intersect`] for eight rays without a limit, into `out` (`None` where not
-    /// `live`): the same hits, several rays' tests in flight at once.
-    pub fn intersect_rays(&self, rays: &[Ray; LANES], live: [bool; LANES], out: &mut [Option<WorldHit>; LANES]) {
+    /// `live`), as [`HitPoint`]s: the same hits, several rays' tests in flight at once.
+    pub fn intersect_rays(&self, rays: &[Ray; LANES], live: [bool; LANES], out: &mut [Option<HitPoint>; LANES]) {
         if self.flats_only {
             out.iter_mut().for_each(|slot| *slot = None);
             FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
-                let lane = self.flats.lanes[k][h.lane];
-                out[r] = Some(self.surface_of(&rays[r], lane.flat.candidate(h.t, h.b1, h.b2), lane.object));
+                out[r] = Some(self.flat_point(&rays[r], self.flats.lanes[k][h.lane], h));
             });
         } else {
             for ((slot, ray), live) in out.iter_mut().zip(rays).zip(live) {
-                *slot = if live { self.intersect(ray, f64::INFINITY) } else { None };
+                *slot = if live { self.intersect(ray, f64::INFINITY).map(HitPoint::from) } else { None };
             }
         }
+    }
+
+    /// The point where `ray` meets the flat of `lane` (a triangle or parallelogram of a mesh
+    /// placed in world space) as [`Self::intersect`] reports it.
+    #[inline]
+    fn flat_point(&self, ray: &Ray, lane: Lane, h: LaneHit) -> HitPoint {
+        let c = lane.flat.candidate(h.t, h.b1, h.b2);
+        let o = &self.objects[lane.object as usize];
+        let Shape::Mesh(mesh) = &o.placed.shape else { unreachable!("flats come from meshes") };
+        let (n, ns, slot) = mesh.normals_and_slot(c.aux as usize, c.bary[0], c.bary[1]);
+        let material = o.slot_materials.get(slot as usize).copied().unwrap_or(o.material);
+        HitPoint { p: ray.at(c.t), n, ns, material, object: lane.object }
     }
 
     /// [`Self::unoccluded`] for eight segments, `rays[r]` over `dist[r]` (false where not `live`).

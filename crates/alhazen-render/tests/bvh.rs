@@ -4,6 +4,7 @@
 
 use alhazen_math::{Ray, Vec3};
 use alhazen_render::World;
+use alhazen_render::world::HitPoint;
 use alhazen_scene::parse_scene;
 use proptest::prelude::*;
 
@@ -110,7 +111,7 @@ proptest! {
             let clear = world.unoccluded_rays(&all, &dist, live);
             for (i, ray) in all.iter().enumerate() {
                 let alone = world.intersect(ray, f64::INFINITY).filter(|_| live[i]);
-                prop_assert_eq!(hits[i].map(|h| (h.hit, h.material, h.object)), alone.map(|h| (h.hit, h.material, h.object)));
+                prop_assert_eq!(hits[i], alone.map(HitPoint::from));
                 prop_assert_eq!(clear[i], live[i] && world.unoccluded(ray.origin, ray.dir, dist[i]));
             }
         }

@@ -19,7 +19,7 @@ use crate::bsdf::{Bsdf, ColorMode};
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
 use crate::shape::VectorUnit;
-use crate::world::WorldHit;
+use crate::world::HitPoint;
 use alhazen_math::{Ray, Vec2, Vec3, sin_cos_turns};
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -158,7 +158,7 @@ impl PathTracer<'_> {
         let mut lights = LightLanes::default();
         let unit = self.world.vector_unit();
         let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
-        let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
+        let mut hits: [Option<HitPoint>; LANES] = [None; LANES];
         loop {
             // Idle lanes start the pixel's next samples; all lanes' rays are traced together.
             for slot in paths.iter_mut().filter(|p| p.is_none()) {
@@ -221,7 +221,7 @@ impl PathTracer<'_> {
     fn prepare_vertex(
         &self,
         path: &mut Path,
-        hit: &Option<WorldHit>,
+        hit: &Option<HitPoint>,
         (v, lights): (&mut Vertices, &mut LightLanes),
         i: usize,
     ) -> bool {
@@ -257,7 +257,7 @@ impl PathTracer<'_> {
                 (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
             }
             None => {
-                let light = self.lights.sample(wh.hit.p, choice.x, u_light);
+                let light = self.lights.sample(wh.p, choice.x, u_light);
                 let light = light.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
                 v.light[i] = light.is_some();
                 if let Some(ls) = light {
@@ -274,12 +274,12 @@ impl PathTracer<'_> {
         v.u_roulette[i] = if roulette { s.next_1d() } else { 0.0 };
         (v.roulette[i], v.u_bsdf[0][i], v.u_bsdf[1][i]) = (roulette, u_bsdf.x, u_bsdf.y);
         v.wo.set(i, -path.ray.dir);
-        v.p.set(i, wh.hit.p);
-        v.ng.set(i, wh.hit.n);
-        v.ns.set(i, wh.hit.ns);
+        v.p.set(i, wh.p);
+        v.ng.set(i, wh.n);
+        v.ns.set(i, wh.ns);
         v.albedo.set(i, lambert.albedo);
         v.beta.set(i, path.beta);
-        path.prev.p = wh.hit.p;
+        path.prev.p = wh.p;
         true
     }
 

@@ -100,24 +100,34 @@ pub fn triangle_hit(ray: &Ray, [p0, p1, p2]: [Vec3; 3]) -> Option<(f64, f64, f64
 }
 
 impl MeshShape {
-    fn surface(&self, ray: &Ray, tri: usize, (t, b1, b2): (f64, f64, f64)) -> SurfaceHit {
+    /// Triangle `tri`'s geometric and shading normals and material slot at barycentric
+    /// `(b1, b2)`: what [`Self::surface_at`] reports, without the rest.
+    #[inline]
+    pub fn normals_and_slot(&self, tri: usize, b1: f64, b2: f64) -> (Vec3, Vec3, u32) {
         let m = &self.accel.mesh;
-        let idx = m.triangles[tri].map(|i| i as usize);
         let n = self.accel.face_normals[tri];
-        let b0 = 1.0 - b1 - b2;
         let ns = if self.smooth && !self.accel.flat[tri] {
+            let idx = m.triangles[tri].map(|i| i as usize);
+            let b0 = 1.0 - b1 - b2;
             let s = m.normals[idx[0]] * b0 + m.normals[idx[1]] * b1 + m.normals[idx[2]] * b2;
             // Keep the shading normal on the geometric normal's side.
             s.try_normalize().map_or(n, |s| if s.dot(n) < 0.0 { -s } else { s })
         } else {
             n
         };
+        (n, ns, m.material_slots.get(tri).copied().unwrap_or(0))
+    }
+
+    fn surface(&self, ray: &Ray, tri: usize, (t, b1, b2): (f64, f64, f64)) -> SurfaceHit {
+        let m = &self.accel.mesh;
+        let idx = m.triangles[tri].map(|i| i as usize);
+        let (n, ns, slot) = self.normals_and_slot(tri, b1, b2);
+        let b0 = 1.0 - b1 - b2;
         let uv = if m.uvs.is_empty() {
             Vec2::new(b1, b2)
         } else {
             m.uvs[idx[0]] * b0 + m.uvs[idx[1]] * b1 + m.uvs[idx[2]] * b2
         };
-        let slot = m.material_slots.get(tri).copied().unwrap_or(0);
         SurfaceHit { t, p: ray.at(t), n, ns, uv, slot, dpduv: [Vec3::ZERO; 2] }
     }
 
