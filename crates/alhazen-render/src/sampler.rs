@@ -11,6 +11,7 @@
 //! Mitsuba 0.5's low-discrepancy sampler does past its `dimension`): deep in a path the
 //! stratification no longer shows in the image, and the hashing costs ~100 instructions a pair.
 
+use crate::shape::VectorUnit;
 use alhazen_math::Vec2;
 
 /// Dimension pairs drawn from the Sobol sequence: the pixel position and, in the common case of
@@ -69,7 +70,7 @@ pub enum Sequence {
 
 /// What every sample of one pixel shares: the hashes of `(seed, pixel)` and of each Sobol
 /// dimension pair, computed once for all the pixel's [`SampleStream`]s.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelSeeds {
     sequence: Sequence,
     /// `mix(pixel seed ⊕ d)` for each Sobol pair `d`.
@@ -222,20 +223,132 @@ impl SampleStream {
     fn pair(&mut self) -> Vec2 {
         match self.sequence {
             Sequence::Sobol if self.dimension < SOBOL_PAIRS => {
-                let h = self.dimensions[self.dimension as usize];
-                // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal
-                // done once).
-                let shuffled = scramble_reversed(self.index_reversed, h as u32).reverse_bits();
-                // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
-                let a = scramble_reversed(shuffled, (h >> 32) as u32);
-                let sb = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
-                let b = scramble_reversed(sobol1_reversed(shuffled), sb);
-                // Both reversed by one 64-bit reversal, which also swaps the halves.
-                let ab = ((b as u64) << 32 | a as u64).reverse_bits();
-                Vec2::new(to_unit((ab >> 32) as u32), to_unit(ab as u32))
+                let (x, y) = sobol_pair(self.dimensions[self.dimension as usize], self.index_reversed);
+                Vec2::new(x, y)
             }
             _ => Vec2::new(self.rng.uniform(), self.rng.uniform()),
         }
+    }
+}
+
+/// The Owen-scrambled Sobol pair of the dimension whose pixel hash is `h`, for the sample whose
+/// index reversed is `index_reversed`.
+#[inline(always)]
+fn sobol_pair(h: u64, index_reversed: u32) -> (f64, f64) {
+    // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal done once).
+    let shuffled = scramble_reversed(index_reversed, h as u32).reverse_bits();
+    // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
+    let a = scramble_reversed(shuffled, (h >> 32) as u32);
+    let sb = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+    let b = scramble_reversed(sobol1_reversed(shuffled), sb);
+    // Both reversed by one 64-bit reversal, which also swaps the halves.
+    let ab = ((b as u64) << 32 | a as u64).reverse_bits();
+    (to_unit((ab >> 32) as u32), to_unit(ab as u32))
+}
+
+/// Streams side by side in [`StreamLanes`].
+pub const STREAM_LANES: usize = 8;
+
+/// Eight [`SampleStream`]s side by side, lane by lane, drawing the same numbers: the lanes'
+/// draws are one loop without branches, which the compiler turns into vector code.
+#[derive(Clone, Debug)]
+pub struct StreamLanes {
+    sequence: Sequence,
+    /// The pixel hash of each Sobol pair, lane by lane ([`PixelSeeds`]).
+    dimensions: [[u64; STREAM_LANES]; SOBOL_PAIRS as usize],
+    index_reversed: [u32; STREAM_LANES],
+    dimension: [u32; STREAM_LANES],
+    rng: [u64; STREAM_LANES],
+}
+
+impl StreamLanes {
+    /// Eight streams of `sequence`, to be started with [`Self::start`].
+    pub fn new(sequence: Sequence) -> Self {
+        Self {
+            sequence,
+            dimensions: [[0; STREAM_LANES]; SOBOL_PAIRS as usize],
+            index_reversed: [0; STREAM_LANES],
+            dimension: [0; STREAM_LANES],
+            rng: [0; STREAM_LANES],
+        }
+    }
+
+    /// Lane `lane` becomes [`PixelSeeds::stream`]`(index)` of `seeds`.
+    pub fn start(&mut self, lane: usize, seeds: &PixelSeeds, index: u32) {
+        debug_assert_eq!(seeds.sequence, self.sequence);
+        for (d, h) in self.dimensions.iter_mut().zip(seeds.dimensions) {
+            d[lane] = h;
+        }
+        self.index_reversed[lane] = index.reverse_bits();
+        self.dimension[lane] = 0;
+        self.rng[lane] = mix(seeds.rng ^ index as u64);
+    }
+
+    /// [`SampleStream::next_2d`] of lane `lane` alone.
+    pub fn next_2d_of(&mut self, lane: usize) -> Vec2 {
+        let (x, y) = self.draw(lane, true);
+        Vec2::new(x, y)
+    }
+
+    /// [`SampleStream::next_2d`] of every lane in `take`, into `out` (`out[0]` the first number
+    /// of each lane, `out[1]` the second; lanes not taken: untouched streams, zero).
+    #[allow(unsafe_code)]
+    pub fn next_2d(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2], unit: VectorUnit) {
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
+            return unsafe { self.next_2d_avx512(take, out) };
+        }
+        let _ = unit;
+        self.next_2d_lanes(take, out);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    #[allow(unsafe_code)]
+    unsafe fn next_2d_avx512(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2]) {
+        self.next_2d_lanes(take, out);
+    }
+
+    #[inline(always)]
+    fn next_2d_lanes(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2]) {
+        // Past the Sobol pairs (most draws of long paths) the hashing is skipped for all lanes.
+        let sobol = self.sequence == Sequence::Sobol && (0..STREAM_LANES).any(|i| self.dimension[i] < SOBOL_PAIRS);
+        for (lane, take) in take.into_iter().enumerate() {
+            let (x, y) = if sobol { self.draw(lane, take) } else { self.draw_independent(lane, take) };
+            (out[0][lane], out[1][lane]) = if take { (x, y) } else { (0.0, 0.0) };
+        }
+    }
+
+    /// [`Self::draw`] for a lane past the Sobol pairs.
+    #[inline(always)]
+    fn draw_independent(&mut self, lane: usize, take: bool) -> (f64, f64) {
+        let first = self.rng[lane].wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let second = first.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let unit = |z: u64| (mix(z) >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+        self.rng[lane] = if take { second } else { self.rng[lane] };
+        self.dimension[lane] += take as u32;
+        (unit(first), unit(second))
+    }
+
+    /// The pair of lane `lane`'s current dimension, and its step to the next when `take`:
+    /// [`SampleStream::pair`] computed both ways and chosen without branches.
+    #[inline(always)]
+    fn draw(&mut self, lane: usize, take: bool) -> (f64, f64) {
+        let d = self.dimension[lane];
+        let sobol = self.sequence == Sequence::Sobol && d < SOBOL_PAIRS;
+        let mut h = 0;
+        for (k, hashes) in self.dimensions.iter().enumerate() {
+            h = if d == k as u32 { hashes[lane] } else { h };
+        }
+        let scrambled = sobol_pair(h, self.index_reversed[lane]);
+        let first = self.rng[lane].wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let second = first.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let unit = |z: u64| (mix(z) >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+        let independent = (unit(first), unit(second));
+        self.rng[lane] = if take && !sobol { second } else { self.rng[lane] };
+        self.dimension[lane] = d + take as u32;
+        if sobol { scrambled } else { independent }
     }
 }
 
@@ -405,6 +518,41 @@ mod tests {
                         pts.iter().map(|p| ((if coord == 0 { p.0 } else { p.1 }) * n as f64) as u32).collect();
                     rows.sort();
                     assert_eq!(rows, (0..n).collect::<Vec<_>>());
+                }
+            }
+        }
+    }
+
+    proptest::proptest! {
+        /// Eight lanes draw what eight streams draw, whichever lanes draw together, past the
+        /// Sobol pairs, with every vector unit and both sequences.
+        #[test]
+        fn stream_lanes_draw_what_streams_draw(
+            seed in 0u64..1000,
+            samples in proptest::collection::vec((0u32..64, 0u32..64, 0u32..4096), STREAM_LANES),
+            takes in proptest::collection::vec(proptest::array::uniform8(proptest::bool::ANY), 1..16),
+            sobol in proptest::bool::ANY,
+        ) {
+            let sequence = if sobol { Sequence::Sobol } else { Sequence::Independent };
+            for unit in VectorUnit::available() {
+                let mut lanes = StreamLanes::new(sequence);
+                let mut streams: Vec<SampleStream> = samples
+                    .iter()
+                    .enumerate()
+                    .map(|(lane, &(x, y, index))| {
+                        lanes.start(lane, &PixelSeeds::new(sequence, seed, x, y), index);
+                        SampleStream::new(sequence, seed, x, y, index)
+                    })
+                    .collect();
+                // The first pair one lane at a time, the rest together.
+                proptest::prop_assert_eq!(lanes.next_2d_of(3), streams[3].next_2d());
+                for take in &takes {
+                    let mut out = [[f64::NAN; STREAM_LANES]; 2];
+                    lanes.next_2d(*take, &mut out, unit);
+                    for (lane, stream) in streams.iter_mut().enumerate() {
+                        let expected = if take[lane] { stream.next_2d() } else { Vec2::ZERO };
+                        proptest::prop_assert_eq!(Vec2::new(out[0][lane], out[1][lane]), expected, "{}", unit.name());
+                    }
                 }
             }
         }

@@ -17,7 +17,7 @@
 use super::{PathTracer, Previous, RR_DEPTH, power_heuristic};
 use crate::bsdf::{Bsdf, ColorMode};
 use crate::lights::{Emitter, Lights};
-use crate::sampler::{PixelSeeds, SampleStream};
+use crate::sampler::{PixelSeeds, StreamLanes};
 use crate::shape::VectorUnit;
 use crate::world::HitPoint;
 use alhazen_math::{Ray, Vec2, Vec3, sin_cos_turns};
@@ -129,7 +129,6 @@ struct Shaded {
 struct Path {
     /// Where its result goes.
     job: usize,
-    stream: SampleStream,
     ray: Ray,
     depth: u32,
     l: Vec3,
@@ -159,15 +158,17 @@ impl PathTracer<'_> {
         let unit = self.world.vector_unit();
         let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
         let mut hits: [Option<HitPoint>; LANES] = [None; LANES];
+        let mut streams = StreamLanes::new(self.sequence);
         loop {
             // Idle lanes start the pixel's next samples; all lanes' rays are traced together.
-            for slot in paths.iter_mut().filter(|p| p.is_none()) {
+            for (i, slot) in paths.iter_mut().enumerate().filter(|(_, p)| p.is_none()) {
                 *slot = next.next().map(|job| {
                     let ((x, y), index) = (pixels[job / spp], (job % spp) as u32);
                     if index == 0 {
                         seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
                     }
-                    self.start_path(&seeds, (x, y), index, job)
+                    streams.start(i, &seeds, index);
+                    self.start_path(streams.next_2d_of(i), (x, y), job)
                 });
             }
             if paths.iter().all(Option::is_none) {
@@ -182,12 +183,13 @@ impl PathTracer<'_> {
             let mut shading = [false; LANES];
             for (i, (slot, hit)) in paths.iter_mut().zip(&hits).enumerate() {
                 let Some(path) = slot else { continue };
-                shading[i] = self.prepare_vertex(path, hit, (&mut vertices, &mut lights), i);
+                shading[i] = self.prepare_vertex(path, hit, &mut vertices, i);
                 if !shading[i] {
                     out[path.job] = path.l;
                     *slot = None;
                 }
             }
+            self.draw_vertex_numbers(&mut streams, shading, (&mut vertices, &mut lights));
             if self.lane_lights.is_some() {
                 sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
             }
@@ -206,25 +208,17 @@ impl PathTracer<'_> {
         }
     }
 
-    /// Sample `index` of pixel `(x, y)`, whose result goes to `out[job]`.
-    fn start_path(&self, seeds: &PixelSeeds, (x, y): (u32, u32), index: u32, job: usize) -> Path {
-        let mut stream = seeds.stream(index);
-        let film = stream.next_2d();
+    /// The path through `film` (the pixel's first pair) of pixel `(x, y)`, whose result goes to
+    /// `out[job]`.
+    fn start_path(&self, film: Vec2, (x, y): (u32, u32), job: usize) -> Path {
         let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
         let prev = Previous { p: ray.origin, pdf: 1.0, delta: true };
-        Path { job, stream, ray, depth: 1, l: Vec3::ZERO, beta: Vec3::ONE, prev }
+        Path { job, ray, depth: 1, l: Vec3::ZERO, beta: Vec3::ONE, prev }
     }
 
-    /// The per-path half of a vertex, as in [`Self::radiance`]: the ray's `hit`, its emission,
-    /// the light sample and the vertex's random numbers, written to lane `i`; false when the
-    /// path ends.
-    fn prepare_vertex(
-        &self,
-        path: &mut Path,
-        hit: &Option<HitPoint>,
-        (v, lights): (&mut Vertices, &mut LightLanes),
-        i: usize,
-    ) -> bool {
+    /// The per-path half of a vertex, as in [`Self::radiance`]: the ray's `hit`, its emission
+    /// and the vertex, written to lane `i`; false when the path ends.
+    fn prepare_vertex(&self, path: &mut Path, hit: &Option<HitPoint>, v: &mut Vertices, i: usize) -> bool {
         let max_depth = self.scene.render.max_depth;
         if path.depth > max_depth {
             return false;
@@ -242,37 +236,7 @@ impl PathTracer<'_> {
         let Some(Bsdf::Lambert(lambert)) = &self.uniform_bsdfs[wh.material as usize] else {
             unreachable!("lanes apply only when every material is Lambert (`lanes_apply`)")
         };
-        let s = &mut path.stream;
-        let choice = if self.lights.len() > 1 { s.next_2d() } else { Vec2::ZERO };
-        let u_light = s.next_2d();
-        match &self.lane_lights {
-            Some(all) => {
-                let k = &all[self.lights.choose(choice.x)];
-                lights.corner.set(i, k.corner);
-                lights.e1.set(i, k.e1);
-                lights.e2.set(i, k.e2);
-                lights.normal.set(i, k.normal);
-                (lights.pdf_area[i], lights.u[0][i], lights.u[1][i]) = (k.pdf_area, u_light.x, u_light.y);
-                v.light_radiance.set(i, k.radiance);
-                (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
-            }
-            None => {
-                let light = self.lights.sample(wh.p, choice.x, u_light);
-                let light = light.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
-                v.light[i] = light.is_some();
-                if let Some(ls) = light {
-                    v.light_dir.set(i, ls.dir);
-                    v.light_radiance.set(i, ls.radiance);
-                    (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
-                }
-            }
-        }
-        let u_bsdf = s.next_2d();
-        let roulette = path.depth >= RR_DEPTH;
-        // Drawn before it is known whether the path survives the continuation; a path that
-        // does not never draws again, so the stream is the per-path tracer's.
-        v.u_roulette[i] = if roulette { s.next_1d() } else { 0.0 };
-        (v.roulette[i], v.u_bsdf[0][i], v.u_bsdf[1][i]) = (roulette, u_bsdf.x, u_bsdf.y);
+        v.roulette[i] = path.depth >= RR_DEPTH;
         v.wo.set(i, -path.ray.dir);
         v.p.set(i, wh.p);
         v.ng.set(i, wh.n);
@@ -281,6 +245,56 @@ impl PathTracer<'_> {
         v.beta.set(i, path.beta);
         path.prev.p = wh.p;
         true
+    }
+
+    /// The random numbers of the vertices of the lanes `shading`, in the per-path tracer's
+    /// order (light choice when there is one, light point, continuation, roulette from
+    /// [`RR_DEPTH`] on), and each lane's light sample.
+    fn draw_vertex_numbers(
+        &self,
+        streams: &mut StreamLanes,
+        shading: [bool; LANES],
+        (v, lights): (&mut Vertices, &mut LightLanes),
+    ) {
+        let unit = self.world.vector_unit();
+        let mut choice = [[0.0; LANES]; 2];
+        if self.lights.len() > 1 {
+            streams.next_2d(shading, &mut choice, unit);
+        }
+        let mut u_light = [[0.0; LANES]; 2];
+        streams.next_2d(shading, &mut u_light, unit);
+        streams.next_2d(shading, &mut v.u_bsdf, unit);
+        // Drawn before it is known whether the path survives the continuation; a path that
+        // does not never draws again, so the streams stay the per-path tracer's.
+        let mut u_roulette = [[0.0; LANES]; 2];
+        streams.next_2d(std::array::from_fn(|i| shading[i] && v.roulette[i]), &mut u_roulette, unit);
+        v.u_roulette = u_roulette[0];
+        for i in (0..LANES).filter(|&i| shading[i]) {
+            match &self.lane_lights {
+                Some(all) => {
+                    let k = &all[self.lights.choose(choice[0][i])];
+                    lights.corner.set(i, k.corner);
+                    lights.e1.set(i, k.e1);
+                    lights.e2.set(i, k.e2);
+                    lights.normal.set(i, k.normal);
+                    lights.pdf_area[i] = k.pdf_area;
+                    v.light_radiance.set(i, k.radiance);
+                    (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
+                }
+                None => {
+                    let u = Vec2::new(u_light[0][i], u_light[1][i]);
+                    let light = self.lights.sample(v.p.get(i), choice[0][i], u);
+                    let light = light.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
+                    v.light[i] = light.is_some();
+                    if let Some(ls) = light {
+                        v.light_dir.set(i, ls.dir);
+                        v.light_radiance.set(i, ls.radiance);
+                        (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
+                    }
+                }
+            }
+        }
+        lights.u = u_light;
     }
 
     /// The per-path half after [`shade`] and the shadow ray (`unoccluded` when it was traced and
@@ -304,7 +318,7 @@ impl PathTracer<'_> {
 fn sample_lights(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
-        // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+        // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
         return unsafe { sample_lights_avx512(k, v, choice_pdf) };
     }
     let _ = unit;
@@ -312,7 +326,7 @@ fn sample_lights(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: Vector
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
 unsafe fn sample_lights_avx512(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
     (0..LANES).for_each(|i| sample_light(k, v, choice_pdf, i));
@@ -339,7 +353,7 @@ fn sample_light(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
 fn shade(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
-        // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+        // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
         return unsafe { shade_avx512(v, out) };
     }
     let _ = unit;
@@ -347,7 +361,7 @@ fn shade(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
 unsafe fn shade_avx512(v: &Vertices, out: &mut Shaded) {
     shade_lanes(v, out)

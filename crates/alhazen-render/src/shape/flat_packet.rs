@@ -240,7 +240,7 @@ enum Unit {
     /// Two halves of four lanes in AVX2 registers.
     #[cfg(target_arch = "x86_64")]
     Avx2,
-    /// All eight lanes in one AVX-512 register.
+    /// All eight lanes in one AVX-512 register (F, DQ, VL and BW present).
     #[cfg(target_arch = "x86_64")]
     Avx512,
 }
@@ -262,7 +262,13 @@ impl VectorUnit {
             if std::arch::is_x86_feature_detected!("avx2") {
                 units.push(Self(Unit::Avx2));
             }
-            if std::arch::is_x86_feature_detected!("avx512f") {
+            // F for the packets; DQ, VL and BW for the path tracer's lanes (64-bit integer
+            // multiplies and conversions): every AVX-512 processor since Skylake-SP has all four.
+            if std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx512dq")
+                && std::arch::is_x86_feature_detected!("avx512vl")
+                && std::arch::is_x86_feature_detected!("avx512bw")
+            {
                 units.push(Self(Unit::Avx512));
             }
         }
