@@ -285,6 +285,7 @@ impl Lights {
     }
 
     /// Chooses a light by `u_choice` and a point on it by `u`, as seen from `p`.
+    #[inline]
     pub fn sample(&self, p: Vec3, u_choice: f64, u: Vec2) -> Option<LightSample> {
         if self.lights.is_empty() {
             return None;

@@ -154,6 +154,7 @@ impl<'a> PathTracer<'a> {
 
     /// What a path carrying `beta` gathers from the sky when `ray` leaves the scene, weighted
     /// against light sampling; `None` where the sky is black.
+    #[inline(never)]
     fn escaped(&self, ray: &Ray, prev: &Previous, beta: Vec3, mode: ColorMode) -> Option<Vec3> {
         let le = self.lights.sky_radiance(ray.dir);
         if le == Vec3::ZERO {
