@@ -75,6 +75,17 @@ pub struct World {
     vectors: VectorUnit,
     /// Everything is flats in one leaf: eight rays are tested at once, ray by lane.
     flats_only: bool,
+    /// Beside `flats.lanes`, for flats without smooth normals: each triangle's normal and
+    /// material.
+    flat_shading: Vec<[Option<FlatShading>; LANES]>,
+}
+
+/// A flat's triangles' normals and materials (the first, then the second of a
+/// parallelogram's pair), which a hit needs besides its point.
+#[derive(Clone, Copy, Debug)]
+struct FlatShading {
+    normal: [Vec3; 2],
+    material: [u32; 2],
 }
 
 /// Where a ray meets the world, without texture coordinates or bump-map tangents (enough to
@@ -254,7 +265,24 @@ impl World {
             && matches!(world.leaves.as_slice(), [leaf] if leaf.spheres.is_empty() && leaf.objects.is_empty())
             && bvh.leaves().count() == 1;
         world.bvh = bvh;
+        world.flat_shading = world.flats.lanes.iter().map(|lanes| lanes.map(|l| world.flat_shading(l))).collect();
         world
+    }
+
+    /// What [`FlatShading`] a hit on `lane` needs; `None` where normals vary over it.
+    fn flat_shading(&self, lane: Lane) -> Option<FlatShading> {
+        let o = &self.objects[lane.object as usize];
+        let Shape::Mesh(mesh) = &o.placed.shape else { return None };
+        let first = lane.flat.triangle as usize;
+        let triangles = [first, first + usize::from(lane.flat.parallelogram)];
+        if !triangles.iter().all(|&t| mesh.shades_flat(t)) {
+            return None;
+        }
+        let [a, b] = triangles.map(|t| {
+            let (n, _, slot) = mesh.normals_and_slot(t, 0.0, 0.0);
+            (n, o.slot_materials.get(slot as usize).copied().unwrap_or(o.material))
+        });
+        Some(FlatShading { normal: [a.0, b.0], material: [a.1, b.1] })
     }
 
     /// Sorts each leaf's primitives into packets of flats, packets of spheres and a list of
@@ -352,7 +380,7 @@ impl World {
         if self.flats_only {
             out.iter_mut().for_each(|slot| *slot = None);
             FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
-                out[r] = Some(self.flat_point(&rays[r], self.flats.lanes[k][h.lane], h));
+                out[r] = Some(self.flat_point(&rays[r], k, h));
             });
         } else {
             for ((slot, ray), live) in out.iter_mut().zip(rays).zip(live) {
@@ -361,11 +389,17 @@ impl World {
         }
     }
 
-    /// The point where `ray` meets the flat of `lane` (a triangle or parallelogram of a mesh
-    /// placed in world space) as [`Self::intersect`] reports it.
+    /// The point where `ray` meets lane `h.lane` of packet `k` as [`Self::intersect`] reports
+    /// it (the flat is a triangle or parallelogram of a mesh placed in world space).
     #[inline]
-    fn flat_point(&self, ray: &Ray, lane: Lane, h: LaneHit) -> HitPoint {
+    fn flat_point(&self, ray: &Ray, k: usize, h: LaneHit) -> HitPoint {
+        let lane = self.flats.lanes[k][h.lane];
         let c = lane.flat.candidate(h.t, h.b1, h.b2);
+        if let Some(s) = &self.flat_shading[k][h.lane] {
+            let second = (c.aux - lane.flat.triangle) as usize;
+            let (n, material) = (s.normal[second], s.material[second]);
+            return HitPoint { p: ray.at(c.t), n, ns: n, material, object: lane.object };
+        }
         let o = &self.objects[lane.object as usize];
         let Shape::Mesh(mesh) = &o.placed.shape else { unreachable!("flats come from meshes") };
         let (n, ns, slot) = mesh.normals_and_slot(c.aux as usize, c.bary[0], c.bary[1]);
@@ -453,5 +487,45 @@ pub fn shading_normal(hit: &SurfaceHit, m: &scene::Material, images: &[Arc<scene
     match &m.bump {
         None => hit.ns,
         Some(b) => scene::texture::bumped_normal(b, hit.uv, hit.ns, hit.dpduv[0], hit.dpduv[1], images),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rays into a one-leaf world of flats with smooth normals (a subdivided cube) and flat
+    /// ones (a box): eight at a time, each hit is what the ray finds alone.
+    #[test]
+    fn eight_rays_meet_smooth_and_flat_flats_as_one_does() {
+        let text = r#"
+[[object]]
+shape = "subdivision"
+base = "cube"
+levels = 0
+smooth = true
+[[object]]
+shape = "box"
+min = [1.5, -1, -1]
+max = [2.5, 1, 1]
+"#;
+        let world = World::build(&scene::parse_scene("smooth.toml".as_ref(), text).unwrap());
+        assert!(world.flats_only, "one leaf of flats");
+        assert!(world.flat_shading.iter().flatten().any(Option::is_none), "some flats shade smoothly");
+        let mut n = 0;
+        for k in 0..64 {
+            let rays: [Ray; LANES] = std::array::from_fn(|i| {
+                let a = (k * LANES + i) as f64 * 0.37;
+                let origin = Vec3::new(4.0 * a.cos(), 1.5 * (1.3 * a).sin(), 4.0 * a.sin());
+                Ray::new(origin, (Vec3::new(0.8 * (2.1 * a).sin(), 0.3 * a.cos(), 0.2) - origin).normalize())
+            });
+            let mut hits = [None; LANES];
+            world.intersect_rays(&rays, [true; LANES], &mut hits);
+            for (ray, hit) in rays.iter().zip(hits) {
+                assert_eq!(hit, world.intersect(ray, f64::INFINITY).map(HitPoint::from));
+                n += usize::from(hit.is_some_and(|h| h.n != h.ns));
+            }
+        }
+        assert!(n > 50, "{n} hits with smooth normals");
     }
 }

@@ -100,13 +100,19 @@ pub fn triangle_hit(ray: &Ray, [p0, p1, p2]: [Vec3; 3]) -> Option<(f64, f64, f64
 }
 
 impl MeshShape {
+    /// True when triangle `tri` is shaded with its face normal (no vertex normals to blend).
+    #[inline]
+    pub fn shades_flat(&self, tri: usize) -> bool {
+        !self.smooth || self.accel.flat[tri]
+    }
+
     /// Triangle `tri`'s geometric and shading normals and material slot at barycentric
     /// `(b1, b2)`: what [`Self::surface_at`] reports, without the rest.
     #[inline]
     pub fn normals_and_slot(&self, tri: usize, b1: f64, b2: f64) -> (Vec3, Vec3, u32) {
         let m = &self.accel.mesh;
         let n = self.accel.face_normals[tri];
-        let ns = if self.smooth && !self.accel.flat[tri] {
+        let ns = if !self.shades_flat(tri) {
             let idx = m.triangles[tri].map(|i| i as usize);
             let b0 = 1.0 - b1 - b2;
             let s = m.normals[idx[0]] * b0 + m.normals[idx[1]] * b1 + m.normals[idx[2]] * b2;
