@@ -7,8 +7,8 @@
 use crate::bvh::Bvh;
 use crate::shape::{
     AaBox, Candidate, Cone, Csg, Cylinder, Disk, FLAT_LANES as LANES, Flat, FlatLane, FlatPacket, LaneHit, MeshAccel,
-    MeshShape, PackedFlats, Placed, Plane, SPHERE_LANES, Shape, Sphere, SpherePacket, SurfaceHit, VectorUnit,
-    flat_primitives,
+    MeshShape, PackedFlats, Placed, Plane, RayPacket, SPHERE_LANES, Shape, Sphere, SpherePacket, SurfaceHit,
+    VectorUnit, flat_primitives,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -376,15 +376,15 @@ impl World {
 
     /// [`Self::intersect`] for eight rays without a limit, into `out` (`None` where not
     /// `live`), as [`HitPoint`]s: the same hits, several rays' tests in flight at once.
-    pub fn intersect_rays(&self, rays: &[Ray; LANES], live: [bool; LANES], out: &mut [Option<HitPoint>; LANES]) {
+    pub fn intersect_rays(&self, rays: &RayPacket, live: [bool; LANES], out: &mut [Option<HitPoint>; LANES]) {
         if self.flats_only {
             out.iter_mut().for_each(|slot| *slot = None);
             FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
-                out[r] = Some(self.flat_point(&rays[r], k, h));
+                out[r] = Some(self.flat_point(&rays.ray(r), k, h));
             });
         } else {
-            for ((slot, ray), live) in out.iter_mut().zip(rays).zip(live) {
-                *slot = if live { self.intersect(ray, f64::INFINITY).map(HitPoint::from) } else { None };
+            for (r, (slot, live)) in out.iter_mut().zip(live).enumerate() {
+                *slot = if live { self.intersect(&rays.ray(r), f64::INFINITY).map(HitPoint::from) } else { None };
             }
         }
     }
@@ -408,12 +408,12 @@ impl World {
     }
 
     /// [`Self::unoccluded`] for eight segments, `rays[r]` over `dist[r]` (false where not `live`).
-    pub fn unoccluded_rays(&self, rays: &[Ray; LANES], dist: &[f64; LANES], live: [bool; LANES]) -> [bool; LANES] {
+    pub fn unoccluded_rays(&self, rays: &RayPacket, dist: &[f64; LANES], live: [bool; LANES]) -> [bool; LANES] {
         if self.flats_only {
             let blocked = FlatPacket::any_of_rays(&self.flats.packets, rays, dist, live, self.vectors);
             return std::array::from_fn(|r| live[r] && !blocked[r]);
         }
-        std::array::from_fn(|r| live[r] && self.unoccluded(rays[r].origin, rays[r].dir, dist[r]))
+        std::array::from_fn(|r| live[r] && self.unoccluded(rays.ray(r).origin, rays.ray(r).dir, dist[r]))
     }
 
     /// The hit of object `i` whose candidate is `c`, with its surface and material.
@@ -514,15 +514,19 @@ max = [2.5, 1, 1]
         assert!(world.flat_shading.iter().flatten().any(Option::is_none), "some flats shade smoothly");
         let mut n = 0;
         for k in 0..64 {
-            let rays: [Ray; LANES] = std::array::from_fn(|i| {
+            let mut rays = RayPacket::default();
+            for i in 0..LANES {
                 let a = (k * LANES + i) as f64 * 0.37;
                 let origin = Vec3::new(4.0 * a.cos(), 1.5 * (1.3 * a).sin(), 4.0 * a.sin());
-                Ray::new(origin, (Vec3::new(0.8 * (2.1 * a).sin(), 0.3 * a.cos(), 0.2) - origin).normalize())
-            });
+                rays.set(
+                    i,
+                    &Ray::new(origin, (Vec3::new(0.8 * (2.1 * a).sin(), 0.3 * a.cos(), 0.2) - origin).normalize()),
+                );
+            }
             let mut hits = [None; LANES];
             world.intersect_rays(&rays, [true; LANES], &mut hits);
-            for (ray, hit) in rays.iter().zip(hits) {
-                assert_eq!(hit, world.intersect(ray, f64::INFINITY).map(HitPoint::from));
+            for (i, hit) in hits.into_iter().enumerate() {
+                assert_eq!(hit, world.intersect(&rays.ray(i), f64::INFINITY).map(HitPoint::from));
                 n += usize::from(hit.is_some_and(|h| h.n != h.ns));
             }
         }

@@ -4,6 +4,7 @@
 
 use alhazen_math::{Ray, Vec3};
 use alhazen_render::World;
+use alhazen_render::shape::RayPacket;
 use alhazen_render::world::HitPoint;
 use alhazen_scene::parse_scene;
 use proptest::prelude::*;
@@ -104,12 +105,14 @@ proptest! {
         for text in [flats_scene(&boxes), random_scene(&spheres, &boxes)] {
             let world = World::build(&parse_scene("rays.toml".as_ref(), &text).unwrap());
             let dir = |i: usize| Vec3::new(rays[i].0.0, rays[i].0.1, rays[i].0.2).try_normalize().unwrap_or(Vec3::Z);
-            let all: [Ray; 8] = std::array::from_fn(|i| Ray::new(Vec3::new(rays[i].1.0, rays[i].1.1, rays[i].1.2), dir(i)));
+            let mut all = RayPacket::default();
+            (0..8).for_each(|i| all.set(i, &Ray::new(Vec3::new(rays[i].1.0, rays[i].1.1, rays[i].1.2), dir(i))));
             let (dist, live): ([f64; 8], [bool; 8]) = (std::array::from_fn(|i| rays[i].2), std::array::from_fn(|i| rays[i].3));
             let mut hits = [None; 8];
             world.intersect_rays(&all, live, &mut hits);
             let clear = world.unoccluded_rays(&all, &dist, live);
-            for (i, ray) in all.iter().enumerate() {
+            for i in 0..8 {
+                let ray = &all.ray(i);
                 let alone = world.intersect(ray, f64::INFINITY).filter(|_| live[i]);
                 prop_assert_eq!(hits[i], alone.map(HitPoint::from));
                 prop_assert_eq!(clear[i], live[i] && world.unoccluded(ray.origin, ray.dir, dist[i]));

@@ -18,7 +18,7 @@ use super::{PathTracer, Previous, RR_DEPTH, power_heuristic};
 use crate::bsdf::{Bsdf, ColorMode};
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, StreamLanes};
-use crate::shape::VectorUnit;
+use crate::shape::{RayPacket, VectorUnit};
 use crate::world::HitPoint;
 use alhazen_math::{Ray, Vec2, Vec3, sin_cos_turns};
 use std::f64::consts::{FRAC_1_PI, PI};
@@ -29,24 +29,17 @@ const LANES: usize = 8;
 /// One number per lane.
 type Lanes = [f64; LANES];
 
-/// One vector per lane, component by component.
-#[derive(Clone, Copy, Debug, Default)]
-struct Lanes3 {
-    x: Lanes,
-    y: Lanes,
-    z: Lanes,
+/// One vector per lane, component by component (a [`RayPacket`]'s layout).
+type Lanes3 = [Lanes; 3];
+
+#[inline(always)]
+fn get(v: &Lanes3, i: usize) -> Vec3 {
+    Vec3::new(v[0][i], v[1][i], v[2][i])
 }
 
-impl Lanes3 {
-    #[inline(always)]
-    fn get(&self, i: usize) -> Vec3 {
-        Vec3::new(self.x[i], self.y[i], self.z[i])
-    }
-
-    #[inline(always)]
-    fn set(&mut self, i: usize, v: Vec3) {
-        (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
-    }
+#[inline(always)]
+fn set(v: &mut Lanes3, i: usize, x: Vec3) {
+    (v[0][i], v[1][i], v[2][i]) = (x.x, x.y, x.z);
 }
 
 /// What the per-path stage leaves for [`shade`], lane by lane.
@@ -162,7 +155,7 @@ impl PathTracer<'_> {
         let (mut vertices, mut shaded) = (Vertices::default(), Shaded::default());
         let mut lights = LightLanes::default();
         let unit = self.world.vector_unit();
-        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
+        let mut rays = RayPacket::default();
         let mut hits: [Option<HitPoint>; LANES] = [None; LANES];
         let mut streams = StreamLanes::new(self.sequence);
         loop {
@@ -174,16 +167,13 @@ impl PathTracer<'_> {
                         seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
                     }
                     streams.start(i, &seeds, index);
-                    self.start_path(streams.next_2d_of(i), (x, y), job)
+                    let path = self.start_path(streams.next_2d_of(i), (x, y), job);
+                    rays.set(i, &path.ray);
+                    path
                 });
             }
             if paths.iter().all(Option::is_none) {
                 return;
-            }
-            for (ray, path) in rays.iter_mut().zip(&paths) {
-                if let Some(p) = path {
-                    *ray = p.ray;
-                }
             }
             self.world.intersect_rays(&rays, paths.each_ref().map(|p| p.is_some()), &mut hits);
             let mut shading = [false; LANES];
@@ -200,13 +190,15 @@ impl PathTracer<'_> {
                 sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
             }
             shade(&vertices, &mut shaded, unit);
-            let shadow_rays = std::array::from_fn(|i| Ray::new(shaded.shadow_origin.get(i), vertices.light_dir.get(i)));
+            let shadow_rays = RayPacket { origin: shaded.shadow_origin, dir: vertices.light_dir };
             let tested = std::array::from_fn(|i| shading[i] && shaded.shadow[i]);
             let clear = self.world.unoccluded_rays(&shadow_rays, &shaded.shadow_dist, tested);
             for (i, slot) in paths.iter_mut().enumerate() {
                 let Some(path) = slot.as_mut().filter(|_| shading[i]) else { continue };
                 self.finish_vertex(path, &shaded, clear[i], i);
-                if !shaded.alive[i] {
+                if shaded.alive[i] {
+                    rays.set(i, &path.ray);
+                } else {
                     out[path.job] = path.l;
                     *slot = None;
                 }
@@ -243,12 +235,12 @@ impl PathTracer<'_> {
             unreachable!("lanes apply only when every material is Lambert (`lanes_apply`)")
         };
         v.roulette[i] = path.depth >= RR_DEPTH;
-        v.wo.set(i, -path.ray.dir);
-        v.p.set(i, wh.p);
-        v.ng.set(i, wh.n);
-        v.ns.set(i, wh.ns);
-        v.albedo.set(i, lambert.albedo);
-        v.beta.set(i, path.beta);
+        set(&mut v.wo, i, -path.ray.dir);
+        set(&mut v.p, i, wh.p);
+        set(&mut v.ng, i, wh.n);
+        set(&mut v.ns, i, wh.ns);
+        set(&mut v.albedo, i, lambert.albedo);
+        set(&mut v.beta, i, path.beta);
         path.prev.p = wh.p;
         true
     }
@@ -279,22 +271,22 @@ impl PathTracer<'_> {
             match &self.lane_lights {
                 Some(all) => {
                     let k = &all[self.lights.choose(choice[0][i])];
-                    lights.corner.set(i, k.corner);
-                    lights.e1.set(i, k.e1);
-                    lights.e2.set(i, k.e2);
-                    lights.normal.set(i, k.normal);
+                    set(&mut lights.corner, i, k.corner);
+                    set(&mut lights.e1, i, k.e1);
+                    set(&mut lights.e2, i, k.e2);
+                    set(&mut lights.normal, i, k.normal);
                     lights.pdf_area[i] = k.pdf_area;
-                    v.light_radiance.set(i, k.radiance);
+                    set(&mut v.light_radiance, i, k.radiance);
                     (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
                 }
                 None => {
                     let u = Vec2::new(u_light[0][i], u_light[1][i]);
-                    let light = self.lights.sample(v.p.get(i), choice[0][i], u);
+                    let light = self.lights.sample(get(&v.p, i), choice[0][i], u);
                     let light = light.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
                     v.light[i] = light.is_some();
                     if let Some(ls) = light {
-                        v.light_dir.set(i, ls.dir);
-                        v.light_radiance.set(i, ls.radiance);
+                        set(&mut v.light_dir, i, ls.dir);
+                        set(&mut v.light_radiance, i, ls.radiance);
                         (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
                     }
                 }
@@ -307,13 +299,13 @@ impl PathTracer<'_> {
     /// met nothing): the light gathered, then the step to the next vertex.
     fn finish_vertex(&self, path: &mut Path, s: &Shaded, unoccluded: bool, i: usize) {
         let clear = !s.shadow[i] || unoccluded;
-        let light = if clear { s.light.get(i) } else { Vec3::ZERO };
+        let light = if clear { get(&s.light, i) } else { Vec3::ZERO };
         path.l += path.beta * light;
         if s.alive[i] {
-            path.beta = s.beta.get(i);
+            path.beta = get(&s.beta, i);
             path.prev.pdf = s.pdf[i];
             path.prev.delta = false;
-            path.ray = Ray::new(s.origin.get(i), s.dir.get(i));
+            path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
             path.depth += 1;
         }
     }
@@ -387,12 +379,12 @@ fn dot(a: (f64, f64, f64), b: (f64, f64, f64)) -> f64 {
 
 #[inline(always)]
 fn lane(v: &Lanes3, i: usize) -> (f64, f64, f64) {
-    (v.x[i], v.y[i], v.z[i])
+    (v[0][i], v[1][i], v[2][i])
 }
 
 #[inline(always)]
 fn put(v: &mut Lanes3, i: usize, (x, y, z): (f64, f64, f64)) {
-    (v.x[i], v.y[i], v.z[i]) = (x, y, z);
+    (v[0][i], v[1][i], v[2][i]) = (x, y, z);
 }
 
 /// `p` moved off its surface towards the side of `dir` ([`super::offset`]).

@@ -32,6 +32,33 @@ pub struct FlatPacket {
     used: usize,
 }
 
+/// Eight rays, coordinate by coordinate: ray `r` starts at `origin[axis][r]` and goes along
+/// `dir[axis][r]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RayPacket {
+    /// Origins.
+    pub origin: [[f64; LANES]; 3],
+    /// Directions.
+    pub dir: [[f64; LANES]; 3],
+}
+
+impl RayPacket {
+    /// Ray `r`.
+    #[inline]
+    pub fn ray(&self, r: usize) -> Ray {
+        let at = |a: &[[f64; LANES]; 3]| Vec3::new(a[0][r], a[1][r], a[2][r]);
+        Ray::new(at(&self.origin), at(&self.dir))
+    }
+
+    /// Makes ray `r` `ray`.
+    #[inline]
+    pub fn set(&mut self, r: usize, ray: &Ray) {
+        for axis in 0..3 {
+            (self.origin[axis][r], self.dir[axis][r]) = (ray.origin[axis], ray.dir[axis]);
+        }
+    }
+}
+
 /// A packet's nearest hit: its lane and [`Flat::hit`]'s `(t, b1, b2)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LaneHit {
@@ -125,7 +152,7 @@ impl FlatPacket {
     #[allow(unsafe_code)]
     pub fn nearest_of_rays(
         packets: &[Self],
-        rays: &[Ray; LANES],
+        rays: &RayPacket,
         live: [bool; LANES],
         unit: VectorUnit,
         mut found: impl FnMut(usize, usize, LaneHit),
@@ -141,7 +168,7 @@ impl FlatPacket {
             return;
         }
         for r in (0..LANES).filter(|&r| live[r]) {
-            if let Some((k, h)) = Self::nearest_of(packets, &rays[r], f64::INFINITY, unit) {
+            if let Some((k, h)) = Self::nearest_of(packets, &rays.ray(r), f64::INFINITY, unit) {
                 found(r, k, h);
             }
         }
@@ -152,7 +179,7 @@ impl FlatPacket {
     #[allow(unsafe_code)]
     pub fn any_of_rays(
         packets: &[Self],
-        rays: &[Ray; LANES],
+        rays: &RayPacket,
         t_max: &[f64; LANES],
         live: [bool; LANES],
         unit: VectorUnit,
@@ -163,7 +190,7 @@ impl FlatPacket {
             let hit = unsafe { avx512::any_rays(packets, rays, t_max) };
             return std::array::from_fn(|r| live[r] && hit & (1 << r) != 0);
         }
-        std::array::from_fn(|r| live[r] && Self::any_of(packets, &rays[r], t_max[r], unit))
+        std::array::from_fn(|r| live[r] && Self::any_of(packets, &rays.ray(r), t_max[r], unit))
     }
 
     /// Lane `lane` as a [`Flat`] (an unused lane: one with a zero normal, which no ray hits).
@@ -388,7 +415,7 @@ mod avx2 {
 #[allow(unsafe_code)]
 mod avx512 {
     use super::super::avx512::{NearestLanes, RayLanes, dot, lane_of, load, load3, ray_lanes};
-    use super::{FlatPacket, LANES, LaneHit};
+    use super::{FlatPacket, LANES, LaneHit, RayPacket};
     use alhazen_math::Ray;
     use std::arch::x86_64::*;
 
@@ -456,12 +483,8 @@ mod avx512 {
     /// Eight rays, one per lane.
     #[inline]
     #[target_feature(enable = "avx512f")]
-    fn rays_in_lanes(rays: &[Ray; LANES]) -> RayLanes {
-        let axis = |f: fn(&Ray) -> f64| load(&std::array::from_fn(|r| f(&rays[r])));
-        RayLanes {
-            origin: [axis(|r| r.origin.x), axis(|r| r.origin.y), axis(|r| r.origin.z)],
-            dir: [axis(|r| r.dir.x), axis(|r| r.dir.y), axis(|r| r.dir.z)],
-        }
+    fn rays_in_lanes(rays: &RayPacket) -> RayLanes {
+        RayLanes { origin: load3(&rays.origin), dir: load3(&rays.dir) }
     }
 
     /// Flat `lane` of `p` in every lane (against eight rays).
@@ -492,7 +515,7 @@ mod avx512 {
     /// nearer replaces, so ties keep the first packet, then the first lane, as
     /// [`nearest`] does.
     #[target_feature(enable = "avx512f")]
-    pub(super) fn nearest_rays(packets: &[FlatPacket], rays: &[Ray; LANES]) -> RaysHits {
+    pub(super) fn nearest_rays(packets: &[FlatPacket], rays: &RayPacket) -> RaysHits {
         let r = rays_in_lanes(rays);
         let limit = _mm512_set1_pd(f64::INFINITY);
         let (mut best_t, mut best_at) = (limit, _mm512_setzero_si512());
@@ -521,7 +544,7 @@ mod avx512 {
 
     /// [`FlatPacket::any_of_rays`]: the rays blocked by some flat, one bit per ray.
     #[target_feature(enable = "avx512f")]
-    pub(super) fn any_rays(packets: &[FlatPacket], rays: &[Ray; LANES], t_max: &[f64; LANES]) -> u8 {
+    pub(super) fn any_rays(packets: &[FlatPacket], rays: &RayPacket, t_max: &[f64; LANES]) -> u8 {
         let (r, limit) = (rays_in_lanes(rays), load(t_max));
         let mut blocked = 0u8;
         for p in packets {
@@ -595,16 +618,18 @@ mod tests {
             prop_assume!(!flats.is_empty() && rays.iter().all(|r| r.1.length() > 1e-3));
             let packets: Vec<FlatPacket> = flats.chunks(fill).map(FlatPacket::new).collect();
             let ray_of = |r: &(Vec3, Vec3, f64, bool)| Ray::new(r.0, r.1.normalize());
-            let (all, t_max) = (std::array::from_fn(|i| ray_of(&rays[i])), std::array::from_fn(|i| rays[i].2));
+            let mut all = RayPacket::default();
+            rays.iter().enumerate().for_each(|(i, r)| all.set(i, &ray_of(r)));
+            let t_max = std::array::from_fn(|i| rays[i].2);
             let live = std::array::from_fn(|i| rays[i].3);
             for unit in VectorUnit::available() {
                 let mut found = [None; LANES];
                 FlatPacket::nearest_of_rays(&packets, &all, live, unit, |r, k, h| found[r] = Some((k, h)));
                 let blocked = FlatPacket::any_of_rays(&packets, &all, &t_max, live, unit);
                 for r in 0..LANES {
-                    let alone = FlatPacket::nearest_of(&packets, &all[r], f64::INFINITY, unit);
+                    let alone = FlatPacket::nearest_of(&packets, &all.ray(r), f64::INFINITY, unit);
                     prop_assert_eq!(found[r], alone.filter(|_| live[r]), "{:?}", unit);
-                    let any = FlatPacket::any_of(&packets, &all[r], t_max[r], unit);
+                    let any = FlatPacket::any_of(&packets, &all.ray(r), t_max[r], unit);
                     prop_assert_eq!(blocked[r], any && live[r], "{:?}", unit);
                 }
             }

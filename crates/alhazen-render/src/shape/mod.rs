@@ -21,7 +21,7 @@ pub use aabox::AaBox;
 pub use csg::Csg;
 pub use cylinder::{Cone, Cylinder};
 pub use flat::{Flat, FlatLane, flat_primitives, parallelogram_of, parallelogram_to_triangle};
-pub use flat_packet::{FlatPacket, LANES as FLAT_LANES, LaneHit, PackedFlats, VectorUnit};
+pub use flat_packet::{FlatPacket, LANES as FLAT_LANES, LaneHit, PackedFlats, RayPacket, VectorUnit};
 pub use mesh::{MeshAccel, MeshShape, triangle_hit};
 pub use plane::{Disk, Plane};
 pub use sphere::Sphere;
