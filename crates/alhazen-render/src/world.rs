@@ -394,12 +394,13 @@ impl World {
     #[inline]
     fn flat_point(&self, ray: &Ray, k: usize, h: LaneHit) -> HitPoint {
         let lane = self.flats.lanes[k][h.lane];
-        let c = lane.flat.candidate(h.t, h.b1, h.b2);
         if let Some(s) = &self.flat_shading[k][h.lane] {
-            let second = (c.aux - lane.flat.triangle) as usize;
+            // The triangle `FlatLane::candidate` picks, chosen without a branch (it is random).
+            let second = usize::from(lane.flat.parallelogram & (h.b1 < h.b2));
             let (n, material) = (s.normal[second], s.material[second]);
-            return HitPoint { p: ray.at(c.t), n, ns: n, material, object: lane.object };
+            return HitPoint { p: ray.at(h.t), n, ns: n, material, object: lane.object };
         }
+        let c = lane.flat.candidate(h.t, h.b1, h.b2);
         let o = &self.objects[lane.object as usize];
         let Shape::Mesh(mesh) = &o.placed.shape else { unreachable!("flats come from meshes") };
         let (n, ns, slot) = mesh.normals_and_slot(c.aux as usize, c.bary[0], c.bary[1]);
