@@ -1,13 +1,14 @@
 //! Criterion benchmarks: the glass-balls scene at reduced size (whole pipeline), rays per
 //! second against the BVH, and the Cornell box's world with rays like a path tracer's (from
 //! inside the room, in every direction), each world once per packet kernel the processor runs
-//! (`portable`, `avx2`, `avx512`: the same hits, so only the speed differs). The full-size
+//! (`portable`, `avx2`, `avx512`: the same hits, so only the speed differs), one ray at a time
+//! and eight at a time (as the path tracer's lanes trace them). The full-size
 //! comparisons are
 //! `bench/povray-compare.sh` and `bench/mitsuba/compare.py`.
 
 use alhazen_math::{Ray, Vec3};
 use alhazen_render::World;
-use alhazen_render::shape::VectorUnit;
+use alhazen_render::shape::{RayPacket, VectorUnit};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;
@@ -75,6 +76,30 @@ fn bench_cornell_rays(c: &mut Criterion) {
         });
         g.bench_function(format!("shadow rays of length 0.5, {} (rays/s)", unit.name()), |b| {
             b.iter(|| rays.iter().filter(|r| world.unoccluded(black_box(r.origin), r.dir, 0.5)).count())
+        });
+        // The path tracer's lanes: eight rays per call (ray by lane with AVX-512).
+        let packets: Vec<RayPacket> = rays
+            .chunks_exact(8)
+            .map(|chunk| {
+                let mut p = RayPacket::default();
+                chunk.iter().enumerate().for_each(|(i, r)| p.set(i, r));
+                p
+            })
+            .collect();
+        g.bench_function(format!("nearest hit, eight at a time, {} (rays/s)", unit.name()), |b| {
+            let mut hits = [None; 8];
+            b.iter(|| {
+                let mut n = 0;
+                for p in &packets {
+                    world.intersect_rays(black_box(p), [true; 8], &mut hits);
+                    n += hits.iter().flatten().count();
+                }
+                n
+            })
+        });
+        g.bench_function(format!("shadow rays of length 0.5, eight at a time, {} (rays/s)", unit.name()), |b| {
+            let dist = [0.5; 8];
+            b.iter(|| packets.iter().flat_map(|p| world.unoccluded_rays(black_box(p), &dist, [true; 8])).count())
         });
     }
     g.finish();
