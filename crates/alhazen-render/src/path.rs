@@ -10,6 +10,9 @@
 //! `k ≤ max_depth` (1 = emitters seen directly, 2 = direct lighting). Emitters shine from the
 //! side their normal points to. Scenes whose glass disperses (`cauchy`, `sellmeier`, `glass`)
 //! are rendered spectrally ([`crate::spectrum`]); all others in RGB.
+//!
+//! Lambertian RGB scenes on processors with AVX2 or AVX-512 are traced eight samples at a time
+//! in vector lanes (`lanes`), with the same arithmetic, so the same samples.
 
 use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_hint};
 use crate::camera::Camera;
@@ -37,8 +40,8 @@ pub struct PathTracer<'a> {
     sequence: Sequence,
     /// Each material's BSDF in RGB when it does not vary over the surface (no texture).
     uniform_bsdfs: Vec<Option<Bsdf>>,
-    /// Pixels are traced eight samples at a time ([`lanes`]); same image.
-    pub in_lanes: bool,
+    /// Samples are traced eight at a time in vector lanes (module `lanes`): the same samples.
+    in_lanes: bool,
     /// The lights, when every one is a parallelogram, for the lanes to sample.
     lane_lights: Option<Vec<lanes::LaneLight>>,
 }

@@ -299,6 +299,11 @@ impl StreamLanes {
             // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
             return unsafe { self.next_2d_avx512(take, out) };
         }
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx2() {
+            // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
+            return unsafe { self.next_2d_avx2(take, out) };
+        }
         let _ = unit;
         self.next_2d_lanes(take, out);
     }
@@ -307,6 +312,13 @@ impl StreamLanes {
     #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
     #[allow(unsafe_code)]
     unsafe fn next_2d_avx512(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2]) {
+        self.next_2d_lanes(take, out);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    unsafe fn next_2d_avx2(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2]) {
         self.next_2d_lanes(take, out);
     }
 

@@ -319,6 +319,19 @@ impl VectorUnit {
         }
     }
 
+    /// The AVX2 kernels run.
+    #[inline]
+    pub fn is_avx2(self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            self.0 == Unit::Avx2
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            false
+        }
+    }
+
     /// The AVX-512 kernels run.
     #[inline]
     pub fn is_avx512(self) -> bool {
