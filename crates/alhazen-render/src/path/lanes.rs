@@ -19,14 +19,14 @@
 //! every sample is bit-identical to the per-path tracer's on every processor (test
 //! `lanes_match_the_per_path_tracer`).
 
-use super::{PathTracer, Previous, RR_DEPTH, power_heuristic};
-use crate::bsdf::{Bsdf, ColorMode};
+use super::{PathTracer, Previous, RR_DEPTH, epsilon, offset, power_heuristic};
+use crate::bsdf::{Bsdf, ColorMode, Frame, cosine_hemisphere, cosine_pdf, same_side};
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, StreamLanes};
 use crate::shape::{RayPacket, VectorUnit};
 use crate::world::HitPoint;
-use alhazen_math::{Ray, Vec2, Vec3, sin_cos_turns};
-use std::f64::consts::{FRAC_1_PI, PI};
+use alhazen_math::{Ray, Vec2, Vec3};
+use std::f64::consts::FRAC_1_PI;
 
 /// Paths traced side by side: one AVX-512 register of `f64` (two AVX2 ones).
 const LANES: usize = 8;
@@ -348,19 +348,18 @@ unsafe fn sample_lights_avx2(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) 
     (0..LANES).for_each(|i| sample_light(k, v, choice_pdf, i));
 }
 
+/// Lane `i`'s point on its parallelogram, as `lights::sample_area` computes it.
 #[inline(always)]
 fn sample_light(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
-    let (ux, uy) = (k.u[0][i], k.u[1][i]);
-    let (o, e1, e2, p) = (lane(&k.corner, i), lane(&k.e1, i), lane(&k.e2, i), lane(&v.p, i));
-    let q = (o.0 + e1.0 * ux + e2.0 * uy, o.1 + e1.1 * ux + e2.1 * uy, o.2 + e1.2 * ux + e2.2 * uy);
-    let to = (q.0 - p.0, q.1 - p.1, q.2 - p.2);
-    let d2 = dot(to, to);
+    let q = get(&k.corner, i) + get(&k.e1, i) * k.u[0][i] + get(&k.e2, i) * k.u[1][i];
+    let to = q - get(&v.p, i);
+    let d2 = to.length_squared();
     let dist = d2.sqrt();
-    let dir = (to.0 / dist, to.1 / dist, to.2 / dist);
-    let cos = -dot(lane(&k.normal, i), dir);
+    let dir = to / dist;
+    let cos = -get(&k.normal, i).dot(dir);
     let pdf = k.pdf_area[i] * d2 / cos * choice_pdf;
     v.light[i] &= dist != 0.0 && not_at_most_zero(cos) && not_at_most_zero(pdf);
-    put(&mut v.light_dir, i, dir);
+    set(&mut v.light_dir, i, dir);
     (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
 }
 
@@ -402,120 +401,61 @@ fn shade_lanes(v: &Vertices, out: &mut Shaded) {
     }
 }
 
-#[inline(always)]
-fn dot(a: (f64, f64, f64), b: (f64, f64, f64)) -> f64 {
-    (a.0 * b.0) + (a.1 * b.1) + (a.2 * b.2)
-}
-
-#[inline(always)]
-fn lane(v: &Lanes3, i: usize) -> (f64, f64, f64) {
-    (v[0][i], v[1][i], v[2][i])
-}
-
-#[inline(always)]
-fn put(v: &mut Lanes3, i: usize, (x, y, z): (f64, f64, f64)) {
-    (v[0][i], v[1][i], v[2][i]) = (x, y, z);
-}
-
-/// `p` moved off its surface towards the side of `dir` ([`super::offset`]).
-#[inline(always)]
-fn offset(p: (f64, f64, f64), ng: (f64, f64, f64), dir: (f64, f64, f64)) -> (f64, f64, f64) {
-    let eps = lane_epsilon(p);
-    let e = if dot(ng, dir) >= 0.0 { eps } else { -eps };
-    (p.0 + ng.0 * e, p.1 + ng.1 * e, p.2 + ng.2 * e)
-}
-
-/// [`super::epsilon`], with glam's `max_element`.
-#[inline(always)]
-fn lane_epsilon(p: (f64, f64, f64)) -> f64 {
-    let max = |a: f64, b: f64| if a > b { a } else { b };
-    1e-9 * (1.0 + max(p.0.abs(), max(p.1.abs(), p.2.abs())))
-}
-
+/// Lane `i` of the Lambertian vertices: the per-path tracer's own functions (`shading_frame`'s
+/// rule, [`Frame`], [`cosine_hemisphere`], [`offset`], [`epsilon`], [`power_heuristic`]) on one
+/// lane, inlined into the all-lane loop.
 #[inline(always)]
 fn shade_lane(v: &Vertices, out: &mut Shaded, i: usize) {
-    let wo = lane(&v.wo, i);
-    let p = lane(&v.p, i);
-    // The shading frame (`PathTracer::shading_frame`, Lambert does not transmit).
-    let (mut ng, mut ns) = (lane(&v.ng, i), lane(&v.ns, i));
-    let ng_wo = dot(ng, wo);
-    if ng_wo < 0.0 {
-        ng = (-ng.0, -ng.1, -ng.2);
-        ns = (-ns.0, -ns.1, -ns.2);
+    let (wo, p) = (get(&v.wo, i), get(&v.p, i));
+    // The shading frame (`PathTracer::shading_frame`; Lambert does not transmit).
+    let (mut ng, mut ns) = (get(&v.ng, i), get(&v.ns, i));
+    if ng.dot(wo) < 0.0 {
+        (ng, ns) = (-ng, -ns);
     }
-    if dot(ns, wo) * dot(ng, wo) <= 0.0 {
+    if ns.dot(wo) * ng.dot(wo) <= 0.0 {
         ns = ng;
     }
-    let (fs, ft) = orthonormal_basis(ns);
-    let local = |w| (dot(w, fs), dot(w, ft), dot(w, ns));
-    let wv = local(wo);
-    let albedo = lane(&v.albedo, i);
-    let rho = (albedo.0 * FRAC_1_PI, albedo.1 * FRAC_1_PI, albedo.2 * FRAC_1_PI);
+    let frame = Frame::around(ns);
+    let wv = frame.to_local(wo);
+    let rho = get(&v.albedo, i) * FRAC_1_PI;
     // Next event (`PathTracer::next_event`).
-    let dir = lane(&v.light_dir, i);
-    let l = local(dir);
-    let same = wv.2 * l.2 > 0.0;
-    let lz = l.2.abs();
-    let f = if same { (rho.0 * lz, rho.1 * lz, rho.2 * lz) } else { (0.0, 0.0, 0.0) };
-    let zero = f.0 == 0.0 && f.1 == 0.0 && f.2 == 0.0;
-    let shadow = v.light[i] && !(zero || (dot(ng, dir) > 0.0) != (l.2 > 0.0));
+    let dir = get(&v.light_dir, i);
+    let l = frame.to_local(dir);
+    let f = if same_side(wv, l) { rho } else { Vec3::ZERO } * l.z.abs();
+    let shadow = v.light[i] && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0));
     let pdf_light = v.light_pdf[i];
-    let bsdf_pdf = if same { lz / PI } else { 0.0 };
-    let w = if v.light_delta[i] { 1.0 } else { power_heuristic(pdf_light, bsdf_pdf) };
-    let rad = lane(&v.light_radiance, i);
-    let k = w / pdf_light;
-    let c = if shadow { (f.0 * rad.0 * k, f.1 * rad.1 * k, f.2 * rad.2 * k) } else { (0.0, 0.0, 0.0) };
-    put(&mut out.light, i, c);
+    let w = if v.light_delta[i] { 1.0 } else { power_heuristic(pdf_light, cosine_pdf(wv, l)) };
+    let c = if shadow { f * get(&v.light_radiance, i) * (w / pdf_light) } else { Vec3::ZERO };
+    set(&mut out.light, i, c);
     out.shadow[i] = shadow;
-    put(&mut out.shadow_origin, i, offset(p, ng, dir));
+    set(&mut out.shadow_origin, i, offset(p, ng, dir));
     let d = v.light_dist[i];
-    out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * lane_epsilon(p) } else { f64::INFINITY };
-    // The continuation (`sample_cosine`, Malley's method).
-    let (ux, uy) = (v.u_bsdf[0][i], v.u_bsdf[1][i]);
-    let r = ux.sqrt();
-    let (sin, cos) = sin_cos_turns(uy);
-    let z = (1.0 - ux).max(0.0).sqrt();
-    let l = (r * cos, r * sin, if wv.2 < 0.0 { -z } else { z });
-    let pdf = if wv.2 * l.2 > 0.0 { l.2.abs() / PI } else { 0.0 };
-    let dir = (
-        fs.0 * l.0 + ft.0 * l.1 + ns.0 * l.2,
-        fs.1 * l.0 + ft.1 * l.1 + ns.1 * l.2,
-        fs.2 * l.0 + ft.2 * l.1 + ns.2 * l.2,
-    );
-    let lz = l.2.abs();
-    let weight = ((rho.0 * lz) / pdf, (rho.1 * lz) / pdf, (rho.2 * lz) / pdf);
-    let finite = weight.0.is_finite() && weight.1.is_finite() && weight.2.is_finite();
-    let nonzero = !(weight.0 == 0.0 && weight.1 == 0.0 && weight.2 == 0.0);
-    let beta = lane(&v.beta, i);
-    let mut beta = (beta.0 * weight.0, beta.1 * weight.1, beta.2 * weight.2);
-    let mut alive = pdf > 0.0 && finite && nonzero;
+    out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * epsilon(p) } else { f64::INFINITY };
+    // The continuation (`sample_cosine`).
+    let l = cosine_hemisphere(Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]), wv);
+    let pdf = cosine_pdf(wv, l);
+    let dir = frame.to_world(l);
+    let weight = rho * l.z.abs() / pdf;
+    let mut beta = get(&v.beta, i) * weight;
+    let mut alive = pdf > 0.0 && weight.is_finite() && weight != Vec3::ZERO;
     if v.roulette[i] {
-        let max = |a: f64, b: f64| if a > b { a } else { b };
-        let q = (max(beta.0, max(beta.1, beta.2)) * 1.0).min(0.95);
+        // `eta_scale` is 1 on Lambertian paths.
+        let q = (beta.max_element() * 1.0).min(0.95);
         // `u ≥ q` ends the path (u is never NaN; a NaN q does not end it).
         alive &= v.u_roulette[i] < q || q.is_nan();
-        beta = (beta.0 / q, beta.1 / q, beta.2 / q);
+        beta /= q;
     }
     out.alive[i] = alive;
     out.pdf[i] = pdf;
-    put(&mut out.beta, i, beta);
-    put(&mut out.dir, i, dir);
-    put(&mut out.origin, i, offset(p, ng, dir));
+    set(&mut out.beta, i, beta);
+    set(&mut out.dir, i, dir);
+    set(&mut out.origin, i, offset(p, ng, dir));
 }
 
 /// `!(x <= 0)`, as the per-path tracer's rejections read (NaN passes).
 #[inline(always)]
 fn not_at_most_zero(x: f64) -> bool {
     x > 0.0 || x.is_nan()
-}
-
-/// [`alhazen_math::orthonormal_basis`] on a tuple, same operations.
-#[inline(always)]
-fn orthonormal_basis(n: (f64, f64, f64)) -> ((f64, f64, f64), (f64, f64, f64)) {
-    let sign = 1f64.copysign(n.2);
-    let a = -1.0 / (sign + n.2);
-    let b = n.0 * n.1 * a;
-    ((1.0 + sign * n.0 * n.0 * a, sign * b, -sign * n.0), (b, sign + n.1 * n.1 * a, -n.1))
 }
 
 #[cfg(test)]
