@@ -93,20 +93,24 @@ material = "white"
     assert!((m - Vec3::ONE).abs().max_element() < 3e-3, "mean {m}");
 }
 
+/// The per-path tracer (cornell-rough) and the lanes (the Lambertian Cornell box, where the
+/// processor has AVX2 or AVX-512).
 #[test]
 fn path_traced_images_do_not_depend_on_the_thread_count() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-rough.toml");
-    let mut scene = alhazen_scene::load_scene(&path).unwrap();
-    scene.render.width = 48;
-    scene.render.height = 48;
-    scene.render.spp = 8;
-    let at = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| render(&scene, &|_, _| {}))
-    };
-    let one = at(1);
-    assert_eq!(one, at(2));
-    assert_eq!(one, at(3));
+    for name in ["cornell-rough", "cornell-box"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../scenes/{name}.toml"));
+        let mut scene = alhazen_scene::load_scene(&path).unwrap();
+        scene.render.width = 48;
+        scene.render.height = 48;
+        scene.render.spp = 8;
+        let at = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| render(&scene, &|_, _| {}))
+        };
+        let one = at(1);
+        assert_eq!(one, at(2), "{name}");
+        assert_eq!(one, at(3), "{name}");
+    }
 }
 
 #[test]
