@@ -4,6 +4,7 @@
 //! an unreadable or invalid scene file, impossible sizes).
 
 use alhazen_render::output::{Format, write_image};
+use alhazen_render::shape::VectorUnit;
 use alhazen_scene::{MAX_PIXELS, Scene, SceneError, load_scene};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -94,6 +95,21 @@ struct RenderArgs {
     /// The path tracer's sampler (overrides the scene).
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
+    /// The vector kernels to use (default: the widest this processor has). Every kernel renders
+    /// the same image; this is for measuring their speed.
+    #[arg(long, value_enum)]
+    kernel: Option<KernelArg>,
+}
+
+/// `--kernel`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum KernelArg {
+    /// Scalar loops, on any processor.
+    Portable,
+    /// AVX2 (x86-64).
+    Avx2,
+    /// AVX-512 F, DQ, VL and BW (x86-64).
+    Avx512,
 }
 
 /// `--integrator`.
@@ -210,7 +226,23 @@ pub(crate) fn check_output_dir(path: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
+/// The kernel `--kernel` names, if this processor has it.
+fn vector_unit(kernel: Option<KernelArg>) -> Result<VectorUnit, Failure> {
+    let Some(kernel) = kernel else { return Ok(VectorUnit::detect()) };
+    let name = match kernel {
+        KernelArg::Portable => "portable",
+        KernelArg::Avx2 => "avx2",
+        KernelArg::Avx512 => "avx512",
+    };
+    let available = VectorUnit::available();
+    available.iter().copied().find(|u| u.name() == name).ok_or_else(|| {
+        let names: Vec<&str> = available.iter().map(|u| u.name()).collect();
+        Failure::input(format!("--kernel {name}: this processor lacks it (it has: {})", names.join(", ")))
+    })
+}
+
 fn run_render(a: &RenderArgs) -> Result<(), Failure> {
+    let unit = vector_unit(a.kernel)?;
     let format = check_output(&a.image.output, a.image.half)?;
     let mut scene = load_sized(&a.image)?;
     apply_overrides(&mut scene, a);
@@ -220,7 +252,7 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     let bar = progress_bar(a.image.quiet);
     let start = Instant::now();
     let image = pool.install(|| {
-        alhazen_render::render(&scene, &|done, total| {
+        alhazen_render::render_with(&scene, unit, &|done, total| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
         })

@@ -51,6 +51,28 @@ fn integrator_and_sampler_can_be_chosen_on_the_command_line() {
     assert!(!exists);
 }
 
+/// `--kernel portable` runs on every processor and renders the bits the default kernel does
+/// (the path tracer, whose Lambertian scenes the wider kernels trace in lanes).
+#[test]
+fn every_kernel_renders_the_same_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), OK);
+    let image = |kernel: &[&str]| {
+        let out = dir.path().join("out.exr");
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet"];
+        args.extend_from_slice(&["--integrator", "path", "--spp", "9"]);
+        args.extend_from_slice(kernel);
+        let o = alhazen(&args);
+        assert_eq!(o.status.code(), Some(0), "{kernel:?}: {}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(&out).unwrap()
+    };
+    assert_eq!(image(&[]), image(&["--kernel", "portable"]));
+    let (code, err, exists) = render(OK, &["--kernel", "sse9"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("possible values: portable, avx2, avx512"), "{err}");
+    assert!(!exists);
+}
+
 #[test]
 fn raster_preview_writes_an_image_and_refuses_unsupported_cameras() {
     let dir = tempfile::tempdir().unwrap();
