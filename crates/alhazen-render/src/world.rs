@@ -2,7 +2,9 @@
 //! bounded ones and a plain list of unbounded ones (planes). Small meshes, rectangles and
 //! untextured boxes are flattened into world-space triangles and parallelograms, which the
 //! BVH's leaves test four or eight at a time ([`FlatPacket`]); a leaf's untransformed spheres,
-//! three or more, are one [`SpherePacket`]; other objects are tested one by one.
+//! three or more, are one [`SpherePacket`]; other objects are tested one by one. Eight rays
+//! can be traced in one call ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path
+//! tracer's lanes); when the world is flats in one leaf, each flat is tested against the eight.
 
 use crate::bvh::Bvh;
 use crate::shape::{

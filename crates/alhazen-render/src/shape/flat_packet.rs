@@ -9,6 +9,8 @@
 //! all lanes without branches, which is what makes the packet pay: a scalar test's early exits
 //! are unpredictable for rays in all directions. With AVX-512, a leaf's packets are tested in
 //! one call that keeps each lane's nearest hit in registers and compares lanes once at the end.
+//! For eight rays at once ([`RayPacket`], the path tracer's lanes) the AVX-512 kernel turns
+//! round: the rays are the lanes and each flat in turn is broadcast against them.
 
 use super::Flat;
 use alhazen_math::{Ray, Vec3};
