@@ -544,7 +544,8 @@ material = "glow"
     }
 
     /// The lanes trace the same bits as the per-path tracer: lights sampled in lanes (the
-    /// Cornell box's parallelogram) and per path (everything else), every depth from 0, a sky,
+    /// Cornell box's parallelogram, and two of them) and per path (everything else), every depth
+    /// from 0, a sky,
     /// sample counts that leave lanes idle; with every vector unit this processor has.
     #[test]
     fn lanes_match_the_per_path_tracer() {
@@ -552,7 +553,13 @@ material = "glow"
         let mut cornell = alhazen_scene::load_scene(&root.join("cornell-box.toml")).unwrap();
         (cornell.render.width, cornell.render.height, cornell.render.spp) = (20, 20, 11);
         let mixed = alhazen_scene::parse_scene("mixed.toml".as_ref(), MIXED).unwrap();
-        for (name, base) in [("cornell-box", cornell), ("mixed", mixed)] {
+        // Two parallelogram lights: the lanes draw the light choice too.
+        let text = std::fs::read_to_string(root.join("cornell-box.toml")).unwrap()
+            + "[[object]]\nshape = \"rectangle\"\nmaterial = \"light\"\n\
+               transform = [{ scale = 0.2 }, { rotate_y = 90 }, { translate = [0.9, 0.2, 0] }]\n";
+        let mut two_lights = alhazen_scene::parse_scene("two-lights.toml".as_ref(), &text).unwrap();
+        (two_lights.render.width, two_lights.render.height, two_lights.render.spp) = (16, 16, 9);
+        for (name, base) in [("cornell-box", cornell), ("mixed", mixed), ("two lights", two_lights)] {
             for depth in [0, 1, 2, 3, 8] {
                 let mut scene = base.clone();
                 scene.render.max_depth = depth;
