@@ -545,8 +545,8 @@ material = "glow"
 
     /// The lanes trace the same bits as the per-path tracer: lights sampled in lanes (the
     /// Cornell box's parallelogram, and two of them) and per path (everything else), every depth
-    /// from 0, a sky,
-    /// sample counts that leave lanes idle; with every vector unit this processor has.
+    /// from 0, a sky, sample counts that leave lanes idle; with every vector unit this processor
+    /// has.
     #[test]
     fn lanes_match_the_per_path_tracer() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
