@@ -41,10 +41,16 @@ pub trait PixelEstimator: Sync {
     /// [`Self::samples`] of several pixels: `out` holds each pixel's in turn (`out.len()` is a
     /// multiple of `pixels.len()`, the sample count).
     fn pixels_samples(&self, pixels: &[(u32, u32)], out: &mut [Vec3]) {
-        let spp = out.len() / pixels.len().max(1);
-        for (&(x, y), samples) in pixels.iter().zip(out.chunks_exact_mut(spp.max(1))) {
-            self.samples(x, y, samples);
-        }
+        pixel_by_pixel(pixels, out, |x, y, samples| self.samples(x, y, samples));
+    }
+}
+
+/// [`PixelEstimator::pixels_samples`] one pixel after the other: `samples(x, y, out)` for each
+/// pixel's share of `out`.
+pub fn pixel_by_pixel(pixels: &[(u32, u32)], out: &mut [Vec3], mut samples: impl FnMut(u32, u32, &mut [Vec3])) {
+    let spp = out.len() / pixels.len().max(1);
+    for (&(x, y), chunk) in pixels.iter().zip(out.chunks_exact_mut(spp.max(1))) {
+        samples(x, y, chunk);
     }
 }
 

@@ -246,6 +246,14 @@ fn sobol_pair(h: u64, index_reversed: u32) -> (f64, f64) {
     (to_unit((ab >> 32) as u32), to_unit(ab as u32))
 }
 
+/// [`Rng::uniform`] twice from generator state `state`: the new state and the pair.
+#[inline(always)]
+fn independent_pair(state: u64) -> (u64, (f64, f64)) {
+    let mut rng = Rng(state);
+    let pair = (rng.uniform(), rng.uniform());
+    (rng.0, pair)
+}
+
 /// Streams side by side in [`StreamLanes`].
 pub const STREAM_LANES: usize = 8;
 
@@ -335,12 +343,10 @@ impl StreamLanes {
     /// [`Self::draw`] for a lane past the Sobol pairs.
     #[inline(always)]
     fn draw_independent(&mut self, lane: usize, take: bool) -> (f64, f64) {
-        let first = self.rng[lane].wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let second = first.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let unit = |z: u64| (mix(z) >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-        self.rng[lane] = if take { second } else { self.rng[lane] };
+        let (state, pair) = independent_pair(self.rng[lane]);
+        self.rng[lane] = if take { state } else { self.rng[lane] };
         self.dimension[lane] += take as u32;
-        (unit(first), unit(second))
+        pair
     }
 
     /// The pair of lane `lane`'s current dimension, and its step to the next when `take`:
@@ -354,11 +360,8 @@ impl StreamLanes {
             h = if d == k as u32 { hashes[lane] } else { h };
         }
         let scrambled = sobol_pair(h, self.index_reversed[lane]);
-        let first = self.rng[lane].wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let second = first.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let unit = |z: u64| (mix(z) >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-        let independent = (unit(first), unit(second));
-        self.rng[lane] = if take && !sobol { second } else { self.rng[lane] };
+        let (state, independent) = independent_pair(self.rng[lane]);
+        self.rng[lane] = if take && !sobol { state } else { self.rng[lane] };
         self.dimension[lane] = d + take as u32;
         if sobol { scrambled } else { independent }
     }

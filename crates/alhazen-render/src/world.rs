@@ -77,8 +77,8 @@ pub struct World {
     vectors: VectorUnit,
     /// Everything is flats in one leaf: eight rays are tested at once, ray by lane.
     flats_only: bool,
-    /// Beside `flats.lanes`, for flats without smooth normals: each triangle's normal and
-    /// material.
+    /// Beside `flats.lanes` in a world of flats only, for flats without smooth normals: each
+    /// triangle's normal and material.
     flat_shading: Vec<[Option<FlatShading>; LANES]>,
 }
 
@@ -264,10 +264,11 @@ impl World {
         let mut world = Self { objects, unbounded, vectors: unit, ..Self::default() };
         world.fill_leaves(&bvh, &primitives);
         world.flats_only = world.unbounded.is_empty()
-            && matches!(world.leaves.as_slice(), [leaf] if leaf.spheres.is_empty() && leaf.objects.is_empty())
-            && bvh.leaves().count() == 1;
+            && matches!(world.leaves.as_slice(), [leaf] if leaf.spheres.is_empty() && leaf.objects.is_empty());
         world.bvh = bvh;
-        world.flat_shading = world.flats.lanes.iter().map(|lanes| lanes.map(|l| world.flat_shading(l))).collect();
+        if world.flats_only {
+            world.flat_shading = world.flats.lanes.iter().map(|lanes| lanes.map(|l| world.flat_shading(l))).collect();
+        }
         world
     }
 
@@ -416,7 +417,10 @@ impl World {
             let blocked = FlatPacket::any_of_rays(&self.flats.packets, rays, dist, live, self.vectors);
             return std::array::from_fn(|r| live[r] && !blocked[r]);
         }
-        std::array::from_fn(|r| live[r] && self.unoccluded(rays.ray(r).origin, rays.ray(r).dir, dist[r]))
+        std::array::from_fn(|r| {
+            let ray = rays.ray(r);
+            live[r] && self.unoccluded(ray.origin, ray.dir, dist[r])
+        })
     }
 
     /// The hit of object `i` whose candidate is `c`, with its surface and material.
