@@ -45,6 +45,12 @@ impl Transform {
     /// The identity map.
     pub const IDENTITY: Self = Self { m: Mat4::IDENTITY, inv: Mat4::IDENTITY };
 
+    /// True when the map reverses orientation (negative determinant, a mirror image): a
+    /// triangle's winding then reverses, so its outside is kept by swapping two corners.
+    pub fn is_mirroring(&self) -> bool {
+        Mat3::from_mat4(self.m).determinant() < 0.0
+    }
+
     /// Checks invertibility and affinity of a user matrix.
     pub fn from_matrix(m: Mat4) -> Result<Self, TransformError> {
         if m.row(3) != crate::Vec4::new(0.0, 0.0, 0.0, 1.0) {

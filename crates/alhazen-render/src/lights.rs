@@ -133,6 +133,7 @@ fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
         let orthogonal = a.dot(b).abs() + b.dot(c).abs() + a.dot(c).abs() < 1e-9 * s * s;
         (same(b) && same(c) && orthogonal).then_some(s)
     };
+    let mirroring = t.is_mirroring();
     let triangles = |tris: Vec<[Vec3; 3]>| {
         let areas: Vec<f64> = tris.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
         let area: f64 = areas.iter().sum();
@@ -149,16 +150,25 @@ fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
         }),
         Shape::Mesh { mesh, .. } => {
             let m = &scene.meshes[*mesh];
-            let tris: Vec<[Vec3; 3]> =
-                m.triangles.iter().map(|tri| tri.map(|i| t.point(m.positions[i as usize]))).collect();
-            parallelogram(&m.triangles, &tris).or_else(|| triangles(tris))
+            let indices: Vec<[u32; 3]> = m.triangles.iter().map(|&tri| outside_first(tri, mirroring)).collect();
+            let tris: Vec<[Vec3; 3]> = indices.iter().map(|tri| tri.map(|i| t.point(m.positions[i as usize]))).collect();
+            parallelogram(&indices, &tris).or_else(|| triangles(tris))
         }
         Shape::Box { min, max } => {
             let m = alhazen_geom::TriangleMesh::cuboid(*min, *max);
-            triangles((0..m.triangle_count()).map(|i| m.corners(i).map(|p| t.point(p))).collect())
+            triangles((0..m.triangle_count()).map(|i| outside_first(m.corners(i).map(|p| t.point(p)), mirroring)).collect())
         }
         _ => None,
     }
+}
+
+/// A triangle's corners in the order that keeps its emitting side after a transform that
+/// mirrors (which reverses the winding) or not.
+fn outside_first<T>(mut tri: [T; 3], mirroring: bool) -> [T; 3] {
+    if mirroring {
+        tri.swap(1, 2);
+    }
+    tri
 }
 
 /// A mesh of two triangles forming a parallelogram.

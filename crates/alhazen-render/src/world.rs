@@ -180,7 +180,7 @@ fn baked(mesh: &TriangleMesh, tf: &alhazen_math::Transform) -> TriangleMesh {
     m.positions.iter_mut().for_each(|p| *p = tf.point(*p));
     m.normals.iter_mut().for_each(|n| *n = tf.normal(*n).normalize_or_zero());
     // A mirroring transform reverses the winding; keep the outside outside.
-    if tf.vector(Vec3::X).cross(tf.vector(Vec3::Y)).dot(tf.vector(Vec3::Z)) < 0.0 {
+    if tf.is_mirroring() {
         m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
     }
     m

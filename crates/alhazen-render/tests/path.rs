@@ -144,3 +144,21 @@ fn the_prism_spreads_white_light_into_a_spectrum() {
     let avg = |v: &[u32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
     assert!(avg(&red) < avg(&green) && avg(&green) < avg(&blue), "{} {} {}", avg(&red), avg(&green), avg(&blue));
 }
+
+#[test]
+fn a_mirrored_emitter_keeps_shining_from_its_front() {
+    // The Cornell box's lamp mirrored in x (a transform of negative determinant, as imported
+    // scenes often have) is the same lamp: the box must be lit the same, not from the ceiling.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lamp = "[[0.23, 0, 0, 0], [0, 0, -0.19, 0.99]";
+    assert!(text.contains(lamp));
+    let mirrored = text.replace(lamp, "[[-0.23, 0, 0, 0], [0, 0, -0.19, 0.99]");
+    let image = |t: &str| {
+        let mut s = parse_scene(&path, t).unwrap();
+        (s.render.width, s.render.height, s.render.spp) = (64, 64, 16);
+        mean(&render(&s, &|_, _| {}))
+    };
+    let (a, b) = (image(&text), image(&mirrored));
+    assert!(((a - b) / a).abs().max_element() < 0.03, "{a} vs {b}");
+}
