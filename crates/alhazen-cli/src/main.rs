@@ -5,7 +5,7 @@
 
 use alhazen_render::output::{Format, write_image};
 use alhazen_render::shape::VectorUnit;
-use alhazen_scene::{MAX_PIXELS, Scene, SceneError, load_scene};
+use alhazen_scene::{MAX_PIXELS, Scene, SceneError};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -54,7 +54,7 @@ enum Command {
 /// What every image-producing command takes: the scene, the output and its size.
 #[derive(Args)]
 pub(crate) struct ImageArgs {
-    /// The scene file (TOML).
+    /// The scene file: alhazen TOML, glTF 2.0 (.gltf/.glb), Mitsuba 3 XML (.xml) or pbrt-v4 (.pbrt).
     pub(crate) scene: PathBuf,
     /// Output image: .png (8-bit sRGB), .exr or .pfm (linear floats).
     #[arg(short, long)]
@@ -182,12 +182,17 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
     }
 }
 
-/// Reads a scene file; every problem with it is bad input (exit code 2).
+/// Reads a scene file in any format alhazen imports (TOML, glTF, Mitsuba XML, pbrt), printing
+/// what the import approximated; every problem with it is bad input (exit code 2).
 pub(crate) fn load(path: &Path) -> Result<Scene, Failure> {
-    load_scene(path).map_err(|e| match e {
+    let imported = alhazen_import::load(path).map_err(|e| match e {
         SceneError::Io { .. } => Failure::input(e.to_string()),
         SceneError::Syntax(d) => Failure::input(d.to_string()),
-    })
+    })?;
+    for w in &imported.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(imported.scene)
 }
 
 /// Reads the scene and applies `--width`/`--height`, refusing sizes that cannot be allocated.

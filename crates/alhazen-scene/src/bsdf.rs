@@ -203,3 +203,24 @@ impl BsdfDesc {
         }
     }
 }
+
+/// Complex indices of refraction `(η, κ)` at red, green and blue of common metals (pbrt-v3's
+/// RGB values of measured spectra).
+pub const METALS: &[(&str, [f64; 3], [f64; 3])] = &[
+    ("gold", [0.143119, 0.374957, 1.44248], [3.98316, 2.38572, 1.60322]),
+    ("silver", [0.155265, 0.116723, 0.138342], [4.82835, 3.12225, 2.14696]),
+    ("copper", [0.200438, 0.924033, 1.10221], [3.91295, 2.45285, 2.14219]),
+    ("aluminium", [1.65746, 0.880369, 0.521229], [9.22387, 6.26952, 4.837]),
+];
+
+/// Sellmeier coefficients of common glasses (Schott data sheets).
+pub const GLASSES: &[(&str, [f64; 3], [f64; 3])] = &[
+    ("bk7", [1.03961212, 0.231792344, 1.01046945], [0.00600069867, 0.0200179144, 103.560653]),
+    ("sf11", [1.73759695, 0.313747346, 1.89878101], [0.013188707, 0.0623068142, 155.23629]),
+    ("fused-silica", [0.6961663, 0.4079426, 0.8974794], [0.0046791483, 0.0135120631, 97.9340025]),
+];
+
+/// The complex index `(η, κ)` of a metal of [`METALS`] by name.
+pub fn metal(name: &str) -> Option<(Rgb, Rgb)> {
+    METALS.iter().find(|m| m.0 == name).map(|m| (Vec3::from_array(m.1), Vec3::from_array(m.2)))
+}

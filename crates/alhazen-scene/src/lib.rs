@@ -27,7 +27,7 @@ pub mod texture;
 
 pub use diagnostic::{Diagnostic, did_you_mean};
 pub use model::*;
-pub use parse::{MAX_PIXELS, MAX_SIDE, parse_scene};
+pub use parse::{MAX_PIXELS, MAX_SIDE, empty_scene, parse_scene, rectangle as rectangle_mesh};
 use std::path::{Path, PathBuf};
 
 /// Why a scene could not be loaded.

@@ -38,7 +38,9 @@ pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
     Ok(p.scene)
 }
 
-fn empty_scene() -> Scene {
+/// The scene an empty file describes: default render settings, a camera at `(0, 0, 5)` looking
+/// at the origin, a black background, the default material and nothing else.
+pub fn empty_scene() -> Scene {
     Scene {
         render: RenderSettings::default(),
         camera: CameraDesc::Perspective {
@@ -507,7 +509,7 @@ fn patch(t: &Table) -> R<alhazen_geom::TriangleMesh> {
 
 /// `shape = "rectangle"`: the square `[−1, 1]²` in the plane `z = 0`, facing `+z` (as Mitsuba's
 /// `rectangle`); place and size it with `transform`.
-fn rectangle() -> alhazen_geom::TriangleMesh {
+pub fn rectangle() -> alhazen_geom::TriangleMesh {
     let positions = vec![
         Vec3::new(-1.0, -1.0, 0.0),
         Vec3::new(1.0, -1.0, 0.0),

@@ -11,22 +11,6 @@ use std::sync::Arc;
 
 const MICROFACET_KEYS: &[&str] = &["roughness", "distribution", "shadowing"];
 
-/// Complex indices of refraction `(η, κ)` at red, green and blue of common metals (pbrt-v3's
-/// RGB values of measured spectra).
-const METALS: &[(&str, [f64; 3], [f64; 3])] = &[
-    ("gold", [0.143119, 0.374957, 1.44248], [3.98316, 2.38572, 1.60322]),
-    ("silver", [0.155265, 0.116723, 0.138342], [4.82835, 3.12225, 2.14696]),
-    ("copper", [0.200438, 0.924033, 1.10221], [3.91295, 2.45285, 2.14219]),
-    ("aluminium", [1.65746, 0.880369, 0.521229], [9.22387, 6.26952, 4.837]),
-];
-
-/// Sellmeier coefficients of common glasses (Schott data sheets).
-const GLASSES: &[(&str, [f64; 3], [f64; 3])] = &[
-    ("bk7", [1.03961212, 0.231792344, 1.01046945], [0.00600069867, 0.0200179144, 103.560653]),
-    ("sf11", [1.73759695, 0.313747346, 1.89878101], [0.013188707, 0.0623068142, 155.23629]),
-    ("fused-silica", [0.6961663, 0.4079426, 0.8974794], [0.0046791483, 0.0135120631, 97.9340025]),
-];
-
 fn names<T>(list: &[(&'static str, T, T)]) -> Vec<&'static str> {
     list.iter().map(|e| e.0).collect()
 }

@@ -1,0 +1,242 @@
+//! What the importers share: reading files with a size limit, located errors and warnings, and
+//! the mapping of the common material models (metallic–roughness, named IORs) to alhazen's
+//! BSDFs (course, §"Physically based models").
+
+use crate::Warning;
+use alhazen_math::Vec3;
+use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
+use alhazen_scene::{Diagnostic, FresnelMode, Material, MaterialId, Rgb, Scene, SceneError, Texture};
+use std::collections::HashSet;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// The largest scene or buffer file an importer reads (2 GiB): larger ones are refused before
+/// anything is allocated.
+pub const MAX_SCENE_FILE_BYTES: u64 = 2 << 30;
+
+/// Reads a whole file, refusing one over [`MAX_SCENE_FILE_BYTES`] (and anything that is not a
+/// regular file, such as `/dev/zero`) before reading.
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
+    let io = |source| SceneError::Io { path: path.to_path_buf(), source };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(io(std::io::Error::other("not a regular file")));
+    }
+    if meta.len() > MAX_SCENE_FILE_BYTES {
+        return Err(io(std::io::Error::other(format!(
+            "{} bytes is more than the {MAX_SCENE_FILE_BYTES} an imported file may have",
+            meta.len()
+        ))));
+    }
+    std::fs::read(path).map_err(io)
+}
+
+/// Reads a text file (see [`read_bytes`]); invalid UTF-8 is an error at its position.
+pub(crate) fn read_text(path: &Path) -> Result<String, SceneError> {
+    String::from_utf8(read_bytes(path)?).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+        located(path, &text, at..at + 1, "the file is not valid UTF-8")
+    })
+}
+
+/// An error at byte range `span` of `text`.
+pub(crate) fn located(file: &Path, text: &str, span: Range<usize>, message: impl Into<String>) -> SceneError {
+    SceneError::Syntax(Box::new(Diagnostic::at(file, text, span, message)))
+}
+
+/// The 1-based line of byte `at` of `text`.
+pub(crate) fn line_of(text: &str, at: usize) -> usize {
+    text.as_bytes()[..at.min(text.len())].iter().filter(|&&b| b == b'\n').count() + 1
+}
+
+/// Warnings, each said once.
+#[derive(Default)]
+pub(crate) struct Warnings {
+    list: Vec<Warning>,
+    seen: HashSet<Warning>,
+}
+
+impl Warnings {
+    /// Records a warning at `file:line` unless the same was said there already.
+    pub(crate) fn add(&mut self, file: &Path, line: usize, message: impl Into<String>) {
+        let w = Warning { file: file.to_path_buf(), line, message: message.into() };
+        if self.seen.insert(w.clone()) {
+            self.list.push(w);
+        }
+    }
+
+    pub(crate) fn into_vec(self) -> Vec<Warning> {
+        self.list
+    }
+}
+
+/// Joins a file name found in a scene with the scene's directory.
+pub(crate) fn relative_to(scene_file: &Path, name: &str) -> PathBuf {
+    scene_file.parent().unwrap_or(Path::new(".")).join(name)
+}
+
+/// Adds a material and returns its id.
+pub(crate) fn add_material(scene: &mut Scene, m: Material) -> MaterialId {
+    scene.materials.push(m);
+    (scene.materials.len() - 1) as MaterialId
+}
+
+/// `base` with `emission` added (a new material; `base` is shared by other objects).
+pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb) -> MaterialId {
+    let mut m = scene.materials[base as usize].clone();
+    m.name = format!("{} (emitting)", m.name);
+    m.emission = emission;
+    add_material(scene, m)
+}
+
+/// A material that is only a path-tracer BSDF (the Whitted coefficients follow its colour).
+pub(crate) fn bsdf_material(name: &str, bsdf: BsdfDesc) -> Material {
+    let color = match &bsdf {
+        BsdfDesc::Lambert { albedo } | BsdfDesc::OrenNayar { albedo, .. } => albedo.clone(),
+        BsdfDesc::CookTorrance { albedo, .. } => albedo.clone(),
+        _ => Texture::Solid(Vec3::splat(0.8)),
+    };
+    let mut m = Material { name: name.to_string(), color, ..Material::default() };
+    match &bsdf {
+        BsdfDesc::Conductor { .. } => {
+            m.diffuse = 0.0;
+            m.mirror = Vec3::splat(0.9);
+        }
+        BsdfDesc::Dielectric { ior, .. } => {
+            m.diffuse = 0.0;
+            m.transparency = Vec3::ONE;
+            m.ior = ior.nominal();
+            m.specular = Vec3::ONE;
+            m.shininess = 200.0;
+        }
+        _ => {}
+    }
+    m.bsdf = Some(bsdf);
+    m
+}
+
+/// Trowbridge–Reitz (GGX) microfacets with Smith shadowing, roughness `α` (clamped away from 0,
+/// where the distribution degenerates).
+pub(crate) fn ggx(alpha_u: f64, alpha_v: f64) -> Microfacets {
+    Microfacets {
+        distribution: Distribution::TrowbridgeReitz,
+        alpha_u: alpha_u.max(1e-3),
+        alpha_v: alpha_v.max(1e-3),
+        shadowing: Shadowing::Smith,
+    }
+}
+
+/// The real index `η` (with `κ = 0`) whose normal-incidence reflectance is `f0`.
+pub(crate) fn eta_from_f0(f0: Rgb) -> Rgb {
+    let r = f0.clamp(Vec3::ZERO, Vec3::splat(0.999)).powf(0.5);
+    (Vec3::ONE + r) / (Vec3::ONE - r)
+}
+
+/// The glTF 2.0 metallic–roughness model (also Mitsuba's `principled` and pbrt's
+/// `coateddiffuse` reduced to it): a metal whose normal-incidence reflectance is the base
+/// colour (Schlick), mixed by `metallic` with a dielectric coating of index `ior` over a
+/// Lambertian base, both with GGX roughness `α = roughness²`; `transmission` mixes in rough glass.
+pub(crate) fn metal_rough(
+    base: Texture,
+    base_mean: Rgb,
+    metallic: f64,
+    roughness: f64,
+    ior: f64,
+    transmission: f64,
+) -> BsdfDesc {
+    let alpha = (roughness * roughness).clamp(0.0, 1.0);
+    let facets = (alpha > 1e-3).then(|| ggx(alpha, alpha));
+    let metal = BsdfDesc::Conductor {
+        facets,
+        eta: eta_from_f0(base_mean),
+        k: Vec3::ZERO,
+        tint: Vec3::ONE,
+        fresnel: FresnelMode::Schlick,
+    };
+    let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+    let plastic = BsdfDesc::CookTorrance {
+        albedo: base,
+        kd: 1.0 - f0,
+        ks: 1.0,
+        facets: ggx(alpha.max(0.01), alpha.max(0.01)),
+        ior,
+        fresnel: FresnelMode::Exact,
+    };
+    let opaque = mix(metal, plastic, metallic);
+    let glass = BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact };
+    mix(glass, opaque, transmission * (1.0 - metallic))
+}
+
+/// `w·a + (1 − w)·b`, or the one that has all the weight.
+pub(crate) fn mix(a: BsdfDesc, b: BsdfDesc, w: f64) -> BsdfDesc {
+    if w >= 1.0 {
+        a
+    } else if w <= 0.0 {
+        b
+    } else {
+        BsdfDesc::Mix { a: Box::new(a), b: Box::new(b), weight: w }
+    }
+}
+
+/// Indices of refraction that Mitsuba and pbrt accept by name (values from standard tables at
+/// the sodium D line).
+pub(crate) const NAMED_IORS: &[(&str, f64)] = &[
+    ("vacuum", 1.0),
+    ("helium", 1.000036),
+    ("hydrogen", 1.000132),
+    ("air", 1.000277),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.333),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.47),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.575),
+    ("diamond", 2.419),
+];
+
+/// The index of refraction a name stands for.
+pub(crate) fn named_ior(name: &str) -> Option<f64> {
+    let n = name.trim().to_ascii_lowercase();
+    NAMED_IORS.iter().find(|e| e.0 == n).map(|e| e.1)
+}
+
+/// The mean colour of a texture (for parameters the model holds as constants).
+pub(crate) fn texture_mean(t: &Texture, scene: &Scene) -> Rgb {
+    match t {
+        Texture::Solid(c) => *c,
+        Texture::Checker { even, odd, .. } => (*even + *odd) * 0.5,
+        Texture::Image { image, .. } => image_mean(&scene.images[*image]),
+    }
+}
+
+/// The mean of an image's pixels.
+pub(crate) fn image_mean(img: &alhazen_scene::ImageData) -> Rgb {
+    let sum = img.pixels.iter().fold(Vec3::ZERO, |s, p| s + Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+    sum / img.pixels.len().max(1) as f64
+}
+
+/// A point light's `cos^e` falloff that best stands for a smooth fall-off from full intensity
+/// inside `inner` to zero at `outer` (half-angles, radians): the exponent that halves the
+/// intensity midway.
+pub(crate) fn spot_exponent(inner: f64, outer: f64) -> f64 {
+    let mid = 0.5 * (inner + outer);
+    if outer - inner < 1e-6 || mid <= 0.0 { 0.0 } else { (0.5f64).ln() / mid.cos().ln() }
+}
+
+/// Checks that every number of a value is finite.
+pub(crate) fn finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}

@@ -1,0 +1,106 @@
+//! `alhazen-import`: scenes written for other programs, read into alhazen's scene model
+//! (`alhazen_scene::Scene`), so that `render`, `raster` and `lines` take them as they are.
+//!
+//! * [`gltf`](mod@gltf) — glTF 2.0 (`.gltf`, `.glb`): the node hierarchy, meshes, the
+//!   metallic–roughness materials, `KHR_lights_punctual`, cameras;
+//! * [`mitsuba`] — Mitsuba 3 XML scenes (`.xml`);
+//! * [`pbrt`] — pbrt-v4 scene descriptions (`.pbrt`);
+//! * anything else is alhazen's own TOML (`alhazen_scene::load_scene`).
+//!
+//! The course describes a scene as a hierarchy of nodes with transforms (course, §"Scene
+//! graphs"); each importer walks its format's hierarchy and emits the flat object list of the
+//! model, every object with its composed object → world transform, meshes shared between
+//! instances. What the model cannot represent is never dropped silently: it becomes a
+//! [`Warning`] at `file:line` saying what was approximated and how; what makes the scene
+//! meaningless is an error with its location (`alhazen_scene::SceneError`).
+//!
+//! ```
+//! use alhazen_import::SceneFormat;
+//! assert_eq!(SceneFormat::from_path("cornell.xml".as_ref()), SceneFormat::Mitsuba);
+//! assert_eq!(SceneFormat::from_path("kitchen.pbrt".as_ref()), SceneFormat::Pbrt);
+//! assert_eq!(SceneFormat::from_path("scene.toml".as_ref()), SceneFormat::Alhazen);
+//! ```
+
+mod common;
+pub mod gltf;
+pub mod mitsuba;
+pub mod pbrt;
+
+use alhazen_scene::{Scene, SceneError};
+use std::path::{Path, PathBuf};
+
+pub use common::MAX_SCENE_FILE_BYTES;
+
+/// Something in an imported file that alhazen approximated or left out.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Warning {
+    /// The file it is in.
+    pub file: PathBuf,
+    /// 1-based line, or 0 when the format has no lines (binary glTF).
+    pub line: usize,
+    /// What was approximated, and how.
+    pub message: String,
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.line {
+            0 => write!(f, "{}: {}", self.file.display(), self.message),
+            line => write!(f, "{}:{line}: {}", self.file.display(), self.message),
+        }
+    }
+}
+
+/// A scene and what importing it had to approximate.
+#[derive(Debug)]
+pub struct Imported {
+    /// The scene.
+    pub scene: Scene,
+    /// Approximations, in the order they were met (each said once).
+    pub warnings: Vec<Warning>,
+}
+
+/// The formats a scene file can be in, by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneFormat {
+    /// alhazen's TOML (any extension not listed below).
+    Alhazen,
+    /// glTF 2.0, `.gltf` (JSON) or `.glb` (binary).
+    Gltf,
+    /// Mitsuba 3 XML, `.xml`.
+    Mitsuba,
+    /// pbrt-v4, `.pbrt`.
+    Pbrt,
+}
+
+impl SceneFormat {
+    /// The format a path's extension names (case-insensitive).
+    pub fn from_path(path: &Path) -> Self {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("gltf" | "glb") => Self::Gltf,
+            Some("xml") => Self::Mitsuba,
+            Some("pbrt") => Self::Pbrt,
+            _ => Self::Alhazen,
+        }
+    }
+
+    /// A name for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Alhazen => "alhazen TOML",
+            Self::Gltf => "glTF 2.0",
+            Self::Mitsuba => "Mitsuba 3 XML",
+            Self::Pbrt => "pbrt-v4",
+        }
+    }
+}
+
+/// Reads a scene file in any supported format (chosen by [`SceneFormat::from_path`]).
+pub fn load(path: &Path) -> Result<Imported, SceneError> {
+    match SceneFormat::from_path(path) {
+        SceneFormat::Alhazen => Ok(Imported { scene: alhazen_scene::load_scene(path)?, warnings: vec![] }),
+        SceneFormat::Gltf => gltf::load(path),
+        SceneFormat::Mitsuba => mitsuba::load(path),
+        SceneFormat::Pbrt => pbrt::load(path),
+    }
+}

@@ -1,0 +1,1195 @@
+//! Mitsuba 3 XML scenes (`.xml`), read with a real XML parser (roxmltree), every element located
+//! by line for messages.
+//!
+//! Supported: `default` parameters and `$name` substitution, `include`, `ref`/`id`; the
+//! `perspective` and `orthographic` sensors (`fov`, `fov_axis`, `focal_length`, `to_world` with
+//! `lookat`/`translate`/`rotate`/`scale`/`matrix`), `hdrfilm` size, the sampler's
+//! `sample_count` and `seed`, the integrator's `max_depth`; shapes `obj`, `ply`, `rectangle`,
+//! `cube`, `sphere`, `disk`, `cylinder`, `shapegroup`/`instance`; BSDFs `diffuse`,
+//! `conductor`/`roughconductor` (named materials or `eta`/`k`), `dielectric`/`roughdielectric`,
+//! `thindielectric`, `plastic`/`roughplastic`, `principled`, `blendbsdf`, `twosided`,
+//! `bumpmap`, `normalmap`, `mask`; textures `bitmap` and `checkerboard`; emitters `area`,
+//! `point`, `spot`, `directional`, `constant`, `envmap`. Scenes of version 0.x have their
+//! camelCase names upgraded as Mitsuba 3 does. Everything else is a located warning.
+//!
+//! Mitsuba's camera looks along its local `+z` with `+x` to the left of the image, which is
+//! alhazen's right-handed camera seen through `lookat`, so scenes map without mirroring.
+
+use crate::Imported;
+use crate::common::{self, Warnings, located};
+use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
+use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
+use alhazen_scene::{
+    Background, Bump, BumpPattern, CameraDesc, FresnelMode, IntegratorKind, Light, LookAt, MaterialId, Object,
+    PerspectiveOpening, SamplerKind, Scene, SceneError, Shape, Texture,
+};
+use roxmltree::Node;
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+type R<T> = Result<T, SceneError>;
+
+/// Reads a Mitsuba 3 XML scene.
+pub fn load(path: &Path) -> Result<Imported, SceneError> {
+    let mut imp = Importer {
+        scene: alhazen_scene::empty_scene(),
+        warnings: Warnings::default(),
+        defaults: HashMap::new(),
+        ids: HashMap::new(),
+        meshes: HashMap::new(),
+        default_material: None,
+        camera_seen: false,
+        version_major: 3,
+    };
+    imp.scene.render.integrator = IntegratorKind::Path;
+    imp.scene.render.width = 768;
+    imp.scene.render.height = 576;
+    imp.scene.render.max_depth = 1000;
+    imp.file(path, 0)?;
+    imp.finish()
+}
+
+/// Mitsuba's conductor names that alhazen has measured indices for.
+const METAL_NAMES: &[(&str, &str)] = &[("Au", "gold"), ("Ag", "silver"), ("Cu", "copper"), ("Al", "aluminium")];
+
+/// Properties that change nothing in an image alhazen makes.
+const HARMLESS: &[&str] =
+    &["pixel_format", "component_format", "file_format", "banner", "high_quality_edges", "near_clip", "far_clip", "id"];
+
+/// What an `id` names.
+#[derive(Clone)]
+enum Named {
+    Bsdf(MaterialId),
+    Texture(Texture),
+    Group(Vec<Object>),
+    Other,
+}
+
+struct Importer {
+    scene: Scene,
+    warnings: Warnings,
+    defaults: HashMap<String, String>,
+    ids: HashMap<String, Named>,
+    meshes: HashMap<(PathBuf, bool), usize>,
+    default_material: Option<MaterialId>,
+    camera_seen: bool,
+    version_major: u32,
+}
+
+/// One file being read.
+struct Ctx<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+/// A plugin element with the names of the properties read so far.
+struct Plugin<'a, 'i> {
+    node: Node<'a, 'i>,
+    kind: String,
+    used: RefCell<HashSet<String>>,
+}
+
+impl Ctx<'_> {
+    fn err(&self, node: Node, msg: impl Into<String>) -> SceneError {
+        located(self.path, self.text, node.range(), msg)
+    }
+
+    fn line(&self, node: Node) -> usize {
+        common::line_of(self.text, node.range().start)
+    }
+}
+
+impl Importer {
+    fn finish(mut self) -> R<Imported> {
+        if !self.camera_seen {
+            self.warnings.add(Path::new("scene"), 0, "the scene has no sensor: alhazen's default camera is used");
+        }
+        Ok(Imported { scene: self.scene, warnings: self.warnings.into_vec() })
+    }
+
+    fn warn(&mut self, ctx: &Ctx, node: Node, msg: impl Into<String>) {
+        let line = ctx.line(node);
+        self.warnings.add(ctx.path, line, msg);
+    }
+
+    /// Reads one file (the scene or an `include`d one) into the scene.
+    fn file(&mut self, path: &Path, depth: usize) -> R<()> {
+        let text = common::read_text(path)?;
+        let doc = roxmltree::Document::parse(&text).map_err(|e| {
+            let p = e.pos();
+            let at = text.lines().take(p.row as usize - 1).map(|l| l.len() + 1).sum::<usize>() + p.col as usize - 1;
+            located(path, &text, at..at + 1, format!("XML syntax error: {e}"))
+        })?;
+        let ctx = Ctx { path, text: &text };
+        let root = doc.root_element();
+        if root.tag_name().name() != "scene" {
+            return Err(ctx.err(root, format!("expected a <scene> element, found <{}>", root.tag_name().name())));
+        }
+        if let Some(v) = root.attribute("version") {
+            let major = v.split('.').next().and_then(|m| m.trim().parse::<u32>().ok());
+            self.version_major =
+                major.ok_or_else(|| ctx.err(root, format!("version \"{v}\" is not a version number")))?;
+        } else if depth == 0 {
+            self.version_major = 3;
+        }
+        for child in root.children().filter(Node::is_element) {
+            self.top_level(&ctx, child, depth)?;
+        }
+        Ok(())
+    }
+
+    fn top_level(&mut self, ctx: &Ctx, node: Node, depth: usize) -> R<()> {
+        match node.tag_name().name() {
+            "default" => {
+                let name = self.req_attr(ctx, node, "name")?;
+                let value = self.req_attr(ctx, node, "value")?;
+                self.defaults.entry(name).or_insert(value);
+            }
+            "include" => {
+                if depth >= 16 {
+                    return Err(ctx.err(node, "includes nested deeper than 16 files (an include cycle?)"));
+                }
+                let name = self.req_attr(ctx, node, "filename")?;
+                let path = common::relative_to(ctx.path, &name);
+                self.file(&path, depth + 1).map_err(|e| match e {
+                    SceneError::Io { source, .. } => {
+                        ctx.err(node, format!("cannot read included file {}: {source}", path.display()))
+                    }
+                    e => e,
+                })?;
+            }
+            "integrator" => self.integrator(ctx, node)?,
+            "sensor" => self.sensor(ctx, node)?,
+            "bsdf" => {
+                let id = self.bsdf_material(ctx, node)?;
+                self.register(ctx, node, Named::Bsdf(id))?;
+            }
+            "texture" => {
+                let t = self.texture(ctx, node)?;
+                self.register(ctx, node, Named::Texture(t))?;
+            }
+            "shape" => {
+                let objects = self.shape(ctx, node)?;
+                if self.attr(ctx, node, "type")?.as_deref() == Some("shapegroup") {
+                    self.register(ctx, node, Named::Group(objects))?;
+                } else {
+                    self.scene.objects.extend(objects);
+                }
+            }
+            "emitter" => self.emitter(ctx, node)?,
+            other => {
+                self.warn(ctx, node, format!("<{other}> is not supported (alhazen renders no participating media, phase functions or volumes); ignored"));
+                if node.attribute("id").is_some() {
+                    self.register(ctx, node, Named::Other)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn register(&mut self, ctx: &Ctx, node: Node, what: Named) -> R<()> {
+        if let Some(id) = self.attr(ctx, node, "id")? {
+            self.ids.insert(id, what);
+        }
+        Ok(())
+    }
+
+    // ---- attributes and properties -------------------------------------------------------
+
+    /// An attribute with `$name` parameters substituted.
+    fn attr(&self, ctx: &Ctx, node: Node, name: &str) -> R<Option<String>> {
+        let Some(raw) = node.attribute(name) else { return Ok(None) };
+        if !raw.contains('$') {
+            return Ok(Some(raw.to_string()));
+        }
+        let mut out = String::new();
+        let mut rest = raw;
+        while let Some(i) = rest.find('$') {
+            out.push_str(&rest[..i]);
+            let tail = &rest[i + 1..];
+            let len = tail.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(tail.len());
+            let key = &tail[..len];
+            let value = self.defaults.get(key).ok_or_else(|| {
+                ctx.err(node, format!("${key} has no value: declare it with <default name=\"{key}\" value=\"…\"/>"))
+            })?;
+            out.push_str(value);
+            rest = &tail[len..];
+        }
+        out.push_str(rest);
+        Ok(Some(out))
+    }
+
+    fn req_attr(&self, ctx: &Ctx, node: Node, name: &str) -> R<String> {
+        self.attr(ctx, node, name)?
+            .ok_or_else(|| ctx.err(node, format!("<{}> needs a `{name}` attribute", node.tag_name().name())))
+    }
+
+    /// A property's name as Mitsuba 3 spells it (0.x scenes used camelCase).
+    fn prop_name(&self, raw: &str) -> String {
+        if self.version_major >= 2 {
+            return raw.to_string();
+        }
+        let mut out = String::new();
+        let chars: Vec<char> = raw.chars().collect();
+        for (i, &c) in chars.iter().enumerate() {
+            let prev_lower = i > 0 && (chars[i - 1].is_lowercase() || chars[i - 1].is_ascii_digit());
+            if c.is_uppercase() && prev_lower {
+                out.push('_');
+            }
+            out.extend(c.to_lowercase());
+        }
+        out
+    }
+
+    fn plugin<'a, 'i>(&self, ctx: &Ctx, node: Node<'a, 'i>) -> R<Plugin<'a, 'i>> {
+        Ok(Plugin { node, kind: self.req_attr(ctx, node, "type")?, used: RefCell::new(HashSet::new()) })
+    }
+
+    /// The child element holding property `name`, marking it read.
+    fn prop<'a, 'i>(&self, p: &Plugin<'a, 'i>, name: &str) -> Option<Node<'a, 'i>> {
+        let found = p.node.children().filter(Node::is_element).find(|c| {
+            c.attribute("name").is_some_and(|n| self.prop_name(n) == name)
+                && !matches!(c.tag_name().name(), "bsdf" | "emitter" | "shape" | "sensor")
+                || (c.tag_name().name() == "ref" && c.attribute("name").is_some_and(|n| self.prop_name(n) == name))
+        });
+        if found.is_some() {
+            p.used.borrow_mut().insert(name.to_string());
+        }
+        found
+    }
+
+    /// Warns about every property of `p` not read.
+    fn unused(&mut self, ctx: &Ctx, p: &Plugin, what: &str) {
+        let used = p.used.borrow().clone();
+        for c in p.node.children().filter(Node::is_element) {
+            let Some(name) = c.attribute("name").map(|n| self.prop_name(n)) else { continue };
+            if used.contains(&name) || HARMLESS.contains(&name.as_str()) {
+                continue;
+            }
+            if matches!(c.tag_name().name(), "bsdf" | "texture" | "ref" | "emitter" | "rfilter" | "sampler" | "film") {
+                continue;
+            }
+            self.warn(ctx, c, format!("property `{name}` of {what} `{}` is not supported; ignored", p.kind));
+        }
+    }
+
+    fn numbers(&self, ctx: &Ctx, node: Node, text: &str) -> R<Vec<f64>> {
+        text.split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .map(|s| {
+                s.parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| ctx.err(node, format!("`{s}` is not a finite number")))
+            })
+            .collect()
+    }
+
+    fn float(&self, ctx: &Ctx, p: &Plugin, name: &str, default: f64) -> R<f64> {
+        let Some(n) = self.prop(p, name) else { return Ok(default) };
+        if !matches!(n.tag_name().name(), "float" | "integer") {
+            return Err(ctx.err(n, format!("`{name}` must be a <float>")));
+        }
+        let v = self.numbers(ctx, n, &self.req_attr(ctx, n, "value")?)?;
+        match v[..] {
+            [x] => Ok(x),
+            _ => Err(ctx.err(n, format!("`{name}` must be one number"))),
+        }
+    }
+
+    fn string(&self, ctx: &Ctx, p: &Plugin, name: &str) -> R<Option<String>> {
+        match self.prop(p, name) {
+            Some(n) => self.attr(ctx, n, "value").and_then(|v| v.map(Some).ok_or_else(|| ctx.err(n, "needs `value`"))),
+            None => Ok(None),
+        }
+    }
+
+    fn boolean(&self, ctx: &Ctx, p: &Plugin, name: &str, default: bool) -> R<bool> {
+        let Some(n) = self.prop(p, name) else { return Ok(default) };
+        match self.req_attr(ctx, n, "value")?.as_str() {
+            "true" | "1" => Ok(true),
+            "false" | "0" => Ok(false),
+            other => Err(ctx.err(n, format!("`{other}` is not a boolean (true or false)"))),
+        }
+    }
+
+    /// A `<point>`/`<vector>` with `x, y, z` attributes or a `value`.
+    fn point_of(&self, ctx: &Ctx, n: Node, default: Vec3) -> R<Vec3> {
+        if let Some(v) = self.attr(ctx, n, "value")? {
+            return match self.numbers(ctx, n, &v)?[..] {
+                [x] => Ok(Vec3::splat(x)),
+                [x, y, z] => Ok(Vec3::new(x, y, z)),
+                _ => Err(ctx.err(n, "expected three numbers")),
+            };
+        }
+        let mut out = default;
+        for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+            if let Some(v) = self.attr(ctx, n, axis)? {
+                out[i] = match self.numbers(ctx, n, &v)?[..] {
+                    [x] => x,
+                    _ => return Err(ctx.err(n, format!("`{axis}` must be one number"))),
+                };
+            }
+        }
+        Ok(out)
+    }
+
+    fn point(&self, ctx: &Ctx, p: &Plugin, name: &str, default: Vec3) -> R<Vec3> {
+        match self.prop(p, name) {
+            Some(n) => self.point_of(ctx, n, Vec3::ZERO),
+            None => Ok(default),
+        }
+    }
+
+    /// A colour: `<rgb>`, `<spectrum>`, `<float>`, or (where `textures` allows) a texture.
+    fn color(&mut self, ctx: &Ctx, p: &Plugin, name: &str, default: Vec3) -> R<Texture> {
+        let Some(n) = self.prop(p, name) else { return Ok(Texture::Solid(default)) };
+        self.color_node(ctx, n)
+    }
+
+    fn color_node(&mut self, ctx: &Ctx, n: Node) -> R<Texture> {
+        match n.tag_name().name() {
+            "rgb" | "srgb" | "color" => {
+                let v = self.req_attr(ctx, n, "value")?;
+                let c = match self.numbers(ctx, n, &v)?[..] {
+                    [x] => Vec3::splat(x),
+                    [r, g, b] => Vec3::new(r, g, b),
+                    _ => return Err(ctx.err(n, "an rgb value is one or three numbers")),
+                };
+                let c = if n.tag_name().name() == "srgb" {
+                    Vec3::new(
+                        alhazen_math::color::srgb_to_linear(c.x),
+                        alhazen_math::color::srgb_to_linear(c.y),
+                        alhazen_math::color::srgb_to_linear(c.z),
+                    )
+                } else {
+                    c
+                };
+                Ok(Texture::Solid(c))
+            }
+            "float" | "integer" => {
+                let v = self.numbers(ctx, n, &self.req_attr(ctx, n, "value")?)?;
+                match v[..] {
+                    [x] => Ok(Texture::Solid(Vec3::splat(x))),
+                    _ => Err(ctx.err(n, "expected one number")),
+                }
+            }
+            "spectrum" => self.spectrum(ctx, n).map(Texture::Solid),
+            "texture" => self.texture(ctx, n),
+            "ref" => {
+                let id = self.req_attr(ctx, n, "id")?;
+                match self.ids.get(&id) {
+                    Some(Named::Texture(t)) => Ok(t.clone()),
+                    Some(_) => Err(ctx.err(n, format!("\"{id}\" is not a texture"))),
+                    None => Err(self.unknown_id(ctx, n, &id)),
+                }
+            }
+            other => {
+                Err(ctx.err(n, format!("<{other}> is not a colour (expected <rgb>, <spectrum>, <float> or <texture>)")))
+            }
+        }
+    }
+
+    /// A spectrum: one value (grey), `λ:value` pairs (averaged over three bands), or a file
+    /// (not read: grey 0.5).
+    fn spectrum(&mut self, ctx: &Ctx, n: Node) -> R<Vec3> {
+        if self.attr(ctx, n, "filename")?.is_some() {
+            self.warn(ctx, n, "spectra from files are not read; approximated by grey 0.5");
+            return Ok(Vec3::splat(0.5));
+        }
+        let v = self.req_attr(ctx, n, "value")?;
+        if !v.contains(':') {
+            return match self.numbers(ctx, n, &v)?[..] {
+                [x] => Ok(Vec3::splat(x)),
+                _ => Err(ctx.err(n, "a spectrum value is one number or `wavelength:value` pairs")),
+            };
+        }
+        let mut bands = [(0.0, 0.0); 3];
+        for pair in v.split(',') {
+            let (l, x) =
+                pair.split_once(':').ok_or_else(|| ctx.err(n, format!("`{pair}` is not `wavelength:value`")))?;
+            let l = self.numbers(ctx, n, l)?.first().copied().unwrap_or(0.0);
+            let x = self.numbers(ctx, n, x)?.first().copied().unwrap_or(0.0);
+            let band = if l >= 600.0 {
+                0
+            } else if l >= 500.0 {
+                1
+            } else {
+                2
+            };
+            bands[band].0 += x;
+            bands[band].1 += 1.0;
+        }
+        self.warn(ctx, n, "a sampled spectrum is approximated by RGB: its mean over 600–700, 500–600 and 400–500 nm");
+        let mean = |b: (f64, f64)| if b.1 > 0.0 { b.0 / b.1 } else { 0.0 };
+        Ok(Vec3::new(mean(bands[0]), mean(bands[1]), mean(bands[2])))
+    }
+
+    fn unknown_id(&self, ctx: &Ctx, n: Node, id: &str) -> SceneError {
+        let mut d = match ctx.err(n, format!("no object has id \"{id}\" (it must be declared before it is used)")) {
+            SceneError::Syntax(d) => d,
+            e => return e,
+        };
+        if let Some(s) = alhazen_scene::did_you_mean(id, self.ids.keys().map(String::as_str)) {
+            *d = d.clone().with_help(format!("did you mean \"{s}\"?"));
+        }
+        SceneError::Syntax(d)
+    }
+
+    /// The `<transform name=…>` property as a matrix (identity when absent).
+    fn matrix(&self, ctx: &Ctx, p: &Plugin, name: &str) -> R<Mat4> {
+        match self.prop(p, name) {
+            Some(n) => self.transform_node(ctx, n),
+            None => Ok(Mat4::IDENTITY),
+        }
+    }
+
+    fn transform_node(&self, ctx: &Ctx, n: Node) -> R<Mat4> {
+        if n.tag_name().name() != "transform" {
+            return Err(ctx.err(n, "expected a <transform>"));
+        }
+        let mut m = Mat4::IDENTITY;
+        for op in n.children().filter(Node::is_element) {
+            let step = match op.tag_name().name() {
+                "translate" => Mat4::from_translation(self.point_of(ctx, op, Vec3::ZERO)?),
+                "scale" => Mat4::from_scale(self.point_of(ctx, op, Vec3::ONE)?),
+                "rotate" => {
+                    let axis = self.point_of(ctx, op, Vec3::ZERO)?;
+                    let angle = self.numbers(ctx, op, &self.req_attr(ctx, op, "angle")?)?;
+                    let (Some(&angle), true) = (angle.first(), axis.length() > 0.0) else {
+                        return Err(ctx.err(op, "<rotate> needs a non-zero axis and an `angle` in degrees"));
+                    };
+                    Mat4::from_axis_angle(axis.normalize(), angle.to_radians())
+                }
+                "matrix" => {
+                    let v = self.numbers(ctx, op, &self.req_attr(ctx, op, "value")?)?;
+                    match v.len() {
+                        16 => Mat4::from_cols_array(&v.try_into().expect("16 numbers")).transpose(),
+                        9 => Mat4::from_mat3(Mat3::from_cols_array(&v.try_into().expect("9 numbers")).transpose()),
+                        _ => return Err(ctx.err(op, "a <matrix> value is 16 numbers (row by row)")),
+                    }
+                }
+                "lookat" => {
+                    let get = |k: &str| -> R<Vec3> {
+                        let v = self.numbers(ctx, op, &self.req_attr(ctx, op, k)?)?;
+                        match v[..] {
+                            [x, y, z] => Ok(Vec3::new(x, y, z)),
+                            _ => Err(ctx.err(op, format!("`{k}` must be three numbers"))),
+                        }
+                    };
+                    let (origin, target) = (get("origin")?, get("target")?);
+                    let dir = (target - origin).normalize_or_zero();
+                    let up = match self.attr(ctx, op, "up")? {
+                        Some(_) => get("up")?,
+                        None => dir.any_orthonormal_vector(),
+                    };
+                    let left = up.cross(dir).normalize_or_zero();
+                    if dir == Vec3::ZERO || left == Vec3::ZERO {
+                        return Err(ctx.err(op, "<lookat>: origin and target coincide, or up is parallel to the view"));
+                    }
+                    let new_up = dir.cross(left);
+                    Mat4::from_cols(left.extend(0.0), new_up.extend(0.0), dir.extend(0.0), origin.extend(1.0))
+                }
+                other => {
+                    return Err(ctx.err(
+                        op,
+                        format!("<{other}> is not a transformation (translate, rotate, scale, matrix, lookat)"),
+                    ));
+                }
+            };
+            m = step * m;
+        }
+        Ok(m)
+    }
+
+    fn transform(&self, ctx: &Ctx, node: Node, m: Mat4) -> R<Transform> {
+        Transform::from_matrix(m).map_err(|e| ctx.err(node, format!("to_world: {e}")))
+    }
+
+    // ---- integrator, sensor --------------------------------------------------------------
+
+    fn integrator(&mut self, ctx: &Ctx, node: Node) -> R<()> {
+        let p = self.plugin(ctx, node)?;
+        let depth = self.float(ctx, &p, "max_depth", -1.0)?;
+        let r = &mut self.scene.render;
+        r.integrator = IntegratorKind::Path;
+        r.max_depth = if depth < 0.0 { 1000 } else { (depth as u32).min(1000) };
+        match p.kind.as_str() {
+            "path" | "volpath" | "volpathmis" | "prb" | "prb_basic" => {}
+            "direct" => self.scene.render.max_depth = 2,
+            other => {
+                self.warn(ctx, node, format!("integrator `{other}` is rendered by alhazen's path tracer"));
+                if let Some(inner) = node.children().find(|c| c.tag_name().name() == "integrator") {
+                    return self.integrator(ctx, inner);
+                }
+            }
+        }
+        self.float(ctx, &p, "rr_depth", 5.0)?;
+        self.unused(ctx, &p, "integrator");
+        Ok(())
+    }
+
+    fn sensor(&mut self, ctx: &Ctx, node: Node) -> R<()> {
+        if self.camera_seen {
+            self.warn(ctx, node, "more than one sensor: the first is used");
+            return Ok(());
+        }
+        self.camera_seen = true;
+        let p = self.plugin(ctx, node)?;
+        for child in node.children().filter(Node::is_element) {
+            match child.tag_name().name() {
+                "film" => self.film(ctx, child)?,
+                "sampler" => self.sampler(ctx, child)?,
+                _ => {}
+            }
+        }
+        let m = self.matrix(ctx, &p, "to_world")?;
+        let l = Mat3::from_mat4(m);
+        let eye = m.transform_point3(Vec3::ZERO);
+        let (fwd, up) = ((l * Vec3::Z).normalize_or_zero(), (l * Vec3::Y).normalize_or_zero());
+        if fwd == Vec3::ZERO || up == Vec3::ZERO || !common::finite(&[eye.x, eye.y, eye.z]) {
+            return Err(ctx.err(node, "the sensor's to_world is singular"));
+        }
+        if l.determinant() < 0.0 {
+            self.warn(ctx, node, "the sensor's to_world mirrors the image; alhazen renders it unmirrored");
+        }
+        let look = LookAt { eye, target: eye + fwd, up };
+        let (w, h) = (self.scene.render.width as f64, self.scene.render.height as f64);
+        self.scene.camera = match p.kind.as_str() {
+            "perspective" | "thinlens" => {
+                if p.kind == "thinlens" {
+                    self.warn(ctx, node, "thinlens: alhazen's camera is a pinhole (no depth of field)");
+                    self.float(ctx, &p, "aperture_radius", 0.0)?;
+                    self.float(ctx, &p, "focus_distance", 0.0)?;
+                }
+                let axis = self.string(ctx, &p, "fov_axis")?.unwrap_or_else(|| "x".into());
+                let (fov, axis) = match self.string(ctx, &p, "focal_length")? {
+                    Some(f) if self.prop(&p, "fov").is_none() => {
+                        let mm = f.trim_end_matches("mm").trim().parse::<f64>().ok().filter(|f| *f > 0.0);
+                        let mm =
+                            mm.ok_or_else(|| ctx.err(node, format!("focal_length \"{f}\" is not a length in mm")))?;
+                        // Mitsuba measures the focal length against a 36 × 24 mm film's diagonal.
+                        (2.0 * (0.5 * 36f64.hypot(24.0) / mm).atan().to_degrees(), "diagonal".to_string())
+                    }
+                    _ => (self.float(ctx, &p, "fov", 0.0)?, axis),
+                };
+                if !(fov > 0.0 && fov < 180.0) {
+                    return Err(ctx.err(node, "a perspective sensor needs `fov` in (0, 180) degrees"));
+                }
+                let half = (fov.to_radians() / 2.0).tan();
+                let (angle, horizontal) = match axis.as_str() {
+                    "x" => (fov.to_radians(), true),
+                    "y" => (fov.to_radians(), false),
+                    "diagonal" => (2.0 * (half * w / w.hypot(h)).atan(), true),
+                    "smaller" => (fov.to_radians(), w <= h),
+                    "larger" => (fov.to_radians(), w >= h),
+                    other => {
+                        return Err(
+                            ctx.err(node, format!("fov_axis \"{other}\" is not x, y, diagonal, smaller or larger"))
+                        );
+                    }
+                };
+                CameraDesc::Perspective { look, opening: PerspectiveOpening::Fov { angle, horizontal } }
+            }
+            "orthographic" => {
+                // The sensor sees [-1, 1] along its shorter axis, scaled by to_world.
+                let sx = (l * Vec3::X).length();
+                CameraDesc::Orthographic { look, width: 2.0 * sx * (w / h).max(1.0) }
+            }
+            other => {
+                self.warn(ctx, node, format!("sensor `{other}` is not supported; a 45° perspective camera stands in"));
+                CameraDesc::Perspective {
+                    look,
+                    opening: PerspectiveOpening::Fov { angle: 45f64.to_radians(), horizontal: true },
+                }
+            }
+        };
+        self.unused(ctx, &p, "sensor");
+        Ok(())
+    }
+
+    fn film(&mut self, ctx: &Ctx, node: Node) -> R<()> {
+        let p = self.plugin(ctx, node)?;
+        let size = |x: f64, n: Node| -> R<u32> {
+            (x >= 1.0 && x <= alhazen_scene::MAX_SIDE as f64 && x.fract() == 0.0).then_some(x as u32).ok_or_else(|| {
+                ctx.err(n, format!("film size {x} is not a whole number of pixels in 1–{}", alhazen_scene::MAX_SIDE))
+            })
+        };
+        self.scene.render.width = size(self.float(ctx, &p, "width", 768.0)?, node)?;
+        self.scene.render.height = size(self.float(ctx, &p, "height", 576.0)?, node)?;
+        if (self.scene.render.width as u64) * (self.scene.render.height as u64) > alhazen_scene::MAX_PIXELS {
+            return Err(ctx.err(node, "the film has more pixels than alhazen can allocate"));
+        }
+        match node.children().find(|c| c.tag_name().name() == "rfilter") {
+            Some(f) if f.attribute("type") == Some("box") => {}
+            Some(f) => {
+                let kind = f.attribute("type").unwrap_or("?");
+                self.warn(
+                    ctx,
+                    f,
+                    format!("pixel filter `{kind}`: alhazen averages each pixel's samples with a box filter"),
+                );
+            }
+            None => self.warn(
+                ctx,
+                node,
+                "Mitsuba's default pixel filter is a Gaussian: alhazen averages each pixel's samples with a box filter",
+            ),
+        }
+        for crop in ["crop_width", "crop_height", "crop_offset_x", "crop_offset_y"] {
+            if let Some(n) = self.prop(&p, crop) {
+                self.warn(ctx, n, format!("`{crop}` is ignored: the whole film is rendered"));
+            }
+        }
+        self.unused(ctx, &p, "film");
+        Ok(())
+    }
+
+    fn sampler(&mut self, ctx: &Ctx, node: Node) -> R<()> {
+        let p = self.plugin(ctx, node)?;
+        let spp = self.float(ctx, &p, "sample_count", 4.0)?;
+        if !(1.0..=1048576.0).contains(&spp) {
+            return Err(ctx.err(node, "sample_count must be 1–1048576"));
+        }
+        self.scene.render.spp = spp as u32;
+        let seed = self.float(ctx, &p, "seed", 0.0)?;
+        self.scene.render.seed = seed.max(0.0) as u64;
+        self.scene.render.sampler = if p.kind == "independent" { SamplerKind::Independent } else { SamplerKind::Sobol };
+        self.unused(ctx, &p, "sampler");
+        Ok(())
+    }
+
+    // ---- materials -----------------------------------------------------------------------
+
+    fn default_material(&mut self) -> MaterialId {
+        if let Some(id) = self.default_material {
+            return id;
+        }
+        let m =
+            common::bsdf_material("mitsuba default", BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::splat(0.5)) });
+        let id = common::add_material(&mut self.scene, m);
+        self.default_material = Some(id);
+        id
+    }
+
+    /// A `<bsdf>` element as a new material.
+    fn bsdf_material(&mut self, ctx: &Ctx, node: Node) -> R<MaterialId> {
+        let (desc, bump) = self.bsdf(ctx, node, 0)?;
+        let name = self.attr(ctx, node, "id")?.unwrap_or_else(|| format!("bsdf at line {}", ctx.line(node)));
+        let mut m = common::bsdf_material(&name, desc);
+        m.bump = bump;
+        Ok(common::add_material(&mut self.scene, m))
+    }
+
+    /// The nested BSDF of a wrapper (`twosided`, `bumpmap`, …).
+    fn inner_bsdf(&mut self, ctx: &Ctx, node: Node, depth: usize) -> R<(BsdfDesc, Option<Bump>)> {
+        let children: Vec<Node> = node
+            .children()
+            .filter(|c| {
+                c.tag_name().name() == "bsdf"
+                    || (c.tag_name().name() == "ref" && c.attribute("name").is_none_or(|n| n.starts_with("bsdf")))
+            })
+            .collect();
+        let Some(first) = children.first() else {
+            return Err(ctx.err(node, "this BSDF needs a nested <bsdf> (or <ref> to one)"));
+        };
+        if children.len() > 1 && node.attribute("type") == Some("twosided") {
+            self.warn(ctx, node, "twosided with a different back BSDF: the front BSDF is used on both sides");
+        }
+        self.bsdf_ref(ctx, *first, depth + 1)
+    }
+
+    fn bsdf_ref(&mut self, ctx: &Ctx, n: Node, depth: usize) -> R<(BsdfDesc, Option<Bump>)> {
+        if n.tag_name().name() == "bsdf" {
+            return self.bsdf(ctx, n, depth);
+        }
+        let id = self.req_attr(ctx, n, "id")?;
+        match self.ids.get(&id) {
+            Some(Named::Bsdf(m)) => {
+                let m = &self.scene.materials[*m as usize];
+                Ok((m.bsdf.clone().expect("imported materials have a BSDF"), m.bump.clone()))
+            }
+            Some(_) => Err(ctx.err(n, format!("\"{id}\" is not a BSDF"))),
+            None => Err(self.unknown_id(ctx, n, &id)),
+        }
+    }
+
+    /// A `<bsdf>` element as a BSDF description and an optional bump map.
+    fn bsdf(&mut self, ctx: &Ctx, node: Node, depth: usize) -> R<(BsdfDesc, Option<Bump>)> {
+        if depth > 32 {
+            return Err(ctx.err(node, "BSDFs nested deeper than 32 levels"));
+        }
+        let p = self.plugin(ctx, node)?;
+        let kind = p.kind.clone();
+        let mut bump = None;
+        let desc = match kind.as_str() {
+            "twosided" => return self.inner_bsdf(ctx, node, depth),
+            "diffuse" => BsdfDesc::Lambert { albedo: self.color(ctx, &p, "reflectance", Vec3::splat(0.5))? },
+            "conductor" | "roughconductor" => {
+                let facets = self.facets(ctx, &p, kind == "roughconductor")?;
+                let tint = self.constant_color(ctx, &p, "specular_reflectance", Vec3::ONE)?;
+                let (eta, k) = match self.string(ctx, &p, "material")? {
+                    Some(name) => self.named_metal(ctx, node, &name),
+                    None if self.prop(&p, "eta").is_some() || self.prop(&p, "k").is_some() => (
+                        self.constant_color(ctx, &p, "eta", Vec3::ZERO)?,
+                        self.constant_color(ctx, &p, "k", Vec3::ONE)?,
+                    ),
+                    None => (Vec3::ZERO, Vec3::ZERO),
+                };
+                BsdfDesc::Conductor { facets, eta, k, tint, fresnel: FresnelMode::Exact }
+            }
+            "dielectric" | "roughdielectric" | "thindielectric" => {
+                let ior = self.ior(ctx, &p)?;
+                for key in ["specular_reflectance", "specular_transmittance"] {
+                    if let Some(n) = self.prop(&p, key) {
+                        self.warn(
+                            ctx,
+                            n,
+                            format!("`{key}` of a dielectric is not supported: alhazen's glass is clear"),
+                        );
+                    }
+                }
+                if kind == "thindielectric" {
+                    self.warn(ctx, node, "thindielectric is approximated by a smooth interface of index 1 (light passes straight through, unreflected)");
+                    BsdfDesc::Dielectric { facets: None, ior: Ior::Constant(1.0), fresnel: FresnelMode::Exact }
+                } else {
+                    let facets = self.facets(ctx, &p, kind == "roughdielectric")?;
+                    BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact }
+                }
+            }
+            "plastic" | "roughplastic" => {
+                let albedo = self.color(ctx, &p, "diffuse_reflectance", Vec3::splat(0.5))?;
+                let ior = self.ior(ctx, &p)?;
+                let facets = self.facets(ctx, &p, true)?.unwrap_or(common::ggx(0.01, 0.01));
+                self.boolean(ctx, &p, "nonlinear", false)?;
+                self.warn(ctx, node, format!("{kind} is approximated by Cook–Torrance: Lambert weighted by 1 − F(0) under a microfacet coat of the same index"));
+                let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+                BsdfDesc::CookTorrance { albedo, kd: 1.0 - f0, ks: 1.0, facets, ior, fresnel: FresnelMode::Exact }
+            }
+            "principled" => {
+                let base = self.color(ctx, &p, "base_color", Vec3::splat(0.8))?;
+                let mean = common::texture_mean(&base, &self.scene);
+                let metallic = self.float(ctx, &p, "metallic", 0.0)?;
+                let roughness = self.float(ctx, &p, "roughness", 0.5)?;
+                let ior = self.float(ctx, &p, "eta", 1.5)?;
+                let trans = self.float(ctx, &p, "spec_trans", 0.0)?;
+                self.warn(ctx, node, "principled is approximated by the glTF metallic–roughness model (base colour, metallic, roughness, eta, spec_trans)");
+                common::metal_rough(base, mean, metallic, roughness, ior, trans)
+            }
+            "blendbsdf" => {
+                let w = match self.prop(&p, "weight") {
+                    Some(n) => self.color_node(ctx, n)?,
+                    None => Texture::Solid(Vec3::splat(0.5)),
+                };
+                if !matches!(w, Texture::Solid(_)) {
+                    self.warn(ctx, node, "a textured blend weight is replaced by its mean");
+                }
+                let w = common::texture_mean(&w, &self.scene).x;
+                let kids: Vec<Node> = node
+                    .children()
+                    .filter(|c| matches!(c.tag_name().name(), "bsdf" | "ref") && c.attribute("name") != Some("weight"))
+                    .collect();
+                let [a, b] = kids[..] else { return Err(ctx.err(node, "blendbsdf needs two nested BSDFs")) };
+                let (a, _) = self.bsdf_ref(ctx, a, depth + 1)?;
+                let (b, _) = self.bsdf_ref(ctx, b, depth + 1)?;
+                // Weight 0 is the first BSDF, 1 the second.
+                common::mix(b, a, w.clamp(0.0, 1.0))
+            }
+            "bumpmap" => {
+                let tex = node.children().find(|c| {
+                    matches!(c.tag_name().name(), "texture")
+                        || (c.tag_name().name() == "ref"
+                            && c.attribute("name").is_none_or(|n| !n.starts_with("bsdf"))
+                            && self.is_texture_ref(c))
+                });
+                let Some(tex) = tex else { return Err(ctx.err(node, "bumpmap needs a nested height <texture>")) };
+                let tex = self.color_node(ctx, tex)?;
+                let scale = self.float(ctx, &p, "scale", 1.0)?;
+                let (inner, _) = self.inner_bsdf(ctx, node, depth)?;
+                bump = match tex {
+                    Texture::Image { image, scale: s } => {
+                        Some(Bump { height: scale, pattern: BumpPattern::Image { image, scale: s } })
+                    }
+                    _ => {
+                        self.warn(ctx, node, "only bitmap textures can be bump maps; the bump map is ignored");
+                        None
+                    }
+                };
+                inner
+            }
+            "normalmap" | "mask" => {
+                self.warn(ctx, node, format!("{kind} is not supported: the nested BSDF is used without it"));
+                p.used.borrow_mut().extend(["opacity".to_string(), "normalmap".to_string()]);
+                return self.inner_bsdf(ctx, node, depth);
+            }
+            other => {
+                self.warn(
+                    ctx,
+                    node,
+                    format!("BSDF `{other}` is not supported; approximated by a diffuse reflectance of 0.5"),
+                );
+                return Ok((BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::splat(0.5)) }, None));
+            }
+        };
+        self.unused(ctx, &p, "bsdf");
+        Ok((desc, bump))
+    }
+
+    fn is_texture_ref(&self, n: &Node) -> bool {
+        n.attribute("id").is_some_and(|id| matches!(self.ids.get(id), Some(Named::Texture(_))))
+    }
+
+    /// A colour that the model holds constant (a texture is replaced by its mean, with a warning).
+    fn constant_color(&mut self, ctx: &Ctx, p: &Plugin, name: &str, default: Vec3) -> R<Vec3> {
+        let t = self.color(ctx, p, name, default)?;
+        if !matches!(t, Texture::Solid(_)) {
+            let n = self.prop(p, name).expect("read above");
+            self.warn(ctx, n, format!("a textured `{name}` is replaced by its mean colour"));
+        }
+        Ok(common::texture_mean(&t, &self.scene))
+    }
+
+    fn named_metal(&mut self, ctx: &Ctx, node: Node, name: &str) -> (Vec3, Vec3) {
+        if name == "none" {
+            return (Vec3::ZERO, Vec3::ZERO);
+        }
+        let ours = METAL_NAMES.iter().find(|m| m.0 == name).map(|m| m.1);
+        match ours.and_then(alhazen_scene::bsdf::metal) {
+            Some(ek) => ek,
+            None => {
+                self.warn(ctx, node, format!("conductor material \"{name}\" is not among alhazen's measured metals (Au, Ag, Cu, Al); rendered as a perfect mirror"));
+                (Vec3::ZERO, Vec3::ZERO)
+            }
+        }
+    }
+
+    /// `int_ior / ext_ior`, each a number or a name.
+    fn ior(&mut self, ctx: &Ctx, p: &Plugin) -> R<f64> {
+        let one = |imp: &mut Self, key: &str, default: f64| -> R<f64> {
+            let Some(n) = imp.prop(p, key) else { return Ok(default) };
+            let v = imp.req_attr(ctx, n, "value")?;
+            if n.tag_name().name() == "string" {
+                return common::named_ior(&v).ok_or_else(|| {
+                    let names: Vec<&str> = common::NAMED_IORS.iter().map(|e| e.0).collect();
+                    ctx.err(n, format!("\"{v}\" is not a known material (known: {})", names.join(", ")))
+                });
+            }
+            match imp.numbers(ctx, n, &v)?[..] {
+                [x] if x > 0.0 => Ok(x),
+                _ => Err(ctx.err(n, format!("`{key}` must be a positive number or a material name"))),
+            }
+        };
+        let int = one(self, "int_ior", 1.5046)?;
+        let ext = one(self, "ext_ior", 1.000277)?;
+        if self.prop(p, "eta").is_some() {
+            return self.float(ctx, p, "eta", 1.5);
+        }
+        Ok(int / ext)
+    }
+
+    /// `distribution`, `alpha` / `alpha_u`, `alpha_v` of a rough BSDF; `None` for a smooth one.
+    fn facets(&mut self, ctx: &Ctx, p: &Plugin, rough: bool) -> R<Option<Microfacets>> {
+        if !rough {
+            return Ok(None);
+        }
+        let distribution = match self.string(ctx, p, "distribution")?.as_deref() {
+            None | Some("beckmann") => Distribution::Beckmann,
+            Some("ggx") => Distribution::TrowbridgeReitz,
+            Some(other) => {
+                let n = self.prop(p, "distribution").expect("read above");
+                return Err(ctx.err(n, format!("distribution \"{other}\" is not beckmann or ggx")));
+            }
+        };
+        let alpha = self.float(ctx, p, "alpha", 0.1)?;
+        let au = self.float(ctx, p, "alpha_u", alpha)?;
+        let av = self.float(ctx, p, "alpha_v", alpha)?;
+        self.boolean(ctx, p, "sample_visible", true)?;
+        if !(au > 0.0 && av > 0.0) {
+            return Err(ctx.err(p.node, "roughness `alpha` must be positive"));
+        }
+        Ok(Some(Microfacets { distribution, alpha_u: au, alpha_v: av, shadowing: Shadowing::Smith }))
+    }
+
+    fn texture(&mut self, ctx: &Ctx, node: Node) -> R<Texture> {
+        let p = self.plugin(ctx, node)?;
+        let uv = self.matrix(ctx, &p, "to_uv")?;
+        let scale = Vec2::new(uv.x_axis.x, uv.y_axis.y);
+        let is_scale = uv.w_axis.truncate() == Vec3::ZERO && uv.x_axis.y == 0.0 && uv.y_axis.x == 0.0;
+        if !is_scale || scale.x == 0.0 || scale.y == 0.0 {
+            self.warn(ctx, node, "to_uv other than a scale is not supported; ignored");
+        }
+        let scale = if is_scale && scale.x != 0.0 && scale.y != 0.0 { scale } else { Vec2::ONE };
+        let t = match p.kind.as_str() {
+            "bitmap" => {
+                let name =
+                    self.string(ctx, &p, "filename")?.ok_or_else(|| ctx.err(node, "bitmap needs a `filename`"))?;
+                let path = common::relative_to(ctx.path, &name);
+                let raw = self.boolean(ctx, &p, "raw", false)?;
+                let hdr = matches!(
+                    path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+                    Some("exr" | "hdr" | "pfm")
+                );
+                let img = if hdr || raw {
+                    alhazen_scene::import::load_hdr_image(&path)
+                } else {
+                    alhazen_scene::import::load_image(&path)
+                };
+                let img = img.map_err(|e| ctx.err(node, e))?;
+                if let Some(w) = self.string(ctx, &p, "wrap_mode")?.filter(|w| w != "repeat") {
+                    self.warn(ctx, node, format!("wrap_mode \"{w}\": alhazen's image textures repeat"));
+                }
+                self.string(ctx, &p, "filter_type")?;
+                self.scene.images.push(Arc::new(img));
+                Texture::Image { image: self.scene.images.len() - 1, scale }
+            }
+            "checkerboard" => {
+                let even = self.constant_color(ctx, &p, "color0", Vec3::splat(0.4))?;
+                let odd = self.constant_color(ctx, &p, "color1", Vec3::splat(0.2))?;
+                if scale.x != scale.y {
+                    self.warn(ctx, node, "a checkerboard scaled differently in u and v uses the mean scale");
+                }
+                Texture::Checker { even, odd, size: 1.0 / (scale.x + scale.y) }
+            }
+            other => {
+                self.warn(ctx, node, format!("texture `{other}` is not supported; approximated by grey 0.5"));
+                return Ok(Texture::Solid(Vec3::splat(0.5)));
+            }
+        };
+        self.unused(ctx, &p, "texture");
+        Ok(t)
+    }
+
+    // ---- shapes ----------------------------------------------------------------------------
+
+    /// A `<shape>` as objects (several for a shapegroup or an instance of one).
+    fn shape(&mut self, ctx: &Ctx, node: Node) -> R<Vec<Object>> {
+        let p = self.plugin(ctx, node)?;
+        let kind = p.kind.clone();
+        if kind == "shapegroup" {
+            let mut objects = vec![];
+            for c in node.children().filter(|c| c.tag_name().name() == "shape") {
+                objects.extend(self.shape(ctx, c)?);
+            }
+            return Ok(objects);
+        }
+        let m = self.matrix(ctx, &p, "to_world")?;
+        let transform = self.transform(ctx, node, m)?;
+        if kind == "instance" {
+            let r = node
+                .children()
+                .find(|c| c.tag_name().name() == "ref")
+                .ok_or_else(|| ctx.err(node, "an instance needs a <ref> to a shapegroup"))?;
+            let id = self.req_attr(ctx, r, "id")?;
+            let group = match self.ids.get(&id) {
+                Some(Named::Group(g)) => g.clone(),
+                Some(_) => return Err(ctx.err(r, format!("\"{id}\" is not a shapegroup"))),
+                None => return Err(self.unknown_id(ctx, r, &id)),
+            };
+            self.unused(ctx, &p, "shape");
+            return Ok(group.into_iter().map(|o| Object { transform: transform * o.transform, ..o }).collect());
+        }
+        let flip = self.boolean(ctx, &p, "flip_normals", false)?;
+        let shape = match kind.as_str() {
+            "obj" | "ply" => {
+                let name = self
+                    .string(ctx, &p, "filename")?
+                    .ok_or_else(|| ctx.err(node, format!("{kind} needs a `filename`")))?;
+                let path = common::relative_to(ctx.path, &name);
+                let face_normals = self.boolean(ctx, &p, "face_normals", false)?;
+                let mesh = self.mesh(ctx, node, &path, flip)?;
+                Shape::Mesh { mesh, smooth: !face_normals }
+            }
+            "rectangle" => {
+                let mut mesh = alhazen_scene::rectangle_mesh();
+                if flip {
+                    flip_mesh(&mut mesh);
+                }
+                self.scene.meshes.push(Arc::new(mesh));
+                Shape::Mesh { mesh: self.scene.meshes.len() - 1, smooth: false }
+            }
+            "cube" => Shape::Box { min: Vec3::splat(-1.0), max: Vec3::ONE },
+            "sphere" => {
+                let radius = self.float(ctx, &p, "radius", 1.0)?;
+                if radius <= 0.0 {
+                    return Err(ctx.err(node, "a sphere's radius must be positive"));
+                }
+                Shape::Sphere { center: self.point(ctx, &p, "center", Vec3::ZERO)?, radius }
+            }
+            "disk" => Shape::Disk { center: Vec3::ZERO, normal: Vec3::Z, radius: 1.0 },
+            "cylinder" => {
+                let (base, top) = (self.point(ctx, &p, "p0", Vec3::ZERO)?, self.point(ctx, &p, "p1", Vec3::Z)?);
+                let radius = self.float(ctx, &p, "radius", 1.0)?;
+                if radius <= 0.0 || base == top {
+                    return Err(ctx.err(node, "a cylinder needs a positive radius and p0 ≠ p1"));
+                }
+                Shape::Cylinder { base, top, radius, capped: false }
+            }
+            "serialized" => {
+                return Err(ctx.err(node, "Mitsuba's serialized meshes are not supported: convert the mesh to PLY (e.g. with mitsuba's own tools or Blender)"));
+            }
+            other => {
+                self.warn(ctx, node, format!("shape `{other}` is not supported; left out"));
+                return Ok(vec![]);
+            }
+        };
+        if flip && !matches!(kind.as_str(), "obj" | "ply" | "rectangle") {
+            self.warn(
+                ctx,
+                node,
+                "flip_normals is applied to meshes only: this shape emits and is shaded from its outside",
+            );
+        }
+        let mut material = None;
+        let mut emission = None;
+        for c in node.children().filter(Node::is_element) {
+            match c.tag_name().name() {
+                "bsdf" => material = Some(self.bsdf_material(ctx, c)?),
+                "ref" if c.attribute("name").is_none_or(|n| n == "bsdf") => {
+                    let id = self.req_attr(ctx, c, "id")?;
+                    material = Some(match self.ids.get(&id) {
+                        Some(Named::Bsdf(m)) => *m,
+                        Some(_) => return Err(ctx.err(c, format!("\"{id}\" is not a BSDF"))),
+                        None => return Err(self.unknown_id(ctx, c, &id)),
+                    });
+                }
+                "emitter" => {
+                    let e = self.plugin(ctx, c)?;
+                    if e.kind != "area" {
+                        return Err(ctx.err(c, format!("a shape can only hold an `area` emitter, not `{}`", e.kind)));
+                    }
+                    let radiance = self.constant_color(ctx, &e, "radiance", Vec3::ONE)?;
+                    self.unused(ctx, &e, "emitter");
+                    emission = Some(radiance);
+                }
+                _ => {}
+            }
+        }
+        let mut material = material.unwrap_or_else(|| self.default_material());
+        if let Some(e) = emission {
+            material = common::emissive(&mut self.scene, material, e);
+        }
+        self.unused(ctx, &p, "shape");
+        let name = self.attr(ctx, node, "id")?;
+        Ok(vec![Object { name, shape, transform, material, mesh_materials: vec![] }])
+    }
+
+    /// A mesh file, loaded once per file (and orientation).
+    fn mesh(&mut self, ctx: &Ctx, node: Node, path: &Path, flip: bool) -> R<usize> {
+        if let Some(&i) = self.meshes.get(&(path.to_path_buf(), flip)) {
+            return Ok(i);
+        }
+        let mut loaded = alhazen_scene::import::load_mesh(path).map_err(|e| ctx.err(node, e))?;
+        // Mitsuba ignores OBJ material libraries: the shape's BSDF applies to every face.
+        loaded.mesh.material_slots.clear();
+        loaded.mesh.material_names.clear();
+        if flip {
+            flip_mesh(&mut loaded.mesh);
+        }
+        self.scene.meshes.push(Arc::new(loaded.mesh));
+        let i = self.scene.meshes.len() - 1;
+        self.meshes.insert((path.to_path_buf(), flip), i);
+        Ok(i)
+    }
+
+    // ---- emitters --------------------------------------------------------------------------
+
+    fn emitter(&mut self, ctx: &Ctx, node: Node) -> R<()> {
+        let p = self.plugin(ctx, node)?;
+        let m = self.matrix(ctx, &p, "to_world")?;
+        let l = Mat3::from_mat4(m);
+        let light = match p.kind.as_str() {
+            "point" => {
+                let position = match self.prop(&p, "position") {
+                    Some(n) => self.point_of(ctx, n, Vec3::ZERO)?,
+                    None => m.transform_point3(Vec3::ZERO),
+                };
+                let intensity = self.constant_color(ctx, &p, "intensity", Vec3::ONE)?;
+                Light::Point { position, intensity, attenuation: [1.0, 0.0, 0.0] }
+            }
+            "spot" => {
+                let intensity = self.constant_color(ctx, &p, "intensity", Vec3::ONE)?;
+                let cutoff = self.float(ctx, &p, "cutoff_angle", 20.0)?;
+                let beam = self.float(ctx, &p, "beam_width", cutoff * 0.75)?;
+                if !(cutoff > 0.0 && cutoff < 180.0) {
+                    return Err(ctx.err(node, "cutoff_angle must be in (0, 180) degrees"));
+                }
+                self.warn(
+                    ctx,
+                    node,
+                    "a spot light's smooth edge is approximated by a cos^e fall-off inside the cutoff cone",
+                );
+                self.prop(&p, "texture").inspect(|_| self.warn(ctx, node, "a projected spot texture is ignored"));
+                Light::Spot {
+                    position: m.transform_point3(Vec3::ZERO),
+                    direction: (l * Vec3::Z).normalize(),
+                    cos_cutoff: cutoff.to_radians().cos(),
+                    falloff: common::spot_exponent(beam.to_radians(), cutoff.to_radians()),
+                    intensity,
+                    attenuation: [1.0, 0.0, 0.0],
+                }
+            }
+            "directional" => {
+                let direction = match self.prop(&p, "direction") {
+                    Some(n) => self.point_of(ctx, n, Vec3::ZERO)?,
+                    None => l * Vec3::Z,
+                };
+                if direction.length() == 0.0 {
+                    return Err(ctx.err(node, "a directional emitter needs a non-zero direction"));
+                }
+                let intensity = self.constant_color(ctx, &p, "irradiance", Vec3::ONE)?;
+                Light::Directional { direction: direction.normalize(), intensity }
+            }
+            "constant" => {
+                let radiance = self.constant_color(ctx, &p, "radiance", Vec3::ONE)?;
+                self.scene.background = Background::Solid(radiance);
+                self.unused(ctx, &p, "emitter");
+                return Ok(());
+            }
+            "envmap" => {
+                let name =
+                    self.string(ctx, &p, "filename")?.ok_or_else(|| ctx.err(node, "envmap needs a `filename`"))?;
+                let path = common::relative_to(ctx.path, &name);
+                let img = alhazen_scene::import::load_hdr_image(&path).map_err(|e| ctx.err(node, e))?;
+                let scale = self.float(ctx, &p, "scale", 1.0)?;
+                let rotation = self.rotation_about_y(ctx, node, l);
+                self.scene.images.push(Arc::new(img));
+                Light::Environment { image: self.scene.images.len() - 1, scale, rotation }
+            }
+            "area" => return Err(ctx.err(node, "an area emitter must be nested in the <shape> it covers")),
+            other => {
+                self.warn(ctx, node, format!("emitter `{other}` is not supported; left out"));
+                return Ok(());
+            }
+        };
+        self.unused(ctx, &p, "emitter");
+        self.scene.lights.push(light);
+        Ok(())
+    }
+
+    /// The angle of a rotation about `+y` (Mitsuba's envmap and alhazen's share the
+    /// equirectangular mapping, `u` from `−z` towards `+x`); other rotations are warned about.
+    fn rotation_about_y(&mut self, ctx: &Ctx, node: Node, l: Mat3) -> f64 {
+        let angle = (l.z_axis.x).atan2(l.z_axis.z);
+        let about_y = Mat3::from_rotation_y(angle);
+        if (l - about_y).to_cols_array().iter().any(|x| x.abs() > 1e-6) {
+            self.warn(
+                ctx,
+                node,
+                "an environment map's to_world other than a rotation about +y is approximated by its turn about +y",
+            );
+        }
+        angle
+    }
+}
+
+/// Turns a mesh inside out: reversed winding and normals.
+pub(crate) fn flip_mesh(mesh: &mut alhazen_geom::TriangleMesh) {
+    for t in &mut mesh.triangles {
+        t.swap(1, 2);
+    }
+    for n in &mut mesh.normals {
+        *n = -*n;
+    }
+}

@@ -1,0 +1,209 @@
+//! The Mitsuba 3 importer: the Cornell box written as Mitsuba XML is the scene of alhazen's own
+//! twin and agrees with Mitsuba's reference image; features and malformed files.
+
+use alhazen_import::Imported;
+use alhazen_math::Vec3;
+use alhazen_scene::bsdf::BsdfDesc;
+use alhazen_scene::{Light, Scene, Shape, Texture};
+use std::path::{Path, PathBuf};
+
+fn repo(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
+}
+
+/// Writes `files` (name, text) to a fresh directory and imports the first.
+fn import(files: &[(&str, &str)]) -> Result<Imported, String> {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    alhazen_import::load(&dir.path().join(files[0].0)).map_err(|e| e.to_string())
+}
+
+fn scene(body: &str) -> String {
+    format!("<scene version=\"3.0.0\">\n{body}\n</scene>\n")
+}
+
+fn albedo(s: &Scene, material: u32) -> Vec3 {
+    match s.materials[material as usize].bsdf.as_ref().unwrap() {
+        BsdfDesc::Lambert { albedo: Texture::Solid(c) } => *c,
+        other => panic!("not Lambert: {other:?}"),
+    }
+}
+
+#[test]
+fn cornell_box_xml_is_the_scene_of_its_toml_twin() {
+    let xml = alhazen_import::load(&repo("scenes/mitsuba/cornell-box.xml")).unwrap();
+    assert!(xml.warnings.is_empty(), "{:?}", xml.warnings);
+    let toml = alhazen_scene::load_scene(&repo("scenes/cornell-box.toml")).unwrap();
+    let (a, b) = (&xml.scene, &toml);
+    assert_eq!(a.render.width, b.render.width);
+    assert_eq!((a.render.spp, a.render.max_depth), (b.render.spp, b.render.max_depth));
+    use alhazen_scene::{CameraDesc::Perspective, PerspectiveOpening::Fov};
+    let (
+        Perspective { look: la, opening: Fov { angle: fa, .. } },
+        Perspective { look: lb, opening: Fov { angle: fb, .. } },
+    ) = (&a.camera, &b.camera)
+    else {
+        panic!("not perspective cameras")
+    };
+    assert_eq!((la.eye, la.up, fa), (lb.eye, lb.up, fb), "square images: the fov axis does not matter");
+    assert!(((la.target - la.eye).normalize() - (lb.target - lb.eye).normalize()).length() < 1e-15);
+    assert_eq!(a.objects.len(), b.objects.len());
+    for o in &b.objects {
+        let m = o.transform.matrix();
+        let twin = a
+            .objects
+            .iter()
+            .find(|x| {
+                x.transform.matrix().abs_diff_eq(m, 1e-6)
+                    && std::mem::discriminant(&x.shape) == std::mem::discriminant(&o.shape)
+            })
+            .unwrap_or_else(|| panic!("no twin for {:?}", o.name));
+        assert!((albedo(a, twin.material) - albedo(b, o.material)).abs().max_element() < 1e-12);
+        let (ea, eb) = (a.materials[twin.material as usize].emission, b.materials[o.material as usize].emission);
+        assert_eq!(ea, eb, "{:?}", o.name);
+    }
+}
+
+#[test]
+fn mitsuba_cornell_box_agrees_with_mitsuba() {
+    let mut s = alhazen_import::load(&repo("scenes/mitsuba/cornell-box.xml")).unwrap().scene;
+    s.render.spp = 128;
+    let img = alhazen_render::render(&s, &|_, _| {});
+    let reference =
+        alhazen_scene::import::load_hdr_image(&repo("crates/alhazen-render/tests/data/mitsuba/cornell-box.exr"))
+            .unwrap();
+    let ours: Vec<Vec3> =
+        (0..img.height).flat_map(|y| (0..img.width).map(move |x| (x, y))).map(|(x, y)| img.get(x, y)).collect();
+    let refs: Vec<Vec3> = reference.pixels.iter().map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)).collect();
+    let (a, b) = (ours.iter().sum::<Vec3>(), refs.iter().sum::<Vec3>());
+    let rel = ((a - b) / b).abs().max_element();
+    eprintln!("image means {a} vs {b}: {rel:.4}");
+    assert!(rel < 0.005, "image means differ by {rel}");
+    // Each 32×32 block's mean within 5 standard errors of its pixels' differences (+0.5 %).
+    for by in 0..8 {
+        for bx in 0..8 {
+            let idx: Vec<usize> = (0..1024).map(|k| (by * 32 + k / 32) * 256 + bx * 32 + k % 32).collect();
+            let d: Vec<Vec3> = idx.iter().map(|&i| ours[i] - refs[i]).collect();
+            let mean = d.iter().sum::<Vec3>() / 1024.0;
+            let var = d.iter().map(|x| (*x - mean) * (*x - mean)).sum::<Vec3>() / 1023.0;
+            let r = idx.iter().map(|&i| refs[i]).sum::<Vec3>() / 1024.0;
+            for c in 0..3 {
+                let allowed = 5.0 * (var[c] / 1024.0).sqrt() + 0.005 * r[c] + 1e-4;
+                assert!(mean[c].abs() < allowed, "block ({bx}, {by}) channel {c}: {} > {allowed}", mean[c]);
+            }
+        }
+    }
+}
+
+#[test]
+fn parameters_includes_groups_and_instances() {
+    let main = scene(
+        r#"<default name="r" value="0.25"/>
+        <include filename="materials.xml"/>
+        <shape type="shapegroup" id="pair">
+            <shape type="sphere"><float name="radius" value="$r"/><ref id="gold"/></shape>
+            <shape type="cube"><ref id="gold"/></shape>
+        </shape>
+        <shape type="instance"><ref id="pair"/><transform name="to_world"><translate x="2"/></transform></shape>
+        <shape type="instance"><ref id="pair"/><transform name="to_world"><translate x="-2"/></transform></shape>"#,
+    );
+    let mats = scene(
+        r#"<bsdf type="roughconductor" id="gold"><string name="material" value="Au"/><float name="alpha" value="0.2"/>
+           <string name="distribution" value="ggx"/></bsdf>"#,
+    );
+    let s = import(&[("main.xml", &main), ("materials.xml", &mats)]).unwrap().scene;
+    assert_eq!(s.objects.len(), 4);
+    assert!(matches!(s.objects[0].shape, Shape::Sphere { radius, .. } if radius == 0.25));
+    assert_eq!(s.objects[0].transform.point(Vec3::ZERO), Vec3::new(2.0, 0.0, 0.0));
+    assert_eq!(s.objects[3].transform.point(Vec3::ZERO), Vec3::new(-2.0, 0.0, 0.0));
+    let BsdfDesc::Conductor { facets: Some(f), eta, .. } =
+        s.materials[s.objects[0].material as usize].bsdf.clone().unwrap()
+    else {
+        panic!("not a rough conductor")
+    };
+    assert_eq!(f.alpha_u, 0.2);
+    assert_eq!(eta, alhazen_scene::bsdf::metal("gold").unwrap().0);
+}
+
+#[test]
+fn emitters_map_to_lights() {
+    let s = import(&[(
+        "e.xml",
+        &scene(
+            r#"<emitter type="point"><point name="position" x="1" y="2" z="3"/><rgb name="intensity" value="5"/></emitter>
+            <emitter type="directional"><vector name="direction" value="0, -1, 0"/><rgb name="irradiance" value="2"/></emitter>
+            <emitter type="constant"><rgb name="radiance" value="0.1, 0.2, 0.3"/></emitter>"#,
+        ),
+    )])
+    .unwrap()
+    .scene;
+    assert_eq!(
+        s.lights[0],
+        Light::Point { position: Vec3::new(1.0, 2.0, 3.0), intensity: Vec3::splat(5.0), attenuation: [1.0, 0.0, 0.0] }
+    );
+    assert_eq!(s.lights[1], Light::Directional { direction: -Vec3::Y, intensity: Vec3::splat(2.0) });
+    assert_eq!(s.sky(Vec3::Y), Vec3::new(0.1, 0.2, 0.3));
+}
+
+#[test]
+fn old_scenes_have_their_names_upgraded() {
+    let s = import(&[(
+        "old.xml",
+        r#"<scene version="0.6.0"><integrator type="path"><integer name="maxDepth" value="3"/></integrator>
+        <bsdf type="dielectric" id="g"><float name="intIOR" value="1.33"/><float name="extIOR" value="1.0"/></bsdf>
+        <shape type="sphere"><ref id="g"/></shape></scene>"#,
+    )])
+    .unwrap();
+    assert_eq!(s.scene.render.max_depth, 3);
+    assert!(
+        matches!(s.scene.materials[s.scene.objects[0].material as usize].bsdf, Some(BsdfDesc::Dielectric { ior: alhazen_scene::bsdf::Ior::Constant(x), .. }) if (x - 1.33).abs() < 1e-12)
+    );
+}
+
+#[test]
+fn what_is_approximated_is_said_with_its_line() {
+    let s = import(&[(
+        "w.xml",
+        &scene(
+            "<shape type=\"sphere\">\n<float name=\"wobble\" value=\"1\"/>\n</shape>\n<bsdf type=\"hair\" id=\"h\"/>",
+        ),
+    )])
+    .unwrap();
+    let text: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        text.iter().any(|w| w.contains("w.xml:3: property `wobble` of shape `sphere` is not supported")),
+        "{text:?}"
+    );
+    assert!(text.iter().any(|w| w.contains("w.xml:5: BSDF `hair` is not supported")), "{text:?}");
+    assert!(text.iter().any(|w| w.contains("no sensor")), "{text:?}");
+}
+
+#[test]
+fn malformed_files_are_located_errors() {
+    let cases: &[(&str, &str)] = &[
+        ("<scene version=\"3.0.0\">\n<shape type=\"sphere\">\n</scene>", "a.xml:3:1: XML syntax error"),
+        (
+            &scene("<shape type=\"sphere\"><ref id=\"glod\"/></shape>\n<bsdf type=\"diffuse\" id=\"gold\"/>"),
+            "no object has id \"glod\"",
+        ),
+        (
+            &scene("<shape type=\"sphere\"><float name=\"radius\" value=\"abc\"/></shape>"),
+            "a.xml:2:22: `abc` is not a finite number",
+        ),
+        (&scene("<shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape>"), "cannot load mesh"),
+        (&scene("<shape type=\"sphere\"><float name=\"radius\" value=\"$rr\"/></shape>"), "$rr has no value"),
+        (
+            &scene("<shape type=\"sphere\"><transform name=\"to_world\"><scale value=\"0\"/></transform></shape>"),
+            "singular",
+        ),
+        ("<scene version=\"3.0.0\"><include filename=\"a.xml\"/></scene>", "nested deeper than 16"),
+        ("<root/>", "expected a <scene> element"),
+        (&scene("<emitter type=\"area\"/>"), "must be nested in the <shape>"),
+    ];
+    for (text, expected) in cases {
+        let err = import(&[("a.xml", text)]).expect_err(expected);
+        assert!(err.contains(expected), "expected {expected:?} in:\n{err}");
+    }
+}
