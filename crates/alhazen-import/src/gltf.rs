@@ -1,8 +1,527 @@
-//! glTF 2.0.
+//! glTF 2.0 (`.gltf` with embedded, data-URI or external buffers and images; `.glb`), read with
+//! the `gltf` crate.
+//!
+//! The default scene's node hierarchy is walked with each node's TRS or matrix composed onto
+//! its parent's (the course's scene graph); every mesh primitive becomes one shared mesh
+//! (positions, normals, first texture coordinates — `v` flipped, glTF's origin being the image's
+//! top — indices; strips and fans unrolled), instanced by every node that uses it. Materials map
+//! through the metallic–roughness model (`common::metal_rough`): the base-colour texture and
+//! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
+//! `KHR_materials_emissive_strength`; textured metallic–roughness and emission by their means, with
+//! a warning. `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the
+//! 683 lm/W that Blender's exporter uses. The first camera met is the camera; without one the
+//! scene's bounds are framed from `+z`.
+
 use crate::Imported;
-use alhazen_scene::SceneError;
+use crate::common::{self, Warnings};
+use alhazen_geom::TriangleMesh;
+use alhazen_math::{Bounds3, Mat4, Transform, Vec2, Vec3};
+use alhazen_scene::{
+    CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object, PerspectiveOpening, Scene,
+    SceneError, Shape, Texture,
+};
+use gltf::mesh::Mode;
+use std::collections::HashMap;
 use std::path::Path;
-/// Reads a glTF file.
+use std::sync::Arc;
+
+type R<T> = Result<T, SceneError>;
+
+/// Luminous efficacy used to turn glTF's photometric light units into radiometric ones (lm/W).
+pub const LUMENS_PER_WATT: f64 = 683.0;
+
+/// Extensions whose absence from the model changes the picture but leaves it meaningful.
+const KNOWN: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_transmission",
+    "KHR_materials_ior",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
+];
+
+/// Reads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<Imported, SceneError> {
-    Err(SceneError::Io { path: path.into(), source: std::io::Error::other("todo") })
+    let bytes = common::read_bytes(path)?;
+    let gltf =
+        gltf::Gltf::from_slice(&bytes).map_err(|e| error(path, &bytes, format!("not a valid glTF 2.0 file: {e}")))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let document = gltf.document;
+    let buffers = gltf::import_buffers(&document, Some(base), gltf.blob)
+        .map_err(|e| error(path, &bytes, format!("cannot read its buffers: {e}")))?;
+    let mut imp = Importer {
+        path,
+        bytes: &bytes,
+        buffers,
+        base,
+        scene: alhazen_scene::empty_scene(),
+        warnings: Warnings::default(),
+        materials: HashMap::new(),
+        meshes: HashMap::new(),
+        images: HashMap::new(),
+        camera: None,
+        bounds: Bounds3::EMPTY,
+    };
+    imp.scene.render.integrator = IntegratorKind::Path;
+    imp.extensions(&document)?;
+    let scene = document.default_scene().or_else(|| document.scenes().next());
+    let Some(scene) = scene else { return Err(error(path, &bytes, "the file has no scene")) };
+    for node in scene.nodes() {
+        imp.node(&node, Mat4::IDENTITY, 0)?;
+    }
+    imp.finish()
+}
+
+/// An error in a glTF file: JSON files are located by the first line naming the problem when
+/// the message carries a position, binary files by the file alone.
+fn error(path: &Path, bytes: &[u8], message: impl Into<String>) -> SceneError {
+    let text = std::str::from_utf8(bytes).unwrap_or("");
+    let message = message.into();
+    // serde_json reports "line L column C"; point there when it does.
+    let at = (|| {
+        let rest = message.split("line ").nth(1)?;
+        let mut it = rest.split(|c: char| !c.is_ascii_digit()).filter(|s| !s.is_empty());
+        let (line, col) = (it.next()?.parse::<usize>().ok()?, it.next()?.parse::<usize>().ok()?);
+        let start = text.split_inclusive('\n').take(line.saturating_sub(1)).map(str::len).sum::<usize>();
+        Some(start + col.saturating_sub(1))
+    })();
+    SceneError::Syntax(Box::new(Diagnostic::at(path, text, at.unwrap_or(0)..at.unwrap_or(0) + 1, message)))
+}
+
+struct Importer<'a> {
+    path: &'a Path,
+    bytes: &'a [u8],
+    buffers: Vec<gltf::buffer::Data>,
+    base: &'a Path,
+    scene: Scene,
+    warnings: Warnings,
+    materials: HashMap<Option<usize>, MaterialId>,
+    meshes: HashMap<(usize, usize), Option<usize>>,
+    images: HashMap<(usize, bool), Arc<ImageData>>,
+    camera: Option<CameraDesc>,
+    bounds: Bounds3,
+}
+
+impl Importer<'_> {
+    fn warn(&mut self, message: impl Into<String>) {
+        self.warnings.add(self.path, 0, message);
+    }
+
+    fn err(&self, message: impl Into<String>) -> SceneError {
+        error(self.path, self.bytes, message)
+    }
+
+    fn extensions(&mut self, doc: &gltf::Document) -> R<()> {
+        for e in doc.extensions_required() {
+            if !KNOWN.contains(&e) {
+                return Err(self.err(format!("the file requires extension {e}, which alhazen cannot read")));
+            }
+        }
+        for e in doc.extensions_used() {
+            if !KNOWN.contains(&e) {
+                self.warn(format!("extension {e} is not supported; ignored"));
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(mut self) -> R<Imported> {
+        self.scene.camera = match self.camera.take() {
+            Some(c) => c,
+            None => {
+                if self.bounds.is_empty() {
+                    self.warn("the scene has no camera and no geometry: alhazen's default camera is used");
+                } else {
+                    self.warn("the scene has no camera: its bounds are framed from +z");
+                }
+                framing(self.bounds, self.scene.render.width as f64 / self.scene.render.height as f64)
+                    .unwrap_or(self.scene.camera.clone())
+            }
+        };
+        if self.scene.lights.is_empty() && self.scene.materials.iter().all(|m| m.emission == Vec3::ZERO) {
+            self.warn("the scene has no lights: a uniform white sky lights it");
+            self.scene.background = alhazen_scene::Background::Solid(Vec3::ONE);
+        }
+        Ok(Imported { scene: self.scene, warnings: self.warnings.into_vec() })
+    }
+
+    fn node(&mut self, node: &gltf::Node, parent: Mat4, depth: usize) -> R<()> {
+        if depth > 256 {
+            return Err(self.err("nodes nested deeper than 256 levels (a cycle?)"));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        if let Some(mesh) = node.mesh() {
+            match Transform::from_matrix(world) {
+                Ok(t) => self.mesh(&mesh, t)?,
+                Err(e) => self.warn(format!("node {} is left out: its transform {e}", node.index())),
+            }
+        }
+        if let Some(camera) = node.camera()
+            && self.camera.is_none()
+        {
+            self.camera = Some(self.camera_of(&camera, world));
+        }
+        if let Some(light) = node.light() {
+            self.light(&light, world);
+        }
+        for child in node.children() {
+            self.node(&child, world, depth + 1)?;
+        }
+        Ok(())
+    }
+
+    // ---- geometry ----------------------------------------------------------------------------
+
+    fn mesh(&mut self, mesh: &gltf::Mesh, t: Transform) -> R<()> {
+        for prim in mesh.primitives() {
+            let key = (mesh.index(), prim.index());
+            let index = match self.meshes.get(&key) {
+                Some(i) => *i,
+                None => {
+                    let i = self.primitive(mesh, &prim)?.map(|m| {
+                        self.scene.meshes.push(Arc::new(m));
+                        self.scene.meshes.len() - 1
+                    });
+                    self.meshes.insert(key, i);
+                    i
+                }
+            };
+            let Some(index) = index else { continue };
+            let material = self.material(prim.material())?;
+            self.bounds = self.bounds.union(t.bounds(&self.scene.meshes[index].bounds()));
+            self.scene.objects.push(Object {
+                name: mesh.name().map(str::to_string),
+                shape: Shape::Mesh { mesh: index, smooth: true },
+                transform: t,
+                material,
+                mesh_materials: vec![],
+            });
+        }
+        Ok(())
+    }
+
+    /// A primitive's triangles; `None` (with a warning) for points and lines.
+    fn primitive(&mut self, mesh: &gltf::Mesh, prim: &gltf::Primitive) -> R<Option<TriangleMesh>> {
+        let name = format!(
+            "mesh {} primitive {}",
+            mesh.name().map_or(mesh.index().to_string(), |n| format!("\"{n}\"")),
+            prim.index()
+        );
+        if matches!(prim.mode(), Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip) {
+            self.warn(format!("{name}: points and lines are not rendered; left out"));
+            return Ok(None);
+        }
+        let buffers = &self.buffers;
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| self.err(format!("{name} has no POSITION attribute")))?
+            .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+            .collect();
+        let normals: Vec<Vec3> = reader
+            .read_normals()
+            .map(|n| n.map(|v| Vec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect())
+            .unwrap_or_default();
+        let uvs: Vec<Vec2> = reader
+            .read_tex_coords(0)
+            .map(|t| t.into_f32().map(|v| Vec2::new(v[0] as f64, 1.0 - v[1] as f64)).collect())
+            .unwrap_or_default();
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(i) => i.into_u32().collect(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        // The reader stops silently at the end of a too-short buffer view: refuse such files.
+        let expected = |sem: &gltf::Semantic| prim.get(sem).map_or(0, |a| a.count());
+        let counts = [
+            ("POSITION", positions.len(), expected(&gltf::Semantic::Positions)),
+            ("NORMAL", normals.len(), expected(&gltf::Semantic::Normals)),
+            ("TEXCOORD_0", uvs.len(), expected(&gltf::Semantic::TexCoords(0))),
+            ("indices", indices.len(), prim.indices().map_or(indices.len(), |a| a.count())),
+        ];
+        for (what, got, want) in counts {
+            if got != want {
+                return Err(
+                    self.err(format!("{name}: its {what} accessor has {want} elements but its buffer holds {got}"))
+                );
+            }
+        }
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(self.err(format!("{name}: index {bad} is not one of its {} vertices", positions.len())));
+        }
+        let triangles: Vec<[u32; 3]> = match prim.mode() {
+            Mode::TriangleStrip => (2..indices.len())
+                .map(|k| {
+                    if k % 2 == 0 {
+                        [indices[k - 2], indices[k - 1], indices[k]]
+                    } else {
+                        [indices[k - 1], indices[k - 2], indices[k]]
+                    }
+                })
+                .collect(),
+            Mode::TriangleFan => (2..indices.len()).map(|k| [indices[0], indices[k - 1], indices[k]]).collect(),
+            _ => indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        };
+        let mut m = TriangleMesh { positions, normals, uvs, triangles, ..Default::default() };
+        if m.normals.iter().any(|n| !n.is_finite()) {
+            self.warn(format!("{name} has non-finite normals; they are recomputed from the faces"));
+            m.normals.clear();
+        }
+        // Degenerate triangles (repeated indices) carry nothing; glTF allows them.
+        m.triangles.retain(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]);
+        if m.triangles.is_empty() {
+            self.warn(format!("{name} has no triangles; left out"));
+            return Ok(None);
+        }
+        m.validate().map_err(|e| self.err(format!("{name}: {e}")))?;
+        Ok(Some(m))
+    }
+
+    // ---- materials -----------------------------------------------------------------------------
+
+    fn material(&mut self, material: gltf::Material) -> R<MaterialId> {
+        if let Some(&id) = self.materials.get(&material.index()) {
+            return Ok(id);
+        }
+        let name = material
+            .name()
+            .map_or_else(|| format!("material {}", material.index().map_or(-1, |i| i as i64)), str::to_string);
+        let pbr = material.pbr_metallic_roughness();
+        let c = pbr.base_color_factor();
+        let factor = rgb([c[0], c[1], c[2]]);
+        let (base, base_mean) = match pbr.base_color_texture() {
+            Some(info) => {
+                let scale = self.texture_scale(&info, &name);
+                let img = self.image(&info.texture(), true)?;
+                let img = scaled(&img, factor);
+                let mean = common::image_mean(&img);
+                self.scene.images.push(Arc::new(img));
+                (Texture::Image { image: self.scene.images.len() - 1, scale }, mean)
+            }
+            None => (Texture::Solid(factor), factor),
+        };
+        let (mut metallic, mut roughness) = (pbr.metallic_factor() as f64, pbr.roughness_factor() as f64);
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            let mean = common::image_mean(&*self.image(&info.texture(), false)?);
+            (roughness, metallic) = (roughness * mean.y, metallic * mean.z);
+            self.warn(format!("{name}: the metallic-roughness texture is replaced by its mean (metallic {metallic:.3}, roughness {roughness:.3})"));
+        }
+        let mut emission = rgb(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0) as f64;
+        if let Some(info) = material.emissive_texture() {
+            emission *= common::image_mean(&*self.image(&info.texture(), true)?);
+            self.warn(format!("{name}: the emissive texture is replaced by its mean colour"));
+        }
+        let transmission = material.transmission().map_or(0.0, |t| {
+            if t.transmission_texture().is_some() {
+                self.warnings.add(
+                    self.path,
+                    0,
+                    format!("{name}: the transmission texture is ignored (its factor is used)"),
+                );
+            }
+            t.transmission_factor() as f64
+        });
+        let ior = material.ior().unwrap_or(1.5) as f64;
+        if material.normal_texture().is_some() {
+            self.warn(format!("{name}: normal maps are not supported; ignored"));
+        }
+        if material.alpha_mode() != gltf::material::AlphaMode::Opaque {
+            self.warn(format!("{name}: alpha {:?} is not supported; the surface is opaque", material.alpha_mode()));
+        }
+        for ext in [
+            "KHR_materials_clearcoat",
+            "KHR_materials_sheen",
+            "KHR_materials_volume",
+            "KHR_materials_specular",
+            "KHR_materials_iridescence",
+            "KHR_materials_anisotropy",
+        ] {
+            if material.extension_value(ext).is_some() {
+                self.warn(format!("{name}: {ext} is not supported; ignored"));
+            }
+        }
+        let bsdf = common::metal_rough(
+            base,
+            base_mean,
+            metallic.clamp(0.0, 1.0),
+            roughness.clamp(0.0, 1.0),
+            ior,
+            transmission.clamp(0.0, 1.0),
+        );
+        let mut m = common::bsdf_material(&name, bsdf);
+        m.emission = emission;
+        let id = common::add_material(&mut self.scene, m);
+        self.materials.insert(material.index(), id);
+        Ok(id)
+    }
+
+    /// `KHR_texture_transform`'s scale (offsets and rotations are warned about) and the
+    /// sampler's wrapping.
+    fn texture_scale(&mut self, info: &gltf::texture::Info, name: &str) -> Vec2 {
+        let sampler = info.texture().sampler();
+        use gltf::texture::WrappingMode::Repeat;
+        if sampler.wrap_s() != Repeat || sampler.wrap_t() != Repeat {
+            self.warn(format!("{name}: clamped or mirrored texture wrapping is rendered as repeat"));
+        }
+        if info.tex_coord() != 0 {
+            self.warn(format!("{name}: texture coordinate set {} is read as set 0", info.tex_coord()));
+        }
+        match info.texture_transform() {
+            Some(t) => {
+                if t.offset() != [0.0, 0.0] || t.rotation() != 0.0 {
+                    self.warn(format!(
+                        "{name}: texture offsets and rotations are not supported; only the scale is used"
+                    ));
+                }
+                Vec2::new(t.scale()[0] as f64, t.scale()[1] as f64)
+            }
+            None => Vec2::ONE,
+        }
+    }
+
+    /// A texture's image in linear RGB (decoded from sRGB when `srgb`).
+    fn image(&mut self, texture: &gltf::Texture, srgb: bool) -> R<Arc<ImageData>> {
+        let source = texture.source();
+        if let Some(img) = self.images.get(&(source.index(), srgb)) {
+            return Ok(img.clone());
+        }
+        let data = gltf::image::Data::from_source(source.source(), Some(self.base), &self.buffers)
+            .map_err(|e| self.err(format!("image {}: {e}", source.index())))?;
+        let img = Arc::new(
+            decode(&data, srgb)
+                .ok_or_else(|| self.err(format!("image {}: unsupported pixel format", source.index())))?,
+        );
+        self.images.insert((source.index(), srgb), img.clone());
+        Ok(img)
+    }
+
+    // ---- camera and lights ---------------------------------------------------------------------
+
+    fn camera_of(&mut self, camera: &gltf::Camera, world: Mat4) -> CameraDesc {
+        let eye = world.transform_point3(Vec3::ZERO);
+        let ahead = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+        let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+        let look = LookAt { eye, target: eye + ahead, up };
+        match camera.projection() {
+            gltf::camera::Projection::Perspective(p) => {
+                if let Some(aspect) = p.aspect_ratio().filter(|a| *a > 0.0 && a.is_finite()) {
+                    let r = &mut self.scene.render;
+                    r.width =
+                        ((r.height as f64 * aspect as f64).round() as u32).clamp(1, alhazen_scene::MAX_SIDE as u32);
+                }
+                let angle = (p.yfov() as f64).clamp(1e-3, 3.1);
+                CameraDesc::Perspective { look, opening: PerspectiveOpening::Fov { angle, horizontal: false } }
+            }
+            gltf::camera::Projection::Orthographic(o) => {
+                let (x, y) = (o.xmag().abs() as f64, o.ymag().abs() as f64);
+                if x > 0.0 && y > 0.0 {
+                    let r = &mut self.scene.render;
+                    r.width = ((r.height as f64 * x / y).round() as u32).clamp(1, alhazen_scene::MAX_SIDE as u32);
+                }
+                CameraDesc::Orthographic { look, width: 2.0 * x.max(1e-9) }
+            }
+        }
+    }
+
+    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Mat4) {
+        use gltf::khr_lights_punctual::Kind;
+        let color = rgb(light.color());
+        let power = color * (light.intensity() as f64 / LUMENS_PER_WATT);
+        let position = world.transform_point3(Vec3::ZERO);
+        let direction = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+        if light.range().is_some() {
+            self.warn("a light's range is ignored: light falls off with the inverse square everywhere");
+        }
+        let l = match light.kind() {
+            Kind::Directional => Light::Directional { direction, intensity: power },
+            Kind::Point => Light::Point { position, intensity: power, attenuation: [1.0, 0.0, 0.0] },
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                let (inner, outer) =
+                    (inner_cone_angle as f64, (outer_cone_angle as f64).clamp(1e-4, std::f64::consts::FRAC_PI_2));
+                if outer - inner > 1e-6 {
+                    self.warn("a spot light's smooth edge is approximated by a cos^e fall-off inside the outer cone");
+                }
+                Light::Spot {
+                    position,
+                    direction,
+                    cos_cutoff: outer.cos(),
+                    falloff: common::spot_exponent(inner, outer),
+                    intensity: power,
+                    attenuation: [1.0, 0.0, 0.0],
+                }
+            }
+        };
+        if direction == Vec3::ZERO && !matches!(l, Light::Point { .. }) {
+            self.warn("a light whose node transform is singular is left out");
+            return;
+        }
+        self.scene.lights.push(l);
+    }
+}
+
+/// An `f32` colour of the file as the model's.
+fn rgb(c: [f32; 3]) -> Vec3 {
+    Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
+}
+
+/// A camera that frames `bounds`: from `+z` and a little above, 45° vertical field of view.
+fn framing(bounds: Bounds3, aspect: f64) -> Option<CameraDesc> {
+    if bounds.is_empty() || !bounds.is_finite() {
+        return None;
+    }
+    let center = (bounds.min + bounds.max) * 0.5;
+    let radius = ((bounds.max - bounds.min).length() * 0.5).max(1e-9);
+    let fov = 45f64.to_radians();
+    let half = (fov / 2.0).min(((fov / 2.0).tan() * aspect).atan());
+    let distance = radius / half.sin() * 1.05;
+    let eye = center + Vec3::new(0.0, 0.35, 1.0).normalize() * distance;
+    Some(CameraDesc::Perspective {
+        look: LookAt { eye, target: center, up: Vec3::Y },
+        opening: PerspectiveOpening::Fov { angle: fov, horizontal: false },
+    })
+}
+
+/// An image multiplied by `factor` (the base-colour factor glTF applies to its texture).
+fn scaled(img: &ImageData, factor: Vec3) -> ImageData {
+    if factor == Vec3::ONE {
+        return img.clone();
+    }
+    let f = factor.to_array().map(|x| x as f32);
+    ImageData { pixels: img.pixels.iter().map(|p| [p[0] * f[0], p[1] * f[1], p[2] * f[2]]).collect(), ..img.clone() }
+}
+
+/// Decoded glTF image data as linear RGB.
+fn decode(data: &gltf::image::Data, srgb: bool) -> Option<ImageData> {
+    use gltf::image::Format::*;
+    let (channels, bytes) = match data.format {
+        R8 => (1, 1),
+        R8G8 => (2, 1),
+        R8G8B8 => (3, 1),
+        R8G8B8A8 => (4, 1),
+        R16 => (1, 2),
+        R16G16 => (2, 2),
+        R16G16B16 => (3, 2),
+        R16G16B16A16 => (4, 2),
+        R32G32B32FLOAT => (3, 4),
+        R32G32B32A32FLOAT => (4, 4),
+    };
+    let n = data.width as usize * data.height as usize;
+    if data.pixels.len() != n * channels * bytes {
+        return None;
+    }
+    let value = |k: usize| -> f32 {
+        let b = &data.pixels[k * bytes..(k + 1) * bytes];
+        let v = match bytes {
+            1 => b[0] as f32 / 255.0,
+            2 => u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
+            _ => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        };
+        if srgb && bytes < 4 { alhazen_math::color::srgb_to_linear(v as f64) as f32 } else { v }
+    };
+    let pixels = (0..n)
+        .map(|p| {
+            let c = |i: usize| value(p * channels + i.min(channels.min(3) - 1));
+            if channels < 3 { [c(0), c(0), c(0)] } else { [c(0), c(1), c(2)] }
+        })
+        .collect();
+    Some(ImageData { width: data.width, height: data.height, pixels })
 }

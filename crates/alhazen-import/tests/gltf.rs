@@ -1,0 +1,242 @@
+//! The glTF 2.0 importer on files written here byte by byte: the node hierarchy, buffers
+//! embedded as data URIs, in a `.glb` and in external files, textures, cameras, lights, and
+//! malformed files.
+
+use alhazen_import::Imported;
+use alhazen_math::{Vec2, Vec3};
+use alhazen_scene::bsdf::BsdfDesc;
+use alhazen_scene::{CameraDesc, Light, PerspectiveOpening, Shape, Texture};
+
+const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+fn base64(bytes: &[u8]) -> String {
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            out.push(if k <= c.len() { B64[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
+        }
+    }
+    out
+}
+
+/// A unit quad in z = 0 facing +z: positions, normals, uvs (f32) and u16 indices.
+fn quad_buffer() -> Vec<u8> {
+    let mut b = vec![];
+    for p in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]] {
+        p.iter().for_each(|x| b.extend(x.to_le_bytes()));
+    }
+    for _ in 0..4 {
+        [0.0f32, 0.0, 1.0].iter().for_each(|x| b.extend(x.to_le_bytes()));
+    }
+    for uv in [[0.0f32, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]] {
+        uv.iter().for_each(|x| b.extend(x.to_le_bytes()));
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        b.extend(i.to_le_bytes());
+    }
+    b
+}
+
+/// A 2×1 PNG: red on the left, blue on the right.
+fn png() -> Vec<u8> {
+    let img = image::RgbImage::from_raw(2, 1, vec![255, 0, 0, 0, 0, 255]).unwrap();
+    let mut out = std::io::Cursor::new(vec![]);
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+/// The JSON of a scene: a root node moved by (1, 0, 0) whose child scales the quad by 2, a
+/// camera, a point light of 683 cd, a textured material; `buffer` is the buffer's `uri` field.
+fn document(buffer: &str, extra_material: &str) -> String {
+    let image = format!("data:image/png;base64,{}", base64(&png()));
+    format!(
+        r#"{{
+  "asset": {{ "version": "2.0" }},
+  "extensionsUsed": ["KHR_lights_punctual"],
+  "scene": 0,
+  "scenes": [{{ "nodes": [0, 2, 3] }}],
+  "nodes": [
+    {{ "translation": [1, 0, 0], "children": [1] }},
+    {{ "scale": [2, 2, 2], "mesh": 0 }},
+    {{ "translation": [0, 0, 5], "camera": 0 }},
+    {{ "translation": [0, 3, 0], "extensions": {{ "KHR_lights_punctual": {{ "light": 0 }} }} }}
+  ],
+  "cameras": [{{ "type": "perspective", "perspective": {{ "yfov": 0.8, "aspectRatio": 2.0, "znear": 0.1 }} }}],
+  "extensions": {{ "KHR_lights_punctual": {{ "lights": [{{ "type": "point", "intensity": 683, "color": [1, 0.5, 0.25] }}] }} }},
+  "meshes": [{{ "name": "quad", "primitives": [{{ "attributes": {{ "POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2 }}, "indices": 3, "material": 0 }}] }}],
+  "materials": [{{ "name": "tex", "pbrMetallicRoughness": {{ "baseColorFactor": [0.5, 1, 1, 1], "baseColorTexture": {{ "index": 0 }}, "metallicFactor": 0, "roughnessFactor": 0.5 }} {extra_material} }}],
+  "textures": [{{ "source": 0 }}],
+  "images": [{{ "uri": "{image}" }}],
+  "buffers": [{{ "byteLength": 140 {buffer} }}],
+  "bufferViews": [
+    {{ "buffer": 0, "byteOffset": 0, "byteLength": 48 }},
+    {{ "buffer": 0, "byteOffset": 48, "byteLength": 48 }},
+    {{ "buffer": 0, "byteOffset": 96, "byteLength": 32 }},
+    {{ "buffer": 0, "byteOffset": 128, "byteLength": 12 }}
+  ],
+  "accessors": [
+    {{ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] }},
+    {{ "bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3" }},
+    {{ "bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2" }},
+    {{ "bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR" }}
+  ]
+}}"#
+    )
+}
+
+fn write_and_import(files: &[(&str, Vec<u8>)]) -> Result<Imported, String> {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, bytes) in files {
+        std::fs::write(dir.path().join(name), bytes).unwrap();
+    }
+    alhazen_import::load(&dir.path().join(files[0].0)).map_err(|e| e.to_string())
+}
+
+fn embedded() -> String {
+    document(&format!(r#", "uri": "data:application/octet-stream;base64,{}""#, base64(&quad_buffer())), "")
+}
+
+/// A binary glTF: header, JSON chunk (padded with spaces), BIN chunk (padded with zeros).
+fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
+    let mut j = json.as_bytes().to_vec();
+    j.resize(j.len().div_ceil(4) * 4, b' ');
+    let mut b = bin.to_vec();
+    b.resize(b.len().div_ceil(4) * 4, 0);
+    let total = 12 + 8 + j.len() + 8 + b.len();
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((j.len() as u32).to_le_bytes());
+    out.extend(0x4E4F_534Au32.to_le_bytes());
+    out.extend(j);
+    out.extend((b.len() as u32).to_le_bytes());
+    out.extend(0x004E_4942u32.to_le_bytes());
+    out.extend(b);
+    out
+}
+
+fn check_scene(s: &Imported) {
+    let sc = &s.scene;
+    assert_eq!(sc.objects.len(), 1);
+    let o = &sc.objects[0];
+    assert_eq!(o.transform.point(Vec3::ZERO), Vec3::new(1.0, 0.0, 0.0), "parent's translation");
+    assert_eq!(o.transform.point(Vec3::X), Vec3::new(3.0, 0.0, 0.0), "child's scale, then the parent");
+    let Shape::Mesh { mesh, .. } = o.shape else { panic!("not a mesh") };
+    let m = &sc.meshes[mesh];
+    assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    assert_eq!(m.uvs[0], Vec2::new(0.0, 0.0), "v flipped: glTF's v = 1 is the image's bottom");
+    assert_eq!(m.uvs[2], Vec2::new(1.0, 1.0));
+    assert_eq!((sc.render.width, sc.render.height), (960, 480), "aspect ratio 2");
+    let CameraDesc::Perspective { look, opening: PerspectiveOpening::Fov { angle, horizontal: false } } = &sc.camera
+    else {
+        panic!("not a vertical-fov perspective camera: {:?}", sc.camera)
+    };
+    assert_eq!((look.eye, (look.target - look.eye).normalize()), (Vec3::new(0.0, 0.0, 5.0), -Vec3::Z));
+    assert!((angle - 0.8).abs() < 1e-6);
+    let Light::Point { position, intensity, .. } = sc.lights[0] else { panic!("not a point light") };
+    assert_eq!(position, Vec3::new(0.0, 3.0, 0.0));
+    assert!((intensity - Vec3::new(1.0, 0.5, 0.25)).abs().max_element() < 1e-6, "683 cd = 1 W/sr");
+    // The base colour: the texture times the factor (0.5, 1, 1), in a dielectric-over-diffuse BSDF.
+    let Some(BsdfDesc::CookTorrance { albedo: Texture::Image { image, scale }, .. }) =
+        &sc.materials[o.material as usize].bsdf
+    else {
+        panic!("not a textured dielectric: {:?}", sc.materials[o.material as usize].bsdf)
+    };
+    assert_eq!(*scale, Vec2::ONE);
+    assert_eq!(sc.images[*image].pixels, vec![[0.5, 0.0, 0.0], [0.0, 0.0, 1.0]]);
+}
+
+#[test]
+fn embedded_buffers_and_images() {
+    let s = write_and_import(&[("scene.gltf", embedded().into_bytes())]).unwrap();
+    check_scene(&s);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+#[test]
+fn binary_gltf_is_the_same_scene() {
+    let json = document("", "");
+    let s = write_and_import(&[("scene.glb", glb(&json, &quad_buffer()))]).unwrap();
+    check_scene(&s);
+}
+
+#[test]
+fn external_buffers_are_read_beside_the_file() {
+    let json = document(r#", "uri": "quad.bin""#, "");
+    let s = write_and_import(&[("scene.gltf", json.into_bytes()), ("quad.bin", quad_buffer())]).unwrap();
+    check_scene(&s);
+}
+
+#[test]
+fn emission_lights_the_render_and_what_is_left_out_is_said() {
+    let extra = r#", "emissiveFactor": [1, 1, 1], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4 } },
+                     "normalTexture": { "index": 0 }, "alphaMode": "BLEND""#;
+    let json = document(
+        &format!(r#", "uri": "data:application/octet-stream;base64,{}""#, base64(&quad_buffer())),
+        extra,
+    )
+    .replace(
+        r#""extensionsUsed": ["KHR_lights_punctual"]"#,
+        r#""extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_sheen"]"#,
+    );
+    let s = write_and_import(&[("e.gltf", json.into_bytes())]).unwrap();
+    let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    for expected in ["normal maps are not supported", "alpha Blend", "KHR_materials_sheen is not supported"] {
+        assert!(said.iter().any(|w| w.contains(expected)), "{expected:?} not in {said:?}");
+    }
+    let mut sc = s.scene;
+    assert_eq!(sc.materials[sc.objects[0].material as usize].emission, Vec3::splat(4.0));
+    // Seen straight on, the emitting quad fills the image's centre with its radiance.
+    sc.lights.clear();
+    (sc.render.width, sc.render.height, sc.render.spp, sc.render.max_depth) = (16, 8, 4, 1);
+    sc.camera = CameraDesc::Perspective {
+        look: alhazen_scene::LookAt { eye: Vec3::new(2.0, 1.0, 3.0), target: Vec3::new(2.0, 1.0, 0.0), up: Vec3::Y },
+        opening: PerspectiveOpening::Fov { angle: 0.3, horizontal: false },
+    };
+    let img = alhazen_render::render(&sc, &|_, _| {});
+    assert!((img.get(8, 4) - Vec3::splat(4.0)).abs().max_element() < 1e-9, "{}", img.get(8, 4));
+}
+
+#[test]
+fn a_scene_without_camera_or_lights_is_framed_and_lit() {
+    let json = embedded()
+        .replace(r#""nodes": [0, 2, 3]"#, r#""nodes": [0]"#)
+        .replace(r#""extensionsUsed": ["KHR_lights_punctual"],"#, "");
+    let s = write_and_import(&[("f.gltf", json.into_bytes())]).unwrap();
+    let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(said.iter().any(|w| w.contains("no camera")) && said.iter().any(|w| w.contains("no lights")), "{said:?}");
+    let CameraDesc::Perspective { look, .. } = s.scene.camera else { panic!("no framing camera") };
+    // The quad spans [1, 3] × [0, 2]: the camera looks at its centre from in front.
+    assert_eq!(look.target, Vec3::new(2.0, 1.0, 0.0));
+    assert!(look.eye.z > 2.0);
+}
+
+#[test]
+fn malformed_files_are_errors() {
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("a.gltf", b"{ \"asset\": { \"version\": \"2.0\" },\n  \"scenes\": [ }".to_vec(), "a.gltf:2:"),
+        ("a.gltf", document(r#", "uri": "missing.bin""#, "").into_bytes(), "cannot read its buffers"),
+        ("a.gltf", b"{ \"asset\": { \"version\": \"2.0\" } }".to_vec(), "the file has no scene"),
+        (
+            "a.gltf",
+            embedded()
+                .replace(
+                    r#""extensionsUsed""#,
+                    r#""extensionsRequired": ["KHR_draco_mesh_compression"], "extensionsUsed""#,
+                )
+                .into_bytes(),
+            "KHR_draco_mesh_compression\": Unsupported extension",
+        ),
+        ("a.glb", b"glTF\x02\0\0\0\x0c\0\0\0".to_vec(), "not a valid glTF"),
+        (
+            "a.gltf",
+            embedded().replace(r#""count": 6"#, r#""count": 600"#).into_bytes(),
+            "its indices accessor has 600 elements",
+        ),
+    ];
+    for (name, bytes, expected) in cases {
+        let err = write_and_import(&[(name, bytes)]).expect_err(expected);
+        assert!(err.contains(expected), "expected {expected:?} in:\n{err}");
+    }
+}
