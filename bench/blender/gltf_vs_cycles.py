@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""Blender's side of the glTF validation (issue 20): build a scene with Blender's Python module,
+export it as glTF 2.0 with Blender's own exporter, and render it with Cycles as the reference.
+
+    python3 bench/blender/gltf_vs_cycles.py OUT_DIR [--spp 4096] [--size 160x120]
+
+writes OUT_DIR/materials.glb (what a Blender user would hand alhazen) and
+OUT_DIR/materials-cycles.exr (Cycles, CPU, 2 threads, box pixel filter of one pixel, no
+denoiser, no adaptive sampling, light paths up to 8 bounces, no caustic filtering).
+Needs `pip install bpy`. The committed copies live in crates/alhazen-import/tests/data/blender/
+and the test `blender_gltf_agrees_with_cycles` compares alhazen's image of the .glb with the EXR.
+"""
+import argparse, math, os, sys, time
+
+import bpy
+
+
+def material(name, color, metallic, roughness):
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    p = m.node_tree.nodes["Principled BSDF"]
+    p.inputs["Base Color"].default_value = (*color, 1.0)
+    p.inputs["Metallic"].default_value = metallic
+    p.inputs["Roughness"].default_value = roughness
+    return m
+
+
+def build():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    bpy.ops.mesh.primitive_plane_add(size=12, location=(0, 0, 0))
+    bpy.context.object.data.materials.append(material("floor", (0.6, 0.6, 0.6), 0.0, 1.0))
+    bpy.ops.mesh.primitive_cube_add(size=2, location=(-1.4, 0.3, 1), rotation=(0, 0, math.radians(25)))
+    bpy.context.object.data.materials.append(material("red", (0.7, 0.08, 0.06), 0.0, 0.6))
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=96, ring_count=48, radius=1, location=(1.3, -0.2, 1))
+    bpy.ops.object.shade_smooth()
+    bpy.context.object.data.materials.append(material("gold", (1.0, 0.77, 0.34), 1.0, 0.35))
+    bpy.ops.object.light_add(type="POINT", location=(1.5, -3.5, 5.0))
+    light = bpy.context.object.data
+    light.energy = 1500.0
+    light.shadow_soft_size = 0.0
+    bpy.ops.object.camera_add(location=(0.3, -8.5, 3.6))
+    cam = bpy.context.object
+    direction = [0.0 - 0.3, 0.0 + 8.5, 0.9 - 3.6]
+    cam.rotation_euler = (math.atan2(math.hypot(direction[0], direction[1]), -direction[2]), 0, math.atan2(direction[0], direction[1]) * -1)
+    cam.data.lens = 35
+    cam.data.sensor_fit = "HORIZONTAL"
+    scene.camera = cam
+    world = bpy.data.worlds.new("black")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+    return scene
+
+
+def render(scene, path, spp, size):
+    w, h = size
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = spp
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.use_denoising = False
+    scene.cycles.max_bounces = 8
+    scene.cycles.diffuse_bounces = 8
+    scene.cycles.glossy_bounces = 8
+    scene.cycles.transmission_bounces = 8
+    scene.cycles.caustics_reflective = True
+    scene.cycles.caustics_refractive = True
+    scene.cycles.blur_glossy = 0.0
+    scene.cycles.sample_clamp_direct = 0.0
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.cycles.pixel_filter_type = "BOX"
+    scene.cycles.filter_width = 1.0
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = 2
+    scene.render.resolution_x, scene.render.resolution_y = w, h
+    scene.render.resolution_percentage = 100
+    scene.view_settings.view_transform = "Standard"
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "16"
+    scene.render.image_settings.color_mode = "RGB"
+    scene.render.filepath = path
+    t0 = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    return time.perf_counter() - t0
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("out")
+    ap.add_argument("--spp", type=int, default=4096)
+    ap.add_argument("--size", default="160x120")
+    a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
+    scene = build()
+    size = tuple(int(x) for x in a.size.split("x"))
+    scene.render.resolution_x, scene.render.resolution_y = size
+    glb = os.path.join(a.out, "materials.glb")
+    bpy.ops.export_scene.gltf(filepath=glb, export_format="GLB", export_lights=True, export_cameras=True, export_yup=True)
+    seconds = render(scene, os.path.join(os.path.abspath(a.out), "materials-cycles.exr"), a.spp, size)
+    print(f"Cycles: {a.spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
