@@ -13,7 +13,7 @@ use std::time::Instant;
 
 #[derive(Args)]
 pub struct LinesArgs {
-    /// The scene file (TOML); not needed with --graph.
+    /// The scene file (TOML, glTF, Mitsuba 3 XML or pbrt-v4); not needed with --graph.
     #[arg(required_unless_present = "graph")]
     scene: Option<PathBuf>,
     /// Output: .svg, .pdf or .png (an antialiased preview).

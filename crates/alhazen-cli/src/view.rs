@@ -21,7 +21,7 @@ use std::time::Instant;
 
 #[derive(Args)]
 pub(crate) struct ViewArgs {
-    /// The scene file (TOML).
+    /// The scene file: alhazen TOML, glTF (.gltf/.glb), Mitsuba 3 XML (.xml) or pbrt-v4 (.pbrt).
     scene: PathBuf,
     /// Window width (overrides the scene's image width).
     #[arg(long, value_parser = clap::value_parser!(u32).range(16..=8192))]

@@ -373,3 +373,69 @@ fn anamorph_prints_and_says_when_the_paper_is_too_small() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("outside the cylinder"));
 }
+
+#[test]
+fn every_importable_format_renders_rasters_and_draws() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let files = [
+        root.join("scenes/mitsuba/cornell-box.xml"),
+        root.join("scenes/pbrt/cornell-box.pbrt"),
+        root.join("crates/alhazen-import/tests/data/blender/materials.glb"),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for f in &files {
+        let f = f.to_str().unwrap();
+        for (cmd, out) in [("render", "a.png"), ("raster", "b.png"), ("lines", "c.svg")] {
+            let out = dir.path().join(out);
+            let mut args = vec![cmd, f, "-o", out.to_str().unwrap()];
+            if cmd != "lines" {
+                args.extend(["--width", "32", "--height", "24", "--quiet"]);
+            }
+            if cmd == "render" {
+                args.extend(["--spp", "1"]);
+            }
+            let o = alhazen(&args);
+            assert_eq!(o.status.code(), Some(0), "{cmd} {f}: {}", String::from_utf8_lossy(&o.stderr));
+            assert!(out.exists(), "{cmd} {f}");
+        }
+    }
+}
+
+#[test]
+fn importers_warn_on_stderr_and_refuse_bad_files_with_exit_code_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.png");
+    let xml = dir.path().join("s.xml");
+    std::fs::write(
+        &xml,
+        "<scene version=\"3.0.0\">\n<shape type=\"sphere\"><float name=\"wobble\" value=\"1\"/></shape>\n</scene>",
+    )
+    .unwrap();
+    let o = alhazen(&[
+        "render",
+        xml.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "1",
+        "-q",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("warning:") && err.contains("s.xml:2: property `wobble`"), "{err}");
+    let pbrt = dir.path().join("s.pbrt");
+    std::fs::write(&pbrt, "WorldBegin\nShape \"sphere\" \"float radius\" [ 1").unwrap();
+    let o = alhazen(&["render", pbrt.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("s.pbrt:2:31"), "{}", String::from_utf8_lossy(&o.stderr));
+    let glb = dir.path().join("s.glb");
+    std::fs::write(&glb, b"not a glb").unwrap();
+    let never = dir.path().join("never.png");
+    let o = alhazen(&["render", glb.to_str().unwrap(), "-o", never.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!never.exists());
+}
