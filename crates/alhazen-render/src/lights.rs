@@ -151,12 +151,15 @@ fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
         Shape::Mesh { mesh, .. } => {
             let m = &scene.meshes[*mesh];
             let indices: Vec<[u32; 3]> = m.triangles.iter().map(|&tri| outside_first(tri, mirroring)).collect();
-            let tris: Vec<[Vec3; 3]> = indices.iter().map(|tri| tri.map(|i| t.point(m.positions[i as usize]))).collect();
+            let tris: Vec<[Vec3; 3]> =
+                indices.iter().map(|tri| tri.map(|i| t.point(m.positions[i as usize]))).collect();
             parallelogram(&indices, &tris).or_else(|| triangles(tris))
         }
         Shape::Box { min, max } => {
             let m = alhazen_geom::TriangleMesh::cuboid(*min, *max);
-            triangles((0..m.triangle_count()).map(|i| outside_first(m.corners(i).map(|p| t.point(p)), mirroring)).collect())
+            triangles(
+                (0..m.triangle_count()).map(|i| outside_first(m.corners(i).map(|p| t.point(p)), mirroring)).collect(),
+            )
         }
         _ => None,
     }
