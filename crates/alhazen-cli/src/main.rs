@@ -49,6 +49,20 @@ enum Command {
         after_help = "Examples:\n  alhazen lines scenes/lines/fig21-cylinder-in-sphere.toml -o fig21.svg\n  alhazen lines scenes/lines/fig1-town-in-cylinder.toml -o fig1.pdf --hidden\n  alhazen lines --graph ripple -o ripple.svg"
     )]
     Lines(lines::LinesArgs),
+    /// Write any scene alhazen reads (glTF, Mitsuba XML, pbrt, TOML) as alhazen TOML, to edit it.
+    #[command(
+        after_help = "The meshes go to binary PLY and the images to OpenEXR files in OUT-assets/ beside OUT.toml.\n\nExample:\n  alhazen convert model.glb -o model.toml"
+    )]
+    Convert(ConvertArgs),
+}
+
+#[derive(Args)]
+struct ConvertArgs {
+    /// The scene to convert: alhazen TOML, glTF 2.0 (.gltf/.glb), Mitsuba 3 XML (.xml) or pbrt-v4 (.pbrt).
+    scene: PathBuf,
+    /// The TOML file to write (its meshes and images go to a folder beside it, named after it).
+    #[arg(short, long)]
+    output: PathBuf,
 }
 
 /// What every image-producing command takes: the scene, the output and its size.
@@ -153,6 +167,7 @@ fn main() -> ExitCode {
         Command::View(args) => view::run(&args),
         Command::Mirror(cmd) => mirror::run(&cmd),
         Command::Lines(args) => lines::run(&args),
+        Command::Convert(args) => run_convert(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -283,6 +298,36 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
             a.image.output.display()
         );
     }
+    Ok(())
+}
+
+fn run_convert(a: &ConvertArgs) -> Result<(), Failure> {
+    if a.output.extension().and_then(|e| e.to_str()) != Some("toml") {
+        return Err(Failure::input(format!("{}: the output of convert is a .toml file", a.output.display())));
+    }
+    check_output_dir(&a.output)?;
+    let scene = load(&a.scene)?;
+    let stem = a.output.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
+    let assets = a.output.with_file_name(format!("{stem}-assets"));
+    let header = format!(
+        "Converted by alhazen {} from {} ({}).\nMeshes and images are in {}/.",
+        env!("CARGO_PKG_VERSION"),
+        a.scene.display(),
+        alhazen_import::SceneFormat::from_path(&a.scene).name(),
+        assets.file_name().and_then(|s| s.to_str()).unwrap_or("")
+    );
+    alhazen_scene::write::write_scene(&scene, &a.output, &assets, &header).map_err(|e| match e {
+        alhazen_scene::write::WriteError::Unsupported(m) => Failure::input(m),
+        e => Failure::work(e.to_string()),
+    })?;
+    eprintln!(
+        "wrote {} ({} objects, {} meshes, {} images in {})",
+        a.output.display(),
+        scene.objects.len(),
+        scene.meshes.len(),
+        scene.images.len(),
+        assets.display()
+    );
     Ok(())
 }
 

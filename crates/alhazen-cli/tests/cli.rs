@@ -439,3 +439,33 @@ fn importers_warn_on_stderr_and_refuse_bad_files_with_exit_code_2() {
     assert_eq!(o.status.code(), Some(2));
     assert!(!never.exists());
 }
+
+#[test]
+fn convert_writes_toml_that_renders_and_refuses_other_outputs() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cornell.toml");
+    let xml = root.join("scenes/mitsuba/cornell-box.xml");
+    let o = alhazen(&["convert", xml.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read_to_string(&out).unwrap().starts_with("# Converted by alhazen"));
+    assert!(dir.path().join("cornell-assets/mesh-0.ply").exists());
+    let png = dir.path().join("c.png");
+    let o = alhazen(&[
+        "render",
+        out.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--spp",
+        "1",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "-q",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = alhazen(&["convert", xml.to_str().unwrap(), "-o", dir.path().join("c.json").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("is a .toml file"));
+}

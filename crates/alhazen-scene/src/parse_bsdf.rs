@@ -68,7 +68,7 @@ impl Parser<'_> {
                 }
             }
             "cook-torrance" => {
-                let (kd, ks) = weights(&t, 0.5)?;
+                let (kd, ks) = fresnel_weights(&t, 0.5)?;
                 let facets = microfacets(&t)?.unwrap_or(default_facets(0.3));
                 BsdfDesc::CookTorrance {
                     albedo,
@@ -119,6 +119,22 @@ impl Parser<'_> {
             rotation: t.opt_f64("rotate_y", 0.0)?.to_radians(),
         })
     }
+}
+
+/// Cook–Torrance's `kd` and `ks`: its specular term carries the Fresnel factor, so energy is
+/// conserved when `k_d + k_s·F(0) ≤ 1` (at normal incidence; `F` grows towards grazing angles
+/// where the microfacet term shrinks) — the course's `k_d + k_s = 1` is the special case of a
+/// perfect reflector.
+fn fresnel_weights(t: &Table, default_ks: f64) -> R<(f64, f64)> {
+    let ks = t.get("ks").map_or(Ok(default_ks), |n| n.in_range(0.0, 1.0))?;
+    let kd = t.get("kd").map_or(Ok(1.0 - ks), |n| n.in_range(0.0, 1.0))?;
+    let ior = t.opt_positive("ior", 1.5)?;
+    let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+    if kd + ks * f0 > 1.0 + 1e-9 {
+        let node = t.get("kd").or(t.get("ks")).expect("one was given");
+        return Err(node.err(format!("kd + ks·F(0) = {} exceeds 1: the surface would create energy", kd + ks * f0)));
+    }
+    Ok((kd, ks))
 }
 
 /// `kd` and `ks` with the course's `k_d + k_s ≤ 1`.
