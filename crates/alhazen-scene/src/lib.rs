@@ -5,7 +5,8 @@
 //! * the native TOML format ([`parse_scene`], [`load_scene`]), documented field by field in
 //!   `docs/scene-format.md`; every error is a [`Diagnostic`] with `file:line:col`, a caret
 //!   under the offending text, what was expected and, for typos, a "did you mean";
-//! * [`import`] — OBJ/MTL and PLY meshes, PNG textures.
+//! * [`import`] — OBJ/MTL and PLY meshes, PNG textures;
+//! * [`write`] — a scene written back as TOML (with its meshes as PLY, images as EXR).
 //!
 //! ```
 //! let text = "[[object]]\nshape = \"sphere\"\nradius = 1.0\n";
@@ -18,12 +19,14 @@
 
 pub mod bsdf;
 mod diagnostic;
+mod graph;
 pub mod import;
 pub mod model;
 mod parse;
 mod parse_bsdf;
 mod reader;
 pub mod texture;
+pub mod write;
 
 pub use diagnostic::{Diagnostic, did_you_mean};
 pub use model::*;

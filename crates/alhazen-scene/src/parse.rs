@@ -17,7 +17,7 @@ pub const MAX_SIDE: u64 = 1 << 16;
 pub const MAX_PIXELS: u64 = 1 << 28;
 
 pub(crate) const TOP_KEYS: &[&str] =
-    &["render", "camera", "background", "ambient", "light", "materials", "meshes", "object"];
+    &["render", "camera", "background", "ambient", "light", "materials", "meshes", "groups", "object"];
 
 /// Parses scene text; `file` names it in messages and anchors relative paths.
 pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
@@ -27,12 +27,13 @@ pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
         let msg = e.message().lines().next().unwrap_or("invalid TOML").trim_end_matches('.').to_string();
         SceneError::Syntax(Box::new(crate::Diagnostic::at(file, text, span, format!("TOML syntax error: {msg}"))))
     })?;
-    let top = Table { src, t: root.get_ref(), span: root.span(), name: "scene" };
+    let top = Table { src, t: root.get_ref(), span: root.span(), name: "scene", scope: None };
     let mut p = Parser {
         dir: file.parent().unwrap_or(Path::new(".")),
         scene: empty_scene(),
         material_names: HashMap::new(),
         mesh_names: HashMap::new(),
+        mesh_files: HashMap::new(),
     };
     p.scene_from(&top).map_err(SceneError::Syntax)?;
     Ok(p.scene)
@@ -62,6 +63,8 @@ pub(crate) struct Parser<'a> {
     pub(crate) scene: Scene,
     material_names: HashMap<String, MaterialId>,
     mesh_names: HashMap<String, (usize, Vec<MaterialId>)>,
+    /// Mesh files already loaded (a group instanced many times shares its meshes).
+    mesh_files: HashMap<std::path::PathBuf, (usize, Vec<MaterialId>)>,
 }
 
 impl Parser<'_> {
@@ -100,9 +103,10 @@ impl Parser<'_> {
             };
             self.scene.lights.push(l);
         }
+        let groups = crate::graph::Groups::of(top)?;
         for n in top.get("object").map(|n| n.array()).transpose()?.unwrap_or_default() {
-            let o = self.object(&n, 0)?;
-            self.scene.objects.push(o);
+            let objects = self.objects_of(&n, &groups, &mut vec![], Transform::IDENTITY)?;
+            self.scene.objects.extend(objects);
         }
         Ok(())
     }
@@ -177,7 +181,12 @@ impl Parser<'_> {
         let i = i.table(&["file", "scale"])?;
         let file = i.req("file")?;
         let path = self.dir.join(file.str()?);
-        let data = import::load_image(&path).map_err(|e| file.err(e))?;
+        let linear = matches!(
+            path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+            Some("exr" | "hdr" | "pfm")
+        );
+        let data = if linear { import::load_hdr_image(&path) } else { import::load_image(&path) };
+        let data = data.map_err(|e| file.err(e))?;
         let scale = match i.get("scale") {
             Some(s) if s.is_table() => return Err(s.err("`scale`: expected a number or [u, v]")),
             Some(s) => match s.v {
@@ -248,6 +257,16 @@ impl Parser<'_> {
 
     fn load_mesh(&mut self, file: &Node) -> R<(usize, Vec<MaterialId>)> {
         let path = self.dir.join(file.str()?);
+        if let Some(m) = self.mesh_files.get(&path) {
+            return Ok(m.clone());
+        }
+        let loaded = self.load_mesh_file(file, &path)?;
+        self.mesh_files.insert(path, loaded.clone());
+        Ok(loaded)
+    }
+
+    fn load_mesh_file(&mut self, file: &Node, path: &Path) -> R<(usize, Vec<MaterialId>)> {
+        let path = path.to_path_buf();
         let loaded = import::load_mesh(&path).map_err(|e| file.err(e))?;
         let slots = loaded
             .materials
@@ -305,7 +324,7 @@ impl Parser<'_> {
         Ok(alhazen_geom::tessellate::polygons_to_triangles(&m))
     }
 
-    fn object(&mut self, n: &Node, depth: usize) -> R<Object> {
+    pub(crate) fn object(&mut self, n: &Node, depth: usize) -> R<Object> {
         const COMMON: &[&str] = &["shape", "name", "material", "transform"];
         let t = n.table_any()?;
         let shape_node = t.req("shape")?;
@@ -619,7 +638,7 @@ impl<'a, 'i> Node<'a, 'i> {
         let toml::de::DeValue::Table(t) = self.v else {
             return Err(self.err(format!("`{}`: expected a table", self.key)));
         };
-        Ok(Table { src: self.src, t, span: self.span.clone(), name: self.key })
+        Ok(Table { src: self.src, t, span: self.span.clone(), name: self.key, scope: self.scope.clone() })
     }
 }
 
@@ -791,7 +810,7 @@ fn light(n: &Node) -> R<Light> {
 
 /// `transform = [ { translate = [..] }, { rotate = { axis = [..], angle = deg } }, … ]`, applied
 /// in the order listed.
-fn transform(n: &Node) -> R<Transform> {
+pub(crate) fn transform(n: &Node) -> R<Transform> {
     let mut total = Transform::IDENTITY;
     for step in n.array()? {
         let t = step.table(&["translate", "scale", "rotate", "rotate_x", "rotate_y", "rotate_z", "matrix"])?;

@@ -22,6 +22,9 @@ impl Src<'_> {
     }
 }
 
+/// The parameters of the group instance being read: `"$name"` values stand for them.
+pub(crate) type Scope<'a, 'i> = Option<std::rc::Rc<std::collections::HashMap<String, Node<'a, 'i>>>>;
+
 /// A value with its span.
 #[derive(Clone)]
 pub(crate) struct Node<'a, 'i> {
@@ -30,6 +33,19 @@ pub(crate) struct Node<'a, 'i> {
     pub span: Range<usize>,
     /// The key this value was found under, for messages.
     pub key: &'a str,
+    /// Group parameters in force where the value was found.
+    pub scope: Scope<'a, 'i>,
+}
+
+impl<'a, 'i> Node<'a, 'i> {
+    /// The node itself, or the parameter value a `"$name"` string stands for in `scope`.
+    pub fn resolved(self) -> Self {
+        let Some(name) = self.v.as_str().and_then(|s| s.strip_prefix('$')) else { return self };
+        match self.scope.as_ref().and_then(|sc| sc.get(name)) {
+            Some(value) => Node { key: self.key, ..value.clone() },
+            None => self,
+        }
+    }
 }
 
 fn kind(v: &DeValue<'_>) -> &'static str {
@@ -50,6 +66,18 @@ impl<'a, 'i> Node<'a, 'i> {
     }
 
     fn expected(&self, what: &str) -> Box<Diagnostic> {
+        if let Some(p) = self.v.as_str().filter(|s| s.starts_with('$')) {
+            let known = self.scope.as_ref().map(|sc| {
+                let mut k: Vec<String> = sc.keys().map(|k| format!("${k}")).collect();
+                k.sort();
+                k.join(", ")
+            });
+            return self.err(format!(
+                "`{}`: parameter `{p}` has no value here (a group's parameters: {})",
+                self.key,
+                known.filter(|k| !k.is_empty()).unwrap_or_else(|| "none: this is not inside a group".into())
+            ));
+        }
         self.err(format!("`{}`: expected {what}, found {}", self.key, kind(self.v)))
     }
 
@@ -122,7 +150,10 @@ impl<'a, 'i> Node<'a, 'i> {
         let DeValue::Array(items) = self.v else { return Err(self.expected("an array")) };
         Ok(items
             .iter()
-            .map(|item| Node { src: self.src, v: item.get_ref(), span: item.span(), key: self.key })
+            .map(|item| {
+                Node { src: self.src, v: item.get_ref(), span: item.span(), key: self.key, scope: self.scope.clone() }
+                    .resolved()
+            })
             .collect())
     }
 
@@ -142,8 +173,14 @@ impl<'a, 'i> Node<'a, 'i> {
         self.numbers::<3>().map(Vec3::from_array)
     }
 
+    /// A direction, normalised; one already of unit length (to rounding) is kept as written, so
+    /// a scene written back by `write` reads to the same bits.
     pub fn unit_vec3(&self) -> R<Vec3> {
-        self.vec3()?.try_normalize().ok_or_else(|| self.err(format!("`{}` must be a non-zero vector", self.key)))
+        let v = self.vec3()?;
+        if (v.length_squared() - 1.0).abs() <= 4.0 * f64::EPSILON {
+            return Ok(v);
+        }
+        v.try_normalize().ok_or_else(|| self.err(format!("`{}` must be a non-zero vector", self.key)))
     }
 
     /// A colour: one number (grey) or `[r, g, b]`, each ≥ 0.
@@ -161,7 +198,7 @@ impl<'a, 'i> Node<'a, 'i> {
 
     pub fn table(&self, keys: &[&str]) -> R<Table<'a, 'i>> {
         let DeValue::Table(t) = self.v else { return Err(self.expected("a table")) };
-        let table = Table { src: self.src, t, span: self.span.clone(), name: self.key };
+        let table = Table { src: self.src, t, span: self.span.clone(), name: self.key, scope: self.scope.clone() };
         table.check_keys(keys)?;
         Ok(table)
     }
@@ -178,15 +215,15 @@ pub(crate) struct Table<'a, 'i> {
     pub t: &'a DeTable<'i>,
     pub span: Range<usize>,
     pub name: &'a str,
+    /// Group parameters in force.
+    pub scope: Scope<'a, 'i>,
 }
 
 impl<'a, 'i> Table<'a, 'i> {
     pub fn get(&self, key: &str) -> Option<Node<'a, 'i>> {
-        self.t.iter().find(|(k, _)| k.get_ref().as_ref() == key).map(|(k, v)| Node {
-            src: self.src,
-            v: v.get_ref(),
-            span: v.span(),
-            key: k.get_ref().as_ref(),
+        self.t.iter().find(|(k, _)| k.get_ref().as_ref() == key).map(|(k, v)| {
+            Node { src: self.src, v: v.get_ref(), span: v.span(), key: k.get_ref().as_ref(), scope: self.scope.clone() }
+                .resolved()
         })
     }
 
