@@ -3,9 +3,10 @@
 //! BSDFs (course, §"Physically based models").
 
 use crate::Warning;
+use alhazen_math::Transform;
 use alhazen_math::Vec3;
 use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
-use alhazen_scene::{Diagnostic, FresnelMode, Material, MaterialId, Rgb, Scene, SceneError, Texture};
+use alhazen_scene::{Diagnostic, FresnelMode, Material, MaterialId, Rgb, Scene, SceneError, Shape, Texture};
 use std::collections::HashSet;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -239,4 +240,18 @@ pub(crate) fn spot_exponent(inner: f64, outer: f64) -> f64 {
 /// Checks that every number of a value is finite.
 pub(crate) fn finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
+}
+
+/// A sphere whose transform only moves and uniformly scales it, stated in world space with no
+/// transform (the renderer tests such spheres several at a time); anything else as it is.
+pub(crate) fn placed_sphere(shape: Shape, transform: Transform) -> (Shape, Transform) {
+    let Shape::Sphere { center, radius } = shape else { return (shape, transform) };
+    let m = transform.matrix();
+    let l = alhazen_math::Mat3::from_mat4(m);
+    let s = l.x_axis.x;
+    let uniform = s > 0.0 && l == alhazen_math::Mat3::from_diagonal(Vec3::splat(s));
+    if !uniform {
+        return (shape, transform);
+    }
+    (Shape::Sphere { center: transform.point(center), radius: radius * s }, Transform::IDENTITY)
 }

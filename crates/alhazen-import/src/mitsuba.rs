@@ -1072,6 +1072,7 @@ impl Importer {
         }
         self.unused(ctx, &p, "shape");
         let name = self.attr(ctx, node, "id")?;
+        let (shape, transform) = common::placed_sphere(shape, transform);
         Ok(vec![Object { name, shape, transform, material, mesh_materials: vec![] }])
     }
 

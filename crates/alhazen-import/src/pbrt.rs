@@ -1268,6 +1268,7 @@ impl Importer {
         if let Some(area) = self.state.area.clone() {
             material = common::emissive(&mut self.scene, material, area.radiance);
         }
+        let (shape, transform) = common::placed_sphere(shape, transform);
         self.emit(Object { name: None, shape, transform, material, mesh_materials: vec![] });
         Ok(())
     }

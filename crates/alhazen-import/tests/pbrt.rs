@@ -33,13 +33,23 @@ fn bits(img: &Image) -> Vec<u64> {
         .collect()
 }
 
-#[test]
-fn pbrt_cornell_box_renders_the_bits_of_its_toml_twin() {
-    let pbrt = alhazen_import::load(&repo("scenes/pbrt/cornell-box.pbrt")).unwrap();
+fn same_bits_as_twin(name: &str) {
+    let pbrt = alhazen_import::load(&repo(&format!("scenes/pbrt/{name}.pbrt"))).unwrap();
     assert!(pbrt.warnings.is_empty(), "{:?}", pbrt.warnings);
-    let toml = alhazen_scene::load_scene(&repo("scenes/cornell-box.toml")).unwrap();
+    let toml = alhazen_scene::load_scene(&repo(&format!("scenes/{name}.toml"))).unwrap();
     assert_eq!(pbrt.scene.render, toml.render);
     assert_eq!(bits(&small(pbrt.scene, 4)), bits(&small(toml, 4)));
+}
+
+#[test]
+fn pbrt_cornell_box_renders_the_bits_of_its_toml_twin() {
+    same_bits_as_twin("cornell-box");
+}
+
+#[test]
+fn pbrt_cornell_rough_renders_the_bits_of_its_toml_twin() {
+    // Spheres, a rough conductor and rough glass; pbrt's spheres are placed by Translate.
+    same_bits_as_twin("cornell-rough");
 }
 
 /// Mean red minus green of the left and right quarters of an image.
