@@ -17,8 +17,8 @@ use crate::common::{self, Warnings};
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::{
-    CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object, PerspectiveOpening, Scene,
-    SceneError, Shape, Texture,
+    Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
+    PerspectiveOpening, Scene, SceneError, Shape, Texture,
 };
 use gltf::mesh::Mode;
 use std::collections::HashMap;
@@ -321,9 +321,18 @@ impl Importer<'_> {
             t.transmission_factor() as f64
         });
         let ior = material.ior().unwrap_or(1.5) as f64;
-        if material.normal_texture().is_some() {
-            self.warn(format!("{name}: normal maps are not supported; ignored"));
-        }
+        let bump = match material.normal_texture() {
+            Some(nt) => {
+                if nt.tex_coord() != 0 {
+                    self.warn(format!("{name}: texture coordinate set {} is read as set 0", nt.tex_coord()));
+                }
+                let image = self.image(&nt.texture(), false)?;
+                self.scene.images.push(image);
+                let image = self.scene.images.len() - 1;
+                Some(Bump { height: nt.scale() as f64, pattern: BumpPattern::NormalMap { image, scale: Vec2::ONE } })
+            }
+            None => None,
+        };
         if material.alpha_mode() != gltf::material::AlphaMode::Opaque {
             self.warn(format!("{name}: alpha {:?} is not supported; the surface is opaque", material.alpha_mode()));
         }
@@ -349,6 +358,7 @@ impl Importer<'_> {
         );
         let mut m = common::bsdf_material(&name, bsdf);
         m.emission = emission;
+        m.bump = bump;
         let id = common::add_material(&mut self.scene, m);
         self.materials.insert(material.index(), id);
         Ok(id)

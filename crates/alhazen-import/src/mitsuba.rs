@@ -8,7 +8,7 @@
 //! `cube`, `sphere`, `disk`, `cylinder`, `shapegroup`/`instance`; BSDFs `diffuse`,
 //! `conductor`/`roughconductor` (named materials or `eta`/`k`), `dielectric`/`roughdielectric`,
 //! `thindielectric`, `plastic`/`roughplastic`, `principled`, `blendbsdf`, `twosided`,
-//! `bumpmap`, `normalmap`, `mask`; textures `bitmap` and `checkerboard`; emitters `area`,
+//! `bumpmap`, `normalmap` (a tangent-space normal map), `mask`; textures `bitmap` and `checkerboard`; emitters `area`,
 //! `point`, `spot`, `directional`, `constant`, `envmap`. Scenes of version 0.x have their
 //! camelCase names upgraded as Mitsuba 3 does. Everything else is a located warning.
 //!
@@ -167,7 +167,7 @@ impl Importer {
                 self.register(ctx, node, Named::Bsdf(id))?;
             }
             "texture" => {
-                let t = self.texture(ctx, node)?;
+                let t = self.texture(ctx, node, false)?;
                 self.register(ctx, node, Named::Texture(t))?;
             }
             "shape" => {
@@ -377,7 +377,7 @@ impl Importer {
                 }
             }
             "spectrum" => self.spectrum(ctx, n).map(Texture::Solid),
-            "texture" => self.texture(ctx, n),
+            "texture" => self.texture(ctx, n, false),
             "ref" => {
                 let id = self.req_attr(ctx, n, "id")?;
                 match self.ids.get(&id) {
@@ -819,9 +819,33 @@ impl Importer {
                 };
                 inner
             }
-            "normalmap" | "mask" => {
-                self.warn(ctx, node, format!("{kind} is not supported: the nested BSDF is used without it"));
-                p.used.borrow_mut().extend(["opacity".to_string(), "normalmap".to_string()]);
+            "normalmap" => {
+                let tex = node.children().find(|c| {
+                    c.tag_name().name() == "texture" || (c.tag_name().name() == "ref" && self.is_texture_ref(c))
+                });
+                let Some(tex) = tex else { return Err(ctx.err(node, "normalmap needs a nested <texture>")) };
+                // Normal maps hold vectors, not colours: read linearly whatever `raw` says.
+                let tex = if tex.tag_name().name() == "texture" {
+                    self.texture(ctx, tex, true)?
+                } else {
+                    self.color_node(ctx, tex)?
+                };
+                p.used.borrow_mut().insert("normalmap".to_string());
+                let (inner, _) = self.inner_bsdf(ctx, node, depth)?;
+                bump = match tex {
+                    Texture::Image { image, scale } => {
+                        Some(Bump { height: 1.0, pattern: BumpPattern::NormalMap { image, scale } })
+                    }
+                    _ => {
+                        self.warn(ctx, node, "only bitmap textures can be normal maps; the normal map is ignored");
+                        None
+                    }
+                };
+                inner
+            }
+            "mask" => {
+                self.warn(ctx, node, "mask is not supported: the nested BSDF is used without it (opaque)");
+                p.used.borrow_mut().insert("opacity".to_string());
                 return self.inner_bsdf(ctx, node, depth);
             }
             other => {
@@ -912,7 +936,8 @@ impl Importer {
         Ok(Some(Microfacets { distribution, alpha_u: au, alpha_v: av, shadowing: Shadowing::Smith }))
     }
 
-    fn texture(&mut self, ctx: &Ctx, node: Node) -> R<Texture> {
+    /// A `<texture>`; `linear` reads a bitmap without sRGB decoding (normal maps).
+    fn texture(&mut self, ctx: &Ctx, node: Node, linear: bool) -> R<Texture> {
         let p = self.plugin(ctx, node)?;
         let uv = self.matrix(ctx, &p, "to_uv")?;
         let scale = Vec2::new(uv.x_axis.x, uv.y_axis.y);
@@ -926,7 +951,7 @@ impl Importer {
                 let name =
                     self.string(ctx, &p, "filename")?.ok_or_else(|| ctx.err(node, "bitmap needs a `filename`"))?;
                 let path = common::relative_to(ctx.path, &name);
-                let raw = self.boolean(ctx, &p, "raw", false)?;
+                let raw = self.boolean(ctx, &p, "raw", false)? || linear;
                 let hdr = matches!(
                     path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
                     Some("exr" | "hdr" | "pfm")

@@ -23,8 +23,8 @@ use crate::mitsuba::flip_mesh;
 use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Ior};
 use alhazen_scene::{
-    Background, CameraDesc, FresnelMode, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
-    PerspectiveOpening, Scene, SceneError, Shape, Texture,
+    Background, Bump, BumpPattern, CameraDesc, FresnelMode, ImageData, IntegratorKind, Light, LookAt, MaterialId,
+    Object, PerspectiveOpening, Scene, SceneError, Shape, Texture,
 };
 use std::collections::HashMap;
 use std::ops::Range;
@@ -879,11 +879,24 @@ impl Importer {
 
     fn material(&mut self, ctx: &Ctx, kind: &str, at: &Range<usize>, p: &mut Params, name: &str) -> R<MaterialId> {
         let bsdf = self.bsdf(ctx, kind, at, p, 0)?;
-        if self.find(p, "displacement").is_some() || self.find(p, "normalmap").is_some() {
-            self.warn(ctx, at, "displacement and normal maps are not supported; ignored");
+        if self.find(p, "displacement").is_some() {
+            self.warn(ctx, at, "displacement is not supported; ignored");
         }
+        let bump = match self.string(ctx, p, "normalmap")? {
+            Some(file) => {
+                let path = common::relative_to(ctx.path, &file);
+                // Normal maps hold vectors: read linearly, not as sRGB colours.
+                let img = alhazen_scene::import::load_hdr_image(&path).map_err(|e| ctx.err(at.clone(), e))?;
+                self.scene.images.push(Arc::new(img));
+                let image = self.scene.images.len() - 1;
+                Some(Bump { height: 1.0, pattern: BumpPattern::NormalMap { image, scale: Vec2::ONE } })
+            }
+            None => None,
+        };
         self.unused(ctx, p, &format!("material \"{kind}\""));
-        Ok(common::add_material(&mut self.scene, common::bsdf_material(name, bsdf)))
+        let mut m = common::bsdf_material(name, bsdf);
+        m.bump = bump;
+        Ok(common::add_material(&mut self.scene, m))
     }
 
     fn bsdf(&mut self, ctx: &Ctx, kind: &str, at: &Range<usize>, p: &mut Params, depth: usize) -> R<BsdfDesc> {

@@ -100,6 +100,8 @@ rotate_y = 31
 [materials.tex]
 color = { image = { file = "tex.png", scale = [2, 3] } }
 bump = { height = 0.02, image = { file = "tex.png", scale = 4 } }
+[materials.dented]
+bump = { height = 0.7, normal_map = { file = "tex.png", scale = 2 } }
 [materials.checks]
 bsdf = { type = "oren-nayar", color = { checker = { even = 0.9, odd = 0.2, size = 0.25 } }, sigma = 17 }
 [materials.glass]
@@ -117,6 +119,10 @@ b = { shape = "sphere", radius = 1.3 }
 material = "checks"
 transform = [{ scale = 0.6 }, { translate = [1.3, 0, 0] }]
 [[object]]
+shape = "box"
+material = "dented"
+transform = [{ translate = [0, -2, 0] }]
+[[object]]
 shape = "cone"
 apex = [0, 2, 0]
 radius = 0.5
@@ -130,6 +136,8 @@ material = "glass"
     assert_eq!(a.lights, b.lights);
     assert_eq!(a.background, b.background);
     assert_eq!(a.objects[1].shape, b.objects[1].shape, "the CSG operands");
+    let bumps = |s: &Scene| s.materials.iter().map(|m| m.bump.clone()).collect::<Vec<_>>();
+    assert_eq!(bumps(&a).len(), bumps(&b).len());
     assert!(a.objects[0].transform.point(Vec3::X) == b.objects[0].transform.point(Vec3::X));
     assert!(bits(a) == bits(b));
 }

@@ -171,7 +171,7 @@ fn external_buffers_are_read_beside_the_file() {
 #[test]
 fn emission_lights_the_render_and_what_is_left_out_is_said() {
     let extra = r#", "emissiveFactor": [1, 1, 1], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4 } },
-                     "normalTexture": { "index": 0 }, "alphaMode": "BLEND""#;
+                     "normalTexture": { "index": 0, "scale": 0.5 }, "alphaMode": "BLEND""#;
     let json = document(
         &format!(r#", "uri": "data:application/octet-stream;base64,{}""#, base64(&quad_buffer())),
         extra,
@@ -182,11 +182,19 @@ fn emission_lights_the_render_and_what_is_left_out_is_said() {
     );
     let s = write_and_import(&[("e.gltf", json.into_bytes())]).unwrap();
     let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
-    for expected in ["normal maps are not supported", "alpha Blend", "KHR_materials_sheen is not supported"] {
+    for expected in ["alpha Blend", "KHR_materials_sheen is not supported"] {
         assert!(said.iter().any(|w| w.contains(expected)), "{expected:?} not in {said:?}");
     }
     let mut sc = s.scene;
-    assert_eq!(sc.materials[sc.objects[0].material as usize].emission, Vec3::splat(4.0));
+    let m = &sc.materials[sc.objects[0].material as usize];
+    assert_eq!(m.emission, Vec3::splat(4.0));
+    // The normal texture is a normal map of strength `scale`, read linearly (not as sRGB).
+    let Some(alhazen_scene::Bump { height, pattern: alhazen_scene::BumpPattern::NormalMap { image, .. } }) = &m.bump
+    else {
+        panic!("no normal map: {:?}", m.bump)
+    };
+    assert_eq!(*height, 0.5);
+    assert_eq!(sc.images[*image].pixels[0], [1.0, 0.0, 0.0]);
     // Seen straight on, the emitting quad fills the image's centre with its radiance.
     sc.lights.clear();
     (sc.render.width, sc.render.height, sc.render.spp, sc.render.max_depth) = (16, 8, 4, 1);

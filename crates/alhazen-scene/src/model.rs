@@ -473,6 +473,15 @@ pub enum BumpPattern {
         /// Repeats per texture unit.
         scale: Vec2,
     },
+    /// A tangent-space normal map (glTF, Mitsuba `normalmap`, pbrt `normalmap`): each texel's
+    /// linear RGB `c` is the normal `2c − 1` in the frame of `∂p/∂u`, the bitangent and `n`;
+    /// the bump's `height` scales its tangential part (glTF's `normalTexture.scale`).
+    NormalMap {
+        /// Index into [`Scene::images`] (linear values, not sRGB).
+        image: usize,
+        /// Repeats per texture unit.
+        scale: Vec2,
+    },
 }
 
 impl Default for Material {

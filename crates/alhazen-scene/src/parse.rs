@@ -176,15 +176,17 @@ impl Parser<'_> {
         })
     }
 
-    /// `{ file = "x.png", scale = s or [u, v] }`: a repeated image (its index and scale).
-    fn image_texture(&mut self, i: &Node) -> R<(usize, Vec2)> {
+    /// `{ file = "x.png", scale = s or [u, v] }`: a repeated image (its index and scale); PNG and
+    /// JPEG are sRGB unless `linear` (normal maps), EXR and HDR always linear.
+    fn image_texture(&mut self, i: &Node, linear: bool) -> R<(usize, Vec2)> {
         let i = i.table(&["file", "scale"])?;
         let file = i.req("file")?;
         let path = self.dir.join(file.str()?);
-        let linear = matches!(
-            path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
-            Some("exr" | "hdr" | "pfm")
-        );
+        let linear = linear
+            || matches!(
+                path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+                Some("exr" | "hdr" | "pfm")
+            );
         let data = if linear { import::load_hdr_image(&path) } else { import::load_image(&path) };
         let data = data.map_err(|e| file.err(e))?;
         let scale = match i.get("scale") {
@@ -201,15 +203,23 @@ impl Parser<'_> {
 
     /// `bump = { height = h, waves = size }` or `bump = { height = h, image = { file, scale } }`.
     fn bump(&mut self, n: &Node) -> R<Bump> {
-        let t = n.table(&["height", "waves", "image"])?;
+        let t = n.table(&["height", "waves", "image", "normal_map"])?;
         let height = t.req("height")?.f64()?;
-        let pattern = match (t.get("waves"), t.get("image")) {
-            (Some(w), None) => BumpPattern::Waves { size: w.positive()? },
-            (None, Some(i)) => {
-                let (image, scale) = self.image_texture(&i)?;
+        let pattern = match (t.get("waves"), t.get("image"), t.get("normal_map")) {
+            (Some(w), None, None) => BumpPattern::Waves { size: w.positive()? },
+            (None, Some(i), None) => {
+                let (image, scale) = self.image_texture(&i, false)?;
                 BumpPattern::Image { image, scale }
             }
-            _ => return Err(n.err("a bump needs exactly one of `waves = size` or `image = { file = … }`")),
+            (None, None, Some(i)) => {
+                let (image, scale) = self.image_texture(&i, true)?;
+                BumpPattern::NormalMap { image, scale }
+            }
+            _ => {
+                return Err(n.err(
+                    "a bump needs exactly one of `waves = size`, `image = { file = … }` or `normal_map = { file = … }`",
+                ));
+            }
         };
         Ok(Bump { height, pattern })
     }
@@ -228,7 +238,7 @@ impl Parser<'_> {
             });
         }
         if let Some(i) = t.get("image") {
-            let (image, scale) = self.image_texture(&i)?;
+            let (image, scale) = self.image_texture(&i, false)?;
             return Ok(Texture::Image { image, scale });
         }
         Err(n.err("`color`: expected a colour, { checker = {...} } or { image = {...} }"))

@@ -96,7 +96,20 @@ fn bump_value(b: &crate::BumpPattern, uv: Vec2, images: &[std::sync::Arc<ImageDa
         crate::BumpPattern::Image { image, scale } => {
             alhazen_math::color::luminance(bilinear(&images[*image], uv * *scale)).clamp(0.0, 1.0)
         }
+        crate::BumpPattern::NormalMap { .. } => 0.0,
     }
+}
+
+/// The normal a tangent-space normal map gives: the texel `2c − 1` in the frame `T` (∂p/∂u
+/// made orthogonal to `n`), `B = ±n × T` (on ∂p/∂v's side), `n`; the tangential part scaled by
+/// `strength`.
+fn mapped_normal(c: Vec3, strength: f64, n: Vec3, pu: Vec3, pv: Vec3) -> Vec3 {
+    let t = (pu - n * n.dot(pu)).try_normalize().unwrap_or_else(|| alhazen_math::orthonormal_basis(n).0);
+    let b = n.cross(t);
+    let b = if b.dot(pv) < 0.0 { -b } else { b };
+    let local = c * 2.0 - Vec3::ONE;
+    let m = t * (local.x * strength) + b * (local.y * strength) + n * local.z.max(0.0);
+    m.try_normalize().unwrap_or(n)
 }
 
 /// The normal of the bumped surface `p̂ = p + d(u, v) n` by the course's approximation
@@ -124,6 +137,9 @@ pub fn bumped_normal(
         crate::BumpPattern::Image { image, scale } => {
             0.5 / (images[*image].width.max(images[*image].height) as f64 * scale.max_element())
         }
+        crate::BumpPattern::NormalMap { image, scale } => {
+            return mapped_normal(bilinear(&images[*image], uv * *scale), bump.height, n, pu, pv);
+        }
     };
     let d = |du: f64, dv: f64| bump.height * bump_value(&bump.pattern, uv + Vec2::new(du, dv), images);
     let (du, dv) = ((d(step, 0.0) - d(-step, 0.0)) / (2.0 * step), (d(0.0, step) - d(0.0, -step)) / (2.0 * step));
@@ -150,6 +166,17 @@ mod bump_tests {
             let want = Vec3::new(-gx, -gy, 1.0).normalize();
             assert!((got - want).length() < 1e-7, "{got} vs {want}");
         }
+        // A flat normal map (texel (½, ½, 1)) leaves the normal alone; a tilted texel tilts it
+        // towards ∂p/∂u, by its strength.
+        let img = |c: [f32; 3]| std::sync::Arc::new(ImageData { width: 1, height: 1, pixels: vec![c] });
+        let map = Bump { height: 1.0, pattern: BumpPattern::NormalMap { image: 0, scale: Vec2::ONE } };
+        let flat = bumped_normal(&map, Vec2::new(0.3, 0.3), Vec3::Z, Vec3::X * 2.0, Vec3::Y, &[img([0.5, 0.5, 1.0])]);
+        assert!((flat - Vec3::Z).length() < 1e-12, "{flat}");
+        let tilted = bumped_normal(&map, Vec2::ZERO, Vec3::Z, Vec3::X, -Vec3::Y, &[img([1.0, 0.5, 0.5])]);
+        assert!((tilted - Vec3::X).length() < 1e-12, "{tilted}");
+        let half = Bump { height: 0.5, ..map };
+        let mixed = bumped_normal(&half, Vec2::ZERO, Vec3::Z, Vec3::X, Vec3::Y, &[img([0.5, 1.0, 1.0])]);
+        assert!((mixed - Vec3::new(0.0, 0.5, 1.0).normalize()).length() < 1e-12, "{mixed}");
         // Zero height leaves the normal alone.
         let flat = Bump { height: 0.0, pattern: BumpPattern::Waves { size } };
         assert_eq!(bumped_normal(&flat, Vec2::new(0.3, 0.3), Vec3::Z, Vec3::X, Vec3::Y, &[]), Vec3::Z);

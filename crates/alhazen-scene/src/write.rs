@@ -324,6 +324,7 @@ impl Writer<'_> {
             let pattern = match &b.pattern {
                 BumpPattern::Waves { size } => format!("waves = {}", num(*size)),
                 BumpPattern::Image { image, scale } => format!("image = {}", self.image(*image, *scale)),
+                BumpPattern::NormalMap { image, scale } => format!("normal_map = {}", self.image(*image, *scale)),
             };
             self.line("bump", format!("{{ height = {}, {pattern} }}", num(b.height)));
         }
