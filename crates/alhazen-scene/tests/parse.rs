@@ -191,7 +191,7 @@ fn physically_based_mistakes_are_explained() {
     assert!(env.contains("s.toml:3:8") && env.contains("cannot load image"), "{env}");
     assert!(err("[render]\nintegrator = \"bdpt\"\n").contains("expected one of"));
     let bump = |b: &str| err(&format!("[materials.m]\nbump = {b}\n"));
-    assert!(bump("{ height = 0.1 }").contains("exactly one of `waves = size` or `image"));
+    assert!(bump("{ height = 0.1 }").contains("exactly one of `waves = size`, `image = { file = … }` or `normal_map"));
     assert!(bump("{ waves = 0.5 }").contains("missing the required key `height`"));
     assert!(bump("{ height = 0.1, waves = -1 }").contains("waves"));
 }
