@@ -30,6 +30,7 @@
 pub mod bsdf;
 pub mod bvh;
 pub mod camera;
+pub mod connect;
 pub mod distribution;
 pub mod envmap;
 pub mod film;
