@@ -168,33 +168,27 @@ impl MirrorShape {
             Source::At(y) => Site::At(y),
             Source::Toward(d) => Site::Toward(d),
         };
-        let curved = |reflexes: Result<alhazen_mirror::Reflexes, _>, found: &mut dyn FnMut(MirrorPath)| {
-            let Ok(r) = reflexes else { return };
-            for reflex in r.all().filter(|r| r.kind != ReflexKind::Virtual) {
-                if self.contains(reflex.point) {
-                    if let Some(path) = self.path(x, reflex.point, reflex.normal, source) {
-                        found(path);
-                    }
-                }
+        let mut visit = |m: Vec3, n: Vec3| {
+            if let Some(path) = self.contains(m).then(|| self.path(x, m, n, source)).flatten() {
+                found(path);
             }
         };
-        match *self {
+        let reflexes = match *self {
             MirrorShape::Sphere { center, radius } => {
-                curved(alhazen_mirror::Sphere { center, radius }.reflexes(Site::At(x), site), &mut found)
+                alhazen_mirror::Sphere { center, radius }.reflexes(Site::At(x), site)
             }
             MirrorShape::Cylinder { base, axis, radius, .. } => {
-                let cylinder = alhazen_mirror::Cylinder { center: base, axis, radius };
-                curved(cylinder.reflexes(Site::At(x), site), &mut found)
+                alhazen_mirror::Cylinder { center: base, axis, radius }.reflexes(Site::At(x), site)
             }
             MirrorShape::Disk { center, normal, .. } | MirrorShape::Plane { point: center, normal } => {
                 if let Some(m) = plane_reflex(center, normal, x, source) {
-                    if self.contains(m) {
-                        if let Some(path) = self.path(x, m, normal, source) {
-                            found(path);
-                        }
-                    }
+                    visit(m, normal);
                 }
+                return;
             }
+        };
+        for reflex in reflexes.iter().flat_map(|r| r.all()).filter(|r| r.kind != ReflexKind::Virtual) {
+            visit(reflex.point, reflex.normal);
         }
     }
 
