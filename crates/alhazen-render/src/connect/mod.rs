@@ -213,7 +213,7 @@ impl MirrorShape {
             Source::Toward(d) => (d, f64::INFINITY),
         };
         let (side_x, side_s) = (to_x.dot(n), to_source.dot(n));
-        if side_x * side_s <= 0.0 || side_x.is_nan() {
+        if (side_x * side_s).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         let dist_to_mirror = to_x.length();
@@ -260,14 +260,14 @@ fn plane_reflex(p: Vec3, n: Vec3, x: Vec3, source: Source) -> Option<Vec3> {
     let (image, dir) = match source {
         Source::At(y) => {
             let hy = (y - p).dot(n);
-            if hx * hy <= 0.0 || hy.is_nan() {
+            if (hx * hy).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return None;
             }
             let image = y - n * (2.0 * hy);
             (Some(image), image - x)
         }
         Source::Toward(d) => {
-            if hx * d.dot(n) <= 0.0 || hx.is_nan() {
+            if (hx * d.dot(n)).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                 return None;
             }
             (None, d - n * (2.0 * d.dot(n)))
