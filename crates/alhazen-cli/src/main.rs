@@ -109,6 +109,10 @@ struct RenderArgs {
     /// The path tracer's sampler (overrides the scene).
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
+    /// Do not join lights to surfaces through sphere, cylinder and plane mirrors exactly (for
+    /// comparison: caustics are then left to sampled paths, and lost under Whitted).
+    #[arg(long)]
+    no_mirror_connections: bool,
     /// The vector kernels to use (default: the widest this processor has). Every kernel renders
     /// the same image; this is for measuring their speed.
     #[arg(long, value_enum)]
@@ -188,6 +192,9 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
             IntegratorArg::Whitted => alhazen_scene::IntegratorKind::Whitted,
             IntegratorArg::Path => alhazen_scene::IntegratorKind::Path,
         };
+    }
+    if a.no_mirror_connections {
+        r.mirror_connections = false;
     }
     if let Some(s) = a.sampler {
         r.sampler = match s {

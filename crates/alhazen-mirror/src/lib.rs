@@ -132,6 +132,17 @@ pub struct Reflexes {
     pub circle: Option<ReflexCircle>,
 }
 
+impl From<Option<Reflex>> for Reflexes {
+    /// The set holding at most this one reflex (e.g. what a `visible_reflex` found).
+    fn from(r: Option<Reflex>) -> Self {
+        let mut out = Reflexes::default();
+        if let Some(r) = r {
+            out.push(r);
+        }
+        out
+    }
+}
+
 impl Reflexes {
     fn push(&mut self, r: Reflex) {
         if self.len < 4 {

@@ -125,14 +125,7 @@ pub struct Lights {
 /// The world-space geometry of an emitting object, when it can be sampled.
 fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
     let t = &o.transform;
-    // Uniform scale factor of a similarity transform (None for shears and unequal scales).
-    let similarity = || {
-        let (a, b, c) = (t.vector(Vec3::X), t.vector(Vec3::Y), t.vector(Vec3::Z));
-        let s = a.length();
-        let same = |v: Vec3| (v.length() - s).abs() < 1e-9 * s;
-        let orthogonal = a.dot(b).abs() + b.dot(c).abs() + a.dot(c).abs() < 1e-9 * s * s;
-        (same(b) && same(c) && orthogonal).then_some(s)
-    };
+    let similarity = || crate::connect::similarity_scale(t);
     let mirroring = t.is_mirroring();
     let triangles = |tris: Vec<[Vec3; 3]>| {
         let areas: Vec<f64> = tris.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
@@ -297,6 +290,48 @@ impl Lights {
         pdf * self.choice_pdf()
     }
 
+    /// Every light, in the order of their indices.
+    pub fn all(&self) -> &[PathLight] {
+        &self.lights
+    }
+
+    /// The light index of scene object `object`, when it is a sampled area light.
+    pub fn of_object(&self, object: u32) -> Option<usize> {
+        self.by_object.get(object as usize).copied().flatten().map(|i| i as usize)
+    }
+
+    /// The scene object of each light (area lights only).
+    pub fn objects(&self) -> Vec<Option<u32>> {
+        let mut of_light = vec![None; self.lights.len()];
+        for (object, light) in self.by_object.iter().enumerate() {
+            if let Some(i) = light {
+                of_light[*i as usize] = Some(object as u32);
+            }
+        }
+        of_light
+    }
+
+    /// A point of area light `light` chosen uniformly by area (not including the light choice):
+    /// the point, its emitting normal and the area density; `None` for other lights.
+    pub fn point_by_area(&self, light: usize, u: Vec2) -> Option<(Vec3, Vec3, f64)> {
+        match &self.lights[light] {
+            PathLight::Area { emitter, .. } => Some(point_by_area(emitter, u)),
+            _ => None,
+        }
+    }
+
+    /// The area density of [`Self::point_by_area`] for area light `light`.
+    pub fn area_density(&self, light: usize) -> f64 {
+        match &self.lights[light] {
+            PathLight::Area { emitter, .. } => match emitter {
+                Emitter::Sphere { radius, .. } => 1.0 / (4.0 * PI * radius * radius),
+                Emitter::Triangles { area, .. } | Emitter::Parallelogram { area, .. } => 1.0 / area,
+                Emitter::Disk { radius, .. } => 1.0 / (PI * radius * radius),
+            },
+            _ => 0.0,
+        }
+    }
+
     /// Chooses a light by `u_choice` and a point on it by `u`, as seen from `p`.
     #[inline]
     pub fn sample(&self, p: Vec3, u_choice: f64, u: Vec2) -> Option<LightSample> {
@@ -356,23 +391,11 @@ fn cone(p: Vec3, center: Vec3, radius: f64) -> Option<(Vec3, f64)> {
     Some((to / d2.sqrt(), sin2 / (1.0 + cos)))
 }
 
-/// A point on an area light: the direction, distance, radiance (0 from its back) and density.
-fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<LightSample> {
-    let (q, n, pdf_area) = match emitter {
+/// A point on an emitter chosen uniformly by area: the point, its unit normal (the emitting
+/// side) and the area density.
+fn point_by_area(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f64) {
+    match emitter {
         Emitter::Sphere { center, radius } => {
-            if let Some((axis, one_minus_cos)) = cone(p, *center, *radius) {
-                // Uniform in the cone, then the near intersection with the sphere.
-                let cos = 1.0 - u.x * one_minus_cos;
-                let sin = (1.0 - cos * cos).max(0.0).sqrt();
-                let phi = 2.0 * PI * u.y;
-                let (s, t) = orthonormal_basis(axis);
-                let dir = (s * phi.cos() + t * phi.sin()) * sin + axis * cos;
-                let d = (*center - p).length();
-                let disc = (radius * radius - d * d * sin * sin).max(0.0);
-                let dist = d * cos - disc.sqrt();
-                let pdf = 1.0 / (2.0 * PI * one_minus_cos);
-                return Some(LightSample { dir, dist, radiance, pdf, delta: false });
-            }
             let n = uniform_sphere(u);
             (*center + n * *radius, n, 1.0 / (4.0 * PI * radius * radius))
         }
@@ -393,7 +416,27 @@ fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<Li
             let (r, phi) = (radius * u.x.sqrt(), 2.0 * PI * u.y);
             (*center + (s * phi.cos() + t * phi.sin()) * r, *normal, 1.0 / (PI * radius * radius))
         }
-    };
+    }
+}
+
+/// A point on an area light: the direction, distance, radiance (0 from its back) and density.
+fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<LightSample> {
+    if let Emitter::Sphere { center, radius } = emitter
+        && let Some((axis, one_minus_cos)) = cone(p, *center, *radius)
+    {
+        // Uniform in the cone, then the near intersection with the sphere.
+        let cos = 1.0 - u.x * one_minus_cos;
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y;
+        let (s, t) = orthonormal_basis(axis);
+        let dir = (s * phi.cos() + t * phi.sin()) * sin + axis * cos;
+        let d = (*center - p).length();
+        let disc = (radius * radius - d * d * sin * sin).max(0.0);
+        let dist = d * cos - disc.sqrt();
+        let pdf = 1.0 / (2.0 * PI * one_minus_cos);
+        return Some(LightSample { dir, dist, radiance, pdf, delta: false });
+    }
+    let (q, n, pdf_area) = point_by_area(emitter, u);
     let to = q - p;
     let d2 = to.length_squared();
     let dist = d2.sqrt();

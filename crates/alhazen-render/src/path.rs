@@ -26,6 +26,7 @@ use alhazen_scene::{SamplerKind, Scene};
 use std::borrow::Cow;
 
 mod lanes;
+mod mirrors;
 
 /// Depth from which Russian roulette may end paths (Mitsuba's `rr_depth`).
 const RR_DEPTH: u32 = 5;
@@ -44,6 +45,8 @@ pub struct PathTracer<'a> {
     in_lanes: bool,
     /// The lights, when every one is a parallelogram, for the lanes to sample.
     lane_lights: Option<Vec<lanes::LaneLight>>,
+    /// Specular connections through the scene's sphere, cylinder and plane mirrors, if any.
+    mirrors: Option<mirrors::MirrorConnections>,
 }
 
 /// Power heuristic with β = 2.
@@ -71,6 +74,17 @@ struct Previous {
     p: Vec3,
     pdf: f64,
     delta: bool,
+    /// The scene object the vertex lies on (`u32::MAX` for the camera).
+    object: u32,
+    /// Set when the path reached a mirror from a non-specular vertex and reflected on it.
+    visit: Option<mirrors::MirrorVisit>,
+}
+
+impl Previous {
+    /// The camera's vertex.
+    fn camera(origin: Vec3) -> Self {
+        Self { p: origin, pdf: 1.0, delta: true, object: u32::MAX, visit: None }
+    }
 }
 
 impl<'a> PathTracer<'a> {
@@ -81,7 +95,7 @@ impl<'a> PathTracer<'a> {
             SamplerKind::Sobol => Sequence::Sobol,
             SamplerKind::Independent => Sequence::Independent,
         };
-        let uniform_bsdfs = scene
+        let uniform_bsdfs: Vec<Option<Bsdf>> = scene
             .materials
             .iter()
             .map(|m| {
@@ -92,8 +106,23 @@ impl<'a> PathTracer<'a> {
             .collect();
         let lights = Lights::build(scene);
         let lane_lights = lanes::lane_lights(&lights);
-        let mut tracer =
-            Self { scene, world, camera, lights, spectral, sequence, uniform_bsdfs, in_lanes: false, lane_lights };
+        let mirrors = scene
+            .render
+            .mirror_connections
+            .then(|| mirrors::MirrorConnections::build(scene, &lights, &uniform_bsdfs))
+            .flatten();
+        let mut tracer = Self {
+            scene,
+            world,
+            camera,
+            lights,
+            spectral,
+            sequence,
+            uniform_bsdfs,
+            in_lanes: false,
+            lane_lights,
+            mirrors,
+        };
         tracer.in_lanes = tracer.lanes_apply();
         tracer
     }
@@ -103,7 +132,7 @@ impl<'a> PathTracer<'a> {
         let max_depth = self.scene.render.max_depth;
         let (mut l, mut beta, mut eta_scale) = (Vec3::ZERO, Vec3::ONE, 1.0);
         let mut hero_only = false;
-        let mut prev = Previous { p: ray.origin, pdf: 1.0, delta: true };
+        let mut prev = Previous::camera(ray.origin);
         for depth in 1..=max_depth {
             let Some(wh) = self.world.intersect(&ray, f64::INFINITY) else {
                 if let Some(sky) = self.escaped(&ray, &prev, beta, mode) {
@@ -133,6 +162,9 @@ impl<'a> PathTracer<'a> {
             let choices = if self.lights.len() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
             if !bsdf.is_delta() {
                 l += beta * self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, choices.x, s);
+                if let Some(c) = self.mirrors.as_ref().filter(|_| depth + 2 <= max_depth) {
+                    l += beta * self.mirror_connections(c, &bsdf, &frame, wh.hit.p, ng, v, wh.object, mode, s);
+                }
             }
             let Some(bs) = bsdf.sample(v, choices.y, s.next_2d()) else { break };
             let dir = frame.to_world(bs.l);
@@ -149,7 +181,11 @@ impl<'a> PathTracer<'a> {
                 }
                 beta /= q;
             }
-            prev = Previous { p: wh.hit.p, pdf: bs.pdf, delta: bs.delta };
+            let visit = match &self.mirrors {
+                Some(c) if bs.delta && !prev.delta => c.visit(prev.p, prev.object, prev.pdf, &HitPoint::from(wh)),
+                _ => None,
+            };
+            prev = Previous { p: wh.hit.p, pdf: bs.pdf, delta: bs.delta, object: wh.object, visit };
             ray = Ray::new(offset(wh.hit.p, ng, dir), dir);
         }
         l
@@ -174,8 +210,11 @@ impl<'a> PathTracer<'a> {
         if le == Vec3::ZERO || h.n.dot(ray.dir) >= 0.0 {
             return Vec3::ZERO;
         }
-        let w =
-            if prev.delta { 1.0 } else { power_heuristic(prev.pdf, self.lights.area_pdf(h.object, prev.p, h.p, h.n)) };
+        let w = match (&prev.visit, &self.mirrors) {
+            (Some(visit), Some(c)) => self.mirror_visit_weight(c, visit, h),
+            _ if prev.delta => 1.0,
+            _ => power_heuristic(prev.pdf, self.lights.area_pdf(h.object, prev.p, h.p, h.n)),
+        };
         mode.color(le) * w
     }
 

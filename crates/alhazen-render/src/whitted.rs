@@ -6,13 +6,14 @@
 //! decays by Beer's law `exp(−σ d)`.
 
 use crate::camera::Camera;
+use crate::connect::{MirrorPath, MirrorShape, Source};
 use crate::film::PixelEstimator;
 use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use crate::sampler::stratified_offset;
 use crate::texture;
 use crate::world::{ShadowHit, World, WorldHit};
 use alhazen_math::{Ray, Vec3};
-use alhazen_scene::{FresnelMode, Material, Scene};
+use alhazen_scene::{FresnelMode, Light, Material, Scene};
 
 /// Rays whose contribution to the pixel would fall below this are not traced (like POV-Ray's
 /// `adc_bailout` of 1/255, but finer).
@@ -25,6 +26,15 @@ pub struct Whitted<'a> {
     scene: &'a Scene,
     world: &'a World,
     max_depth: u32,
+    /// Sphere, cylinder and plane mirrors that lights shine through onto other surfaces.
+    mirrors: Vec<Mirror>,
+}
+
+/// A mirror surface of the scene for specular connections ([`crate::connect`]).
+struct Mirror {
+    object: u32,
+    shape: MirrorShape,
+    reflectance: Vec3,
 }
 
 /// A self-intersection guard scaled to the magnitude of the coordinates.
@@ -39,6 +49,26 @@ fn fresnel(m: &Material, cos: f64, eta: f64) -> f64 {
         FresnelMode::Exact => fresnel_dielectric(cos, eta),
         FresnelMode::Schlick => fresnel_schlick(cos, eta),
         FresnelMode::Off => 0.0,
+    }
+}
+
+/// The intensity arriving along a mirror path: `I·G` (`I^dir·G` for a directional light),
+/// with a spot's cone and fall-off seen along the leaving direction and the attenuation
+/// `[a, b, c]` at the unfolded length `d` applied as `d²/(a d² + b d + c)`; `None` outside a
+/// spot's cone.
+fn intensity_through(light: &Light, path: &MirrorPath) -> Option<Vec3> {
+    let unfolded = |attenuation: &[f64; 3]| {
+        let d = path.dist_to_mirror + path.dist_to_source;
+        d * d / (attenuation[0] * d * d + attenuation[1] * d + attenuation[2])
+    };
+    match light {
+        Light::Point { intensity, attenuation, .. } => Some(*intensity * (path.geometry * unfolded(attenuation))),
+        Light::Spot { direction, cos_cutoff, falloff, intensity, attenuation, .. } => {
+            let cos = -path.to_source.dot(*direction);
+            (cos >= *cos_cutoff).then(|| *intensity * (cos.powf(*falloff) * path.geometry * unfolded(attenuation)))
+        }
+        Light::Directional { intensity, .. } => Some(*intensity * path.geometry),
+        Light::Environment { .. } => None,
     }
 }
 
@@ -69,7 +99,22 @@ impl PixelEstimator for WhittedEstimator<'_> {
 impl<'a> Whitted<'a> {
     /// The integrator for `scene` over `world`.
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
-        Self { scene, world, max_depth: scene.render.max_depth.max(1) }
+        let mirrors = scene
+            .objects
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| scene.render.mirror_connections && o.mesh_materials.is_empty())
+            .flat_map(|(i, o)| {
+                let m = &scene.materials[o.material as usize];
+                let shapes = if m.mirror != Vec3::ZERO && m.bump.is_none() {
+                    MirrorShape::pieces(&o.shape, &o.transform)
+                } else {
+                    Vec::new()
+                };
+                shapes.into_iter().map(move |shape| Mirror { object: i as u32, shape, reflectance: m.mirror })
+            })
+            .collect();
+        Self { scene, world, max_depth: scene.render.max_depth.max(1), mirrors }
     }
 
     /// `RT_trace`: radiance along `ray` (unit direction); `depth` starts at 1 for camera rays,
@@ -98,6 +143,9 @@ impl<'a> Whitted<'a> {
         }
         let a = texture::eval(&m.color, h.uv, &self.scene.images) * m.diffuse;
         let mut color = a * self.scene.ambient + self.direct(m, a, h.p, n, ng, v);
+        if !self.mirrors.is_empty() {
+            color += self.through_mirrors(m, a, h.p, n, ng, v, wh.object);
+        }
         if front {
             color += m.emission; // emitters look lit (they light others only under the path tracer)
         }
@@ -132,6 +180,54 @@ impl<'a> Whitted<'a> {
             sum += through * i_dir * local;
         }
         sum
+    }
+
+    /// The course's local model for light that reaches `p` after one reflection on a sphere,
+    /// cylinder or plane mirror (every exact solution of Alhazen's problem, [`crate::connect`]):
+    /// the light's intensity focused by the generalised geometry term (its attenuation taken at
+    /// the unfolded length), times the mirror's reflectance and both legs' transmittance.
+    fn through_mirrors(&self, m: &Material, a: Vec3, p: Vec3, n: Vec3, ng: Vec3, v: Vec3, object: u32) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        for light in &self.scene.lights {
+            let source = match *light {
+                Light::Point { position, .. } | Light::Spot { position, .. } => Source::At(position),
+                Light::Directional { direction, .. } => Source::Toward(-direction),
+                Light::Environment { .. } => continue,
+            };
+            let facing = |mirror: &&Mirror| mirror.object != object && mirror.shape.in_front_of(p, ng);
+            for mirror in self.mirrors.iter().filter(facing) {
+                mirror.shape.reflections(p, source, |path| {
+                    let l = path.to_mirror;
+                    let cos = n.dot(l);
+                    if cos <= 0.0 || ng.dot(l) <= 0.0 {
+                        return;
+                    }
+                    let Some(i) = intensity_through(light, &path) else { return };
+                    let through = self.legs_transmittance(p, ng, &path);
+                    if through == Vec3::ZERO {
+                        return;
+                    }
+                    let mut local = a * cos;
+                    if m.specular != Vec3::ZERO {
+                        local += m.specular * m.highlight(n, l, v);
+                    }
+                    sum += through * mirror.reflectance * i * local;
+                });
+            }
+        }
+        sum
+    }
+
+    /// What passes both legs of a mirror path: `p → m` short of the mirror, `m → light`.
+    fn legs_transmittance(&self, p: Vec3, ng: Vec3, path: &MirrorPath) -> Vec3 {
+        let m = path.point;
+        let to_mirror = path.dist_to_mirror * (1.0 - 1e-7) - 4.0 * epsilon(m);
+        let first = self.transmittance(p + ng * epsilon(p), path.to_mirror, to_mirror);
+        if first == Vec3::ZERO {
+            return first;
+        }
+        let to_light = path.dist_to_source * (1.0 - 1e-7) - 4.0 * epsilon(m);
+        first * self.transmittance(m + path.normal * epsilon(m), path.to_source, to_light)
     }
 
     /// How much light passes from `origin` along `l` over `dist`: 0 at an opaque surface; at a

@@ -70,6 +70,9 @@ pub struct RenderSettings {
     pub integrator: IntegratorKind,
     /// The path tracer's sampler.
     pub sampler: SamplerKind,
+    /// Join lights to non-specular points through sphere, cylinder and plane mirrors exactly
+    /// (specular connections, both ray tracers).
+    pub mirror_connections: bool,
 }
 
 impl Default for RenderSettings {
@@ -82,6 +85,7 @@ impl Default for RenderSettings {
             seed: 0,
             integrator: IntegratorKind::Whitted,
             sampler: SamplerKind::Sobol,
+            mirror_connections: true,
         }
     }
 }

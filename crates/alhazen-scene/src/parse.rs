@@ -653,7 +653,7 @@ impl<'a, 'i> Node<'a, 'i> {
 }
 
 fn render_settings(n: &Node) -> R<RenderSettings> {
-    let t = n.table(&["width", "height", "spp", "max_depth", "seed", "integrator", "sampler"])?;
+    let t = n.table(&["width", "height", "spp", "max_depth", "seed", "integrator", "sampler", "mirror_connections"])?;
     let d = RenderSettings::default();
     let r = RenderSettings {
         width: t.get("width").map_or(Ok(d.width as u64), |n| n.integer(1, MAX_SIDE))? as u32,
@@ -675,6 +675,7 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
             },
             None => d.sampler,
         },
+        mirror_connections: t.opt_bool("mirror_connections", d.mirror_connections)?,
     };
     if r.width as u64 * r.height as u64 > MAX_PIXELS {
         return Err(t

@@ -177,6 +177,9 @@ impl Writer<'_> {
             SamplerKind::Independent => "independent",
         };
         self.line("sampler", string(sampler));
+        if !r.mirror_connections {
+            self.line("mirror_connections", "false".to_string());
+        }
     }
 
     fn look(&mut self, l: &LookAt) {

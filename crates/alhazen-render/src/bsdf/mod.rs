@@ -117,6 +117,16 @@ impl Bsdf {
         }
     }
 
+    /// The weight of the mirror lobe (a smooth metal's delta reflection) at incidence cosine
+    /// `cos`: what a specular connection through this surface carries; zero without one.
+    pub fn mirror_reflectance(&self, cos: f64) -> Vec3 {
+        match self {
+            Bsdf::Conductor(c) if c.facets.is_none() => c.fresnel(cos),
+            Bsdf::Mix(m) => m.a.mirror_reflectance(cos) * m.weight + m.b.mirror_reflectance(cos) * (1.0 - m.weight),
+            _ => Vec3::ZERO,
+        }
+    }
+
     /// True when light passes through (the surface has an inside).
     pub fn transmits(&self) -> bool {
         match self {

@@ -15,7 +15,7 @@
 //! area at `x`, so `E⊥(x) = I·F·G` for a point light of intensity `I`.
 
 use alhazen_math::{Transform, Vec3, orthonormal_basis};
-use alhazen_mirror::{ReflexKind, Site};
+use alhazen_mirror::{ReflexKind, Reflexes, Site};
 
 /// A mirror's surface in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,6 +37,8 @@ pub enum MirrorShape {
         height: f64,
         /// Radius.
         radius: f64,
+        /// Closed by caps: nothing outside reaches the inside of its wall.
+        closed: bool,
     },
     /// A flat disk (disk objects, cylinder caps).
     Disk {
@@ -109,7 +111,8 @@ impl MirrorShape {
                 let (b, e) = (t.point(*base), t.point(*top));
                 let Some(axis) = (e - b).try_normalize() else { return Vec::new() };
                 let radius = radius * s;
-                let mut v = vec![MirrorShape::Cylinder { base: b, axis, height: (e - b).length(), radius }];
+                let height = (e - b).length();
+                let mut v = vec![MirrorShape::Cylinder { base: b, axis, height, radius, closed: *capped }];
                 if *capped {
                     v.push(MirrorShape::Disk { center: b, normal: -axis, radius });
                     v.push(MirrorShape::Disk { center: e, normal: axis, radius });
@@ -130,7 +133,7 @@ impl MirrorShape {
     pub fn distance(&self, p: Vec3) -> f64 {
         match *self {
             MirrorShape::Sphere { center, radius } => ((p - center).length() - radius).abs(),
-            MirrorShape::Cylinder { base, axis, height, radius } => {
+            MirrorShape::Cylinder { base, axis, height, radius, .. } => {
                 let h = (p - base).dot(axis);
                 let radial = (p - base - axis * h).length();
                 (radial - radius).abs() + (-h).max(h - height).max(0.0)
@@ -140,6 +143,35 @@ impl MirrorShape {
                 h.abs() + ((p - center - normal * h).length() - radius).max(0.0)
             }
             MirrorShape::Plane { point, normal } => (p - point).dot(normal).abs(),
+        }
+    }
+
+    /// False when the whole mirror lies behind the plane through `x` with normal `n` (no light
+    /// can come from it to a surface that only reflects).
+    pub fn in_front_of(&self, x: Vec3, n: Vec3) -> bool {
+        let (center, reach) = match *self {
+            MirrorShape::Sphere { center, radius } => (center, radius),
+            MirrorShape::Cylinder { base, axis, height, radius, .. } => {
+                (base + axis * (0.5 * height), (radius * radius + 0.25 * height * height).sqrt())
+            }
+            MirrorShape::Disk { center, radius, .. } => (center, radius),
+            MirrorShape::Plane { .. } => return true,
+        };
+        (center - x).dot(n) > -reach
+    }
+
+    /// True when reflections on the inside cannot reach `x` from a point light: `x` outside a
+    /// sphere, or outside a closed cylinder (the light would have to pass the wall). Then only
+    /// the visible reflex is sought (the bracketed search, no quartic).
+    fn outside_only(&self, x: Vec3) -> bool {
+        match *self {
+            MirrorShape::Sphere { center, radius } => (x - center).length_squared() > radius * radius,
+            MirrorShape::Cylinder { base, axis, height, radius, closed } => {
+                let h = (x - base).dot(axis);
+                let radial = (x - base - axis * h).length_squared();
+                closed && (radial > radius * radius || h < 0.0 || h > height)
+            }
+            _ => false,
         }
     }
 
@@ -173,9 +205,18 @@ impl MirrorShape {
                 found(path);
             }
         };
+        let visible_only = self.outside_only(x);
         let reflexes = match *self {
+            MirrorShape::Sphere { center, radius } if visible_only => {
+                let sphere = alhazen_mirror::Sphere { center, radius };
+                sphere.visible_reflex(Site::At(x), site).map(Reflexes::from)
+            }
             MirrorShape::Sphere { center, radius } => {
                 alhazen_mirror::Sphere { center, radius }.reflexes(Site::At(x), site)
+            }
+            MirrorShape::Cylinder { base, axis, radius, .. } if visible_only => {
+                let cylinder = alhazen_mirror::Cylinder { center: base, axis, radius };
+                cylinder.visible_reflex(Site::At(x), site).map(Reflexes::from)
             }
             MirrorShape::Cylinder { base, axis, radius, .. } => {
                 alhazen_mirror::Cylinder { center: base, axis, radius }.reflexes(Site::At(x), site)

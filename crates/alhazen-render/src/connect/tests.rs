@@ -57,7 +57,7 @@ fn finite_cylinder_keeps_only_reflexes_on_its_length() {
     // A point on the floor of a cup under the sun: light reflected by the inner wall arrives
     // from heights `horizontal distance × tan(elevation)`, so a deep cup has them all and a
     // shallow one none.
-    let cup = |height| MirrorShape::Cylinder { base: Vec3::ZERO, axis: Vec3::Z, height, radius: 1.0 };
+    let cup = |height| MirrorShape::Cylinder { base: Vec3::ZERO, axis: Vec3::Z, height, radius: 1.0, closed: false };
     let x = Vec3::new(0.2, 0.1, 0.0);
     let sun = Source::Toward(Vec3::new(0.6, 0.0, 0.8));
     let paths = all_paths(&cup(3.0), x, sun);
@@ -91,11 +91,11 @@ fn compare_with_solver(mirror: &MirrorShape, x: Vec3, source: Source) -> Result<
 #[test]
 fn geometry_term_matches_the_solver_on_named_configurations() {
     let ball = MirrorShape::Sphere { center: Vec3::ZERO, radius: 1.0 };
-    let cup = MirrorShape::Cylinder { base: Vec3::ZERO, axis: Vec3::Z, height: 3.0, radius: 1.0 };
+    let cup = MirrorShape::Cylinder { base: Vec3::ZERO, axis: Vec3::Z, height: 3.0, radius: 1.0, closed: false };
     let cases = [
         // Outside of a ball: a point light and the sun.
-        (ball, Vec3::new(0.3, -0.2, -3.0), Source::At(Vec3::new(2.0, 1.0, 1.5))),
-        (ball, Vec3::new(0.3, -0.2, -3.0), Source::Toward(Vec3::new(0.4, 0.3, 0.8).normalize())),
+        (ball, Vec3::new(0.3, -0.2, -3.0), Source::At(Vec3::new(2.0, 1.0, -1.5))),
+        (ball, Vec3::new(0.3, -0.2, -3.0), Source::Toward(Vec3::new(0.4, 0.3, -0.8).normalize())),
         // Inside a ball (a concave mirror).
         (ball, Vec3::new(0.2, 0.1, -0.3), Source::At(Vec3::new(-0.4, 0.3, 0.2))),
         // Inside a cup under a point light and the sun.
@@ -111,11 +111,12 @@ fn geometry_term_matches_the_solver_on_named_configurations() {
 fn mirrors() -> impl Strategy<Value = MirrorShape> {
     prop_oneof![
         (0.3f64..2.0).prop_map(|radius| MirrorShape::Sphere { center: Vec3::ZERO, radius }),
-        (0.3f64..2.0, -0.5f64..0.5).prop_map(|(radius, tilt)| MirrorShape::Cylinder {
+        (0.3f64..2.0, -0.5f64..0.5, any::<bool>()).prop_map(|(radius, tilt, closed)| MirrorShape::Cylinder {
             base: Vec3::new(0.0, 0.0, -50.0),
             axis: Vec3::new(tilt, 0.2, 1.0).normalize(),
             height: 100.0,
             radius,
+            closed,
         }),
     ]
 }
@@ -157,6 +158,24 @@ proptest! {
             let back = mirror.geometry(-path.to_source, path.dist_to_source, path.point, path.dist_to_mirror);
             let rel = (back - path.geometry).abs() / path.geometry;
             prop_assert!(rel < 1e-7 || !(1e-6..1e6).contains(&path.geometry), "{back} vs {}", path.geometry);
+        }
+    }
+
+    /// Where only the visible reflex is sought (outside a closed mirror), it is the full
+    /// solution's reflection on the outside, and the full solution has no other reachable one.
+    #[test]
+    fn the_visible_reflex_is_all_that_reaches_outside_a_closed_mirror(
+        radius in 0.3f64..2.0, x in point(), y in point()
+    ) {
+        let ball = MirrorShape::Sphere { center: Vec3::ZERO, radius };
+        prop_assume!(well_placed(&ball, x) && well_placed(&ball, y) && x.length() > radius && y.length() > radius);
+        let fast = all_paths(&ball, x, Source::At(y));
+        let full = alhazen_mirror::Sphere { center: Vec3::ZERO, radius }.reflexes(Site::At(x), Site::At(y)).unwrap();
+        let outside: Vec<_> = full.of_kind(ReflexKind::Outside).collect();
+        prop_assert!(fast.len() <= 1 && outside.len() <= 1);
+        prop_assert_eq!(fast.len(), outside.len());
+        if let (Some(a), Some(b)) = (fast.first(), outside.first()) {
+            prop_assert!((a.point - b.point).length() < 1e-9);
         }
     }
 

@@ -216,7 +216,7 @@ impl PathTracer<'_> {
     /// `out[job]`.
     fn start_path(&self, film: Vec2, (x, y): (u32, u32), job: usize) -> Path {
         let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
-        let prev = Previous { p: ray.origin, pdf: 1.0, delta: true };
+        let prev = Previous::camera(ray.origin);
         Path { job, ray, depth: 1, l: Vec3::ZERO, beta: Vec3::ONE, prev }
     }
 
