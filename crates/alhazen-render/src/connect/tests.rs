@@ -150,6 +150,24 @@ proptest! {
         compare_with_solver(&mirror, x, source).map_err(TestCaseError::fail)?;
     }
 
+    /// On a sphere the term has the closed form of Coddington's equations: the tangential and
+    /// sagittal cross-sections `t₁ + t₂ + 2t₁t₂/(r cos θ)` and `t₁ + t₂ + 2t₁t₂ cos θ / r`
+    /// (`−r` on the concave inside), `G = 1/|product|`.
+    #[test]
+    fn sphere_geometry_term_is_coddingtons(radius in 0.3f64..2.0, x in point(), y in point()) {
+        let ball = MirrorShape::Sphere { center: Vec3::ZERO, radius };
+        prop_assume!(well_placed(&ball, x) && well_placed(&ball, y) && (x - y).length() > 0.1);
+        for path in all_paths(&ball, x, Source::At(y)) {
+            let convex = path.normal.dot(path.point) > 0.0;
+            let r = if convex { radius } else { -radius };
+            let cos = path.to_mirror.dot(path.normal).abs();
+            let (t1, t2) = (path.dist_to_mirror, path.dist_to_source);
+            let coddington = 1.0 / ((t1 + t2 + 2.0 * t1 * t2 / (r * cos)) * (t1 + t2 + 2.0 * t1 * t2 * cos / r)).abs();
+            let rel = (coddington - path.geometry).abs() / path.geometry;
+            prop_assert!(rel < 1e-8 || !(1e-6..1e6).contains(&path.geometry), "{coddington} vs {}", path.geometry);
+        }
+    }
+
     /// Reciprocity: the term is the same traced from the source's end.
     #[test]
     fn geometry_term_is_reciprocal(mirror in mirrors(), x in point(), y in point()) {
