@@ -1,6 +1,9 @@
 //! `alhazen-render`: the photoreal path of alhazen — a Whitted ray tracer (lecture
 //! "Viewing and recursive ray tracing"; course §"Lighting models") over an SAH BVH.
 //!
+//! Both integrators join lights to surfaces through sphere, cylinder and plane mirrors exactly
+//! ([`connect`]: every solution of Alhazen's problem by `alhazen-mirror`, Glaeser §1–2).
+//!
 //! Data flow: [`alhazen_scene::Scene`] → [`World`] (shapes placed, BVH built) and [`Camera`] →
 //! [`Whitted`] traces stratified samples per pixel in parallel tiles → [`Image`] (linear RGB) →
 //! [`output::write_image`] (PNG / EXR / PFM, atomically).

@@ -11,6 +11,10 @@
 //! side their normal points to. Scenes whose glass disperses (`cauchy`, `sellmeier`, `glass`)
 //! are rendered spectrally ([`crate::spectrum`]); all others in RGB.
 //!
+//! Where the scene has sphere, cylinder or plane mirrors, each non-specular vertex also joins the
+//! lights to itself through them exactly (`mirrors`, specular connections), MIS-weighted against
+//! BSDF paths that reach an area light after the mirror.
+//!
 //! Lambertian RGB scenes on processors with AVX2 or AVX-512 are traced eight samples at a time
 //! in vector lanes (`lanes`), with the same arithmetic, so the same samples.
 
