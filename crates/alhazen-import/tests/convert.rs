@@ -1,13 +1,12 @@
 //! `alhazen convert`'s round trip: every scene alhazen ships, and the imported twins, written as
 //! TOML (meshes as PLY, images as EXR) and read again, render the same bits.
 
+mod common;
+use common::repo;
+
 use alhazen_math::Vec3;
 use alhazen_scene::Scene;
 use std::path::{Path, PathBuf};
-
-fn repo(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
-}
 
 fn bits(mut s: Scene) -> Vec<u64> {
     (s.render.width, s.render.height, s.render.spp) = (24, 16, 2);

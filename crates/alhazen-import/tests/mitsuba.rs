@@ -1,24 +1,12 @@
 //! The Mitsuba 3 importer: the Cornell box written as Mitsuba XML is the scene of alhazen's own
 //! twin and agrees with Mitsuba's reference image; features and malformed files.
 
-use alhazen_import::Imported;
+mod common;
+use common::*;
+
 use alhazen_math::Vec3;
 use alhazen_scene::bsdf::BsdfDesc;
 use alhazen_scene::{Light, Scene, Shape, Texture};
-use std::path::{Path, PathBuf};
-
-fn repo(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
-}
-
-/// Writes `files` (name, text) to a fresh directory and imports the first.
-fn import(files: &[(&str, &str)]) -> Result<Imported, String> {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, text) in files {
-        std::fs::write(dir.path().join(name), text).unwrap();
-    }
-    alhazen_import::load(&dir.path().join(files[0].0)).map_err(|e| e.to_string())
-}
 
 fn scene(body: &str) -> String {
     format!("<scene version=\"3.0.0\">\n{body}\n</scene>\n")

@@ -1,24 +1,13 @@
 //! The pbrt-v4 importer: a Cornell box written from the file-format documentation renders the
 //! bits of its native twin; pbrt's left-handed camera; features and malformed files.
 
-use alhazen_import::Imported;
+mod common;
+use common::*;
+
 use alhazen_math::Vec3;
 use alhazen_render::Image;
 use alhazen_scene::bsdf::BsdfDesc;
 use alhazen_scene::{Light, Scene, Shape, Texture};
-use std::path::{Path, PathBuf};
-
-fn repo(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
-}
-
-fn import(files: &[(&str, &str)]) -> Result<Imported, String> {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, text) in files {
-        std::fs::write(dir.path().join(name), text).unwrap();
-    }
-    alhazen_import::load(&dir.path().join(files[0].0)).map_err(|e| e.to_string())
-}
 
 fn small(mut s: Scene, spp: u32) -> Image {
     (s.render.width, s.render.height, s.render.spp) = (64, 64, spp);
