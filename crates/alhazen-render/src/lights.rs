@@ -420,6 +420,7 @@ fn point_by_area(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f64) {
 }
 
 /// A point on an area light: the direction, distance, radiance (0 from its back) and density.
+#[inline(always)]
 fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<LightSample> {
     if let Emitter::Sphere { center, radius } = emitter
         && let Some((axis, one_minus_cos)) = cone(p, *center, *radius)

@@ -78,16 +78,12 @@ struct Previous {
     p: Vec3,
     pdf: f64,
     delta: bool,
-    /// The scene object the vertex lies on (`u32::MAX` for the camera).
-    object: u32,
-    /// Set when the path reached a mirror from a non-specular vertex and reflected on it.
-    visit: Option<mirrors::MirrorVisit>,
 }
 
 impl Previous {
     /// The camera's vertex.
     fn camera(origin: Vec3) -> Self {
-        Self { p: origin, pdf: 1.0, delta: true, object: u32::MAX, visit: None }
+        Self { p: origin, pdf: 1.0, delta: true }
     }
 }
 
@@ -137,6 +133,9 @@ impl<'a> PathTracer<'a> {
         let (mut l, mut beta, mut eta_scale) = (Vec3::ZERO, Vec3::ONE, 1.0);
         let mut hero_only = false;
         let mut prev = Previous::camera(ray.origin);
+        // Specular connections' bookkeeping: the object of the previous vertex, and the visit
+        // of a mirror reached from a non-specular vertex (for the next emission's MIS weight).
+        let (mut prev_object, mut visit) = (u32::MAX, None);
         for depth in 1..=max_depth {
             let Some(wh) = self.world.intersect(&ray, f64::INFINITY) else {
                 if let Some(sky) = self.escaped(&ray, &prev, beta, mode) {
@@ -144,7 +143,7 @@ impl<'a> PathTracer<'a> {
                 }
                 break;
             };
-            l += beta * self.emitted(&HitPoint::from(wh), &ray, &prev, mode);
+            l += beta * self.emitted(&HitPoint::from(wh), &ray, &prev, visit.as_ref(), mode);
             if depth == max_depth {
                 break;
             }
@@ -185,11 +184,12 @@ impl<'a> PathTracer<'a> {
                 }
                 beta /= q;
             }
-            let visit = match &self.mirrors {
-                Some(c) if bs.delta && !prev.delta => c.visit(prev.p, prev.object, prev.pdf, &HitPoint::from(wh)),
-                _ => None,
-            };
-            prev = Previous { p: wh.hit.p, pdf: bs.pdf, delta: bs.delta, object: wh.object, visit };
+            if let Some(c) = &self.mirrors {
+                let reflected = bs.delta && !prev.delta;
+                visit = reflected.then(|| c.visit(prev.p, prev_object, prev.pdf, &HitPoint::from(wh))).flatten();
+                prev_object = wh.object;
+            }
+            prev = Previous { p: wh.hit.p, pdf: bs.pdf, delta: bs.delta };
             ray = Ray::new(offset(wh.hit.p, ng, dir), dir);
         }
         l
@@ -208,13 +208,21 @@ impl<'a> PathTracer<'a> {
         Some(beta * mode.color(le) * w)
     }
 
-    /// Emission of the surface hit, weighted against light sampling.
-    fn emitted(&self, h: &HitPoint, ray: &Ray, prev: &Previous, mode: ColorMode) -> Vec3 {
+    /// Emission of the surface hit, weighted against light sampling (and against the specular
+    /// connection when the path came through a mirror, `visit`).
+    fn emitted(
+        &self,
+        h: &HitPoint,
+        ray: &Ray,
+        prev: &Previous,
+        visit: Option<&mirrors::MirrorVisit>,
+        mode: ColorMode,
+    ) -> Vec3 {
         let le = self.scene.materials[h.material as usize].emission;
         if le == Vec3::ZERO || h.n.dot(ray.dir) >= 0.0 {
             return Vec3::ZERO;
         }
-        let w = match (&prev.visit, &self.mirrors) {
+        let w = match (visit, &self.mirrors) {
             (Some(visit), Some(c)) => self.mirror_visit_weight(c, visit, h),
             _ if prev.delta => 1.0,
             _ => power_heuristic(prev.pdf, self.lights.area_pdf(h.object, prev.p, h.p, h.n)),

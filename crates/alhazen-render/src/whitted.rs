@@ -186,6 +186,8 @@ impl<'a> Whitted<'a> {
     /// cylinder or plane mirror (every exact solution of Alhazen's problem, [`crate::connect`]):
     /// the light's intensity focused by the generalised geometry term (its attenuation taken at
     /// the unfolded length), times the mirror's reflectance and both legs' transmittance.
+    /// Out of line: `shade` stays as small as it was for scenes without mirrors.
+    #[inline(never)]
     fn through_mirrors(&self, m: &Material, a: Vec3, p: Vec3, n: Vec3, ng: Vec3, v: Vec3, object: u32) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for light in &self.scene.lights {

@@ -233,7 +233,7 @@ impl PathTracer<'_> {
             }
             return false;
         };
-        path.l += path.beta * self.emitted(wh, &path.ray, &path.prev, ColorMode::Rgb);
+        path.l += path.beta * self.emitted(wh, &path.ray, &path.prev, None, ColorMode::Rgb);
         if path.depth == max_depth {
             return false;
         }

@@ -92,6 +92,7 @@ impl MirrorConnections {
 
     /// The visit to record when the path sampled a delta lobe at `hit` after sampling a
     /// non-delta one at the previous vertex `x`.
+    #[inline(never)]
     pub(super) fn visit(&self, x: Vec3, x_object: u32, pdf_x: f64, hit: &HitPoint) -> Option<MirrorVisit> {
         if hit.object == x_object {
             return None;
@@ -110,6 +111,7 @@ impl MirrorConnections {
 impl PathTracer<'_> {
     /// Light reaching `x` through one mirror reflection from every connected light: `Σ f·cos·F·L`
     /// with the generalised geometry term, MIS-weighted for area lights.
+    #[inline(never)]
     pub(super) fn mirror_connections(
         &self,
         c: &MirrorConnections,
@@ -227,6 +229,7 @@ impl PathTracer<'_> {
     /// The power-heuristic weight of emission at `hit`, reached through the mirror of `visit`
     /// by BSDF sampling, against the connection that finds the same path (1 when the
     /// connection would not).
+    #[inline(never)]
     pub(super) fn mirror_visit_weight(&self, c: &MirrorConnections, visit: &MirrorVisit, hit: &HitPoint) -> f64 {
         let piece = &c.pieces[visit.piece as usize];
         let Some(light) = self.lights.of_object(hit.object) else { return 1.0 };
