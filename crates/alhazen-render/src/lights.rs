@@ -392,7 +392,9 @@ fn cone(p: Vec3, center: Vec3, radius: f64) -> Option<(Vec3, f64)> {
 }
 
 /// A point on an emitter chosen uniformly by area: the point, its unit normal (the emitting
-/// side) and the area density.
+/// side) and the area density. Always inlined: the connections call it too, and sampling a
+/// light for next-event estimation must not pay a call for it.
+#[inline(always)]
 fn point_by_area(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f64) {
     match emitter {
         Emitter::Sphere { center, radius } => {
