@@ -160,17 +160,20 @@ impl MirrorShape {
         (center - x).dot(n) > -reach
     }
 
-    /// True when reflections on the inside cannot reach `x` from a point light: `x` outside a
-    /// sphere, or outside a closed cylinder (the light would have to pass the wall). Then only
-    /// the visible reflex is sought (the bracketed search, no quartic).
-    fn outside_only(&self, x: Vec3) -> bool {
-        match *self {
-            MirrorShape::Sphere { center, radius } => (x - center).length_squared() > radius * radius,
-            MirrorShape::Cylinder { base, axis, height, radius, closed } => {
-                let h = (x - base).dot(axis);
-                let radial = (x - base - axis * h).length_squared();
-                closed && (radial > radius * radius || h < 0.0 || h > height)
+    /// True when no reflection on the inside can join `p` to the mirror: `p` outside a sphere
+    /// or a closed cylinder, or beside an open one (radially outside, between its ends: a
+    /// straight leg to the inner wall would have to pass over an end, but both of its ends lie
+    /// between them). A point at infinity is beside an open cylinder unless it lies along the axis.
+    fn outside_only(&self, p: Site) -> bool {
+        match (*self, p) {
+            (MirrorShape::Sphere { center, radius }, Site::At(p)) => (p - center).length_squared() > radius * radius,
+            (MirrorShape::Cylinder { base, axis, height, radius, closed }, Site::At(p)) => {
+                let h = (p - base).dot(axis);
+                let outside = (p - base - axis * h).length_squared() > radius * radius;
+                outside && (closed || (0.0..=height).contains(&h)) || closed && !(0.0..=height).contains(&h)
             }
+            (MirrorShape::Sphere { .. }, Site::Toward(_)) => true,
+            (MirrorShape::Cylinder { closed, .. }, Site::Toward(_)) => closed,
             _ => false,
         }
     }
@@ -205,7 +208,8 @@ impl MirrorShape {
                 found(path);
             }
         };
-        let visible_only = self.outside_only(x);
+        // Inside reflections need both legs inside: either end beside or outside rules them out.
+        let visible_only = self.outside_only(Site::At(x)) || self.outside_only(site);
         let reflexes = match *self {
             MirrorShape::Sphere { center, radius } if visible_only => {
                 let sphere = alhazen_mirror::Sphere { center, radius };

@@ -197,6 +197,29 @@ proptest! {
         }
     }
 
+    /// Beside an open cylinder (radially outside, between its ends) every reflection on the
+    /// inside that the full solution finds on the cylinder's length is blocked by its wall: the
+    /// straight leg enters the circle (in the projection along the axis) between the ends. So
+    /// seeking only the visible reflex there loses nothing.
+    #[test]
+    fn beside_an_open_cylinder_inside_reflections_are_blocked(
+        radius in 0.3f64..2.0, height in 0.5f64..4.0, angle in 0.0f64..6.28, dist in 1.05f64..3.0, z in 0.0f64..1.0, y in point()
+    ) {
+        let x = Vec3::new(angle.cos() * radius * dist, angle.sin() * radius * dist, z * height);
+        let full = alhazen_mirror::Cylinder { center: Vec3::ZERO, axis: Vec3::Z, radius };
+        let Ok(r) = full.reflexes(Site::At(x), Site::At(y)) else { return Ok(()) };
+        for m in r.of_kind(ReflexKind::Inside).map(|r| r.point).filter(|m| (0.0..=height).contains(&m.z)) {
+            // Entry of the segment x → m into the circle (projection along z).
+            let (p, d) = (x.truncate(), (m - x).truncate());
+            let (a, b, c) = (d.length_squared(), 2.0 * p.dot(d), p.length_squared() - radius * radius);
+            let t = (-b - (b * b - 4.0 * a * c).max(0.0).sqrt()) / (2.0 * a);
+            let entry_height = x.z + (m.z - x.z) * t;
+            prop_assert!(t < 1.0 - 1e-9 && (0.0..=height).contains(&entry_height), "t {t}, height {entry_height}");
+        }
+        let cup = MirrorShape::Cylinder { base: Vec3::ZERO, axis: Vec3::Z, height, radius, closed: false };
+        prop_assert!(all_paths(&cup, x, Source::At(y)).iter().all(|p| p.normal.dot(p.point.truncate().extend(0.0)) > 0.0));
+    }
+
     /// Every path obeys the law of reflection and lies on the mirror.
     #[test]
     fn paths_obey_the_law_of_reflection(mirror in mirrors(), x in point(), y in point()) {
