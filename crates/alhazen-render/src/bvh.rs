@@ -15,6 +15,9 @@ const MAX_LEAF: usize = 4;
 pub const PACK: usize = 4;
 /// Deeper subtrees become leaves, so traversal's fixed stack never overflows.
 const MAX_DEPTH: usize = 48;
+/// Nodes over at least this many primitives build their two subtrees in parallel (the same
+/// tree as one thread builds: only who computes each subtree changes).
+const PARALLEL_ITEMS: usize = 1 << 14;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
@@ -79,6 +82,12 @@ impl Bvh {
     /// in a leaf: the surface area heuristic charges a leaf one test per started group of
     /// them plus one per other primitive, so leaves of such primitives grow large.
     pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool) -> Self {
+        Self::build_split_from(bounds, packed, PARALLEL_ITEMS)
+    }
+
+    /// [`Self::build_packed`] building subtrees of at least `parallel_from` primitives in
+    /// parallel.
+    fn build_split_from(bounds: &[Bounds3], packed: impl Fn(usize) -> bool, parallel_from: usize) -> Self {
         let mut items: Vec<Item> = bounds
             .iter()
             .enumerate()
@@ -89,12 +98,12 @@ impl Bvh {
             // A node's slab test costs about what a packet's test does, an eighth of a
             // triangle's (pbrt's ratio).
             let packets = items.iter().any(|it| it.packed);
-            bvh.build_node(&mut items, 0, if packets { 1.0 } else { 0.125 });
+            bvh.build_node(&mut items, 0, if packets { 1.0 } else { 0.125 }, parallel_from);
         }
         bvh
     }
 
-    fn build_node(&mut self, items: &mut [Item], depth: usize, traversal: f64) -> usize {
+    fn build_node(&mut self, items: &mut [Item], depth: usize, traversal: f64, parallel_from: usize) -> usize {
         let bounds = items.iter().fold(Bounds3::EMPTY, |b, it| b.union(it.bounds));
         let me = self.nodes.len();
         self.nodes.push(Node { bounds, offset: 0, count: 0, axis: 0 });
@@ -107,14 +116,39 @@ impl Bvh {
                 self.order.extend(items.iter().map(|it| it.index));
             }
             Some((axis, mid)) => {
+                let parallel = items.len() >= parallel_from;
                 let (left, right) = items.split_at_mut(mid);
-                self.build_node(left, depth + 1, traversal);
-                let second = self.build_node(right, depth + 1, traversal);
+                let second = if parallel {
+                    let (mut a, mut b) = (Bvh::default(), Bvh::default());
+                    let next = depth + 1;
+                    rayon::join(
+                        || a.build_node(left, next, traversal, parallel_from),
+                        || b.build_node(right, next, traversal, parallel_from),
+                    );
+                    self.append(a);
+                    let second = self.nodes.len();
+                    self.append(b);
+                    second
+                } else {
+                    self.build_node(left, depth + 1, traversal, parallel_from);
+                    self.build_node(right, depth + 1, traversal, parallel_from)
+                };
                 self.nodes[me].offset = second as u32;
                 self.nodes[me].axis = axis as u8;
             }
         }
         me
+    }
+
+    /// Appends a subtree built on its own (its indices counted from 0) after this one's nodes and
+    /// primitives, as the depth-first build would have laid it out.
+    fn append(&mut self, sub: Bvh) {
+        let (node_base, order_base) = (self.nodes.len() as u32, self.order.len() as u32);
+        self.nodes.extend(sub.nodes.into_iter().map(|mut n| {
+            n.offset += if n.count > 0 { order_base } else { node_base };
+            n
+        }));
+        self.order.extend(sub.order);
     }
 
     /// Visits candidate primitives front to back. `visit(index, t_max)` returns a closer hit
@@ -272,4 +306,33 @@ fn partition(items: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
         }
     }
     i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Building subtrees on several threads lays out the very tree one thread builds.
+    #[test]
+    fn parallel_build_is_the_sequential_tree() {
+        let mut state = 0x9e3779b97f4a7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let bounds: Vec<Bounds3> = (0..50_000)
+            .map(|_| {
+                let c = Vec3::new(next(), next(), next()) * 100.0;
+                let r = Vec3::new(next(), next(), next());
+                Bounds3 { min: c - r, max: c + r }
+            })
+            .collect();
+        let sequential = Bvh::build_split_from(&bounds, |i| i % 3 == 0, usize::MAX);
+        let parallel = Bvh::build_split_from(&bounds, |i| i % 3 == 0, 256);
+        assert_eq!(sequential.order, parallel.order);
+        assert_eq!(format!("{:?}", sequential.nodes), format!("{:?}", parallel.nodes));
+        assert!(sequential.nodes.len() > 1000);
+    }
 }
