@@ -244,6 +244,13 @@ pub(crate) fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
     Ok(format)
 }
 
+/// Opens the output (its temporary file) before any work, so that a place where it cannot be
+/// written is refused at once (exit 2) instead of after the render.
+pub(crate) fn open_output(path: &Path) -> Result<alhazen_render::output::PendingFile, Failure> {
+    alhazen_render::output::PendingFile::create(path)
+        .map_err(|e| Failure::input(format!("cannot write {}: {e}", path.display())))
+}
+
 /// Refuses an output path whose directory does not exist, before any work is done.
 pub(crate) fn check_output_dir(path: &Path) -> Result<(), Failure> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
@@ -271,6 +278,7 @@ fn vector_unit(kernel: Option<KernelArg>) -> Result<VectorUnit, Failure> {
 fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     let unit = vector_unit(a.kernel)?;
     let format = check_output(&a.image.output, a.image.half)?;
+    let output = open_output(&a.image.output)?;
     let mut scene = load_sized(&a.image)?;
     apply_overrides(&mut scene, a);
     let threads = a.image.threads.map_or(0, |t| t as usize);
@@ -286,7 +294,9 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     });
     bar.finish_and_clear();
     let elapsed = start.elapsed();
-    save(&image, &a.image.output, format)?;
+    output
+        .write_image(&image, format)
+        .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.image.output.display())))?;
     if !a.image.quiet {
         let r = &scene.render;
         let integrator = match r.integrator {

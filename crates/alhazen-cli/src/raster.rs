@@ -1,7 +1,7 @@
 //! `alhazen raster`: the software raster pipeline (issue 6) as an offline renderer — the quick
 //! preview of a scene before a long ray-traced render.
 
-use crate::{Failure, ImageArgs, check_output, load_sized, save};
+use crate::{Failure, ImageArgs, check_output, load_sized};
 use alhazen_raster::pipeline::stencil::StencilMode;
 use alhazen_raster::pipeline::{RasterOptions, Shading, ShadowMethod, Visibility, prepare, render_prepared};
 use alhazen_render::Image;
@@ -93,6 +93,7 @@ fn parse_plane(s: &str) -> Result<alhazen_math::Vec4, String> {
 
 pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
     let format = check_output(&a.image.output, a.image.half)?;
+    let output = crate::open_output(&a.image.output)?;
     let scene = load_sized(&a.image)?;
     let opts = RasterOptions {
         shading: match a.shading {
@@ -134,7 +135,9 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
     let elapsed = start.elapsed().as_secs_f64();
     let (fb, stats) = last.expect("at least one frame");
     let image = Image { width: fb.width, height: fb.height, pixels: fb.color };
-    save(&image, &a.image.output, format)?;
+    output
+        .write_image(&image, format)
+        .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.image.output.display())))?;
     if !a.image.quiet {
         let per_frame = elapsed / a.frames as f64;
         eprintln!(

@@ -216,6 +216,20 @@ fn failed_write_keeps_the_old_file() {
     assert!(leftovers.is_empty());
 }
 
+/// An output that cannot be created is refused before the work (exit 2), naming the user's
+/// path, not the hidden temporary file (`/proc` takes no new files, even from root).
+#[test]
+fn unwritable_output_is_refused_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), OK);
+    for command in ["render", "raster"] {
+        let o = alhazen(&[command, scene.to_str().unwrap(), "-o", "/proc/alhazen-out.png", "--quiet"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{command}: {err}");
+        assert!(err.contains("cannot write /proc/alhazen-out.png") && !err.contains(".alhazen-"), "{command}: {err}");
+    }
+}
+
 #[test]
 fn help_shows_an_example() {
     let o = alhazen(&["render", "--help"]);

@@ -100,6 +100,7 @@ fn average(samples: &[Vec3]) -> [f32; 3] {
         // A NaN or infinity from a degenerate input must not poison the pixel.
         sum += if c.is_finite() { c } else { Vec3::ZERO };
     }
-    let c = sum / samples.len() as f64;
+    // Beyond the float range a pixel keeps the largest float, not an infinity.
+    let c = (sum / samples.len() as f64).clamp(Vec3::splat(-f32::MAX as f64), Vec3::splat(f32::MAX as f64));
     [c.x as f32, c.y as f32, c.z as f32]
 }

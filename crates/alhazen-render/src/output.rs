@@ -36,26 +36,62 @@ impl Format {
 
 /// Writes `img` to `path` atomically.
 pub fn write_image(img: &Image, path: &Path, format: Format) -> io::Result<()> {
-    write_atomically(path, |file| match format {
-        Format::Png => encode_png(img, file),
-        Format::ExrHalf | Format::ExrFloat => encode_exr(img, file, format == Format::ExrHalf),
-        Format::Pfm => encode_pfm(img, &mut BufWriter::new(file)),
-    })
+    PendingFile::create(path)?.write_image(img, format)
 }
 
 /// Creates `path` through a temporary file in the same directory, filled by `fill`, synced and
 /// renamed into place: readers see the old file or the complete new one, never a part.
 pub fn write_atomically(path: &Path, fill: impl FnOnce(&mut std::fs::File) -> io::Result<()>) -> io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new().prefix(".alhazen-").suffix(".part").tempfile_in(dir)?;
-    fill(tmp.as_file_mut())?;
-    tmp.as_file().sync_all()?;
-    set_readable_permissions(tmp.path(), path)?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    PendingFile::create(path)?.finish(fill)
+}
+
+/// An output file opened before the work that fills it: its temporary file already exists
+/// beside `path`, so an unwritable place is found before a render, not after. Dropped
+/// unfinished, it leaves nothing behind (and `path` untouched).
+pub struct PendingFile {
+    tmp: tempfile::NamedTempFile,
+    path: std::path::PathBuf,
+}
+
+/// An I/O error without the temporary file's name (messages name the user's path): tempfile
+/// appends ` at path "…"` to the system's message.
+fn plain(e: io::Error) -> io::Error {
+    if let Some(code) = e.raw_os_error() {
+        return io::Error::from_raw_os_error(code);
+    }
+    let text = e.to_string();
+    let system = text.split(" at path ").next().unwrap_or(&text).to_string();
+    io::Error::new(e.kind(), system)
+}
+
+impl PendingFile {
+    /// Creates the temporary file for `path`.
+    pub fn create(path: &Path) -> io::Result<Self> {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let tmp = tempfile::Builder::new().prefix(".alhazen-").suffix(".part").tempfile_in(dir).map_err(plain)?;
+        Ok(Self { tmp, path: path.to_path_buf() })
+    }
+
+    /// Encodes `img` as `format` and renames it into place.
+    pub fn write_image(self, img: &Image, format: Format) -> io::Result<()> {
+        self.finish(|file| match format {
+            Format::Png => encode_png(img, file),
+            Format::ExrHalf | Format::ExrFloat => encode_exr(img, file, format == Format::ExrHalf),
+            Format::Pfm => encode_pfm(img, &mut BufWriter::new(file)),
+        })
+    }
+
+    /// Fills the file by `fill`, syncs it and renames it into place.
+    pub fn finish(mut self, fill: impl FnOnce(&mut std::fs::File) -> io::Result<()>) -> io::Result<()> {
+        fill(self.tmp.as_file_mut())?;
+        self.tmp.as_file().sync_all().map_err(plain)?;
+        set_readable_permissions(self.tmp.path(), &self.path).map_err(plain)?;
+        self.tmp.persist(&self.path).map_err(|e| plain(e.error))?;
+        Ok(())
+    }
 }
 
 /// Temporary files are private (0600); give the image the permissions of the file it

@@ -186,3 +186,14 @@ fn exr_files_are_the_same_bytes_every_time() {
         assert!(bytes.iter().all(|b| *b == bytes[0]), "{f:?}");
     }
 }
+
+/// A pixel beyond the float range keeps the largest float, never an infinity (issue 22: an
+/// attenuation of 1e-300 used to give +Inf pixels).
+#[test]
+fn pixels_beyond_the_float_range_stay_finite() {
+    let img = render_text(&format!(
+        "{FLAT}[[light]]\ntype = \"point\"\nposition = [0, 0, 2]\nattenuation = [0, 0, 1e-300]\n"
+    ));
+    let c = img.get(4, 4);
+    assert!(c.is_finite() && c.x == f32::MAX as f64, "{c}");
+}
