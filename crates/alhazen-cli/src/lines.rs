@@ -20,7 +20,7 @@ pub struct LinesArgs {
     #[arg(short, long)]
     output: PathBuf,
     /// Paper width in millimetres (the height follows the scene's image aspect).
-    #[arg(long, default_value_t = 200.0, value_parser = positive)]
+    #[arg(long, default_value_t = 200.0, value_parser = paper_width)]
     width_mm: f64,
     /// Also draw hidden lines (dashed, on their own layer).
     #[arg(long)]
@@ -29,7 +29,7 @@ pub struct LinesArgs {
     #[arg(long)]
     no_reflections: bool,
     /// Mesh edges whose faces meet at more than this angle (degrees) are drawn.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, value_parser = angle)]
     feature_angle: f64,
     /// Stroke width of visible lines in millimetres.
     #[arg(long, default_value_t = 0.35, value_parser = positive)]
@@ -76,6 +76,22 @@ fn positive(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
         _ => Err(format!("expected a positive number, got {s:?}")),
+    }
+}
+
+/// A paper width in millimetres: positive, at most 10 m.
+fn paper_width(s: &str) -> Result<f64, String> {
+    match positive(s)? {
+        v if v <= 10_000.0 => Ok(v),
+        _ => Err(format!("{s} mm is wider than the 10000 mm a drawing may be")),
+    }
+}
+
+/// An angle in degrees from 0 to 180.
+fn angle(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.0..=180.0).contains(&v) => Ok(v),
+        _ => Err(format!("expected an angle from 0 to 180 degrees, got {s:?}")),
     }
 }
 

@@ -98,7 +98,7 @@ struct RenderArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
     spp: Option<u32>,
     /// Maximum ray depth (overrides the scene).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=1000))]
     depth: Option<u32>,
     /// Random seed (overrides the scene).
     #[arg(long)]

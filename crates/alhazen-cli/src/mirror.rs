@@ -96,6 +96,7 @@ pub fn run(cmd: &MirrorCommand) -> Result<(), Failure> {
     match cmd {
         MirrorCommand::Reflex { input } => run_reflex(input.as_deref()),
         MirrorCommand::Caustic(a) => {
+            check_svg(&a.output)?;
             let radius_ok = a.radius > 0.0 && a.radius.is_finite();
             if !radius_ok || a.eye_distance.is_nan() || a.eye_distance <= 0.0 {
                 return Err(Failure::input("--radius must be positive and finite, --eye-distance positive (or inf)"));
@@ -109,11 +110,20 @@ pub fn run(cmd: &MirrorCommand) -> Result<(), Failure> {
             write_text(&a.output, &figures::caustic_svg(a.radius, a.eye_distance, side, a.rays as usize))
         }
         MirrorCommand::Conics(a) => {
+            check_svg(&a.output)?;
             let svg = figures::conics_svg(a.radius, a.eye, a.point).map_err(|e| Failure::input(e.to_string()))?;
             write_text(&a.output, &svg)
         }
         MirrorCommand::Anamorph(a) => crate::anamorph::run(a),
     }
+}
+
+/// Refuses an output that is not an `.svg` file (the figures are SVG text), before any work.
+fn check_svg(path: &Path) -> Result<(), Failure> {
+    if path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() != Some("svg") {
+        return Err(Failure::input(format!("{}: this figure is written as SVG; name the output .svg", path.display())));
+    }
+    crate::check_output_dir(path)
 }
 
 /// Writes a text file atomically.

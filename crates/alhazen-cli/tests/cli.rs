@@ -230,6 +230,59 @@ fn unwritable_output_is_refused_before_rendering() {
     }
 }
 
+/// Inputs that used to be accepted though meaningless (issue 22) are refused with exit 2 and a
+/// message saying what is expected; `--depth 0` (emitters only) is accepted like `max_depth = 0`.
+#[test]
+fn meaningless_inputs_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let scene = scene_file(dir.path(), OK);
+    let s = scene.to_str().unwrap();
+    let empty = dir.path().join("empty.toml");
+    std::fs::write(&empty, "\n  \n").unwrap();
+    let glass = dir.path().join("glass.toml");
+    std::fs::write(&glass, "[materials.m]\ntransparency = [0.5, 2, 0.5]\n").unwrap();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["mirror".into(), "caustic".into(), "--eye-distance".into(), "3".into(), "-o".into(), out("c.png")],
+            "name the output .svg",
+        ),
+        (
+            vec![
+                "mirror".into(),
+                "conics".into(),
+                "--eye".into(),
+                "3,0".into(),
+                "--point".into(),
+                "1,1".into(),
+                "-o".into(),
+                out("c.pdf"),
+            ],
+            "name the output .svg",
+        ),
+        (
+            vec!["lines".into(), s.into(), "-o".into(), out("l.svg"), "--feature-angle".into(), "nan".into()],
+            "angle from 0 to 180",
+        ),
+        (
+            vec!["lines".into(), s.into(), "-o".into(), out("l.svg"), "--width-mm".into(), "1e308".into()],
+            "1e308 mm is wider",
+        ),
+        (vec!["render".into(), "/dev/zero".into(), "-o".into(), out("z.png")], "not a regular file"),
+        (vec!["render".into(), empty.to_str().unwrap().into(), "-o".into(), out("e.png")], "the scene file is empty"),
+        (vec!["render".into(), glass.to_str().unwrap().into(), "-o".into(), out("g.png")], "must lie in [0, 1]"),
+    ];
+    for (args, expected) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = alhazen(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(expected), "{args:?}: {err}");
+    }
+    let o = alhazen(&["render", s, "-o", &out("d.png"), "--depth", "0", "--quiet"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 #[test]
 fn help_shows_an_example() {
     let o = alhazen(&["render", "--help"]);

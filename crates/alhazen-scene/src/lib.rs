@@ -58,9 +58,25 @@ impl std::fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
+/// The largest scene file read (256 MiB): larger ones, and anything that is not a regular file
+/// (such as `/dev/zero`), are refused before reading.
+pub const MAX_SCENE_BYTES: u64 = 256 << 20;
+
 /// Reads and parses a scene file.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let io = |source| SceneError::Io { path: path.to_path_buf(), source };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(io(std::io::Error::other("not a regular file")));
+    }
+    if meta.len() > MAX_SCENE_BYTES {
+        let message = format!("{} bytes is more than the {MAX_SCENE_BYTES} a scene file may have", meta.len());
+        return Err(io(std::io::Error::other(message)));
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(SceneError::Syntax(Box::new(Diagnostic::at(path, "", 0..0, "the scene file is empty"))));
+    }
     let text = String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let text = String::from_utf8_lossy(e.as_bytes()).into_owned();

@@ -157,7 +157,7 @@ impl Parser<'_> {
                 None => d.highlight,
             },
             mirror: t.opt_rgb("mirror", d.mirror)?,
-            transparency: t.opt_rgb("transparency", d.transparency)?,
+            transparency: unit_rgb(&t, "transparency", d.transparency)?,
             ior: t.get("ior").map_or(Ok(d.ior), |n| n.positive())?,
             absorption: t.opt_rgb("absorption", d.absorption)?,
             fresnel: match t.get("fresnel") {
@@ -862,4 +862,13 @@ pub(crate) fn transform(n: &Node) -> R<Transform> {
         total = m * total;
     }
     Ok(total)
+}
+
+/// An RGB coefficient in `[0, 1]` per channel (a surface cannot pass on more light than it gets).
+fn unit_rgb(t: &Table, key: &str, default: Vec3) -> R<Vec3> {
+    let v = t.opt_rgb(key, default)?;
+    if v.max_element() > 1.0 {
+        return Err(t.req(key)?.err(format!("`{key}` must lie in [0, 1] per channel (it scales the light passed on)")));
+    }
+    Ok(v)
 }
