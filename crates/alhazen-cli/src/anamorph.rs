@@ -17,10 +17,10 @@ pub struct AnamorphArgs {
     /// The picture: a PNG image, or an SVG line drawing (its polylines and lines).
     image: PathBuf,
     /// Radius of the mirror cylinder in millimetres.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     radius: f64,
     /// Height of the mirror cylinder in millimetres.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     height: f64,
     /// Eye position `x,y,z` in millimetres, `y` up, the cylinder's axis the `y` axis.
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]

@@ -100,8 +100,8 @@ struct RenderArgs {
     /// Maximum ray depth (overrides the scene).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=1000))]
     depth: Option<u32>,
-    /// Random seed (overrides the scene).
-    #[arg(long)]
+    /// Random seed (overrides the scene): a whole number from 0 to 2^64 − 1.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
     seed: Option<u64>,
     /// Integrator (overrides the scene): recursive ray tracing or path tracing.
     #[arg(long, value_enum)]
@@ -242,6 +242,10 @@ pub(crate) fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
         .ok_or_else(|| Failure::input(format!("{}: unknown image format; use .png, .exr or .pfm", path.display())))?;
     check_output_dir(path)?;
     Ok(format)
+}
+
+fn parse_seed(s: &str) -> Result<u64, String> {
+    s.parse::<u64>().map_err(|_| format!("a seed is a whole number from 0 to 18446744073709551615, not {s:?}"))
 }
 
 /// Opens the output (its temporary file) before any work, so that a place where it cannot be

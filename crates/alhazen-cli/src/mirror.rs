@@ -46,10 +46,10 @@ and processing continues; the exit code is 2 if any line was bad."#)]
 #[derive(Args)]
 pub struct CausticArgs {
     /// Radius of the mirror circle.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     radius: f64,
     /// Distance of the eye from the centre; `inf` for parallel rays.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     eye_distance: f64,
     /// Reflection on the inside of the circle instead of the outside.
     #[arg(long)]
@@ -65,7 +65,7 @@ pub struct CausticArgs {
 #[derive(Args)]
 pub struct ConicsArgs {
     /// Radius of the mirror circle (centred at the origin).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     radius: f64,
     /// Eye position `x,y`.
     #[arg(long, value_parser = parse_vec2, allow_hyphen_values = true)]

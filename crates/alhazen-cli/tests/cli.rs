@@ -240,6 +240,11 @@ fn meaningless_inputs_are_refused() {
     let s = scene.to_str().unwrap();
     let empty = dir.path().join("empty.toml");
     std::fs::write(&empty, "\n  \n").unwrap();
+    let profile = dir.path().join("profile.toml");
+    std::fs::write(&profile, "[[object]]\nshape = \"revolution\"\nprofile = [[1, 0], [-0.5, 1], [1, 2]]\n").unwrap();
+    let guide = dir.path().join("guide.toml");
+    std::fs::write(&guide, "[[object]]\nshape = \"sweep\"\nguide = [[0, 0, 0], [1, 0, 0], [1, 0, 0], [2, 1, 0]]\n")
+        .unwrap();
     let glass = dir.path().join("glass.toml");
     std::fs::write(&glass, "[materials.m]\ntransparency = [0.5, 2, 0.5]\n").unwrap();
     let cases: Vec<(Vec<String>, &str)> = vec![
@@ -271,6 +276,28 @@ fn meaningless_inputs_are_refused() {
         (vec!["render".into(), "/dev/zero".into(), "-o".into(), out("z.png")], "not a regular file"),
         (vec!["render".into(), empty.to_str().unwrap().into(), "-o".into(), out("e.png")], "the scene file is empty"),
         (vec!["render".into(), glass.to_str().unwrap().into(), "-o".into(), out("g.png")], "must lie in [0, 1]"),
+        (vec!["render".into(), profile.to_str().unwrap().into(), "-o".into(), out("p.png")], "cannot be negative"),
+        (
+            vec!["render".into(), guide.to_str().unwrap().into(), "-o".into(), out("s.png")],
+            "guide points 2 and 3 coincide",
+        ),
+        (
+            vec!["render".into(), s.into(), "-o".into(), out("n.png"), "--seed".into(), "-1".into()],
+            "a seed is a whole number",
+        ),
+        (
+            vec![
+                "mirror".into(),
+                "caustic".into(),
+                "--radius".into(),
+                "-40".into(),
+                "--eye-distance".into(),
+                "3".into(),
+                "-o".into(),
+                out("c.svg"),
+            ],
+            "--radius must be positive",
+        ),
     ];
     for (args, expected) in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();

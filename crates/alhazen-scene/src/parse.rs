@@ -584,8 +584,14 @@ fn loft(t: &Table) -> R<alhazen_geom::TriangleMesh> {
 /// interpolant of `profile = [[radius, height], …]`.
 fn revolution(t: &Table) -> R<alhazen_geom::TriangleMesh> {
     let node = t.req("profile")?;
-    let profile: Vec<(f64, f64)> =
-        node.array()?.iter().map(|p| p.numbers::<2>().map(|[r, h]| (r, h))).collect::<R<_>>()?;
+    let points = node.array()?;
+    let profile: Vec<(f64, f64)> = points.iter().map(|p| p.numbers::<2>().map(|[r, h]| (r, h))).collect::<R<_>>()?;
+    if let Some(k) = profile.iter().position(|&(r, _)| r < 0.0) {
+        return Err(points[k].err("a profile point's radius (its distance from the axis) cannot be negative"));
+    }
+    if let Some(k) = profile.windows(2).position(|w| w[0] == w[1]) {
+        return Err(points[k + 1].err(format!("profile points {} and {} coincide", k + 1, k + 2)));
+    }
     let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
     let surface = alhazen_geom::construct::revolution(&profile)
         .ok_or_else(|| node.err("a profile needs at least 2 points with distinct consecutive positions"))?;
@@ -600,7 +606,11 @@ fn revolution(t: &Table) -> R<alhazen_geom::TriangleMesh> {
 /// `shape = "sweep"`: a tube of `radius` swept along the cubic interpolant of `guide`.
 fn sweep(t: &Table) -> R<alhazen_geom::TriangleMesh> {
     let node = t.req("guide")?;
-    let guide: Vec<Vec3> = node.array()?.iter().map(|p| p.vec3()).collect::<R<_>>()?;
+    let points = node.array()?;
+    let guide: Vec<Vec3> = points.iter().map(|p| p.vec3()).collect::<R<_>>()?;
+    if let Some(k) = guide.windows(2).position(|w| w[0] == w[1]) {
+        return Err(points[k + 1].err(format!("guide points {} and {} coincide", k + 1, k + 2)));
+    }
     let radius = t.get("radius").map_or(Ok(0.1), |n| n.positive())?;
     let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
     let surface = alhazen_geom::construct::swept_tube(&guide, radius)
