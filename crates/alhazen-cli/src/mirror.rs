@@ -169,6 +169,14 @@ fn answer(r: &Reflexes) -> serde_json::Value {
     serde_json::json!({"reflexes": r.visible().map(|v| vec![p(v.point)]).unwrap_or_default(), "all": all})
 }
 
+/// serde's message without its position inside the one line (the reply's `line` field says
+/// which line), with the column kept: `column 2: expected ident`.
+fn json_error(e: serde_json::Error) -> String {
+    let text = e.to_string();
+    let message = text.split(" at line ").next().unwrap_or(&text);
+    if e.column() > 0 { format!("column {}: {message}", e.column()) } else { message.to_string() }
+}
+
 fn run_reflex(input: Option<&Path>) -> Result<(), Failure> {
     let reader: Box<dyn BufRead> = match input {
         Some(path) => Box::new(std::io::BufReader::new(
@@ -185,7 +193,7 @@ fn run_reflex(input: Option<&Path>) -> Result<(), Failure> {
             continue;
         }
         let reply =
-            serde_json::from_str::<Query>(&line).map_err(|e| e.to_string()).and_then(|q| solve(&q)).map(|r| answer(&r));
+            serde_json::from_str::<Query>(&line).map_err(json_error).and_then(|q| solve(&q)).map(|r| answer(&r));
         let value = reply.unwrap_or_else(|e| {
             bad += 1;
             serde_json::json!({"line": no + 1, "error": e})

@@ -240,6 +240,9 @@ fn meaningless_inputs_are_refused() {
     let s = scene.to_str().unwrap();
     let empty = dir.path().join("empty.toml");
     std::fs::write(&empty, "\n  \n").unwrap();
+    std::fs::write(dir.path().join("two.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1 2 3\n").unwrap();
+    let lines_obj = dir.path().join("obj.toml");
+    std::fs::write(&lines_obj, "[[object]]\nshape = \"mesh\"\nfile = \"two.obj\"\n").unwrap();
     let profile = dir.path().join("profile.toml");
     std::fs::write(&profile, "[[object]]\nshape = \"revolution\"\nprofile = [[1, 0], [-0.5, 1], [1, 2]]\n").unwrap();
     let guide = dir.path().join("guide.toml");
@@ -277,6 +280,10 @@ fn meaningless_inputs_are_refused() {
         (vec!["render".into(), empty.to_str().unwrap().into(), "-o".into(), out("e.png")], "the scene file is empty"),
         (vec!["render".into(), glass.to_str().unwrap().into(), "-o".into(), out("g.png")], "must lie in [0, 1]"),
         (vec!["render".into(), profile.to_str().unwrap().into(), "-o".into(), out("p.png")], "cannot be negative"),
+        (
+            vec!["render".into(), lines_obj.to_str().unwrap().into(), "-o".into(), out("o.png")],
+            "line 4: a face needs at least 3 vertices",
+        ),
         (
             vec!["render".into(), guide.to_str().unwrap().into(), "-o".into(), out("s.png")],
             "guide points 2 and 3 coincide",
@@ -388,6 +395,16 @@ mod mirror {
         assert_eq!(code, 2);
         assert_eq!(lines[0]["line"], 1);
         assert!(lines[1]["error"].as_str().unwrap().contains("radius"));
+        // The error names the column only: the line is the reply's `line` (a mixed file used to
+        // say "line 1" in the text of an error on line 2).
+        let (_, mixed) = reflex(concat!(
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1,"eye":[0,0,5],"point":[3,0,4]}"#,
+            "
+not json
+"
+        ));
+        assert_eq!(mixed[1]["line"], 2);
+        assert_eq!(mixed[1]["error"], "column 2: expected ident");
         // Straight behind the ball: forbidden, no visible reflex, but other solutions.
         assert_eq!(lines[2]["reflexes"].as_array().unwrap().len(), 0);
         assert!(!lines[2]["all"].as_array().unwrap().is_empty());

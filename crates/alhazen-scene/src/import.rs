@@ -37,6 +37,7 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh, String> {
 }
 
 fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
+    check_obj_faces(path)?;
     let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let (models, mtl) = tobj::load_obj(path, &opts).map_err(|e| e.to_string())?;
     // A missing .mtl file is not fatal: the object's own material is used.
@@ -86,6 +87,21 @@ fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
 
 /// MTL → Whitted material: `Kd` colour, `Ks`/`Ns` highlight, `d`/`Tr` transparency, `Ni` ior;
 /// illumination models 3–7 add a mirror term of `Ks`.
+/// Refuses faces of fewer than three vertices (tobj would drop them silently), naming the line.
+fn check_obj_faces(path: &Path) -> Result<(), String> {
+    let text = std::fs::read(path).map_err(|e| e.to_string())?;
+    for (no, line) in text.split(|&b| b == b'\n').enumerate() {
+        let mut words = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty());
+        if words.next() == Some(b"f".as_slice()) {
+            let corners = words.take_while(|w| w[0] != b'#').count();
+            if corners < 3 {
+                return Err(format!("line {}: a face needs at least 3 vertices, this one has {corners}", no + 1));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn mtl_material(m: &tobj::Material) -> Material {
     let rgb = |c: Option<[f32; 3]>, d: Vec3| c.map_or(d, |c| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64));
     let d = Material::default();
