@@ -2,6 +2,10 @@
 //! every error can point at it.
 
 use crate::diagnostic::{Diagnostic, did_you_mean};
+
+/// The largest magnitude of a number in a scene file: squares and products of numbers up to it
+/// stay finite in f64, so nothing derived from the scene overflows to infinity or NaN.
+pub const MAX_MAGNITUDE: f64 = 1e100;
 use alhazen_math::Vec3;
 use std::ops::Range;
 use std::path::Path;
@@ -91,7 +95,11 @@ impl<'a, 'i> Node<'a, 'i> {
             _ => return Err(self.expected("a number")),
         };
         match parsed {
-            Some(x) if x.is_finite() => Ok(x),
+            Some(x) if x.abs() <= MAX_MAGNITUDE => Ok(x),
+            Some(x) if x.is_finite() => Err(self.err(format!(
+                "`{}`: {x:e} is beyond ±1e100, the largest magnitude alhazen computes with (its squares and products would overflow)",
+                self.key
+            ))),
             _ => Err(self.err(format!("`{}`: expected a finite number", self.key))),
         }
     }
