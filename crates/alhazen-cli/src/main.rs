@@ -248,6 +248,21 @@ fn parse_seed(s: &str) -> Result<u64, String> {
     s.parse::<u64>().map_err(|_| format!("a seed is a whole number from 0 to 18446744073709551615, not {s:?}"))
 }
 
+/// Warns when the scene has no light `renderer` uses but emitting objects it ignores (only the
+/// path tracer lights with them), saying what to do.
+pub(crate) fn warn_unlit(scene: &Scene, renderer: &str, remedy: &str) {
+    let emitters = scene
+        .objects
+        .iter()
+        .filter(|o| scene.materials[o.material as usize].emission.abs().max_element() > 0.0)
+        .count();
+    if scene.lights.is_empty() && emitters > 0 {
+        eprintln!(
+            "warning: {renderer} lights only with [[light]] entries; this scene has none, only {emitters} emitting object(s), which it shows but does not light with ({remedy})"
+        );
+    }
+}
+
 /// Opens the output (its temporary file) before any work, so that a place where it cannot be
 /// written is refused at once (exit 2) instead of after the render.
 pub(crate) fn open_output(path: &Path) -> Result<alhazen_render::output::PendingFile, Failure> {
@@ -285,6 +300,9 @@ fn run_render(a: &RenderArgs) -> Result<(), Failure> {
     let output = open_output(&a.image.output)?;
     let mut scene = load_sized(&a.image)?;
     apply_overrides(&mut scene, a);
+    if scene.render.integrator == alhazen_scene::IntegratorKind::Whitted {
+        warn_unlit(&scene, "Whitted ray tracing", "use --integrator path");
+    }
     let threads = a.image.threads.map_or(0, |t| t as usize);
     let pool =
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Failure::work(e.to_string()))?;

@@ -319,6 +319,22 @@ fn meaningless_inputs_are_refused() {
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// A scene lit only by emitting objects, rendered by a renderer that ignores them, says so
+/// (issue 21: the black Whitted Cornell box and preview); the path tracer does not warn.
+#[test]
+fn renderers_that_ignore_emitters_say_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let c = cornell.to_str().unwrap();
+    let out = dir.path().join("x.png");
+    let o = out.to_str().unwrap();
+    let small = ["--width", "16", "--height", "16", "-q"];
+    let run = |args: &[&str]| String::from_utf8_lossy(&alhazen(&[args, &small[..]].concat()).stderr).into_owned();
+    assert!(run(&["render", c, "-o", o, "--integrator", "whitted"]).contains("use --integrator path"));
+    assert!(run(&["raster", c, "-o", o]).contains("render it with --integrator path"));
+    assert!(!run(&["render", c, "-o", o, "--spp", "1"]).contains("warning"));
+}
+
 #[test]
 fn help_shows_an_example() {
     let o = alhazen(&["render", "--help"]);
