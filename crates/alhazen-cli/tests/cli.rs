@@ -243,6 +243,9 @@ fn meaningless_inputs_are_refused() {
     std::fs::write(dir.path().join("two.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\nf 1 2 3\n").unwrap();
     let lines_obj = dir.path().join("obj.toml");
     std::fs::write(&lines_obj, "[[object]]\nshape = \"mesh\"\nfile = \"two.obj\"\n").unwrap();
+    std::fs::write(dir.path().join("sail.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let csg = dir.path().join("csg.toml");
+    std::fs::write(&csg, "[[object]]\nshape = \"csg\"\nop = \"union\"\na = { shape = \"mesh\", file = \"sail.obj\" }\nb = { shape = \"sphere\" }\n").unwrap();
     let huge = dir.path().join("huge.toml");
     std::fs::write(&huge, "[[object]]\nshape = \"sphere\"\ncenter = [1e308, 0, 0]\n").unwrap();
     let profile = dir.path().join("profile.toml");

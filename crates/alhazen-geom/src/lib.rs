@@ -127,6 +127,32 @@ impl TriangleMesh {
         Self { positions, triangles, ..Self::default() }
     }
 
+    /// True when the mesh bounds a solid: every edge, matched by its end points' positions (so
+    /// vertices split at texture seams still join), is used exactly once in each direction.
+    /// Degenerate triangles (two equal corners) are ignored.
+    pub fn is_closed(&self) -> bool {
+        use std::collections::HashMap;
+        let key = |i: u32| self.positions[i as usize].to_array().map(f64::to_bits);
+        let mut edges: HashMap<([u64; 3], [u64; 3]), i32> = HashMap::with_capacity(3 * self.triangles.len());
+        for t in &self.triangles {
+            let k = t.map(key);
+            if k[0] == k[1] || k[1] == k[2] || k[0] == k[2] {
+                continue;
+            }
+            for (a, b) in [(k[0], k[1]), (k[1], k[2]), (k[2], k[0])] {
+                // +1 for a → b, −1 for b → a, on the edge's canonical key.
+                let (edge, sign) = if a < b { ((a, b), 1) } else { ((b, a), -1) };
+                let count = edges.entry(edge).or_insert(0);
+                *count += sign;
+                // A second use in the same direction: not a solid's boundary.
+                if count.abs() > 1 {
+                    return false;
+                }
+            }
+        }
+        !edges.is_empty() && edges.values().all(|&c| c == 0)
+    }
+
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
@@ -159,6 +185,30 @@ impl TriangleMesh {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn closedness_is_measured_from_the_edges() {
+        let cube = TriangleMesh::cuboid(Vec3::ZERO, Vec3::ONE);
+        assert!(cube.is_closed());
+        // A face missing: open (the lofted sail, the teapot without its bottom).
+        let mut open = cube.clone();
+        open.triangles.truncate(10);
+        assert!(!open.is_closed());
+        // Vertices split per face (as at texture seams) still join by position.
+        let mut split = TriangleMesh::default();
+        for t in &cube.triangles {
+            let base = split.positions.len() as u32;
+            split.positions.extend(t.map(|i| cube.positions[i as usize]));
+            split.triangles.push([base, base + 1, base + 2]);
+        }
+        assert!(split.is_closed());
+        // One face turned inside out: an edge used twice in one direction.
+        let mut flipped = cube.clone();
+        flipped.triangles[0].swap(1, 2);
+        assert!(!flipped.is_closed());
+        assert!(!TriangleMesh::default().is_closed());
+    }
+
     use super::*;
 
     #[test]

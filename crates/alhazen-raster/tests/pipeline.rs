@@ -383,3 +383,22 @@ fn preparation_builds_only_what_is_asked_and_widens_to_serve_more() {
         assert_eq!(a.color, b.color);
     }
 }
+
+/// An open mesh is seen from both sides (issue 21: every mesh was taken as closed and its faces
+/// turned away were culled, so a sail vanished): closedness is measured from the edges.
+#[test]
+fn open_meshes_are_seen_from_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    // One triangle whose front faces away from the camera (it looks down −z, the camera is at +z).
+    std::fs::write(dir.path().join("sail.obj"), "v -1 -1 0\nv 0 1 0\nv 1 -1 0\nf 1 2 3\n").unwrap();
+    let text = "ambient = 0.5\nbackground = [0, 0, 0]\n[render]\nwidth = 16\nheight = 16\n\
+        [camera]\ntype = \"orthographic\"\neye = [0, 0, 5]\nwidth = 3\n\
+        [[object]]\nshape = \"mesh\"\nfile = \"sail.obj\"\nmaterial = { color = 1 }\n";
+    let path = dir.path().join("sail.toml");
+    std::fs::write(&path, text).unwrap();
+    let scene = alhazen_scene::load_scene(&path).unwrap();
+    assert!(!scene.meshes[0].is_closed());
+    let (fb, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    let centre = fb.color[(8 * 16 + 8) as usize];
+    assert!(centre[0] > 0.1, "the back of an open mesh is drawn: {centre:?}");
+}

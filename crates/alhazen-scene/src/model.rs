@@ -597,9 +597,10 @@ pub enum Shape {
 
 impl Shape {
     /// True when the shape bounds a volume, as CSG needs.
-    pub fn is_closed(&self) -> bool {
+    pub fn is_closed(&self, meshes: &[std::sync::Arc<alhazen_geom::TriangleMesh>]) -> bool {
         match self {
-            Shape::Sphere { .. } | Shape::Box { .. } | Shape::Mesh { .. } | Shape::Csg { .. } => true,
+            Shape::Mesh { mesh, .. } => meshes.get(*mesh).is_some_and(|m| m.is_closed()),
+            Shape::Sphere { .. } | Shape::Box { .. } | Shape::Csg { .. } => true,
             Shape::Cylinder { capped, .. } | Shape::Cone { capped, .. } => *capped,
             Shape::Disk { .. } | Shape::Plane { .. } => false,
         }

@@ -454,7 +454,7 @@ impl Parser<'_> {
                 let mut operand = |key: &str| -> R<Box<Object>> {
                     let node = t.req(key)?;
                     let o = self.object(&node, depth + 1)?;
-                    if !o.shape.is_closed() {
+                    if !o.shape.is_closed(&self.scene.meshes) {
                         return Err(node.err(format!("CSG operand `{key}` must be a closed shape (sphere, box, capped cylinder or cone, closed mesh, csg)")));
                     }
                     Ok(Box::new(o))

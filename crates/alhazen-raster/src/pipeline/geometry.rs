@@ -199,6 +199,12 @@ pub fn world_triangles(scene: &Scene, object: &alhazen_scene::Object) -> Option<
 /// Every object of `scene` as world-space triangles.
 pub fn scene_triangles(scene: &Scene) -> SceneTriangles {
     let (mut triangles, mut skipped) = (vec![], 0);
+    // Whether each mesh bounds a solid is measured once (back faces of open ones are seen).
+    let closed_meshes: Vec<bool> = scene.meshes.iter().map(|m| m.is_closed()).collect();
+    let is_closed = |s: &Shape| match s {
+        Shape::Mesh { mesh, .. } => closed_meshes[*mesh],
+        s => s.is_closed(&scene.meshes),
+    };
     for (object, o) in scene.objects.iter().enumerate() {
         let object = object as u32;
         let Some(tris) = object_triangles(scene, &o.shape) else {
@@ -223,7 +229,7 @@ pub fn scene_triangles(scene: &Scene) -> SceneTriangles {
             if e1.cross(e2).length_squared() <= 1e-20 * longest * longest {
                 continue;
             }
-            triangles.push(Triangle { v: t, material, closed: o.shape.is_closed(), unbounded, object });
+            triangles.push(Triangle { v: t, material, closed: is_closed(&o.shape), unbounded, object });
         }
     }
     SceneTriangles { triangles, skipped }
