@@ -402,3 +402,30 @@ fn open_meshes_are_seen_from_behind() {
     let centre = fb.color[(8 * 16 + 8) as usize];
     assert!(centre[0] > 0.1, "the back of an open mesh is drawn: {centre:?}");
 }
+
+#[test]
+fn an_unbounded_plane_is_lit_per_pixel_whatever_the_shading() {
+    // A plane's triangles reach far past the view, so flat shading (lit at the centroid) made
+    // the floor black and Gouraud (lit at the corners) lost its shadows. The floor must agree
+    // with the ray tracer under every shading, shadows included.
+    let text = SCENE.replace(
+        "shape = \"disk\"\ncenter = [0, 0, 0]\nnormal = [0, 1, 0]\nradius = 3",
+        "shape = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 1, 0]",
+    );
+    assert_ne!(text, SCENE);
+    let scene = parse_scene("plane.toml".as_ref(), &text).unwrap();
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    // Floor pixels only: the bottom rows, below every object.
+    let rows = 100..120usize;
+    let floor =
+        |c: &[[f32; 3]]| -> Vec<[f32; 3]> { rows.clone().flat_map(|y| c[y * 160..(y + 1) * 160].to_vec()).collect() };
+    let reference = floor(&traced.pixels);
+    let brightness = reference.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / reference.len() as f64;
+    assert!(brightness > 0.1, "the traced floor is lit: {brightness}");
+    for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
+        let (fb, _) = render_scene(&scene, &RasterOptions { shading, ..Default::default() }).unwrap();
+        let err = mean_abs(&floor(&fb.color), &reference) / brightness;
+        eprintln!("{shading:?}: floor differs by {:.2} % of its brightness", err * 100.0);
+        assert!(err < 0.02, "{shading:?}: floor differs by {:.2} %", err * 100.0);
+    }
+}

@@ -330,7 +330,7 @@ fn process(
     }
     let m = &scene.materials[t.material as usize];
     let color = |v: &geometry::Vertex| match opts.shading {
-        Shading::Gouraud => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), shadows),
+        Shading::Gouraud if !t.unbounded => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), shadows),
         _ => (Vec3::ZERO, Vec3::ZERO),
     };
     let poly: Vec<ClipVertex> =
@@ -361,7 +361,13 @@ fn fragment_color(
 ) -> Vec3 {
     let t = &tris[src as usize];
     let m = &scene.materials[t.material as usize];
-    match opts.shading {
+    // An unbounded plane's triangles reach far beyond the view: their corners and centroid
+    // say nothing about the pixels, so they are lit per pixel whatever the shading (for a
+    // plane the interpolated normal is the face normal: flat, Gouraud and Phong agree but for
+    // where the light is evaluated). Without this the floor went black (flat) or lost its
+    // shadows (Gouraud).
+    let shading = if t.unbounded { Shading::Phong } else { opts.shading };
+    match shading {
         Shading::Gouraud => {
             let p = Vec3::new(attr[0], attr[1], attr[2]);
             let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
