@@ -12,7 +12,8 @@
 //!   orthographic and perspective frustum matrices `(l, r, b, t, n, f)` and their inverses,
 //!   window→viewport, homogenisation, stereo frusta;
 //! * [`color`] — the course's sRGB transfer function and the XYZ→sRGB matrix;
-//! * [`poly`] — numerically careful real roots of low-degree polynomials.
+//! * [`poly`] — numerically careful real roots of low-degree polynomials;
+//! * [`exact_sum`] — order-independent exact sums of doubles (the film's pixel sums).
 //!
 //! ```
 //! use alhazen_math::{Ray, Vec3, Transform};
@@ -23,6 +24,7 @@
 
 pub mod bounds;
 pub mod color;
+pub mod exact_sum;
 pub mod poly;
 pub mod ray;
 pub mod transform;
