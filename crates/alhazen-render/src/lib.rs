@@ -66,19 +66,40 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(usize, usize) + Sync)) -> Image 
 /// [`render`] with the packets tested by `unit`'s kernel (one of [`shape::VectorUnit::available`]):
 /// the same image from every kernel.
 pub fn render_with(scene: &Scene, unit: shape::VectorUnit, progress: &(dyn Fn(usize, usize) + Sync)) -> Image {
+    let (w, h) = film_size(scene);
+    with_estimator(scene, unit, &|estimator| film::render_image(w, h, estimator, scene.render.spp, progress))
+}
+
+/// The film's size for `scene`: its image size, or twice its width for a side-by-side stereo
+/// camera.
+pub fn film_size(scene: &Scene) -> (u32, u32) {
+    let camera = Camera::new(&scene.camera, scene.render.width, scene.render.height);
+    (camera.film_width, camera.film_height)
+}
+
+/// Renders part of `scene`'s film (a [`film::Job`]: some tiles, some samples), handing each
+/// tile to `done` as it finishes; tiles not begun when `stop` is set are skipped. The tiles
+/// of any set of jobs covering the film merge to the bits of [`render_with`] ([`film::part`]).
+pub fn render_tiles_with(
+    scene: &Scene,
+    unit: shape::VectorUnit,
+    job: &film::Job,
+    stop: &std::sync::atomic::AtomicBool,
+    done: &(dyn Fn(film::TileResult) + Sync),
+) {
+    let (w, h) = film_size(scene);
+    with_estimator(scene, unit, &|estimator| film::render_tiles(w, h, estimator, job, stop, done))
+}
+
+/// Calls `work` with the scene's integrator over its world.
+fn with_estimator<T>(scene: &Scene, unit: shape::VectorUnit, work: &dyn Fn(&dyn film::PixelEstimator) -> T) -> T {
     let world = World::build_with(scene, unit);
     let s = &scene.render;
     let camera = Camera::new(&scene.camera, s.width, s.height);
-    let (w, h) = (camera.film_width, camera.film_height);
     match s.integrator {
         IntegratorKind::Whitted => {
-            let estimator =
-                WhittedEstimator { whitted: Whitted::new(scene, &world), camera: &camera, spp: s.spp, seed: s.seed };
-            film::render_image(w, h, &estimator, s.spp, progress)
+            work(&WhittedEstimator { whitted: Whitted::new(scene, &world), camera: &camera, spp: s.spp, seed: s.seed })
         }
-        IntegratorKind::Path => {
-            let estimator = PathTracer::new(scene, &world, &camera);
-            film::render_image(w, h, &estimator, s.spp, progress)
-        }
+        IntegratorKind::Path => work(&PathTracer::new(scene, &world, &camera)),
     }
 }

@@ -289,20 +289,20 @@ fn is_dispersive(b: &Bsdf) -> bool {
 }
 
 impl PixelEstimator for PathTracer<'_> {
-    fn samples(&self, x: u32, y: u32, out: &mut [Vec3]) {
+    fn samples(&self, x: u32, y: u32, first: u32, out: &mut [Vec3]) {
         if self.in_lanes {
-            self.pixels_in_lanes(&[(x, y)], out);
+            self.pixels_in_lanes(&[(x, y)], first, out);
         } else {
             let seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
-            out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample_of(seeds.stream(i as u32), x, y));
+            out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample_of(seeds.stream(first + i as u32), x, y));
         }
     }
 
-    fn pixels_samples(&self, pixels: &[(u32, u32)], out: &mut [Vec3]) {
+    fn pixels_samples(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
         if self.in_lanes {
-            self.pixels_in_lanes(pixels, out);
+            self.pixels_in_lanes(pixels, first, out);
         } else {
-            crate::film::pixel_by_pixel(pixels, out, |x, y, samples| self.samples(x, y, samples));
+            crate::film::pixel_by_pixel(pixels, out, |x, y, samples| self.samples(x, y, first, samples));
         }
     }
 

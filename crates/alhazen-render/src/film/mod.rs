@@ -1,12 +1,21 @@
 //! The film: linear radiance per pixel, rendered in parallel tiles. The tile order and the
 //! thread count do not affect any pixel (each sample's randomness is seeded from its pixel and
-//! index), so images are identical at any thread count.
+//! index), and a pixel's samples are summed exactly ([`alhazen_math::exact_sum`]), so the sum
+//! does not depend on how the samples were grouped either: a render made in parts — tiles on
+//! different machines, shares of the samples ([`part`]), or resumed from a checkpoint — merges
+//! to the bits of the render made at once.
+
+pub mod part;
 
 use alhazen_math::Vec3;
+use alhazen_math::exact_sum::{Digits, ExactSum, MAX_TERM};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::ops::Range;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-const TILE: u32 = 32;
+/// The side of the film's square tiles, in pixels.
+pub const TILE: u32 = 32;
 
 /// A rendered image: linear RGB, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,16 +41,16 @@ pub trait PixelEstimator: Sync {
     /// Linear RGB of sample `index` of pixel `(x, y)`: a pure function of its arguments.
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3;
 
-    /// Every sample of pixel `(x, y)`: `out[i] = self.sample(x, y, i)`, in whatever order
-    /// the estimator computes them fastest.
-    fn samples(&self, x: u32, y: u32, out: &mut [Vec3]) {
-        out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample(x, y, i as u32));
+    /// Consecutive samples of pixel `(x, y)`: `out[i] = self.sample(x, y, first + i)`, in
+    /// whatever order the estimator computes them fastest.
+    fn samples(&self, x: u32, y: u32, first: u32, out: &mut [Vec3]) {
+        out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample(x, y, first + i as u32));
     }
 
     /// [`Self::samples`] of several pixels: `out` holds each pixel's in turn (`out.len()` is a
     /// multiple of `pixels.len()`, the sample count).
-    fn pixels_samples(&self, pixels: &[(u32, u32)], out: &mut [Vec3]) {
-        pixel_by_pixel(pixels, out, |x, y, samples| self.samples(x, y, samples));
+    fn pixels_samples(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
+        pixel_by_pixel(pixels, out, |x, y, samples| self.samples(x, y, first, samples));
     }
 }
 
@@ -54,6 +63,140 @@ pub fn pixel_by_pixel(pixels: &[(u32, u32)], out: &mut [Vec3], mut samples: impl
     }
 }
 
+/// One of the film's tiles: a rectangle of pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tile {
+    /// Left column.
+    pub x0: u32,
+    /// Top row.
+    pub y0: u32,
+    /// Width in pixels (`TILE` but at the right edge).
+    pub width: u32,
+    /// Height in pixels (`TILE` but at the bottom edge).
+    pub height: u32,
+}
+
+impl Tile {
+    /// Its pixel count.
+    pub fn len(&self) -> usize {
+        (self.width * self.height) as usize
+    }
+
+    /// Whether it has no pixel (never, for a film's tiles).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// The tiles of a `w × h` film, row by row: the unit of parallel work, of progress, of
+/// checkpoints and of distributed renders.
+pub fn tiles(w: u32, h: u32) -> Vec<Tile> {
+    (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .map(|(x0, y0)| Tile { x0, y0, width: TILE.min(w - x0), height: TILE.min(h - y0) })
+        .collect()
+}
+
+/// What part of a render to make: some of the film's tiles, and a range of each pixel's
+/// sample indices (all of `0..spp` for a whole render).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Job {
+    /// Indices into [`tiles`] to render, in increasing order.
+    pub tiles: Vec<usize>,
+    /// Sample indices of every pixel.
+    pub samples: Range<u32>,
+    /// Whether each tile's exact sums are kept (for parts that are merged later).
+    pub keep_sums: bool,
+}
+
+impl Job {
+    /// Every tile of a `w × h` film with every sample of `spp`.
+    pub fn whole(w: u32, h: u32, spp: u32) -> Self {
+        Self { tiles: (0..tiles(w, h).len()).collect(), samples: 0..spp, keep_sums: false }
+    }
+}
+
+/// A rendered tile: its pixels over the job's samples and, when asked, their exact sums.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TileResult {
+    /// Index into [`tiles`].
+    pub index: usize,
+    /// The tile's pixels, row by row: each the mean of the job's samples.
+    pub pixels: Vec<[f32; 3]>,
+    /// Each pixel's exact channel sums, when the job keeps them.
+    pub sums: Option<PixelSums>,
+}
+
+/// Exact sums of a tile's pixels, three channels per pixel, as canonical digits
+/// ([`Digits`]): `heads[3p + c]` is (negative, first, count) of pixel `p`'s channel `c`, whose
+/// digits follow one another in `digits`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PixelSums {
+    /// Sign, place of the lowest digit and number of digits of each channel sum.
+    pub heads: Vec<[u8; 3]>,
+    /// The digits, channel after channel.
+    pub digits: Vec<u32>,
+}
+
+impl PixelSums {
+    fn push(&mut self, sums: &[ExactSum; 3]) {
+        for s in sums {
+            let d = s.digits();
+            self.heads.push([d.negative as u8, d.first as u8, d.digits.len() as u8]);
+            self.digits.extend_from_slice(&d.digits);
+        }
+    }
+
+    /// The channel sums one after the other.
+    pub fn channels(&self) -> impl Iterator<Item = Digits> + '_ {
+        self.heads.iter().scan(0usize, |at, &[negative, first, n]| {
+            let range = *at..*at + n as usize;
+            *at = range.end;
+            Some(Digits { negative: negative != 0, first: first as usize, digits: self.digits[range].to_vec() })
+        })
+    }
+}
+
+/// Renders the job's tiles of a `w × h` film with the job's samples of `spp`, handing each
+/// tile to `done` as it finishes (from worker threads, in any order). Tiles not yet begun
+/// when `stop` is set are skipped: what `done` received is all that was rendered.
+pub fn render_tiles(
+    w: u32,
+    h: u32,
+    estimator: &dyn PixelEstimator,
+    job: &Job,
+    stop: &AtomicBool,
+    done: &(dyn Fn(TileResult) + Sync),
+) {
+    let all = tiles(w, h);
+    job.tiles.par_iter().for_each(|&index| {
+        if !stop.load(Ordering::Relaxed) {
+            done(render_tile(all[index], index, estimator, job));
+        }
+    });
+}
+
+fn render_tile(tile: Tile, index: usize, estimator: &dyn PixelEstimator, job: &Job) -> TileResult {
+    let count = job.samples.len();
+    let mut pixels = Vec::with_capacity(tile.len());
+    let mut kept = job.keep_sums.then(PixelSums::default);
+    // A tile row at a time: the estimator may trace several pixels' samples together.
+    let mut samples = vec![Vec3::ZERO; count * tile.width as usize];
+    let mut sums: [ExactSum; 3] = Default::default();
+    for y in tile.y0..tile.y0 + tile.height {
+        let row: Vec<(u32, u32)> = (tile.x0..tile.x0 + tile.width).map(|x| (x, y)).collect();
+        estimator.pixels_samples(&row, job.samples.start, &mut samples);
+        for i in 0..row.len() {
+            sum_samples(&samples[i * count..(i + 1) * count], &mut sums);
+            pixels.push(pixel_value(&sums, count as u64));
+            if let Some(k) = kept.as_mut() {
+                k.push(&sums);
+            }
+        }
+    }
+    TileResult { index, pixels, sums: kept }
+}
+
 /// Renders a `w × h` image with `spp` samples per pixel, averaged with a box filter;
 /// `progress(done, total)` is called as tiles finish (from worker threads).
 pub fn render_image(
@@ -63,44 +206,46 @@ pub fn render_image(
     spp: u32,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Image {
-    let tiles: Vec<(u32, u32)> =
-        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE))).collect();
-    let done = AtomicUsize::new(0);
-    let rendered: Vec<Vec<[f32; 3]>> = tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let mut out = Vec::with_capacity((TILE * TILE) as usize);
-            let row_end = (x0 + TILE).min(w);
-            // A tile row at a time: the estimator may trace several pixels' samples together.
-            let mut samples = vec![Vec3::ZERO; spp as usize * (row_end - x0) as usize];
-            for y in y0..(y0 + TILE).min(h) {
-                let row: Vec<(u32, u32)> = (x0..row_end).map(|x| (x, y)).collect();
-                estimator.pixels_samples(&row, &mut samples);
-                out.extend(row.iter().enumerate().map(|(i, _)| average(&samples[i * spp as usize..][..spp as usize])));
-            }
-            progress(done.fetch_add(1, Ordering::Relaxed) + 1, tiles.len());
-            out
-        })
-        .collect();
-    let mut pixels = vec![[0f32; 3]; (w * h) as usize];
-    for (&(x0, y0), tile) in tiles.iter().zip(&rendered) {
-        let tw = (x0 + TILE).min(w) - x0;
-        for (k, px) in tile.iter().enumerate() {
-            let (x, y) = (x0 + k as u32 % tw, y0 + k as u32 / tw);
+    let job = Job::whole(w, h, spp);
+    let rendered = Mutex::new(vec![Vec::new(); job.tiles.len()]);
+    let finished = AtomicUsize::new(0);
+    render_tiles(w, h, estimator, &job, &AtomicBool::new(false), &|t| {
+        rendered.lock().unwrap_or_else(|e| e.into_inner())[t.index] = t.pixels;
+        progress(finished.fetch_add(1, Ordering::Relaxed) + 1, job.tiles.len());
+    });
+    let rendered = rendered.into_inner().unwrap_or_else(|e| e.into_inner());
+    assemble(w, h, rendered.iter().enumerate().map(|(i, p)| (i, p.as_slice())))
+}
+
+/// The image whose tiles (index into [`tiles`], pixels) are given; missing ones stay black.
+pub fn assemble<'a>(w: u32, h: u32, rendered: impl Iterator<Item = (usize, &'a [[f32; 3]])>) -> Image {
+    let all = tiles(w, h);
+    let mut pixels = vec![[0f32; 3]; (w as usize) * (h as usize)];
+    for (index, tile_pixels) in rendered {
+        let t = all[index];
+        for (k, px) in tile_pixels.iter().enumerate() {
+            let (x, y) = (t.x0 + k as u32 % t.width, t.y0 + k as u32 / t.width);
             pixels[(y * w + x) as usize] = *px;
         }
     }
     Image { width: w, height: h, pixels }
 }
 
-/// The box-filtered pixel of its samples, summed in index order.
-fn average(samples: &[Vec3]) -> [f32; 3] {
-    let mut sum = Vec3::ZERO;
-    for &c in samples {
-        // A NaN or infinity from a degenerate input must not poison the pixel.
-        sum += if c.is_finite() { c } else { Vec3::ZERO };
+/// A pixel's samples summed exactly, channel by channel. A NaN or infinity from a degenerate
+/// input adds nothing (it must not poison the pixel); huge values are clamped so no partial
+/// overflows.
+fn sum_samples(samples: &[Vec3], sums: &mut [ExactSum; 3]) {
+    sums.iter_mut().for_each(ExactSum::clear);
+    for c in samples.iter().filter(|c| c.is_finite()) {
+        for (s, v) in sums.iter_mut().zip([c.x, c.y, c.z]) {
+            s.add(v.clamp(-MAX_TERM, MAX_TERM));
+        }
     }
-    // Beyond the float range a pixel keeps the largest float, not an infinity.
-    let c = (sum / samples.len() as f64).clamp(Vec3::splat(-f32::MAX as f64), Vec3::splat(f32::MAX as f64));
-    [c.x as f32, c.y as f32, c.z as f32]
+}
+
+/// The box-filtered pixel: the exact sums of `count` samples divided by `count`. Beyond the
+/// float range a pixel keeps the largest float, not an infinity.
+pub fn pixel_value(sums: &[ExactSum; 3], count: u64) -> [f32; 3] {
+    let mean = |s: &ExactSum| (s.value() / count.max(1) as f64).clamp(-f32::MAX as f64, f32::MAX as f64) as f32;
+    [mean(&sums[0]), mean(&sums[1]), mean(&sums[2])]
 }

@@ -151,9 +151,9 @@ impl PathTracer<'_> {
             })
     }
 
-    /// Every sample of `pixels`, traced in lanes: `out` holds each pixel's samples in turn,
-    /// sample `i` of pixel `p` at `out[p × spp + i]`.
-    pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], out: &mut [Vec3]) {
+    /// Samples `first..` of `pixels`, traced in lanes: `out` holds each pixel's samples in
+    /// turn, sample `first + i` of pixel `p` at `out[p × n + i]` (`n` samples per pixel).
+    pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
         let mut paths: [Option<Path>; LANES] = Default::default();
         let spp = out.len() / pixels.len().max(1);
         let mut next = 0..out.len();
@@ -168,8 +168,8 @@ impl PathTracer<'_> {
             // Idle lanes start the pixel's next samples; all lanes' rays are traced together.
             for (i, slot) in paths.iter_mut().enumerate().filter(|(_, p)| p.is_none()) {
                 *slot = next.next().map(|job| {
-                    let ((x, y), index) = (pixels[job / spp], (job % spp) as u32);
-                    if index == 0 {
+                    let ((x, y), index) = (pixels[job / spp], first + (job % spp) as u32);
+                    if job % spp == 0 {
                         seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
                     }
                     streams.start(i, &seeds, index);
@@ -532,9 +532,9 @@ material = "glow"
                 let row: Vec<(u32, u32)> = (0..w).map(|x| (x, y)).collect();
                 let mut samples = vec![Vec3::NAN; spp * row.len()];
                 if y % 2 == 0 {
-                    tracer.pixels_samples(&row, &mut samples);
+                    tracer.pixels_samples(&row, 0, &mut samples);
                 } else {
-                    samples.chunks_mut(spp).zip(&row).for_each(|(s, &(x, y))| tracer.samples(x, y, s));
+                    samples.chunks_mut(spp).zip(&row).for_each(|(s, &(x, y))| tracer.samples(x, y, 0, s));
                 }
                 out.extend(samples);
             }
