@@ -4,18 +4,17 @@
 //! an unreadable or invalid scene file, impossible sizes).
 
 use alhazen_render::output::{Format, write_image};
-use alhazen_render::shape::VectorUnit;
 use alhazen_scene::{MAX_PIXELS, Scene, SceneError};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 
 mod anamorph;
 mod lines;
 mod mirror;
 mod raster;
+mod render;
 mod view;
 
 #[derive(Parser)]
@@ -31,7 +30,7 @@ enum Command {
     #[command(
         after_help = "Example:\n  alhazen render scenes/glass-balls.toml -o glass-balls.png --spp 16\n\nThe scene format is described in docs/scene-format.md."
     )]
-    Render(RenderArgs),
+    Render(render::RenderArgs),
     /// Rasterise a scene (the fast preview): z-buffer, shadow maps, flat/Gouraud/Phong shading.
     #[command(after_help = "Example:\n  alhazen raster scenes/glass-balls.toml -o preview.png --shading gouraud")]
     Raster(raster::RasterArgs),
@@ -54,6 +53,12 @@ enum Command {
         after_help = "The meshes go to binary PLY and the images to OpenEXR files in OUT-assets/ beside OUT.toml.\n\nExample:\n  alhazen convert model.glb -o model.toml"
     )]
     Convert(ConvertArgs),
+    /// Join film parts rendered with `render --tile/--pass` (e.g. on a cluster) into the image:
+    /// bit for bit the one a single render makes.
+    #[command(
+        after_help = "Example:\n  for i in 0 1 2 3; do alhazen render scene.toml --tile $i/4 -o part$i.film; done\n  alhazen merge part*.film -o scene.exr"
+    )]
+    Merge(render::MergeArgs),
 }
 
 #[derive(Args)]
@@ -90,64 +95,6 @@ pub(crate) struct ImageArgs {
     pub(crate) quiet: bool,
 }
 
-#[derive(Args)]
-struct RenderArgs {
-    #[command(flatten)]
-    image: ImageArgs,
-    /// Samples per pixel (overrides the scene).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1048576))]
-    spp: Option<u32>,
-    /// Maximum ray depth (overrides the scene).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=1000))]
-    depth: Option<u32>,
-    /// Random seed (overrides the scene): a whole number from 0 to 2^64 − 1.
-    #[arg(long, allow_negative_numbers = true, value_parser = parse_seed)]
-    seed: Option<u64>,
-    /// Integrator (overrides the scene): recursive ray tracing or path tracing.
-    #[arg(long, value_enum)]
-    integrator: Option<IntegratorArg>,
-    /// The path tracer's sampler (overrides the scene).
-    #[arg(long, value_enum)]
-    sampler: Option<SamplerArg>,
-    /// Do not join lights to surfaces through sphere, cylinder and plane mirrors exactly (for
-    /// comparison: caustics are then left to sampled paths, and lost under Whitted).
-    #[arg(long)]
-    no_mirror_connections: bool,
-    /// The vector kernels to use (default: the widest this processor has). Every kernel renders
-    /// the same image; this is for measuring their speed.
-    #[arg(long, value_enum)]
-    kernel: Option<KernelArg>,
-}
-
-/// `--kernel`.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-enum KernelArg {
-    /// Scalar loops, on any processor.
-    Portable,
-    /// AVX2 (x86-64).
-    Avx2,
-    /// AVX-512 F, DQ, VL and BW (x86-64).
-    Avx512,
-}
-
-/// `--integrator`.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-enum IntegratorArg {
-    /// The lecture's recursive ray tracer.
-    Whitted,
-    /// Path tracing with next-event estimation and MIS.
-    Path,
-}
-
-/// `--sampler`.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-enum SamplerArg {
-    /// Owen-scrambled Sobol points.
-    Sobol,
-    /// Independent uniform numbers.
-    Independent,
-}
-
 /// An error and the exit code it deserves.
 pub(crate) struct Failure {
     code: u8,
@@ -166,7 +113,8 @@ impl Failure {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => run_render(&args),
+        Command::Render(args) => render::run(&args),
+        Command::Merge(args) => render::run_merge(&args),
         Command::Raster(args) => raster::run(&args),
         Command::View(args) => view::run(&args),
         Command::Mirror(cmd) => mirror::run(&cmd),
@@ -179,28 +127,6 @@ fn main() -> ExitCode {
             eprintln!("error: {}", f.message);
             ExitCode::from(f.code)
         }
-    }
-}
-
-fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
-    let r = &mut scene.render;
-    r.spp = a.spp.unwrap_or(r.spp);
-    r.max_depth = a.depth.unwrap_or(r.max_depth);
-    r.seed = a.seed.unwrap_or(r.seed);
-    if let Some(i) = a.integrator {
-        r.integrator = match i {
-            IntegratorArg::Whitted => alhazen_scene::IntegratorKind::Whitted,
-            IntegratorArg::Path => alhazen_scene::IntegratorKind::Path,
-        };
-    }
-    if a.no_mirror_connections {
-        r.mirror_connections = false;
-    }
-    if let Some(s) = a.sampler {
-        r.sampler = match s {
-            SamplerArg::Sobol => alhazen_scene::SamplerKind::Sobol,
-            SamplerArg::Independent => alhazen_scene::SamplerKind::Independent,
-        };
     }
 }
 
@@ -244,10 +170,6 @@ pub(crate) fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
     Ok(format)
 }
 
-fn parse_seed(s: &str) -> Result<u64, String> {
-    s.parse::<u64>().map_err(|_| format!("a seed is a whole number from 0 to 18446744073709551615, not {s:?}"))
-}
-
 /// Warns when the scene has no light `renderer` uses but emitting objects it ignores (only the
 /// path tracer lights with them), saying what to do.
 pub(crate) fn warn_unlit(scene: &Scene, renderer: &str, remedy: &str) {
@@ -275,67 +197,6 @@ pub(crate) fn check_output_dir(path: &Path) -> Result<(), Failure> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     if !dir.is_dir() {
         return Err(Failure::input(format!("{}: the directory {} does not exist", path.display(), dir.display())));
-    }
-    Ok(())
-}
-
-/// The kernel `--kernel` names, if this processor has it.
-fn vector_unit(kernel: Option<KernelArg>) -> Result<VectorUnit, Failure> {
-    let Some(kernel) = kernel else { return Ok(VectorUnit::detect()) };
-    let name = match kernel {
-        KernelArg::Portable => "portable",
-        KernelArg::Avx2 => "avx2",
-        KernelArg::Avx512 => "avx512",
-    };
-    let available = VectorUnit::available();
-    available.iter().copied().find(|u| u.name() == name).ok_or_else(|| {
-        let names: Vec<&str> = available.iter().map(|u| u.name()).collect();
-        Failure::input(format!("--kernel {name}: this processor lacks it (it has: {})", names.join(", ")))
-    })
-}
-
-fn run_render(a: &RenderArgs) -> Result<(), Failure> {
-    let unit = vector_unit(a.kernel)?;
-    let format = check_output(&a.image.output, a.image.half)?;
-    let output = open_output(&a.image.output)?;
-    let mut scene = load_sized(&a.image)?;
-    apply_overrides(&mut scene, a);
-    if scene.render.integrator == alhazen_scene::IntegratorKind::Whitted {
-        warn_unlit(&scene, "Whitted ray tracing", "use --integrator path");
-    }
-    let threads = a.image.threads.map_or(0, |t| t as usize);
-    let pool =
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| Failure::work(e.to_string()))?;
-    let bar = progress_bar(a.image.quiet);
-    let start = Instant::now();
-    let image = pool.install(|| {
-        alhazen_render::render_with(&scene, unit, &|done, total| {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-        })
-    });
-    bar.finish_and_clear();
-    let elapsed = start.elapsed();
-    output
-        .write_image(&image, format)
-        .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.image.output.display())))?;
-    if !a.image.quiet {
-        let r = &scene.render;
-        let integrator = match r.integrator {
-            alhazen_scene::IntegratorKind::Whitted => "Whitted ray tracing".to_string(),
-            alhazen_scene::IntegratorKind::Path => format!("path tracing, {:?} sampler", r.sampler).to_lowercase(),
-        };
-        eprintln!(
-            "rendered {} ({}×{}, {} spp, depth {}, {integrator}) in {:.3} s on {} threads → {}",
-            a.image.scene.display(),
-            image.width,
-            image.height,
-            r.spp,
-            r.max_depth,
-            elapsed.as_secs_f64(),
-            pool.current_num_threads(),
-            a.image.output.display()
-        );
     }
     Ok(())
 }
