@@ -3,8 +3,8 @@
 //! resumed after an interruption. Every way gives the same bits.
 
 use crate::{Failure, ImageArgs, check_output, check_output_dir, load_sized, open_output, progress_bar, warn_unlit};
-use alhazen_render::film::part::{self, Part, fingerprint, merge, share};
-use alhazen_render::film::{Job, TileResult, tiles};
+use alhazen_render::film::part::{self, Part, fingerprint, merge, share, share_samples};
+use alhazen_render::film::{Job, SAMPLE_BLOCK, TileResult, tiles};
 use alhazen_render::shape::VectorUnit;
 use alhazen_scene::Scene;
 use clap::Args;
@@ -53,8 +53,8 @@ pub(crate) struct RenderArgs {
     /// be joined with `alhazen merge`: e.g. one band per machine or per job of an array.
     #[arg(long, value_name = "I/N", value_parser = parse_split)]
     tile: Option<(u32, u32)>,
-    /// Render share I of N of every pixel's samples (0 ≤ I < N) into a film part (-o NAME.film);
-    /// merged, the shares give the bits of one render with all the samples.
+    /// Render share I of N of every pixel's samples (0 ≤ I < N; shares are whole blocks of 8
+    /// samples) into a film part (-o NAME.film); merged, the shares give the bits of one render.
     #[arg(long, value_name = "I/N", value_parser = parse_split)]
     pass: Option<(u32, u32)>,
     /// Save progress to FILE (a film part, .film) every --checkpoint-every seconds and when
@@ -177,7 +177,7 @@ impl Plan {
         let spp = scene.render.spp;
         let count = tiles(width, height).len();
         let band = a.tile.map_or(0..count as u64, |(i, n)| share(count as u64, i, n));
-        let samples = a.pass.map_or(0..spp as u64, |(i, n)| share(spp as u64, i, n));
+        let samples = a.pass.map_or(0..spp, |(i, n)| share_samples(spp, i, n));
         if band.is_empty() {
             let n = a.tile.map_or(1, |t| t.1);
             return Err(Failure::input(format!(
@@ -186,10 +186,17 @@ impl Plan {
         }
         if samples.is_empty() {
             let n = a.pass.map_or(1, |p| p.1);
-            return Err(Failure::input(format!("--pass …/{n}: {spp} samples per pixel make at most {spp} passes")));
+            let most = spp.div_ceil(SAMPLE_BLOCK);
+            return Err(Failure::input(format!(
+                "--pass …/{n}: passes split the samples in blocks of {SAMPLE_BLOCK}, so {spp} samples per pixel make at most {most} passes"
+            )));
         }
-        let (band, samples) = (band.start as usize..band.end as usize, samples.start as u32..samples.end as u32);
-        Ok(Self { width, height, spp, fingerprint: fingerprint(scene), band, samples })
+        let band = band.start as usize..band.end as usize;
+        // Only what is saved to be merged or resumed needs the fingerprint (hashing a big
+        // scene's meshes takes a moment).
+        let saved = is_part(&a.image.output) || a.checkpoint.is_some();
+        let fingerprint = if saved { fingerprint(scene) } else { 0 };
+        Ok(Self { width, height, spp, fingerprint, band, samples })
     }
 
     fn empty_part(&self) -> Part {

@@ -68,7 +68,7 @@ fn same_file(dir: &Path, a: &str, b: &str) -> bool {
 fn tiles_and_passes_merge_to_the_bytes_of_one_render() {
     let dir = setup();
     let d = dir.path();
-    for (flag, n) in [("--tile", 3), ("--pass", 5)] {
+    for (flag, n) in [("--tile", 3), ("--pass", 3)] {
         let names: Vec<String> = (0..n).map(|i| format!("{}-{i}.film", &flag[2..])).collect();
         for (i, name) in names.iter().enumerate() {
             ok(alhazen(d, &["render", "s.toml", flag, &format!("{i}/{n}"), "-o", name, "-q", "--threads", "1"]));
@@ -99,9 +99,9 @@ fn bad_parts_and_options_are_refused() {
     let (c, e) = code(alhazen(d, &["render", "s.toml", "--pass", "2/2", "-o", "x.film"]));
     assert_eq!(c, Some(2));
     assert!(e.contains("expected I/N with 0 ≤ I < N"), "{e}");
-    let (c, e) = code(alhazen(d, &["render", "s.toml", "--pass", "0/30", "-o", "x.film"]));
+    let (c, e) = code(alhazen(d, &["render", "s.toml", "--pass", "0/4", "-o", "x.film"]));
     assert_eq!(c, Some(2));
-    assert!(e.contains("24 samples per pixel make at most 24 passes"), "{e}");
+    assert!(e.contains("24 samples per pixel make at most 3 passes"), "{e}");
     // Parts of different renders, and a damaged part.
     ok(alhazen(d, &["render", "s.toml", "--tile", "0/2", "-o", "a.film", "-q"]));
     ok(alhazen(d, &["render", "s.toml", "--tile", "1/2", "-o", "b.film", "-q", "--seed", "9"]));

@@ -62,6 +62,9 @@ impl ExactSum {
     #[inline]
     pub fn add(&mut self, x: f64) {
         debug_assert!(x.is_finite(), "{x}");
+        if x == 0.0 {
+            return; // common (black), and it would widen the digits to carry
+        }
         let bits = x.to_bits();
         let exponent = ((bits >> 52) & 0x7ff) as u32;
         let fraction = bits & ((1 << 52) - 1);
@@ -125,27 +128,27 @@ impl ExactSum {
     }
 
     /// The exact sum rounded to the nearest double, ties to even (in the subnormal range
-    /// within one unit of the last place, still a function of the exact sum alone).
-    pub fn value(&self) -> f64 {
-        // `digits().value()` without allocating: this runs once per pixel and channel.
+    /// within one unit of the last place, still a function of the exact sum alone). Carries
+    /// in place, without allocating: this runs once per pixel and channel.
+    pub fn value(&mut self) -> f64 {
         let (lo, hi) = self.touched;
         if lo > hi {
             return 0.0;
         }
-        let mut c = self.chunks;
-        let mut top = carry(&mut c, lo, hi);
-        let negative = c[top] < 0;
-        if negative {
-            c[lo..=top].iter_mut().for_each(|d| *d = -*d);
-            top = carry(&mut c, lo, top);
+        let mut top = carry(&mut self.chunks, lo, hi);
+        self.touched.1 = top;
+        self.adds = 0;
+        if self.chunks[top] < 0 {
+            return self.digits().value(); // negative sums are rare: through a copy
         }
+        let c = &self.chunks;
         while top > lo && c[top] == 0 {
             top -= 1;
         }
         let base = top.saturating_sub(2);
         let window = c[base..=top].iter().rev().fold(0u128, |v, &d| (v << 32) | d as u128);
         let sticky = c[lo.min(base)..base].iter().any(|&d| d != 0);
-        round(window, sticky, base, negative)
+        round(window, sticky, base, false)
     }
 }
 
@@ -158,8 +161,9 @@ fn round(window: u128, sticky: bool, place: usize, negative: bool) -> f64 {
     if negative { -v } else { v }
 }
 
-/// Carries `c[lo..]` upward until nothing is left to carry past `hi`; returns the top digit's
-/// index. Every digit below it is then in `0..2^32`; the top one is negative for a negative sum.
+/// Carries `c[lo..]` upward until nothing is left to carry past `hi` (digits above `hi` are
+/// zero); returns the top digit's index. Every digit below it is then in `0..2^32`; the top one
+/// is negative for a negative sum (and the carrying stops there, not at the last digit).
 fn carry(c: &mut [i64; CHUNKS], lo: usize, hi: usize) -> usize {
     let mut top = hi;
     for k in lo..CHUNKS - 1 {
@@ -170,6 +174,9 @@ fn carry(c: &mut [i64; CHUNKS], lo: usize, hi: usize) -> usize {
         c[k] -= carry << 32;
         c[k + 1] += carry;
         top = top.max(k + 1);
+        if k >= hi && (-(1 << 32)..0).contains(&c[k + 1]) {
+            break;
+        }
     }
     top
 }
@@ -268,7 +275,7 @@ mod tests {
         #[test]
         fn order_and_grouping_do_not_matter(raw in prop::collection::vec(fixed_point(), 1..60), cut in 0usize..60, seed in any::<u64>()) {
             let terms: Vec<f64> = raw.into_iter().map(|u| as_double(representable(u))).collect();
-            let whole = sum(&terms);
+            let mut whole = sum(&terms);
             // Two passes summed apart, then merged by their digits.
             let cut = cut.min(terms.len());
             let (a, mut b) = (sum(&terms[..cut]), sum(&terms[cut..]));

@@ -2,7 +2,7 @@
 //! resumed — merges to the bits of the render made at once; damaged or mismatched parts are
 //! refused with a reason, never a panic.
 
-use alhazen_render::film::part::{self, Part, fingerprint, merge, share};
+use alhazen_render::film::part::{self, Part, fingerprint, merge, share, share_samples};
 use alhazen_render::film::{Job, TileResult, tiles};
 use alhazen_render::shape::VectorUnit;
 use alhazen_render::{Image, film_size, render_tiles_with, render_with};
@@ -14,7 +14,7 @@ const SCENE: &str = r#"
 [render]
 width = 75
 height = 41
-spp = 7
+spp = 37
 max_depth = 4
 integrator = "path"
 [camera]
@@ -71,8 +71,8 @@ fn part_of(scene: &Scene, job: &Job) -> Part {
 fn job(scene: &Scene, (i, n): (u32, u32), (j, m): (u32, u32)) -> Job {
     let (w, h) = film_size(scene);
     let t = share(tiles(w, h).len() as u64, i, n);
-    let s = share(scene.render.spp as u64, j, m);
-    Job { tiles: (t.start as usize..t.end as usize).collect(), samples: s.start as u32..s.end as u32, keep_sums: true }
+    let samples = share_samples(scene.render.spp, j, m);
+    Job { tiles: (t.start as usize..t.end as usize).collect(), samples, keep_sums: true }
 }
 
 fn round_trip(p: &Part) -> Part {
@@ -89,7 +89,7 @@ fn assert_same(a: &Image, b: &Image, what: &str) {
 fn parts_merge_to_the_bits_of_one_render() {
     for (name, scene) in scenes() {
         let whole = render_with(&scene, VectorUnit::detect(), &|_, _| {});
-        for (n, m) in [(1, 1), (3, 1), (1, 3), (2, 7), (4, 2)] {
+        for (n, m) in [(1, 1), (3, 1), (1, 3), (2, 5), (4, 2)] {
             let parts: Vec<Part> = (0..n)
                 .flat_map(|i| (0..m).map(move |j| (i, j)))
                 .map(|(i, j)| round_trip(&part_of(&scene, &job(&scene, (i, n), (j, m)))))
@@ -145,7 +145,7 @@ fn mismatched_and_incomplete_parts_are_refused() {
     let q = part_of(&scene, &job(&scene, (0, 1), (1, 3)));
     assert!(merge(&[p.clone(), q]).unwrap_err().message.contains("split them differently"));
     let err = merge(&[p]).unwrap_err();
-    assert!(err.message.contains("lacks samples 3..7"), "{err}");
+    assert!(err.message.contains("lacks samples 16..37"), "{err}");
     assert!(merge(&[]).is_err());
 }
 
@@ -165,6 +165,23 @@ fn damaged_files_are_refused_not_read() {
     }
     assert!(Part::decode(b"P6\n1 1\n255\n").unwrap_err().contains("not a film part"));
     assert_eq!(part::EXTENSION, "film");
+}
+
+#[test]
+fn sample_passes_split_at_blocks() {
+    assert_eq!(share_samples(37, 0, 2), 0..16);
+    assert_eq!(share_samples(37, 1, 2), 16..37);
+    assert!((0..6).any(|i| share_samples(37, i, 6).is_empty()), "five blocks make at most five passes");
+    for n in 1..6 {
+        let passes: Vec<_> = (0..n).map(|i| share_samples(37, i, n)).collect();
+        assert!(passes.iter().all(|p| !p.is_empty() && p.start % 8 == 0 && (p.end % 8 == 0 || p.end == 37)));
+        assert!(passes.windows(2).all(|w| w[0].end == w[1].start) && passes[n as usize - 1].end == 37);
+    }
+    // A part whose samples do not start at a block is not one alhazen writes: refused on reading.
+    let (_, scene) = scenes().remove(0);
+    let mut odd = job(&scene, (0, 4), (0, 1));
+    odd.samples = 3..37;
+    assert!(Part::decode(&part_of(&scene, &odd).encode()).unwrap_err().contains("holds samples 3..37"));
 }
 
 #[test]

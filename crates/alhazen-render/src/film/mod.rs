@@ -103,7 +103,8 @@ pub fn tiles(w: u32, h: u32) -> Vec<Tile> {
 pub struct Job {
     /// Indices into [`tiles`] to render, in increasing order.
     pub tiles: Vec<usize>,
-    /// Sample indices of every pixel.
+    /// Sample indices of every pixel: to merge with other jobs' bit for bit, from and to
+    /// multiples of [`SAMPLE_BLOCK`] (or `spp`), as [`part::share_samples`] splits them.
     pub samples: Range<u32>,
     /// Whether each tile's exact sums are kept (for parts that are merged later).
     pub keep_sums: bool,
@@ -187,8 +188,8 @@ fn render_tile(tile: Tile, index: usize, estimator: &dyn PixelEstimator, job: &J
         let row: Vec<(u32, u32)> = (tile.x0..tile.x0 + tile.width).map(|x| (x, y)).collect();
         estimator.pixels_samples(&row, job.samples.start, &mut samples);
         for i in 0..row.len() {
-            sum_samples(&samples[i * count..(i + 1) * count], &mut sums);
-            pixels.push(pixel_value(&sums, count as u64));
+            sum_samples(&samples[i * count..(i + 1) * count], job.samples.start, &mut sums);
+            pixels.push(pixel_value(&mut sums, count as u64));
             if let Some(k) = kept.as_mut() {
                 k.push(&sums);
             }
@@ -231,21 +232,32 @@ pub fn assemble<'a>(w: u32, h: u32, rendered: impl Iterator<Item = (usize, &'a [
     Image { width: w, height: h, pixels }
 }
 
-/// A pixel's samples summed exactly, channel by channel. A NaN or infinity from a degenerate
-/// input adds nothing (it must not poison the pixel); huge values are clamped so no partial
-/// overflows.
-fn sum_samples(samples: &[Vec3], sums: &mut [ExactSum; 3]) {
+/// Samples are summed in blocks of this many consecutive indices (`[8j, 8j + 8)`), each block
+/// in index order in doubles, and the blocks' sums exactly: the pixel then depends only on its
+/// samples, whichever jobs made them, as long as jobs split the samples at block boundaries
+/// ([`part::share_samples`]) — at an eighth of the cost of summing every sample exactly.
+pub const SAMPLE_BLOCK: u32 = 8;
+
+/// A pixel's samples (indices `first..`) summed by blocks, channel by channel. A NaN or
+/// infinity from a degenerate input adds nothing (it must not poison the pixel); huge values
+/// are clamped so no block sum overflows.
+fn sum_samples(samples: &[Vec3], first: u32, sums: &mut [ExactSum; 3]) {
     sums.iter_mut().for_each(ExactSum::clear);
-    for c in samples.iter().filter(|c| c.is_finite()) {
-        for (s, v) in sums.iter_mut().zip([c.x, c.y, c.z]) {
-            s.add(v.clamp(-MAX_TERM, MAX_TERM));
+    let to_boundary = ((SAMPLE_BLOCK - first % SAMPLE_BLOCK) % SAMPLE_BLOCK) as usize;
+    let (head, rest) = samples.split_at(to_boundary.min(samples.len()));
+    for block in std::iter::once(head).filter(|h| !h.is_empty()).chain(rest.chunks(SAMPLE_BLOCK as usize)) {
+        let mut block_sum = Vec3::ZERO;
+        for c in block.iter().filter(|c| c.is_finite()) {
+            block_sum += c.clamp(Vec3::splat(-MAX_TERM), Vec3::splat(MAX_TERM));
+        }
+        for (s, v) in sums.iter_mut().zip([block_sum.x, block_sum.y, block_sum.z]) {
+            s.add(v);
         }
     }
 }
 
 /// The box-filtered pixel: the exact sums of `count` samples divided by `count`. Beyond the
 /// float range a pixel keeps the largest float, not an infinity.
-pub fn pixel_value(sums: &[ExactSum; 3], count: u64) -> [f32; 3] {
-    let mean = |s: &ExactSum| (s.value() / count.max(1) as f64).clamp(-f32::MAX as f64, f32::MAX as f64) as f32;
-    [mean(&sums[0]), mean(&sums[1]), mean(&sums[2])]
+pub fn pixel_value(sums: &mut [ExactSum; 3], count: u64) -> [f32; 3] {
+    sums.each_mut().map(|s| (s.value() / count.max(1) as f64).clamp(-f32::MAX as f64, f32::MAX as f64) as f32)
 }

@@ -76,6 +76,21 @@ pub fn share(total: u64, i: u32, n: u32) -> Range<u64> {
     at(i)..at(i + 1)
 }
 
+/// Pass `i` of `n` of the sample indices `0..spp`: the shares split at multiples of
+/// [`SAMPLE_BLOCK`](super::SAMPLE_BLOCK) (so that they merge exactly), and are empty when there
+/// are more passes than blocks.
+pub fn share_samples(spp: u32, i: u32, n: u32) -> Range<u32> {
+    let block = super::SAMPLE_BLOCK;
+    let r = share(spp.div_ceil(block) as u64, i, n);
+    (r.start as u32 * block).min(spp)..(r.end as u32 * block).min(spp)
+}
+
+/// Whether `samples` of `0..spp` starts and ends where sample blocks do (or at `spp`).
+fn block_aligned(samples: &Range<u32>, spp: u32) -> bool {
+    let at_boundary = |k: u32| k.is_multiple_of(super::SAMPLE_BLOCK) || k == spp;
+    at_boundary(samples.start) && at_boundary(samples.end)
+}
+
 impl Part {
     /// A part of the film `width × height × spp` holding nothing yet.
     pub fn new(fingerprint: u64, width: u32, height: u32, spp: u32) -> Self {
@@ -145,7 +160,7 @@ impl Part {
             let Some(tile) = all.get(index) else {
                 return Err(format!("tile {index} does not exist in a {width}×{height} film"));
             };
-            if start >= end || end > spp {
+            if start >= end || end > spp || !block_aligned(&(start..end), spp) {
                 return Err(format!("tile {index} holds samples {start}..{end} of {spp}"));
             }
             let with_sums = r.u8()? != 0;
@@ -294,7 +309,8 @@ fn spans(indices: &[usize]) -> String {
             _ => runs.push((i, i)),
         }
     }
-    let text: Vec<String> = runs.iter().map(|&(a, b)| if a == b { a.to_string() } else { format!("{a}–{b}") }).collect();
+    let text: Vec<String> =
+        runs.iter().map(|&(a, b)| if a == b { a.to_string() } else { format!("{a}–{b}") }).collect();
     text.join(", ")
 }
 
@@ -324,7 +340,7 @@ fn merge_tile(list: &[Piece], spp: u32) -> Vec<[f32; 3]> {
                     s.add_digits(&part.next().expect("three sums per pixel"));
                 }
             }
-            super::pixel_value(&sums, spp as u64)
+            super::pixel_value(&mut sums, spp as u64)
         })
         .collect()
 }
