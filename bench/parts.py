@@ -22,6 +22,12 @@ SUITE = [("cornell-box", ["--integrator", "path", "--spp", "64"]),
          ("glass-balls", ["--width", "1920", "--height", "1080", "--spp", "1"]),
          ("haas-haus", [])]
 
+# Passes split samples in blocks of 8: every scene here has at least 32 spp.
+SPLIT = [("cornell-box", ["--integrator", "path", "--spp", "64"]),
+         ("cornell-rough", ["--spp", "32"]),
+         ("prism", ["--spp", "32"]),
+         ("glass-balls", ["--width", "640", "--height", "480", "--spp", "32"])]
+
 
 def timed(binary, args):
     t = time.perf_counter()
@@ -58,7 +64,7 @@ def split(runs):
     print("| scene | one render (s) | 4 bands + merge (s) | 4 passes + merge (s) | same bytes | bands / passes on disk (MiB) |")
     print("|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as d:
-        for name, extra in SUITE[:3] + SUITE[5:6]:
+        for name, extra in SPLIT:
             scene = [f"scenes/{name}.toml", *extra, "-q"]
             one, bands, passes = [], [], []
             for _ in range(runs):
