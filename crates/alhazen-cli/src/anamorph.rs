@@ -123,6 +123,12 @@ fn raster_print(a: &AnamorphArgs, paper: Vec2, out: &str) -> Result<Vec<u8>, Fai
     // The print at `n`× the resolution, averaged over n × n blocks in linear light.
     let n = a.supersample as usize;
     let fine_rows = (at.paper.y / 25.4 * a.dpi * n as f64).round().max(1.0) as u64;
+    // The print (sRGB bytes, then its encoding) and one fine row of texture coordinates.
+    let pixels = (at.paper.x / 25.4 * a.dpi).round() * (at.paper.y / 25.4 * a.dpi).round();
+    let row = at.paper.x / 25.4 * a.dpi * n as f64 * 32.0;
+    let needed = (pixels * 6.0 + row).min(u64::MAX as f64) as u64;
+    let what = format!("a {:.0} × {:.0} mm print at {} dpi", at.paper.x, at.paper.y, a.dpi);
+    crate::check_memory(needed, &what)?;
     let (mut rgb, mut sums, mut w) = (vec![], vec![], 0usize);
     let bar = crate::progress_bar(false);
     bar.set_length(fine_rows);

@@ -20,8 +20,73 @@ mod view;
 #[derive(Parser)]
 #[command(name = "alhazen", version, about = "Mirrors, glass and line art: one scene, exact reflections.")]
 struct Cli {
+    /// The memory alhazen may use, e.g. 12G or 512M (K, M, G, T: powers of 1024). A scene or
+    /// an output that would need more is refused before anything is allocated. Default: three
+    /// quarters of this machine's memory, or of the process's limit (ulimit -v, cgroup) if lower.
+    #[arg(long, global = true, value_name = "SIZE", value_parser = parse_size)]
+    max_memory: Option<u64>,
     #[command(subcommand)]
     command: Command,
+}
+
+/// The memory budget of this run (`--max-memory` or the machine's share), set once in `main`.
+static MEMORY_BUDGET: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+
+/// The memory budget of this run.
+pub(crate) fn memory_budget() -> u64 {
+    *MEMORY_BUDGET.get_or_init(default_memory_budget)
+}
+
+/// Refuses work that needs more than the memory budget (bad input: exit 2), naming the need.
+pub(crate) fn check_memory(needed: u64, what: &str) -> Result<(), Failure> {
+    let budget = memory_budget();
+    if needed <= budget {
+        return Ok(());
+    }
+    Err(Failure::input(format!(
+        "{what} needs about {}, more than the memory budget of {} (--max-memory raises it)",
+        alhazen_scene::format_bytes(needed),
+        alhazen_scene::format_bytes(budget)
+    )))
+}
+
+/// Three quarters of the least of: the machine's memory, the process's address-space limit,
+/// its cgroup's memory limit (8 GiB where none can be read).
+fn default_memory_budget() -> u64 {
+    let read = |p: &str| std::fs::read_to_string(p).ok();
+    let total = read("/proc/meminfo").and_then(|m| {
+        let line = m.lines().find(|l| l.starts_with("MemTotal:"))?.to_string();
+        Some(line.split_whitespace().nth(1)?.parse::<u64>().ok()? * 1024)
+    });
+    let address_space = read("/proc/self/limits").and_then(|l| {
+        let line = l.lines().find(|l| l.starts_with("Max address space"))?.to_string();
+        line.split_whitespace().nth(3)?.parse::<u64>().ok()
+    });
+    let cgroup = read("/sys/fs/cgroup/memory.max").and_then(|v| v.trim().parse::<u64>().ok());
+    let least = [total, address_space, cgroup].into_iter().flatten().min().unwrap_or(8 << 30);
+    least / 4 * 3
+}
+
+fn parse_size(s: &str) -> Result<u64, String> {
+    let t = s.trim().trim_end_matches(['B', 'b']).trim_end_matches('i');
+    let (digits, unit) = match t.char_indices().find(|(_, c)| c.is_ascii_alphabetic()) {
+        Some((i, _)) => (&t[..i], &t[i..]),
+        None => (t, ""),
+    };
+    let shift = match unit.to_ascii_uppercase().as_str() {
+        "" => 0,
+        "K" => 10,
+        "M" => 20,
+        "G" => 30,
+        "T" => 40,
+        _ => return Err(format!("a size such as 12G, 512M or 4096K, not {s:?}")),
+    };
+    match digits.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v * (1u64 << shift) as f64 <= u64::MAX as f64 => {
+            Ok((v * (1u64 << shift) as f64) as u64)
+        }
+        _ => Err(format!("a size such as 12G, 512M or 4096K, not {s:?}")),
+    }
 }
 
 #[derive(Subcommand)]
@@ -112,6 +177,9 @@ impl Failure {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(bytes) = cli.max_memory {
+        let _ = MEMORY_BUDGET.set(bytes);
+    }
     let result = match cli.command {
         Command::Render(args) => render::run(&args),
         Command::Merge(args) => render::run_merge(&args),
@@ -133,7 +201,7 @@ fn main() -> ExitCode {
 /// Reads a scene file in any format alhazen imports (TOML, glTF, Mitsuba XML, pbrt), printing
 /// what the import approximated; every problem with it is bad input (exit code 2).
 pub(crate) fn load(path: &Path) -> Result<Scene, Failure> {
-    let imported = alhazen_import::load(path).map_err(|e| match e {
+    let imported = alhazen_import::load_within(path, memory_budget()).map_err(|e| match e {
         SceneError::Io { .. } => Failure::input(e.to_string()),
         SceneError::Syntax(d) => Failure::input(d.to_string()),
     })?;

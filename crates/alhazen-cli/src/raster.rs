@@ -119,6 +119,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
             VisibilityArg::Bsp => Visibility::Bsp,
         },
     };
+    crate::check_memory(alhazen_raster::pipeline::memory_estimate(&scene, &opts), "previewing this scene")?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.image.threads.map_or(0, |t| t as usize))
         .build()

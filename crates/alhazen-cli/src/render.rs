@@ -236,6 +236,8 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         warn_unlit(&scene, "Whitted ray tracing", "use --integrator path");
     }
     let plan = Plan::new(&scene, a)?;
+    let what = format!("rendering this {}×{} film", plan.width, plan.height);
+    crate::check_memory(alhazen_render::memory_estimate(&scene), &what)?;
     let resumed = match &a.checkpoint {
         Some(c) => open_checkpoint(c, a.resume, &plan)?,
         None => plan.empty_part(),
@@ -270,7 +272,7 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
     let written = match format {
         None => output.finish(|f| f.write_all(&part.encode())),
         Some(format) => {
-            let image = merge(std::slice::from_ref(&part)).map_err(|e| Failure::work(e.to_string()))?;
+            let image = part.into_image().map_err(|e| Failure::work(e.to_string()))?;
             output.write_image(&image, format)
         }
     };

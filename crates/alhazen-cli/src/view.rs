@@ -127,6 +127,8 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
         _ => return Err(Failure::input("alhazen view needs a perspective or orthographic camera")),
     };
     let mut prepared_for = RasterOptions::default();
+    let bsp = RasterOptions { visibility: alhazen_raster::pipeline::Visibility::Bsp, ..RasterOptions::default() };
+    crate::check_memory(alhazen_raster::pipeline::memory_estimate(&scene, &bsp), "previewing this scene")?;
     let mut prepared = prepare(&scene, &prepared_for);
     let mut window = Window::new("alhazen view", w, h, WindowOptions::default())
         .map_err(|e| Failure::work(format!("cannot open a window (is an X server running?): {e}")))?;

@@ -601,3 +601,41 @@ fn convert_writes_toml_that_renders_and_refuses_other_outputs() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("is a .toml file"));
 }
+
+#[test]
+fn work_beyond_the_memory_budget_is_refused_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let many: String =
+        (0..2000).map(|i| format!("[[object]]\nshape = \"sphere\"\ncenter = [{i}, 0, 0]\nradius = 0.4\n")).collect();
+    std::fs::write(d.join("many.toml"), format!("{OK}{many}")).unwrap();
+    std::fs::write(d.join("sub.toml"), "[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 6\n").unwrap();
+    let run = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_alhazen")).current_dir(d).args(args).output().unwrap();
+        (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    let cases: [(&[&str], &str); 3] = [
+        (&["raster", "many.toml", "-o", "m.png", "--max-memory", "64M"], "previewing this scene needs about"),
+        (
+            &["render", "many.toml", "-o", "m.png", "--width", "8000", "--height", "8000", "--max-memory", "64M"],
+            "rendering this 8000×8000 film needs",
+        ),
+        (
+            &["render", "sub.toml", "-o", "s.png", "--max-memory", "4M"],
+            "sub.toml:4:10: subdividing this 6-face mesh 6 times",
+        ),
+    ];
+    for (args, what) in cases {
+        let (code, err) = run(args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert!(err.contains(what) && err.contains("more than the memory budget of"), "{args:?}: {err}");
+        assert!(!d.join("m.png").exists() && !d.join("s.png").exists());
+    }
+    let (code, err) = run(&["render", "sub.toml", "-o", "s.png", "--max-memory", "lots"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("a size such as 12G"), "{err}");
+    // Within the budget the same scene renders.
+    let (code, err) =
+        run(&["render", "sub.toml", "-o", "s.png", "--max-memory", "2G", "--width", "32", "--height", "24"]);
+    assert_eq!(code, Some(0), "{err}");
+}

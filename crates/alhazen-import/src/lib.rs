@@ -97,8 +97,16 @@ impl SceneFormat {
 
 /// Reads a scene file in any supported format (chosen by [`SceneFormat::from_path`]).
 pub fn load(path: &Path) -> Result<Imported, SceneError> {
+    load_within(path, alhazen_scene::DEFAULT_MEMORY_BUDGET)
+}
+
+/// [`load`], refusing geometry the scene generates beyond `memory_budget` bytes (before
+/// allocating it).
+pub fn load_within(path: &Path, memory_budget: u64) -> Result<Imported, SceneError> {
     match SceneFormat::from_path(path) {
-        SceneFormat::Alhazen => Ok(Imported { scene: alhazen_scene::load_scene(path)?, warnings: vec![] }),
+        SceneFormat::Alhazen => {
+            Ok(Imported { scene: alhazen_scene::load_scene_within(path, memory_budget)?, warnings: vec![] })
+        }
         SceneFormat::Gltf => gltf::load(path),
         SceneFormat::Mitsuba => mitsuba::load(path),
         SceneFormat::Pbrt => pbrt::load(path),

@@ -429,3 +429,24 @@ fn an_unbounded_plane_is_lit_per_pixel_whatever_the_shading() {
         assert!(err < 0.02, "{shading:?}: floor differs by {:.2} %", err * 100.0);
     }
 }
+
+#[test]
+fn the_memory_estimate_counts_every_triangle_drawn() {
+    // The estimate counts triangles without tessellating; it must not count fewer than are made.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        let scene = alhazen_scene::load_scene(&path).unwrap();
+        let made = alhazen_raster::pipeline::geometry::scene_triangles(&scene).triangles.len() as u64;
+        let counted: u64 =
+            scene.objects.iter().map(|o| alhazen_raster::pipeline::geometry::triangle_count(&scene, &o.shape)).sum();
+        assert!(counted >= made, "{}: {counted} counted, {made} made", path.display());
+        assert!(alhazen_raster::pipeline::memory_estimate(&scene, &RasterOptions::default()) > made * 200);
+        checked += 1;
+    }
+    assert!(checked > 20);
+}

@@ -95,6 +95,9 @@ fn parts_merge_to_the_bits_of_one_render() {
                 .map(|(i, j)| round_trip(&part_of(&scene, &job(&scene, (i, n), (j, m)))))
                 .collect();
             assert_same(&merge(&parts).unwrap(), &whole, &format!("{name}: {n} bands × {m} passes"));
+            if (n, m) == (1, 1) {
+                assert_same(&parts[0].clone().into_image().unwrap(), &whole, "into_image");
+            }
         }
     }
 }

@@ -30,7 +30,7 @@ pub mod write;
 
 pub use diagnostic::{Diagnostic, did_you_mean};
 pub use model::*;
-pub use parse::{MAX_PIXELS, MAX_SIDE, empty_scene, parse_scene, rectangle as rectangle_mesh};
+pub use parse::{MAX_PIXELS, MAX_SIDE, empty_scene, parse_scene, parse_scene_within, rectangle as rectangle_mesh};
 use std::path::{Path, PathBuf};
 
 /// Why a scene could not be loaded.
@@ -62,8 +62,26 @@ impl std::error::Error for SceneError {}
 /// (such as `/dev/zero`), are refused before reading.
 pub const MAX_SCENE_BYTES: u64 = 256 << 20;
 
+/// What geometry a scene generates (subdivision) may take when the caller does not say: 8 GiB.
+pub const DEFAULT_MEMORY_BUDGET: u64 = 8 << 30;
+
+/// `bytes` for people: "3.2 GB", "512 MB", "12 kB".
+pub fn format_bytes(bytes: u64) -> String {
+    let b = bytes as f64;
+    match bytes {
+        0..1_000_000 => format!("{:.0} kB", b / 1e3),
+        1_000_000..1_000_000_000 => format!("{:.0} MB", b / 1e6),
+        _ => format!("{:.1} GB", b / 1e9),
+    }
+}
+
 /// Reads and parses a scene file.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    load_scene_within(path, DEFAULT_MEMORY_BUDGET)
+}
+
+/// [`load_scene`] within a memory budget for generated geometry ([`parse_scene_within`]).
+pub fn load_scene_within(path: &Path, memory_budget: u64) -> Result<Scene, SceneError> {
     let io = |source| SceneError::Io { path: path.to_path_buf(), source };
     let meta = std::fs::metadata(path).map_err(io)?;
     if !meta.is_file() {
@@ -82,5 +100,5 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
         let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
         SceneError::Syntax(Box::new(Diagnostic::at(path, &text, at..at + 1, "the scene file is not valid UTF-8")))
     })?;
-    parse_scene(path, &text)
+    parse_scene_within(path, &text, memory_budget)
 }

@@ -19,8 +19,15 @@ pub const MAX_PIXELS: u64 = 1 << 28;
 pub(crate) const TOP_KEYS: &[&str] =
     &["render", "camera", "background", "ambient", "light", "materials", "meshes", "groups", "object"];
 
-/// Parses scene text; `file` names it in messages and anchors relative paths.
+/// Parses scene text; `file` names it in messages and anchors relative paths. Geometry the
+/// scene generates (subdivision) may take [`DEFAULT_MEMORY_BUDGET`](crate::DEFAULT_MEMORY_BUDGET).
 pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
+    parse_scene_within(file, text, crate::DEFAULT_MEMORY_BUDGET)
+}
+
+/// [`parse_scene`], refusing (with the location) generated geometry that would take more than
+/// `memory_budget` bytes, before allocating it.
+pub fn parse_scene_within(file: &Path, text: &str, memory_budget: u64) -> Result<Scene, SceneError> {
     let src = Src { file, text };
     let root = DeTable::parse(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
@@ -34,6 +41,7 @@ pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
         material_names: HashMap::new(),
         mesh_names: HashMap::new(),
         mesh_files: HashMap::new(),
+        memory_budget,
     };
     p.scene_from(&top).map_err(SceneError::Syntax)?;
     Ok(p.scene)
@@ -65,6 +73,8 @@ pub(crate) struct Parser<'a> {
     mesh_names: HashMap<String, (usize, Vec<MaterialId>)>,
     /// Mesh files already loaded (a group instanced many times shares its meshes).
     mesh_files: HashMap<std::path::PathBuf, (usize, Vec<MaterialId>)>,
+    /// Bytes that generated geometry may take.
+    memory_budget: u64,
 }
 
 impl Parser<'_> {
@@ -323,6 +333,19 @@ impl Parser<'_> {
             None => false,
         };
         let levels = t.get("levels").map_or(Ok(3), |n| n.integer(0, 6))?;
+        // Each level quadruples the halfedges; the meshes of two levels and the triangles
+        // take about this much per halfedge of the last.
+        const BYTES_PER_HALFEDGE: u64 = 96;
+        let needed = base.halfedges.len() as u64 * 4u64.pow(levels as u32) * BYTES_PER_HALFEDGE;
+        if needed > self.memory_budget {
+            let at = t.get("levels").unwrap_or(t.req("shape")?);
+            return Err(at.err(format!(
+                "subdividing this {}-face mesh {levels} times needs about {}, more than the memory budget of {} (lower `levels`, or raise the budget: alhazen --max-memory)",
+                base.faces.len(),
+                crate::format_bytes(needed),
+                crate::format_bytes(self.memory_budget)
+            )));
+        }
         let mut m = base;
         for _ in 0..levels {
             m = if doo_sabin {

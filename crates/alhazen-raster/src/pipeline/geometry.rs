@@ -182,6 +182,22 @@ fn object_triangles(scene: &Scene, shape: &Shape) -> Option<Vec<[Vertex; 3]>> {
     })
 }
 
+/// How many triangles [`object_triangles`] makes of `shape`, without making them (for the
+/// memory estimate).
+pub fn triangle_count(scene: &Scene, shape: &Shape) -> u64 {
+    let round = SEGMENTS as u64;
+    match shape {
+        Shape::Sphere { .. } => round * round,
+        Shape::Cylinder { capped, .. } => 2 * round + if *capped { 2 * round } else { 0 },
+        Shape::Cone { capped, .. } => 2 * round + if *capped { round } else { 0 },
+        Shape::Disk { .. } => round,
+        Shape::Plane { .. } => 128,
+        Shape::Box { .. } => 12,
+        Shape::Mesh { mesh, .. } => scene.meshes[*mesh].triangles.len() as u64,
+        Shape::Csg { .. } => 0,
+    }
+}
+
 fn place(tri: [Vertex; 3], tf: &Transform) -> [Vertex; 3] {
     let mut t = tri.map(|v| Vertex { p: tf.point(v.p), n: tf.normal(v.n).normalize_or_zero(), uv: v.uv });
     // A mirroring transform reverses the winding.

@@ -393,6 +393,20 @@ fn fragment_color(
 
 const BAND: u32 = 16;
 
+/// About how many bytes [`render_scene`] takes for `scene` at its size with `opts`: the world's
+/// triangles and their screen copies (one and a half per triangle, for clipping), the BSP
+/// tree's when asked for, the frame and depth buffers, and room for shadow maps. Computed
+/// without tessellating, so a scene that would not fit is refused before allocating.
+pub fn memory_estimate(scene: &Scene, opts: &RasterOptions) -> u64 {
+    let triangles: u64 = scene.objects.iter().map(|o| geometry::triangle_count(scene, &o.shape)).sum();
+    let world = std::mem::size_of::<Triangle>() as u64;
+    let screen = std::mem::size_of::<ScreenTriangle>() as u64;
+    let per_triangle = world + screen * 3 / 2 + 16 + if opts.visibility == Visibility::Bsp { 2 * world } else { 0 };
+    let pixels = scene.render.width as u64 * scene.render.height as u64;
+    const SHADOW_MAPS: u64 = 64 << 20;
+    triangles * per_triangle + pixels * 32 + SHADOW_MAPS * scene.lights.len().min(16) as u64
+}
+
 /// Renders `scene` at its `[render]` size with the camera of the scene file.
 pub fn render_scene(scene: &Scene, opts: &RasterOptions) -> Result<(Framebuffer, RasterStats), RasterError> {
     render_prepared(scene, &prepare(scene, opts), opts)

@@ -221,15 +221,19 @@ pub fn render_image(
 /// The image whose tiles (index into [`tiles`], pixels) are given; missing ones stay black.
 pub fn assemble<'a>(w: u32, h: u32, rendered: impl Iterator<Item = (usize, &'a [[f32; 3]])>) -> Image {
     let all = tiles(w, h);
-    let mut pixels = vec![[0f32; 3]; (w as usize) * (h as usize)];
+    let mut image = Image { width: w, height: h, pixels: vec![[0f32; 3]; (w as usize) * (h as usize)] };
     for (index, tile_pixels) in rendered {
-        let t = all[index];
-        for (k, px) in tile_pixels.iter().enumerate() {
-            let (x, y) = (t.x0 + k as u32 % t.width, t.y0 + k as u32 / t.width);
-            pixels[(y * w + x) as usize] = *px;
-        }
+        place(&mut image, all[index], tile_pixels);
     }
-    Image { width: w, height: h, pixels }
+    image
+}
+
+/// Copies a tile's pixels (row by row) into the image.
+pub fn place(image: &mut Image, t: Tile, tile_pixels: &[[f32; 3]]) {
+    for (row, line) in tile_pixels.chunks_exact(t.width as usize).enumerate() {
+        let at = ((t.y0 + row as u32) * image.width + t.x0) as usize;
+        image.pixels[at..at + line.len()].copy_from_slice(line);
+    }
 }
 
 /// Samples are summed in blocks of this many consecutive indices (`[8j, 8j + 8)`), each block

@@ -324,6 +324,24 @@ pub fn merge(parts: &[Part]) -> Result<Image, MergeError> {
     Ok(super::assemble(w, h, merged.iter().enumerate().map(|(i, p)| (i, p.as_slice()))))
 }
 
+impl Part {
+    /// The image of a part that holds every sample of every tile (a whole render, or a
+    /// resumed one), taking its tiles' pixels one by one: the peak memory is one image, not two.
+    pub fn into_image(mut self) -> Result<Image, MergeError> {
+        coverage(std::slice::from_ref(&self))?;
+        let (w, h) = (self.width, self.height);
+        let all = tiles(w, h);
+        let mut image = Image { width: w, height: h, pixels: vec![[0f32; 3]; (w as usize) * (h as usize)] };
+        while let Some((_, tile)) = self.tiles.pop() {
+            super::place(&mut image, all[tile.index], &tile.pixels);
+            if self.tiles.len() * 4 < self.tiles.capacity() {
+                self.tiles.shrink_to_fit();
+            }
+        }
+        Ok(image)
+    }
+}
+
 /// One tile's pixels from its parts (which cover `0..spp`).
 fn merge_tile(list: &[Piece], spp: u32) -> Vec<[f32; 3]> {
     if let [(_, whole)] = list {
