@@ -143,30 +143,55 @@ struct Query {
     axis: Option<[f64; 3]>,
 }
 
-fn solve(q: &Query) -> Result<Reflexes, String> {
-    let (eye, point) = (Site::At(Vec3::from_array(q.eye)), Site::At(Vec3::from_array(q.point)));
+/// The reflexes `q` asks for, solved for the mirror scaled to unit radius at the origin (the
+/// solver's tolerances are absolute, so a mirror of radius 1e-300 or a scene at 1e150 would
+/// otherwise find nothing), with the map back to the query's coordinates.
+fn solve(q: &Query) -> Result<(Reflexes, Unscale), String> {
     let center = Vec3::from_array(q.center);
+    if !(q.radius.is_finite() && q.radius > 0.0) {
+        return Err(format!("\"radius\" must be positive, not {}", q.radius));
+    }
+    let unscale = Unscale { center, scale: q.radius };
+    let local = |v: [f64; 3]| (Vec3::from_array(v) - center) / q.radius;
+    let (eye, point) = (local(q.eye), local(q.point));
+    // Beyond 1e100 radii squares overflow: such an eye or point is at infinity for the solver.
+    if !(eye.length() <= 1e100 && point.length() <= 1e100) {
+        return Err("the eye or the point is more than 1e100 radii from the mirror: too far to solve".into());
+    }
+    let (eye, point) = (Site::At(eye), Site::At(point));
     let result: Result<Reflexes, MirrorError> = match (q.mirror.as_str(), q.axis) {
-        ("sphere", None) => Sphere { center, radius: q.radius }.reflexes(eye, point),
+        ("sphere", None) => Sphere { center: Vec3::ZERO, radius: 1.0 }.reflexes(eye, point),
         ("sphere", Some(_)) => return Err("a sphere takes no \"axis\"".into()),
         ("cylinder", Some(axis)) => {
-            Cylinder { center, axis: Vec3::from_array(axis), radius: q.radius }.reflexes(eye, point)
+            Cylinder { center: Vec3::ZERO, axis: Vec3::from_array(axis), radius: 1.0 }.reflexes(eye, point)
         }
         ("cylinder", None) => return Err("a cylinder needs \"axis\"".into()),
         (other, _) => return Err(format!("unknown mirror \"{other}\": expected \"sphere\" or \"cylinder\"")),
     };
-    result.map_err(|e| e.to_string())
+    result.map(|r| (r, unscale)).map_err(|e| e.to_string())
 }
 
-fn answer(r: &Reflexes) -> serde_json::Value {
+/// From the unit mirror's coordinates back to the query's.
+struct Unscale {
+    center: Vec3,
+    scale: f64,
+}
+
+impl Unscale {
+    fn point(&self, v: Vec3) -> Vec3 {
+        self.center + v * self.scale
+    }
+}
+
+fn answer((r, back): &(Reflexes, Unscale)) -> serde_json::Value {
     let p = |v: Vec3| serde_json::json!([v.x, v.y, v.z]);
     let kind = |k: alhazen_mirror::ReflexKind| format!("{k:?}").to_lowercase();
     let mut all: Vec<serde_json::Value> =
-        r.all().map(|x| serde_json::json!({"point": p(x.point), "kind": kind(x.kind)})).collect();
+        r.all().map(|x| serde_json::json!({"point": p(back.point(x.point)), "kind": kind(x.kind)})).collect();
     if let Some(c) = r.circle {
-        all.push(serde_json::json!({"circle": {"center": p(c.center), "axis": p(c.axis), "radius": c.radius}, "kind": kind(c.kind)}));
+        all.push(serde_json::json!({"circle": {"center": p(back.point(c.center)), "axis": p(c.axis), "radius": c.radius * back.scale}, "kind": kind(c.kind)}));
     }
-    serde_json::json!({"reflexes": r.visible().map(|v| vec![p(v.point)]).unwrap_or_default(), "all": all})
+    serde_json::json!({"reflexes": r.visible().map(|v| vec![p(back.point(v.point))]).unwrap_or_default(), "all": all})
 }
 
 /// serde's message without its position inside the one line (the reply's `line` field says

@@ -405,6 +405,36 @@ mod mirror {
     }
 
     #[test]
+    fn reflexes_do_not_depend_on_the_scale() {
+        // The same configuration at radius 1, 1e-300 and 1e150: the answers scale with it
+        // (the solver's tolerances are absolute; a tiny or huge mirror used to find nothing).
+        let at = |s: f64| {
+            let q = format!(
+                r#"{{"mirror":"sphere","center":[{c},0,0],"radius":{s:e},"eye":[{c},0,{e:e}],"point":[{px:e},0,{pz:e}]}}"#,
+                c = 7.0 * s,
+                e = 5.0 * s,
+                px = 10.0 * s,
+                pz = 4.0 * s
+            );
+            let (code, lines) = reflex(&format!("{q}\n"));
+            assert_eq!(code, 0, "{q}");
+            let p: Vec<f64> = lines[0]["reflexes"][0].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            [p[0] / s - 7.0, p[1] / s, p[2] / s]
+        };
+        let unit = at(1.0);
+        for s in [1e-300, 1e150] {
+            let scaled = at(s);
+            assert!((0..3).all(|k| (scaled[k] - unit[k]).abs() < 1e-12), "{s}: {scaled:?} vs {unit:?}");
+        }
+        let (code, lines) = reflex(concat!(
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1e-300,"eye":[0,0,5],"point":[3,0,4]}"#,
+            "\n"
+        ));
+        assert_eq!(code, 2);
+        assert!(lines[0]["error"].as_str().unwrap().contains("more than 1e100 radii"), "{lines:?}");
+    }
+
+    #[test]
     fn bad_lines_are_reported_and_skipped() {
         let (code, lines) = reflex(concat!(
             "not json\n",
@@ -600,6 +630,21 @@ fn convert_writes_toml_that_renders_and_refuses_other_outputs() {
     let o = alhazen(&["convert", xml.to_str().unwrap(), "-o", dir.path().join("c.json").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("is a .toml file"));
+}
+
+#[test]
+fn deep_nesting_and_control_characters_are_named() {
+    let deep = format!(
+        "[[object]]\nshape = \"csg\"\nop = \"union\"\na = {}{{ shape = \"sphere\", radius = 1 }}{}\nb = {{ shape = \"sphere\", radius = 1 }}\n",
+        "{ op = \"union\", a = ".repeat(90),
+        ", b = { shape = \"sphere\", radius = 1 } }".repeat(90)
+    );
+    let (code, err, _) = render(&deep, &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("nested too deeply") && err.contains("64 levels"), "{err}");
+    let (code, err, _) = render("[camera]\neye = [0, 0, 5]\0\n", &[]);
+    assert_eq!(code, 2);
+    assert!(err.contains("U+0000, a NUL byte") && err.contains("scene.toml:2:"), "{err}");
 }
 
 #[test]

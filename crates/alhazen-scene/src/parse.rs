@@ -31,7 +31,20 @@ pub fn parse_scene_within(file: &Path, text: &str, memory_budget: u64) -> Result
     let src = Src { file, text };
     let root = DeTable::parse(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
-        let msg = e.message().lines().next().unwrap_or("invalid TOML").trim_end_matches('.').to_string();
+        let mut msg = e.message().lines().next().unwrap_or("invalid TOML").trim_end_matches('.').to_string();
+        if msg.contains("recurs") {
+            msg =
+                "tables nested too deeply for the TOML reader (CSG operands and groups nest at most 64 levels)".into();
+        }
+        if let Some(c) =
+            text.get(span.start..).and_then(|t| t.chars().next()).filter(|c| c.is_control() && !c.is_whitespace())
+        {
+            msg += &format!(
+                " (the file has a control character here, U+{:04X}{})",
+                c as u32,
+                if c == '\0' { ", a NUL byte" } else { "" }
+            );
+        }
         SceneError::Syntax(Box::new(crate::Diagnostic::at(file, text, span, format!("TOML syntax error: {msg}"))))
     })?;
     let top = Table { src, t: root.get_ref(), span: root.span(), name: "scene", scope: None };
