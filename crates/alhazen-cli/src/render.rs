@@ -346,11 +346,20 @@ fn render_plan(scene: &Scene, unit: VectorUnit, plan: &Plan, resumed: Part, a: &
     let bar = progress_bar(a.image.quiet);
     bar.set_length(plan.band.len() as u64);
     bar.set_position(resumed.tiles.len() as u64);
-    let state =
-        Mutex::new(Progress { part: resumed, saved: Instant::now(), started: Instant::now(), new: 0, warned: false });
+    let state = Mutex::new(Progress {
+        part: resumed,
+        saved: Instant::now(),
+        started: Instant::now(),
+        new: 0,
+        warned: false,
+        unusable: 0,
+        clamped: 0,
+    });
     let every = Duration::from_secs_f64(a.checkpoint_every);
     render_tiles(scene, unit, &job, &|t| {
         let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
+        s.unusable += t.unusable_samples;
+        s.clamped += t.clamped_pixels;
         s.part.push(job.samples.clone(), t);
         s.new += 1;
         bar.inc(1);
@@ -363,7 +372,20 @@ fn render_plan(scene: &Scene, unit: VectorUnit, plan: &Plan, resumed: Part, a: &
         }
     });
     bar.finish_and_clear();
-    let part = state.into_inner().unwrap_or_else(|e| e.into_inner()).part;
+    let progress = state.into_inner().unwrap_or_else(|e| e.into_inner());
+    if progress.unusable > 0 {
+        eprintln!(
+            "warning: {} samples had a radiance that is not a finite number or is beyond ±1e300 (a degenerate value in the scene?): left out or clamped",
+            progress.unusable
+        );
+    }
+    if progress.clamped > 0 {
+        eprintln!(
+            "warning: {} pixels are brighter than a 32-bit float can hold and keep the largest one (3.4e38); is a light or an emission absurdly strong?",
+            progress.clamped
+        );
+    }
+    let part = progress.part;
     let stopped = STOP.load(Ordering::SeqCst) && part.tiles.len() < plan.band.len();
     (part, stopped)
 }
@@ -378,6 +400,10 @@ struct Progress {
     started: Instant,
     new: usize,
     warned: bool,
+    /// Samples the film left out or clamped.
+    unusable: u64,
+    /// Pixels beyond the float range.
+    clamped: u64,
 }
 
 impl Progress {

@@ -633,6 +633,22 @@ fn convert_writes_toml_that_renders_and_refuses_other_outputs() {
 }
 
 #[test]
+fn clamped_pixels_are_reported() {
+    let text =
+        OK.replace("position = [3, 3, 3]", "position = [3, 3, 3]\nattenuation = [0, 0, 1e-100]\nintensity = 1e100");
+    assert_ne!(text, OK);
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), &text);
+    let out = dir.path().join("out.exr");
+    let o = alhazen(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("pixels are brighter than a 32-bit float can hold"), "{err}");
+    let (_, err, _) = render(OK, &[]);
+    assert!(!err.contains("warning"), "{err}");
+}
+
+#[test]
 fn deep_nesting_and_control_characters_are_named() {
     let deep = format!(
         "[[object]]\nshape = \"csg\"\nop = \"union\"\na = {}{{ shape = \"sphere\", radius = 1 }}{}\nb = {{ shape = \"sphere\", radius = 1 }}\n",

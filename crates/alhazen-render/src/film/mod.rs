@@ -126,6 +126,12 @@ pub struct TileResult {
     pub pixels: Vec<[f32; 3]>,
     /// Each pixel's exact channel sums, when the job keeps them.
     pub sums: Option<PixelSums>,
+    /// Samples left out because they were not finite (NaN or infinite radiance from a
+    /// degenerate input), or clamped to ±[`MAX_TERM`]: for the render's summary. Not saved in
+    /// parts.
+    pub unusable_samples: u64,
+    /// Pixels whose value is beyond the float range and kept the largest float.
+    pub clamped_pixels: u64,
 }
 
 /// Exact sums of a tile's pixels, three channels per pixel, as canonical digits
@@ -184,18 +190,21 @@ fn render_tile(tile: Tile, index: usize, estimator: &dyn PixelEstimator, job: &J
     // A tile row at a time: the estimator may trace several pixels' samples together.
     let mut samples = vec![Vec3::ZERO; count * tile.width as usize];
     let mut sums: [ExactSum; 3] = Default::default();
+    let (mut unusable_samples, mut clamped_pixels) = (0, 0);
     for y in tile.y0..tile.y0 + tile.height {
         let row: Vec<(u32, u32)> = (tile.x0..tile.x0 + tile.width).map(|x| (x, y)).collect();
         estimator.pixels_samples(&row, job.samples.start, &mut samples);
         for i in 0..row.len() {
-            sum_samples(&samples[i * count..(i + 1) * count], job.samples.start, &mut sums);
-            pixels.push(pixel_value(&mut sums, count as u64));
+            unusable_samples += sum_samples(&samples[i * count..(i + 1) * count], job.samples.start, &mut sums);
+            let pixel = pixel_value(&mut sums, count as u64);
+            clamped_pixels += pixel.iter().any(|c| c.abs() == f32::MAX) as u64;
+            pixels.push(pixel);
             if let Some(k) = kept.as_mut() {
                 k.push(&sums);
             }
         }
     }
-    TileResult { index, pixels, sums: kept }
+    TileResult { index, pixels, sums: kept, unusable_samples, clamped_pixels }
 }
 
 /// Renders a `w × h` image with `spp` samples per pixel, averaged with a box filter;
@@ -244,20 +253,30 @@ pub const SAMPLE_BLOCK: u32 = 8;
 
 /// A pixel's samples (indices `first..`) summed by blocks, channel by channel. A NaN or
 /// infinity from a degenerate input adds nothing (it must not poison the pixel); huge values
-/// are clamped so no block sum overflows.
-fn sum_samples(samples: &[Vec3], first: u32, sums: &mut [ExactSum; 3]) {
+/// are clamped so no block sum overflows. Returns how many samples were left out or clamped.
+fn sum_samples(samples: &[Vec3], first: u32, sums: &mut [ExactSum; 3]) -> u64 {
+    let limit = Vec3::splat(MAX_TERM);
+    let mut unusable = 0;
     sums.iter_mut().for_each(ExactSum::clear);
     let to_boundary = ((SAMPLE_BLOCK - first % SAMPLE_BLOCK) % SAMPLE_BLOCK) as usize;
     let (head, rest) = samples.split_at(to_boundary.min(samples.len()));
     for block in std::iter::once(head).filter(|h| !h.is_empty()).chain(rest.chunks(SAMPLE_BLOCK as usize)) {
         let mut block_sum = Vec3::ZERO;
-        for c in block.iter().filter(|c| c.is_finite()) {
-            block_sum += c.clamp(Vec3::splat(-MAX_TERM), Vec3::splat(MAX_TERM));
+        for c in block {
+            if c.is_finite() && c.abs().cmple(limit).all() {
+                block_sum += *c;
+            } else {
+                unusable += 1;
+                if c.is_finite() {
+                    block_sum += c.clamp(-limit, limit);
+                }
+            }
         }
         for (s, v) in sums.iter_mut().zip([block_sum.x, block_sum.y, block_sum.z]) {
             s.add(v);
         }
     }
+    unusable
 }
 
 /// The box-filtered pixel: the exact sums of `count` samples divided by `count`. Beyond the

@@ -173,7 +173,7 @@ impl Part {
             if sums.is_none() && (start..end) != (0..spp) {
                 return Err(format!("tile {index} holds samples {start}..{end} of {spp} without their sums"));
             }
-            part.tiles.push((start..end, TileResult { index, pixels, sums }));
+            part.tiles.push((start..end, TileResult { index, pixels, sums, unusable_samples: 0, clamped_pixels: 0 }));
         }
         if r.at != body.len() {
             return Err(format!("{} bytes follow the last tile", body.len() - r.at));
