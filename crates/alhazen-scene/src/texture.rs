@@ -8,8 +8,9 @@ pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Ve
     match tex {
         Texture::Solid(c) => *c,
         Texture::Checker { even, odd, size } => {
-            let k = (uv.x / size).floor() as i64 + (uv.y / size).floor() as i64;
-            if k.rem_euclid(2) == 0 { *even } else { *odd }
+            // The squares' parity in doubles: a tiny `size` makes indices beyond any integer type.
+            let parity = |t: f64| (t / size).floor().rem_euclid(2.0);
+            if parity(uv.x) == parity(uv.y) { *even } else { *odd }
         }
         Texture::Image { image, scale } => bilinear(&images[*image], uv * *scale),
     }
@@ -62,6 +63,23 @@ mod tests {
         assert_eq!(eval(&t, Vec2::new(1.5, 0.5), &[]), Vec3::ZERO);
         assert_eq!(eval(&t, Vec2::new(-0.5, 0.5), &[]), Vec3::ZERO);
         assert_eq!(eval(&t, Vec2::new(-0.5, -0.5), &[]), Vec3::ONE);
+    }
+
+    #[test]
+    fn tiny_squares_and_far_coordinates_do_not_overflow() {
+        // Found by the fuzzer: `size = 1e-320` overflowed the integer square index.
+        let t = Texture::Checker { even: Vec3::ONE, odd: Vec3::ZERO, size: 1e-320 };
+        for uv in [Vec2::new(3.0, -7.0), Vec2::new(1e300, 2.5), Vec2::new(-1e300, -1e300)] {
+            let c = eval(&t, uv, &[]);
+            assert!(c == Vec3::ONE || c == Vec3::ZERO);
+        }
+        // Where indices fit an integer, the parity is the sum's.
+        let t = Texture::Checker { even: Vec3::ONE, odd: Vec3::ZERO, size: 0.3 };
+        for (x, y) in [(0.1, 0.7), (-2.9, 4.4), (100.05, -33.3), (7.0, 7.0)] {
+            let k = (x / 0.3f64).floor() as i64 + (y / 0.3f64).floor() as i64;
+            let want = if k.rem_euclid(2) == 0 { Vec3::ONE } else { Vec3::ZERO };
+            assert_eq!(eval(&t, Vec2::new(x, y), &[]), want, "({x}, {y})");
+        }
     }
 
     #[test]
