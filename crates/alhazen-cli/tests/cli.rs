@@ -633,6 +633,27 @@ fn convert_writes_toml_that_renders_and_refuses_other_outputs() {
 }
 
 #[test]
+fn a_missing_material_library_is_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+    for (name, text, warned) in
+        [("with.obj", format!("mtllib missing.mtl\n{obj}"), true), ("without.obj", obj.to_string(), false)]
+    {
+        std::fs::write(dir.path().join(name), text).unwrap();
+        let scene = scene_file(dir.path(), &format!("{OK}[[object]]\nshape = \"mesh\"\nfile = \"{name}\"\n"));
+        let out = dir.path().join("out.png");
+        let o = alhazen(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "-q"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "{err}");
+        assert_eq!(
+            err.contains("warning:") && err.contains("material library could not be read"),
+            warned,
+            "{name}: {err}"
+        );
+    }
+}
+
+#[test]
 fn clamped_pixels_are_reported() {
     let text =
         OK.replace("position = [3, 3, 3]", "position = [3, 3, 3]\nattenuation = [0, 0, 1e-100]\nintensity = 1e100");

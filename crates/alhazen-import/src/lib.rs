@@ -105,7 +105,10 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
 pub fn load_within(path: &Path, memory_budget: u64) -> Result<Imported, SceneError> {
     match SceneFormat::from_path(path) {
         SceneFormat::Alhazen => {
-            Ok(Imported { scene: alhazen_scene::load_scene_within(path, memory_budget)?, warnings: vec![] })
+            let (scene, warnings) = alhazen_scene::load_scene_reporting(path, memory_budget)?;
+            let warnings =
+                warnings.into_iter().map(|message| Warning { file: path.to_path_buf(), line: 0, message }).collect();
+            Ok(Imported { scene, warnings })
         }
         SceneFormat::Gltf => gltf::load(path),
         SceneFormat::Mitsuba => mitsuba::load(path),

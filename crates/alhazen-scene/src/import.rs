@@ -14,6 +14,8 @@ pub struct LoadedMesh {
     pub mesh: TriangleMesh,
     /// Materials referenced by `mesh.material_slots`.
     pub materials: Vec<Material>,
+    /// What could not be read but did not stop the loading (a missing material library).
+    pub warnings: Vec<String>,
 }
 
 /// Loads an `.obj` or `.ply` file; the error message names the file.
@@ -24,11 +26,11 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh, String> {
         Some("bpt") => std::fs::read_to_string(path)
             .map_err(|e| e.to_string())
             .and_then(|t| parse_bpt(&t))
-            .map(|mesh| LoadedMesh { mesh, materials: vec![] }),
+            .map(|mesh| LoadedMesh { mesh, materials: vec![], warnings: vec![] }),
         Some("ply") => std::fs::read(path)
             .map_err(|e| e.to_string())
             .and_then(|b| parse_ply(&b))
-            .map(|mesh| LoadedMesh { mesh, materials: vec![] }),
+            .map(|mesh| LoadedMesh { mesh, materials: vec![], warnings: vec![] }),
         _ => Err("unsupported mesh format (expected .obj, .ply or .bpt)".into()),
     };
     let loaded = result.map_err(|e| format!("cannot load mesh {}: {e}", path.display()))?;
@@ -40,8 +42,19 @@ fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     check_obj_faces(path)?;
     let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let (models, mtl) = tobj::load_obj(path, &opts).map_err(|e| e.to_string())?;
-    // A missing .mtl file is not fatal: the object's own material is used.
-    let mtl = mtl.unwrap_or_default();
+    // A missing .mtl file is not fatal: the object's own material is used, and the user told.
+    let mut warnings = Vec::new();
+    let mtl = mtl.unwrap_or_else(|e| {
+        let has_library =
+            std::fs::read_to_string(path).is_ok_and(|t| t.lines().any(|l| l.trim_start().starts_with("mtllib")));
+        if has_library {
+            warnings.push(format!(
+                "{}: its material library could not be read ({e}); the object's own material is used instead",
+                path.display()
+            ));
+        }
+        Vec::new()
+    });
     let mut mesh = TriangleMesh::default();
     let mut any_normals = true;
     let mut any_uvs = true;
@@ -82,7 +95,7 @@ fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
         }
     }
     mesh.material_names = materials.iter().map(|m| m.name.clone()).collect();
-    Ok(LoadedMesh { mesh, materials })
+    Ok(LoadedMesh { mesh, materials, warnings })
 }
 
 /// MTL → Whitted material: `Kd` colour, `Ks`/`Ns` highlight, `d`/`Tr` transparency, `Ni` ior;

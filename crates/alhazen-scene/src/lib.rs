@@ -30,7 +30,10 @@ pub mod write;
 
 pub use diagnostic::{Diagnostic, did_you_mean};
 pub use model::*;
-pub use parse::{MAX_PIXELS, MAX_SIDE, empty_scene, parse_scene, parse_scene_within, rectangle as rectangle_mesh};
+pub use parse::{
+    MAX_PIXELS, MAX_SIDE, empty_scene, parse_scene, parse_scene_reporting, parse_scene_within,
+    rectangle as rectangle_mesh,
+};
 use std::path::{Path, PathBuf};
 
 /// Why a scene could not be loaded.
@@ -82,6 +85,11 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 
 /// [`load_scene`] within a memory budget for generated geometry ([`parse_scene_within`]).
 pub fn load_scene_within(path: &Path, memory_budget: u64) -> Result<Scene, SceneError> {
+    load_scene_reporting(path, memory_budget).map(|(scene, _)| scene)
+}
+
+/// [`load_scene_within`] with the warnings ([`parse_scene_reporting`]).
+pub fn load_scene_reporting(path: &Path, memory_budget: u64) -> Result<(Scene, Vec<String>), SceneError> {
     let io = |source| SceneError::Io { path: path.to_path_buf(), source };
     let meta = std::fs::metadata(path).map_err(io)?;
     if !meta.is_file() {
@@ -100,5 +108,5 @@ pub fn load_scene_within(path: &Path, memory_budget: u64) -> Result<Scene, Scene
         let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
         SceneError::Syntax(Box::new(Diagnostic::at(path, &text, at..at + 1, "the scene file is not valid UTF-8")))
     })?;
-    parse_scene_within(path, &text, memory_budget)
+    parse_scene_reporting(path, &text, memory_budget)
 }

@@ -28,6 +28,12 @@ pub fn parse_scene(file: &Path, text: &str) -> Result<Scene, SceneError> {
 /// [`parse_scene`], refusing (with the location) generated geometry that would take more than
 /// `memory_budget` bytes, before allocating it.
 pub fn parse_scene_within(file: &Path, text: &str, memory_budget: u64) -> Result<Scene, SceneError> {
+    parse_scene_reporting(file, text, memory_budget).map(|(scene, _)| scene)
+}
+
+/// [`parse_scene_within`] with the warnings: what was read only in part (an OBJ file's missing
+/// material library), each naming its file.
+pub fn parse_scene_reporting(file: &Path, text: &str, memory_budget: u64) -> Result<(Scene, Vec<String>), SceneError> {
     let src = Src { file, text };
     let root = DeTable::parse(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
@@ -55,9 +61,10 @@ pub fn parse_scene_within(file: &Path, text: &str, memory_budget: u64) -> Result
         mesh_names: HashMap::new(),
         mesh_files: HashMap::new(),
         memory_budget,
+        warnings: Vec::new(),
     };
     p.scene_from(&top).map_err(SceneError::Syntax)?;
-    Ok(p.scene)
+    Ok((p.scene, p.warnings))
 }
 
 /// The scene an empty file describes: default render settings, a camera at `(0, 0, 5)` looking
@@ -88,6 +95,8 @@ pub(crate) struct Parser<'a> {
     mesh_files: HashMap<std::path::PathBuf, (usize, Vec<MaterialId>)>,
     /// Bytes that generated geometry may take.
     memory_budget: u64,
+    /// What was read only in part.
+    warnings: Vec<String>,
 }
 
 impl Parser<'_> {
@@ -300,7 +309,8 @@ impl Parser<'_> {
 
     fn load_mesh_file(&mut self, file: &Node, path: &Path) -> R<(usize, Vec<MaterialId>)> {
         let path = path.to_path_buf();
-        let loaded = import::load_mesh(&path).map_err(|e| file.err(e))?;
+        let mut loaded = import::load_mesh(&path).map_err(|e| file.err(e))?;
+        self.warnings.append(&mut loaded.warnings);
         let slots = loaded
             .materials
             .into_iter()
