@@ -10,8 +10,9 @@ dir=${ALHAZEN_SLURM_DIR:-/tmp/alhazen-slurm}
 conf=$dir/slurm.conf
 
 stop() {
+    # Only a process of that name (a stale pid file may name another process by now).
     for daemon in slurmd slurmctld; do
-        [ -f "$dir/$daemon.pid" ] && kill "$(cat "$dir/$daemon.pid")" 2>/dev/null || true
+        [ -f "$dir/$daemon.pid" ] && pkill -F "$dir/$daemon.pid" -x "$daemon" 2>/dev/null || true
     done
 }
 if [ "${1:-}" = "--stop" ]; then stop; exit 0; fi
