@@ -632,6 +632,45 @@ fn convert_writes_toml_that_renders_and_refuses_other_outputs() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("is a .toml file"));
 }
 
+/// What the fuzz test (tests/fuzz.rs) found: each used to panic.
+#[test]
+fn inputs_found_by_fuzzing_are_refused_or_rendered() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_alhazen")).current_dir(d).args(args).output().unwrap();
+        (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    // A Radiance HDR texture of 2 × 0 pixels (texture lookups divided by zero).
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 0 +X 2\n".to_vec();
+    hdr.extend([0u8; 8]);
+    std::fs::write(d.join("t.hdr"), hdr).unwrap();
+    let textured = format!(
+        "{OK}[materials.t]\ncolor = {{ image = {{ file = \"t.hdr\" }} }}\n[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"t\"\n"
+    );
+    std::fs::write(d.join("t.toml"), textured).unwrap();
+    let (code, err) = run(&["render", "t.toml", "-o", "o.png", "-q"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("t.hdr: the image is 2 × 0 pixels"), "{err}");
+    // A glTF mesh whose POSITION accessor does not exist (the gltf crate's validation panicked).
+    std::fs::write(
+        d.join("m.gltf"),
+        r#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#,
+    )
+    .unwrap();
+    let (code, err) = run(&["render", "m.gltf", "-o", "o.png", "-q"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("not a valid glTF 2.0 file") && !err.contains("panicked"), "{err}");
+    // A checker of squares 1e-320 wide (the square index overflowed).
+    let checker = OK.replace(
+        "[[object]]",
+        "[materials.c]\ncolor = { checker = { even = 1, odd = 0, size = 1e-320 } }\n[[object]]\nmaterial = \"c\"",
+    );
+    std::fs::write(d.join("c.toml"), checker).unwrap();
+    let (code, err) = run(&["render", "c.toml", "-o", "o.png", "-q"]);
+    assert_eq!(code, Some(0), "{err}");
+}
+
 #[test]
 fn a_missing_material_library_is_a_warning() {
     let dir = tempfile::tempdir().unwrap();

@@ -42,15 +42,29 @@ const KNOWN: &[&str] = &[
 /// Reads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<Imported, SceneError> {
     let bytes = common::read_bytes(path)?;
+    // The gltf crate's validation panics on some inconsistent files (an index out of bounds in
+    // gltf-json 1.4, found by fuzzing): such a panic is caught, kept off the terminal, and
+    // reported as a bad file. (The hook is the process's: a panic elsewhere at this moment
+    // would be silent too, and still fail.)
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_bytes(path, &bytes)));
+    std::panic::set_hook(hook);
+    result.unwrap_or_else(|_| {
+        Err(error(path, &bytes, "not a valid glTF 2.0 file: its parts are inconsistent (the glTF reader failed on it)"))
+    })
+}
+
+fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
     let gltf =
-        gltf::Gltf::from_slice(&bytes).map_err(|e| error(path, &bytes, format!("not a valid glTF 2.0 file: {e}")))?;
+        gltf::Gltf::from_slice(bytes).map_err(|e| error(path, bytes, format!("not a valid glTF 2.0 file: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let document = gltf.document;
     let buffers = gltf::import_buffers(&document, Some(base), gltf.blob)
-        .map_err(|e| error(path, &bytes, format!("cannot read its buffers: {e}")))?;
+        .map_err(|e| error(path, bytes, format!("cannot read its buffers: {e}")))?;
     let mut imp = Importer {
         path,
-        bytes: &bytes,
+        bytes,
         buffers,
         base,
         scene: alhazen_scene::empty_scene(),
@@ -64,7 +78,7 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.extensions(&document)?;
     let scene = document.default_scene().or_else(|| document.scenes().next());
-    let Some(scene) = scene else { return Err(error(path, &bytes, "the file has no scene")) };
+    let Some(scene) = scene else { return Err(error(path, bytes, "the file has no scene")) };
     for node in scene.nodes() {
         imp.node(&node, Mat4::IDENTITY, 0)?;
     }
@@ -533,5 +547,5 @@ fn decode(data: &gltf::image::Data, srgb: bool) -> Option<ImageData> {
             if channels < 3 { [c(0), c(0), c(0)] } else { [c(0), c(1), c(2)] }
         })
         .collect();
-    Some(ImageData { width: data.width, height: data.height, pixels })
+    (data.width > 0 && data.height > 0).then_some(ImageData { width: data.width, height: data.height, pixels })
 }

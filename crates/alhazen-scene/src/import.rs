@@ -415,6 +415,7 @@ pub fn parse_bpt(text: &str) -> Result<TriangleMesh, String> {
 /// Loads an image and converts it from sRGB to linear RGB.
 pub fn load_image(path: &Path) -> Result<ImageData, String> {
     let img = image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))?.to_rgb8();
+    has_pixels(path, img.width(), img.height())?;
     let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f64 / 255.0) as f32).collect();
     Ok(ImageData {
         width: img.width(),
@@ -423,10 +424,20 @@ pub fn load_image(path: &Path) -> Result<ImageData, String> {
     })
 }
 
+/// Refuses an image of no pixels (a header saying 0 × 2: found by fuzzing, it made texture
+/// lookups divide by zero).
+fn has_pixels(path: &Path, w: u32, h: u32) -> Result<(), String> {
+    if w == 0 || h == 0 {
+        return Err(format!("{}: the image is {w} × {h} pixels: it has none", path.display()));
+    }
+    Ok(())
+}
+
 /// Loads a high-dynamic-range image (Radiance `.hdr` or OpenEXR), whose values are linear
 /// radiance already.
 pub fn load_hdr_image(path: &Path) -> Result<ImageData, String> {
     let img = image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))?.to_rgb32f();
+    has_pixels(path, img.width(), img.height())?;
     let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
     if pixels.iter().flatten().any(|v| !v.is_finite() || *v < 0.0) {
         return Err(format!("{}: the image has negative, infinite or NaN values", path.display()));
