@@ -661,6 +661,14 @@ fn inputs_found_by_fuzzing_are_refused_or_rendered() {
     let (code, err) = run(&["render", "m.gltf", "-o", "o.png", "-q"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("not a valid glTF 2.0 file") && !err.contains("panicked"), "{err}");
+    // A pbrt integrator with an absurd maxdepth (the depth + 1 overflowed).
+    std::fs::write(
+        d.join("i.pbrt"),
+        "Integrator \"path\" \"integer maxdepth\" [ 1e30 ]\nWorldBegin\nShape \"sphere\"\n",
+    )
+    .unwrap();
+    let (code, err) = run(&["render", "i.pbrt", "-o", "o.png", "-q", "--width", "8", "--height", "6", "--spp", "1"]);
+    assert!(matches!(code, Some(0) | Some(2)) && !err.contains("panicked"), "{err}");
     // A checker of squares 1e-320 wide (the square index overflowed).
     let checker = OK.replace(
         "[[object]]",

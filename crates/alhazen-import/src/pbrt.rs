@@ -543,7 +543,7 @@ impl Importer {
                 let (kind, _) = self.string_arg(ctx, tokens, i, word, &at)?;
                 let mut p = self.params(ctx, tokens, i)?;
                 let depth = self.float(ctx, &mut p, "maxdepth", 5.0)?;
-                self.scene.render.max_depth = (depth.max(0.0) as u32 + 1).min(1000);
+                self.scene.render.max_depth = (depth.max(0.0) as u32).saturating_add(1).min(1000);
                 if !matches!(kind.as_str(), "path" | "volpath") {
                     self.warn(ctx, &at, format!("integrator \"{kind}\" is rendered by alhazen's path tracer"));
                 }
