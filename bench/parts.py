@@ -13,6 +13,8 @@ parts' sizes. Needs numpy.
 """
 import argparse, glob, os, subprocess, tempfile, time
 
+from connections import pfm  # the PFM reader the other benchmark scripts use
+
 NEW = "target/release/alhazen"
 SUITE = [("cornell-box", ["--integrator", "path", "--spp", "64"]),
          ("cornell-rough", ["--spp", "16"]),
@@ -33,15 +35,6 @@ def timed(binary, args):
     t = time.perf_counter()
     subprocess.run([binary, *args], check=True)
     return time.perf_counter() - t
-
-
-def pfm(path):
-    import numpy as np
-    with open(path, "rb") as f:
-        f.readline()
-        f.readline()
-        scale = float(f.readline())
-        return np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
 
 
 def sums(old, runs):
