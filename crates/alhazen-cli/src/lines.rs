@@ -1,14 +1,16 @@
 //! `alhazen lines`: exact hidden-line drawings of a scene with its reflections in spherical and
 //! cylindrical mirrors, as SVG, PDF or a PNG preview; `--graph` draws a function graph with
-//! the floating-horizon algorithm instead.
+//! the floating-horizon algorithm instead; `--optimize` and HP-GL output for pen plotters.
 
 use crate::{Failure, load};
 use alhazen_lines::drawing::{Drawing, Layer, Stroke, default_stroke};
 use alhazen_lines::horizon::{Graph, Layout, floating_horizon};
-use alhazen_lines::{Options, draw};
+use alhazen_lines::{Options, Progress, draw_reporting};
 use alhazen_math::Vec2;
 use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 #[derive(Args)]
@@ -16,7 +18,9 @@ pub struct LinesArgs {
     /// The scene file (TOML, glTF, Mitsuba 3 XML or pbrt-v4); not needed with --graph.
     #[arg(required_unless_present = "graph")]
     scene: Option<PathBuf>,
-    /// Output: .svg, .pdf or .png (an antialiased preview).
+    /// Output: .svg (a layer per kind of line, read as layers by Inkscape and vpype), .pdf,
+    /// .hpgl or .plt (HP-GL for pen plotters: pen 1 visible, 2 reflected, 3 hidden) or .png
+    /// (an antialiased preview).
     #[arg(short, long)]
     output: PathBuf,
     /// Paper width in millimetres (the height follows the scene's image aspect).
@@ -40,6 +44,13 @@ pub struct LinesArgs {
     /// Stroke width of reflected lines in millimetres.
     #[arg(long, default_value_t = 0.25, value_parser = positive)]
     stroke_reflected: f64,
+    /// Order the lines for a pen plotter: join strokes that meet, tour each layer nearest end
+    /// first, improved by 2-opt, and report the pen-up travel saved.
+    #[arg(long)]
+    optimize: bool,
+    /// With --optimize, strokes whose ends lie this close (millimetres) are drawn as one.
+    #[arg(long, default_value_t = 0.05, value_parser = non_negative, requires = "optimize")]
+    join_tolerance: f64,
     /// Width of a PNG preview in pixels.
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(16..=20000))]
     png_width: u32,
@@ -79,6 +90,13 @@ fn positive(s: &str) -> Result<f64, String> {
     }
 }
 
+fn non_negative(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v >= 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("expected a number ≥ 0, got {s:?}")),
+    }
+}
+
 /// A paper width in millimetres: positive, at most 10 m.
 fn paper_width(s: &str) -> Result<f64, String> {
     match positive(s)? {
@@ -100,6 +118,7 @@ enum Kind {
     Svg,
     Pdf,
     Png,
+    Hpgl,
 }
 
 fn output_kind(path: &Path) -> Result<Kind, Failure> {
@@ -108,7 +127,13 @@ fn output_kind(path: &Path) -> Result<Kind, Failure> {
         Some("svg") => Kind::Svg,
         Some("pdf") => Kind::Pdf,
         Some("png") => Kind::Png,
-        _ => return Err(Failure::input(format!("{}: unknown drawing format; use .svg, .pdf or .png", path.display()))),
+        Some("hpgl" | "plt") => Kind::Hpgl,
+        _ => {
+            return Err(Failure::input(format!(
+                "{}: unknown drawing format; use .svg, .pdf, .hpgl, .plt or .png",
+                path.display()
+            )));
+        }
     };
     crate::check_output_dir(path)?;
     Ok(kind)
@@ -132,9 +157,10 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
                 sampled: a.sampled,
                 ..Options::default()
             };
-            let (d, s) = pool
-                .install(|| draw(&scene, &opts))
-                .map_err(|e| Failure::input(format!("{}: {}", path.display(), camera_error(e))))?;
+            let progress = StageBar::new(a.quiet);
+            let drawn = pool.install(|| draw_reporting(&scene, &opts, &progress));
+            progress.bar.finish_and_clear();
+            let (d, s) = drawn.map_err(|e| Failure::input(format!("{}: {}", path.display(), camera_error(e))))?;
             let mut summary = format!(
                 "{} scene lines → {} visible, {} hidden, {} reflected polylines ({} mirrors)",
                 s.scene_lines, s.visible, s.hidden, s.reflected, s.mirrors
@@ -149,6 +175,18 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
         }
         (None, None) => return Err(Failure::input("give a scene file or --graph")),
     };
+    let (drawing, summary) = if a.optimize {
+        let o = alhazen_lines::plotter::optimize(drawing, a.join_tolerance);
+        let (b, f) = (o.before, o.after);
+        let saved = if b.pen_up_mm > 0.0 { 100.0 * (1.0 - f.pen_up_mm / b.pen_up_mm) } else { 0.0 };
+        let plot = format!(
+            "; optimized for plotting: pen-up travel {:.0} mm → {:.0} mm ({saved:.0} % saved), {} → {} strokes",
+            b.pen_up_mm, f.pen_up_mm, b.polylines, f.polylines
+        );
+        (o.drawing, summary + &plot)
+    } else {
+        (drawing, summary)
+    };
     let stroke = |l: Layer| {
         let width = match l {
             Layer::Visible => a.stroke,
@@ -161,6 +199,7 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
         Kind::Svg => drawing.to_svg(stroke).into_bytes(),
         Kind::Pdf => drawing.to_pdf(stroke),
         Kind::Png => drawing.to_png(a.png_width, stroke).map_err(|e| Failure::work(e.to_string()))?,
+        Kind::Hpgl => alhazen_lines::plotter::to_hpgl(&drawing).into_bytes(),
     };
     alhazen_render::output::write_atomically(&a.output, |f| std::io::Write::write_all(f, &bytes))
         .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.output.display())))?;
@@ -168,6 +207,45 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
         eprintln!("{summary} in {:.3} s → {}", start.elapsed().as_secs_f64(), a.output.display());
     }
     Ok(())
+}
+
+/// The drawing's stages on a terminal: a spinner while a stage is not counted, a bar with its
+/// estimate when it is.
+struct StageBar {
+    bar: ProgressBar,
+    done: AtomicU64,
+}
+
+impl StageBar {
+    fn new(quiet: bool) -> StageBar {
+        let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        StageBar { bar, done: AtomicU64::new(0) }
+    }
+}
+
+impl Progress for StageBar {
+    fn stage(&self, name: &'static str, steps: u64) {
+        let template = if steps == 0 {
+            "{spinner} {msg} … elapsed {elapsed}"
+        } else {
+            "{spinner} {msg} [{bar:40}] {percent:>3}% {pos}/{len} elapsed {elapsed} eta {eta}"
+        };
+        let style = ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar());
+        self.done.store(0, Ordering::Relaxed);
+        self.bar.set_message(name);
+        self.bar.set_length(steps);
+        self.bar.set_position(0);
+        self.bar.set_style(style.progress_chars("=> "));
+    }
+
+    fn advance(&self, n: u64) {
+        let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
+        // The bar takes a lock: tell it every 256 steps and at the end.
+        if done % 256 < n || Some(done) == self.bar.length() {
+            self.bar.set_position(done);
+        }
+    }
 }
 
 /// The drawing's own words for a camera it cannot use.

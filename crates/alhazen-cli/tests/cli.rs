@@ -503,12 +503,44 @@ fn lines_writes_svg_pdf_and_png_and_refuses_bad_input() {
     }
     let bad_ext = alhazen(&["lines", scene.to_str().unwrap(), "-o", dir.path().join("d.jpg").to_str().unwrap()]);
     assert_eq!(bad_ext.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&bad_ext.stderr).contains(".svg, .pdf or .png"));
+    assert!(String::from_utf8_lossy(&bad_ext.stderr).contains(".svg, .pdf, .hpgl, .plt or .png"));
     let graph = alhazen(&["lines", "--graph", "saddle", "-o", dir.path().join("g.svg").to_str().unwrap(), "-q"]);
     assert_eq!(graph.status.code(), Some(0));
     let stereo = scene_file(dir.path(), "[camera]\ntype = \"stereo\"\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
     let o = alhazen(&["lines", stereo.to_str().unwrap(), "-o", dir.path().join("s.svg").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn lines_for_pen_plotters_are_optimized_layered_and_written_as_hpgl() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(
+        dir.path(),
+        "[camera]\neye = [4, 3, 5]\n[[object]]\nshape = \"box\"\n\
+         [[object]]\nshape = \"sphere\"\ncenter = [2.2, 0, 0]\nradius = 0.8\nmaterial = { mirror = 1 }\n",
+    );
+    let svg = dir.path().join("p.svg");
+    let o = alhazen(&["lines", scene.to_str().unwrap(), "-o", svg.to_str().unwrap(), "--hidden", "--optimize"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let said = String::from_utf8_lossy(&o.stderr);
+    assert!(said.contains("pen-up travel") && said.contains("% saved"), "{said}");
+    let s = std::fs::read_to_string(&svg).unwrap();
+    for label in ["1 visible", "2 reflected", "3 hidden"] {
+        assert!(s.contains(&format!("inkscape:groupmode=\"layer\" inkscape:label=\"{label}\"")), "{s}");
+    }
+    assert!(!s.contains("<rect"), "a plotter would draw a background rectangle");
+    let hpgl = dir.path().join("p.hpgl");
+    let o = alhazen(&["lines", scene.to_str().unwrap(), "-o", hpgl.to_str().unwrap(), "--optimize", "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let h = std::fs::read_to_string(&hpgl).unwrap();
+    assert!(h.starts_with("IN;\nSP1;\nPU") && h.contains("SP2;") && h.ends_with("PU;SP0;\n"), "{h}");
+    let o = alhazen(&["lines", scene.to_str().unwrap(), "-o", hpgl.to_str().unwrap(), "--join-tolerance", "0.1"]);
+    assert_eq!(o.status.code(), Some(2), "--join-tolerance needs --optimize");
+    // vpype, when installed, reads the three layers as layers 1, 2, 3.
+    if let Ok(v) = Command::new("vpype").args(["read", svg.to_str().unwrap(), "stat"]).output() {
+        let stat = String::from_utf8_lossy(&v.stdout);
+        assert!(v.status.success() && ["Layer 1", "Layer 2", "Layer 3"].iter().all(|l| stat.contains(l)), "{stat}");
+    }
 }
 
 #[test]

@@ -21,6 +21,16 @@ impl Layer {
     /// All layers, bottom to top.
     pub const ALL: [Layer; 3] = [Layer::Hidden, Layer::Reflected, Layer::Visible];
 
+    /// The layer's number: its pen on a plotter, its layer in vpype and Inkscape (visible 1,
+    /// reflected 2, hidden 3).
+    pub fn pen(self) -> u32 {
+        match self {
+            Layer::Visible => 1,
+            Layer::Reflected => 2,
+            Layer::Hidden => 3,
+        }
+    }
+
     /// The layer's name in SVG ids and PDF layer lists.
     pub fn name(self) -> &'static str {
         match self {
@@ -166,11 +176,12 @@ impl Drawing {
     pub fn to_svg(&self, stroke: impl Fn(Layer) -> Stroke) -> String {
         let mut s = String::new();
         let (w, h) = (self.size.x, self.size.y);
+        // No background rectangle: a plotter would draw it. Each layer is an Inkscape layer
+        // whose label starts with its pen number, as vpype reads layers.
         let _ = writeln!(
             s,
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w:.3}mm\" height=\"{h:.3}mm\" viewBox=\"0 0 {w:.3} {h:.3}\">"
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" width=\"{w:.3}mm\" height=\"{h:.3}mm\" viewBox=\"0 0 {w:.3} {h:.3}\" style=\"background-color:white\">"
         );
-        let _ = writeln!(s, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>");
         for layer in Layer::ALL {
             let st = stroke(layer);
             let grey = (st.grey.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -181,8 +192,9 @@ impl Drawing {
             };
             let _ = writeln!(
                 s,
-                "<g id=\"{}\" fill=\"none\" stroke=\"rgb({grey},{grey},{grey})\" stroke-width=\"{:.3}\" stroke-linecap=\"round\" stroke-linejoin=\"round\"{dash}>",
+                "<g id=\"{0}\" inkscape:groupmode=\"layer\" inkscape:label=\"{1} {0}\" fill=\"none\" stroke=\"rgb({grey},{grey},{grey})\" stroke-width=\"{2:.3}\" stroke-linecap=\"round\" stroke-linejoin=\"round\"{dash}>",
                 layer.name(),
+                layer.pen(),
                 st.width
             );
             for (_, pts) in self.lines.iter().filter(|(l, _)| *l == layer) {

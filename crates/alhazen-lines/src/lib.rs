@@ -14,6 +14,7 @@
 //!   the paper's Fig. 16, drawn where the eye sees the mirror point and the reflected ray
 //!   reaches the line;
 //! * [`drawing`] — millimetres on paper: SVG, PDF (layers), antialiased PNG preview;
+//! * [`plotter`] — pen plotters: joined, ordered strokes and HP-GL;
 //! * [`horizon`] — the floating-horizon algorithm for graphs `z = f(x, y)`.
 //!
 //! ```no_run
@@ -30,6 +31,7 @@ pub mod curves;
 pub mod drawing;
 pub mod horizon;
 pub mod intersect;
+pub mod plotter;
 pub mod reflect;
 pub mod view;
 pub mod visibility;
@@ -91,18 +93,43 @@ pub struct Stats {
     pub skipped: usize,
 }
 
+/// Told how far a drawing has come: the stages in order, each with its count of steps (0 when
+/// it is not counted), then steps done. Called from worker threads.
+pub trait Progress: Sync {
+    /// A stage begins.
+    fn stage(&self, name: &'static str, steps: u64);
+    /// `n` more steps of the current stage are done.
+    fn advance(&self, n: u64);
+}
+
+/// Progress nobody watches.
+pub struct Unwatched;
+
+impl Progress for Unwatched {
+    fn stage(&self, _: &'static str, _: u64) {}
+    fn advance(&self, _: u64) {}
+}
+
 /// Draws `scene` from its camera.
 pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterError> {
+    draw_reporting(scene, opts, &Unwatched)
+}
+
+/// [`draw`], telling `progress` of each stage: long on scenes of millions of triangles.
+pub fn draw_reporting(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(Drawing, Stats), RasterError> {
+    progress.stage("building the scene's index", 0);
     let world = World::build(scene);
     let view = view::View::new(scene, &world, opts.width_mm)?;
     let edge_opts = curves::EdgeOptions { feature_angle: opts.feature_angle_deg.to_radians() };
+    progress.stage("finding edges, contours and intersections", 0);
     let polyhedra = curves::polyhedra(scene);
     let (mut lines, tessellated, skipped) = curves::scene_lines(scene, &polyhedra, &view, &edge_opts);
     lines.extend(intersect::intersection_lines(scene, &polyhedra));
     let chords = visibility::chords(&lines, &view, opts.tol_mm);
+    progress.stage("deciding visibility", chords.len() as u64);
     let pieces = match opts.sampled {
-        Some(step) => visibility::pieces_sampled(&lines, &chords, &view, &world, step),
-        None => visibility::pieces(&lines, &chords, &view, &world),
+        Some(step) => visibility::pieces_sampled(&lines, &chords, &view, &world, step, progress),
+        None => visibility::pieces(&lines, &chords, &view, &world, progress),
     };
     let mut drawing = Drawing { size: view.paper(), lines: vec![] };
     for p in &pieces {
@@ -116,14 +143,23 @@ pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterErr
     let tol_px = opts.tol_mm / view.mm_per_px;
     let ropts = reflect::ReflectOptions { tol_px, knots: 16 };
     let jobs: Vec<(usize, usize)> = (0..mirrors.len()).flat_map(|m| (0..lines.len()).map(move |l| (m, l))).collect();
-    let reflected: Vec<Vec<Vec<Vec3>>> =
-        jobs.par_iter().map(|&(m, l)| reflect::reflect_line(&mirrors[m], &lines[l], &view, &world, &ropts)).collect();
+    progress.stage("reflecting lines in mirrors", jobs.len() as u64);
+    let reflected: Vec<Vec<Vec<Vec3>>> = jobs
+        .par_iter()
+        .map(|&(m, l)| {
+            let runs = reflect::reflect_line(&mirrors[m], &lines[l], &view, &world, &ropts);
+            progress.advance(1);
+            runs
+        })
+        .collect();
     let mut reflected = reflected;
+    progress.stage("reflecting contours and silhouettes", 0);
     reflected.extend(reflex_contours(scene, &mirrors, &view, &world, tol_px));
     reflected.extend(mesh_reflex_silhouettes(scene, &polyhedra, &mirrors, &view, &world, &edge_opts, tol_px));
     for run in reflected.into_iter().flatten() {
         drawing.lines.push((Layer::Reflected, run.iter().map(|p| view.to_paper(*p)).collect()));
     }
+    progress.stage("joining lines", 0);
     let drawing = drawing.clipped().joined();
     let stats = Stats {
         scene_lines: lines.len(),

@@ -6,6 +6,7 @@
 //! midpoint on the true curve. No step size enters the answer: chords of circles are only used
 //! to find crossings, within the drawing tolerance.
 
+use crate::Progress;
 use crate::curves::SceneLine;
 use crate::view::{Leeway, View};
 use alhazen_math::{Ray, Vec2, Vec3};
@@ -180,7 +181,14 @@ fn crossings(a: (Vec2, Vec2), b: (Vec2, Vec2), out: &mut Vec<f64>) {
 }
 
 /// Splits every chord where visibility may change and decides each piece by a ray test.
-pub fn pieces(lines: &[SceneLine], chords: &[Chord], view: &View, world: &World) -> Vec<Piece> {
+/// Each chord decided is a step of `progress`.
+pub fn pieces(
+    lines: &[SceneLine],
+    chords: &[Chord],
+    view: &View,
+    world: &World,
+    progress: &dyn Progress,
+) -> Vec<Piece> {
     let grid = Grid::new(chords);
     let per_chord: Vec<Vec<Piece>> = chords
         .par_iter()
@@ -210,8 +218,9 @@ pub fn pieces(lines: &[SceneLine], chords: &[Chord], view: &View, world: &World)
                     let mid = curve.point(s(0.5 * (w[0] + w[1])));
                     Piece { line: c.line, s: (s(w[0]), s(w[1])), visible: view.sees_with(world, mid, &leeway) }
                 })
-                .collect()
+                .collect::<Vec<_>>()
         })
+        .inspect(|_| progress.advance(1))
         .collect();
     merge(per_chord.into_iter().flatten())
 }
@@ -219,9 +228,17 @@ pub fn pieces(lines: &[SceneLine], chords: &[Chord], view: &View, world: &World)
 /// The baseline the exact method is measured against (fogleman/ln's approach): visibility
 /// tested by a ray at sample points every `step_px` pixels along each chord, pieces cut halfway
 /// between samples that disagree. Its answer depends on the step.
-pub fn pieces_sampled(lines: &[SceneLine], chords: &[Chord], view: &View, world: &World, step_px: f64) -> Vec<Piece> {
+pub fn pieces_sampled(
+    lines: &[SceneLine],
+    chords: &[Chord],
+    view: &View,
+    world: &World,
+    step_px: f64,
+    progress: &dyn Progress,
+) -> Vec<Piece> {
     let per_chord: Vec<Vec<Piece>> = chords
         .par_iter()
+        .inspect(|_| progress.advance(1))
         .map(|c| {
             let n = ((c.q.1 - c.q.0).length() / step_px).ceil().max(1.0) as usize;
             let curve = lines[c.line].curve;
