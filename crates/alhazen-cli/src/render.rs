@@ -2,7 +2,7 @@
 //! of tiles, shares of the samples: `alhazen_render::film::part`), or saved to a checkpoint and
 //! resumed after an interruption. Every way gives the same bits.
 
-use crate::{Failure, ImageArgs, check_output, check_output_dir, load_sized, open_output, progress_bar, warn_unlit};
+use crate::{Failure, ImageArgs, check_output, check_output_dir, load_sized, open_output, progress_bar};
 use alhazen_render::film::part::{self, Part, fingerprint, merge, share, share_samples};
 use alhazen_render::film::{Job, SAMPLE_BLOCK, TileResult, tiles};
 use alhazen_render::shape::VectorUnit;
@@ -121,6 +121,20 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
     }
 }
 
+/// Whitted lights with emitting spheres, disks, boxes and meshes; says which others it only
+/// shows.
+fn warn_unsampled_emitters(scene: &Scene) {
+    let lights = alhazen_render::lights::Lights::build(scene);
+    let emits = |o: &alhazen_scene::Object| scene.materials[o.material as usize].emission != alhazen_math::Vec3::ZERO;
+    let unsampled =
+        scene.objects.iter().enumerate().filter(|(i, o)| emits(o) && lights.of_object(*i as u32).is_none()).count();
+    if unsampled > 0 {
+        eprintln!(
+            "warning: {unsampled} emitting object(s) light nothing under Whitted ray tracing (only spheres, disks, boxes and meshes do; not cylinders, cones, patches, CSG or distorted spheres): they are shown, not sampled; use --integrator path"
+        );
+    }
+}
+
 fn parse_seed(s: &str) -> Result<u64, String> {
     s.parse::<u64>().map_err(|_| format!("a seed is a whole number from 0 to 18446744073709551615, not {s:?}"))
 }
@@ -233,7 +247,7 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
     let mut scene = load_sized(&a.image)?;
     apply_overrides(&mut scene, a);
     if scene.render.integrator == alhazen_scene::IntegratorKind::Whitted {
-        warn_unlit(&scene, "Whitted ray tracing", "use --integrator path");
+        warn_unsampled_emitters(&scene);
     }
     let plan = Plan::new(&scene, a)?;
     let what = format!("rendering this {}×{} film", plan.width, plan.height);

@@ -333,7 +333,16 @@ fn renderers_that_ignore_emitters_say_so() {
     let o = out.to_str().unwrap();
     let small = ["--width", "16", "--height", "16", "-q"];
     let run = |args: &[&str]| String::from_utf8_lossy(&alhazen(&[args, &small[..]].concat()).stderr).into_owned();
-    assert!(run(&["render", c, "-o", o, "--integrator", "whitted"]).contains("use --integrator path"));
+    assert!(
+        !run(&["render", c, "-o", o, "--integrator", "whitted"]).contains("warning"),
+        "Whitted lights with the lamp"
+    );
+    let tube = scene_file(
+        dir.path(),
+        "[[object]]\nshape = \"cylinder\"\nmaterial = { emission = [4, 4, 4] }\n[[object]]\nshape = \"box\"\n",
+    );
+    let said = run(&["render", tube.to_str().unwrap(), "-o", o, "--integrator", "whitted"]);
+    assert!(said.contains("1 emitting object(s) light nothing") && said.contains("use --integrator path"), "{said}");
     assert!(run(&["raster", c, "-o", o]).contains("render it with --integrator path"));
     assert!(!run(&["render", c, "-o", o, "--spp", "1"]).contains("warning"));
 }

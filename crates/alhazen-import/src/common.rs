@@ -91,30 +91,9 @@ pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb) -> Ma
     add_material(scene, m)
 }
 
-/// A material that is only a path-tracer BSDF (the Whitted coefficients follow its colour).
+/// A material that is only a path-tracer BSDF (the Whitted coefficients follow it).
 pub(crate) fn bsdf_material(name: &str, bsdf: BsdfDesc) -> Material {
-    let color = match &bsdf {
-        BsdfDesc::Lambert { albedo } | BsdfDesc::OrenNayar { albedo, .. } => albedo.clone(),
-        BsdfDesc::CookTorrance { albedo, .. } => albedo.clone(),
-        _ => Texture::Solid(Vec3::splat(0.8)),
-    };
-    let mut m = Material { name: name.to_string(), color, ..Material::default() };
-    match &bsdf {
-        BsdfDesc::Conductor { .. } => {
-            m.diffuse = 0.0;
-            m.mirror = Vec3::splat(0.9);
-        }
-        BsdfDesc::Dielectric { ior, .. } => {
-            m.diffuse = 0.0;
-            m.transparency = Vec3::ONE;
-            m.ior = ior.nominal();
-            m.specular = Vec3::ONE;
-            m.shininess = 200.0;
-        }
-        _ => {}
-    }
-    m.bsdf = Some(bsdf);
-    m
+    Material::from_bsdf(name, bsdf)
 }
 
 /// Trowbridge–Reitz (GGX) microfacets with Smith shadowing, roughness `α` (clamped away from 0,

@@ -343,6 +343,12 @@ impl Lights {
         Some(s)
     }
 
+    /// A point of light `light` seen from `p`, chosen by `u`; its density leaves out the
+    /// choice of the light.
+    pub fn sample_light(&self, light: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
+        self.sample_one(&self.lights[light], p, u)
+    }
+
     fn sample_one(&self, light: &PathLight, p: Vec3, u: Vec2) -> Option<LightSample> {
         let delta = |to: Vec3, radiance: Vec3| {
             let d = to.length();

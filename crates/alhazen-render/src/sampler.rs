@@ -45,6 +45,13 @@ impl Rng {
         Self(mix(rng_pixel_hash(seed, x, y) ^ sample as u64))
     }
 
+    /// A generator seeded by a point's coordinates, where no pixel sample is at hand
+    /// (Whitted's area lights): the same point always draws the same numbers.
+    #[inline]
+    pub fn for_point(p: alhazen_math::Vec3) -> Self {
+        Self(mix(mix(mix(p.x.to_bits()) ^ p.y.to_bits()) ^ p.z.to_bits()))
+    }
+
     /// Next 64 random bits.
     #[inline]
     pub fn next_u64(&mut self) -> u64 {

@@ -8,7 +8,9 @@
 use crate::camera::Camera;
 use crate::connect::{MirrorPath, MirrorShape, Source};
 use crate::film::PixelEstimator;
+use crate::lights::{Lights, PathLight};
 use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
+use crate::sampler::Rng;
 use crate::sampler::stratified_offset;
 use crate::texture;
 use crate::world::{ShadowHit, World, WorldHit};
@@ -20,6 +22,8 @@ use alhazen_scene::{FresnelMode, Light, Material, Scene};
 const MIN_WEIGHT: f64 = 1.0 / 1024.0;
 /// How many transparent surfaces a shadow ray may pass before it counts as blocked.
 const MAX_SHADOW_SURFACES: usize = 64;
+/// Points taken on each emitting object per shading point: a 4 × 4 stratified grid.
+const EMITTER_STRATA: u32 = 4;
 
 /// The Whitted integrator over a built world.
 pub struct Whitted<'a> {
@@ -28,6 +32,10 @@ pub struct Whitted<'a> {
     max_depth: u32,
     /// Sphere, cylinder and plane mirrors that lights shine through onto other surfaces.
     mirrors: Vec<Mirror>,
+    /// The scene's lights as the path tracer samples them, for its emitting objects.
+    lights: Lights,
+    /// The emitting objects that light others: `(light index in lights, object)`.
+    emitters: Vec<(usize, u32)>,
 }
 
 /// A mirror surface of the scene for specular connections ([`crate::connect`]).
@@ -114,7 +122,13 @@ impl<'a> Whitted<'a> {
                 shapes.into_iter().map(move |shape| Mirror { object: i as u32, shape, reflectance: m.mirror })
             })
             .collect();
-        Self { scene, world, max_depth: scene.render.max_depth.max(1), mirrors }
+        let emits = scene.objects.iter().any(|o| scene.materials[o.material as usize].emission != Vec3::ZERO);
+        let lights = if emits { Lights::build(scene) } else { Lights::default() };
+        let emitters = (lights.objects().into_iter().enumerate())
+            .filter(|(i, _)| matches!(lights.all()[*i], PathLight::Area { .. }))
+            .filter_map(|(i, o)| Some((i, o?)))
+            .collect();
+        Self { scene, world, max_depth: scene.render.max_depth.max(1), mirrors, lights, emitters }
     }
 
     /// `RT_trace`: radiance along `ray` (unit direction); `depth` starts at 1 for camera rays,
@@ -143,11 +157,14 @@ impl<'a> Whitted<'a> {
         }
         let a = texture::eval(&m.color, h.uv, &self.scene.images) * m.diffuse;
         let mut color = a * self.scene.ambient + self.direct(m, a, h.p, n, ng, v);
+        if !self.emitters.is_empty() {
+            color += self.lit_by_emitters(m, a, h.p, n, ng, v, wh.object);
+        }
         if !self.mirrors.is_empty() {
             color += self.through_mirrors(m, a, h.p, n, ng, v, wh.object);
         }
         if front {
-            color += m.emission; // emitters look lit (they light others only under the path tracer)
+            color += m.emission;
         }
         if depth < self.max_depth {
             color += self.secondary(m, h.p, n, ng, v, front, depth, weight);
@@ -180,6 +197,42 @@ impl<'a> Whitted<'a> {
             sum += through * i_dir * local;
         }
         sum
+    }
+
+    /// The course's local model lit by emitting objects, in the path tracer's units: each patch
+    /// `dA` of an emitter of radiance `L` is a point light of intensity `L cos θ_y dA`, and the
+    /// model's `a cos θ_x + k_s·highlight` is divided by π, the Lambert BRDF's normalisation
+    /// (emission is radiance, not the course's light intensity), so the term is
+    /// `∫ L (a cos θ_x + k_s·highlight)/π dω` — for Lambert the path tracer's direct light. Estimated with 4 × 4
+    /// stratified points per emitter (spheres by the cone they show), jittered by a generator
+    /// seeded with `p`, each tested by a shadow ray.
+    #[inline(never)]
+    fn lit_by_emitters(&self, m: &Material, a: Vec3, p: Vec3, n: Vec3, ng: Vec3, v: Vec3, object: u32) -> Vec3 {
+        let mut rng = Rng::for_point(p);
+        let strata = EMITTER_STRATA as f64;
+        let mut sum = Vec3::ZERO;
+        for &(light, _) in self.emitters.iter().filter(|e| e.1 != object) {
+            for k in 0..EMITTER_STRATA * EMITTER_STRATA {
+                let (i, j) = ((k % EMITTER_STRATA) as f64, (k / EMITTER_STRATA) as f64);
+                let u = alhazen_math::Vec2::new((i + rng.uniform()) / strata, (j + rng.uniform()) / strata);
+                let Some(s) = self.lights.sample_light(light, p, u) else { continue };
+                let cos = n.dot(s.dir);
+                if cos <= 0.0 || ng.dot(s.dir) <= 0.0 || s.pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                    continue;
+                }
+                let reach = s.dist * (1.0 - 1e-7) - 4.0 * epsilon(p + s.dir * s.dist);
+                let through = self.transmittance(p + ng * epsilon(p), s.dir, reach);
+                if through == Vec3::ZERO {
+                    continue;
+                }
+                let mut local = a * cos;
+                if m.specular != Vec3::ZERO {
+                    local += m.specular * m.highlight(n, s.dir, v);
+                }
+                sum += through * s.radiance * local / s.pdf;
+            }
+        }
+        sum / (strata * strata * std::f64::consts::PI)
     }
 
     /// The course's local model for light that reaches `p` after one reflection on a sphere,

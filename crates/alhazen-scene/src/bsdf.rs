@@ -180,6 +180,52 @@ pub enum BsdfDesc {
     },
 }
 
+impl crate::model::Material {
+    /// A material that is only a path-tracer BSDF, with the Whitted and preview coefficients
+    /// following it: its diffuse albedo (and `k_d`) as `color` (and `diffuse`), a Phong lobe's
+    /// `k_s` and exponent as the highlight, a smooth metal as a mirror of 0.9 (a rough one, α >
+    /// 0.05, as a highlight of exponent `2/α² − 2`), glass as transparent
+    /// with the BSDF's index; a mix follows its first part.
+    pub fn from_bsdf(name: &str, bsdf: BsdfDesc) -> crate::model::Material {
+        let mut m = crate::model::Material { name: name.to_string(), ..Default::default() };
+        m.follow(&bsdf);
+        m.bsdf = Some(bsdf);
+        m
+    }
+
+    fn follow(&mut self, bsdf: &BsdfDesc) {
+        match bsdf {
+            BsdfDesc::Lambert { albedo } | BsdfDesc::OrenNayar { albedo, .. } => self.color = albedo.clone(),
+            BsdfDesc::CookTorrance { albedo, kd, .. } => (self.color, self.diffuse) = (albedo.clone(), *kd),
+            BsdfDesc::Phong { albedo, kd, ks, exponent } | BsdfDesc::BlinnPhong { albedo, kd, ks, exponent, .. } => {
+                (self.color, self.diffuse) = (albedo.clone(), *kd);
+                (self.specular, self.shininess) = (Vec3::splat(*ks), *exponent);
+            }
+            BsdfDesc::Conductor { facets, .. } => {
+                self.color = Texture::Solid(Vec3::splat(0.8));
+                self.diffuse = 0.0;
+                match facets.map(|f| f.alpha_u.max(f.alpha_v)).filter(|&a| a > 0.05) {
+                    // Rough: a highlight of the Phong exponent matching the roughness.
+                    Some(alpha) => {
+                        self.specular = Vec3::splat(0.9);
+                        self.shininess = (2.0 / (alpha * alpha) - 2.0).max(1.0);
+                    }
+                    None => self.mirror = Vec3::splat(0.9),
+                }
+            }
+            BsdfDesc::Dielectric { ior, .. } => {
+                self.color = Texture::Solid(Vec3::splat(0.8));
+                self.diffuse = 0.0;
+                self.transparency = Vec3::ONE;
+                self.ior = ior.nominal();
+                self.specular = Vec3::ONE;
+                self.shininess = 200.0;
+            }
+            BsdfDesc::Mix { a, .. } => self.follow(a),
+        }
+    }
+}
+
 impl BsdfDesc {
     /// True when some colour of it is a texture (so hits need texture coordinates).
     pub fn is_textured(&self) -> bool {

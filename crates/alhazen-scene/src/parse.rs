@@ -169,12 +169,12 @@ impl Parser<'_> {
             "scratches",
         ];
         let t = n.table(KEYS)?;
-        let d = Material::default();
-        let color = match t.get("color") {
-            Some(c) => self.texture(&c)?,
-            None => d.color.clone(),
-        };
-        let bsdf = t.get("bsdf").map(|b| self.bsdf(&b, &color)).transpose()?;
+        let plain = Material::default();
+        let given = t.get("color").map(|c| self.texture(&c)).transpose()?;
+        let bsdf = t.get("bsdf").map(|b| self.bsdf(&b, given.as_ref().unwrap_or(&plain.color))).transpose()?;
+        // The Whitted and preview coefficients not given follow the BSDF.
+        let d = bsdf.clone().map_or(plain, |b| Material::from_bsdf(name, b));
+        let color = given.unwrap_or_else(|| d.color.clone());
         Ok(Material {
             name: name.to_string(),
             color,

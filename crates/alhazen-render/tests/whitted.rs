@@ -1,0 +1,80 @@
+//! Whitted ray tracing lit by emitting objects: where nothing reflects or refracts, its image
+//! is the path tracer's direct light (paths of two segments), block by block.
+
+use alhazen_math::Vec3;
+use alhazen_render::{Image, render};
+use alhazen_scene::{IntegratorKind, Scene, load_scene, parse_scene};
+use std::path::Path;
+
+fn with(mut scene: Scene, integrator: IntegratorKind, spp: u32) -> Image {
+    scene.render.width = 32;
+    scene.render.height = 32;
+    scene.render.spp = spp;
+    scene.render.max_depth = 2;
+    scene.render.integrator = integrator;
+    render(&scene, &|_, _| {})
+}
+
+/// Each 8 × 8 block's mean over the pixels that do not see a lamp (both values below 1; a
+/// lamp's edge pixels differ by the sampling of the pixel's area, not of the light): within
+/// `rel` of the path tracer's or `abs` of it.
+fn blocks_agree(whitted: &Image, path: &Image, rel: f64, abs: f64) {
+    for (bx, by) in (0..4).flat_map(|y| (0..4).map(move |x| (x, y))) {
+        let (mut w, mut p, mut n) = (Vec3::ZERO, Vec3::ZERO, 0.0f64);
+        for (x, y) in (0..8).flat_map(|y| (0..8).map(move |x| (8 * bx + x, 8 * by + y))) {
+            let (a, b) = (whitted.get(x, y), path.get(x, y));
+            if a.max_element() < 1.0 && b.max_element() < 1.0 {
+                (w, p, n) = (w + a, p + b, n + 1.0);
+            }
+        }
+        let (w, p) = (w / n.max(1.0), p / n.max(1.0));
+        let ok = (w - p).abs().max_element() <= (rel * p.max_element()).max(abs);
+        assert!(ok, "block ({bx}, {by}): Whitted {w:?}, path tracer {p:?}");
+    }
+}
+
+#[test]
+fn whitted_lit_by_the_cornell_lamp_is_the_path_tracers_direct_light() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let scene = load_scene(&path).unwrap();
+    let whitted = with(scene.clone(), IntegratorKind::Whitted, 32);
+    let traced = with(scene, IntegratorKind::Path, 1024);
+    blocks_agree(&whitted, &traced, 0.04, 2e-3);
+}
+
+#[test]
+fn sphere_and_disk_lamps_light_whitted_as_they_light_the_path_tracer() {
+    let text = r#"
+background = [0, 0, 0]
+[camera]
+eye = [0, 2.5, 5]
+target = [0, 0.3, 0]
+fov = 45
+[materials.floor]
+bsdf = { type = "lambert", color = [0.7, 0.6, 0.5] }
+[[object]]
+shape = "rectangle"
+transform = [{ scale = 4 }, { rotate_x = -90 }]
+material = "floor"
+[[object]]
+shape = "box"
+min = [-0.4, 0, -0.4]
+max = [0.4, 0.8, 0.4]
+material = { color = [0.3, 0.5, 0.8] }
+[[object]]
+shape = "sphere"
+center = [0.8, 2.9, 3.2]
+radius = 0.3
+material = { emission = [6, 5, 4] }
+[[object]]
+shape = "disk"
+center = [-1.3, 1.8, -0.2]
+normal = [0.3, -1, 0]
+radius = 0.4
+material = { emission = [2, 3, 4] }
+"#;
+    let scene = parse_scene("lamps.toml".as_ref(), text).unwrap();
+    let whitted = with(scene.clone(), IntegratorKind::Whitted, 32);
+    let traced = with(scene, IntegratorKind::Path, 1024);
+    blocks_agree(&whitted, &traced, 0.04, 2e-3);
+}
