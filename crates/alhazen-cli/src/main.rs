@@ -238,21 +238,6 @@ pub(crate) fn check_output(path: &Path, half: bool) -> Result<Format, Failure> {
     Ok(format)
 }
 
-/// Warns when the scene has no light `renderer` uses but emitting objects it ignores (only the
-/// path tracer lights with them), saying what to do.
-pub(crate) fn warn_unlit(scene: &Scene, renderer: &str, remedy: &str) {
-    let emitters = scene
-        .objects
-        .iter()
-        .filter(|o| scene.materials[o.material as usize].emission.abs().max_element() > 0.0)
-        .count();
-    if scene.lights.is_empty() && emitters > 0 {
-        eprintln!(
-            "warning: {renderer} lights only with [[light]] entries; this scene has none, only {emitters} emitting object(s), which it shows but does not light with ({remedy})"
-        );
-    }
-}
-
 /// Opens the output (its temporary file) before any work, so that a place where it cannot be
 /// written is refused at once (exit 2) instead of after the render.
 pub(crate) fn open_output(path: &Path) -> Result<alhazen_render::output::PendingFile, Failure> {

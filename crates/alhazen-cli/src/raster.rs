@@ -95,7 +95,6 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
     let format = check_output(&a.image.output, a.image.half)?;
     let output = crate::open_output(&a.image.output)?;
     let scene = load_sized(&a.image)?;
-    crate::warn_unlit(&scene, "the raster preview", "render it with --integrator path");
     let opts = RasterOptions {
         shading: match a.shading {
             ShadingArg::Flat => Shading::Flat,

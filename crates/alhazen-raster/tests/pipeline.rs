@@ -450,3 +450,27 @@ fn the_memory_estimate_counts_every_triangle_drawn() {
     }
     assert!(checked > 20);
 }
+
+#[test]
+fn the_preview_is_lit_by_the_cornell_lamp_as_whitted_is() {
+    // The lamp is an emitting rectangle: four shadow-mapped lights in the preview, 4 × 4 shadow
+    // rays in Whitted; the walls' brightness must agree, the shadows' edges may not (hard vs soft).
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let mut scene = alhazen_scene::load_scene(&path).unwrap();
+    (scene.render.width, scene.render.height, scene.render.spp) = (64, 64, 16);
+    scene.render.integrator = alhazen_scene::IntegratorKind::Whitted;
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    let (fb, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    let err = relative_error(&fb, &traced);
+    assert!(err < 0.2, "mean absolute difference {:.1} % of the mean brightness", err * 100.0);
+    // Means over the pixels that do not see the lamp (the lamp's edge is sampled differently).
+    let lit = |p: &[f32; 3]| p.iter().all(|c| *c < 1.0);
+    let (mut r, mut t, mut n) = (0.0, 0.0, 0.0);
+    for (a, b) in fb.color.iter().zip(&traced.pixels).filter(|(a, b)| lit(a) && lit(b)) {
+        r += (a[0] + a[1] + a[2]) as f64;
+        t += (b[0] + b[1] + b[2]) as f64;
+        n += 1.0;
+    }
+    let (r, t) = (r / n, t / n);
+    assert!((r - t).abs() < 0.05 * t, "preview mean {r}, Whitted mean {t}");
+}

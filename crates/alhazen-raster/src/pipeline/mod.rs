@@ -13,6 +13,7 @@
 
 pub mod bsp;
 pub mod clip;
+pub mod emitters;
 pub mod geometry;
 pub mod ibl;
 pub mod raster;
@@ -119,6 +120,8 @@ pub struct Prepared {
     pub ibl: Option<Ibl>,
     /// The BSP tree, when the painter's algorithm is asked for.
     pub bsp: Option<bsp::BspTree>,
+    /// The lights standing for emitting objects ([`emitters`]).
+    pub emitters: Vec<emitters::EmitterLight>,
 }
 
 /// Image-based light: the environment's irradiance, and the environment prefiltered for glossy
@@ -158,8 +161,9 @@ impl Prepared {
 /// lighting and builds its BSP tree.
 pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
     let geometry = scene_triangles(scene);
+    let emitters = emitters::emitter_lights(scene, &geometry.triangles);
     let maps = opts.shadows && opts.shadow_method == ShadowMethod::Maps;
-    let shadows = maps.then(|| shadow::Shadows::build(scene, &geometry.triangles, SHADOW_MAP_SIZE));
+    let shadows = maps.then(|| shadow::Shadows::build(scene, &geometry.triangles, &emitters, SHADOW_MAP_SIZE));
     let ibl = opts.ibl.then(|| Ibl {
         irradiance: ibl::Sh9::irradiance_of(&|d| scene.sky(d), 8, 400),
         specular: ibl::SpecularIbl::build(&|d| scene.sky(d), 32),
@@ -169,7 +173,7 @@ pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
             geometry.triangles.iter().fold(alhazen_math::Bounds3::EMPTY, |b, t| t.v.iter().fold(b, |b, v| b.grow(v.p)));
         bsp::BspTree::build(&geometry.triangles, 1e-9 * (1.0 + b.extent().length()))
     });
-    Prepared { geometry, shadows, ibl, bsp }
+    Prepared { geometry, shadows, ibl, bsp, emitters }
 }
 
 /// What the pipeline did.
@@ -432,6 +436,7 @@ pub fn render_prepared(
         irradiance: prepared.ibl.as_ref().filter(|_| opts.ibl).map(|i| &i.irradiance),
         specular: prepared.ibl.as_ref().filter(|_| opts.ibl).map(|i| &i.specular),
         blocked: 0,
+        emitters: &prepared.emitters,
         hemisphere: opts
             .hemispherical
             .then(|| (scene.background.radiance(Vec3::Y), scene.background.radiance(Vec3::NEG_Y))),

@@ -1,6 +1,7 @@
 //! The course's local lighting models for the preview (§"Lighting models"): ambient, Lambert and
 //! the Phong or Blinn–Phong highlight (`⟨h, n⟩^{2m}`), for every light on the viewer's side of
-//! the surface (the factor ν), with the course's distance attenuation; no shadows.
+//! the surface (the factor ν), with the course's distance attenuation, and the lights that
+//! stand for emitting objects ([`super::emitters`]).
 
 use super::ibl::{Sh9, SpecularIbl};
 use super::shadow::Shadows;
@@ -17,6 +18,8 @@ pub struct Lighting<'a> {
     pub specular: Option<&'a SpecularIbl>,
     /// Lights (bit `k` for light `k`) that a stencil shadow volume hides at this pixel.
     pub blocked: u64,
+    /// Lights standing for emitting objects, after the scene's (their shadow maps follow).
+    pub emitters: &'a [super::emitters::EmitterLight],
     /// The course's hemispherical lighting instead of the ambient constant: sky and ground
     /// intensities (the background straight up and straight down).
     pub hemisphere: Option<(Vec3, Vec3)>,
@@ -45,7 +48,8 @@ pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &
         diffuse += sh.eval(n).max(Vec3::ZERO) * FRAC_1_PI;
     }
     let shadows = extra.shadows;
-    for (k, light) in scene.lights.iter().enumerate() {
+    let lights = scene.lights.iter().chain(extra.emitters.iter().map(|e| &e.light));
+    for (k, light) in lights.enumerate() {
         let Some((l, _, i)) = light.arriving(p) else { continue };
         let cos = n.dot(l);
         let stenciled = k < 64 && extra.blocked >> k & 1 == 1;

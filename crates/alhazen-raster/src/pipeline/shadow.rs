@@ -7,6 +7,7 @@
 //! tolerance, against self-shadowing ("shadow acne").
 
 use super::clip::{ATTRIBUTES, ClipVertex, clip_polygon};
+use super::emitters::EmitterLight;
 use super::geometry::Triangle;
 use super::raster::{rasterize, to_screen};
 use alhazen_math::viewing::{Frustum, ViewFrame};
@@ -56,10 +57,19 @@ pub struct Shadows {
     lights: Vec<Option<LightShadow>>,
 }
 
-fn face(tris: &[Triangle], frame: ViewFrame, projection: Mat4, size: u32, texel: f64, metric: Metric) -> Face {
+/// One shadow map: the depths of `tris` but those of object `skip` (a light's own emitter).
+fn face(
+    tris: &[Triangle],
+    skip: Option<u32>,
+    frame: ViewFrame,
+    projection: Mat4,
+    size: u32,
+    texel: f64,
+    metric: Metric,
+) -> Face {
     let world_to_clip = projection * frame.world_to_view();
     let mut depth = vec![f64::INFINITY; (size * size) as usize];
-    for t in tris {
+    for t in tris.iter().filter(|t| Some(t.object) != skip) {
         let poly: Vec<ClipVertex> =
             t.v.iter()
                 .map(|v| {
@@ -92,32 +102,37 @@ pub(super) fn finite_bounds(tris: &[Triangle]) -> Bounds3 {
 }
 
 impl Shadows {
-    /// Renders the shadow maps of every light of `scene` over `tris` (`size` texels a side).
-    pub fn build(scene: &Scene, tris: &[Triangle], size: u32) -> Self {
+    /// Renders the shadow maps of every light of `scene`, then of the lights standing for its
+    /// emitters, over `tris` (`size` texels a side).
+    pub fn build(scene: &Scene, tris: &[Triangle], emitters: &[EmitterLight], size: u32) -> Self {
         let bounds = finite_bounds(tris);
         let extent = if bounds.is_empty() { 1.0 } else { bounds.extent().length().max(1e-6) };
         let (near, far) = (1e-4 * extent, 1e4 * extent);
-        let lights = scene
-            .lights
+        let all: Vec<(&Light, Option<u32>)> =
+            scene.lights.iter().map(|l| (l, None)).chain(emitters.iter().map(|e| (&e.light, Some(e.object)))).collect();
+        let cube = |position: Vec3, skip: Option<u32>| {
+            let p = Frustum::symmetric(std::f64::consts::FRAC_PI_2, 1.0, near, far).perspective();
+            let dirs = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+            let metric = Metric::From(position);
+            let faces = dirs
+                .iter()
+                .map(|d| face(tris, skip, frame_towards(position, *d), p, size, 2.0 / size as f64, metric))
+                .collect();
+            Some(LightShadow { faces, metric, perspective: true })
+        };
+        let lights = all
             .par_iter()
-            .map(|light| match *light {
-                Light::Point { position, .. } => {
-                    let p = Frustum::symmetric(std::f64::consts::FRAC_PI_2, 1.0, near, far).perspective();
-                    let dirs = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
-                    let metric = Metric::From(position);
-                    let faces = dirs
-                        .iter()
-                        .map(|d| face(tris, frame_towards(position, *d), p, size, 2.0 / size as f64, metric))
-                        .collect();
-                    Some(LightShadow { faces, metric, perspective: true })
-                }
+            .map(|&(light, skip)| match *light {
+                Light::Point { position, .. } => cube(position, skip),
+                // Cones wider than 120° are seen through the six faces of a point light.
+                Light::Spot { position, cos_cutoff, .. } if cos_cutoff < 0.5 => cube(position, skip),
                 Light::Spot { position, direction, cos_cutoff, .. } => {
                     let fov = (2.0 * cos_cutoff.clamp(-1.0, 1.0).acos()).clamp(1e-3, 170f64.to_radians());
                     let p = Frustum::symmetric(fov, 1.0, near, far).perspective();
                     let metric = Metric::From(position);
                     let texel = 2.0 * (fov / 2.0).tan() / size as f64;
                     Some(LightShadow {
-                        faces: vec![face(tris, frame_towards(position, direction), p, size, texel, metric)],
+                        faces: vec![face(tris, skip, frame_towards(position, direction), p, size, texel, metric)],
                         metric,
                         perspective: true,
                     })
@@ -133,6 +148,7 @@ impl Shadows {
                     Some(LightShadow {
                         faces: vec![face(
                             tris,
+                            skip,
                             frame_towards(origin, direction),
                             p,
                             size,
@@ -194,7 +210,7 @@ shape = "plane"
 "#;
         let scene = alhazen_scene::parse_scene("s.toml".as_ref(), text).unwrap();
         let tris = super::super::geometry::scene_triangles(&scene).triangles;
-        let sh = Shadows::build(&scene, &tris, 256);
+        let sh = Shadows::build(&scene, &tris, &[], 256);
         for light in 0..2 {
             assert!(!sh.lit(light, Vec3::new(0.0, 0.0, 0.0), Vec3::Y), "under the box (light {light})");
             assert!(sh.lit(light, Vec3::new(3.0, 0.0, 0.5), Vec3::Y), "beside it (light {light})");
