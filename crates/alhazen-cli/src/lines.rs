@@ -251,7 +251,7 @@ impl Progress for StageBar {
 /// The drawing's own words for a camera it cannot use.
 fn camera_error(e: alhazen_raster::pipeline::RasterError) -> String {
     let alhazen_raster::pipeline::RasterError::UnsupportedCamera(kind) = e;
-    format!("line drawings support perspective, orthographic and axonometric cameras, not {kind}")
+    format!("line drawings support perspective, orthographic, axonometric and stereo cameras, not {kind}")
 }
 
 /// A floating-horizon drawing of a built-in function on paper `width_mm` wide.

@@ -66,6 +66,9 @@ pub(crate) struct RasterArgs {
     /// The course's hemispherical lighting (background up and down) instead of the ambient term.
     #[arg(long)]
     hemispherical: bool,
+    /// With a stereo camera: one red–cyan anaglyph instead of the two views side by side.
+    #[arg(long)]
+    anaglyph: bool,
     /// Hidden-surface removal: depth buffer, or the painter's algorithm over a BSP tree.
     #[arg(long, value_enum, default_value = "zbuffer")]
     visibility: VisibilityArg,
@@ -106,6 +109,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         shadows: !a.no_shadows,
         ibl: a.ibl,
         hemispherical: a.hemispherical,
+        anaglyph: a.anaglyph,
         clip_planes: a.clip_plane.clone(),
         cull_planes: a.cull_plane.clone(),
         shadow_method: match a.shadow_method {

@@ -130,7 +130,7 @@ fn warn_unsampled_emitters(scene: &Scene) {
         scene.objects.iter().enumerate().filter(|(i, o)| emits(o) && lights.of_object(*i as u32).is_none()).count();
     if unsampled > 0 {
         eprintln!(
-            "warning: {unsampled} emitting object(s) light nothing under Whitted ray tracing (only spheres, disks, boxes and meshes do; not cylinders, cones, patches, CSG or distorted spheres): they are shown, not sampled; use --integrator path"
+            "warning: {unsampled} emitting object(s) light nothing under Whitted ray tracing (only spheres, disks, rectangles, boxes and meshes do; not cylinders, cones, patches, CSG or distorted spheres): they are shown, not sampled; use --integrator path"
         );
     }
 }

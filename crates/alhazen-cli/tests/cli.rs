@@ -92,10 +92,13 @@ fn raster_preview_writes_an_image_and_refuses_unsupported_cameras() {
         assert!(String::from_utf8_lossy(&o.stderr).contains("fps"));
     }
     assert!(out.exists());
-    let pano = scene_file(dir.path(), "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n");
+    let pano = scene_file(dir.path(), "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
     let o = alhazen(&["raster", pano.to_str().unwrap(), "-o", dir.path().join("p.png").to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("perspective, orthographic and axonometric"));
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let stereo = scene_file(dir.path(), "[camera]\ntype = \"stereo\"\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
+    let o =
+        alhazen(&["raster", stereo.to_str().unwrap(), "-o", dir.path().join("s.png").to_str().unwrap(), "--anaglyph"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 #[test]
@@ -339,7 +342,7 @@ fn renderers_that_ignore_emitters_say_so() {
     );
     let tube = scene_file(
         dir.path(),
-        "[[object]]\nshape = \"cylinder\"\nmaterial = { emission = [4, 4, 4] }\n[[object]]\nshape = \"box\"\n",
+        "[[object]]\nshape = \"cylinder\"\nradius = 0.2\nmaterial = { emission = [4, 4, 4] }\n[[object]]\nshape = \"box\"\n",
     );
     let said = run(&["render", tube.to_str().unwrap(), "-o", o, "--integrator", "whitted"]);
     assert!(said.contains("1 emitting object(s) light nothing") && said.contains("use --integrator path"), "{said}");
@@ -516,8 +519,14 @@ fn lines_writes_svg_pdf_and_png_and_refuses_bad_input() {
     let graph = alhazen(&["lines", "--graph", "saddle", "-o", dir.path().join("g.svg").to_str().unwrap(), "-q"]);
     assert_eq!(graph.status.code(), Some(0));
     let stereo = scene_file(dir.path(), "[camera]\ntype = \"stereo\"\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
-    let o = alhazen(&["lines", stereo.to_str().unwrap(), "-o", dir.path().join("s.svg").to_str().unwrap()]);
+    let pair = dir.path().join("s.svg");
+    let o = alhazen(&["lines", stereo.to_str().unwrap(), "-o", pair.to_str().unwrap(), "--width-mm", "100"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read_to_string(&pair).unwrap().contains("width=\"200.000mm\""), "two 100 mm views side by side");
+    let pano = scene_file(dir.path(), "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
+    let o = alhazen(&["lines", pano.to_str().unwrap(), "-o", dir.path().join("p.svg").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not panorama"));
 }
 
 #[test]

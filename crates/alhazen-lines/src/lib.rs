@@ -115,8 +115,34 @@ pub fn draw(scene: &Scene, opts: &Options) -> Result<(Drawing, Stats), RasterErr
     draw_reporting(scene, opts, &Unwatched)
 }
 
-/// [`draw`], telling `progress` of each stage: long on scenes of millions of triangles.
+/// [`draw`], telling `progress` of each stage: long on scenes of millions of triangles. A
+/// stereo camera gives both eyes' drawings side by side on paper twice as wide (left eye on
+/// the left), as the ray tracer's stereo images are.
 pub fn draw_reporting(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(Drawing, Stats), RasterError> {
+    let aspect = scene.render.width as f64 / scene.render.height as f64;
+    let Some(eyes) = scene.camera.stereo_eyes(aspect) else { return draw_view(scene, opts, progress) };
+    let mut halves = vec![];
+    for camera in eyes {
+        let eye = Scene { camera, ..scene.clone() };
+        halves.push(draw_view(&eye, opts, progress)?);
+    }
+    let (right, r) = halves.pop().expect("two eyes");
+    let (mut left, l) = halves.pop().expect("two eyes");
+    let shift = alhazen_math::Vec2::new(left.size.x, 0.0);
+    left.lines
+        .extend(right.lines.into_iter().map(|(layer, pts)| (layer, pts.into_iter().map(|p| p + shift).collect())));
+    left.size.x += right.size.x;
+    let stats = Stats {
+        visible: l.visible + r.visible,
+        hidden: l.hidden + r.hidden,
+        reflected: l.reflected + r.reflected,
+        ..l
+    };
+    Ok((left, stats))
+}
+
+/// The drawing from one camera a projection matrix gives.
+fn draw_view(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(Drawing, Stats), RasterError> {
     progress.stage("building the scene's index", 0);
     let world = World::build(scene);
     let view = view::View::new(scene, &world, opts.width_mm)?;

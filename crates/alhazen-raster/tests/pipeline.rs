@@ -2,7 +2,7 @@
 //! model, no reflections and no shadows in view — the images must agree up to tessellation.
 
 use alhazen_math::Vec3;
-use alhazen_raster::pipeline::{RasterError, RasterOptions, Shading, render_scene};
+use alhazen_raster::pipeline::{RasterOptions, Shading, render_scene};
 use alhazen_scene::parse_scene;
 
 const SCENE: &str = r#"
@@ -101,12 +101,33 @@ fn depth_buffer_keeps_the_nearest_surface() {
 }
 
 #[test]
-fn unsupported_cameras_are_reported() {
-    let text = "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n";
-    let scene = parse_scene("p.toml".as_ref(), text).unwrap();
-    let err = render_scene(&scene, &RasterOptions::default()).unwrap_err();
-    assert_eq!(err, RasterError::UnsupportedCamera("panorama"));
-    assert!(err.to_string().contains("perspective, orthographic and axonometric"));
+fn stereo_and_panorama_previews_agree_with_the_ray_tracer() {
+    // The same scene through a stereo pair (side by side) and a 200° panorama: the preview's
+    // two views and its cube map resampled against the ray tracer's cameras.
+    let cameras = [
+        "[camera]\ntype = \"stereo\"\neye = [0, 1.5, 6]\ntarget = [0, 0.5, 0]\neye_distance = 0.3\nscreen_distance = 6\nscreen_width = 7",
+        "[camera]\ntype = \"panorama\"\neye = [0, 1.5, 6]\ntarget = [0, 0.5, 0]\nfov = 200",
+    ];
+    for camera in cameras {
+        let text = SCENE.replace("[camera]\neye = [0, 1.5, 6]\ntarget = [0, 0.5, 0]\nfov = 50", camera);
+        let scene = parse_scene("cameras.toml".as_ref(), &text).unwrap();
+        let traced = alhazen_render::render(&scene, &|_, _| {});
+        let (fb, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+        assert_eq!((fb.width, fb.height), (traced.width, traced.height), "{camera}");
+        let err = relative_error(&fb, &traced);
+        eprintln!("{camera}: mean absolute difference {:.2} % of the mean brightness", err * 100.0);
+        assert!(err < 0.03, "{camera}: mean error {:.2} % of the mean brightness", err * 100.0);
+    }
+    // The anaglyph: red from the left view, green and blue from the right.
+    let text = SCENE.replace("[camera]\neye = [0, 1.5, 6]\ntarget = [0, 0.5, 0]\nfov = 50", cameras[0]);
+    let scene = parse_scene("cameras.toml".as_ref(), &text).unwrap();
+    let (pair, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    let (ana, _) = render_scene(&scene, &RasterOptions { anaglyph: true, ..Default::default() }).unwrap();
+    assert_eq!((ana.width, ana.height), (pair.width / 2, pair.height));
+    let (x, y) = (40, 70);
+    let k = (y * ana.width + x) as usize;
+    assert_eq!(ana.color[k][0], pair.color[(y * pair.width + x) as usize][0]);
+    assert_eq!(ana.color[k][1], pair.color[(y * pair.width + x + ana.width) as usize][1]);
 }
 
 #[test]

@@ -211,6 +211,33 @@ pub enum CameraDesc {
     },
 }
 
+impl CameraDesc {
+    /// A stereo camera's two eyes as perspective cameras (left, right) for images of aspect
+    /// `aspect` (per eye): each eye `∓eye_distance/2` along the view's horizontal axis, looking
+    /// parallel, with the skewed frusta of the course's §"Stereoscopic vision" (near plane at 1)
+    /// that show both the same screen rectangle. `None` for other cameras.
+    pub fn stereo_eyes(&self, aspect: f64) -> Option<[CameraDesc; 2]> {
+        let CameraDesc::Stereo { look, eye_distance, screen_distance, screen_width } = *self else { return None };
+        let u = alhazen_math::viewing::ViewFrame::look_at(look.eye, look.target, look.up).map_or(Vec3::X, |f| f.u);
+        let (l, r) = alhazen_math::viewing::stereo_frusta(
+            eye_distance,
+            screen_distance,
+            screen_width,
+            screen_width / aspect,
+            1.0,
+            1000.0,
+        );
+        let eye = |side: f64, f: alhazen_math::viewing::Frustum| {
+            let shift = u * (side * eye_distance / 2.0);
+            CameraDesc::Perspective {
+                look: LookAt { eye: look.eye + shift, target: look.target + shift, up: look.up },
+                opening: PerspectiveOpening::Frustum { lrbtn: [f.l, f.r, f.b, f.t, f.n] },
+            }
+        };
+        Some([eye(-1.0, l), eye(1.0, r)])
+    }
+}
+
 /// What a ray that hits nothing sees.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Background {

@@ -12,6 +12,7 @@
 //! stencil volumes), image-based and hemispherical light. The camera and the sample position (pixel centres) match `alhazen render`'s.
 
 pub mod bsp;
+pub mod cameras;
 pub mod clip;
 pub mod emitters;
 pub mod geometry;
@@ -77,6 +78,8 @@ pub struct RasterOptions {
     /// Replace the ambient constant by the course's hemispherical lighting (sky and ground
     /// colours from the background).
     pub hemispherical: bool,
+    /// A stereo camera's eyes as one red–cyan anaglyph instead of side by side.
+    pub anaglyph: bool,
 }
 
 /// Shadow algorithm.
@@ -101,6 +104,7 @@ impl Default for RasterOptions {
             visibility: Visibility::ZBuffer,
             shadow_method: ShadowMethod::Maps,
             hemispherical: false,
+            anaglyph: false,
         }
     }
 }
@@ -213,7 +217,7 @@ impl std::fmt::Display for RasterError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Self::UnsupportedCamera(k) => {
-                write!(f, "the raster preview supports perspective, orthographic and axonometric cameras, not {k}")
+                write!(f, "this view supports perspective, orthographic and axonometric cameras, not {k}")
             }
         }
     }
@@ -284,6 +288,7 @@ pub fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projecti
             let frame = ViewFrame { eye: *target - dir * 1e4, u, v: w.cross(u), w };
             return Ok(Projection { world_to_clip: m, clip_to_world: m.inverse(), frame, perspective: false });
         }
+        // Drawn by `render_prepared` as two perspective views and as a cube map.
         CameraDesc::Stereo { .. } => return Err(RasterError::UnsupportedCamera("stereo")),
         CameraDesc::Panorama { .. } => return Err(RasterError::UnsupportedCamera("panorama")),
     };
@@ -419,13 +424,39 @@ pub fn render_scene(scene: &Scene, opts: &RasterOptions) -> Result<(Framebuffer,
 /// Renders prepared geometry (built once by [`prepare`], then drawn as often as the camera or
 /// the options change). What `opts` asks for but was not prepared (see [`Prepared::serves`])
 /// is left out: no shadow maps, no image-based light, the z-buffer instead of the BSP tree.
+///
+/// A stereo camera gives both eyes side by side (`2 × width`), or as a red–cyan anaglyph when
+/// `opts.anaglyph`; a panorama is resampled from the six faces of a cube map rendered from its
+/// eye.
 pub fn render_prepared(
     scene: &Scene,
     prepared: &Prepared,
     opts: &RasterOptions,
 ) -> Result<(Framebuffer, RasterStats), RasterError> {
     let (w, h) = (scene.render.width, scene.render.height);
-    let proj = projection(&scene.camera, w, h)?;
+    if let Some([left, right]) = scene.camera.stereo_eyes(w as f64 / h as f64) {
+        let (l, ls) = render_view(scene, prepared, opts, &projection(&left, w, h)?, (w, h))?;
+        let (r, rs) = render_view(scene, prepared, opts, &projection(&right, w, h)?, (w, h))?;
+        let fb = if opts.anaglyph { cameras::anaglyph(&l, &r) } else { cameras::side_by_side(&l, &r) };
+        return Ok((fb, cameras::sum(ls, rs)));
+    }
+    if let CameraDesc::Panorama { look, angle } = scene.camera {
+        return cameras::panorama(look, angle, (w, h), |desc, size| {
+            render_view(scene, prepared, opts, &projection(desc, size, size)?, (size, size))
+        });
+    }
+    render_view(scene, prepared, opts, &projection(&scene.camera, w, h)?, (w, h))
+}
+
+/// One view through `proj` at `w × h`.
+fn render_view(
+    scene: &Scene,
+    prepared: &Prepared,
+    opts: &RasterOptions,
+    proj: &Projection,
+    (w, h): (u32, u32),
+) -> Result<(Framebuffer, RasterStats), RasterError> {
+    let proj = *proj;
     let geometry = &prepared.geometry;
     let stencil_mode = match (opts.shadows, opts.shadow_method, proj.perspective) {
         (true, ShadowMethod::Volumes(mode), true) => Some(mode),
