@@ -164,6 +164,10 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
                 format!(", {} CSG objects skipped", stats.skipped_objects)
             } else {
                 String::new()
+            } + &if stats.reflexes > 0 {
+                format!(", {} pieces drawn as their reflexes in spherical mirrors", stats.reflexes)
+            } else {
+                String::new()
             },
             per_frame,
             1.0 / per_frame,

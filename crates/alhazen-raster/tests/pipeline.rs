@@ -495,3 +495,66 @@ fn the_preview_is_lit_by_the_cornell_lamp_as_whitted_is() {
     let (r, t) = (r / n, t / n);
     assert!((r - t).abs() < 0.05 * t, "preview mean {r}, Whitted mean {t}");
 }
+
+/// Inside a mirror's outline (pixels whose corners all see the mirror first): the mean absolute
+/// difference from the ray tracer relative to its mean brightness there, and the same for the
+/// preview's old stand-in, the sky in the reflected direction.
+fn mirror_error(scene: &alhazen_scene::Scene, mirror: &str) -> (f64, f64) {
+    let (w, h) = (scene.render.width, scene.render.height);
+    let traced = alhazen_render::render(scene, &|_, _| {});
+    let (fb, stats) = render_scene(scene, &RasterOptions::default()).unwrap();
+    assert!(stats.reflexes > 0);
+    let object = scene.objects.iter().position(|o| o.name.as_deref() == Some(mirror)).unwrap() as u32;
+    let world = alhazen_render::World::build(scene);
+    let camera = alhazen_render::Camera::new(&scene.camera, w, h);
+    let (mut diff, mut sky, mut sum, mut n) = (0.0, 0.0, 0.0, 0.0);
+    for (y, x) in (0..h).flat_map(|y| (0..w).map(move |x| (y, x))) {
+        let sees = |fx: f64, fy: f64| {
+            world.intersect(&camera.ray(fx, fy), f64::INFINITY).is_some_and(|hit| hit.object == object)
+        };
+        let (fx, fy) = (x as f64, y as f64);
+        if !(sees(fx, fy) && sees(fx + 1.0, fy) && sees(fx, fy + 1.0) && sees(fx + 1.0, fy + 1.0)) {
+            continue;
+        }
+        let ray = camera.ray(fx + 0.5, fy + 0.5);
+        let Some(hit) = world.intersect(&ray, f64::INFINITY) else { continue };
+        let k = (y * w + x) as usize;
+        let (a, b) = (fb.color[k], traced.pixels[k]);
+        let nrm = hit.hit.n;
+        let r = ray.dir - nrm * (2.0 * ray.dir.dot(nrm));
+        let s = scene.sky(r) * 0.9;
+        diff += (0..3).map(|c| (a[c] - b[c]).abs() as f64).sum::<f64>() / 3.0;
+        sky += (0..3).map(|c| (s[c] - b[c] as f64).abs()).sum::<f64>() / 3.0;
+        sum += (b[0] + b[1] + b[2]) as f64 / 3.0;
+        n += 1.0;
+    }
+    assert!(n > 100.0, "the mirror covers {n} pixels");
+    (diff / sum, sky / sum)
+}
+
+#[test]
+fn a_mirror_ball_shows_in_the_preview_what_the_ray_tracer_shows() {
+    // Glaeser's method (every vertex to its reflex, triangles rasterised as their reflexes)
+    // against Whitted's reflected rays, inside the ball's outline: the teapot beside it and the
+    // checker floor to the horizon.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/teapot.toml");
+    let mut scene = alhazen_scene::load_scene(&path).unwrap();
+    (scene.render.width, scene.render.height, scene.render.spp, scene.render.max_depth) = (320, 240, 4, 2);
+    scene.render.integrator = alhazen_scene::IntegratorKind::Whitted;
+    let (err, sky) = mirror_error(&scene, "mirror ball");
+    eprintln!("teapot: mean absolute difference in the mirror {:.2} % (sky only: {:.2} %)", err * 100.0, sky * 100.0);
+    assert!(err < 0.09 && err < sky / 4.0, "{err} vs the sky's {sky}");
+    // The benchmark scene: the mirror ball shows the glass balls, which the preview draws as
+    // flat as it draws them directly; the floor, the red ball and the sky must agree.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/glass-balls.toml");
+    let mut scene = alhazen_scene::load_scene(&path).unwrap();
+    (scene.render.width, scene.render.height, scene.render.spp, scene.render.max_depth) = (320, 240, 4, 2);
+    scene.render.integrator = alhazen_scene::IntegratorKind::Whitted;
+    let (err, sky) = mirror_error(&scene, "mirror ball");
+    eprintln!(
+        "glass balls: mean absolute difference in the mirror {:.2} % (sky only: {:.2} %)",
+        err * 100.0,
+        sky * 100.0
+    );
+    assert!(err < 0.6 * sky, "{err} vs the sky's {sky}");
+}

@@ -16,6 +16,7 @@ pub fn sum(a: RasterStats, b: RasterStats) -> RasterStats {
         culled: a.culled + b.culled,
         drawn: a.drawn + b.drawn,
         skipped_objects: a.skipped_objects,
+        reflexes: a.reflexes + b.reflexes,
     }
 }
 

@@ -17,6 +17,7 @@ pub mod clip;
 pub mod emitters;
 pub mod geometry;
 pub mod ibl;
+pub mod mirrors;
 pub mod raster;
 pub mod shade;
 pub mod shadow;
@@ -191,6 +192,8 @@ pub struct RasterStats {
     pub drawn: usize,
     /// Objects without a triangle form (CSG).
     pub skipped_objects: usize,
+    /// Pieces of triangles rasterised as their reflexes in spherical mirrors.
+    pub reflexes: usize,
 }
 
 /// A rendered frame: linear RGB and depth (`z/w`), rows top to bottom.
@@ -467,6 +470,7 @@ fn render_view(
         irradiance: prepared.ibl.as_ref().filter(|_| opts.ibl).map(|i| &i.irradiance),
         specular: prepared.ibl.as_ref().filter(|_| opts.ibl).map(|i| &i.specular),
         blocked: 0,
+        reflected: None,
         emitters: &prepared.emitters,
         hemisphere: opts
             .hemispherical
@@ -484,6 +488,17 @@ fn render_view(
     };
     let painter = opts.visibility == Visibility::Bsp && prepared.bsp.is_some();
     let volumes = stencil_mode.map(|_| stencil::volumes(scene, tris, proj.world_to_clip, (w, h))).unwrap_or_default();
+    // Spherical mirrors by Glaeser's method: what each shows, before the frame is shaded.
+    let mirror_images: Vec<mirrors::MirrorImage> = if proj.perspective {
+        let plain = *shadows;
+        let found = mirrors::sphere_mirrors(scene);
+        found
+            .iter()
+            .map(|m| mirrors::mirror_image(scene, &geometry.triangles, m, &proj, (w, h), opts, &plain))
+            .collect()
+    } else {
+        vec![]
+    };
     let processed: Vec<(bool, Vec<ScreenTriangle>)> =
         order.par_iter().map(|&i| process(scene, &proj, &tris[i as usize], i, opts, shadows, (w, h))).collect();
     let culled = processed.iter().filter(|p| p.0).count();
@@ -526,7 +541,12 @@ fn render_view(
             let color = (0..n)
                 .map(|k| {
                     let (src, attr) = &owner[k];
-                    let shadows = &shade::Lighting { blocked: blocked[k], ..*shadows };
+                    let global = (y0 * w) as usize + k;
+                    let reflected = (*src != u32::MAX)
+                        .then(|| tris[*src as usize].object)
+                        .and_then(|o| mirror_images.iter().find(|i| i.object == o))
+                        .and_then(|i| i.color[global]);
+                    let shadows = &shade::Lighting { blocked: blocked[k], reflected, ..*shadows };
                     let c = if *src == u32::MAX {
                         let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
                         scene.background.radiance(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
@@ -552,7 +572,9 @@ fn render_view(
     if opts.wireframe {
         draw_wireframe(&mut fb, &screen);
     }
-    let stats = RasterStats { triangles: tris.len(), culled, drawn: screen.len(), skipped_objects: geometry.skipped };
+    let reflexes = mirror_images.iter().map(|i| i.drawn).sum();
+    let stats =
+        RasterStats { triangles: tris.len(), culled, drawn: screen.len(), skipped_objects: geometry.skipped, reflexes };
     Ok((fb, stats))
 }
 

@@ -18,6 +18,8 @@ pub struct Lighting<'a> {
     pub specular: Option<&'a SpecularIbl>,
     /// Lights (bit `k` for light `k`) that a stencil shadow volume hides at this pixel.
     pub blocked: u64,
+    /// What a mirror shows at this pixel ([`super::mirrors`]), instead of the sky.
+    pub reflected: Option<Vec3>,
     /// Lights standing for emitting objects, after the scene's (their shadow maps follow).
     pub emitters: &'a [super::emitters::EmitterLight],
     /// The course's hemispherical lighting instead of the ambient constant: sky and ground
@@ -87,7 +89,7 @@ pub fn combine(
         c += m.specular * ibl.filtered(r, rough) * ibl.split_factor(v.dot(n), 0.04);
     }
     if m.mirror != Vec3::ZERO {
-        c += m.mirror * scene.background.radiance(2.0 * v.dot(n) * n - v);
+        c += m.mirror * extra.reflected.unwrap_or_else(|| scene.background.radiance(2.0 * v.dot(n) * n - v));
     }
     if m.transparency != Vec3::ZERO {
         c += m.transparency * scene.background.radiance(-v);

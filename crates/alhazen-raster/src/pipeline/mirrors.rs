@@ -1,0 +1,358 @@
+//! Spherical mirrors in the preview by Glaeser's own method (*Reflections on spheres and
+//! cylinders of revolution*, §3): every vertex of the scene is mapped to its reflex — the point
+//! of the sphere where the eye sees it — by the batch solver of `alhazen-mirror`, and each
+//! triangle is rasterised as its reflex: the triangle of its corners' reflexes, subdivided where
+//! the reflex of an edge's midpoint strays from the chord by more than half a pixel (the
+//! paper's adaptive knots; a triangle whose reflex folds over the contour, Theorem 10, keeps
+//! splitting and its pieces that still disagree at the finest level are left out). Depth is the
+//! length of the reflected path `|E R| + |R P|`, tested in the mirror's own buffer; each pixel is
+//! lit at the reflected point as seen from the mirror. Pixels of the sphere that no reflex
+//! covers show the sky in the exactly reflected direction. Perspective cameras only (the batch
+//! solver's eye is finite).
+
+use super::clip::ATTRIBUTES;
+use super::geometry::{Triangle, Vertex};
+use super::raster::{ScreenTriangle, rasterize};
+use super::{Projection, RasterOptions, shade};
+use alhazen_math::{Vec2, Vec3, Vec4};
+use alhazen_mirror::batch::{PointsSoA, ReflexesSoA};
+use alhazen_mirror::{Site, Sphere};
+use alhazen_scene::{Scene, Shape};
+use rayon::prelude::*;
+
+/// Finest subdivision of a triangle's reflex: splits are adaptive, so only pieces along a
+/// curving reflex go this deep (an unbounded floor's towards its horizon).
+const MAX_LEVEL: u32 = 12;
+/// At the finest level a piece whose reflex still strays is drawn when it covers at most this
+/// many pixels across, and left out when larger (it folds over the contour).
+const FINEST_PX: f64 = 4.0;
+/// Largest distance on screen, in pixels, between the reflex of an edge's midpoint and the
+/// chord's midpoint before the triangle is split.
+const TOLERANCE_PX: f64 = 0.5;
+
+/// A spherical mirror of the scene: its object and sphere.
+#[derive(Clone, Copy, Debug)]
+pub struct SphereMirror {
+    /// The scene object.
+    pub object: u32,
+    /// The sphere in world space.
+    pub sphere: Sphere,
+}
+
+/// The spheres of `scene` whose material reflects (`mirror > 0`) under a transform that keeps
+/// them spheres.
+pub fn sphere_mirrors(scene: &Scene) -> Vec<SphereMirror> {
+    scene
+        .objects
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| scene.materials[o.material as usize].mirror != Vec3::ZERO)
+        .filter_map(|(i, o)| {
+            let Shape::Sphere { center, radius } = o.shape else { return None };
+            let axes = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| o.transform.vector(a));
+            let s = axes[0].length();
+            let similar = axes.iter().all(|a| (a.length() - s).abs() <= 1e-9 * s)
+                && axes[0].dot(axes[1]).abs() + axes[1].dot(axes[2]).abs() + axes[0].dot(axes[2]).abs() <= 1e-9 * s * s;
+            let sphere = Sphere { center: o.transform.point(center), radius: radius * s };
+            (similar && s > 0.0).then_some(SphereMirror { object: i as u32, sphere })
+        })
+        .collect()
+}
+
+/// What a mirror shows, per pixel of the image: `None` off the sphere.
+pub struct MirrorImage {
+    /// The mirror's object.
+    pub object: u32,
+    /// The reflected radiance per pixel, rows top to bottom.
+    pub color: Vec<Option<Vec3>>,
+    /// Reflex triangles rasterised.
+    pub drawn: usize,
+}
+
+/// The screen position of world point `p`.
+fn to_screen(proj: &Projection, p: Vec3, (w, h): (u32, u32)) -> Vec2 {
+    let c = proj.world_to_clip * Vec4::new(p.x, p.y, p.z, 1.0);
+    Vec2::new((c.x / c.w + 1.0) * 0.5 * w as f64, (1.0 - c.y / c.w) * 0.5 * h as f64)
+}
+
+/// Renders what `mirror` reflects of `tris` as seen through `proj` (perspective) at `w × h`.
+pub fn mirror_image(
+    scene: &Scene,
+    tris: &[Triangle],
+    mirror: &SphereMirror,
+    proj: &Projection,
+    (w, h): (u32, u32),
+    opts: &RasterOptions,
+    light: &shade::Lighting,
+) -> MirrorImage {
+    let eye = proj.frame.eye;
+    let sphere = mirror.sphere;
+    // Unbounded planes are re-meshed in rings around the mirror (their large squares would
+    // need splitting twenty times over to resolve what lies near it).
+    let planes = plane_rings(tris, &sphere);
+    let all: Vec<&Triangle> = tris.iter().filter(|t| !t.unbounded).chain(planes.iter().map(|p| &p.0)).collect();
+    let source: Vec<u32> = tris
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| !t.unbounded)
+        .map(|(i, _)| i as u32)
+        .chain(planes.iter().map(|p| p.1))
+        .collect();
+    let others: Vec<u32> = (0..all.len() as u32).filter(|&i| all[i as usize].object != mirror.object).collect();
+    let reflexes = corner_reflexes(&all, &others, &sphere, eye);
+    let pieces: Vec<ScreenTriangle> = others
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(k, &i)| {
+            let t = all[i as usize];
+            let mut out = vec![];
+            // Back faces seen from the mirror are culled as they are from the eye.
+            let corners = reflexes[k];
+            let facing = corners.iter().flatten().next().is_none_or(|r| {
+                let face = (t.v[1].p - t.v[0].p).cross(t.v[2].p - t.v[0].p);
+                !(opts.cull && t.closed) || face.dot(*r - t.v[0].p) >= 0.0
+            });
+            if facing {
+                let job = Reflexes { sphere: &sphere, eye, proj, size: (w, h) };
+                job.split(t.v, corners, source[i as usize], 0, &mut out);
+            }
+            out
+        })
+        .collect();
+    let drawn = pieces.len();
+    let band = super::BAND;
+    let color: Vec<Option<Vec3>> = (0..h.div_ceil(band))
+        .into_par_iter()
+        .flat_map_iter(|b| {
+            let (y0, y1) = (b * band, ((b + 1) * band).min(h));
+            let n = ((y1 - y0) * w) as usize;
+            let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; ATTRIBUTES]); n]);
+            for t in pieces.iter().filter(|t| {
+                let (lo, hi) = (
+                    t.y.iter().copied().fold(f64::INFINITY, f64::min),
+                    t.y.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                );
+                hi >= y0 as f64 && lo <= y1 as f64
+            }) {
+                rasterize(t, w, y0, y1, |f| {
+                    let k = ((f.y - y0) * w + f.x) as usize;
+                    if f.depth < depth[k] {
+                        depth[k] = f.depth;
+                        owner[k] = (t.source, f.attr);
+                    }
+                });
+            }
+            (0..n)
+                .map(|k| {
+                    let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
+                    let d = eye_ray(proj, 2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64);
+                    let hit = hit_sphere(&sphere, eye, d)?;
+                    let (src, attr) = &owner[k];
+                    Some(if *src == u32::MAX {
+                        let n = (hit - sphere.center) / sphere.radius;
+                        scene.sky(d - 2.0 * d.dot(n) * n)
+                    } else {
+                        reflected_color(scene, &tris[*src as usize], attr, light)
+                    })
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    MirrorImage { object: mirror.object, color, drawn }
+}
+
+/// Each unbounded plane as rings around the foot of the sphere's centre: radii growing by 1.4
+/// from a fiftieth of the radius out to the plane's squares (10⁴), 48 sectors; texture
+/// coordinates continued from the plane's own triangle (they are affine in the position). Each
+/// ring triangle comes with the index of the plane triangle that stands for its material.
+fn plane_rings(tris: &[Triangle], sphere: &Sphere) -> Vec<(Triangle, u32)> {
+    let mut out = vec![];
+    let mut done: Vec<u32> = vec![];
+    for (index, t) in tris.iter().enumerate().filter(|(_, t)| t.unbounded) {
+        if done.contains(&t.object) {
+            continue;
+        }
+        done.push(t.object);
+        let [a, b, c] = t.v;
+        let n = (b.p - a.p).cross(c.p - a.p).normalize_or_zero();
+        let (e1, e2) = alhazen_math::orthonormal_basis(n);
+        let foot = sphere.center - n * n.dot(sphere.center - a.p);
+        // uv(p) = uv_a + α (uv_b − uv_a) + β (uv_c − uv_a) with p − a = α (b − a) + β (c − a).
+        let (u, v) = (b.p - a.p, c.p - a.p);
+        let (uu, uv_, vv) = (u.dot(u), u.dot(v), v.dot(v));
+        let det = uu * vv - uv_ * uv_;
+        let uv_at = |p: Vec3| {
+            let d = p - a.p;
+            let (du, dv) = (d.dot(u), d.dot(v));
+            let (al, be) = ((vv * du - uv_ * dv) / det, (uu * dv - uv_ * du) / det);
+            a.uv + (b.uv - a.uv) * al + (c.uv - a.uv) * be
+        };
+        let at = |r: f64, k: usize| {
+            let phi = std::f64::consts::TAU * k as f64 / 48.0;
+            let p = foot + (e1 * phi.cos() + e2 * phi.sin()) * r;
+            Vertex { p, n, uv: uv_at(p) }
+        };
+        let mut radii = vec![0.0];
+        let mut r = sphere.radius / 50.0;
+        while r < 1e4 {
+            radii.push(r);
+            r *= 1.4;
+        }
+        let tri = |v: [Vertex; 3]| (Triangle { v, unbounded: false, closed: false, ..*t }, index as u32);
+        for w in radii.windows(2) {
+            for k in 0..48 {
+                let (p, q, s, o) = (at(w[0], k), at(w[0], k + 1), at(w[1], k + 1), at(w[1], k));
+                out.push(tri([p, o, s]));
+                if w[0] > 0.0 {
+                    out.push(tri([p, s, q]));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The visible reflex of every corner of the triangles `which`, by the batch solver.
+fn corner_reflexes(tris: &[&Triangle], which: &[u32], sphere: &Sphere, eye: Vec3) -> Vec<[Option<Vec3>; 3]> {
+    let corners: Vec<Vec3> = which.iter().flat_map(|&i| tris[i as usize].v.map(|v| v.p)).collect();
+    let solved: Vec<Option<Vec3>> = corners
+        .par_chunks(4096)
+        .flat_map_iter(|chunk| {
+            let (x, y, z): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+                chunk.iter().map(|p| p.x).collect(),
+                chunk.iter().map(|p| p.y).collect(),
+                chunk.iter().map(|p| p.z).collect(),
+            );
+            let mut out = ReflexesSoA::default();
+            let ok = sphere.visible_reflexes_batch(eye, PointsSoA { x: &x, y: &y, z: &z }, &mut out).is_ok();
+
+            (0..chunk.len())
+                .map(|i| (ok && out.visible[i]).then(|| Vec3::new(out.x[i], out.y[i], out.z[i])))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    solved.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
+
+/// The unit direction from the eye through NDC `(x, y)` (by the near plane, which stays finite
+/// under the infinite far plane).
+fn eye_ray(proj: &Projection, x: f64, y: f64) -> Vec3 {
+    let q = proj.clip_to_world * Vec4::new(x, y, -1.0, 1.0);
+    (q.truncate() / q.w - proj.frame.eye).normalize_or_zero()
+}
+
+/// Where a ray from `eye` along unit `d` first meets the sphere.
+fn hit_sphere(s: &Sphere, eye: Vec3, d: Vec3) -> Option<Vec3> {
+    let oc = eye - s.center;
+    let b = oc.dot(d);
+    let disc = b * b - (oc.length_squared() - s.radius * s.radius);
+    let t = -b - disc.max(0.0).sqrt();
+    (disc >= 0.0 && t > 0.0).then(|| eye + d * t)
+}
+
+/// A reflected point lit as the mirror sees it: the attributes hold the point, its normal, its
+/// texture coordinates and the mirror point it is seen at.
+fn reflected_color(scene: &Scene, t: &Triangle, attr: &[f64; ATTRIBUTES], light: &shade::Lighting) -> Vec3 {
+    let m = &scene.materials[t.material as usize];
+    let p = Vec3::new(attr[0], attr[1], attr[2]);
+    let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
+    let at = Vec3::new(attr[8], attr[9], attr[10]);
+    shade::shade(scene, m, p, n, (at - p).normalize_or_zero(), Vec2::new(attr[6], attr[7]), light)
+}
+
+/// The reflexes of one mirror seen from one eye, to split triangles into.
+struct Reflexes<'a> {
+    sphere: &'a Sphere,
+    eye: Vec3,
+    proj: &'a Projection,
+    size: (u32, u32),
+}
+
+impl Reflexes<'_> {
+    fn reflex(&self, p: Vec3) -> Option<Vec3> {
+        self.sphere.visible_reflex(Site::At(self.eye), Site::At(p)).ok().flatten().map(|r| r.point)
+    }
+
+    /// Emits the reflex of triangle `v` (corner reflexes `r`), split until each piece's edges
+    /// are within the tolerance.
+    fn split(&self, v: [Vertex; 3], r: [Option<Vec3>; 3], source: u32, level: u32, out: &mut Vec<ScreenTriangle>) {
+        // Pieces a pixel across are done: drawn when every corner has a reflex, else (deeper
+        // down) left out: they lie on the border of the region without reflexes.
+        let present: Vec<Vec2> = r.iter().flatten().map(|p| to_screen(self.proj, *p, self.size)).collect();
+        let span = present.iter().map(|p| (*p - present[0]).length()).fold(0.0, f64::max);
+        if present.len() == 3 && span <= 1.0 {
+            // Most triangles of a fine mesh: their reflex is smaller than a pixel (a convex
+            // mirror shrinks), no midpoint needs solving.
+            self.emit(v, r.map(|x| x.expect("three reflexes")), source, out);
+            return;
+        }
+        if level >= 3 && present.len() == 2 && span <= 1.0 {
+            return;
+        }
+        let mid = |a: &Vertex, b: &Vertex| Vertex {
+            p: (a.p + b.p) / 2.0,
+            n: (a.n + b.n).normalize_or_zero(),
+            uv: (a.uv + b.uv) / 2.0,
+        };
+        let m = [mid(&v[1], &v[2]), mid(&v[2], &v[0]), mid(&v[0], &v[1])];
+        let rm = m.map(|x| self.reflex(x.p));
+        // Without a reflex at any corner or midpoint the piece lies in the region the mirror
+        // does not show; with one, deep down, on its border.
+        let known = present.len() + rm.iter().flatten().count();
+        if known == 0 || (level >= 4 && known <= 1) {
+            return;
+        }
+        let screen = |p: Vec3| to_screen(self.proj, p, self.size);
+        let fits = match (r, rm) {
+            ([Some(a), Some(b), Some(c)], [Some(ma), Some(mb), Some(mc)]) => {
+                let (sa, sb, sc) = (screen(a), screen(b), screen(c));
+                let off = [(ma, sb, sc), (mb, sc, sa), (mc, sa, sb)]
+                    .iter()
+                    .map(|&(mr, s0, s1)| (screen(mr) - (s0 + s1) / 2.0).length())
+                    .fold(0.0, f64::max);
+                off <= TOLERANCE_PX
+            }
+            _ => false,
+        };
+        let small = || {
+            let s: Vec<Vec2> = r.iter().flatten().map(|p| screen(*p)).collect();
+            s.len() == 3 && s.iter().all(|p| (*p - s[0]).length() <= FINEST_PX)
+        };
+        if fits || (level == MAX_LEVEL && small()) {
+            self.emit(v, r.map(|x| x.expect("three reflexes")), source, out);
+        } else if level < MAX_LEVEL {
+            for (tri, refl) in [
+                ([v[0], m[2], m[1]], [r[0], rm[2], rm[1]]),
+                ([m[2], v[1], m[0]], [rm[2], r[1], rm[0]]),
+                ([m[1], m[0], v[2]], [rm[1], rm[0], r[2]]),
+                ([m[0], m[1], m[2]], [rm[0], rm[1], rm[2]]),
+            ] {
+                self.split(tri, refl, source, level + 1, out);
+            }
+        }
+    }
+
+    fn emit(&self, v: [Vertex; 3], r: [Vec3; 3], source: u32, out: &mut Vec<ScreenTriangle>) {
+        let s = r.map(|p| to_screen(self.proj, p, self.size));
+        let (w, h) = (self.size.0 as f64, self.size.1 as f64);
+        if s.iter().all(|p| p.x < 0.0)
+            || s.iter().all(|p| p.x > w)
+            || s.iter().all(|p| p.y < 0.0)
+            || s.iter().all(|p| p.y > h)
+        {
+            return;
+        }
+        let attr = |k: usize| {
+            let (p, n, uv, at) = (v[k].p, v[k].n, v[k].uv, r[k]);
+            [p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, at.x, at.y, at.z, 0.0, 0.0, 0.0]
+        };
+        out.push(ScreenTriangle {
+            x: s.map(|p| p.x),
+            y: s.map(|p| p.y),
+            z: std::array::from_fn(|k| (r[k] - self.eye).length() + (v[k].p - r[k]).length()),
+            inv_w: [1.0; 3],
+            attr_w: std::array::from_fn(attr),
+            source,
+        });
+    }
+}
