@@ -165,7 +165,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
             } else {
                 String::new()
             } + &if stats.reflexes > 0 {
-                format!(", {} pieces drawn as their reflexes in spherical mirrors", stats.reflexes)
+                format!(", {} pieces drawn in mirrors", stats.reflexes)
             } else {
                 String::new()
             },

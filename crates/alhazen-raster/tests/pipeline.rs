@@ -533,7 +533,7 @@ fn mirror_error(scene: &alhazen_scene::Scene, mirror: &str) -> (f64, f64) {
 }
 
 #[test]
-fn a_mirror_ball_shows_in_the_preview_what_the_ray_tracer_shows() {
+fn mirrors_show_in_the_preview_what_the_ray_tracer_shows() {
     // Glaeser's method (every vertex to its reflex, triangles rasterised as their reflexes)
     // against Whitted's reflected rays, inside the ball's outline: the teapot beside it and the
     // checker floor to the horizon.
@@ -557,4 +557,16 @@ fn a_mirror_ball_shows_in_the_preview_what_the_ray_tracer_shows() {
         sky * 100.0
     );
     assert!(err < 0.6 * sky, "{err} vs the sky's {sky}");
+    // A plane mirror (Glaeser's Fig. 3): the scene through the reflected projection.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/lines/fig3-plane-mirror.toml");
+    let mut scene = alhazen_scene::load_scene(&path).unwrap();
+    (scene.render.width, scene.render.height, scene.render.spp, scene.render.max_depth) = (320, 240, 4, 2);
+    scene.render.integrator = alhazen_scene::IntegratorKind::Whitted;
+    let (err, sky) = mirror_error(&scene, "mirror");
+    eprintln!(
+        "plane mirror: mean absolute difference in the mirror {:.2} % (sky only: {:.2} %)",
+        err * 100.0,
+        sky * 100.0
+    );
+    assert!(err < 0.05 && err < sky / 4.0, "{err} vs the sky's {sky}");
 }

@@ -9,6 +9,11 @@
 //! lit at the reflected point as seen from the mirror. Pixels of the sphere that no reflex
 //! covers show the sky in the exactly reflected direction. Perspective cameras only (the batch
 //! solver's eye is finite).
+//!
+//! Plane mirrors (flat emitters of `mirror > 0`: rectangles, disks, flat meshes) are drawn as
+//! the course draws them: the scene rendered once more through the projection composed with the
+//! reflection in the mirror's plane, clipped to the half-space in front of it, and shown on the
+//! mirror's pixels.
 
 use super::clip::ATTRIBUTES;
 use super::geometry::{Triangle, Vertex};
@@ -57,6 +62,77 @@ pub fn sphere_mirrors(scene: &Scene) -> Vec<SphereMirror> {
             (similar && s > 0.0).then_some(SphereMirror { object: i as u32, sphere })
         })
         .collect()
+}
+
+/// A plane mirror of the scene: its object and its plane `n·x = d` (`n` towards the side it
+/// reflects).
+#[derive(Clone, Copy, Debug)]
+pub struct PlaneMirror {
+    /// The scene object.
+    pub object: u32,
+    /// Unit normal.
+    pub normal: Vec3,
+    /// `n·x` on the plane.
+    pub offset: f64,
+}
+
+/// The flat objects of `scene` whose material reflects, from their triangles (all corners on
+/// the first triangle's plane).
+pub fn plane_mirrors(scene: &Scene, tris: &[Triangle]) -> Vec<PlaneMirror> {
+    let mut by_object: std::collections::BTreeMap<u32, Vec<&Triangle>> = Default::default();
+    for t in tris.iter().filter(|t| scene.materials[t.material as usize].mirror != Vec3::ZERO) {
+        if !matches!(scene.objects[t.object as usize].shape, Shape::Sphere { .. }) {
+            by_object.entry(t.object).or_default().push(t);
+        }
+    }
+    by_object
+        .into_iter()
+        .filter_map(|(object, ts)| {
+            let [a, b, c] = ts[0].v.map(|v| v.p);
+            let normal = (b - a).cross(c - a).try_normalize()?;
+            let offset = normal.dot(a);
+            let extent = ts.iter().flat_map(|t| t.v.iter()).map(|v| (v.p - a).length()).fold(0.0, f64::max);
+            let flat =
+                ts.iter().flat_map(|t| t.v.iter()).all(|v| (normal.dot(v.p) - offset).abs() <= 1e-9 * (1.0 + extent));
+            flat.then_some(PlaneMirror { object, normal, offset })
+        })
+        .collect()
+}
+
+impl PlaneMirror {
+    /// The reflection in the mirror's plane as a matrix.
+    pub fn reflection(&self) -> alhazen_math::Mat4 {
+        let n = self.normal;
+        let col = |i: usize| {
+            let e = Vec3::AXES[i];
+            (e - n * (2.0 * n.dot(e))).extend(0.0)
+        };
+        alhazen_math::Mat4::from_cols(col(0), col(1), col(2), (n * (2.0 * self.offset)).extend(1.0))
+    }
+
+    /// `proj` seen in the mirror: the projection of reflected points, the eye reflected; `None`
+    /// when the eye is behind the mirror (it sees the mirror's back).
+    pub fn reflected(&self, proj: &Projection) -> Option<(Projection, Vec4)> {
+        let side = self.normal.dot(proj.frame.eye) - self.offset;
+        if side <= 0.0 {
+            return None;
+        }
+        let m = self.reflection();
+        let f = proj.frame;
+        let dir = |v: Vec3| v - self.normal * (2.0 * self.normal.dot(v));
+        let frame =
+            alhazen_math::viewing::ViewFrame { eye: m.transform_point3(f.eye), u: dir(f.u), v: dir(f.v), w: dir(f.w) };
+        let reflected = Projection {
+            world_to_clip: proj.world_to_clip * m,
+            clip_to_world: m * proj.clip_to_world,
+            frame,
+            perspective: proj.perspective,
+        };
+        // Keep what lies strictly in front of the mirror, n·x − d ≥ ε: the mirror itself (and
+        // what lies on its plane) would cover its own reflection.
+        let eps = 1e-7 * (1.0 + self.offset.abs() + side);
+        Some((reflected, self.normal.extend(-self.offset - eps)))
+    }
 }
 
 /// What a mirror shows, per pixel of the image: `None` off the sphere.

@@ -192,7 +192,7 @@ pub struct RasterStats {
     pub drawn: usize,
     /// Objects without a triangle form (CSG).
     pub skipped_objects: usize,
-    /// Pieces of triangles rasterised as their reflexes in spherical mirrors.
+    /// Triangles (pieces of them in spherical mirrors) drawn as mirrors show them.
     pub reflexes: usize,
 }
 
@@ -451,13 +451,26 @@ pub fn render_prepared(
     render_view(scene, prepared, opts, &projection(&scene.camera, w, h)?, (w, h))
 }
 
-/// One view through `proj` at `w × h`.
+/// One view through `proj` at `w × h`, with what its mirrors show.
 fn render_view(
     scene: &Scene,
     prepared: &Prepared,
     opts: &RasterOptions,
     proj: &Projection,
+    size: (u32, u32),
+) -> Result<(Framebuffer, RasterStats), RasterError> {
+    render_view_in(scene, prepared, opts, proj, size, false)
+}
+
+/// One view through `proj`; `in_mirror` for the view a plane mirror shows (whose own mirrors
+/// show the sky: one reflection deep).
+fn render_view_in(
+    scene: &Scene,
+    prepared: &Prepared,
+    opts: &RasterOptions,
+    proj: &Projection,
     (w, h): (u32, u32),
+    in_mirror: bool,
 ) -> Result<(Framebuffer, RasterStats), RasterError> {
     let proj = *proj;
     let geometry = &prepared.geometry;
@@ -489,16 +502,24 @@ fn render_view(
     let painter = opts.visibility == Visibility::Bsp && prepared.bsp.is_some();
     let volumes = stencil_mode.map(|_| stencil::volumes(scene, tris, proj.world_to_clip, (w, h))).unwrap_or_default();
     // Spherical mirrors by Glaeser's method: what each shows, before the frame is shaded.
-    let mirror_images: Vec<mirrors::MirrorImage> = if proj.perspective {
+    let mut mirror_images: Vec<mirrors::MirrorImage> = vec![];
+    if proj.perspective && !in_mirror {
         let plain = *shadows;
         let found = mirrors::sphere_mirrors(scene);
-        found
-            .iter()
-            .map(|m| mirrors::mirror_image(scene, &geometry.triangles, m, &proj, (w, h), opts, &plain))
-            .collect()
-    } else {
-        vec![]
-    };
+        mirror_images.extend(
+            found.iter().map(|m| mirrors::mirror_image(scene, &geometry.triangles, m, &proj, (w, h), opts, &plain)),
+        );
+    }
+    // Plane mirrors: the scene once more through the reflected projection, clipped to the
+    // mirror's front.
+    for plane in mirrors::plane_mirrors(scene, &geometry.triangles).iter().filter(|_| !in_mirror) {
+        let Some((reflected, front)) = plane.reflected(&proj) else { continue };
+        let mut seen = opts.clone();
+        seen.clip_planes.push(front);
+        let (fb, s) = render_view_in(scene, prepared, &seen, &reflected, (w, h), true)?;
+        let color = fb.color.iter().map(|c| Some(Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64))).collect();
+        mirror_images.push(mirrors::MirrorImage { object: plane.object, color, drawn: s.drawn });
+    }
     let processed: Vec<(bool, Vec<ScreenTriangle>)> =
         order.par_iter().map(|&i| process(scene, &proj, &tris[i as usize], i, opts, shadows, (w, h))).collect();
     let culled = processed.iter().filter(|p| p.0).count();
