@@ -557,6 +557,13 @@ fn mirrors_show_in_the_preview_what_the_ray_tracer_shows() {
         sky * 100.0
     );
     assert!(err < 0.6 * sky, "{err} vs the sky's {sky}");
+    let (err, sky) = mirror_error(&scene, "mirror cylinder");
+    eprintln!(
+        "glass balls' cylinder: mean absolute difference in the mirror {:.2} % (sky only: {:.2} %)",
+        err * 100.0,
+        sky * 100.0
+    );
+    assert!(err < 0.6 * sky, "{err} vs the sky's {sky}");
     // A plane mirror (Glaeser's Fig. 3): the scene through the reflected projection.
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/lines/fig3-plane-mirror.toml");
     let mut scene = alhazen_scene::load_scene(&path).unwrap();

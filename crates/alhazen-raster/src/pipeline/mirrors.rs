@@ -1,12 +1,12 @@
-//! Spherical mirrors in the preview by Glaeser's own method (*Reflections on spheres and
+//! Spherical and cylindrical mirrors in the preview by Glaeser's own method (*Reflections on spheres and
 //! cylinders of revolution*, §3): every vertex of the scene is mapped to its reflex — the point
-//! of the sphere where the eye sees it — by the batch solver of `alhazen-mirror`, and each
+//! of the sphere or cylinder where the eye sees it — by the batch solver of `alhazen-mirror`, and each
 //! triangle is rasterised as its reflex: the triangle of its corners' reflexes, subdivided where
 //! the reflex of an edge's midpoint strays from the chord by more than half a pixel (the
 //! paper's adaptive knots; a triangle whose reflex folds over the contour, Theorem 10, keeps
 //! splitting and its pieces that still disagree at the finest level are left out). Depth is the
 //! length of the reflected path `|E R| + |R P|`, tested in the mirror's own buffer; each pixel is
-//! lit at the reflected point as seen from the mirror. Pixels of the sphere that no reflex
+//! lit at the reflected point as seen from the mirror. Pixels of the mirror that no reflex
 //! covers show the sky in the exactly reflected direction. Perspective cameras only (the batch
 //! solver's eye is finite).
 //!
@@ -21,7 +21,7 @@ use super::raster::{ScreenTriangle, rasterize};
 use super::{Projection, RasterOptions, shade};
 use alhazen_math::{Vec2, Vec3, Vec4};
 use alhazen_mirror::batch::{PointsSoA, ReflexesSoA};
-use alhazen_mirror::{Site, Sphere};
+use alhazen_mirror::{Cylinder, Site, Sphere};
 use alhazen_scene::{Scene, Shape};
 use rayon::prelude::*;
 
@@ -35,17 +35,33 @@ const FINEST_PX: f64 = 4.0;
 /// chord's midpoint before the triangle is split.
 const TOLERANCE_PX: f64 = 0.5;
 
-/// A spherical mirror of the scene: its object and sphere.
+/// A curved mirror's surface: a sphere, or the side of a finite cylinder.
+#[derive(Clone, Copy, Debug)]
+pub enum Curved {
+    /// A sphere.
+    Sphere(Sphere),
+    /// The side of a cylinder from `base` to `base + axis` (its caps are not this mirror).
+    Cylinder {
+        /// The infinite cylinder.
+        cylinder: Cylinder,
+        /// Centre of the bottom.
+        base: Vec3,
+        /// From the bottom's centre to the top's.
+        axis: Vec3,
+    },
+}
+
+/// A spherical or cylindrical mirror of the scene: its object and surface.
 #[derive(Clone, Copy, Debug)]
 pub struct SphereMirror {
     /// The scene object.
     pub object: u32,
-    /// The sphere in world space.
-    pub sphere: Sphere,
+    /// The surface in world space.
+    pub surface: Curved,
 }
 
-/// The spheres of `scene` whose material reflects (`mirror > 0`) under a transform that keeps
-/// them spheres.
+/// The spheres and cylinders of `scene` whose material reflects (`mirror > 0`) under a
+/// transform that keeps them what they are (a similarity).
 pub fn sphere_mirrors(scene: &Scene) -> Vec<SphereMirror> {
     scene
         .objects
@@ -53,15 +69,104 @@ pub fn sphere_mirrors(scene: &Scene) -> Vec<SphereMirror> {
         .enumerate()
         .filter(|(_, o)| scene.materials[o.material as usize].mirror != Vec3::ZERO)
         .filter_map(|(i, o)| {
-            let Shape::Sphere { center, radius } = o.shape else { return None };
             let axes = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| o.transform.vector(a));
             let s = axes[0].length();
             let similar = axes.iter().all(|a| (a.length() - s).abs() <= 1e-9 * s)
                 && axes[0].dot(axes[1]).abs() + axes[1].dot(axes[2]).abs() + axes[0].dot(axes[2]).abs() <= 1e-9 * s * s;
-            let sphere = Sphere { center: o.transform.point(center), radius: radius * s };
-            (similar && s > 0.0).then_some(SphereMirror { object: i as u32, sphere })
+            if !similar || s <= 0.0 {
+                return None;
+            }
+            let t = &o.transform;
+            let surface = match o.shape {
+                Shape::Sphere { center, radius } => {
+                    Curved::Sphere(Sphere { center: t.point(center), radius: radius * s })
+                }
+                Shape::Cylinder { base, top, radius, .. } => {
+                    let (base, top) = (t.point(base), t.point(top));
+                    let cylinder = Cylinder { center: base, axis: top - base, radius: radius * s };
+                    Curved::Cylinder { cylinder, base, axis: top - base }
+                }
+                _ => return None,
+            };
+            Some(SphereMirror { object: i as u32, surface })
         })
         .collect()
+}
+
+impl Curved {
+    /// The visible reflex of `p` seen from `eye` on the mirror (on a cylinder's side between
+    /// its rims).
+    fn reflex(&self, eye: Vec3, p: Vec3) -> Option<Vec3> {
+        match self {
+            Curved::Sphere(s) => s.visible_reflex(Site::At(eye), Site::At(p)).ok().flatten().map(|r| r.point),
+            Curved::Cylinder { cylinder, .. } => {
+                let r = cylinder.visible_reflex(Site::At(eye), Site::At(p)).ok().flatten()?.point;
+                self.on_side(r).then_some(r)
+            }
+        }
+    }
+
+    /// Whether a point of the infinite cylinder lies between the rims.
+    fn on_side(&self, r: Vec3) -> bool {
+        match self {
+            Curved::Sphere(_) => true,
+            Curved::Cylinder { base, axis, .. } => {
+                (0.0..=1.0).contains(&((r - *base).dot(*axis) / axis.length_squared()))
+            }
+        }
+    }
+
+    /// The visible reflexes of a batch of points, by the batch solver.
+    fn batch(&self, eye: Vec3, points: PointsSoA, out: &mut ReflexesSoA) -> bool {
+        let ok = match self {
+            Curved::Sphere(s) => s.visible_reflexes_batch(eye, points, out).is_ok(),
+            Curved::Cylinder { cylinder, .. } => cylinder.visible_reflexes_batch(eye, points, out).is_ok(),
+        };
+        if ok && matches!(self, Curved::Cylinder { .. }) {
+            for i in 0..out.visible.len() {
+                out.visible[i] = out.visible[i] && self.on_side(Vec3::new(out.x[i], out.y[i], out.z[i]));
+            }
+        }
+        ok
+    }
+
+    /// Where a ray from `eye` along unit `d` first meets the mirror, and the normal there.
+    fn hit(&self, eye: Vec3, d: Vec3) -> Option<(Vec3, Vec3)> {
+        match self {
+            Curved::Sphere(s) => {
+                let oc = eye - s.center;
+                let b = oc.dot(d);
+                let disc = b * b - (oc.length_squared() - s.radius * s.radius);
+                let t = -b - disc.max(0.0).sqrt();
+                (disc >= 0.0 && t > 0.0).then(|| (eye + d * t, (eye + d * t - s.center) / s.radius))
+            }
+            Curved::Cylinder { cylinder, base, axis } => {
+                // Components across the axis: |(o + t d)⊥|² = r².
+                let a = *axis / axis.length();
+                let (o, dp) = (eye - *base - a * (eye - *base).dot(a), d - a * d.dot(a));
+                let (qa, qb, qc) =
+                    (dp.length_squared(), o.dot(dp), o.length_squared() - cylinder.radius * cylinder.radius);
+                let disc = qb * qb - qa * qc;
+                if qa == 0.0 || disc < 0.0 {
+                    return None;
+                }
+                let t = (-qb - disc.sqrt()) / qa;
+                let p = eye + d * t;
+                let foot = *base + a * (p - *base).dot(a);
+                (t > 0.0 && self.on_side(p)).then(|| (p, (p - foot) / cylinder.radius))
+            }
+        }
+    }
+
+    /// A point to centre the rings of an unbounded plane on, and the mirror's size.
+    fn centre_and_size(&self) -> (Vec3, f64) {
+        match self {
+            Curved::Sphere(s) => (s.center, s.radius),
+            Curved::Cylinder { cylinder, base, axis } => {
+                (*base + *axis * 0.5, cylinder.radius.max(axis.length() / 2.0))
+            }
+        }
+    }
 }
 
 /// A plane mirror of the scene: its object and its plane `n·x = d` (`n` towards the side it
@@ -81,7 +186,7 @@ pub struct PlaneMirror {
 pub fn plane_mirrors(scene: &Scene, tris: &[Triangle]) -> Vec<PlaneMirror> {
     let mut by_object: std::collections::BTreeMap<u32, Vec<&Triangle>> = Default::default();
     for t in tris.iter().filter(|t| scene.materials[t.material as usize].mirror != Vec3::ZERO) {
-        if !matches!(scene.objects[t.object as usize].shape, Shape::Sphere { .. }) {
+        if !matches!(scene.objects[t.object as usize].shape, Shape::Sphere { .. } | Shape::Cylinder { .. }) {
             by_object.entry(t.object).or_default().push(t);
         }
     }
@@ -162,10 +267,10 @@ pub fn mirror_image(
     light: &shade::Lighting,
 ) -> MirrorImage {
     let eye = proj.frame.eye;
-    let sphere = mirror.sphere;
+    let surface = mirror.surface;
     // Unbounded planes are re-meshed in rings around the mirror (their large squares would
     // need splitting twenty times over to resolve what lies near it).
-    let planes = plane_rings(tris, &sphere);
+    let planes = plane_rings(tris, surface.centre_and_size());
     let all: Vec<&Triangle> = tris.iter().filter(|t| !t.unbounded).chain(planes.iter().map(|p| &p.0)).collect();
     let source: Vec<u32> = tris
         .iter()
@@ -175,7 +280,7 @@ pub fn mirror_image(
         .chain(planes.iter().map(|p| p.1))
         .collect();
     let others: Vec<u32> = (0..all.len() as u32).filter(|&i| all[i as usize].object != mirror.object).collect();
-    let reflexes = corner_reflexes(&all, &others, &sphere, eye);
+    let reflexes = corner_reflexes(&all, &others, &surface, eye);
     let pieces: Vec<ScreenTriangle> = others
         .par_iter()
         .enumerate()
@@ -189,7 +294,7 @@ pub fn mirror_image(
                 !(opts.cull && t.closed) || face.dot(*r - t.v[0].p) >= 0.0
             });
             if facing {
-                let job = Reflexes { sphere: &sphere, eye, proj, size: (w, h) };
+                let job = Reflexes { surface: &surface, eye, proj, size: (w, h) };
                 job.split(t.v, corners, source[i as usize], 0, &mut out);
             }
             out
@@ -222,10 +327,9 @@ pub fn mirror_image(
                 .map(|k| {
                     let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
                     let d = eye_ray(proj, 2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64);
-                    let hit = hit_sphere(&sphere, eye, d)?;
+                    let (_, n) = surface.hit(eye, d)?;
                     let (src, attr) = &owner[k];
                     Some(if *src == u32::MAX {
-                        let n = (hit - sphere.center) / sphere.radius;
                         scene.sky(d - 2.0 * d.dot(n) * n)
                     } else {
                         reflected_color(scene, &tris[*src as usize], attr, light)
@@ -237,11 +341,11 @@ pub fn mirror_image(
     MirrorImage { object: mirror.object, color, drawn }
 }
 
-/// Each unbounded plane as rings around the foot of the sphere's centre: radii growing by 1.4
-/// from a fiftieth of the radius out to the plane's squares (10⁴), 48 sectors; texture
+/// Each unbounded plane as rings around the foot of the mirror's centre: radii growing by 1.4
+/// from a fiftieth of the mirror's size out to the plane's squares (10⁴), 48 sectors; texture
 /// coordinates continued from the plane's own triangle (they are affine in the position). Each
 /// ring triangle comes with the index of the plane triangle that stands for its material.
-fn plane_rings(tris: &[Triangle], sphere: &Sphere) -> Vec<(Triangle, u32)> {
+fn plane_rings(tris: &[Triangle], (centre, size): (Vec3, f64)) -> Vec<(Triangle, u32)> {
     let mut out = vec![];
     let mut done: Vec<u32> = vec![];
     for (index, t) in tris.iter().enumerate().filter(|(_, t)| t.unbounded) {
@@ -252,7 +356,7 @@ fn plane_rings(tris: &[Triangle], sphere: &Sphere) -> Vec<(Triangle, u32)> {
         let [a, b, c] = t.v;
         let n = (b.p - a.p).cross(c.p - a.p).normalize_or_zero();
         let (e1, e2) = alhazen_math::orthonormal_basis(n);
-        let foot = sphere.center - n * n.dot(sphere.center - a.p);
+        let foot = centre - n * n.dot(centre - a.p);
         // uv(p) = uv_a + α (uv_b − uv_a) + β (uv_c − uv_a) with p − a = α (b − a) + β (c − a).
         let (u, v) = (b.p - a.p, c.p - a.p);
         let (uu, uv_, vv) = (u.dot(u), u.dot(v), v.dot(v));
@@ -269,7 +373,7 @@ fn plane_rings(tris: &[Triangle], sphere: &Sphere) -> Vec<(Triangle, u32)> {
             Vertex { p, n, uv: uv_at(p) }
         };
         let mut radii = vec![0.0];
-        let mut r = sphere.radius / 50.0;
+        let mut r = size / 50.0;
         while r < 1e4 {
             radii.push(r);
             r *= 1.4;
@@ -289,7 +393,7 @@ fn plane_rings(tris: &[Triangle], sphere: &Sphere) -> Vec<(Triangle, u32)> {
 }
 
 /// The visible reflex of every corner of the triangles `which`, by the batch solver.
-fn corner_reflexes(tris: &[&Triangle], which: &[u32], sphere: &Sphere, eye: Vec3) -> Vec<[Option<Vec3>; 3]> {
+fn corner_reflexes(tris: &[&Triangle], which: &[u32], surface: &Curved, eye: Vec3) -> Vec<[Option<Vec3>; 3]> {
     let corners: Vec<Vec3> = which.iter().flat_map(|&i| tris[i as usize].v.map(|v| v.p)).collect();
     let solved: Vec<Option<Vec3>> = corners
         .par_chunks(4096)
@@ -300,7 +404,7 @@ fn corner_reflexes(tris: &[&Triangle], which: &[u32], sphere: &Sphere, eye: Vec3
                 chunk.iter().map(|p| p.z).collect(),
             );
             let mut out = ReflexesSoA::default();
-            let ok = sphere.visible_reflexes_batch(eye, PointsSoA { x: &x, y: &y, z: &z }, &mut out).is_ok();
+            let ok = surface.batch(eye, PointsSoA { x: &x, y: &y, z: &z }, &mut out);
 
             (0..chunk.len())
                 .map(|i| (ok && out.visible[i]).then(|| Vec3::new(out.x[i], out.y[i], out.z[i])))
@@ -317,15 +421,6 @@ fn eye_ray(proj: &Projection, x: f64, y: f64) -> Vec3 {
     (q.truncate() / q.w - proj.frame.eye).normalize_or_zero()
 }
 
-/// Where a ray from `eye` along unit `d` first meets the sphere.
-fn hit_sphere(s: &Sphere, eye: Vec3, d: Vec3) -> Option<Vec3> {
-    let oc = eye - s.center;
-    let b = oc.dot(d);
-    let disc = b * b - (oc.length_squared() - s.radius * s.radius);
-    let t = -b - disc.max(0.0).sqrt();
-    (disc >= 0.0 && t > 0.0).then(|| eye + d * t)
-}
-
 /// A reflected point lit as the mirror sees it: the attributes hold the point, its normal, its
 /// texture coordinates and the mirror point it is seen at.
 fn reflected_color(scene: &Scene, t: &Triangle, attr: &[f64; ATTRIBUTES], light: &shade::Lighting) -> Vec3 {
@@ -338,7 +433,7 @@ fn reflected_color(scene: &Scene, t: &Triangle, attr: &[f64; ATTRIBUTES], light:
 
 /// The reflexes of one mirror seen from one eye, to split triangles into.
 struct Reflexes<'a> {
-    sphere: &'a Sphere,
+    surface: &'a Curved,
     eye: Vec3,
     proj: &'a Projection,
     size: (u32, u32),
@@ -346,7 +441,7 @@ struct Reflexes<'a> {
 
 impl Reflexes<'_> {
     fn reflex(&self, p: Vec3) -> Option<Vec3> {
-        self.sphere.visible_reflex(Site::At(self.eye), Site::At(p)).ok().flatten().map(|r| r.point)
+        self.surface.reflex(self.eye, p)
     }
 
     /// Emits the reflex of triangle `v` (corner reflexes `r`), split until each piece's edges
