@@ -577,3 +577,61 @@ fn mirrors_show_in_the_preview_what_the_ray_tracer_shows() {
     );
     assert!(err < 0.05 && err < sky / 4.0, "{err} vs the sky's {sky}");
 }
+
+#[test]
+fn csg_bodies_show_in_the_preview_as_the_ray_tracer_shows_them() {
+    // A box minus a sphere, lit from the eye's side: the per-pixel ray cast against Whitted on
+    // the pixels that see the body (its self-shadows are the ray tracer's only).
+    let text = r#"
+background = [0.2, 0.3, 0.5]
+ambient = 0.1
+[render]
+width = 160
+height = 120
+spp = 4
+max_depth = 1
+[camera]
+eye = [2.5, 2.5, 4]
+target = [0, 0.4, 0]
+fov = 40
+[[light]]
+type = "point"
+position = [3, 4, 5]
+[[object]]
+shape = "disk"
+center = [0, 0, 0]
+normal = [0, 1, 0]
+radius = 4
+material = { color = 0.7 }
+[[object]]
+name = "body"
+shape = "csg"
+op = "difference"
+material = { color = [0.85, 0.3, 0.25], specular = 0.4, shininess = 50 }
+transform = [{ rotate_y = 25 }, { translate = [0, 0.7, 0] }]
+a = { shape = "box", min = [-0.7, -0.7, -0.7], max = [0.7, 0.7, 0.7] }
+b = { shape = "sphere", radius = 0.9 }
+"#;
+    let mut scene = parse_scene("csg.toml".as_ref(), text).unwrap();
+    scene.render.integrator = alhazen_scene::IntegratorKind::Whitted;
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    let (fb, stats) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    assert_eq!(stats.skipped_objects, 0);
+    let world = alhazen_render::World::build(&scene);
+    let camera = alhazen_render::Camera::new(&scene.camera, 160, 120);
+    let (mut diff, mut sum, mut n) = (0.0, 0.0, 0);
+    for (y, x) in (0..120u32).flat_map(|y| (0..160u32).map(move |x| (y, x))) {
+        let sees =
+            |fx: f64, fy: f64| world.intersect(&camera.ray(fx, fy), f64::INFINITY).is_some_and(|h| h.object == 1);
+        let (fx, fy) = (x as f64, y as f64);
+        if sees(fx, fy) && sees(fx + 1.0, fy) && sees(fx, fy + 1.0) && sees(fx + 1.0, fy + 1.0) {
+            let k = (y * 160 + x) as usize;
+            diff += (0..3).map(|c| (fb.color[k][c] - traced.pixels[k][c]).abs() as f64).sum::<f64>() / 3.0;
+            sum += (0..3).map(|c| traced.pixels[k][c] as f64).sum::<f64>() / 3.0;
+            n += 1;
+        }
+    }
+    assert!(n > 300, "the body covers {n} pixels");
+    eprintln!("CSG body: mean absolute difference {:.2} % over {n} pixels", 100.0 * diff / sum);
+    assert!(diff / sum < 0.05, "{}", diff / sum);
+}

@@ -14,6 +14,7 @@
 pub mod bsp;
 pub mod cameras;
 pub mod clip;
+pub mod csg;
 pub mod emitters;
 pub mod geometry;
 pub mod ibl;
@@ -127,6 +128,8 @@ pub struct Prepared {
     pub bsp: Option<bsp::BspTree>,
     /// The lights standing for emitting objects ([`emitters`]).
     pub emitters: Vec<emitters::EmitterLight>,
+    /// The CSG bodies, ray cast per pixel ([`csg`]).
+    pub csg: Option<csg::CsgBodies>,
 }
 
 /// Image-based light: the environment's irradiance, and the environment prefiltered for glossy
@@ -178,7 +181,8 @@ pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
             geometry.triangles.iter().fold(alhazen_math::Bounds3::EMPTY, |b, t| t.v.iter().fold(b, |b, v| b.grow(v.p)));
         bsp::BspTree::build(&geometry.triangles, 1e-9 * (1.0 + b.extent().length()))
     });
-    Prepared { geometry, shadows, ibl, bsp, emitters }
+    let csg = csg::CsgBodies::of(scene);
+    Prepared { geometry, shadows, ibl, bsp, emitters, csg }
 }
 
 /// What the pipeline did.
@@ -558,9 +562,25 @@ fn render_view_in(
                     }
                 }
             }
+            // CSG bodies: a ray per pixel, kept where nearer than the z-buffer.
+            let ndc = |k: usize| {
+                let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
+                (2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64)
+            };
+            let bodies: Vec<Option<(f64, Vec3)>> = match &prepared.csg {
+                Some(b) => (0..n)
+                    .map(|k| {
+                        b.cast(scene, &proj, ndc(k), depth[k], &shade::Lighting { blocked: blocked[k], ..*shadows })
+                    })
+                    .collect(),
+                None => vec![],
+            };
             // Deferred: each visible pixel is shaded once.
             let color = (0..n)
                 .map(|k| {
+                    if let Some(Some((_, c))) = bodies.get(k) {
+                        return [c.x as f32, c.y as f32, c.z as f32];
+                    }
                     let (src, attr) = &owner[k];
                     let global = (y0 * w) as usize + k;
                     let reflected = (*src != u32::MAX)
@@ -577,6 +597,11 @@ fn render_view_in(
                     [c.x as f32, c.y as f32, c.z as f32]
                 })
                 .collect();
+            for (d, body) in depth.iter_mut().zip(&bodies) {
+                if let Some((z, _)) = body {
+                    *d = *z;
+                }
+            }
             (color, depth)
         })
         .collect();
@@ -594,8 +619,13 @@ fn render_view_in(
         draw_wireframe(&mut fb, &screen);
     }
     let reflexes = mirror_images.iter().map(|i| i.drawn).sum();
-    let stats =
-        RasterStats { triangles: tris.len(), culled, drawn: screen.len(), skipped_objects: geometry.skipped, reflexes };
+    let stats = RasterStats {
+        triangles: tris.len(),
+        culled,
+        drawn: screen.len(),
+        skipped_objects: if prepared.csg.is_some() { 0 } else { geometry.skipped },
+        reflexes,
+    };
     Ok((fb, stats))
 }
 
