@@ -333,28 +333,37 @@ fn process(
     opts: &RasterOptions,
     shadows: &shade::Lighting,
     (w, h): (u32, u32),
-) -> (bool, Vec<ScreenTriangle>) {
+    out: &mut Vec<ScreenTriangle>,
+) -> bool {
     let [a, b, c] = t.v;
     let face = (b.p - a.p).cross(c.p - a.p);
     let centroid = (a.p + b.p + c.p) / 3.0;
     if opts.cull && t.closed && face.dot(proj.to_viewer(centroid)) < 0.0 {
-        return (true, vec![]);
+        return true;
     }
     let below = |pl: &Vec4, p: Vec3| pl.truncate().dot(p) + pl.w < 0.0;
     if opts.cull_planes.iter().any(|pl| t.v.iter().all(|v| below(pl, v.p))) {
-        return (true, vec![]);
+        return true;
     }
     let m = &scene.materials[t.material as usize];
     let color = |v: &geometry::Vertex| match opts.shading {
         Shading::Gouraud if !t.unbounded => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), shadows),
         _ => (Vec3::ZERO, Vec3::ZERO),
     };
-    let poly: Vec<ClipVertex> =
-        t.v.iter()
-            .map(|v| ClipVertex { pos: proj.world_to_clip * v.p.extend(1.0), attr: attributes(v, color(v)) })
-            .collect();
-    let clipped = clip::clip_user_planes(clip_polygon(&poly), &opts.clip_planes);
-    (false, raster::to_screen(&clipped, (w, h), index))
+    let corners: [ClipVertex; 3] =
+        t.v.map(|v| ClipVertex { pos: proj.world_to_clip * v.p.extend(1.0), attr: attributes(&v, color(&v)) });
+    // Inside the view volume and no user planes: clipping would return the corners as they are.
+    let inside = |c: &ClipVertex| {
+        let q = c.pos;
+        q.w > 0.0 && q.x.abs() <= q.w && q.y.abs() <= q.w && q.z.abs() <= q.w
+    };
+    if opts.clip_planes.is_empty() && corners.iter().all(inside) {
+        out.push(raster::triangle_to_screen(&corners, (w, h), index));
+        return false;
+    }
+    let clipped = clip::clip_user_planes(clip_polygon(&corners), &opts.clip_planes);
+    out.extend(raster::to_screen(&clipped, (w, h), index));
+    false
 }
 
 /// The normal bent by the material's bump map, with the triangle's `∂p/∂u`, `∂p/∂v` from its
@@ -524,24 +533,41 @@ fn render_view_in(
         let color = fb.color.iter().map(|c| Some(Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64))).collect();
         mirror_images.push(mirrors::MirrorImage { object: plane.object, color, drawn: s.drawn });
     }
-    let processed: Vec<(bool, Vec<ScreenTriangle>)> =
-        order.par_iter().map(|&i| process(scene, &proj, &tris[i as usize], i, opts, shadows, (w, h))).collect();
-    let culled = processed.iter().filter(|p| p.0).count();
+    let processed: Vec<(usize, Vec<ScreenTriangle>)> = order
+        .par_chunks(4096)
+        .map(|chunk| {
+            let mut out = Vec::with_capacity(chunk.len());
+            let culled = chunk
+                .iter()
+                .filter(|&&i| process(scene, &proj, &tris[i as usize], i, opts, shadows, (w, h), &mut out))
+                .count();
+            (culled, out)
+        })
+        .collect();
+    let culled = processed.iter().map(|p| p.0).sum();
     let screen: Vec<ScreenTriangle> = processed.into_iter().flat_map(|p| p.1).collect();
+    // Each band's triangles, in drawing order.
+    let band_count = h.div_ceil(BAND) as usize;
+    let mut bins: Vec<Vec<u32>> = vec![vec![]; band_count];
+    for (i, t) in screen.iter().enumerate() {
+        let lo = t.y.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = t.y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if !(hi >= 0.0 && lo <= h as f64) {
+            continue;
+        }
+        let first = ((lo.max(0.0) / BAND as f64) as usize).min(band_count - 1);
+        let last = ((hi.min(h as f64) / BAND as f64) as usize).min(band_count - 1);
+        for bin in &mut bins[first..=last] {
+            bin.push(i as u32);
+        }
+    }
     let bands: Vec<(Vec<[f32; 3]>, Vec<f64>)> = (0..h.div_ceil(BAND))
         .into_par_iter()
         .map(|band| {
             let (y0, y1) = (band * BAND, ((band + 1) * BAND).min(h));
             let n = ((y1 - y0) * w) as usize;
             let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; ATTRIBUTES]); n]);
-            for t in &screen {
-                let (lo, hi) = (
-                    t.y.iter().copied().fold(f64::INFINITY, f64::min),
-                    t.y.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-                );
-                if hi < y0 as f64 || lo > y1 as f64 {
-                    continue;
-                }
+            for t in bins[band as usize].iter().map(|&i| &screen[i as usize]) {
                 rasterize(t, w, y0, y1, |f| {
                     let k = ((f.y - y0) * w + f.x) as usize;
                     if (painter || f.depth < depth[k]) && f.depth >= -1.0 {

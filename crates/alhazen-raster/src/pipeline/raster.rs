@@ -27,14 +27,7 @@ pub struct ScreenTriangle {
 /// The perspective division and viewport transform of a clipped convex polygon (clip space,
 /// `w > 0`), fanned into screen triangles of a `w × h` image tagged with `source`.
 pub fn to_screen(clipped: &[super::clip::ClipVertex], (w, h): (u32, u32), source: u32) -> Vec<ScreenTriangle> {
-    let pts: Vec<_> = clipped
-        .iter()
-        .map(|cv| {
-            let inv_w = 1.0 / cv.pos.w;
-            let (x, y, z) = (cv.pos.x * inv_w, cv.pos.y * inv_w, cv.pos.z * inv_w);
-            ((x + 1.0) * 0.5 * w as f64, (1.0 - y) * 0.5 * h as f64, z, inv_w, cv.attr.map(|a| a * inv_w))
-        })
-        .collect();
+    let pts: Vec<_> = clipped.iter().map(|cv| divide(cv, (w, h))).collect();
     (1..pts.len().saturating_sub(1))
         .map(|k| {
             let c = [&pts[0], &pts[k], &pts[k + 1]];
@@ -48,6 +41,30 @@ pub fn to_screen(clipped: &[super::clip::ClipVertex], (w, h): (u32, u32), source
             }
         })
         .collect()
+}
+
+/// A corner after the perspective division and the viewport: `x, y, z/w, 1/w, attributes/w`.
+type ScreenCorner = (f64, f64, f64, f64, [f64; ATTRIBUTES]);
+
+#[inline]
+fn divide(cv: &super::clip::ClipVertex, (w, h): (u32, u32)) -> ScreenCorner {
+    let inv_w = 1.0 / cv.pos.w;
+    let (x, y, z) = (cv.pos.x * inv_w, cv.pos.y * inv_w, cv.pos.z * inv_w);
+    ((x + 1.0) * 0.5 * w as f64, (1.0 - y) * 0.5 * h as f64, z, inv_w, cv.attr.map(|a| a * inv_w))
+}
+
+/// [`to_screen`] of a triangle that needs no clipping (inside the view volume): the same
+/// numbers, without allocating.
+pub fn triangle_to_screen(c: &[super::clip::ClipVertex; 3], size: (u32, u32), source: u32) -> ScreenTriangle {
+    let p = c.each_ref().map(|cv| divide(cv, size));
+    ScreenTriangle {
+        x: p.each_ref().map(|q| q.0),
+        y: p.each_ref().map(|q| q.1),
+        z: p.each_ref().map(|q| q.2),
+        inv_w: p.each_ref().map(|q| q.3),
+        attr_w: p.each_ref().map(|q| q.4),
+        source,
+    }
 }
 
 /// One covered pixel: position, depth and perspective-correct attributes.
