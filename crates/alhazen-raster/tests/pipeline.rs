@@ -635,3 +635,33 @@ b = { shape = "sphere", radius = 0.9 }
     eprintln!("CSG body: mean absolute difference {:.2} % over {n} pixels", 100.0 * diff / sum);
     assert!(diff / sum < 0.05, "{}", diff / sum);
 }
+
+#[test]
+fn glass_shows_what_lies_behind_it_blended_by_fresnel() {
+    // A glass ball before a red wall: its centre shows the wall (transmitted, 1 − F ≈ 0.96 at
+    // normal incidence), its rim more of the reflected sky.
+    let text = r#"
+background = [0.2, 0.3, 0.9]
+ambient = 1
+[render]
+width = 64
+height = 64
+[camera]
+eye = [0, 0, 5]
+fov = 30
+[[object]]
+shape = "sphere"
+radius = 0.8
+material = { color = 0, diffuse = 0, transparency = 1, ior = 1.5 }
+[[object]]
+shape = "rectangle"
+transform = [{ scale = 3 }, { translate = [0, 0, -2] }]
+material = { color = [0.9, 0.1, 0.1] }
+"#;
+    let scene = parse_scene("glass.toml".as_ref(), text).unwrap();
+    let (fb, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    // At normal incidence F = ((1.5 − 1)/(1.5 + 1))² = 0.04: 0.96 of the wall, 0.04 of the sky.
+    let centre = fb.color[32 * 64 + 32];
+    let want = [0.96 * 0.9 + 0.04 * 0.2, 0.96 * 0.1 + 0.04 * 0.3, 0.96 * 0.1 + 0.04 * 0.9];
+    assert!((0..3).all(|c| (centre[c] as f64 - want[c]).abs() < 2e-3), "{centre:?} vs {want:?}");
+}

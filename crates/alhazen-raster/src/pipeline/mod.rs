@@ -472,19 +472,28 @@ fn render_view(
     proj: &Projection,
     size: (u32, u32),
 ) -> Result<(Framebuffer, RasterStats), RasterError> {
-    render_view_in(scene, prepared, opts, proj, size, false)
+    render_view_in(scene, prepared, opts, proj, size, Pass::Main)
 }
 
-/// One view through `proj`; `in_mirror` for the view a plane mirror shows (whose own mirrors
-/// show the sky: one reflection deep).
+/// Which view a frame is: the camera's, a plane mirror's (whose own mirrors and glass show the
+/// sky: one reflection deep), or what lies behind glass (drawn without transparent objects).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Pass {
+    Main,
+    InMirror,
+    BehindGlass,
+}
+
+/// One view through `proj`.
 fn render_view_in(
     scene: &Scene,
     prepared: &Prepared,
     opts: &RasterOptions,
     proj: &Projection,
     (w, h): (u32, u32),
-    in_mirror: bool,
+    pass: Pass,
 ) -> Result<(Framebuffer, RasterStats), RasterError> {
+    let in_mirror = pass != Pass::Main;
     let proj = *proj;
     let geometry = &prepared.geometry;
     let stencil_mode = match (opts.shadows, opts.shadow_method, proj.perspective) {
@@ -497,6 +506,7 @@ fn render_view_in(
         specular: prepared.ibl.as_ref().filter(|_| opts.ibl).map(|i| &i.specular),
         blocked: 0,
         reflected: None,
+        behind: None,
         emitters: &prepared.emitters,
         hemisphere: opts
             .hemispherical
@@ -529,16 +539,24 @@ fn render_view_in(
         let Some((reflected, front)) = plane.reflected(&proj) else { continue };
         let mut seen = opts.clone();
         seen.clip_planes.push(front);
-        let (fb, s) = render_view_in(scene, prepared, &seen, &reflected, (w, h), true)?;
+        let (fb, s) = render_view_in(scene, prepared, &seen, &reflected, (w, h), Pass::InMirror)?;
         let color = fb.color.iter().map(|c| Some(Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64))).collect();
         mirror_images.push(mirrors::MirrorImage { object: plane.object, color, drawn: s.drawn });
     }
+    // Glass: the frame once more without transparent objects, what they let through.
+    let clear = |t: &Triangle| scene.materials[t.material as usize].transparency == Vec3::ZERO;
+    let behind_glass = if pass == Pass::Main && !tris.iter().all(clear) {
+        Some(render_view_in(scene, prepared, opts, &proj, (w, h), Pass::BehindGlass)?.0)
+    } else {
+        None
+    };
     let processed: Vec<(usize, Vec<ScreenTriangle>)> = order
         .par_chunks(4096)
         .map(|chunk| {
             let mut out = Vec::with_capacity(chunk.len());
             let culled = chunk
                 .iter()
+                .filter(|&&i| pass != Pass::BehindGlass || clear(&tris[i as usize]))
                 .filter(|&&i| process(scene, &proj, &tris[i as usize], i, opts, shadows, (w, h), &mut out))
                 .count();
             (culled, out)
@@ -613,7 +631,11 @@ fn render_view_in(
                         .then(|| tris[*src as usize].object)
                         .and_then(|o| mirror_images.iter().find(|i| i.object == o))
                         .and_then(|i| i.color[global]);
-                    let shadows = &shade::Lighting { blocked: blocked[k], reflected, ..*shadows };
+                    let behind = behind_glass.as_ref().map(|b| {
+                        let c = b.color[global];
+                        Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
+                    });
+                    let shadows = &shade::Lighting { blocked: blocked[k], reflected, behind, ..*shadows };
                     let c = if *src == u32::MAX {
                         let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
                         scene.background.radiance(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))

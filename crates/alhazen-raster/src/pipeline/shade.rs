@@ -20,6 +20,9 @@ pub struct Lighting<'a> {
     pub blocked: u64,
     /// What a mirror shows at this pixel ([`super::mirrors`]), instead of the sky.
     pub reflected: Option<Vec3>,
+    /// What lies behind a transparent surface at this pixel (the frame drawn without
+    /// transparent objects), instead of the sky.
+    pub behind: Option<Vec3>,
     /// Lights standing for emitting objects, after the scene's (their shadow maps follow).
     pub emitters: &'a [super::emitters::EmitterLight],
     /// The course's hemispherical lighting instead of the ambient constant: sky and ground
@@ -67,8 +70,9 @@ pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &
 }
 
 /// Radiance towards the viewer from the light factors of [`lighting`] at texture coordinates
-/// `uv`: `a·diffuse + specular`, plus emission and, for mirrors and glass, the background in the
-/// reflected and the viewing direction (environment mapping; the preview traces no rays).
+/// `uv`: `a·diffuse + specular`, plus emission; for mirrors what they show (or the background in
+/// the reflected direction); for glass a Fresnel-weighted blend of what lies behind it
+/// (unrefracted) and the reflected background.
 pub fn combine(
     scene: &Scene,
     m: &Material,
@@ -92,7 +96,11 @@ pub fn combine(
         c += m.mirror * extra.reflected.unwrap_or_else(|| scene.background.radiance(2.0 * v.dot(n) * n - v));
     }
     if m.transparency != Vec3::ZERO {
-        c += m.transparency * scene.background.radiance(-v);
+        // A Fresnel-weighted blend of what lies behind (not refracted) and the reflected sky.
+        let f = alhazen_render::optics::fresnel_dielectric(v.dot(n), m.ior);
+        let behind = extra.behind.unwrap_or_else(|| scene.background.radiance(-v));
+        let mirrored = scene.background.radiance(2.0 * v.dot(n) * n - v);
+        c += m.transparency * (behind * (1.0 - f) + mirrored * f);
     }
     c
 }
