@@ -49,7 +49,7 @@ pub struct LinesArgs {
     #[arg(long)]
     optimize: bool,
     /// With --optimize, strokes whose ends lie this close (millimetres) are drawn as one.
-    #[arg(long, default_value_t = 0.05, value_parser = non_negative, requires = "optimize")]
+    #[arg(long, default_value_t = 0.05, value_parser = non_negative, requires = "optimize", allow_negative_numbers = true)]
     join_tolerance: f64,
     /// Width of a PNG preview in pixels.
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(16..=20000))]

@@ -554,6 +554,19 @@ fn lines_for_pen_plotters_are_optimized_layered_and_written_as_hpgl() {
     assert!(h.starts_with("IN;\nSP1;\nPU") && h.contains("SP2;") && h.ends_with("PU;SP0;\n"), "{h}");
     let o = alhazen(&["lines", scene.to_str().unwrap(), "-o", hpgl.to_str().unwrap(), "--join-tolerance", "0.1"]);
     assert_eq!(o.status.code(), Some(2), "--join-tolerance needs --optimize");
+    for bad in ["nan", "inf", "-1", "x"] {
+        let o = alhazen(&[
+            "lines",
+            scene.to_str().unwrap(),
+            "-o",
+            hpgl.to_str().unwrap(),
+            "--optimize",
+            "--join-tolerance",
+            bad,
+        ]);
+        assert_eq!(o.status.code(), Some(2), "--join-tolerance {bad}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains("expected a number ≥ 0"), "--join-tolerance {bad}");
+    }
     // vpype, when installed, reads the three layers as layers 1, 2, 3.
     if let Ok(v) = Command::new("vpype").args(["read", svg.to_str().unwrap(), "stat"]).output() {
         let stat = String::from_utf8_lossy(&v.stdout);
