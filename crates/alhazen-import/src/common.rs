@@ -91,11 +91,6 @@ pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb) -> Ma
     add_material(scene, m)
 }
 
-/// A material that is only a path-tracer BSDF (the Whitted coefficients follow it).
-pub(crate) fn bsdf_material(name: &str, bsdf: BsdfDesc) -> Material {
-    Material::from_bsdf(name, bsdf)
-}
-
 /// Trowbridge–Reitz (GGX) microfacets with Smith shadowing, roughness `α` (clamped away from 0,
 /// where the distribution degenerates).
 pub(crate) fn ggx(alpha_u: f64, alpha_v: f64) -> Microfacets {

@@ -370,7 +370,7 @@ impl Importer<'_> {
             ior,
             transmission.clamp(0.0, 1.0),
         );
-        let mut m = common::bsdf_material(&name, bsdf);
+        let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
         m.emission = emission;
         m.bump = bump;
         let id = common::add_material(&mut self.scene, m);

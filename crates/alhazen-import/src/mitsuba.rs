@@ -667,8 +667,10 @@ impl Importer {
         if let Some(id) = self.default_material {
             return id;
         }
-        let m =
-            common::bsdf_material("mitsuba default", BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::splat(0.5)) });
+        let m = alhazen_scene::Material::from_bsdf(
+            "mitsuba default",
+            BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::splat(0.5)) },
+        );
         let id = common::add_material(&mut self.scene, m);
         self.default_material = Some(id);
         id
@@ -678,7 +680,7 @@ impl Importer {
     fn bsdf_material(&mut self, ctx: &Ctx, node: Node) -> R<MaterialId> {
         let (desc, bump) = self.bsdf(ctx, node, 0)?;
         let name = self.attr(ctx, node, "id")?.unwrap_or_else(|| format!("bsdf at line {}", ctx.line(node)));
-        let mut m = common::bsdf_material(&name, desc);
+        let mut m = alhazen_scene::Material::from_bsdf(&name, desc);
         m.bump = bump;
         Ok(common::add_material(&mut self.scene, m))
     }

@@ -894,7 +894,7 @@ impl Importer {
             None => None,
         };
         self.unused(ctx, p, &format!("material \"{kind}\""));
-        let mut m = common::bsdf_material(name, bsdf);
+        let mut m = alhazen_scene::Material::from_bsdf(name, bsdf);
         m.bump = bump;
         Ok(common::add_material(&mut self.scene, m))
     }
@@ -1192,7 +1192,10 @@ impl Importer {
         if let Some(m) = self.default_material {
             return m;
         }
-        let m = common::bsdf_material("pbrt default", BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::splat(0.5)) });
+        let m = alhazen_scene::Material::from_bsdf(
+            "pbrt default",
+            BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::splat(0.5)) },
+        );
         let id = common::add_material(&mut self.scene, m);
         self.default_material = Some(id);
         id

@@ -496,6 +496,22 @@ fn the_preview_is_lit_by_the_cornell_lamp_as_whitted_is() {
     assert!((r - t).abs() < 0.05 * t, "preview mean {r}, Whitted mean {t}");
 }
 
+/// The pixels whose four corners all see `object` first (inside its outline, off its edge).
+fn inside_outline(scene: &alhazen_scene::Scene, object: u32) -> Vec<(u32, u32)> {
+    let (w, h) = (scene.render.width, scene.render.height);
+    let world = alhazen_render::World::build(scene);
+    let camera = alhazen_render::Camera::new(&scene.camera, w, h);
+    let sees =
+        |fx: f64, fy: f64| world.intersect(&camera.ray(fx, fy), f64::INFINITY).is_some_and(|h| h.object == object);
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let (fx, fy) = (x as f64, y as f64);
+            sees(fx, fy) && sees(fx + 1.0, fy) && sees(fx, fy + 1.0) && sees(fx + 1.0, fy + 1.0)
+        })
+        .collect()
+}
+
 /// Inside a mirror's outline (pixels whose corners all see the mirror first): the mean absolute
 /// difference from the ray tracer relative to its mean brightness there, and the same for the
 /// preview's old stand-in, the sky in the reflected direction.
@@ -508,15 +524,8 @@ fn mirror_error(scene: &alhazen_scene::Scene, mirror: &str) -> (f64, f64) {
     let world = alhazen_render::World::build(scene);
     let camera = alhazen_render::Camera::new(&scene.camera, w, h);
     let (mut diff, mut sky, mut sum, mut n) = (0.0, 0.0, 0.0, 0.0);
-    for (y, x) in (0..h).flat_map(|y| (0..w).map(move |x| (y, x))) {
-        let sees = |fx: f64, fy: f64| {
-            world.intersect(&camera.ray(fx, fy), f64::INFINITY).is_some_and(|hit| hit.object == object)
-        };
-        let (fx, fy) = (x as f64, y as f64);
-        if !(sees(fx, fy) && sees(fx + 1.0, fy) && sees(fx, fy + 1.0) && sees(fx + 1.0, fy + 1.0)) {
-            continue;
-        }
-        let ray = camera.ray(fx + 0.5, fy + 0.5);
+    for (x, y) in inside_outline(scene, object) {
+        let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5);
         let Some(hit) = world.intersect(&ray, f64::INFINITY) else { continue };
         let k = (y * w + x) as usize;
         let (a, b) = (fb.color[k], traced.pixels[k]);
@@ -617,19 +626,12 @@ b = { shape = "sphere", radius = 0.9 }
     let traced = alhazen_render::render(&scene, &|_, _| {});
     let (fb, stats) = render_scene(&scene, &RasterOptions::default()).unwrap();
     assert_eq!(stats.skipped_objects, 0);
-    let world = alhazen_render::World::build(&scene);
-    let camera = alhazen_render::Camera::new(&scene.camera, 160, 120);
     let (mut diff, mut sum, mut n) = (0.0, 0.0, 0);
-    for (y, x) in (0..120u32).flat_map(|y| (0..160u32).map(move |x| (y, x))) {
-        let sees =
-            |fx: f64, fy: f64| world.intersect(&camera.ray(fx, fy), f64::INFINITY).is_some_and(|h| h.object == 1);
-        let (fx, fy) = (x as f64, y as f64);
-        if sees(fx, fy) && sees(fx + 1.0, fy) && sees(fx, fy + 1.0) && sees(fx + 1.0, fy + 1.0) {
-            let k = (y * 160 + x) as usize;
-            diff += (0..3).map(|c| (fb.color[k][c] - traced.pixels[k][c]).abs() as f64).sum::<f64>() / 3.0;
-            sum += (0..3).map(|c| traced.pixels[k][c] as f64).sum::<f64>() / 3.0;
-            n += 1;
-        }
+    for (x, y) in inside_outline(&scene, 1) {
+        let k = (y * 160 + x) as usize;
+        diff += (0..3).map(|c| (fb.color[k][c] - traced.pixels[k][c]).abs() as f64).sum::<f64>() / 3.0;
+        sum += (0..3).map(|c| traced.pixels[k][c] as f64).sum::<f64>() / 3.0;
+        n += 1;
     }
     assert!(n > 300, "the body covers {n} pixels");
     eprintln!("CSG body: mean absolute difference {:.2} % over {n} pixels", 100.0 * diff / sum);

@@ -5,7 +5,7 @@
 //! shadows on others are not drawn (shadow maps hold triangles).
 
 use super::{Projection, shade};
-use alhazen_math::{Ray, Vec2, Vec3, Vec4};
+use alhazen_math::{Vec2, Vec3};
 use alhazen_render::World;
 use alhazen_scene::{Scene, Shape};
 
@@ -32,13 +32,7 @@ impl CsgBodies {
         depth: f64,
         light: &shade::Lighting,
     ) -> Option<(f64, Vec3)> {
-        let at = |z: f64| {
-            let q = proj.clip_to_world * Vec4::new(x, y, z, 1.0);
-            q.truncate() / q.w
-        };
-        let origin = at(-1.0);
-        let dir = (at(0.0) - origin).normalize_or_zero();
-        let hit = self.world.intersect(&Ray::new(origin, dir), f64::INFINITY)?;
+        let hit = self.world.intersect(&proj.near_ray(x, y), f64::INFINITY)?;
         let p = hit.hit.p;
         let c = proj.world_to_clip * p.extend(1.0);
         let z = c.z / c.w;

@@ -326,7 +326,7 @@ pub fn mirror_image(
             (0..n)
                 .map(|k| {
                     let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
-                    let d = eye_ray(proj, 2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64);
+                    let d = proj.near_ray(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64).dir;
                     let (_, n) = surface.hit(eye, d)?;
                     let (src, attr) = &owner[k];
                     Some(if *src == u32::MAX {
@@ -412,13 +412,6 @@ fn corner_reflexes(tris: &[&Triangle], which: &[u32], surface: &Curved, eye: Vec
         })
         .collect();
     solved.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
-}
-
-/// The unit direction from the eye through NDC `(x, y)` (by the near plane, which stays finite
-/// under the infinite far plane).
-fn eye_ray(proj: &Projection, x: f64, y: f64) -> Vec3 {
-    let q = proj.clip_to_world * Vec4::new(x, y, -1.0, 1.0);
-    (q.truncate() / q.w - proj.frame.eye).normalize_or_zero()
 }
 
 /// A reflected point lit as the mirror sees it: the attributes hold the point, its normal, its

@@ -309,6 +309,17 @@ impl Projection {
         if self.perspective { (self.frame.eye - p).normalize_or_zero() } else { self.frame.w }
     }
 
+    /// The eye ray through NDC `(x, y)`: from the near plane, along the line through the
+    /// depth-0 point (both stay finite under the infinite far plane, unlike [`Self::ray_dir`]'s).
+    pub fn near_ray(&self, x: f64, y: f64) -> alhazen_math::Ray {
+        let at = |z: f64| {
+            let q = self.clip_to_world * Vec4::new(x, y, z, 1.0);
+            q.truncate() / q.w
+        };
+        let origin = at(-1.0);
+        alhazen_math::Ray::new(origin, (at(0.0) - origin).normalize_or_zero())
+    }
+
     /// The world direction of the ray through NDC `(x, y)`.
     fn ray_dir(&self, x: f64, y: f64) -> Vec3 {
         let h = |z: f64| {
