@@ -15,8 +15,9 @@
 //! lights to itself through them exactly (`mirrors`, specular connections), MIS-weighted against
 //! BSDF paths that reach an area light after the mirror.
 //!
-//! Lambertian RGB scenes on processors with AVX2 or AVX-512 are traced eight samples at a time
-//! in vector lanes (`lanes`), with the same arithmetic, so the same samples.
+//! Where the world tests eight rays at once faster than one by one (`World::traces_rays_together`),
+//! eight samples are traced side by side (`lanes`), each with the same arithmetic ([`PathTracer::vertex`]),
+//! so the same samples, whatever the materials.
 
 use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_hint};
 use crate::camera::Camera;
@@ -45,10 +46,12 @@ pub struct PathTracer<'a> {
     sequence: Sequence,
     /// Each material's BSDF in RGB when it does not vary over the surface (no texture).
     uniform_bsdfs: Vec<Option<Bsdf>>,
-    /// Samples are traced eight at a time in vector lanes (module `lanes`): the same samples.
+    /// Samples are traced eight at a time in lanes (module `lanes`): the same samples.
     in_lanes: bool,
-    /// The lights, when every one is a parallelogram, for the lanes to sample.
+    /// The lights, when every one is a parallelogram, for the lanes' Lambert kernel to sample.
     lane_lights: Option<Vec<lanes::LaneLight>>,
+    /// Per material: the lanes shade its vertices with the Lambert kernel.
+    lambert_kernel: Vec<bool>,
     /// Specular connections through the scene's sphere, cylinder and plane mirrors, if any.
     mirrors: Option<mirrors::MirrorConnections>,
 }
@@ -61,13 +64,13 @@ fn power_heuristic(a: f64, b: f64) -> f64 {
 }
 
 /// The self-intersection guard at `p`, scaled to the magnitude of its coordinates.
-#[inline]
+#[inline(always)]
 fn epsilon(p: Vec3) -> f64 {
     1e-9 * (1.0 + p.abs().max_element())
 }
 
 /// A point moved off its surface towards the side of `dir`.
-#[inline]
+#[inline(always)]
 fn offset(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
     let eps = epsilon(p);
     p + ng * if ng.dot(dir) >= 0.0 { eps } else { -eps }
@@ -85,6 +88,69 @@ impl Previous {
     fn camera(origin: Vec3) -> Self {
         Self { p: origin, pdf: 1.0, delta: true }
     }
+}
+
+/// One sample's path in flight: what its walk carries from vertex to vertex.
+struct PathState {
+    /// The ray to the next vertex, the `depth`-th segment from the camera.
+    ray: Ray,
+    depth: u32,
+    /// Radiance gathered so far, and the throughput.
+    l: Vec3,
+    beta: Vec3,
+    /// Product of the squared relative indices crossed (for Russian roulette).
+    eta_scale: f64,
+    /// A dispersive surface left only the hero wavelength.
+    hero_only: bool,
+    prev: Previous,
+    /// Specular connections' bookkeeping: the object of the previous vertex, and the visit
+    /// of a mirror reached from a non-specular vertex (for the next emission's MIS weight).
+    prev_object: u32,
+    visit: Option<mirrors::MirrorVisit>,
+}
+
+impl PathState {
+    fn new(ray: Ray) -> Self {
+        let prev = Previous::camera(ray.origin);
+        Self {
+            ray,
+            depth: 1,
+            l: Vec3::ZERO,
+            beta: Vec3::ONE,
+            eta_scale: 1.0,
+            hero_only: false,
+            prev,
+            prev_object: u32::MAX,
+            visit: None,
+        }
+    }
+
+    /// Adds what `vertex` gathered, its light sample only if its shadow segment is `clear`.
+    #[inline]
+    fn gather(&mut self, vertex: &Vertex, clear: bool) {
+        if let Some(light) = vertex.light {
+            self.l += vertex.beta * if clear { light } else { Vec3::ZERO };
+        }
+        if let Some(mirrored) = vertex.mirrored {
+            self.l += vertex.beta * mirrored;
+        }
+    }
+}
+
+/// What [`PathTracer::vertex`] leaves to be added once its shadow ray has been traced.
+#[derive(Default)]
+struct Vertex {
+    /// The throughput at the vertex.
+    beta: Vec3,
+    /// The light sample's contribution if its shadow segment is clear (`None` at specular
+    /// vertices, which sample no light).
+    light: Option<Vec3>,
+    /// The shadow segment to trace: a ray and its length.
+    shadow: Option<(Ray, f64)>,
+    /// Light through the scene's mirrors (specular connections).
+    mirrored: Option<Vec3>,
+    /// The path goes on along its new ray.
+    goes_on: bool,
 }
 
 impl<'a> PathTracer<'a> {
@@ -105,7 +171,6 @@ impl<'a> PathTracer<'a> {
             })
             .collect();
         let lights = Lights::build(scene);
-        let lane_lights = lanes::lane_lights(&lights);
         let mirrors = scene
             .render
             .mirror_connections
@@ -120,79 +185,108 @@ impl<'a> PathTracer<'a> {
             sequence,
             uniform_bsdfs,
             in_lanes: false,
-            lane_lights,
+            lane_lights: None,
+            lambert_kernel: vec![],
             mirrors,
         };
+        tracer.lane_lights = lanes::lane_lights(&tracer.lights);
+        tracer.lambert_kernel = lanes::lambert_kernel(&tracer);
         tracer.in_lanes = tracer.lanes_apply();
         tracer
     }
 
     /// Radiance along `ray` in the channels of `mode`.
-    pub fn radiance(&self, mut ray: Ray, mode: ColorMode, s: &mut SampleStream) -> Vec3 {
-        let max_depth = self.scene.render.max_depth;
-        let (mut l, mut beta, mut eta_scale) = (Vec3::ZERO, Vec3::ONE, 1.0);
-        let mut hero_only = false;
-        let mut prev = Previous::camera(ray.origin);
-        // Specular connections' bookkeeping: the object of the previous vertex, and the visit
-        // of a mirror reached from a non-specular vertex (for the next emission's MIS weight).
-        let (mut prev_object, mut visit) = (u32::MAX, None);
-        for depth in 1..=max_depth {
-            let Some(wh) = self.world.intersect(&ray, f64::INFINITY) else {
-                if let Some(sky) = self.escaped(&ray, &prev, beta, mode) {
-                    l += sky;
-                }
-                break;
-            };
-            l += beta * self.emitted(&HitPoint::from(wh), &ray, &prev, visit.as_ref(), mode);
-            if depth == max_depth {
-                break;
+    pub fn radiance(&self, ray: Ray, mode: ColorMode, s: &mut SampleStream) -> Vec3 {
+        let mut path = PathState::new(ray);
+        let mut vertex = Vertex::default();
+        loop {
+            let hit = self.world.intersect(&path.ray, f64::INFINITY);
+            self.vertex(&mut path, hit.as_ref(), mode, s, &mut vertex);
+            let clear = vertex.shadow.is_none_or(|(ray, dist)| self.world.unoccluded(ray.origin, ray.dir, dist));
+            path.gather(&vertex, clear);
+            if !vertex.goes_on {
+                return path.l;
             }
-            let m = &self.scene.materials[wh.material as usize];
-            let bsdf = match (&self.uniform_bsdfs[wh.material as usize], mode) {
-                (Some(b), ColorMode::Rgb) => Cow::Borrowed(b),
-                _ => Cow::Owned(bsdf_at(m, wh.hit.uv, &self.scene.images, mode)),
-            };
-            if self.spectral && !hero_only && is_dispersive(&bsdf) {
-                // Wavelength-dependent paths: only the hero survives (×3 keeps it unbiased).
-                beta *= Vec3::new(3.0, 0.0, 0.0);
-                hero_only = true;
-            }
-            let wo = -ray.dir;
-            let (frame, ng) = self.shading_frame(&wh, &bsdf, wo, tangent_hint(m));
-            let v = frame.to_local(wo);
-            // One pair picks the light and the BSDF lobe, drawn only when there is a choice;
-            // one pair each places the points.
-            let choices = if self.lights.len() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
-            if !bsdf.is_delta() {
-                l += beta * self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, choices.x, s);
-                if let Some(c) = self.mirrors.as_ref().filter(|_| depth + 2 <= max_depth) {
-                    l += beta * self.mirror_connections(c, &bsdf, &frame, wh.hit.p, ng, v, wh.object, mode, s);
-                }
-            }
-            let Some(bs) = bsdf.sample(v, choices.y, s.next_2d()) else { break };
-            let dir = frame.to_world(bs.l);
-            let weight = bs.f * bs.l.z.abs() / bs.pdf;
-            if !weight.is_finite() || weight == Vec3::ZERO {
-                break;
-            }
-            beta *= weight;
-            eta_scale *= bs.eta * bs.eta;
-            if depth >= RR_DEPTH {
-                let q = (beta.max_element() * eta_scale).min(0.95);
-                if s.next_1d() >= q {
-                    break;
-                }
-                beta /= q;
-            }
-            if let Some(c) = &self.mirrors {
-                let reflected = bs.delta && !prev.delta;
-                visit = reflected.then(|| c.visit(prev.p, prev_object, prev.pdf, &HitPoint::from(wh))).flatten();
-                prev_object = wh.object;
-            }
-            prev = Previous { p: wh.hit.p, pdf: bs.pdf, delta: bs.delta };
-            ray = Ray::new(offset(wh.hit.p, ng, dir), dir);
         }
-        l
+    }
+
+    /// One vertex of `path` where its ray meets `hit` (or leaves the scene): emission added,
+    /// the light sample and the mirror connections left in the result (the light sample's
+    /// shadow ray untraced), the path moved on to its next ray. Both tracers run it: the per-path
+    /// one ([`Self::radiance`]) and the lanes, which trace eight paths' rays together.
+    #[inline(always)]
+    fn vertex(
+        &self,
+        path: &mut PathState,
+        hit: Option<&WorldHit>,
+        mode: ColorMode,
+        s: &mut SampleStream,
+        out: &mut Vertex,
+    ) {
+        let max_depth = self.scene.render.max_depth;
+        *out = Vertex { beta: path.beta, ..Vertex::default() };
+        if path.depth > max_depth {
+            return;
+        }
+        let Some(wh) = hit else {
+            if let Some(sky) = self.escaped(&path.ray, &path.prev, path.beta, mode) {
+                path.l += sky;
+            }
+            return;
+        };
+        path.l += path.beta * self.emitted(&HitPoint::from(wh), &path.ray, &path.prev, path.visit.as_ref(), mode);
+        if path.depth == max_depth {
+            return;
+        }
+        let m = &self.scene.materials[wh.material as usize];
+        let bsdf = match (&self.uniform_bsdfs[wh.material as usize], mode) {
+            (Some(b), ColorMode::Rgb) => Cow::Borrowed(b),
+            _ => Cow::Owned(bsdf_at(m, wh.hit.uv, &self.scene.images, mode)),
+        };
+        if self.spectral && !path.hero_only && is_dispersive(&bsdf) {
+            // Wavelength-dependent paths: only the hero survives (×3 keeps it unbiased).
+            path.beta *= Vec3::new(3.0, 0.0, 0.0);
+            path.hero_only = true;
+        }
+        out.beta = path.beta;
+        let wo = -path.ray.dir;
+        let (frame, ng) = self.shading_frame(wh, &bsdf, wo, tangent_hint(m));
+        let v = frame.to_local(wo);
+        // One pair picks the light and the BSDF lobe, drawn only when there is a choice;
+        // one pair each places the points.
+        let choices = if self.lights.len() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
+        if !bsdf.is_delta() {
+            let (light, shadow) = self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, choices.x, s);
+            (out.light, out.shadow) = (Some(light), shadow);
+            if let Some(c) = self.mirrors.as_ref().filter(|_| path.depth + 2 <= max_depth) {
+                out.mirrored = Some(self.mirror_connections(c, &bsdf, &frame, wh.hit.p, ng, v, wh.object, mode, s));
+            }
+        }
+        let Some(bs) = bsdf.sample(v, choices.y, s.next_2d()) else { return };
+        let dir = frame.to_world(bs.l);
+        let weight = bs.f * bs.l.z.abs() / bs.pdf;
+        if !weight.is_finite() || weight == Vec3::ZERO {
+            return;
+        }
+        path.beta *= weight;
+        path.eta_scale *= bs.eta * bs.eta;
+        if path.depth >= RR_DEPTH {
+            let q = (path.beta.max_element() * path.eta_scale).min(0.95);
+            if s.next_1d() >= q {
+                return;
+            }
+            path.beta /= q;
+        }
+        if let Some(c) = &self.mirrors {
+            let reflected = bs.delta && !path.prev.delta;
+            path.visit =
+                reflected.then(|| c.visit(path.prev.p, path.prev_object, path.prev.pdf, &HitPoint::from(wh))).flatten();
+            path.prev_object = wh.object;
+        }
+        path.prev = Previous { p: wh.hit.p, pdf: bs.pdf, delta: bs.delta };
+        path.ray = Ray::new(offset(wh.hit.p, ng, dir), dir);
+        path.depth += 1;
+        out.goes_on = true;
     }
 
     /// What a path carrying `beta` gathers from the sky when `ray` leaves the scene, weighted
@@ -210,6 +304,7 @@ impl<'a> PathTracer<'a> {
 
     /// Emission of the surface hit, weighted against light sampling (and against the specular
     /// connection when the path came through a mirror, `visit`).
+    #[inline(always)]
     fn emitted(
         &self,
         h: &HitPoint,
@@ -232,6 +327,7 @@ impl<'a> PathTracer<'a> {
 
     /// The local frame (normal on the viewer's side for opaque surfaces — the course's two-sided
     /// reading of the same-side factor) and the geometric normal on the same side.
+    #[inline(always)]
     fn shading_frame(&self, wh: &WorldHit, bsdf: &Bsdf, wo: Vec3, tangent: Option<Vec3>) -> (Frame, Vec3) {
         let m = &self.scene.materials[wh.material as usize];
         let (mut ng, mut ns) = (wh.hit.n, crate::world::shading_normal(&wh.hit, m, &self.scene.images));
@@ -246,7 +342,10 @@ impl<'a> PathTracer<'a> {
         (tangent.map_or_else(|| Frame::around(ns), |t| Frame::new(ns, t)), ng)
     }
 
-    /// One light sample, weighted by the power heuristic against the BSDF's density.
+    /// One light sample, weighted by the power heuristic against the BSDF's density: what it
+    /// brings if the shadow segment it returns (a ray and its length) is clear; zero, and no
+    /// segment, when it brings nothing anyway.
+    #[inline(always)]
     fn next_event(
         &self,
         bsdf: &Bsdf,
@@ -257,26 +356,23 @@ impl<'a> PathTracer<'a> {
         mode: ColorMode,
         u_choice: f64,
         s: &mut SampleStream,
-    ) -> Vec3 {
-        let Some(ls) = self.lights.sample(p, u_choice, s.next_2d()) else { return Vec3::ZERO };
+    ) -> (Vec3, Option<(Ray, f64)>) {
+        let Some(ls) = self.lights.sample(p, u_choice, s.next_2d()) else { return (Vec3::ZERO, None) };
         if ls.radiance == Vec3::ZERO || ls.pdf <= 0.0 {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, None);
         }
         let l = frame.to_local(ls.dir);
         let f = bsdf.eval(v, l) * l.z.abs();
         // Light must leave from the side of the geometry the BSDF sends it to.
         if f == Vec3::ZERO || (ng.dot(ls.dir) > 0.0) != (l.z > 0.0) && !bsdf.transmits() {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, None);
         }
         let origin = offset(p, ng, ls.dir);
         // Stop short of the light point by more than the origin moved, so the light does not
         // shadow itself.
         let dist = if ls.dist.is_finite() { ls.dist * (1.0 - 1e-7) - 4.0 * epsilon(p) } else { f64::INFINITY };
-        if !self.world.unoccluded(origin, ls.dir, dist) {
-            return Vec3::ZERO;
-        }
         let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf.pdf(v, l)) };
-        f * mode.color(ls.radiance) * (w / ls.pdf)
+        (f * mode.color(ls.radiance) * (w / ls.pdf), Some((Ray::new(origin, ls.dir), dist)))
     }
 }
 

@@ -11,7 +11,6 @@
 //! Mitsuba 0.5's low-discrepancy sampler does past its `dimension`): deep in a path the
 //! stratification no longer shows in the image, and the hashing costs ~100 instructions a pair.
 
-use crate::shape::VectorUnit;
 use alhazen_math::Vec2;
 
 /// Dimension pairs drawn from the Sobol sequence: the pixel position and, in the common case of
@@ -253,127 +252,6 @@ fn sobol_pair(h: u64, index_reversed: u32) -> (f64, f64) {
     (to_unit((ab >> 32) as u32), to_unit(ab as u32))
 }
 
-/// [`Rng::uniform`] twice from generator state `state`: the new state and the pair.
-#[inline(always)]
-fn independent_pair(state: u64) -> (u64, (f64, f64)) {
-    let mut rng = Rng(state);
-    let pair = (rng.uniform(), rng.uniform());
-    (rng.0, pair)
-}
-
-/// Streams side by side in [`StreamLanes`].
-pub const STREAM_LANES: usize = 8;
-
-/// Eight [`SampleStream`]s side by side, lane by lane, drawing the same numbers: the lanes'
-/// draws are one loop without branches, which the compiler turns into vector code.
-#[derive(Clone, Debug)]
-pub struct StreamLanes {
-    sequence: Sequence,
-    /// The pixel hash of each Sobol pair, lane by lane ([`PixelSeeds`]).
-    dimensions: [[u64; STREAM_LANES]; SOBOL_PAIRS as usize],
-    index_reversed: [u32; STREAM_LANES],
-    dimension: [u32; STREAM_LANES],
-    rng: [u64; STREAM_LANES],
-}
-
-impl StreamLanes {
-    /// Eight streams of `sequence`, to be started with [`Self::start`].
-    pub fn new(sequence: Sequence) -> Self {
-        Self {
-            sequence,
-            dimensions: [[0; STREAM_LANES]; SOBOL_PAIRS as usize],
-            index_reversed: [0; STREAM_LANES],
-            dimension: [0; STREAM_LANES],
-            rng: [0; STREAM_LANES],
-        }
-    }
-
-    /// Lane `lane` becomes [`PixelSeeds::stream`]`(index)` of `seeds`.
-    pub fn start(&mut self, lane: usize, seeds: &PixelSeeds, index: u32) {
-        debug_assert_eq!(seeds.sequence, self.sequence);
-        for (d, h) in self.dimensions.iter_mut().zip(seeds.dimensions) {
-            d[lane] = h;
-        }
-        self.index_reversed[lane] = index.reverse_bits();
-        self.dimension[lane] = 0;
-        self.rng[lane] = mix(seeds.rng ^ index as u64);
-    }
-
-    /// [`SampleStream::next_2d`] of lane `lane` alone.
-    pub fn next_2d_of(&mut self, lane: usize) -> Vec2 {
-        let (x, y) = self.draw(lane, true);
-        Vec2::new(x, y)
-    }
-
-    /// [`SampleStream::next_2d`] of every lane in `take`, into `out` (`out[0]` the first number
-    /// of each lane, `out[1]` the second; lanes not taken: untouched streams, zero).
-    #[allow(unsafe_code)]
-    pub fn next_2d(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2], unit: VectorUnit) {
-        #[cfg(target_arch = "x86_64")]
-        if unit.is_avx512() {
-            // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-            return unsafe { self.next_2d_avx512(take, out) };
-        }
-        #[cfg(target_arch = "x86_64")]
-        if unit.is_avx2() {
-            // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-            return unsafe { self.next_2d_avx2(take, out) };
-        }
-        let _ = unit;
-        self.next_2d_lanes(take, out);
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
-    #[allow(unsafe_code)]
-    unsafe fn next_2d_avx512(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2]) {
-        self.next_2d_lanes(take, out);
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[allow(unsafe_code)]
-    unsafe fn next_2d_avx2(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2]) {
-        self.next_2d_lanes(take, out);
-    }
-
-    #[inline(always)]
-    fn next_2d_lanes(&mut self, take: [bool; STREAM_LANES], out: &mut [[f64; STREAM_LANES]; 2]) {
-        // Past the Sobol pairs (most draws of long paths) the hashing is skipped for all lanes.
-        let sobol = self.sequence == Sequence::Sobol && (0..STREAM_LANES).any(|i| self.dimension[i] < SOBOL_PAIRS);
-        for (lane, take) in take.into_iter().enumerate() {
-            let (x, y) = if sobol { self.draw(lane, take) } else { self.draw_independent(lane, take) };
-            (out[0][lane], out[1][lane]) = if take { (x, y) } else { (0.0, 0.0) };
-        }
-    }
-
-    /// [`Self::draw`] for a lane past the Sobol pairs.
-    #[inline(always)]
-    fn draw_independent(&mut self, lane: usize, take: bool) -> (f64, f64) {
-        let (state, pair) = independent_pair(self.rng[lane]);
-        self.rng[lane] = if take { state } else { self.rng[lane] };
-        self.dimension[lane] += take as u32;
-        pair
-    }
-
-    /// The pair of lane `lane`'s current dimension, and its step to the next when `take`:
-    /// [`SampleStream::pair`] computed both ways and chosen without branches.
-    #[inline(always)]
-    fn draw(&mut self, lane: usize, take: bool) -> (f64, f64) {
-        let d = self.dimension[lane];
-        let sobol = self.sequence == Sequence::Sobol && d < SOBOL_PAIRS;
-        let mut h = 0;
-        for (k, hashes) in self.dimensions.iter().enumerate() {
-            h = if d == k as u32 { hashes[lane] } else { h };
-        }
-        let scrambled = sobol_pair(h, self.index_reversed[lane]);
-        let (state, independent) = independent_pair(self.rng[lane]);
-        self.rng[lane] = if take && !sobol { state } else { self.rng[lane] };
-        self.dimension[lane] = d + take as u32;
-        if sobol { scrambled } else { independent }
-    }
-}
-
 /// The position in `[0, 1)²` of sample `i` of `n` in a pixel: jittered on a `k × k` grid when
 /// `n = k²`, otherwise N-rooks (one sample per row and per column stratum); the pixel centre
 /// for `n = 1`.
@@ -540,41 +418,6 @@ mod tests {
                         pts.iter().map(|p| ((if coord == 0 { p.0 } else { p.1 }) * n as f64) as u32).collect();
                     rows.sort();
                     assert_eq!(rows, (0..n).collect::<Vec<_>>());
-                }
-            }
-        }
-    }
-
-    proptest::proptest! {
-        /// Eight lanes draw what eight streams draw, whichever lanes draw together, past the
-        /// Sobol pairs, with every vector unit and both sequences.
-        #[test]
-        fn stream_lanes_draw_what_streams_draw(
-            seed in 0u64..1000,
-            samples in proptest::collection::vec((0u32..64, 0u32..64, 0u32..4096), STREAM_LANES),
-            takes in proptest::collection::vec(proptest::array::uniform8(proptest::bool::ANY), 1..16),
-            sobol in proptest::bool::ANY,
-        ) {
-            let sequence = if sobol { Sequence::Sobol } else { Sequence::Independent };
-            for unit in VectorUnit::available() {
-                let mut lanes = StreamLanes::new(sequence);
-                let mut streams: Vec<SampleStream> = samples
-                    .iter()
-                    .enumerate()
-                    .map(|(lane, &(x, y, index))| {
-                        lanes.start(lane, &PixelSeeds::new(sequence, seed, x, y), index);
-                        SampleStream::new(sequence, seed, x, y, index)
-                    })
-                    .collect();
-                // The first pair one lane at a time, the rest together.
-                proptest::prop_assert_eq!(lanes.next_2d_of(3), streams[3].next_2d());
-                for take in &takes {
-                    let mut out = [[f64::NAN; STREAM_LANES]; 2];
-                    lanes.next_2d(*take, &mut out, unit);
-                    for (lane, stream) in streams.iter_mut().enumerate() {
-                        let expected = if take[lane] { stream.next_2d() } else { Vec2::ZERO };
-                        proptest::prop_assert_eq!(Vec2::new(out[0][lane], out[1][lane]), expected, "{}", unit.name());
-                    }
                 }
             }
         }

@@ -107,7 +107,15 @@ pub struct HitPoint {
 }
 
 impl From<WorldHit> for HitPoint {
+    #[inline]
     fn from(h: WorldHit) -> Self {
+        Self::from(&h)
+    }
+}
+
+impl From<&WorldHit> for HitPoint {
+    #[inline]
+    fn from(h: &WorldHit) -> Self {
         Self { p: h.hit.p, n: h.hit.n, ns: h.hit.ns, material: h.material, object: h.object }
     }
 }
@@ -276,6 +284,9 @@ impl World {
     fn flat_shading(&self, lane: Lane) -> Option<FlatShading> {
         let o = &self.objects[lane.object as usize];
         let Shape::Mesh(mesh) = &o.placed.shape else { return None };
+        if o.placed.uv || o.bumpy {
+            return None;
+        }
         let first = lane.flat.triangle as usize;
         let triangles = [first, first + usize::from(lane.flat.parallelogram)];
         if !triangles.iter().all(|&t| mesh.shades_flat(t)) {
@@ -318,6 +329,12 @@ impl World {
             let (spheres, objects) = (first_sphere..self.spheres.len(), first_object..self.leaf_objects.len());
             self.leaves.push(Leaf { packets, spheres, objects });
         }
+    }
+
+    /// Eight rays are traced at once faster than one by one ([`Self::intersect_rays`]): the
+    /// world is flats in one leaf and the processor has AVX2 or AVX-512.
+    pub fn traces_rays_together(&self) -> bool {
+        self.flats_only && (self.vectors.is_avx512() || self.vectors.is_avx2())
     }
 
     /// The kernel its packets are tested with.
@@ -378,37 +395,35 @@ impl World {
     }
 
     /// [`Self::intersect`] for eight rays without a limit, into `out` (`None` where not
-    /// `live`), as [`HitPoint`]s: the same hits, several rays' tests in flight at once.
-    pub fn intersect_rays(&self, rays: &RayPacket, live: [bool; LANES], out: &mut [Option<HitPoint>; LANES]) {
+    /// `live`): the same hits, several rays' tests in flight at once.
+    pub fn intersect_rays(&self, rays: &RayPacket, live: [bool; LANES], out: &mut [Option<WorldHit>; LANES]) {
         if self.flats_only {
             out.iter_mut().for_each(|slot| *slot = None);
             FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
-                out[r] = Some(self.flat_point(&rays.ray(r), k, h));
+                out[r] = Some(self.flat_hit(&rays.ray(r), k, h));
             });
         } else {
             for (r, (slot, live)) in out.iter_mut().zip(live).enumerate() {
-                *slot = if live { self.intersect(&rays.ray(r), f64::INFINITY).map(HitPoint::from) } else { None };
+                *slot = if live { self.intersect(&rays.ray(r), f64::INFINITY) } else { None };
             }
         }
     }
 
-    /// The point where `ray` meets lane `h.lane` of packet `k` as [`Self::intersect`] reports
-    /// it (the flat is a triangle or parallelogram of a mesh placed in world space).
+    /// The hit of `ray` on lane `h.lane` of packet `k` as [`Self::intersect`] reports it (the
+    /// flat is a triangle or parallelogram of a mesh placed in world space). Flats whose
+    /// materials look at no texture coordinates and whose normals do not vary skip the
+    /// surface's interpolation: their hits carry zero texture coordinates.
     #[inline]
-    fn flat_point(&self, ray: &Ray, k: usize, h: LaneHit) -> HitPoint {
+    fn flat_hit(&self, ray: &Ray, k: usize, h: LaneHit) -> WorldHit {
         let lane = self.flats.lanes[k][h.lane];
         if let Some(s) = &self.flat_shading[k][h.lane] {
             // The triangle `FlatLane::candidate` picks, chosen without a branch (it is random).
             let second = usize::from(lane.flat.parallelogram & (h.b1 < h.b2));
             let (n, material) = (s.normal[second], s.material[second]);
-            return HitPoint { p: ray.at(h.t), n, ns: n, material, object: lane.object };
+            let hit = SurfaceHit::flat(h.t, ray.at(h.t), n, alhazen_math::Vec2::ZERO);
+            return WorldHit { hit, material, object: lane.object };
         }
-        let c = lane.flat.candidate(h.t, h.b1, h.b2);
-        let o = &self.objects[lane.object as usize];
-        let Shape::Mesh(mesh) = &o.placed.shape else { unreachable!("flats come from meshes") };
-        let (n, ns, slot) = mesh.normals_and_slot(c.aux as usize, c.bary[0], c.bary[1]);
-        let material = o.slot_materials.get(slot as usize).copied().unwrap_or(o.material);
-        HitPoint { p: ray.at(c.t), n, ns, material, object: lane.object }
+        self.surface_of(ray, lane.flat.candidate(h.t, h.b1, h.b2), lane.object)
     }
 
     /// [`Self::unoccluded`] for eight segments, `rays[r]` over `dist[r]` (false where not `live`).
@@ -501,8 +516,9 @@ pub fn shading_normal(hit: &SurfaceHit, m: &scene::Material, images: &[Arc<scene
 mod tests {
     use super::*;
 
-    /// Rays into a one-leaf world of flats with smooth normals (a subdivided cube) and flat
-    /// ones (a box): eight at a time, each hit is what the ray finds alone.
+    /// Rays into a one-leaf world of flats with smooth normals and a checker texture (a
+    /// subdivided cube) and flat ones (a box): eight at a time, each hit is what the ray finds
+    /// alone, with its texture coordinates where the material looks at them.
     #[test]
     fn eight_rays_meet_smooth_and_flat_flats_as_one_does() {
         let text = r#"
@@ -511,6 +527,7 @@ shape = "subdivision"
 base = "cube"
 levels = 0
 smooth = true
+material = { color = { checker = { even = [1, 1, 1], odd = [0, 0, 0], size = 0.1 } } }
 [[object]]
 shape = "box"
 min = [1.5, -1, -1]
@@ -519,7 +536,7 @@ max = [2.5, 1, 1]
         let world = World::build(&scene::parse_scene("smooth.toml".as_ref(), text).unwrap());
         assert!(world.flats_only, "one leaf of flats");
         assert!(world.flat_shading.iter().flatten().any(Option::is_none), "some flats shade smoothly");
-        let mut n = 0;
+        let (mut n, mut uv) = (0, 0);
         for k in 0..64 {
             let mut rays = RayPacket::default();
             for i in 0..LANES {
@@ -533,10 +550,16 @@ max = [2.5, 1, 1]
             let mut hits = [None; LANES];
             world.intersect_rays(&rays, [true; LANES], &mut hits);
             for (i, hit) in hits.into_iter().enumerate() {
-                assert_eq!(hit, world.intersect(&rays.ray(i), f64::INFINITY).map(HitPoint::from));
-                n += usize::from(hit.is_some_and(|h| h.n != h.ns));
+                let alone = world.intersect(&rays.ray(i), f64::INFINITY);
+                assert_eq!(hit.map(HitPoint::from), alone.map(HitPoint::from));
+                if let (Some(h), Some(a)) = (hit, alone)
+                    && world.objects[h.object as usize].placed.uv
+                {
+                    (n, uv) = (n + usize::from(h.hit.n != h.hit.ns), uv + 1);
+                    assert_eq!(h.hit.uv, a.hit.uv);
+                }
             }
         }
-        assert!(n > 50, "{n} hits with smooth normals");
+        assert!(n > 50 && uv == n, "{n} hits with smooth normals, {uv} with texture coordinates");
     }
 }

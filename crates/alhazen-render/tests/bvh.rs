@@ -114,7 +114,7 @@ proptest! {
             for i in 0..8 {
                 let ray = &all.ray(i);
                 let alone = world.intersect(ray, f64::INFINITY).filter(|_| live[i]);
-                prop_assert_eq!(hits[i], alone.map(HitPoint::from));
+                prop_assert_eq!(hits[i].map(HitPoint::from), alone.map(HitPoint::from));
                 prop_assert_eq!(clear[i], live[i] && world.unoccluded(ray.origin, ray.dir, dist[i]));
             }
         }

@@ -1,30 +1,37 @@
-//! The path tracer's common case in lanes: eight samples traced side by side, so their rays
-//! and their shading run in the processor's vector units (a small wavefront: Laine, Karras and
-//! Aila 2013, "Megakernels Considered Harmful", split a path tracer into stages over many
-//! paths). It applies when every material is an untextured Lambert BSDF in RGB and the
-//! processor has AVX2 or AVX-512 ([`PathTracer::lanes_apply`]).
+//! The path tracer in lanes: eight paths traced side by side, whatever their materials, lights
+//! and colours, so that their rays are tested together and their vertices shaded by material
+//! kernels (a small wavefront: Laine, Karras and Aila 2013, "Megakernels Considered Harmful",
+//! split a path tracer into stages over many paths).
 //!
 //! One bounce is a round of stages over the eight lanes: the rays' nearest hits in one call
-//! ([`crate::World::intersect_rays`]: with AVX-512, in a world of flats, each flat against the
-//! eight rays at once); per path, emission and the vertex ([`PathTracer::prepare_vertex`]);
-//! the vertices' random numbers ([`StreamLanes`]) and light points ([`sample_lights`]) for all
-//! lanes; the shading frame, next-event weights, cosine-weighted continuation and Russian
-//! roulette ([`shade`]); the shadow rays in one call; per path, the step to the next vertex.
-//! The all-lane stages are loops without branches the compiler turns into AVX-512 or AVX2
-//! code. A lane whose path ends starts the next sample of the tile row it was given, so lanes
-//! stay busy until the row's samples run out.
+//! ([`crate::World::intersect_rays`]: in a world of flats, each flat against the eight rays at
+//! once, in AVX-512 or AVX2); per path, the vertex; the shadow rays in one call
+//! ([`crate::World::unoccluded_rays`]), after which each path gathers its light and steps on. A
+//! lane whose path ends starts the next sample of the pixels it was given, so lanes stay busy
+//! until their samples run out.
+//!
+//! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
+//! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
+//! and specular connection. Vertices on untextured Lambert surfaces in RGB scenes without
+//! specular connections take the Lambert kernel instead: their random numbers and emission per
+//! lane ([`PathTracer::lambert_vertex`]), then light points on parallelogram lights
+//! ([`sample_lights`]) and the shading frame, next-event weights, cosine-weighted continuation
+//! and Russian roulette ([`shade`]) for all lanes at once, loops without branches the compiler
+//! turns into AVX-512 or AVX2 code.
 //!
 //! Every lane performs exactly the floating-point operations of [`PathTracer::radiance`], in
-//! the same order (no fused multiply–adds, no reassociation), and draws the same numbers, so
-//! every sample is bit-identical to the per-path tracer's on every processor (test
+//! the same order (no fused multiply–adds, no reassociation), draws the same numbers from its
+//! own stream, and the batched ray tests find the hits the rays find alone, so every sample is
+//! bit-identical to the per-path tracer's on every processor (test
 //! `lanes_match_the_per_path_tracer`).
 
-use super::{PathTracer, Previous, RR_DEPTH, epsilon, offset, power_heuristic};
+use super::{PathState, PathTracer, RR_DEPTH, Vertex, epsilon, offset, power_heuristic};
 use crate::bsdf::{Bsdf, ColorMode, Frame, cosine_hemisphere, cosine_pdf, same_side};
 use crate::lights::{Emitter, Lights};
-use crate::sampler::{PixelSeeds, StreamLanes};
+use crate::sampler::{PixelSeeds, SampleStream};
 use crate::shape::{RayPacket, VectorUnit};
-use crate::world::HitPoint;
+use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
+use crate::world::{HitPoint, WorldHit};
 use alhazen_math::{Ray, Vec2, Vec3};
 use std::f64::consts::FRAC_1_PI;
 
@@ -123,198 +130,235 @@ struct Shaded {
     beta: Lanes3,
 }
 
-/// One sample's path in flight.
-struct Path {
+/// One sample's path in a lane.
+struct LanePath {
     /// Where its result goes.
     job: usize,
-    ray: Ray,
-    depth: u32,
-    l: Vec3,
-    beta: Vec3,
-    prev: Previous,
+    path: PathState,
+    stream: SampleStream,
+    /// RGB, or the wavelengths of a spectral sample.
+    mode: ColorMode,
+}
+
+impl LanePath {
+    /// The sample's value: its radiance, in RGB.
+    fn value(&self) -> Vec3 {
+        match self.mode {
+            ColorMode::Spectral(lambdas) => spectrum_to_rgb(self.path.l, &lambdas),
+            ColorMode::Rgb => self.path.l,
+        }
+    }
+}
+
+/// How lane `i`'s vertex of this bounce is shaded.
+#[derive(Clone, Copy, PartialEq)]
+enum Kernel {
+    /// No path in the lane.
+    Idle,
+    /// [`PathTracer::vertex`]: its result in the lane's [`Vertex`].
+    General,
+    /// The Lambert kernel: its result in the lanes' [`Shaded`].
+    Lambert,
+}
+
+/// Per material: its vertices take the Lambert kernel (untextured Lambert without bump map or
+/// tangent), in a scene whose vertices may (RGB, no specular connections).
+pub(super) fn lambert_kernel(tracer: &PathTracer) -> Vec<bool> {
+    let scene_allows = !tracer.spectral && tracer.mirrors.is_none();
+    tracer
+        .scene
+        .materials
+        .iter()
+        .zip(&tracer.uniform_bsdfs)
+        .map(|(m, b)| {
+            scene_allows
+                && matches!(b, Some(Bsdf::Lambert(_)))
+                && m.bump.is_none()
+                && crate::bsdf::tangent_hint(m).is_none()
+        })
+        .collect()
 }
 
 impl PathTracer<'_> {
-    /// True when every material is an untextured Lambert BSDF, colours are RGB and the
-    /// processor has AVX2 or AVX-512: the case [`Self::pixels_in_lanes`] traces faster. (Its
-    /// portable loops, exact but scalar, are 7 % slower than the per-path tracer.)
+    /// True where the processor has a vector unit (AVX2 or AVX-512) for the kernels: the
+    /// lanes are then faster than paths one by one. (Portably the Lambert kernel's loops are
+    /// exact but scalar, and slower than the per-path tracer.)
     pub(super) fn lanes_apply(&self) -> bool {
         let unit = self.world.vector_unit();
-        (unit.is_avx512() || unit.is_avx2()) && self.lanes_could_apply()
-    }
-
-    /// [`Self::lanes_apply`] whatever the processor.
-    pub(super) fn lanes_could_apply(&self) -> bool {
-        !self.spectral
-            && self.scene.materials.iter().zip(&self.uniform_bsdfs).all(|(m, b)| {
-                matches!(b, Some(Bsdf::Lambert(_))) && m.bump.is_none() && crate::bsdf::tangent_hint(m).is_none()
-            })
+        unit.is_avx512() || unit.is_avx2()
     }
 
     /// Samples `first..` of `pixels`, traced in lanes: `out` holds each pixel's samples in
     /// turn, sample `first + i` of pixel `p` at `out[p × n + i]` (`n` samples per pixel).
     pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
-        let mut paths: [Option<Path>; LANES] = Default::default();
+        let mut lanes: [Option<LanePath>; LANES] = Default::default();
         let spp = out.len() / pixels.len().max(1);
         let mut next = 0..out.len();
         let mut seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, 0, 0);
-        let (mut vertices, mut shaded) = (Vertices::default(), Shaded::default());
-        let mut lights = LightLanes::default();
-        let unit = self.world.vector_unit();
         let mut rays = RayPacket::default();
-        let mut hits: [Option<HitPoint>; LANES] = [None; LANES];
-        let mut streams = StreamLanes::new(self.sequence);
+        let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
+        let mut general: [Vertex; LANES] = Default::default();
+        let (mut lambert, mut lights, mut shaded) = (Vertices::default(), LightLanes::default(), Shaded::default());
+        let (mut shadows, mut dist) = (RayPacket::default(), [0.0; LANES]);
+        let unit = self.world.vector_unit();
+        let together = self.world.traces_rays_together();
         loop {
-            // Idle lanes start the pixel's next samples; all lanes' rays are traced together.
-            for (i, slot) in paths.iter_mut().enumerate().filter(|(_, p)| p.is_none()) {
+            // Idle lanes start the pixels' next samples; all lanes' rays are traced together.
+            for (i, slot) in lanes.iter_mut().enumerate().filter(|(_, p)| p.is_none()) {
                 *slot = next.next().map(|job| {
                     let ((x, y), index) = (pixels[job / spp], first + (job % spp) as u32);
                     if job % spp == 0 {
                         seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
                     }
-                    streams.start(i, &seeds, index);
-                    let path = self.start_path(streams.next_2d_of(i), (x, y), job);
-                    rays.set(i, &path.ray);
-                    path
+                    let lane = self.start(job, seeds.stream(index), (x, y));
+                    rays.set(i, &lane.path.ray);
+                    lane
                 });
             }
-            if paths.iter().all(Option::is_none) {
+            if lanes.iter().all(Option::is_none) {
                 return;
             }
-            self.world.intersect_rays(&rays, paths.each_ref().map(|p| p.is_some()), &mut hits);
-            let mut shading = [false; LANES];
-            for (i, (slot, hit)) in paths.iter_mut().zip(&hits).enumerate() {
-                let Some(path) = slot else { continue };
-                shading[i] = self.prepare_vertex(path, hit, &mut vertices, i);
-                if !shading[i] {
-                    out[path.job] = path.l;
-                    *slot = None;
+            if together {
+                self.world.intersect_rays(&rays, lanes.each_ref().map(|p| p.is_some()), &mut hits);
+            }
+            let mut kernels = [Kernel::Idle; LANES];
+            let mut tested = [false; LANES];
+            for (i, (slot, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
+                let Some(lane) = slot else { continue };
+                // Traced here when not together: a local hit costs no copy into `hits`.
+                let alone = if together { None } else { self.world.intersect(&lane.path.ray, f64::INFINITY) };
+                let hit = if together { hit.as_ref() } else { alone.as_ref() };
+                if self.lambert_vertex(lane, hit, (&mut lambert, &mut lights), i) {
+                    kernels[i] = Kernel::Lambert;
+                    continue;
+                }
+                kernels[i] = Kernel::General;
+                self.vertex(&mut lane.path, hit, lane.mode, &mut lane.stream, &mut general[i]);
+                if let Some((ray, d)) = general[i].shadow {
+                    (tested[i], dist[i]) = (true, d);
+                    shadows.set(i, &ray);
                 }
             }
-            self.draw_vertex_numbers(&mut streams, shading, (&mut vertices, &mut lights));
-            if self.lane_lights.is_some() {
-                sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
+            if kernels.contains(&Kernel::Lambert) {
+                if self.lane_lights.is_some() {
+                    sample_lights(&lights, &mut lambert, self.lights.choice_pdf(), unit);
+                }
+                shade(&lambert, &mut shaded, unit);
+                for i in (0..LANES).filter(|&i| kernels[i] == Kernel::Lambert && shaded.shadow[i]) {
+                    (tested[i], dist[i]) = (true, shaded.shadow_dist[i]);
+                    shadows.set(i, &Ray::new(get(&shaded.shadow_origin, i), get(&lambert.light_dir, i)));
+                }
             }
-            shade(&vertices, &mut shaded, unit);
-            let shadow_rays = RayPacket { origin: shaded.shadow_origin, dir: vertices.light_dir };
-            let tested = std::array::from_fn(|i| shading[i] && shaded.shadow[i]);
-            let clear = self.world.unoccluded_rays(&shadow_rays, &shaded.shadow_dist, tested);
-            for (i, slot) in paths.iter_mut().enumerate() {
-                let Some(path) = slot.as_mut().filter(|_| shading[i]) else { continue };
-                self.finish_vertex(path, &shaded, clear[i], i);
-                if shaded.alive[i] {
-                    rays.set(i, &path.ray);
+            let clear = self.world.unoccluded_rays(&shadows, &dist, tested);
+            for (i, slot) in lanes.iter_mut().enumerate() {
+                let Some(lane) = slot.as_mut() else { continue };
+                let goes_on = match kernels[i] {
+                    Kernel::Lambert => finish_lambert(&mut lane.path, &shaded, !tested[i] || clear[i], i),
+                    _ => {
+                        lane.path.gather(&general[i], !tested[i] || clear[i]);
+                        general[i].goes_on
+                    }
+                };
+                if goes_on {
+                    rays.set(i, &lane.path.ray);
                 } else {
-                    out[path.job] = path.l;
+                    out[lane.job] = lane.value();
                     *slot = None;
                 }
             }
         }
     }
 
-    /// The path through `film` (the pixel's first pair) of pixel `(x, y)`, whose result goes to
-    /// `out[job]`.
-    fn start_path(&self, film: Vec2, (x, y): (u32, u32), job: usize) -> Path {
+    /// The path of sample `stream` of pixel `(x, y)`, whose result goes to `out[job]`, as
+    /// [`Self::sample_of`] starts it.
+    fn start(&self, job: usize, mut stream: SampleStream, (x, y): (u32, u32)) -> LanePath {
+        let film = stream.next_2d();
         let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
-        let prev = Previous::camera(ray.origin);
-        Path { job, ray, depth: 1, l: Vec3::ZERO, beta: Vec3::ONE, prev }
+        let mode =
+            if self.spectral { ColorMode::Spectral(sample_wavelengths(stream.next_1d())) } else { ColorMode::Rgb };
+        LanePath { job, path: PathState::new(ray), stream, mode }
     }
 
-    /// The per-path half of a vertex, as in [`Self::radiance`]: the ray's `hit`, its emission
-    /// and the vertex, written to lane `i`; false when the path ends.
-    fn prepare_vertex(&self, path: &mut Path, hit: &Option<HitPoint>, v: &mut Vertices, i: usize) -> bool {
-        let max_depth = self.scene.render.max_depth;
-        if path.depth > max_depth {
+    /// The per-path half of a Lambert kernel's vertex, as in [`Self::vertex`]: emission, the
+    /// vertex and its random numbers and light sample, written to lane `i`. False (nothing done)
+    /// when the vertex is not the Lambert kernel's: the ray missed, the path ends here, or the
+    /// material is another.
+    fn lambert_vertex(
+        &self,
+        lane: &mut LanePath,
+        hit: Option<&WorldHit>,
+        (v, lights): (&mut Vertices, &mut LightLanes),
+        i: usize,
+    ) -> bool {
+        let path = &mut lane.path;
+        let Some(wh) = hit.filter(|h| self.lambert_kernel[h.material as usize]) else { return false };
+        if path.depth >= self.scene.render.max_depth {
             return false;
         }
-        let Some(wh) = hit else {
-            if let Some(sky) = self.escaped(&path.ray, &path.prev, path.beta, ColorMode::Rgb) {
-                path.l += sky;
-            }
-            return false;
-        };
-        path.l += path.beta * self.emitted(wh, &path.ray, &path.prev, None, ColorMode::Rgb);
-        if path.depth == max_depth {
-            return false;
-        }
-        let Some(Bsdf::Lambert(lambert)) = &self.uniform_bsdfs[wh.material as usize] else {
-            unreachable!("lanes apply only when every material is Lambert (`lanes_apply`)")
-        };
+        let Some(Bsdf::Lambert(lambert)) = &self.uniform_bsdfs[wh.material as usize] else { return false };
+        let h = HitPoint::from(wh);
+        path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, None, ColorMode::Rgb);
         v.roulette[i] = path.depth >= RR_DEPTH;
         set(&mut v.wo, i, -path.ray.dir);
-        set(&mut v.p, i, wh.p);
-        set(&mut v.ng, i, wh.n);
-        set(&mut v.ns, i, wh.ns);
+        set(&mut v.p, i, h.p);
+        set(&mut v.ng, i, h.n);
+        set(&mut v.ns, i, h.ns);
         set(&mut v.albedo, i, lambert.albedo);
         set(&mut v.beta, i, path.beta);
-        path.prev.p = wh.p;
-        true
-    }
-
-    /// The random numbers of the vertices of the lanes `shading`, in the per-path tracer's
-    /// order (light choice when there is one, light point, continuation, roulette from
-    /// [`RR_DEPTH`] on), and each lane's light sample.
-    fn draw_vertex_numbers(
-        &self,
-        streams: &mut StreamLanes,
-        shading: [bool; LANES],
-        (v, lights): (&mut Vertices, &mut LightLanes),
-    ) {
-        let unit = self.world.vector_unit();
-        let mut choice = [[0.0; LANES]; 2];
-        if self.lights.len() > 1 {
-            streams.next_2d(shading, &mut choice, unit);
+        path.prev.p = h.p;
+        // The vertex's numbers in the per-path tracer's order: light choice when there is one,
+        // light point, continuation, roulette from `RR_DEPTH` on. Roulette's is drawn before it
+        // is known whether the path survives the continuation; a path that does not never draws
+        // again, so the stream stays the per-path tracer's.
+        let s = &mut lane.stream;
+        let choice = if self.lights.len() > 1 { s.next_2d().x } else { 0.0 };
+        let u_light = s.next_2d();
+        let u_bsdf = s.next_2d();
+        (v.u_bsdf[0][i], v.u_bsdf[1][i]) = (u_bsdf.x, u_bsdf.y);
+        if v.roulette[i] {
+            v.u_roulette[i] = s.next_1d();
         }
-        let mut u_light = [[0.0; LANES]; 2];
-        streams.next_2d(shading, &mut u_light, unit);
-        streams.next_2d(shading, &mut v.u_bsdf, unit);
-        // Drawn before it is known whether the path survives the continuation; a path that
-        // does not never draws again, so the streams stay the per-path tracer's.
-        let mut u_roulette = [[0.0; LANES]; 2];
-        streams.next_2d(std::array::from_fn(|i| shading[i] && v.roulette[i]), &mut u_roulette, unit);
-        v.u_roulette = u_roulette[0];
-        for i in (0..LANES).filter(|&i| shading[i]) {
-            match &self.lane_lights {
-                Some(all) => {
-                    let k = &all[self.lights.choose(choice[0][i])];
-                    set(&mut lights.corner, i, k.corner);
-                    set(&mut lights.e1, i, k.e1);
-                    set(&mut lights.e2, i, k.e2);
-                    set(&mut lights.normal, i, k.normal);
-                    lights.pdf_area[i] = k.pdf_area;
-                    set(&mut v.light_radiance, i, k.radiance);
-                    (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
-                }
-                None => {
-                    let u = Vec2::new(u_light[0][i], u_light[1][i]);
-                    let light = self.lights.sample(get(&v.p, i), choice[0][i], u);
-                    let light = light.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
-                    v.light[i] = light.is_some();
-                    if let Some(ls) = light {
-                        set(&mut v.light_dir, i, ls.dir);
-                        set(&mut v.light_radiance, i, ls.radiance);
-                        (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
-                    }
+        match &self.lane_lights {
+            Some(all) => {
+                let k = &all[self.lights.choose(choice)];
+                set(&mut lights.corner, i, k.corner);
+                set(&mut lights.e1, i, k.e1);
+                set(&mut lights.e2, i, k.e2);
+                set(&mut lights.normal, i, k.normal);
+                lights.pdf_area[i] = k.pdf_area;
+                (lights.u[0][i], lights.u[1][i]) = (u_light.x, u_light.y);
+                set(&mut v.light_radiance, i, k.radiance);
+                (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
+            }
+            None => {
+                let light = self.lights.sample(h.p, choice, u_light);
+                let light = light.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
+                v.light[i] = light.is_some();
+                if let Some(ls) = light {
+                    set(&mut v.light_dir, i, ls.dir);
+                    set(&mut v.light_radiance, i, ls.radiance);
+                    (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
                 }
             }
         }
-        lights.u = u_light;
+        true
     }
+}
 
-    /// The per-path half after [`shade`] and the shadow ray (`unoccluded` when it was traced and
-    /// met nothing): the light gathered, then the step to the next vertex.
-    fn finish_vertex(&self, path: &mut Path, s: &Shaded, unoccluded: bool, i: usize) {
-        let clear = !s.shadow[i] || unoccluded;
-        let light = if clear { get(&s.light, i) } else { Vec3::ZERO };
-        path.l += path.beta * light;
-        if s.alive[i] {
-            path.beta = get(&s.beta, i);
-            path.prev.pdf = s.pdf[i];
-            path.prev.delta = false;
-            path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
-            path.depth += 1;
-        }
+/// The per-path half of a Lambert kernel's vertex after [`shade`] and the shadow ray (`clear`
+/// when it was not traced or met nothing): the light gathered, then the step to the next
+/// vertex. True when the path goes on.
+fn finish_lambert(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> bool {
+    let light = if clear { get(&s.light, i) } else { Vec3::ZERO };
+    path.l += path.beta * light;
+    if s.alive[i] {
+        path.beta = get(&s.beta, i);
+        path.prev.pdf = s.pdf[i];
+        path.prev.delta = false;
+        path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
+        path.depth += 1;
     }
+    s.alive[i]
 }
 
 /// Every lane's point on its parallelogram light, as `Lights::sample` computes it.
@@ -462,10 +506,13 @@ fn not_at_most_zero(x: f64) -> bool {
 mod tests {
     use super::*;
     use crate::film::PixelEstimator;
+    use crate::shape::VectorUnit;
     use crate::{Camera, World};
 
-    /// A Lambertian scene the lanes trace with per-path light sampling: spheres, a box and a
-    /// plane, an emitting box (triangles) and sphere, point and spot lights, a gradient sky.
+    /// A scene of every kind of material and light: Lambert, Oren–Nayar, Cook–Torrance and
+    /// textured surfaces, a bump map, rough and smooth glass, a rough conductor and a mirror
+    /// (with specular connections), spheres, boxes and a plane, an emitting box (triangles)
+    /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
 background = { zenith = [0.3, 0.4, 0.9], horizon = [0.8, 0.8, 0.7], ground = [0.2, 0.15, 0.1] }
 [render]
@@ -474,6 +521,7 @@ height = 18
 spp = 13
 max_depth = 6
 integrator = "path"
+mirror_connections = true
 [camera]
 eye = [0, 1.5, 6]
 target = [0, 0.5, 0]
@@ -490,20 +538,44 @@ intensity = 8
 [materials.glow]
 color = [0.5, 0.5, 0.5]
 emission = [4, 3, 2]
+[materials.chrome]
+color = 0
+diffuse = 0
+mirror = 0.9
 [[object]]
 shape = "plane"
 normal = [0, 1, 0]
-material = { color = [0.6, 0.6, 0.5] }
+material = { color = { checker = { even = [0.7, 0.7, 0.6], odd = [0.2, 0.2, 0.2], size = 0.5 } }, bump = { height = 0.02, waves = 0.5 } }
 [[object]]
 shape = "sphere"
 center = [-1, 1, 0]
 radius = 1
-material = { color = [0.8, 0.2, 0.2] }
+material = { bsdf = { type = "conductor", roughness = 0.2, distribution = "ggx", eta = [0.2, 0.4, 1.4], k = [3.9, 2.4, 1.6] } }
+[[object]]
+shape = "sphere"
+center = [0.3, 0.5, 1.2]
+radius = 0.5
+material = { bsdf = { type = "dielectric", roughness = 0.15, distribution = "ggx", ior = 1.5 } }
+[[object]]
+shape = "sphere"
+center = [-2.2, 0.4, 1.5]
+radius = 0.4
+material = { bsdf = { type = "dielectric", ior = 1.5 } }
+[[object]]
+shape = "sphere"
+center = [1.6, 0.6, -0.8]
+radius = 0.6
+material = "chrome"
 [[object]]
 shape = "box"
 min = [0.5, 0, -1]
 max = [1.5, 1.2, 0]
-material = { color = [0.2, 0.7, 0.3] }
+material = { bsdf = { type = "cook-torrance", roughness = 0.1, distribution = "beckmann", color = [0.2, 0.7, 0.3], kd = 0.7, ks = 0.3 } }
+[[object]]
+shape = "box"
+min = [-2.5, 0, -2]
+max = [-1.8, 0.6, -1.3]
+material = { bsdf = { type = "oren-nayar", sigma = 20, color = [0.6, 0.5, 0.3] } }
 [[object]]
 shape = "box"
 min = [-0.3, 2.5, -0.3]
@@ -522,7 +594,6 @@ material = "glow"
         let world = World::build_with(scene, unit);
         let camera = Camera::new(&scene.camera, scene.render.width, scene.render.height);
         let mut tracer = PathTracer::new(scene, &world, &camera);
-        assert!(tracer.lanes_could_apply(), "the scene is Lambertian: lanes apply");
         let mut all = [vec![], vec![]];
         for (in_lanes, out) in [true, false].into_iter().zip(&mut all) {
             tracer.in_lanes = in_lanes;
@@ -543,23 +614,37 @@ material = "glow"
         (lanes, per_path)
     }
 
-    /// The lanes trace the same bits as the per-path tracer: lights sampled in lanes (the
-    /// Cornell box's parallelogram, and two of them) and per path (everything else), every depth
-    /// from 0, a sky, sample counts that leave lanes idle; with every vector unit this processor
-    /// has.
+    fn small(name: &str, (w, h, spp): (u32, u32, u32)) -> alhazen_scene::Scene {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        let mut scene = alhazen_scene::load_scene(&root.join(format!("{name}.toml"))).unwrap();
+        (scene.render.width, scene.render.height, scene.render.spp) = (w, h, spp);
+        scene.render.integrator = alhazen_scene::IntegratorKind::Path;
+        scene
+    }
+
+    /// The lanes trace the same bits as the per-path tracer, on every kind of scene: the
+    /// Cornell box (flats in one leaf: rays tested eight at once), with two lights, its rough
+    /// version (gold and glass), the prism (spectral), textures, bump maps, mirrors with
+    /// specular connections and every light type (`MIXED`); every depth from 0, sample counts
+    /// that leave lanes idle; with every vector unit this processor has.
     #[test]
     fn lanes_match_the_per_path_tracer() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-        let mut cornell = alhazen_scene::load_scene(&root.join("cornell-box.toml")).unwrap();
-        (cornell.render.width, cornell.render.height, cornell.render.spp) = (20, 20, 11);
         let mixed = alhazen_scene::parse_scene("mixed.toml".as_ref(), MIXED).unwrap();
-        // Two parallelogram lights: the lanes draw the light choice too.
+        // Two parallelogram lights: the vertices choose one.
         let text = std::fs::read_to_string(root.join("cornell-box.toml")).unwrap()
             + "[[object]]\nshape = \"rectangle\"\nmaterial = \"light\"\n\
                transform = [{ scale = 0.2 }, { rotate_y = 90 }, { translate = [0.9, 0.2, 0] }]\n";
         let mut two_lights = alhazen_scene::parse_scene("two-lights.toml".as_ref(), &text).unwrap();
         (two_lights.render.width, two_lights.render.height, two_lights.render.spp) = (16, 16, 9);
-        for (name, base) in [("cornell-box", cornell), ("mixed", mixed), ("two lights", two_lights)] {
+        let scenes = [
+            ("cornell-box", small("cornell-box", (20, 20, 11))),
+            ("cornell-rough", small("cornell-rough", (16, 16, 7))),
+            ("prism", small("prism", (16, 12, 5))),
+            ("mixed", mixed),
+            ("two lights", two_lights),
+        ];
+        for (name, base) in scenes {
             for depth in [0, 1, 2, 3, 8] {
                 let mut scene = base.clone();
                 scene.render.max_depth = depth;
@@ -578,18 +663,19 @@ material = "glow"
         }
     }
 
+    /// The lanes trace every scene where the processor has a vector unit for their kernels;
+    /// the world tests their eight rays at once where it is flats in one leaf.
     #[test]
-    fn lanes_apply_only_to_lambertian_rgb_scenes_with_vector_units() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-        for (name, lambertian) in [("cornell-box", true), ("cornell-rough", false), ("prism", false)] {
-            let scene = alhazen_scene::load_scene(&root.join(format!("{name}.toml"))).unwrap();
+    fn lanes_apply_with_vector_units() {
+        for (name, flats) in [("cornell-box", true), ("cornell-rough", false), ("prism", false)] {
+            let scene = small(name, (8, 8, 1));
             for unit in VectorUnit::available() {
                 let world = World::build_with(&scene, unit);
                 let camera = Camera::new(&scene.camera, 8, 8);
                 let tracer = PathTracer::new(&scene, &world, &camera);
-                assert_eq!(tracer.lanes_could_apply(), lambertian, "{name}");
                 let vectors = unit.is_avx512() || unit.is_avx2();
-                assert_eq!(tracer.in_lanes, lambertian && vectors, "{name}, {}", unit.name());
+                assert_eq!(tracer.in_lanes, vectors, "{name}, {}", unit.name());
+                assert_eq!(world.traces_rays_together(), flats && vectors, "{name}, {}", unit.name());
             }
         }
     }
