@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""Issue 18's benchmark suite: alhazen's path tracer against Mitsuba 3 on six scenes, each a
+Mitsuba XML file that both renderers read as it is (so the twins are one file).
+
+    python3 bench/mitsuba/suite/make_data.py           # textures, sky, meshes (once)
+    python3 bench/mitsuba/suite.py reference [NAME…]   # Mitsuba's converged images (committed)
+    python3 bench/mitsuba/suite.py run [--runs 3] [NAME…]
+
+`run`, per scene, 256×256, 64 spp, max depth 8, on all cores:
+1. Equal samples: median wall time of the whole `alhazen render` process (parse, build, render,
+   write EXR; its default Sobol sampler, `ALHAZEN_SAMPLER=independent` for the files' own) against `mi.render` in Mitsuba `llvm_ad_rgb` (after one warm-up render, so the JIT
+   is excluded; alhazen and llvm runs alternate so the VM's drift hits both) and `scalar_rgb`.
+2. Equal time: alhazen renders with the most samples whose run (median of 3) fits in llvm's
+   time; RMSE and mean relative error of both images against the committed reference
+   (suite/ref/NAME.exr, Mitsuba llvm at 4096 spp), and the relative difference of the means of
+   alhazen's 64-spp image and the reference (the model's agreement, not noise).
+
+Needs `pip install mitsuba numpy`, `apt-get install libllvm19`.
+"""
+import argparse, os, subprocess, sys, tempfile, time
+
+os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so")
+import numpy as np
+import mitsuba as mi
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+SUITE = os.path.join(HERE, "suite")
+SCENES = {
+    "cornell-box": os.path.join(ROOT, "scenes/mitsuba/cornell-box.xml"),
+    "cornell-rough": os.path.join(ROOT, "scenes/mitsuba/cornell-rough.xml"),
+    "textured": os.path.join(SUITE, "textured.xml"),
+    "glossy": os.path.join(SUITE, "glossy.xml"),
+    "envmap": os.path.join(SUITE, "envmap.xml"),
+    "million": os.path.join(SUITE, "million.xml"),
+}
+EXE = os.environ.get("ALHAZEN", os.path.join(ROOT, "target/release/alhazen"))
+# Each renderer with its default sampler: alhazen's Sobol points (the files ask for Mitsuba's
+# default, `independent`, which alhazen honours unless told otherwise).
+SAMPLER = os.environ.get("ALHAZEN_SAMPLER", "sobol")
+
+
+def load(path):
+    mi.set_variant("scalar_rgb")
+    return np.array(mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False))[..., :3].astype(np.float64)
+
+
+def errors(img, ref):
+    rmse = float(np.sqrt(((img - ref) ** 2).mean()))
+    rel = float((np.abs(img - ref) / np.maximum(ref, 1e-2)).mean())
+    return rmse, rel
+
+
+def alhazen_run(path, spp, out):
+    t0 = time.perf_counter()
+    subprocess.run([EXE, "render", path, "-o", out, "--spp", str(spp), "--sampler", SAMPLER, "--quiet"],
+                   check=True, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - t0
+
+
+def mitsuba_renderer(variant, path, spp, out):
+    """Times one Mitsuba render of the scene, loaded and warmed up beforehand; writes `out`."""
+    mi.set_variant(variant)
+    import drjit as dr
+    scene = mi.load_file(path, spp=spp)
+    dr.eval(mi.render(scene, spp=spp))
+    count = [0]
+
+    def run():
+        mi.set_variant(variant)
+        count[0] += 1
+        t0 = time.perf_counter()
+        img = mi.render(scene, spp=spp, seed=count[0])
+        dr.eval(img)
+        arr = np.array(img)
+        elapsed = time.perf_counter() - t0
+        mi.Bitmap(arr).write(out)
+        return elapsed
+    return run
+
+
+def reference(name, spp):
+    mi.set_variant("llvm_ad_rgb")
+    scene = mi.load_file(SCENES[name], spp=256)
+    passes, acc = max(1, spp // 256), None
+    for i in range(passes):
+        arr = np.array(mi.render(scene, spp=256, seed=1000 + i), dtype=np.float64)
+        acc = arr if acc is None else acc + arr
+        print(f"{name}: pass {i + 1}/{passes}", file=sys.stderr, end="\r")
+    os.makedirs(os.path.join(SUITE, "ref"), exist_ok=True)
+    out = os.path.join(SUITE, "ref", f"{name}.exr")
+    mi.Bitmap((acc / passes).astype(np.float32)).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float16, False).write(out)
+    print(f"\n{name}: wrote {out} ({spp} spp)", file=sys.stderr)
+
+
+def run(name, runs, spp, tmp):
+    path = SCENES[name]
+    llvm = mitsuba_renderer("llvm_ad_rgb", path, spp, f"{tmp}/llvm.exr")
+    alhazen_run(path, spp, f"{tmp}/ours.exr")  # warm the file cache
+    pairs = [(alhazen_run(path, spp, f"{tmp}/ours.exr"), llvm()) for _ in range(runs)]
+    t_ours, t_llvm = (float(np.median(ts)) for ts in zip(*pairs))
+    scalar = mitsuba_renderer("scalar_rgb", path, spp, f"{tmp}/scalar.exr")
+    t_scalar = float(np.median([scalar() for _ in range(max(1, runs // 2))]))
+    spp_eq = max(1, int(spp * t_llvm / t_ours))
+    t_eq = float(np.median([alhazen_run(path, spp_eq, f"{tmp}/eq.exr") for _ in range(3)]))
+    while t_eq > t_llvm and spp_eq > 1:
+        spp_eq -= 1
+        t_eq = float(np.median([alhazen_run(path, spp_eq, f"{tmp}/eq.exr") for _ in range(3)]))
+    ref = load(os.path.join(SUITE, "ref", f"{name}.exr"))
+    ours, eq, mits = (load(f"{tmp}/{f}.exr") for f in ("ours", "eq", "llvm"))
+    e_eq, e_mi = errors(eq, ref), errors(mits, ref)
+    bias = float(ours.mean() / ref.mean() - 1)
+    print(f"| {name} | {t_ours:.3f} s | {t_llvm:.3f} s | {t_scalar:.3f} s | **{t_ours / t_llvm:.2f}** | "
+          f"{t_ours / t_scalar:.2f} | {spp_eq} spp {t_eq:.2f} s: {e_eq[0]:.5f} / {e_eq[1]:.4f} | "
+          f"{e_mi[0]:.5f} / {e_mi[1]:.4f} | {bias * 100:+.2f} % |", flush=True)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("mode", choices=["reference", "run"])
+    ap.add_argument("names", nargs="*")
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--ref-spp", type=int, default=4096)
+    a = ap.parse_args()
+    names = a.names or list(SCENES)
+    if a.mode == "reference":
+        for n in names:
+            reference(n, a.ref_spp)
+        return
+    if "ALHAZEN" not in os.environ:
+        subprocess.run(["cargo", "build", "--release", "-q", "-p", "alhazen-cli"], cwd=ROOT, check=True)
+    tmp = tempfile.mkdtemp()
+    print(f"{os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}")
+    print("| scene | alhazen | Mitsuba llvm | Mitsuba scalar | alhazen/llvm | alhazen/scalar "
+          "| alhazen at llvm's time: RMSE / mean rel. | Mitsuba llvm: RMSE / mean rel. | mean vs ref. |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for n in names:
+        run(n, a.runs, a.spp, tmp)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,69 @@
+//! Traces a file of rays against a mesh with alhazen's world (top-level BVH over objects, SAH
+//! BVH over the mesh's triangles): the BVH side of `bench/embree/bvh.py`, which traces the same
+//! rays with Embree 4.
+//!
+//! ```sh
+//! cargo run --release -p alhazen-render --example trace_rays -- MESH.ply RAYS.bin HITS.bin [THREADS]
+//! ```
+//!
+//! `RAYS.bin`: little-endian `f32` records `ox oy oz dx dy dz` (directions need not be unit).
+//! `HITS.bin`: one `f32` per ray, the hit distance along the ray's unit direction (infinity
+//! for a miss). Prints the world's build time (the mesh already loaded) and rays per second,
+//! best of three passes, on `THREADS` threads (default: all).
+
+use alhazen_math::{Ray, Vec3};
+use alhazen_render::World;
+use rayon::prelude::*;
+use std::time::Instant;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [mesh, rays, hits, rest @ ..] = args.as_slice() else {
+        return Err("usage: trace_rays MESH.ply RAYS.bin HITS.bin [THREADS]".into());
+    };
+    let threads = rest.first().map(|t| t.parse()).transpose()?.unwrap_or(0);
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build_global()?;
+    let mesh = std::path::absolute(mesh)?;
+    let text = format!(
+        "[meshes.m]\nfile = {:?}\n[[object]]\nshape = \"mesh\"\nmesh = \"m\"\nsmooth = false\n",
+        mesh.display().to_string()
+    );
+    let scene = alhazen_scene::parse_scene("trace_rays.toml".as_ref(), &text)?;
+    let bytes = std::fs::read(rays)?;
+    let floats: Vec<f32> = bytes.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+    let rays: Vec<Ray> = floats
+        .chunks_exact(6)
+        .map(|r| {
+            let v = |i: usize| Vec3::new(r[i] as f64, r[i + 1] as f64, r[i + 2] as f64);
+            Ray::new(v(0), v(3).normalize())
+        })
+        .collect();
+    let t0 = Instant::now();
+    let world = World::build(&scene);
+    let build = t0.elapsed().as_secs_f64();
+    let mut best = f64::INFINITY;
+    let mut t: Vec<f32> = vec![];
+    for _ in 0..3 {
+        let t0 = Instant::now();
+        t = rays
+            .par_chunks(4096)
+            .flat_map_iter(|chunk| {
+                chunk.iter().map(|ray| world.intersect(ray, f64::INFINITY).map_or(f32::INFINITY, |h| h.hit.t as f32))
+            })
+            .collect();
+        best = best.min(t0.elapsed().as_secs_f64());
+    }
+    std::fs::write(hits, t.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>())?;
+    let hit_count = t.iter().filter(|x| x.is_finite()).count();
+    println!(
+        "alhazen: {} triangles, build {:.3} s, {} rays ({} hit) in {:.3} s: {:.2} Mrays/s on {} threads",
+        scene.meshes.iter().map(|m| m.triangle_count()).sum::<usize>(),
+        build,
+        rays.len(),
+        hit_count,
+        best,
+        rays.len() as f64 / best / 1e6,
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
