@@ -5,7 +5,7 @@
 
 use alhazen_render::output::{Format, write_image};
 use alhazen_scene::{MAX_PIXELS, Scene, SceneError};
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -158,6 +158,46 @@ pub(crate) struct ImageArgs {
     /// No progress bar or summary.
     #[arg(short, long)]
     pub(crate) quiet: bool,
+    #[command(flatten)]
+    pub(crate) display: DisplayArgs,
+}
+
+/// How radiance is shown: exposure and tone mapping.
+#[derive(Args)]
+pub(crate) struct DisplayArgs {
+    /// Exposure in stops: radiance is scaled by 2^EV before it is written (every format).
+    #[arg(long, value_name = "EV", default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_exposure)]
+    pub(crate) exposure: f64,
+    /// Tone mapping of .png output (EXR and PFM stay linear): none (colours beyond white are
+    /// desaturated towards it), reinhard (L/(1+L) on luminance), filmic (Hable's curve).
+    #[arg(long, value_enum, default_value = "none")]
+    pub(crate) tonemap: TonemapArg,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum TonemapArg {
+    None,
+    Reinhard,
+    Filmic,
+}
+
+impl DisplayArgs {
+    pub(crate) fn display(&self) -> alhazen_render::output::Display {
+        use alhazen_math::color::Tonemap;
+        let tonemap = match self.tonemap {
+            TonemapArg::None => Tonemap::None,
+            TonemapArg::Reinhard => Tonemap::Reinhard,
+            TonemapArg::Filmic => Tonemap::Filmic,
+        };
+        alhazen_render::output::Display { exposure: self.exposure, tonemap }
+    }
+}
+
+fn parse_exposure(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(ev) if ev.is_finite() && ev.abs() <= 64.0 => Ok(ev),
+        _ => Err(format!("an exposure is a number of stops from -64 to 64, not {s:?}")),
+    }
 }
 
 /// An error and the exit code it deserves.

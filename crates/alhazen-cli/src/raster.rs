@@ -141,7 +141,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
     let (fb, stats) = last.expect("at least one frame");
     let image = Image { width: fb.width, height: fb.height, pixels: fb.color };
     output
-        .write_image(&image, format)
+        .write_image(&image, format, a.image.display.display())
         .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.image.output.display())))?;
     if !a.image.quiet {
         let per_frame = elapsed / a.frames as f64;

@@ -2,7 +2,7 @@
 //! of tiles, shares of the samples: `alhazen_render::film::part`), or saved to a checkpoint and
 //! resumed after an interruption. Every way gives the same bits.
 
-use crate::{Failure, ImageArgs, check_output, check_output_dir, load_sized, open_output, progress_bar};
+use crate::{DisplayArgs, Failure, ImageArgs, check_output, check_output_dir, load_sized, open_output, progress_bar};
 use alhazen_render::film::part::{self, Part, fingerprint, merge, share, share_samples};
 use alhazen_render::film::{Job, SAMPLE_BLOCK, TileResult, tiles};
 use alhazen_render::shape::VectorUnit;
@@ -287,7 +287,7 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         None => output.finish(|f| f.write_all(&part.encode())),
         Some(format) => {
             let image = part.into_image().map_err(|e| Failure::work(e.to_string()))?;
-            output.write_image(&image, format)
+            output.write_image(&image, format, a.image.display.display())
         }
     };
     written.map_err(|e| Failure::work(format!("cannot write {}: {e}", out.display())))?;
@@ -483,6 +483,8 @@ pub(crate) struct MergeArgs {
     /// No summary.
     #[arg(short, long)]
     quiet: bool,
+    #[command(flatten)]
+    display: DisplayArgs,
 }
 
 pub(crate) fn run_merge(a: &MergeArgs) -> Result<(), Failure> {
@@ -497,7 +499,7 @@ pub(crate) fn run_merge(a: &MergeArgs) -> Result<(), Failure> {
         }
     })?;
     output
-        .write_image(&image, format)
+        .write_image(&image, format, a.display.display())
         .map_err(|e| Failure::work(format!("cannot write {}: {e}", a.output.display())))?;
     if !a.quiet {
         eprintln!(

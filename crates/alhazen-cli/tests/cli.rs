@@ -831,3 +831,56 @@ fn work_beyond_the_memory_budget_is_refused_before_allocating() {
         run(&["render", "sub.toml", "-o", "s.png", "--max-memory", "2G", "--width", "32", "--height", "24"]);
     assert_eq!(code, Some(0), "{err}");
 }
+
+/// Colours leave the program in gamut by desaturation: the prism's spectral colours (negative
+/// components in RGB before) have none in the PFM; `--exposure` brightens every format,
+/// `--tonemap` changes the PNG only; bad values are refused before rendering.
+#[test]
+fn exposure_tone_mapping_and_gamut() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let dir = tempfile::tempdir().unwrap();
+    let prism = dir.path().join("prism.pfm");
+    let o = alhazen(&[
+        "render",
+        root.join("prism.toml").to_str().unwrap(),
+        "-o",
+        prism.to_str().unwrap(),
+        "--width",
+        "80",
+        "--height",
+        "60",
+        "--spp",
+        "16",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = alhazen_render::output::read_pfm(&std::fs::read(&prism).unwrap()).unwrap();
+    assert!(img.pixels.iter().flatten().all(|&c| c >= 0.0 && c.is_finite()), "a negative or non-finite component");
+    let scene = scene_file(dir.path(), OK);
+    let mean = |extra: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet"];
+        args.extend_from_slice(extra);
+        let o = alhazen(&args);
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        if name.ends_with(".pfm") {
+            let img = alhazen_render::output::read_pfm(&std::fs::read(&out).unwrap()).unwrap();
+            return img.pixels.iter().flatten().map(|&c| c as f64).sum::<f64>();
+        }
+        image::open(&out).unwrap().to_rgb8().pixels().flat_map(|p| p.0).map(f64::from).sum::<f64>()
+    };
+    let plain = mean(&[], "plain.png");
+    assert!(mean(&["--exposure", "1"], "bright.png") > plain);
+    assert!(mean(&["--exposure", "-2"], "dark.png") < plain);
+    assert_ne!(mean(&["--tonemap", "filmic"], "filmic.png"), plain);
+    assert_ne!(mean(&["--tonemap", "reinhard"], "reinhard.png"), plain);
+    let linear = mean(&[], "plain.pfm");
+    assert!((mean(&["--exposure", "1"], "bright.pfm") - 2.0 * linear).abs() < 1e-6 * linear);
+    assert_eq!(mean(&["--tonemap", "filmic"], "filmic.pfm"), linear);
+    for bad in [&["--exposure", "nan"][..], &["--exposure", "100"], &["--exposure", "x"], &["--tonemap", "aces"]] {
+        let (code, err, exists) = render(OK, bad);
+        assert_eq!(code, 2, "{bad:?}: {err}");
+        assert!(err.contains("exposure") || err.contains("possible values"), "{bad:?}: {err}");
+        assert!(!exists);
+    }
+}

@@ -1,10 +1,14 @@
 //! Image files: PNG (8-bit sRGB through the course's transfer function), OpenEXR (linear, half
-//! or float) and PFM (linear float). Every file is written to a temporary file in the target
+//! or float) and PFM (linear float). On the way out colours are brought into the file's gamut by
+//! desaturation, never clipped ([`alhazen_math::color::desaturate_into_gamut`]): negative
+//! components (spectral colours beyond sRGB) in every format, components above 1 in PNG, after
+//! the [`Display`]'s exposure and tone mapping. Every file is written to a temporary file in the target
 //! directory and renamed into place, so a reader never sees half an image and an existing file
 //! is only replaced by a complete one.
 
 use crate::film::Image;
-use alhazen_math::color::srgb_encode;
+use alhazen_math::Vec3;
+use alhazen_math::color::{Tonemap, desaturate_into_gamut, srgb_encode};
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
@@ -34,9 +38,43 @@ impl Format {
     }
 }
 
-/// Writes `img` to `path` atomically.
+/// How radiance becomes a picture: an exposure in stops (all formats) and a tone mapping (8-bit
+/// formats only; EXR and PFM stay linear radiance).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Display {
+    /// Radiance is scaled by `2^exposure`.
+    pub exposure: f64,
+    /// Tone mapping, for 8-bit formats.
+    pub tonemap: Tonemap,
+}
+
+impl Display {
+    /// Pixel `p` of a linear (EXR, PFM) file: exposed, negatives desaturated away.
+    pub fn linear(&self, p: [f32; 3]) -> [f32; 3] {
+        let c = desaturate_into_gamut(self.exposed(p), None);
+        [c.x as f32, c.y as f32, c.z as f32]
+    }
+
+    /// Pixel `p` on a display, in `[0, 1]`: exposed, tone mapped, desaturated into the gamut.
+    pub fn shown(&self, p: [f32; 3]) -> Vec3 {
+        desaturate_into_gamut(self.tonemap.apply(self.exposed(p)), Some(1.0))
+    }
+
+    fn exposed(&self, p: [f32; 3]) -> Vec3 {
+        let c = Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        if self.exposure == 0.0 { c } else { c * self.exposure.exp2() }
+    }
+
+    /// 8-bit sRGB bytes of `img`, row-major RGB.
+    pub fn srgb8(&self, img: &Image) -> Vec<u8> {
+        let byte = |x: f64| (srgb_encode(x) * 255.0 + 0.5) as u8;
+        img.pixels.iter().flat_map(|&p| self.shown(p).to_array().map(byte)).collect()
+    }
+}
+
+/// Writes `img` to `path` atomically, as the default [`Display`] shows it.
 pub fn write_image(img: &Image, path: &Path, format: Format) -> io::Result<()> {
-    PendingFile::create(path)?.write_image(img, format)
+    PendingFile::create(path)?.write_image(img, format, Display::default())
 }
 
 /// Creates `path` through a temporary file in the same directory, filled by `fill`, synced and
@@ -75,12 +113,15 @@ impl PendingFile {
         Ok(Self { tmp, path: path.to_path_buf() })
     }
 
-    /// Encodes `img` as `format` and renames it into place.
-    pub fn write_image(self, img: &Image, format: Format) -> io::Result<()> {
+    /// Encodes `img` as `format`, as `display` shows it, and renames it into place.
+    pub fn write_image(self, img: &Image, format: Format, display: Display) -> io::Result<()> {
+        if format == Format::Png {
+            return self.finish(|file| encode_png(img, file, &display));
+        }
+        let linear = Image { pixels: img.pixels.iter().map(|&p| display.linear(p)).collect(), ..*img };
         self.finish(|file| match format {
-            Format::Png => encode_png(img, file),
-            Format::ExrHalf | Format::ExrFloat => encode_exr(img, file, format == Format::ExrHalf),
-            Format::Pfm => encode_pfm(img, &mut BufWriter::new(file)),
+            Format::ExrHalf | Format::ExrFloat => encode_exr(&linear, file, format == Format::ExrHalf),
+            _ => encode_pfm(&linear, &mut BufWriter::new(file)),
         })
     }
 
@@ -109,17 +150,18 @@ fn set_readable_permissions(_tmp: &Path, _target: &Path) -> io::Result<()> {
     Ok(())
 }
 
-/// 8-bit sRGB bytes, row-major RGB.
+/// 8-bit sRGB bytes, row-major RGB, as the default [`Display`] shows `img`.
 pub fn to_srgb8(img: &Image) -> Vec<u8> {
-    img.pixels.iter().flat_map(|p| p.map(|c| (srgb_encode(c as f64) * 255.0 + 0.5) as u8)).collect()
+    Display::default().srgb8(img)
 }
 
-fn encode_png(img: &Image, out: &mut std::fs::File) -> io::Result<()> {
+fn encode_png(img: &Image, out: &mut std::fs::File, display: &Display) -> io::Result<()> {
     use image::ImageEncoder;
     use image::codecs::png::{CompressionType, FilterType, PngEncoder};
     // Fast deflate: a render's PNG is written once and read by people, not shipped.
     let enc = PngEncoder::new_with_quality(BufWriter::new(out), CompressionType::Fast, FilterType::Adaptive);
-    enc.write_image(&to_srgb8(img), img.width, img.height, image::ExtendedColorType::Rgb8).map_err(io::Error::other)
+    enc.write_image(&display.srgb8(img), img.width, img.height, image::ExtendedColorType::Rgb8)
+        .map_err(io::Error::other)
 }
 
 fn encode_exr(img: &Image, out: &mut std::fs::File, half: bool) -> io::Result<()> {

@@ -260,7 +260,10 @@ impl Parser<'_> {
         if !n.is_table() {
             return Ok(Texture::Solid(n.rgb()?));
         }
-        let t = n.table(&["checker", "image"])?;
+        let t = n.table(&["hsv", "hsl", "checker", "image"])?;
+        if t.get("hsv").is_some() || t.get("hsl").is_some() {
+            return Ok(Texture::Solid(n.rgb()?));
+        }
         if let Some(c) = t.get("checker") {
             let c = c.table(&["even", "odd", "size"])?;
             return Ok(Texture::Checker {
@@ -273,7 +276,7 @@ impl Parser<'_> {
             let (image, scale) = self.image_texture(&i, false)?;
             return Ok(Texture::Image { image, scale });
         }
-        Err(n.err("`color`: expected a colour, { checker = {...} } or { image = {...} }"))
+        Err(n.err("`color`: expected a colour, { hsv = [h, s, v] }, { hsl = [h, s, l] }, { checker = {...} } or { image = {...} }"))
     }
 
     fn material_ref(&mut self, n: &Node, object_name: &str) -> R<MaterialId> {

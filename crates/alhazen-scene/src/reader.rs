@@ -191,17 +191,38 @@ impl<'a, 'i> Node<'a, 'i> {
         v.try_normalize().ok_or_else(|| self.err(format!("`{}` must be a non-zero vector", self.key)))
     }
 
-    /// A colour: one number (grey) or `[r, g, b]`, each ≥ 0.
+    /// A colour: one number (grey), `[r, g, b]` (each ≥ 0), `{ hsv = [h, s, v] }` or
+    /// `{ hsl = [h, s, l] }` (hue in degrees, the others in `[0, 1]`; the course's colour models).
     pub fn rgb(&self) -> R<Vec3> {
         let c = match self.v {
             DeValue::Integer(_) | DeValue::Float(_) => Vec3::splat(self.f64()?),
             DeValue::Array(_) => self.vec3()?,
-            _ => return Err(self.expected("a colour (a number or [r, g, b])")),
+            DeValue::Table(_) => self.hue_model()?,
+            _ => {
+                return Err(self.expected("a colour (a number, [r, g, b], { hsv = [h, s, v] } or { hsl = [h, s, l] })"));
+            }
         };
         if c.min_element() < 0.0 {
             return Err(self.err(format!("`{}`: colour components must be ≥ 0", self.key)));
         }
         Ok(c)
+    }
+
+    /// `{ hsv = [h, s, v] }` or `{ hsl = [h, s, l] }` as RGB.
+    fn hue_model(&self) -> R<Vec3> {
+        let t = self.table(&["hsv", "hsl"])?;
+        let (n, hsv) = match (t.get("hsv"), t.get("hsl")) {
+            (Some(n), None) => (n, true),
+            (None, Some(n)) => (n, false),
+            _ => return Err(self.err(format!("`{}`: a colour table has one key, `hsv` or `hsl`", self.key))),
+        };
+        let [h, s, x] = n.numbers::<3>()?;
+        if !h.is_finite() || !(0.0..=1.0).contains(&s) || !(0.0..=1.0).contains(&x) {
+            let what =
+                if hsv { "[hue in degrees, saturation, value]" } else { "[hue in degrees, saturation, lightness]" };
+            return Err(n.err(format!("`{}`: expected {what}, saturation and the last within [0, 1]", n.key)));
+        }
+        Ok(if hsv { alhazen_math::color::hsv_to_rgb(h, s, x) } else { alhazen_math::color::hsl_to_rgb(h, s, x) })
     }
 
     pub fn table(&self, keys: &[&str]) -> R<Table<'a, 'i>> {

@@ -195,3 +195,42 @@ fn physically_based_mistakes_are_explained() {
     assert!(bump("{ waves = 0.5 }").contains("missing the required key `height`"));
     assert!(bump("{ height = 0.1, waves = -1 }").contains("waves"));
 }
+
+/// Colours in the course's HSV and HSL models, wherever a colour goes (a material, a checker's
+/// squares, emission); bad ones are refused where they are written.
+#[test]
+fn colours_in_hsv_and_hsl() {
+    let text = r#"
+[materials.a]
+color = { hsv = [120, 1, 0.5] }
+emission = { hsl = [240, 1, 0.25] }
+[materials.b]
+color = { checker = { even = { hsl = [0, 1, 0.5] }, odd = { hsv = [60, 0.5, 1] } } }
+[[object]]
+shape = "sphere"
+radius = 1
+material = "a"
+[[object]]
+shape = "sphere"
+radius = 1
+material = "b"
+"#;
+    let scene = parse_scene("hsv.toml".as_ref(), text).unwrap();
+    let a = &scene.materials[scene.objects[0].material as usize];
+    assert_eq!(a.color, Texture::Solid(Vec3::new(0.0, 0.5, 0.0)));
+    assert_eq!(a.emission, Vec3::new(0.0, 0.0, 0.5));
+    let b = &scene.materials[scene.objects[1].material as usize];
+    let Texture::Checker { even, odd, .. } = b.color else { panic!("a checker") };
+    assert_eq!((even, odd), (Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.5)));
+    for (bad, expected) in [
+        ("{ hsv = [120, 1.5, 0.5] }", "3:9"),
+        ("{ hsl = [120, 1, -0.5] }", "3:9"),
+        ("{ hsv = [120, 1] }", "3:9"),
+        ("{ hsv = [1, 1, 1], hsl = [1, 1, 1] }", "3:9"),
+        ("{ rgb = [1, 1, 1] }", "3:9"),
+    ] {
+        let e = err(&format!("[materials.a]\n# {bad}\ncolor = {bad}\n"));
+        assert!(e.contains("hsv") || e.contains("hsl") || e.contains("saturation"), "{bad}: {e}");
+        assert!(e.contains(expected) || e.contains("3:"), "{bad}: {e}");
+    }
+}
