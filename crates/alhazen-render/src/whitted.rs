@@ -4,7 +4,14 @@
 //! then reflection and refraction rays up to the maximum depth. Transparent surfaces split their
 //! transmission coefficient by a Fresnel factor; light travelling inside an absorbing medium
 //! decays by Beer's law `exp(−σ d)`.
+//!
+//! Scenes with dispersive glass (the lecture's wavelength-dependent index) are traced
+//! spectrally, as the path tracer does: each sample carries radiance at three wavelengths (a
+//! hero and two rotations, [`crate::spectrum`]), every colour upsampled to them; at dispersive
+//! glass the reflected ray keeps all three (Fresnel per wavelength) and the refracted one the
+//! hero alone, bent by its own index (weighted ×3 once, which keeps the estimate unbiased).
 
+use crate::bsdf::ColorMode;
 use crate::camera::Camera;
 use crate::connect::{MirrorPath, MirrorShape, Source};
 use crate::film::PixelEstimator;
@@ -12,9 +19,11 @@ use crate::lights::{Lights, PathLight};
 use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use crate::sampler::Rng;
 use crate::sampler::stratified_offset;
+use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::texture;
 use crate::world::{ShadowHit, World, WorldHit};
 use alhazen_math::{Ray, Vec3};
+use alhazen_scene::bsdf::{BsdfDesc, Ior};
 use alhazen_scene::{FresnelMode, Light, Material, Scene};
 
 /// Rays whose contribution to the pixel would fall below this are not traced (like POV-Ray's
@@ -36,6 +45,27 @@ pub struct Whitted<'a> {
     lights: Lights,
     /// The emitting objects that light others: `(light index in lights, object)`.
     emitters: Vec<(usize, u32)>,
+    /// Per material, its index when it disperses (the scene is then traced spectrally).
+    dispersion: Vec<Option<Ior>>,
+}
+
+/// The channels a ray carries: RGB, or radiance at three wavelengths; `hero_only` once a
+/// refraction at dispersive glass has left only the first.
+#[derive(Clone, Copy, Debug)]
+pub struct Channels {
+    mode: ColorMode,
+    hero_only: bool,
+}
+
+impl Channels {
+    /// Linear RGB.
+    pub const RGB: Self = Self { mode: ColorMode::Rgb, hero_only: false };
+
+    /// A colour in these channels.
+    #[inline]
+    fn c(&self, rgb: Vec3) -> Vec3 {
+        self.mode.color(rgb)
+    }
 }
 
 /// A mirror surface of the scene for specular connections ([`crate::connect`]).
@@ -100,7 +130,14 @@ impl PixelEstimator for WhittedEstimator<'_> {
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
         let (dx, dy) = stratified_offset(self.seed, x, y, index, self.spp);
         let ray = self.camera.ray(x as f64 + dx, y as f64 + dy);
-        self.whitted.trace(&ray, 1, 1.0)
+        if !self.whitted.is_spectral() {
+            return self.whitted.trace(&ray, 1, 1.0);
+        }
+        // The wavelengths stratified over the pixel's samples, jittered per sample.
+        let jitter = Rng::for_sample(self.seed ^ 0x5eed_1a4b_da00, x, y, index).uniform();
+        let lambdas = sample_wavelengths((index as f64 + jitter) / self.spp as f64);
+        let channels = Channels { mode: ColorMode::Spectral(lambdas), hero_only: false };
+        spectrum_to_rgb(self.whitted.trace_in(&ray, 1, 1.0, channels), &lambdas)
     }
 }
 
@@ -128,24 +165,40 @@ impl<'a> Whitted<'a> {
             .filter(|(i, _)| matches!(lights.all()[*i], PathLight::Area { .. }))
             .filter_map(|(i, o)| Some((i, o?)))
             .collect();
-        Self { scene, world, max_depth: scene.render.max_depth.max(1), mirrors, lights, emitters }
+        let dispersion = scene
+            .materials
+            .iter()
+            .map(|m| match &m.bsdf {
+                Some(BsdfDesc::Dielectric { ior, .. }) if ior.is_dispersive() && m.transparency != Vec3::ZERO => {
+                    Some(*ior)
+                }
+                _ => None,
+            })
+            .collect();
+        Self { scene, world, max_depth: scene.render.max_depth.max(1), mirrors, lights, emitters, dispersion }
     }
 
-    /// `RT_trace`: radiance along `ray` (unit direction); `depth` starts at 1 for camera rays,
-    /// `weight` is the ray's share of the pixel.
+    /// Some glass of the scene disperses: samples are traced at sampled wavelengths.
+    pub fn is_spectral(&self) -> bool {
+        self.dispersion.iter().any(Option::is_some)
+    }
+
+    /// `RT_trace`: radiance along `ray` (unit direction) in RGB; `depth` starts at 1 for camera
+    /// rays, `weight` is the ray's share of the pixel.
     pub fn trace(&self, ray: &Ray, depth: u32, weight: f64) -> Vec3 {
+        self.trace_in(ray, depth, weight, Channels::RGB)
+    }
+
+    /// [`Self::trace`] in the channels `ch`.
+    pub fn trace_in(&self, ray: &Ray, depth: u32, weight: f64, ch: Channels) -> Vec3 {
         match self.world.intersect(ray, f64::INFINITY) {
-            Some(hit) => self.shade(&hit, ray, depth, weight),
-            None => self.background(ray.dir),
+            Some(hit) => self.shade(&hit, ray, depth, weight, ch),
+            None => ch.c(self.scene.sky(ray.dir)),
         }
     }
 
-    fn background(&self, dir: Vec3) -> Vec3 {
-        self.scene.sky(dir)
-    }
-
     /// `RT_shade`.
-    fn shade(&self, wh: &WorldHit, ray: &Ray, depth: u32, weight: f64) -> Vec3 {
+    fn shade(&self, wh: &WorldHit, ray: &Ray, depth: u32, weight: f64, ch: Channels) -> Vec3 {
         let m = &self.scene.materials[wh.material as usize];
         let h = &wh.hit;
         let v = -ray.dir;
@@ -155,29 +208,30 @@ impl<'a> Whitted<'a> {
         if n.dot(v) <= 0.0 {
             n = ng;
         }
-        let a = texture::eval(&m.color, h.uv, &self.scene.images) * m.diffuse;
-        let mut color = a * self.scene.ambient + self.direct(m, a, h.p, n, ng, v);
+        let a = ch.c(texture::eval(&m.color, h.uv, &self.scene.images)) * m.diffuse;
+        let mut color = a * ch.c(self.scene.ambient) + self.direct(m, a, (h.p, n, ng, v), ch);
         if !self.emitters.is_empty() {
-            color += self.lit_by_emitters(m, a, h.p, n, ng, v, wh.object);
+            color += self.lit_by_emitters(m, a, (h.p, n, ng, v), wh.object, ch);
         }
         if !self.mirrors.is_empty() {
-            color += self.through_mirrors(m, a, h.p, n, ng, v, wh.object);
+            color += self.through_mirrors(m, a, (h.p, n, ng, v), wh.object, ch);
         }
         if front {
-            color += m.emission;
+            color += ch.c(m.emission);
         }
         if depth < self.max_depth {
-            color += self.secondary(m, h.p, n, ng, v, front, depth, weight);
+            let dispersion = self.dispersion[wh.material as usize].as_ref();
+            color += self.secondary(m, dispersion, (h.p, n, ng, v), front, (depth, weight), ch);
         }
         if !front {
             // The ray travelled h.t inside this object's medium.
-            color *= beer(m.absorption, h.t);
+            color *= beer(ch.c(m.absorption), h.t);
         }
         color
     }
 
     /// The course's local model summed over the lights (ν: light and viewer on one side).
-    fn direct(&self, m: &Material, a: Vec3, p: Vec3, n: Vec3, ng: Vec3, v: Vec3) -> Vec3 {
+    fn direct(&self, m: &Material, a: Vec3, (p, n, ng, v): (Vec3, Vec3, Vec3, Vec3), ch: Channels) -> Vec3 {
         let has_specular = m.specular != Vec3::ZERO;
         let mut sum = Vec3::ZERO;
         for light in &self.scene.lights {
@@ -186,15 +240,15 @@ impl<'a> Whitted<'a> {
             if cos <= 0.0 || ng.dot(l) <= 0.0 {
                 continue;
             }
-            let through = self.transmittance(p + ng * epsilon(p), l, dist);
+            let through = self.transmittance(p + ng * epsilon(p), l, dist, ch);
             if through == Vec3::ZERO {
                 continue;
             }
             let mut local = a * cos;
             if has_specular {
-                local += m.specular * m.highlight(n, l, v);
+                local += ch.c(m.specular) * m.highlight(n, l, v);
             }
-            sum += through * i_dir * local;
+            sum += through * ch.c(i_dir) * local;
         }
         sum
     }
@@ -207,7 +261,14 @@ impl<'a> Whitted<'a> {
     /// stratified points per emitter (spheres by the cone they show), jittered by a generator
     /// seeded with `p`, each tested by a shadow ray.
     #[inline(never)]
-    fn lit_by_emitters(&self, m: &Material, a: Vec3, p: Vec3, n: Vec3, ng: Vec3, v: Vec3, object: u32) -> Vec3 {
+    fn lit_by_emitters(
+        &self,
+        m: &Material,
+        a: Vec3,
+        (p, n, ng, v): (Vec3, Vec3, Vec3, Vec3),
+        object: u32,
+        ch: Channels,
+    ) -> Vec3 {
         let mut rng = Rng::for_point(p);
         let strata = EMITTER_STRATA as f64;
         let mut sum = Vec3::ZERO;
@@ -221,15 +282,15 @@ impl<'a> Whitted<'a> {
                     continue;
                 }
                 let reach = s.dist * (1.0 - 1e-7) - 4.0 * epsilon(p + s.dir * s.dist);
-                let through = self.transmittance(p + ng * epsilon(p), s.dir, reach);
+                let through = self.transmittance(p + ng * epsilon(p), s.dir, reach, ch);
                 if through == Vec3::ZERO {
                     continue;
                 }
                 let mut local = a * cos;
                 if m.specular != Vec3::ZERO {
-                    local += m.specular * m.highlight(n, s.dir, v);
+                    local += ch.c(m.specular) * m.highlight(n, s.dir, v);
                 }
-                sum += through * s.radiance * local / s.pdf;
+                sum += through * ch.c(s.radiance) * local / s.pdf;
             }
         }
         sum / (strata * strata * std::f64::consts::PI)
@@ -241,7 +302,14 @@ impl<'a> Whitted<'a> {
     /// the unfolded length), times the mirror's reflectance and both legs' transmittance.
     /// Out of line: `shade` stays as small as it was for scenes without mirrors.
     #[inline(never)]
-    fn through_mirrors(&self, m: &Material, a: Vec3, p: Vec3, n: Vec3, ng: Vec3, v: Vec3, object: u32) -> Vec3 {
+    fn through_mirrors(
+        &self,
+        m: &Material,
+        a: Vec3,
+        (p, n, ng, v): (Vec3, Vec3, Vec3, Vec3),
+        object: u32,
+        ch: Channels,
+    ) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for light in &self.scene.lights {
             let source = match *light {
@@ -258,15 +326,15 @@ impl<'a> Whitted<'a> {
                         return;
                     }
                     let Some(i) = intensity_through(light, &path) else { return };
-                    let through = self.legs_transmittance(p, ng, &path);
+                    let through = self.legs_transmittance(p, ng, &path, ch);
                     if through == Vec3::ZERO {
                         return;
                     }
                     let mut local = a * cos;
                     if m.specular != Vec3::ZERO {
-                        local += m.specular * m.highlight(n, l, v);
+                        local += ch.c(m.specular) * m.highlight(n, l, v);
                     }
-                    sum += through * mirror.reflectance * i * local;
+                    sum += through * ch.c(mirror.reflectance) * ch.c(i) * local;
                 });
             }
         }
@@ -274,20 +342,20 @@ impl<'a> Whitted<'a> {
     }
 
     /// What passes both legs of a mirror path: `p → m` short of the mirror, `m → light`.
-    fn legs_transmittance(&self, p: Vec3, ng: Vec3, path: &MirrorPath) -> Vec3 {
+    fn legs_transmittance(&self, p: Vec3, ng: Vec3, path: &MirrorPath, ch: Channels) -> Vec3 {
         let m = path.point;
         let to_mirror = path.dist_to_mirror * (1.0 - 1e-7) - 4.0 * epsilon(m);
-        let first = self.transmittance(p + ng * epsilon(p), path.to_mirror, to_mirror);
+        let first = self.transmittance(p + ng * epsilon(p), path.to_mirror, to_mirror, ch);
         if first == Vec3::ZERO {
             return first;
         }
         let to_light = path.dist_to_source * (1.0 - 1e-7) - 4.0 * epsilon(m);
-        first * self.transmittance(m + path.normal * epsilon(m), path.to_source, to_light)
+        first * self.transmittance(m + path.normal * epsilon(m), path.to_source, to_light, ch)
     }
 
     /// How much light passes from `origin` along `l` over `dist`: 0 at an opaque surface; at a
     /// transparent one its transmission times `1 − F`, and Beer's law inside absorbing media.
-    fn transmittance(&self, mut origin: Vec3, l: Vec3, mut dist: f64) -> Vec3 {
+    fn transmittance(&self, mut origin: Vec3, l: Vec3, mut dist: f64, ch: Channels) -> Vec3 {
         let mut through = Vec3::ONE;
         for _ in 0..MAX_SHADOW_SURFACES {
             let materials = &self.scene.materials;
@@ -301,9 +369,9 @@ impl<'a> Whitted<'a> {
             let cos_n = wh.hit.n.dot(l);
             let entering = cos_n < 0.0;
             let eta = if entering { m.ior } else { 1.0 / m.ior };
-            through *= m.transparency * (1.0 - fresnel(m, cos_n, eta));
+            through *= ch.c(m.transparency) * (1.0 - fresnel(m, cos_n, eta));
             if !entering {
-                through *= beer(m.absorption, wh.hit.t);
+                through *= beer(ch.c(m.absorption), wh.hit.t);
             }
             if through.max_element() < 1e-6 {
                 return Vec3::ZERO;
@@ -314,38 +382,50 @@ impl<'a> Whitted<'a> {
         Vec3::ZERO
     }
 
-    /// Reflected and refracted rays.
+    /// Reflected and refracted rays; at dispersive glass (`dispersion`) in spectral channels,
+    /// Fresnel per wavelength and the refracted ray for the hero wavelength alone.
     fn secondary(
         &self,
         m: &Material,
-        p: Vec3,
-        n: Vec3,
-        ng: Vec3,
-        v: Vec3,
+        dispersion: Option<&Ior>,
+        (p, n, ng, v): (Vec3, Vec3, Vec3, Vec3),
         front: bool,
-        depth: u32,
-        weight: f64,
+        (depth, weight): (u32, f64),
+        ch: Channels,
     ) -> Vec3 {
         let mut color = Vec3::ZERO;
-        let mut reflect_w = m.mirror;
+        let mut reflect_w = ch.c(m.mirror);
         if m.transparency != Vec3::ZERO {
+            let transparency = ch.c(m.transparency);
             // eta = η_I/η_T for the lecture's T; the Fresnel formula takes η_T/η_I.
-            let eta = if front { 1.0 / m.ior } else { m.ior };
-            let f = fresnel(m, n.dot(v), 1.0 / eta);
-            reflect_w += m.transparency * f;
-            let trans_w = m.transparency * (1.0 - f);
+            let (eta, f, trans_w, refracted) = match (dispersion, ch.mode) {
+                (Some(ior), ColorMode::Spectral(lambdas)) => {
+                    let etas = lambdas.map(|l| if front { 1.0 / ior.at(l) } else { ior.at(l) });
+                    let f = Vec3::from_array(etas.map(|eta| fresnel(m, n.dot(v), 1.0 / eta)));
+                    // Only the hero goes on; ×3 the first time keeps the estimate unbiased.
+                    let share = if ch.hero_only { 1.0 } else { 3.0 };
+                    let trans_w = Vec3::new(transparency.x * (1.0 - f.x) * share, 0.0, 0.0);
+                    (etas[0], f, trans_w, Channels { hero_only: true, ..ch })
+                }
+                _ => {
+                    let eta = if front { 1.0 / m.ior } else { m.ior };
+                    let f = fresnel(m, n.dot(v), 1.0 / eta);
+                    (eta, Vec3::splat(f), transparency * (1.0 - f), ch)
+                }
+            };
+            reflect_w += transparency * f;
             if let Some(t) = refract(v, n, eta) {
                 let w = weight * trans_w.max_element();
                 if w > MIN_WEIGHT {
                     let origin = p - ng * epsilon(p);
-                    color += trans_w * self.trace(&Ray::new(origin, t.normalize()), depth + 1, w);
+                    color += trans_w * self.trace_in(&Ray::new(origin, t.normalize()), depth + 1, w, refracted);
                 }
             }
         }
         let w = weight * reflect_w.max_element();
         if w > MIN_WEIGHT {
             let r = reflect(v, n).normalize();
-            color += reflect_w * self.trace(&Ray::new(p + ng * epsilon(p), r), depth + 1, w);
+            color += reflect_w * self.trace_in(&Ray::new(p + ng * epsilon(p), r), depth + 1, w, ch);
         }
         color
     }
