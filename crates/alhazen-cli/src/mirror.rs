@@ -15,6 +15,9 @@ pub enum MirrorCommand {
     #[command(after_help = r#"Input, one JSON object per line (from FILE or standard input):
   {"mirror":"sphere","center":[0,0,0],"radius":1,"eye":[0,0,5],"point":[3,0,4]}
   {"mirror":"cylinder","center":[0,0,0],"axis":[0,1,0],"radius":1,"eye":[0,1,6],"point":[2,3,1]}
+  {"mirror":"sphere","center":[0,0,0],"radius":1,"eye_direction":[0,0,1],"point_direction":[1,1,0]}
+"eye_direction" / "point_direction" instead of "eye" / "point" put them at infinity in that
+direction (a parallel projection, the sun: the paper's equation (7)).
 Output, one line per input line:
   {"reflexes":[[x,y,z]],"all":[{"point":[x,y,z],"kind":"outside"},…]}
 "reflexes" holds the visible reflection on the outside (empty in the forbidden region); "all" every
@@ -138,9 +141,27 @@ struct Query {
     mirror: String,
     center: [f64; 3],
     radius: f64,
-    eye: [f64; 3],
-    point: [f64; 3],
+    eye: Option<[f64; 3]>,
+    eye_direction: Option<[f64; 3]>,
+    point: Option<[f64; 3]>,
+    point_direction: Option<[f64; 3]>,
     axis: Option<[f64; 3]>,
+}
+
+/// The site a query names by `at` (a point) or `toward` (a direction to infinity): exactly one.
+fn site(name: &str, at: Option<[f64; 3]>, toward: Option<[f64; 3]>) -> Result<Site, String> {
+    match (at, toward) {
+        (Some(p), None) => Ok(Site::At(Vec3::from_array(p))),
+        (None, Some(d)) => {
+            let d = Vec3::from_array(d);
+            if !(d.is_finite() && d != Vec3::ZERO) {
+                return Err(format!("\"{name}_direction\" must be a non-zero finite vector"));
+            }
+            Ok(Site::Toward(d))
+        }
+        (None, None) => Err(format!("missing \"{name}\" (a point) or \"{name}_direction\" (a point at infinity)")),
+        (Some(_), Some(_)) => Err(format!("give \"{name}\" or \"{name}_direction\", not both")),
+    }
 }
 
 /// The reflexes `q` asks for, solved for the mirror scaled to unit radius at the origin (the
@@ -152,13 +173,21 @@ fn solve(q: &Query) -> Result<(Reflexes, Unscale), String> {
         return Err(format!("\"radius\" must be positive, not {}", q.radius));
     }
     let unscale = Unscale { center, scale: q.radius };
-    let local = |v: [f64; 3]| (Vec3::from_array(v) - center) / q.radius;
-    let (eye, point) = (local(q.eye), local(q.point));
+    // Points into the unit mirror's frame; directions need no change.
+    let local = |s: Site| match s {
+        Site::At(p) => Site::At((p - center) / q.radius),
+        toward => toward,
+    };
+    let eye = local(site("eye", q.eye, q.eye_direction)?);
+    let point = local(site("point", q.point, q.point_direction)?);
     // Beyond 1e100 radii squares overflow: such an eye or point is at infinity for the solver.
-    if !(eye.length() <= 1e100 && point.length() <= 1e100) {
-        return Err("the eye or the point is more than 1e100 radii from the mirror: too far to solve".into());
+    let near = |s: Site| match s {
+        Site::At(p) => p.length() <= 1e100,
+        Site::Toward(_) => true,
+    };
+    if !(near(eye) && near(point)) {
+        return Err("the eye or the point is more than 1e100 radii from the mirror: too far to solve (give a direction instead)".into());
     }
-    let (eye, point) = (Site::At(eye), Site::At(point));
     let result: Result<Reflexes, MirrorError> = match (q.mirror.as_str(), q.axis) {
         ("sphere", None) => Sphere { center: Vec3::ZERO, radius: 1.0 }.reflexes(eye, point),
         ("sphere", Some(_)) => return Err("a sphere takes no \"axis\"".into()),

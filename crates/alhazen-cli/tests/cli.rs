@@ -446,6 +446,49 @@ mod mirror {
         assert!(lines[0]["error"].as_str().unwrap().contains("more than 1e100 radii"), "{lines:?}");
     }
 
+    /// Eyes and points at infinity (the paper's equation (7)): the reflex of a direction seen
+    /// from a direction bisects them, and matches a point far along that direction; a site is
+    /// given once, as a point or as a non-zero direction.
+    #[test]
+    fn eyes_and_points_at_infinity() {
+        let first = |line: &serde_json::Value| -> Vec<f64> {
+            line["reflexes"][0].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+        };
+        let (code, lines) = reflex(concat!(
+            r#"{"mirror":"sphere","center":[1,2,3],"radius":2,"eye_direction":[0,0,1],"point_direction":[1,0,1]}"#,
+            "\n",
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1,"eye_direction":[0,0,1],"point":[3,0,4]}"#,
+            "\n",
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1,"eye":[0,0,1e9],"point":[3,0,4]}"#,
+            "\n",
+            r#"{"mirror":"cylinder","center":[0,0,0],"axis":[0,1,0],"radius":1,"eye_direction":[0,1,3],"point":[2,3,1]}"#,
+            "\n",
+            r#"{"mirror":"cylinder","center":[0,0,0],"axis":[0,1,0],"radius":1,"eye":[0,1e9,3e9],"point":[2,3,1]}"#,
+            "\n",
+        ));
+        assert_eq!(code, 0, "{lines:?}");
+        let p = first(&lines[0]);
+        let bisector = std::f64::consts::FRAC_PI_8;
+        let expected = [1.0 + 2.0 * bisector.sin(), 2.0, 3.0 + 2.0 * bisector.cos()];
+        assert!((0..3).all(|k| (p[k] - expected[k]).abs() < 1e-12), "{p:?}");
+        for (infinite, far) in [(1, 2), (3, 4)] {
+            let (a, b) = (first(&lines[infinite]), first(&lines[far]));
+            assert!((0..3).all(|k| (a[k] - b[k]).abs() < 1e-6), "{a:?} vs {b:?}");
+        }
+        let (code, lines) = reflex(concat!(
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1,"eye":[0,0,5],"eye_direction":[0,0,1],"point":[3,0,4]}"#,
+            "\n",
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1,"point":[3,0,4]}"#,
+            "\n",
+            r#"{"mirror":"sphere","center":[0,0,0],"radius":1,"eye":[0,0,5],"point_direction":[0,0,0]}"#,
+            "\n",
+        ));
+        assert_eq!(code, 2);
+        assert!(lines[0]["error"].as_str().unwrap().contains("not both"), "{lines:?}");
+        assert!(lines[1]["error"].as_str().unwrap().contains("eye_direction"), "{lines:?}");
+        assert!(lines[2]["error"].as_str().unwrap().contains("non-zero"), "{lines:?}");
+    }
+
     #[test]
     fn bad_lines_are_reported_and_skipped() {
         let (code, lines) = reflex(concat!(
