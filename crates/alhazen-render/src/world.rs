@@ -75,7 +75,10 @@ pub struct World {
     unbounded: Vec<u32>,
     /// The packets' kernel for this processor.
     vectors: VectorUnit,
-    /// Everything is flats in one leaf: eight rays are tested at once, ray by lane.
+    /// Everything is in one leaf and nothing is unbounded: its flats are tested against eight
+    /// rays at once, ray by lane (then each ray's spheres and other objects).
+    one_leaf: bool,
+    /// ... and the leaf holds only flats.
     flats_only: bool,
     /// Beside `flats.lanes` in a world of flats only, for flats without smooth normals: each
     /// triangle's normal and material.
@@ -271,10 +274,11 @@ impl World {
         let bvh = Bvh::build_packed(&prim_bounds, |k| matches!(primitives[k], Primitive::Flat { .. }));
         let mut world = Self { objects, unbounded, vectors: unit, ..Self::default() };
         world.fill_leaves(&bvh, &primitives);
-        world.flats_only = world.unbounded.is_empty()
+        world.one_leaf = world.unbounded.is_empty() && world.leaves.len() == 1;
+        world.flats_only = world.one_leaf
             && matches!(world.leaves.as_slice(), [leaf] if leaf.spheres.is_empty() && leaf.objects.is_empty());
         world.bvh = bvh;
-        if world.flats_only {
+        if world.one_leaf {
             world.flat_shading = world.flats.lanes.iter().map(|lanes| lanes.map(|l| world.flat_shading(l))).collect();
         }
         world
@@ -332,9 +336,10 @@ impl World {
     }
 
     /// Eight rays are traced at once faster than one by one ([`Self::intersect_rays`]): the
-    /// world is flats in one leaf and the processor has AVX2 or AVX-512.
+    /// world is one leaf (its flats tested against the eight rays at once) and the processor
+    /// has AVX2 or AVX-512.
     pub fn traces_rays_together(&self) -> bool {
-        self.flats_only && (self.vectors.is_avx512() || self.vectors.is_avx2())
+        self.one_leaf && (self.vectors.is_avx512() || self.vectors.is_avx2())
     }
 
     /// The kernel its packets are tested with.
@@ -360,31 +365,54 @@ impl World {
         }
         // The nearest flat's packet and lane; made a candidate once, after the traversal.
         let mut best_flat: Option<(Lane, LaneHit)> = None;
-        self.bvh.traverse_leaves(ray, t_best, |range, mut t_max| {
+        self.bvh.traverse_leaves(ray, t_best, |range, t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
             let mut closer = None;
+            let mut t_max = t_max;
             if let Some((lane, h)) = self.flats.nearest(leaf.packets.clone(), ray, t_max, self.vectors) {
                 best_flat = Some((lane, h));
                 (t_max, closer) = (h.t, Some(h.t));
             }
-            let spheres = &self.spheres[leaf.spheres.clone()];
-            // Most leaves hold no sphere packet: skip the kernel's call.
-            if !spheres.is_empty()
-                && let Some((k, lane, t)) = SpherePacket::nearest_of(spheres, ray, t_max, self.vectors)
-            {
-                let object = self.sphere_objects[leaf.spheres.start + k][lane];
-                (best, best_flat) = (Some((Candidate { t, aux: 0, bary: [0.0; 2] }, object)), None);
-                (t_max, closer) = (t, Some(t));
-            }
-            for &i in &self.leaf_objects[leaf.objects.clone()] {
-                if let Some(c) = self.objects[i as usize].placed.hit(ray, t_max) {
-                    (best, best_flat) = (Some((c, i)), None);
-                    (t_max, closer) = (c.t, Some(c.t));
-                }
+            if let Some((c, i)) = self.nearest_solid(leaf, ray, t_max) {
+                (best, best_flat) = (Some((c, i)), None);
+                closer = Some(c.t);
             }
             closer
         });
         best_flat.map(|(lane, h)| (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)).or(best)
+    }
+
+    /// The nearest of `leaf`'s spheres and other objects before `t_max` (its flats tested
+    /// already): the candidate and its object.
+    #[inline]
+    fn nearest_solid(&self, leaf: &Leaf, ray: &Ray, mut t_max: f64) -> Option<(Candidate, u32)> {
+        let mut best = None;
+        let spheres = &self.spheres[leaf.spheres.clone()];
+        // Most leaves hold no sphere packet: skip the kernel's call.
+        if !spheres.is_empty()
+            && let Some((k, lane, t)) = SpherePacket::nearest_of(spheres, ray, t_max, self.vectors)
+        {
+            let object = self.sphere_objects[leaf.spheres.start + k][lane];
+            best = Some((Candidate { t, aux: 0, bary: [0.0; 2] }, object));
+            t_max = t;
+        }
+        for &i in &self.leaf_objects[leaf.objects.clone()] {
+            if let Some(c) = self.objects[i as usize].placed.hit(ray, t_max) {
+                best = Some((c, i));
+                t_max = c.t;
+            }
+        }
+        best
+    }
+
+    /// True when one of `leaf`'s spheres or other objects lies on `ray` before `t_max`.
+    #[inline]
+    fn solid_blocks(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> bool {
+        !leaf.spheres.is_empty()
+            && SpherePacket::nearest_of(&self.spheres[leaf.spheres.clone()], ray, t_max, self.vectors).is_some()
+            || self.leaf_objects[leaf.objects.clone()]
+                .iter()
+                .any(|&i| self.objects[i as usize].placed.hit(ray, t_max).is_some())
     }
 
     /// The nearest hit in `(0, t_max)` with its surface and material.
@@ -402,6 +430,8 @@ impl World {
             FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
                 out[r] = Some(self.flat_hit(&rays.ray(r), k, h));
             });
+        } else if self.one_leaf {
+            self.intersect_rays_in_leaf(rays, live, out);
         } else {
             for (r, (slot, live)) in out.iter_mut().zip(live).enumerate() {
                 *slot = if live { self.intersect(&rays.ray(r), f64::INFINITY) } else { None };
@@ -409,11 +439,32 @@ impl World {
         }
     }
 
+    /// [`Self::intersect_rays`] in a one-leaf world: its flats against the eight rays at once,
+    /// then each ray's spheres and other objects, as [`Self::nearest`] tests them.
+    #[inline(never)]
+    fn intersect_rays_in_leaf(&self, rays: &RayPacket, live: [bool; LANES], out: &mut [Option<WorldHit>; LANES]) {
+        let mut flat = [None; LANES];
+        FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
+            flat[r] = Some((k, h));
+        });
+        let leaf = &self.leaves[0];
+        for (r, slot) in out.iter_mut().enumerate() {
+            let ray = rays.ray(r);
+            let t_max = flat[r].map_or(f64::INFINITY, |(_, h)| h.t);
+            let solid = if live[r] { self.nearest_solid(leaf, &ray, t_max) } else { None };
+            *slot = match (solid, flat[r]) {
+                (Some((c, i)), _) => Some(self.surface_of(&ray, c, i)),
+                (None, Some((k, h))) => Some(self.flat_hit(&ray, k, h)),
+                (None, None) => None,
+            };
+        }
+    }
+
     /// The hit of `ray` on lane `h.lane` of packet `k` as [`Self::intersect`] reports it (the
     /// flat is a triangle or parallelogram of a mesh placed in world space). Flats whose
     /// materials look at no texture coordinates and whose normals do not vary skip the
     /// surface's interpolation: their hits carry zero texture coordinates.
-    #[inline]
+    #[inline(always)]
     fn flat_hit(&self, ray: &Ray, k: usize, h: LaneHit) -> WorldHit {
         let lane = self.flats.lanes[k][h.lane];
         if let Some(s) = &self.flat_shading[k][h.lane] {
@@ -428,9 +479,12 @@ impl World {
 
     /// [`Self::unoccluded`] for eight segments, `rays[r]` over `dist[r]` (false where not `live`).
     pub fn unoccluded_rays(&self, rays: &RayPacket, dist: &[f64; LANES], live: [bool; LANES]) -> [bool; LANES] {
-        if self.flats_only {
+        if self.one_leaf {
             let blocked = FlatPacket::any_of_rays(&self.flats.packets, rays, dist, live, self.vectors);
-            return std::array::from_fn(|r| live[r] && !blocked[r]);
+            let leaf = &self.leaves[0];
+            return std::array::from_fn(|r| {
+                live[r] && !blocked[r] && (self.flats_only || !self.solid_blocks(leaf, &rays.ray(r), dist[r]))
+            });
         }
         std::array::from_fn(|r| {
             let ray = rays.ray(r);
@@ -479,12 +533,7 @@ impl World {
         self.bvh.traverse_leaves(&ray, dist, |range, t_max| {
             let leaf = &self.leaves[self.leaf_at[range.start] as usize];
             blocked = FlatPacket::any_of(&self.flats.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
-                || !leaf.spheres.is_empty()
-                    && SpherePacket::nearest_of(&self.spheres[leaf.spheres.clone()], &ray, t_max, self.vectors)
-                        .is_some()
-                || self.leaf_objects[leaf.objects.clone()]
-                    .iter()
-                    .any(|&i| self.objects[i as usize].placed.hit(&ray, t_max).is_some());
+                || self.solid_blocks(leaf, &ray, t_max);
             blocked.then_some(0.0)
         });
         !blocked
@@ -515,6 +564,45 @@ pub fn shading_normal(hit: &SurfaceHit, m: &scene::Material, images: &[Arc<scene
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Rays into one-leaf worlds of flats and solids (a sphere packet; spheres and a cylinder
+    /// tested one by one), eight at a time and one by one: the same hits and the same shadows.
+    #[test]
+    fn eight_rays_meet_a_leaf_of_flats_and_solids_as_one_does() {
+        let rectangle = "[[object]]\nshape = \"rectangle\"\ntransform = [{ scale = 3 }, { rotate_x = -90 }, { translate = [0, -1, 0] }]\n";
+        let sphere = |x: f64| format!("[[object]]\nshape = \"sphere\"\ncenter = [{x}, 0, 0]\nradius = 0.6\n");
+        let packet = format!("{rectangle}{}{}{}", sphere(-1.5), sphere(0.0), sphere(1.5));
+        let cylinder = "[[object]]\nshape = \"cylinder\"\nradius = 0.3\nbase = [0, -1, 0]\ntop = [0, 0.8, 0]\n";
+        let singles = format!("{rectangle}{}{}{cylinder}", sphere(-1.5), sphere(1.5));
+        for (text, packets) in [(packet, 1), (singles, 0)] {
+            let world = World::build(&scene::parse_scene("leaf.toml".as_ref(), &text).unwrap());
+            assert!(world.one_leaf && !world.flats_only, "one leaf of flats and solids");
+            assert_eq!(world.spheres.len(), packets);
+            let mut n = 0;
+            for k in 0..64 {
+                let mut rays = RayPacket::default();
+                for i in 0..LANES {
+                    let a = (k * LANES + i) as f64 * 0.41;
+                    let origin = Vec3::new(4.0 * a.cos(), 2.0 + (1.3 * a).sin(), 4.0 * a.sin());
+                    let target = Vec3::new(1.8 * (2.1 * a).sin(), -0.8 + 0.5 * a.cos(), 0.5 * (0.7 * a).cos());
+                    rays.set(i, &Ray::new(origin, (target - origin).normalize()));
+                }
+                let live: [bool; LANES] = std::array::from_fn(|i| (k + i) % 7 != 3);
+                let mut hits = [None; LANES];
+                world.intersect_rays(&rays, live, &mut hits);
+                let dist: [f64; LANES] = std::array::from_fn(|i| 2.0 + i as f64);
+                let clear = world.unoccluded_rays(&rays, &dist, live);
+                for i in 0..LANES {
+                    let ray = rays.ray(i);
+                    let alone = world.intersect(&ray, f64::INFINITY).filter(|_| live[i]);
+                    assert_eq!(hits[i].map(HitPoint::from), alone.map(HitPoint::from));
+                    assert_eq!(clear[i], live[i] && world.unoccluded(ray.origin, ray.dir, dist[i]));
+                    n += usize::from(alone.is_some_and(|h| h.object > 0));
+                }
+            }
+            assert!(n > 100, "{n} rays meet solids");
+        }
+    }
 
     /// Rays into a one-leaf world of flats with smooth normals and a checker texture (a
     /// subdivided cube) and flat ones (a box): eight at a time, each hit is what the ray finds
