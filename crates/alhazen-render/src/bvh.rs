@@ -1,8 +1,8 @@
 //! A bounding volume hierarchy built with the surface area heuristic (binned SAH, 12 bins),
 //! flattened depth-first so that a node's first child follows it. Used twice: over the objects
 //! of a scene and over the triangles of each mesh. The world's tree charges one test per
-//! started group of four packed primitives ([`Bvh::build_packed`]), so a room of walls and
-//! boxes becomes one leaf of packets rather than a tree of overlapping boxes.
+//! started group of four packed primitives ([`Bvh::build_packed`]: flats and spheres), so a room
+//! of walls, boxes and balls becomes one leaf of packets rather than a tree of overlapping boxes.
 
 use alhazen_math::{Bounds3, Ray, Vec3};
 
