@@ -4,7 +4,8 @@
 //! BVH's leaves test four or eight at a time ([`FlatPacket`]); a leaf's untransformed spheres,
 //! three or more, are one [`SpherePacket`]; other objects are tested one by one. Eight rays
 //! can be traced in one call ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path
-//! tracer's lanes); when the world is flats in one leaf, each flat is tested against the eight.
+//! tracer's lanes); when the world is one leaf, each flat is tested against the eight at once,
+//! then each ray's spheres and other objects.
 
 use crate::bvh::Bvh;
 use crate::shape::{
@@ -80,7 +81,7 @@ pub struct World {
     one_leaf: bool,
     /// ... and the leaf holds only flats.
     flats_only: bool,
-    /// Beside `flats.lanes` in a world of flats only, for flats without smooth normals: each
+    /// Beside `flats.lanes` in a one-leaf world, for flats without smooth normals: each
     /// triangle's normal and material.
     flat_shading: Vec<[Option<FlatShading>; LANES]>,
 }
