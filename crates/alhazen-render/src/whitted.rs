@@ -110,6 +110,40 @@ fn intensity_through(light: &Light, path: &MirrorPath) -> Option<Vec3> {
     }
 }
 
+/// A point being shaded: its material, diffuse colour `a`, position, shading and geometric
+/// normals on the viewer's side, direction to the viewer, and the channels of its ray.
+struct Shading<'m> {
+    m: &'m Material,
+    a: Vec3,
+    p: Vec3,
+    n: Vec3,
+    ng: Vec3,
+    v: Vec3,
+    ch: Channels,
+}
+
+impl Shading<'_> {
+    /// The cosine of light arriving from `l`, if it arrives on the viewer's side of both normals.
+    fn facing(&self, l: Vec3) -> Option<f64> {
+        let cos = self.n.dot(l);
+        (cos > 0.0 && self.ng.dot(l) > 0.0).then_some(cos)
+    }
+
+    /// The course's local model for light from `l` at cosine `cos`: `a cos + s·highlight`.
+    fn local(&self, l: Vec3, cos: f64) -> Vec3 {
+        let mut local = self.a * cos;
+        if self.m.specular != Vec3::ZERO {
+            local += self.ch.c(self.m.specular) * self.m.highlight(self.n, l, self.v);
+        }
+        local
+    }
+
+    /// Where shadow rays leave from.
+    fn origin(&self) -> Vec3 {
+        self.p + self.ng * epsilon(self.p)
+    }
+}
+
 fn beer(sigma: Vec3, d: f64) -> Vec3 {
     if sigma == Vec3::ZERO { Vec3::ONE } else { (-sigma * d).exp() }
 }
@@ -209,12 +243,13 @@ impl<'a> Whitted<'a> {
             n = ng;
         }
         let a = ch.c(texture::eval(&m.color, h.uv, &self.scene.images)) * m.diffuse;
-        let mut color = a * ch.c(self.scene.ambient) + self.direct(m, a, (h.p, n, ng, v), ch);
+        let at = Shading { m, a, p: h.p, n, ng, v, ch };
+        let mut color = a * ch.c(self.scene.ambient) + self.direct(&at);
         if !self.emitters.is_empty() {
-            color += self.lit_by_emitters(m, a, (h.p, n, ng, v), wh.object, ch);
+            color += self.lit_by_emitters(&at, wh.object);
         }
         if !self.mirrors.is_empty() {
-            color += self.through_mirrors(m, a, (h.p, n, ng, v), wh.object, ch);
+            color += self.through_mirrors(&at, wh.object);
         }
         if front {
             color += ch.c(m.emission);
@@ -231,24 +266,16 @@ impl<'a> Whitted<'a> {
     }
 
     /// The course's local model summed over the lights (ν: light and viewer on one side).
-    fn direct(&self, m: &Material, a: Vec3, (p, n, ng, v): (Vec3, Vec3, Vec3, Vec3), ch: Channels) -> Vec3 {
-        let has_specular = m.specular != Vec3::ZERO;
+    fn direct(&self, at: &Shading) -> Vec3 {
         let mut sum = Vec3::ZERO;
         for light in &self.scene.lights {
-            let Some((l, dist, i_dir)) = light.arriving(p) else { continue };
-            let cos = n.dot(l);
-            if cos <= 0.0 || ng.dot(l) <= 0.0 {
-                continue;
-            }
-            let through = self.transmittance(p + ng * epsilon(p), l, dist, ch);
+            let Some((l, dist, i_dir)) = light.arriving(at.p) else { continue };
+            let Some(cos) = at.facing(l) else { continue };
+            let through = self.transmittance(at.origin(), l, dist, at.ch);
             if through == Vec3::ZERO {
                 continue;
             }
-            let mut local = a * cos;
-            if has_specular {
-                local += ch.c(m.specular) * m.highlight(n, l, v);
-            }
-            sum += through * ch.c(i_dir) * local;
+            sum += through * at.ch.c(i_dir) * at.local(l, cos);
         }
         sum
     }
@@ -261,14 +288,8 @@ impl<'a> Whitted<'a> {
     /// stratified points per emitter (spheres by the cone they show), jittered by a generator
     /// seeded with `p`, each tested by a shadow ray.
     #[inline(never)]
-    fn lit_by_emitters(
-        &self,
-        m: &Material,
-        a: Vec3,
-        (p, n, ng, v): (Vec3, Vec3, Vec3, Vec3),
-        object: u32,
-        ch: Channels,
-    ) -> Vec3 {
+    fn lit_by_emitters(&self, at: &Shading, object: u32) -> Vec3 {
+        let p = at.p;
         let mut rng = Rng::for_point(p);
         let strata = EMITTER_STRATA as f64;
         let mut sum = Vec3::ZERO;
@@ -277,20 +298,16 @@ impl<'a> Whitted<'a> {
                 let (i, j) = ((k % EMITTER_STRATA) as f64, (k / EMITTER_STRATA) as f64);
                 let u = alhazen_math::Vec2::new((i + rng.uniform()) / strata, (j + rng.uniform()) / strata);
                 let Some(s) = self.lights.sample_light(light, p, u) else { continue };
-                let cos = n.dot(s.dir);
-                if cos <= 0.0 || ng.dot(s.dir) <= 0.0 || s.pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                let Some(cos) = at.facing(s.dir) else { continue };
+                if s.pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                     continue;
                 }
                 let reach = s.dist * (1.0 - 1e-7) - 4.0 * epsilon(p + s.dir * s.dist);
-                let through = self.transmittance(p + ng * epsilon(p), s.dir, reach, ch);
+                let through = self.transmittance(at.origin(), s.dir, reach, at.ch);
                 if through == Vec3::ZERO {
                     continue;
                 }
-                let mut local = a * cos;
-                if m.specular != Vec3::ZERO {
-                    local += ch.c(m.specular) * m.highlight(n, s.dir, v);
-                }
-                sum += through * ch.c(s.radiance) * local / s.pdf;
+                sum += through * at.ch.c(s.radiance) * at.local(s.dir, cos) / s.pdf;
             }
         }
         sum / (strata * strata * std::f64::consts::PI)
@@ -302,14 +319,8 @@ impl<'a> Whitted<'a> {
     /// the unfolded length), times the mirror's reflectance and both legs' transmittance.
     /// Out of line: `shade` stays as small as it was for scenes without mirrors.
     #[inline(never)]
-    fn through_mirrors(
-        &self,
-        m: &Material,
-        a: Vec3,
-        (p, n, ng, v): (Vec3, Vec3, Vec3, Vec3),
-        object: u32,
-        ch: Channels,
-    ) -> Vec3 {
+    fn through_mirrors(&self, at: &Shading, object: u32) -> Vec3 {
+        let (p, ng, ch) = (at.p, at.ng, at.ch);
         let mut sum = Vec3::ZERO;
         for light in &self.scene.lights {
             let source = match *light {
@@ -321,20 +332,13 @@ impl<'a> Whitted<'a> {
             for mirror in self.mirrors.iter().filter(facing) {
                 mirror.shape.reflections(p, source, |path| {
                     let l = path.to_mirror;
-                    let cos = n.dot(l);
-                    if cos <= 0.0 || ng.dot(l) <= 0.0 {
-                        return;
-                    }
+                    let Some(cos) = at.facing(l) else { return };
                     let Some(i) = intensity_through(light, &path) else { return };
                     let through = self.legs_transmittance(p, ng, &path, ch);
                     if through == Vec3::ZERO {
                         return;
                     }
-                    let mut local = a * cos;
-                    if m.specular != Vec3::ZERO {
-                        local += ch.c(m.specular) * m.highlight(n, l, v);
-                    }
-                    sum += through * ch.c(mirror.reflectance) * ch.c(i) * local;
+                    sum += through * ch.c(mirror.reflectance) * ch.c(i) * at.local(l, cos);
                 });
             }
         }
