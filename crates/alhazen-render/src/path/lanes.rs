@@ -4,8 +4,9 @@
 //! split a path tracer into stages over many paths).
 //!
 //! One bounce is a round of stages over the eight lanes: the rays' nearest hits in one call
-//! ([`crate::World::intersect_rays`]: in a world of flats, each flat against the eight rays at
-//! once, in AVX-512 or AVX2); per path, the vertex; the shadow rays in one call
+//! ([`crate::World::intersect_rays`]: in a world of one leaf, each flat against the eight rays
+//! at once, in AVX-512 or AVX2, then each ray's spheres and other objects; elsewhere ray by ray,
+//! inside the per-path stage); per path, the vertex; the shadow rays in one call
 //! ([`crate::World::unoccluded_rays`]), after which each path gathers its light and steps on. A
 //! lane whose path ends starts the next sample of the pixels it was given, so lanes stay busy
 //! until their samples run out.
@@ -624,7 +625,7 @@ material = "glow"
 
     /// The lanes trace the same bits as the per-path tracer, on every kind of scene: the
     /// Cornell box (flats in one leaf: rays tested eight at once), with two lights, its rough
-    /// version (gold and glass), the prism (spectral), textures, bump maps, mirrors with
+    /// version (gold and glass spheres in the same leaf), the prism (spectral), textures, bump maps, mirrors with
     /// specular connections and every light type (`MIXED`); every depth from 0, sample counts
     /// that leave lanes idle; with every vector unit this processor has.
     #[test]
