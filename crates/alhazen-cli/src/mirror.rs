@@ -60,7 +60,11 @@ pub struct CausticArgs {
     /// Number of reflected rays drawn.
     #[arg(long, default_value_t = 48, value_parser = clap::value_parser!(u32).range(0..=100000))]
     rays: u32,
-    /// Output SVG file.
+    /// Write the sphere's caustic surface instead (the curve turned about the axis through the
+    /// eye and the centre, the x axis; the paper's Fig. 10) as a .ply mesh.
+    #[arg(long)]
+    surface: bool,
+    /// Output file: .svg (the figure), or .ply with --surface.
     #[arg(short, long)]
     output: PathBuf,
 }
@@ -99,7 +103,11 @@ pub fn run(cmd: &MirrorCommand) -> Result<(), Failure> {
     match cmd {
         MirrorCommand::Reflex { input } => run_reflex(input.as_deref()),
         MirrorCommand::Caustic(a) => {
-            check_svg(&a.output)?;
+            if a.surface {
+                check_extension(&a.output, "ply", "--surface writes a .ply mesh")?;
+            } else {
+                check_svg(&a.output)?;
+            }
             let radius_ok = a.radius > 0.0 && a.radius.is_finite();
             if !radius_ok || a.eye_distance.is_nan() || a.eye_distance <= 0.0 {
                 return Err(Failure::input("--radius must be positive and finite, --eye-distance positive (or inf)"));
@@ -110,6 +118,9 @@ pub fn run(cmd: &MirrorCommand) -> Result<(), Failure> {
                 ));
             }
             let side = if a.inside { Side::Inside } else { Side::Outside };
+            if a.surface {
+                return write_caustic_surface(a.radius, a.eye_distance, side, &a.output);
+            }
             write_text(&a.output, &figures::caustic_svg(a.radius, a.eye_distance, side, a.rays as usize))
         }
         MirrorCommand::Conics(a) => {
@@ -119,6 +130,28 @@ pub fn run(cmd: &MirrorCommand) -> Result<(), Failure> {
         }
         MirrorCommand::Anamorph(a) => crate::anamorph::run(a),
     }
+}
+
+/// The caustic surface of a sphere of radius `r` at the origin, the eye at `e` on the x axis
+/// (`inf`: parallel rays along it), as a PLY mesh; cut 4 radii (or twice the eye's distance)
+/// from the centre where it runs off to infinity.
+fn write_caustic_surface(r: f64, e: f64, side: Side, path: &Path) -> Result<(), Failure> {
+    use alhazen_mirror::caustic::{Eye, sphere_surface};
+    let eye = if e.is_finite() { Eye::At(e) } else { Eye::AtInfinity };
+    let clip = if e.is_finite() { (2.0 * e).max(4.0 * r) } else { 4.0 * r };
+    let mesh = sphere_surface(Vec3::ZERO, Vec3::X, r, eye, side, 720, 96, clip);
+    if mesh.triangles.is_empty() {
+        return Err(Failure::input("this eye sees no caustic on that side of the sphere"));
+    }
+    let bytes = alhazen_scene::write::ply_bytes(&mesh);
+    alhazen_render::output::write_atomically(path, |f| f.write_all(&bytes))
+        .map_err(|e| Failure::work(format!("cannot write {}: {e}", path.display())))
+}
+
+/// Refuses an output whose extension is not `ext`, saying `why`, before any work.
+fn check_extension(path: &Path, ext: &str, why: &str) -> Result<(), Failure> {
+    let ok = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if ok { Ok(()) } else { Err(Failure::input(format!("{}: {why}", path.display()))) }
 }
 
 /// Refuses an output that is not an `.svg` file (the figures are SVG text), before any work.

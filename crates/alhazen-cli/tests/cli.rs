@@ -516,6 +516,28 @@ not json
         assert!(!lines[2]["all"].as_array().unwrap().is_empty());
     }
 
+    /// `--surface` writes the sphere's caustic surface as a mesh: for parallel light inside the
+    /// sphere the nephroid turned about the axis, whose cusp lies on the axis at r/2 from the
+    /// centre (the paraxial focus); it refuses an output that is not .ply.
+    #[test]
+    fn caustic_surfaces_are_meshes() {
+        let dir = tempfile::tempdir().unwrap();
+        let ply = dir.path().join("nephroid.ply");
+        let args = ["mirror", "caustic", "--radius", "2", "--eye-distance", "inf", "--inside", "--surface", "-o"];
+        let o = alhazen(&[&args[..], &[ply.to_str().unwrap()]].concat());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let mesh = alhazen_scene::import::load_mesh(&ply).unwrap().mesh;
+        assert!(mesh.triangle_count() > 10_000);
+        let near_axis: Vec<f64> = mesh.positions.iter().filter(|p| p.y.hypot(p.z) < 1e-3).map(|p| p.x.abs()).collect();
+        assert!(!near_axis.is_empty() && near_axis.iter().all(|x| (x - 1.0).abs() < 1e-2), "{near_axis:?}");
+        assert!(mesh.positions.iter().all(|p| p.is_finite() && p.length() <= 2.0 + 1e-9));
+        let svg = dir.path().join("nephroid.svg");
+        let o = alhazen(&[&args[..], &[svg.to_str().unwrap()]].concat());
+        assert_eq!(o.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&o.stderr).contains(".ply"));
+        assert!(!svg.exists());
+    }
+
     #[test]
     fn figures_are_written() {
         let dir = tempfile::tempdir().unwrap();
