@@ -25,6 +25,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 import cornell  # noqa: E402
+import suite  # noqa: E402
 
 REF = os.path.join(ROOT, "crates/alhazen-render/tests/data/mitsuba/cornell-box.exr")
 
@@ -53,25 +54,9 @@ def time_alhazen(spp, out, runs):
 
 
 def mitsuba_renderer(variant, spp, out):
-    """A function timing one Mitsuba render of a scene loaded and warmed up (JIT) beforehand;
-    it writes the last image to `out`."""
-    mi.set_variant(variant)
-    import drjit as dr
-    scene = mi.load_dict(cornell.scene_dict("cornell", spp))
-    dr.eval(mi.render(scene, spp=spp))  # warm-up (JIT)
-    count = [0]
-
-    def run():
-        mi.set_variant(variant)
-        count[0] += 1
-        t0 = time.perf_counter()
-        img = mi.render(scene, spp=spp, seed=count[0])
-        dr.eval(img)
-        np.array(img)  # make sure the image is computed and on the host
-        elapsed = time.perf_counter() - t0
-        mi.Bitmap(img).write(out)
-        return elapsed
-    return run
+    """A function timing one Mitsuba render of the Cornell box (the suite's timer)."""
+    mi.set_variant(variant)  # the scene dict is built with the variant's types
+    return suite.mitsuba_renderer(variant, cornell.scene_dict("cornell", spp), spp, out)
 
 
 def time_mitsuba(variant, spp, out, runs):

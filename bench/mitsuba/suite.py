@@ -58,11 +58,12 @@ def alhazen_run(path, spp, out):
     return time.perf_counter() - t0
 
 
-def mitsuba_renderer(variant, path, spp, out):
-    """Times one Mitsuba render of the scene, loaded and warmed up beforehand; writes `out`."""
+def mitsuba_renderer(variant, scene, spp, out):
+    """A function timing one Mitsuba render of `scene` (an XML file's path or a scene dict),
+    loaded and warmed up (JIT) beforehand; it writes the last image to `out`."""
     mi.set_variant(variant)
     import drjit as dr
-    scene = mi.load_file(path, spp=spp)
+    scene = mi.load_dict(scene) if isinstance(scene, dict) else mi.load_file(scene, spp=spp)
     dr.eval(mi.render(scene, spp=spp))
     count = [0]
 

@@ -115,13 +115,11 @@ impl PendingFile {
 
     /// Encodes `img` as `format`, as `display` shows it, and renames it into place.
     pub fn write_image(self, img: &Image, format: Format, display: Display) -> io::Result<()> {
-        if format == Format::Png {
-            return self.finish(|file| encode_png(img, file, &display));
-        }
-        let linear = Image { pixels: img.pixels.iter().map(|&p| display.linear(p)).collect(), ..*img };
+        // Pixels are mapped as they are encoded: no second copy of a large image.
         self.finish(|file| match format {
-            Format::ExrHalf | Format::ExrFloat => encode_exr(&linear, file, format == Format::ExrHalf),
-            _ => encode_pfm(&linear, &mut BufWriter::new(file)),
+            Format::Png => encode_png(img, file, &display),
+            Format::ExrHalf | Format::ExrFloat => encode_exr(img, file, format == Format::ExrHalf, &display),
+            Format::Pfm => encode_pfm(img, &mut BufWriter::new(file), &display),
         })
     }
 
@@ -164,10 +162,10 @@ fn encode_png(img: &Image, out: &mut std::fs::File, display: &Display) -> io::Re
         .map_err(io::Error::other)
 }
 
-fn encode_exr(img: &Image, out: &mut std::fs::File, half: bool) -> io::Result<()> {
+fn encode_exr(img: &Image, out: &mut std::fs::File, half: bool, display: &Display) -> io::Result<()> {
     use exr::prelude::*;
     let (w, h) = (img.width as usize, img.height as usize);
-    let px = |x: usize, y: usize| img.pixels[y * w + x];
+    let px = |x: usize, y: usize| display.linear(img.pixels[y * w + x]);
     let result = if half {
         let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
             let c = px(p.x(), p.y());
@@ -185,12 +183,12 @@ fn encode_exr(img: &Image, out: &mut std::fs::File, half: bool) -> io::Result<()
 }
 
 /// PFM: `PF`, size, a negative scale for little-endian, then rows bottom to top.
-fn encode_pfm(img: &Image, out: &mut impl Write) -> io::Result<()> {
+fn encode_pfm(img: &Image, out: &mut impl Write, display: &Display) -> io::Result<()> {
     write!(out, "PF\n{} {}\n-1.0\n", img.width, img.height)?;
     for y in (0..img.height as usize).rev() {
         let row = &img.pixels[y * img.width as usize..(y + 1) * img.width as usize];
-        for p in row {
-            for c in p {
+        for &p in row {
+            for c in display.linear(p) {
                 out.write_all(&c.to_le_bytes())?;
             }
         }
