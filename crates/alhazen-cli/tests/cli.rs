@@ -942,7 +942,13 @@ fn exposure_tone_mapping_and_gamut() {
     let linear = mean(&[], "plain.pfm");
     assert!((mean(&["--exposure", "1"], "bright.pfm") - 2.0 * linear).abs() < 1e-6 * linear);
     assert_eq!(mean(&["--tonemap", "filmic"], "filmic.pfm"), linear);
-    for bad in [&["--exposure", "nan"][..], &["--exposure", "100"], &["--exposure", "x"], &["--tonemap", "aces"]] {
+    for bad in [
+        &["--exposure", "nan"][..],
+        &["--exposure", "inf"],
+        &["--exposure", "100"],
+        &["--exposure", "x"],
+        &["--tonemap", "aces"],
+    ] {
         let (code, err, exists) = render(OK, bad);
         assert_eq!(code, 2, "{bad:?}: {err}");
         assert!(err.contains("exposure") || err.contains("possible values"), "{bad:?}: {err}");
