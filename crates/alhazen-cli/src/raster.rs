@@ -81,6 +81,11 @@ pub(crate) struct RasterArgs {
     /// Render this many frames and report frames per second (the last one is written).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10000))]
     frames: u32,
+    /// Show a radiosity solution written by `alhazen render --integrator radiosity --export
+    /// FILE.ply` (of this scene) instead of lighting the scene: its elements, Gouraud-shaded
+    /// by their vertex-averaged light, textures per pixel. No solving again.
+    #[arg(long, value_name = "FILE.ply")]
+    radiosity: Option<std::path::PathBuf>,
 }
 
 /// `a,b,c,d` with a non-zero normal `(a, b, c)`.
@@ -128,7 +133,10 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         .build()
         .map_err(|e| Failure::work(e.to_string()))?;
     let start = Instant::now();
-    let prepared = pool.install(|| prepare(&scene, &opts));
+    let prepared = match &a.radiosity {
+        Some(path) => pool.install(|| crate::radiosity::prepare_solution(path, &scene))?,
+        None => pool.install(|| prepare(&scene, &opts)),
+    };
     let tessellation = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let mut last = None;
@@ -151,11 +159,12 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
             image.width,
             image.height,
             stats.triangles,
-            match (opts.shadows, opts.visibility) {
-                (true, Visibility::Bsp) => ", shadow maps and BSP tree built",
-                (true, Visibility::ZBuffer) => " and shadow maps rendered",
-                (false, Visibility::Bsp) => " and BSP tree built",
-                (false, Visibility::ZBuffer) => "",
+            match (opts.shadows, opts.visibility, &a.radiosity) {
+                (_, _, Some(_)) => " from the radiosity solution",
+                (true, Visibility::Bsp, None) => ", shadow maps and BSP tree built",
+                (true, Visibility::ZBuffer, None) => " and shadow maps rendered",
+                (false, Visibility::Bsp, None) => " and BSP tree built",
+                (false, Visibility::ZBuffer, None) => "",
             },
             tessellation,
             stats.culled,

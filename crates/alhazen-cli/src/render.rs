@@ -68,6 +68,8 @@ pub(crate) struct RenderArgs {
     /// and the image has the bits of an uninterrupted render.
     #[arg(long, requires = "checkpoint")]
     resume: bool,
+    #[command(flatten)]
+    radiosity: crate::radiosity::RadiosityArgs,
 }
 
 /// `--kernel`.
@@ -88,6 +90,9 @@ enum IntegratorArg {
     Whitted,
     /// Path tracing with next-event estimation and MIS.
     Path,
+    /// The course's radiosity (diffuse interreflection, solved once), then an image by ray
+    /// casting the solution (mirrors and glass followed).
+    Radiosity,
 }
 
 /// `--sampler`.
@@ -108,6 +113,8 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
         r.integrator = match i {
             IntegratorArg::Whitted => alhazen_scene::IntegratorKind::Whitted,
             IntegratorArg::Path => alhazen_scene::IntegratorKind::Path,
+            // The scene keeps its own; the solution's image is made by the CLI.
+            IntegratorArg::Radiosity => r.integrator,
         };
     }
     if a.no_mirror_connections {
@@ -246,10 +253,18 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
     let output = open_output(out)?;
     let mut scene = load_sized(&a.image)?;
     apply_overrides(&mut scene, a);
-    if scene.render.integrator == alhazen_scene::IntegratorKind::Whitted {
+    let radiosity = matches!(a.integrator, Some(IntegratorArg::Radiosity));
+    a.radiosity.check(radiosity)?;
+    if scene.render.integrator == alhazen_scene::IntegratorKind::Whitted && !radiosity {
         warn_unsampled_emitters(&scene);
     }
-    let plan = Plan::new(&scene, a)?;
+    let mut plan = Plan::new(&scene, a)?;
+    if radiosity && plan.fingerprint != 0 {
+        // Parts of renders with other radiosity settings must not merge.
+        let settings = format!("radiosity {:?}", a.radiosity.settings());
+        plan.fingerprint ^=
+            settings.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+    }
     let what = format!("rendering this {}×{} film", plan.width, plan.height);
     crate::check_memory(alhazen_render::memory_estimate(&scene), &what)?;
     let resumed = match &a.checkpoint {
@@ -268,7 +283,11 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         .map_err(|e| Failure::work(format!("cannot catch interrupts for the checkpoint: {e}")))?;
     }
     let start = Instant::now();
-    let (part, stopped) = pool.install(|| render_plan(&scene, unit, &plan, resumed, a));
+    let solution = match radiosity {
+        true => Some(pool.install(|| crate::radiosity::solve(&scene, &a.radiosity, a.image.quiet))?),
+        false => None,
+    };
+    let (part, stopped) = pool.install(|| render_plan(&scene, unit, &plan, resumed, a, solution.as_ref()));
     let elapsed = start.elapsed();
     let total = plan.band.len();
     if stopped {
@@ -295,7 +314,7 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         let _ = std::fs::remove_file(c); // its work is in the output now
     }
     if !a.image.quiet {
-        summary(&scene, a, &plan, elapsed, pool.current_num_threads());
+        summary(&scene, a, &plan, elapsed, pool.current_num_threads(), solution.as_ref());
     }
     Ok(())
 }
@@ -346,7 +365,14 @@ fn save_checkpoint(path: &Path, part: &Part) -> Result<(), Failure> {
 
 /// Renders the plan's tiles that `resumed` lacks; returns them all, and whether an interrupt
 /// stopped the render.
-fn render_plan(scene: &Scene, unit: VectorUnit, plan: &Plan, resumed: Part, a: &RenderArgs) -> (Part, bool) {
+fn render_plan(
+    scene: &Scene,
+    unit: VectorUnit,
+    plan: &Plan,
+    resumed: Part,
+    a: &RenderArgs,
+    solution: Option<&alhazen_radiosity::Solution>,
+) -> (Part, bool) {
     let done: Vec<bool> = {
         let mut d = vec![false; plan.band.end];
         resumed.tiles.iter().for_each(|(_, t)| d[t.index] = true);
@@ -370,7 +396,7 @@ fn render_plan(scene: &Scene, unit: VectorUnit, plan: &Plan, resumed: Part, a: &
         clamped: 0,
     });
     let every = Duration::from_secs_f64(a.checkpoint_every);
-    render_tiles(scene, unit, &job, &|t| {
+    render_tiles(scene, unit, solution, &job, &|t| {
         let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
         s.unusable += t.unusable_samples;
         s.clamped += t.clamped_pixels;
@@ -404,8 +430,21 @@ fn render_plan(scene: &Scene, unit: VectorUnit, plan: &Plan, resumed: Part, a: &
     (part, stopped)
 }
 
-fn render_tiles(scene: &Scene, unit: VectorUnit, job: &Job, done: &(dyn Fn(TileResult) + Sync)) {
-    alhazen_render::render_tiles_with(scene, unit, job, &STOP, done)
+/// The job's tiles by the scene's integrator, or from a radiosity solution.
+fn render_tiles(
+    scene: &Scene,
+    unit: VectorUnit,
+    solution: Option<&alhazen_radiosity::Solution>,
+    job: &Job,
+    done: &(dyn Fn(TileResult) + Sync),
+) {
+    match solution {
+        Some(s) => {
+            let (w, h) = alhazen_render::film_size(scene);
+            alhazen_render::film::render_tiles(w, h, &alhazen_radiosity::FinalGather::new(s), job, &STOP, done)
+        }
+        None => alhazen_render::render_tiles_with(scene, unit, job, &STOP, done),
+    }
 }
 
 struct Progress {
@@ -439,11 +478,29 @@ impl Progress {
     }
 }
 
-fn summary(scene: &Scene, a: &RenderArgs, plan: &Plan, elapsed: Duration, threads: usize) {
+fn summary(
+    scene: &Scene,
+    a: &RenderArgs,
+    plan: &Plan,
+    elapsed: Duration,
+    threads: usize,
+    solution: Option<&alhazen_radiosity::Solution>,
+) {
     let r = &scene.render;
-    let integrator = match r.integrator {
-        alhazen_scene::IntegratorKind::Whitted => "Whitted ray tracing".to_string(),
-        alhazen_scene::IntegratorKind::Path => format!("path tracing, {:?} sampler", r.sampler).to_lowercase(),
+    let integrator = match (r.integrator, solution) {
+        (_, Some(s)) => {
+            let st = &s.stats;
+            format!(
+                "radiosity: {} patches of at most {:.3}, {} elements, {} shots, {:.2} % left unshot",
+                st.patches,
+                st.patch_size,
+                st.elements,
+                st.shots,
+                100.0 * st.unshot
+            )
+        }
+        (alhazen_scene::IntegratorKind::Whitted, None) => "Whitted ray tracing".to_string(),
+        (alhazen_scene::IntegratorKind::Path, None) => format!("path tracing, {:?} sampler", r.sampler).to_lowercase(),
     };
     let what = match (a.tile, a.pass) {
         (None, None) => String::new(),

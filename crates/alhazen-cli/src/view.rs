@@ -38,6 +38,10 @@ pub(crate) struct ViewArgs {
     /// Frames to draw before `--screenshot` (each orbits the camera by one degree).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=100000))]
     frames: u32,
+    /// Orbit a radiosity solution (`alhazen render --integrator radiosity --export FILE.ply`)
+    /// of this scene instead of the lit scene: the solution does not depend on the view.
+    #[arg(long, value_name = "FILE.ply")]
+    radiosity: Option<PathBuf>,
 }
 
 /// The orbiting camera: the look-at frame of the scene, moved by the user.
@@ -129,7 +133,10 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
     let mut prepared_for = RasterOptions::default();
     let bsp = RasterOptions { visibility: alhazen_raster::pipeline::Visibility::Bsp, ..RasterOptions::default() };
     crate::check_memory(alhazen_raster::pipeline::memory_estimate(&scene, &bsp), "previewing this scene")?;
-    let mut prepared = prepare(&scene, &prepared_for);
+    let mut prepared = match &a.radiosity {
+        Some(path) => crate::radiosity::prepare_solution(path, &scene)?,
+        None => prepare(&scene, &prepared_for),
+    };
     let mut window = Window::new("alhazen view", w, h, WindowOptions::default())
         .map_err(|e| Failure::work(format!("cannot open a window (is an X server running?): {e}")))?;
     window.set_target_fps(60);

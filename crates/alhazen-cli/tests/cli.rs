@@ -955,3 +955,69 @@ fn exposure_tone_mapping_and_gamut() {
         assert!(!exists);
     }
 }
+
+/// `render --integrator radiosity --export` solves once; `raster --radiosity` shows the same
+/// solution without solving: per pixel the two images agree to a few per cent of the mean
+/// (the raster interpolates the same vertex values; edges are sampled differently).
+#[test]
+fn a_radiosity_solution_is_rendered_exported_and_shown_by_the_preview() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let (image, ply, raster) = (dir.path().join("r.pfm"), dir.path().join("s.ply"), dir.path().join("p.pfm"));
+    let size = ["--width", "48", "--height", "48"];
+    let mut args = vec!["render", scene.to_str().unwrap(), "-o", image.to_str().unwrap(), "--quiet"];
+    args.extend(["--integrator", "radiosity", "--spp", "1", "--export", ply.to_str().unwrap()]);
+    args.extend(size);
+    let o = alhazen(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut args = vec!["raster", scene.to_str().unwrap(), "-o", raster.to_str().unwrap(), "--quiet"];
+    args.extend(["--radiosity", ply.to_str().unwrap()]);
+    args.extend(size);
+    let o = alhazen(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("another"), "the solution is this scene's");
+    let read = |p: &Path| alhazen_render::output::read_pfm(&std::fs::read(p).unwrap()).unwrap();
+    let (a, b) = (read(&image), read(&raster));
+    let (mut diff, mut sum) = (0.0, 0.0);
+    for (p, q) in a.pixels.iter().zip(&b.pixels) {
+        diff += (0..3).map(|k| (p[k] - q[k]).abs() as f64).sum::<f64>();
+        sum += (0..3).map(|k| p[k] as f64).sum::<f64>();
+    }
+    assert!(sum > 0.0 && diff / sum < 0.05, "mean difference {:.2} % of the mean", 100.0 * diff / sum);
+}
+
+#[test]
+fn radiosity_options_and_solution_files_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = dir.path().join("s.ply");
+    let (code, err, _) = render(OK, &["--export", ply.to_str().unwrap()]);
+    assert_eq!(code, 2, "--export without radiosity: {err}");
+    assert!(err.contains("--integrator radiosity"), "{err}");
+    let (code, err, exists) = render(OK, &["--integrator", "radiosity", "--export", "s.obj"]);
+    assert_eq!((code, exists), (2, false), "{err}");
+    assert!(err.contains(".ply"), "{err}");
+    for bad in [["--patch-size", "0"], ["--radiosity-tolerance", "1.5"], ["--levels", "9"]] {
+        let (code, err, _) = render(OK, &[&["--integrator", "radiosity"][..], &bad[..]].concat());
+        assert_eq!(code, 2, "{bad:?}: {err}");
+    }
+    // A point light on a sphere over an unbounded floor: solved, the floor cut and said so.
+    let floor = format!("{OK}[[object]]\nshape = \"plane\"\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\n");
+    let (code, err, exists) = render(&floor, &["--integrator", "radiosity"]);
+    assert_eq!((code, exists), (0, true), "{err}");
+    assert!(err.contains("cut to squares"), "{err}");
+    // Not a solution: refused with the reason, nothing written.
+    let scene = scene_file(dir.path(), OK);
+    std::fs::write(&ply, b"ply\nformat ascii 1.0\nend_header\n").unwrap();
+    let out = dir.path().join("p.png");
+    let o = alhazen(&[
+        "raster",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--radiosity",
+        ply.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("binary"), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.exists());
+}

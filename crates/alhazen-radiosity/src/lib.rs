@@ -46,4 +46,4 @@ pub mod ply;
 pub mod solve;
 
 pub use display::FinalGather;
-pub use solve::{RadiosityError, Settings, Solution, Stats, solve};
+pub use solve::{RadiosityError, Settings, Solution, Stats, memory_estimate, solve};

@@ -177,7 +177,20 @@ pub struct Node {
     pub side: [Side; 2],
     /// The front's emission is still to be shot.
     pub emission_unshot: bool,
+    /// Index of the patch (in [`Tree::patches`]) the node belongs to; [`NO_PATCH`] above the
+    /// patch level.
+    pub patch: u32,
+    /// Irradiance received by the whole node and not yet handed down to its leaves (front,
+    /// back): the hierarchy's push, done when the leaves' values are needed.
+    pub pending: [Vec3; 2],
+    /// `Σ area · ρ` over the leaves below (the node's own when a leaf).
+    pub rho_area: Vec3,
+    /// The parent (the root's is itself).
+    pub parent: u32,
 }
+
+/// [`Node::patch`] of nodes above the patch level.
+pub const NO_PATCH: u32 = u32::MAX;
 
 impl Node {
     /// True for an element.
@@ -208,6 +221,10 @@ pub struct Tree {
     pub emission: Vec3,
     /// Deepest level refinement may reach.
     pub max_level: u8,
+    /// Most nodes refinement may make (the tree's share of the scene's budget).
+    pub max_nodes: usize,
+    /// The input triangle's area.
+    pub area: f64,
 }
 
 /// The four children of a triangle of corners `[a, b, c]`: three at the corners and the
@@ -247,16 +264,60 @@ impl Tree {
         (i, l)
     }
 
+    /// The area of node `i`.
+    #[inline]
+    pub fn node_area(&self, i: u32) -> f64 {
+        self.area / 4f64.powi(self.nodes[i as usize].level as i32)
+    }
+
     /// Splits leaf `i` into four, each inheriting what it received; `rho` gives a child's
-    /// reflectance from its corners.
+    /// reflectance from its corners. The sums `ρ · area` above it follow.
     pub fn subdivide(&mut self, i: u32, rho: impl Fn([[f64; 2]; 3]) -> Vec3) {
         let parent = self.nodes[i as usize];
         debug_assert!(parent.is_leaf());
         let first = self.nodes.len() as u32;
+        let area = self.node_area(i) / 4.0;
+        let mut sum = Vec3::ZERO;
         for bary in split(parent.bary) {
-            self.nodes.push(Node { bary, children: 0, level: parent.level + 1, rho: rho(bary), ..parent });
+            let rho = rho(bary);
+            sum += rho * area;
+            let level = parent.level + 1;
+            let pending = [Vec3::ZERO; 2];
+            self.nodes.push(Node { bary, children: 0, level, rho, pending, rho_area: rho * area, parent: i, ..parent });
         }
         self.nodes[i as usize].children = first;
+        let delta = sum - parent.rho_area;
+        let mut k = i;
+        loop {
+            self.nodes[k as usize].rho_area += delta;
+            if k == 0 {
+                break;
+            }
+            k = self.nodes[k as usize].parent;
+        }
+    }
+
+    /// Hands the irradiance pending at node `i` and below down to the leaves.
+    pub fn push_down(&mut self, i: u32) {
+        let mut stack = vec![i];
+        while let Some(n) = stack.pop() {
+            let node = &mut self.nodes[n as usize];
+            let pending = std::mem::take(&mut node.pending);
+            if node.is_leaf() {
+                for (side, p) in node.side.iter_mut().zip(pending) {
+                    side.h += p;
+                    side.unshot += p;
+                }
+                continue;
+            }
+            let first = node.children;
+            for c in first..first + 4 {
+                let child = &mut self.nodes[c as usize];
+                child.pending[0] += pending[0];
+                child.pending[1] += pending[1];
+                stack.push(c);
+            }
+        }
     }
 
     /// The leaves below node `i` (itself when it is one).
@@ -305,11 +366,17 @@ mod tests {
                 rho: Vec3::ONE,
                 side: [Side::default(); 2],
                 emission_unshot: false,
+                patch: 0,
+                pending: [Vec3::ZERO; 2],
+                rho_area: Vec3::ONE,
+                parent: 0,
             }],
             patches: vec![0],
             power: vec![[0.0; 2]],
             emission: Vec3::ZERO,
             max_level: 4,
+            max_nodes: 1000,
+            area: 1.0,
         };
         tree.subdivide(0, |_| Vec3::ONE);
         tree.subdivide(4, |_| Vec3::ONE); // the middle child
@@ -331,6 +398,8 @@ mod tests {
             assert!(w.iter().all(|&x| x > -1e-12), "weights inside the leaf: {w:?}");
         }
         assert_eq!(tree.elements(), 10);
+        // The leaves' ρ · area add up at the root: 10 leaves of ρ = 1 over the area 1.
+        assert!((tree.nodes[0].rho_area - Vec3::ONE).abs().max_element() < 1e-15);
     }
 
     #[test]

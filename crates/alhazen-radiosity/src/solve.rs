@@ -18,7 +18,7 @@
 //! light coming from point light sources"); what they light is then shot on like the rest.
 
 use crate::form_factor::{self, Polygon};
-use crate::mesh::{InputTriangle, Node, Side, Tree, patch_level, surfaces};
+use crate::mesh::{InputTriangle, NO_PATCH, Node, Side, Tree, patch_level, surfaces};
 use alhazen_math::Vec3;
 use alhazen_math::color::luminance;
 use alhazen_render::World;
@@ -52,12 +52,24 @@ pub const TARGET_PATCHES: usize = 1024;
 /// Most patches a scene may have (a larger count is met by larger patches).
 pub const MAX_PATCHES: usize = 1 << 20;
 
-/// Most nodes the quadtrees may hold (about 160 bytes each); refinement stops there.
-pub const MAX_NODES: usize = 1 << 24;
+/// About how many nodes the quadtrees may hold in all (each tree its share by area, at least
+/// 64 per patch; a node and its display values take about [`NODE_BYTES`]); refinement stops
+/// there.
+pub const MAX_NODES: usize = 1 << 22;
+
+/// Bytes per node, with its corners' display values.
+pub const NODE_BYTES: u64 = 320;
+
+/// An upper bound of the bytes a solve of `scene` may take with `settings` (the quadtrees at
+/// their cap, the triangles twice: elements and ray-cast world).
+pub fn memory_estimate(scene: &Scene) -> u64 {
+    let triangles = alhazen_raster::pipeline::geometry::scene_triangles(scene).triangles.len() as u64;
+    2 * MAX_NODES as u64 * NODE_BYTES + triangles * (64 * NODE_BYTES + 1000)
+}
 
 impl Default for Settings {
     fn default() -> Self {
-        Self { patch_size: None, levels: 3, tolerance: 0.01, refine: 0.002, rays: 4, max_shots: None }
+        Self { patch_size: None, levels: 3, tolerance: 0.002, refine: 0.002, rays: 4, max_shots: None }
     }
 }
 
@@ -150,7 +162,14 @@ pub fn solve(
     let world = World::build(&triangle_scene(&scene, &triangles));
     let patch_size = settings.patch_size.unwrap_or_else(|| auto_patch_size(&triangles));
     let patch_size = fit_patch_size(&triangles, patch_size);
-    let trees: Vec<Tree> = triangles.par_iter().map(|t| tree_of(&scene, t, patch_size, settings.levels)).collect();
+    let area: f64 = triangles.iter().map(|t| t.area).sum();
+    let trees: Vec<Tree> = triangles
+        .par_iter()
+        .map(|t| {
+            let cap = (MAX_NODES as f64 * t.area / area) as usize;
+            tree_of(&scene, t, patch_size, settings.levels, cap)
+        })
+        .collect();
     let mut solver = Solver { scene: &scene, world: &world, triangles: &triangles, trees, settings, eps: 0.0 };
     solver.eps = settings.refine * solver.brightest();
     solver.eps = solver.eps.max(f64::MIN_POSITIVE);
@@ -169,7 +188,8 @@ pub fn solve(
         left = solver.unshot_power();
         progress(shots, left / initial);
     }
-    let trees = solver.trees;
+    let mut trees = solver.trees;
+    trees.par_iter_mut().for_each(|t| t.push_down(0));
     let elements = trees.iter().map(Tree::elements).sum();
     let unshot = if initial > 0.0 { left / initial } else { 0.0 };
     let stats = Stats {
@@ -214,7 +234,7 @@ fn reflectance(scene: &Scene, tri: &InputTriangle, bary: [[f64; 2]; 3]) -> Vec3 
     (sum * 0.25 * m.diffuse).clamp(Vec3::ZERO, Vec3::ONE)
 }
 
-fn tree_of(scene: &Scene, tri: &InputTriangle, patch_size: f64, levels: u8) -> Tree {
+fn tree_of(scene: &Scene, tri: &InputTriangle, patch_size: f64, levels: u8, cap: usize) -> Tree {
     let m = &scene.materials[tri.material as usize];
     let emission = m.emission * PI;
     let bary = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
@@ -225,9 +245,23 @@ fn tree_of(scene: &Scene, tri: &InputTriangle, patch_size: f64, levels: u8) -> T
         rho: reflectance(scene, tri, bary),
         side: [Side::default(); 2],
         emission_unshot: emission != Vec3::ZERO,
+        patch: NO_PATCH,
+        pending: [Vec3::ZERO; 2],
+        rho_area: Vec3::ZERO,
+        parent: 0,
     };
     let level = patch_level(tri.longest_edge(), patch_size, 10);
-    let mut tree = Tree { nodes: vec![root], patches: vec![], power: vec![], emission, max_level: level + levels };
+    let mut root = root;
+    root.rho_area = root.rho * tri.area;
+    let mut tree = Tree {
+        nodes: vec![root],
+        patches: vec![],
+        power: vec![],
+        emission,
+        max_level: level + levels,
+        max_nodes: 0,
+        area: tri.area,
+    };
     let mut frontier = vec![0u32];
     for _ in 0..level {
         let mut next = Vec::with_capacity(frontier.len() * 4);
@@ -237,6 +271,10 @@ fn tree_of(scene: &Scene, tri: &InputTriangle, patch_size: f64, levels: u8) -> T
             next.extend(first..first + 4);
         }
         frontier = next;
+    }
+    tree.max_nodes = cap.max(tree.nodes.len() + 64 * frontier.len());
+    for (k, &p) in frontier.iter().enumerate() {
+        tree.nodes[p as usize].patch = k as u32;
     }
     tree.power = vec![[0.0; 2]; frontier.len()];
     tree.patches = frontier;
@@ -324,6 +362,12 @@ const SKY_DIRECTIONS: [Vec3; 7] = [
     Vec3::new(-0.577, 0.577, -0.577),
 ];
 
+/// The share of a shot above which a node must have an even form factor.
+const UNEVEN: f64 = 0.01;
+
+/// The share of a shot a node above the patch level may take whole.
+const NEGLIGIBLE: f64 = 1e-4;
+
 /// Directions per node for the sky's irradiance.
 const SKY_RAYS: usize = 64;
 
@@ -340,6 +384,8 @@ struct Transfer {
     uneven: bool,
     /// The factor times visibility (`G/π v`) from a patch, for the energy bound.
     factor: f64,
+    /// The fraction of a patch's shot the node takes (unoccluded).
+    share: f64,
 }
 
 struct Solver<'a> {
@@ -402,8 +448,9 @@ impl Solver<'_> {
     /// Patch `p` of tree `t` shoots its side `side`'s unshot radiosity.
     fn shoot_patch(&mut self, t: usize, p: usize, side: usize) {
         let tri = &self.triangles[t];
+        let node_index = self.trees[t].patches[p];
+        self.trees[t].push_down(node_index);
         let tree = &self.trees[t];
-        let node_index = tree.patches[p];
         let node = tree.nodes[node_index as usize];
         let mut leaves = vec![];
         tree.leaves_below(node_index, &mut leaves);
@@ -451,10 +498,7 @@ impl Solver<'_> {
             .map(|(mut tree, tri)| {
                 let (mut got, mut share) = (vec![], 0.0);
                 if this.reaches(source, tri) {
-                    for p in 0..tree.patches.len() {
-                        let root = tree.patches[p];
-                        share += this.receive(source, tri, &mut tree, root, &mut got);
-                    }
+                    share = this.receive(source, tri, &mut tree, 0, &mut got);
                 }
                 (tree, got, share)
             })
@@ -466,12 +510,8 @@ impl Solver<'_> {
         };
         self.trees = received
             .into_par_iter()
-            .zip(this.triangles)
-            .map(|((mut tree, got, _), tri)| {
-                if !got.is_empty() {
-                    apply(&mut tree, &got, scale);
-                    (0..tree.patches.len()).for_each(|p| update_power(tri, &mut tree, p));
-                }
+            .map(|(mut tree, got, _)| {
+                apply(&mut tree, &got, scale);
                 tree
             })
             .collect();
@@ -496,11 +536,19 @@ impl Solver<'_> {
             let n = if s == 0 { tri.normal } else { -tri.normal };
             if s < sides { self.transfer(source, x, n, corners, node.rho, true) } else { Transfer::default() }
         });
-        if t.iter().all(|t| t.h == Vec3::ZERO && t.potential == 0.0) {
+        if t.iter().all(|t| t.h == Vec3::ZERO && t.potential == 0.0 && !t.uneven) {
             return 0.0;
         }
-        let wants = |t: &Transfer| t.uneven || t.potential > self.eps || (t.partial && t.potential > 0.1 * self.eps);
-        let room = !node.is_leaf() || tree.nodes.len() + 4 <= MAX_NODES;
+        // Above the patch level a node takes a shot whole only where its share is negligible
+        // and nothing stands between part of it and the patch.
+        let coarse = node.patch == NO_PATCH;
+        let wants = |t: &Transfer| {
+            t.uneven
+                || t.potential > self.eps
+                || (t.partial && t.potential > 0.1 * self.eps)
+                || (coarse && (t.share > NEGLIGIBLE || t.partial))
+        };
+        let room = !node.is_leaf() || tree.nodes.len() + 4 <= tree.max_nodes;
         if node.level < tree.max_level && room && t.iter().any(wants) {
             if node.is_leaf() {
                 tree.subdivide(i, |b| reflectance(self.scene, tri, b));
@@ -520,31 +568,48 @@ impl Solver<'_> {
         let sees = |to: Vec3, dist: f64| !occlusion || self.world.unoccluded(from, to, dist);
         match source {
             Source::Patch { poly, centre, normal, radiosity, aims, area } => {
-                if (x - *centre).dot(*normal) <= 0.0 {
+                // A node across the patch's plane is refined (only its children can tell); one
+                // that touches it counts as in front.
+                let height = corners.map(|c| (c - *centre).dot(*normal));
+                let across = height.iter().any(|&h| h < -eps);
+                if height.iter().all(|&h| h <= eps) {
                     return Transfer::default();
                 }
-                // The factor at the centres of the node's four children: their mean is the
-                // node's, their spread says whether the node is small enough for one value.
-                let quarters = crate::mesh::split([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]).map(|q| {
-                    let w = [0, 1].map(|k| (q[0][k] + q[1][k] + q[2][k]) / 3.0);
-                    let p = corners[0] * w[0] + corners[1] * w[1] + corners[2] * (1.0 - w[0] - w[1]);
-                    form_factor::point_to_polygon(p, n, poly)
-                });
-                let ff = quarters.iter().sum::<f64>() / 4.0;
+                if (x - *centre).dot(*normal) <= 0.0 {
+                    return Transfer { uneven: true, share: 1.0, ..Transfer::default() };
+                }
+                let node_area = 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length();
+                // Near the patch: the factor at the centres of the node's four children, whose
+                // mean is the node's and whose spread says whether one value will do. Far from
+                // it (both sizes under a quarter of the distance), the centre's.
+                let near = (node_area.sqrt() + area.sqrt()) > 0.25 * (x - *centre).length();
+                let (ff, spread) = if near {
+                    let quarters = crate::mesh::split([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0]]).map(|q| {
+                        let w = [0, 1].map(|k| (q[0][k] + q[1][k] + q[2][k]) / 3.0);
+                        let p = corners[0] * w[0] + corners[1] * w[1] + corners[2] * (1.0 - w[0] - w[1]);
+                        form_factor::point_to_polygon(p, n, poly)
+                    });
+                    let ff = quarters.iter().sum::<f64>() / 4.0;
+                    (ff, quarters.iter().fold(0.0f64, |m, q| m.max((q - ff).abs())))
+                } else {
+                    (form_factor::point_to_polygon(x, n, poly), 0.0)
+                };
                 if ff <= 0.0 {
                     return Transfer::default();
                 }
-                let spread = quarters.iter().fold(0.0f64, |m, q| m.max((q - ff).abs()));
-                let node_area = 0.5 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).length();
+                // Rays from points spread over the node (its centre and corners drawn in) to
+                // points spread over the patch, in pairs: a shadow edge across either shows.
+                let probes = probes(x, corners);
                 let (mut seen, mut tried) = (0, 0);
-                for &q in aims {
-                    let d = q - from;
+                for (k, &q) in aims.iter().enumerate() {
+                    let o = probes[k % 4] + n * eps;
+                    let d = q - o;
                     if d.dot(n) <= 0.0 || d.dot(*normal) >= 0.0 {
                         continue;
                     }
                     tried += 1;
                     let dist = d.length();
-                    seen += sees(d / dist, dist * (1.0 - 1e-9) - eps) as usize;
+                    seen += (!occlusion || self.world.unoccluded(o, d / dist, dist * (1.0 - 1e-9) - eps)) as usize;
                 }
                 let v = if tried == 0 { 0.0 } else { seen as f64 / tried as f64 };
                 Transfer {
@@ -553,8 +618,9 @@ impl Solver<'_> {
                     partial: seen > 0 && seen < tried,
                     // More than 1 % of the shot lands on a node whose factor varies by more
                     // than a quarter across it.
-                    uneven: spread > 0.25 * ff && ff * node_area > 0.01 * *area,
+                    uneven: across || (spread > 0.25 * ff && ff * node_area > UNEVEN * *area),
                     factor: ff * v,
+                    share: ff * node_area / *area,
                 }
             }
             Source::Point { position, intensity, spot } => {
@@ -581,6 +647,7 @@ impl Solver<'_> {
                     partial: seen > 0 && seen < 4,
                     uneven: false,
                     factor: 0.0,
+                    share: 1.0,
                 }
             }
             Source::Directional { towards, irradiance } => {
@@ -600,6 +667,7 @@ impl Solver<'_> {
                     partial: seen > 0 && seen < 4,
                     uneven: false,
                     factor: 0.0,
+                    share: 1.0,
                 }
             }
             Source::Sky => {
@@ -622,6 +690,7 @@ impl Solver<'_> {
                     partial: seen > 0 && seen < SKY_RAYS,
                     uneven: false,
                     factor: 0.0,
+                    share: 1.0,
                 }
             }
         }
@@ -641,16 +710,22 @@ fn leaf_area(tri: &InputTriangle, node: &Node) -> f64 {
 /// What a node received from a shot, front and back.
 type Received = (u32, [Vec3; 2]);
 
-/// Adds what nodes received (times `scale`) to all their leaves.
+/// Adds what nodes received (times `scale`) to them, pending for their leaves, and the power
+/// it gives to their patches'. A node above the patch level hands it to its patches.
 fn apply(tree: &mut Tree, got: &[Received], scale: f64) {
-    let mut leaves = vec![];
+    let mut stack = vec![];
     for &(i, h) in got {
-        tree.leaves_below(i, &mut leaves);
-        for &l in &leaves {
-            let leaf = &mut tree.nodes[l as usize];
+        let h = h.map(|h| h * scale);
+        stack.push(i);
+        while let Some(n) = stack.pop() {
+            let node = &mut tree.nodes[n as usize];
+            if node.patch == NO_PATCH {
+                stack.extend(node.children..node.children + 4);
+                continue;
+            }
             for s in 0..2 {
-                leaf.side[s].h += h[s] * scale;
-                leaf.side[s].unshot += h[s] * scale;
+                node.pending[s] += h[s];
+                tree.power[node.patch as usize][s] += luminance(node.rho_area * h[s]);
             }
         }
     }

@@ -130,6 +130,20 @@ pub struct Prepared {
     pub emitters: Vec<emitters::EmitterLight>,
     /// The CSG bodies, ray cast per pixel ([`csg`]).
     pub csg: Option<csg::CsgBodies>,
+    /// Light computed elsewhere (a radiosity solution), one per triangle: the triangles are
+    /// drawn with it alone ([`prepare_lit`]).
+    pub prelit: Option<Vec<Prelit>>,
+}
+
+/// The light of one triangle of a solved scene: the irradiance over π at its corners, which
+/// the material's `ρ(uv)` multiplies per pixel, and whether the triangle is its surface's front
+/// (where emission shows).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prelit {
+    /// Irradiance over π at the corners.
+    pub irradiance: [Vec3; 3],
+    /// The surface's front side.
+    pub front: bool,
 }
 
 /// Image-based light: the environment's irradiance, and the environment prefiltered for glossy
@@ -156,8 +170,11 @@ impl RasterOptions {
 }
 
 impl Prepared {
-    /// True when everything `opts` asks for was prepared.
+    /// True when everything `opts` asks for was prepared (a lit scene needs nothing more).
     pub fn serves(&self, opts: &RasterOptions) -> bool {
+        if self.prelit.is_some() {
+            return true;
+        }
         let maps = opts.shadows && opts.shadow_method == ShadowMethod::Maps;
         (!maps || self.shadows.is_some())
             && (!opts.ibl || self.ibl.is_some())
@@ -182,7 +199,22 @@ pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
         bsp::BspTree::build(&geometry.triangles, 1e-9 * (1.0 + b.extent().length()))
     });
     let csg = csg::CsgBodies::of(scene);
-    Prepared { geometry, shadows, ibl, bsp, emitters, csg }
+    Prepared { geometry, shadows, ibl, bsp, emitters, csg, prelit: None }
+}
+
+/// Triangles whose light is already known (a radiosity solution: `lit[i]` for
+/// `triangles[i]`), drawn with it alone: no lights, shadows, mirrors, glass or CSG passes, and
+/// always by the depth buffer.
+pub fn prepare_lit(triangles: Vec<Triangle>, lit: Vec<Prelit>) -> Prepared {
+    Prepared {
+        geometry: geometry::SceneTriangles { triangles, skipped: 0 },
+        shadows: None,
+        ibl: None,
+        bsp: None,
+        emitters: vec![],
+        csg: None,
+        prelit: Some(lit),
+    }
 }
 
 /// What the pipeline did.
@@ -341,6 +373,7 @@ fn process(
     proj: &Projection,
     t: &Triangle,
     index: u32,
+    lit: Option<&Prelit>,
     opts: &RasterOptions,
     shadows: &shade::Lighting,
     (w, h): (u32, u32),
@@ -361,8 +394,11 @@ fn process(
         Shading::Gouraud if !t.unbounded => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), shadows),
         _ => (Vec3::ZERO, Vec3::ZERO),
     };
-    let corners: [ClipVertex; 3] =
-        t.v.map(|v| ClipVertex { pos: proj.world_to_clip * v.p.extend(1.0), attr: attributes(&v, color(&v)) });
+    let corners: [ClipVertex; 3] = std::array::from_fn(|k| {
+        let v = t.v[k];
+        let light = lit.map_or_else(|| color(&v), |l| (l.irradiance[k], Vec3::ZERO));
+        ClipVertex { pos: proj.world_to_clip * v.p.extend(1.0), attr: attributes(&v, light) }
+    });
     // Inside the view volume and no user planes: clipping would return the corners as they are.
     let inside = |c: &ClipVertex| {
         let q = c.pos;
@@ -383,6 +419,17 @@ fn bumped(scene: &Scene, m: &alhazen_scene::Material, t: &Triangle, uv: Vec2, n:
     let Some(b) = &m.bump else { return n };
     let [pu, pv] = alhazen_scene::texture::uv_tangents(t.v.map(|v| v.p), t.v.map(|v| v.uv));
     alhazen_scene::texture::bumped_normal(b, uv, n, pu, pv, &scene.images)
+}
+
+/// The colour of a fragment of a lit triangle: its emission on the front, and the material's
+/// `ρ(uv)` times the irradiance over π interpolated from the corners (the course's display of a
+/// radiosity solution, with the texture per pixel).
+fn lit_color(scene: &Scene, t: &Triangle, lit: &Prelit, attr: &[f64; ATTRIBUTES]) -> Vec3 {
+    let m = &scene.materials[t.material as usize];
+    let rho = alhazen_scene::texture::eval(&m.color, Vec2::new(attr[6], attr[7]), &scene.images) * m.diffuse;
+    let e = Vec3::new(attr[8], attr[9], attr[10]).max(Vec3::ZERO);
+    let emitted = if lit.front { m.emission } else { Vec3::ZERO };
+    emitted + rho.clamp(Vec3::ZERO, Vec3::ONE) * e
 }
 
 /// The colour of a fragment.
@@ -507,8 +554,9 @@ fn render_view_in(
     let in_mirror = pass != Pass::Main;
     let proj = *proj;
     let geometry = &prepared.geometry;
+    let prelit = prepared.prelit.as_deref();
     let stencil_mode = match (opts.shadows, opts.shadow_method, proj.perspective) {
-        (true, ShadowMethod::Volumes(mode), true) => Some(mode),
+        (true, ShadowMethod::Volumes(mode), true) if prelit.is_none() => Some(mode),
         _ => None,
     };
     let light = shade::Lighting {
@@ -534,6 +582,9 @@ fn render_view_in(
         _ => (&geometry.triangles, (0..geometry.triangles.len() as u32).collect()),
     };
     let painter = opts.visibility == Visibility::Bsp && prepared.bsp.is_some();
+    // A lit scene's light is all in its triangles: no second passes.
+    let in_mirror = in_mirror || prelit.is_some();
+    let pass = if prelit.is_some() { Pass::InMirror } else { pass };
     let volumes = stencil_mode.map(|_| stencil::volumes(scene, tris, proj.world_to_clip, (w, h))).unwrap_or_default();
     // Spherical mirrors by Glaeser's method: what each shows, before the frame is shaded.
     let mut mirror_images: Vec<mirrors::MirrorImage> = vec![];
@@ -568,7 +619,10 @@ fn render_view_in(
             let culled = chunk
                 .iter()
                 .filter(|&&i| pass != Pass::BehindGlass || clear(&tris[i as usize]))
-                .filter(|&&i| process(scene, &proj, &tris[i as usize], i, opts, shadows, (w, h), &mut out))
+                .filter(|&&i| {
+                    let lit = prelit.map(|l| &l[i as usize]);
+                    process(scene, &proj, &tris[i as usize], i, lit, opts, shadows, (w, h), &mut out)
+                })
                 .count();
             (culled, out)
         })
@@ -651,7 +705,10 @@ fn render_view_in(
                         let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
                         scene.background.radiance(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
                     } else {
-                        fragment_color(scene, &proj, tris, *src, attr, opts, shadows)
+                        match prelit {
+                            Some(lit) => lit_color(scene, &tris[*src as usize], &lit[*src as usize], attr),
+                            None => fragment_color(scene, &proj, tris, *src, attr, opts, shadows),
+                        }
                     };
                     [c.x as f32, c.y as f32, c.z as f32]
                 })
