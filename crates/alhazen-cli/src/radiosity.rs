@@ -10,6 +10,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
+/// Surface triangles beyond which the solve is slow.
+const MANY_TRIANGLES: usize = 20_000;
+
 /// The radiosity integrator's settings.
 #[derive(Args, Clone, Debug)]
 pub(crate) struct RadiosityArgs {
@@ -73,6 +76,12 @@ impl RadiosityArgs {
 pub(crate) fn solve(scene: &Scene, a: &RadiosityArgs, quiet: bool) -> Result<Solution, Failure> {
     crate::check_memory(alhazen_radiosity::memory_estimate(scene), "solving this scene's radiosity")?;
     let export = a.export.as_deref().map(open_output).transpose()?;
+    let triangles = alhazen_raster::pipeline::geometry::scene_triangles(scene).triangles.len();
+    if triangles > MANY_TRIANGLES && !quiet {
+        eprintln!(
+            "warning: {triangles} surface triangles: every triangle shoots and receives on its own (no clusters), so radiosity's time grows with their square; expect minutes"
+        );
+    }
     let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(
         ProgressStyle::with_template("{spinner} radiosity [{bar:40}] {msg} elapsed {elapsed}")

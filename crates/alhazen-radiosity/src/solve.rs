@@ -33,7 +33,9 @@ pub struct Settings {
     /// Longest edge of a shooting patch, in scene units; `None` chooses it so that the scene
     /// has about [`TARGET_PATCHES`] patches.
     pub patch_size: Option<f64>,
-    /// Levels of refinement allowed below the patches (each splits an element in four).
+    /// Levels of refinement allowed below the patches (each splits an element in four): the
+    /// smallest element's edge is the patch size over `2^levels`, for small surface triangles
+    /// too.
     pub levels: u8,
     /// Stop when the unshot power is at most this fraction of the power first to be shot.
     pub tolerance: f64,
@@ -258,7 +260,8 @@ fn tree_of(scene: &Scene, tri: &InputTriangle, patch_size: f64, levels: u8, cap:
         patches: vec![],
         power: vec![],
         emission,
-        max_level: level + levels,
+        // Elements no smaller than a patch split `levels` times, however small the triangle.
+        max_level: patch_level(tri.longest_edge(), patch_size / f64::from(1u32 << levels), 10 + levels).max(level),
         max_nodes: 0,
         area: tri.area,
     };
