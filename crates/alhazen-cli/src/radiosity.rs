@@ -26,6 +26,11 @@ pub(crate) struct RadiosityArgs {
     /// Radiosity: stop when at most this fraction of the light is left unshot.
     #[arg(long, default_value_t = 0.002, value_name = "FRACTION", value_parser = parse_fraction)]
     radiosity_tolerance: f64,
+    /// Radiosity: shoot through the course's hemicube of N pixels across (the item buffer
+    /// filled by ray casting) instead of Lambert's exact form factors; the elements are then
+    /// fixed in advance (every patch split --levels times).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(8..=4096))]
+    hemicube: Option<u32>,
     /// Radiosity: also write the solution as a PLY mesh (per-vertex irradiance and sRGB
     /// colour), which `alhazen raster --radiosity` and `alhazen view --radiosity` show without
     /// solving again.
@@ -54,6 +59,7 @@ impl RadiosityArgs {
             patch_size: self.patch_size,
             levels: self.levels,
             tolerance: self.radiosity_tolerance,
+            hemicube: self.hemicube,
             ..Settings::default()
         }
     }

@@ -9,9 +9,9 @@
 //! `G/π = 1/(2π) Σ_k γ_k n·(r_k × r_{k+1}) / |r_k × r_{k+1}|`,
 //!
 //! with `r_k = v_k − p` and `γ_k` the angle the edge subtends at `p` — exact for any planar
-//! polygon above the tangent plane of `p`; parts below it are clipped off first. (The course
-//! measures the same projected area on the five faces of a hemicube; the closed form has no
-//! aliasing and costs one polygon clip.)
+//! polygon above the tangent plane of `p`; parts below it are clipped off first. The course
+//! measures the same projected area on the five faces of a [`Hemicube`]; the solver uses the
+//! closed form by default (no aliasing, one polygon clip) and the hemicube when asked.
 //!
 //! [`analytic`] holds the textbook closed forms between whole patches (parallel and
 //! perpendicular rectangles, coaxial disks) the tests check the integrated point factors against.
@@ -246,5 +246,94 @@ mod tests {
         let (a, b) = (point_to_polygon(Vec3::ZERO, Vec3::Z, &sq), point_to_polygon(Vec3::ZERO, Vec3::Z, &upper));
         assert!(a > 0.0 && (a - b).abs() < 1e-15, "{a} vs {b}");
         assert_eq!(point_to_polygon(Vec3::ZERO, Vec3::NEG_Z, &upper), 0.0);
+    }
+}
+
+/// The course's hemicube: the five faces (the top `z = 1` and the four half sides) of the cube
+/// `[−1, 1]² × [0, 1]` over a point, each face `resolution` pixels across (the sides half as
+/// high). Each pixel has its *delta form factor*, the area its image takes under Nusselt's
+/// double projection over `π`: `ΔA / (π (x² + y² + 1)²)` on the top, `z ΔA / (π (y² + z² + 1)²)`
+/// on a side; they add up to 1 less the discretisation error.
+#[derive(Clone, Debug)]
+pub struct Hemicube {
+    /// Per pixel: its direction in the frame `(s, t, n)` (not unit) and delta form factor.
+    pub pixels: Vec<(Vec3, f64)>,
+}
+
+impl Hemicube {
+    /// The hemicube of `resolution` pixels across the top (even, at least 2).
+    pub fn new(resolution: u32) -> Self {
+        let r = resolution.max(2) & !1;
+        let step = 2.0 / r as f64;
+        let area = step * step;
+        let mut pixels = Vec::with_capacity((3 * r * r) as usize);
+        let at = |i: u32| -1.0 + (i as f64 + 0.5) * step;
+        for i in 0..r {
+            for j in 0..r {
+                let (x, y) = (at(i), at(j));
+                pixels.push((Vec3::new(x, y, 1.0), area / (std::f64::consts::PI * (x * x + y * y + 1.0).powi(2))));
+            }
+        }
+        // The four sides: u across the side, z up it.
+        for side in 0..4 {
+            for i in 0..r {
+                for k in 0..r / 2 {
+                    let (u, z) = (at(i), (k as f64 + 0.5) * step);
+                    let d = match side {
+                        0 => Vec3::new(1.0, u, z),
+                        1 => Vec3::new(-1.0, u, z),
+                        2 => Vec3::new(u, 1.0, z),
+                        _ => Vec3::new(u, -1.0, z),
+                    };
+                    pixels.push((d, z * area / (std::f64::consts::PI * (u * u + z * z + 1.0).powi(2))));
+                }
+            }
+        }
+        Self { pixels }
+    }
+
+    /// The delta form factors gathered by what each pixel sees from `p` (unit normal `n`):
+    /// `seen(origin, unit direction)` names the element a pixel's ray meets first (the course's
+    /// item buffer, filled by ray casting instead of five projections), or `None`. Calls
+    /// `add(element, ΔF)` pixel by pixel, in a fixed order.
+    pub fn gather<K>(&self, p: Vec3, n: Vec3, seen: impl Fn(Vec3, Vec3) -> Option<K>, mut add: impl FnMut(K, f64)) {
+        let (s, t) = alhazen_math::orthonormal_basis(n);
+        for &(d, df) in &self.pixels {
+            let dir = (s * d.x + t * d.y + n * d.z).normalize();
+            if let Some(k) = seen(p, dir) {
+                add(k, df);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod hemicube_tests {
+    use super::*;
+
+    #[test]
+    fn the_delta_form_factors_add_up_to_one() {
+        for r in [20, 100, 300] {
+            let sum: f64 = Hemicube::new(r).pixels.iter().map(|p| p.1).sum();
+            assert!((sum - 1.0).abs() < 2.0 / r as f64, "{r}: {sum}");
+        }
+    }
+
+    #[test]
+    fn the_hemicube_agrees_with_lambert_on_a_square() {
+        // A unit square above the point, offset: what the hemicube's pixels see of it.
+        let corner = Vec3::new(-0.2, 0.1, 0.7);
+        let (e1, e2) = (Vec3::X, Vec3::Y);
+        let square = Polygon::of(&[corner, corner + e1, corner + e1 + e2, corner + e2]);
+        let seen = |o: Vec3, d: Vec3| {
+            let t = (corner.z - o.z) / d.z;
+            let q = o + d * t;
+            (t > 0.0 && (0.0..=1.0).contains(&(q.x - corner.x)) && (0.0..=1.0).contains(&(q.y - corner.y)))
+                .then_some(())
+        };
+        let mut f = 0.0;
+        Hemicube::new(200).gather(Vec3::ZERO, Vec3::Z, seen, |_, df| f += df);
+        let exact = point_to_polygon(Vec3::ZERO, Vec3::Z, &square);
+        assert!((f - exact).abs() < 0.01 * exact, "hemicube {f}, Lambert {exact}");
     }
 }

@@ -2,7 +2,8 @@
 //! method", "Global lighting models") for the diffuse surfaces of any scene.
 //!
 //! * [`form_factor`] — `G_ij/π` of a point towards a polygon in closed form (Nusselt's analogy,
-//!   Lambert's edge sum), the textbook patch-to-patch closed forms;
+//!   Lambert's edge sum), the course's hemicube with its delta form factors, the textbook
+//!   patch-to-patch closed forms;
 //! * [`mesh`] — the surfaces as quadtrees of triangular elements below shooting patches;
 //! * [`solve`] — progressive refinement: the brightest unshot patch shoots, receivers refine
 //!   where the light changes, point lights and the sky shoot first;

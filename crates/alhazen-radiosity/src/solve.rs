@@ -46,6 +46,10 @@ pub struct Settings {
     pub rays: u32,
     /// Most shots; `None` for 50 per patch.
     pub max_shots: Option<u64>,
+    /// Shoot through the course's hemicube of this many pixels across instead of Lambert's
+    /// closed form: the elements are then the patches split `levels` times, fixed in advance
+    /// (the item buffer cannot ask for finer ones).
+    pub hemicube: Option<u32>,
 }
 
 /// Patches aimed at when no patch size is given.
@@ -71,7 +75,7 @@ pub fn memory_estimate(scene: &Scene) -> u64 {
 
 impl Default for Settings {
     fn default() -> Self {
-        Self { patch_size: None, levels: 3, tolerance: 0.002, refine: 0.002, rays: 4, max_shots: None }
+        Self { patch_size: None, levels: 3, tolerance: 0.002, refine: 0.002, rays: 4, max_shots: None, hemicube: None }
     }
 }
 
@@ -141,6 +145,9 @@ impl Settings {
         if ![1, 4, 16].contains(&self.rays) {
             return bad(format!("{} visibility rays: expected 1, 4 or 16", self.rays));
         }
+        if let Some(r) = self.hemicube.filter(|r| !(8..=4096).contains(r)) {
+            return bad(format!("a hemicube of {r} pixels across: expected 8 to 4096"));
+        }
         if self.levels > 8 {
             return bad(format!("{} refinement levels: at most 8 (each multiplies elements by 4)", self.levels));
         }
@@ -172,7 +179,13 @@ pub fn solve(
             tree_of(&scene, t, patch_size, settings.levels, cap)
         })
         .collect();
-    let mut solver = Solver { scene: &scene, world: &world, triangles: &triangles, trees, settings, eps: 0.0 };
+    let mut trees = trees;
+    if settings.hemicube.is_some() {
+        trees.par_iter_mut().zip(&triangles).for_each(|(t, tri)| split_all(&scene, tri, t));
+    }
+    let hemicube = settings.hemicube.map(form_factor::Hemicube::new);
+    let mut solver =
+        Solver { scene: &scene, world: &world, triangles: &triangles, trees, settings, eps: 0.0, hemicube };
     solver.eps = settings.refine * solver.brightest();
     solver.eps = solver.eps.max(f64::MIN_POSITIVE);
     for source in sources(&scene) {
@@ -288,6 +301,18 @@ fn tree_of(scene: &Scene, tri: &InputTriangle, patch_size: f64, levels: u8, cap:
     tree
 }
 
+/// Splits every leaf of `tree` down to its deepest level (within its node budget).
+fn split_all(scene: &Scene, tri: &InputTriangle, tree: &mut Tree) {
+    let mut i = 0;
+    while i < tree.nodes.len() {
+        let node = tree.nodes[i];
+        if node.is_leaf() && node.level < tree.max_level && tree.nodes.len() + 4 <= tree.max_nodes {
+            tree.subdivide(i as u32, |b| reflectance(scene, tri, b));
+        }
+        i += 1;
+    }
+}
+
 /// The scene of the surface triangles, one mesh whose triangle `i` has slot `i`, for ray casts.
 fn triangle_scene(scene: &Scene, tris: &[InputTriangle]) -> Scene {
     let mut mesh = alhazen_geom::TriangleMesh::default();
@@ -398,6 +423,8 @@ struct Solver<'a> {
     trees: Vec<Tree>,
     settings: &'a Settings,
     eps: f64,
+    /// The hemicube patches shoot through, when asked for.
+    hemicube: Option<form_factor::Hemicube>,
 }
 
 impl Solver<'_> {
@@ -473,7 +500,13 @@ impl Solver<'_> {
             aims: aims(corners, self.settings.rays),
             area,
         };
-        self.shoot_all(&source);
+        match self.hemicube.take() {
+            Some(cube) => {
+                self.shoot_hemicube(&cube, &source);
+                self.hemicube = Some(cube);
+            }
+            None => self.shoot_all(&source),
+        }
         // What was shot is no longer unshot.
         let tree = &mut self.trees[t];
         for &l in &leaves {
@@ -484,6 +517,43 @@ impl Solver<'_> {
             }
         }
         update_power(tri, tree, p);
+    }
+
+    /// Cohen's shot through a hemicube at the patch's centre: each pixel's ray finds the element
+    /// it sees, which receives `ΔF · A_patch / A_element` of the patch's radiosity as irradiance
+    /// (reciprocity). The delta form factors add up to at most 1: no energy is made.
+    fn shoot_hemicube(&mut self, cube: &form_factor::Hemicube, source: &Source) {
+        let Source::Patch { centre, normal, radiosity, area, .. } = source else { return };
+        let eps = 1e-7 * (1.0 + centre.abs().max_element());
+        let this = &*self;
+        let seen = |o: Vec3, d: Vec3| -> Option<Seen> {
+            let hit = this.world.intersect(&alhazen_math::Ray::new(o + *normal * eps, d), f64::INFINITY)?;
+            let t = hit.hit.slot;
+            let tri = &this.triangles[t as usize];
+            let side = usize::from(d.dot(tri.normal) > 0.0);
+            (side < tri.sides()).then(|| (t, this.trees[t as usize].locate(tri.barycentric(hit.hit.p)).0, side))
+        };
+        let chunks: Vec<Vec<(Seen, f64)>> = cube
+            .pixels
+            .par_chunks(1024)
+            .map(|pixels| {
+                let part = form_factor::Hemicube { pixels: pixels.to_vec() };
+                let mut out = vec![];
+                part.gather(*centre, *normal, seen, |k, df| out.push((k, df)));
+                out
+            })
+            .collect();
+        let mut factors: std::collections::BTreeMap<Seen, f64> = Default::default();
+        for (k, df) in chunks.into_iter().flatten() {
+            *factors.entry(k).or_default() += df;
+        }
+        for ((t, leaf, side), f) in factors {
+            let tree = &mut self.trees[t as usize];
+            let h = *radiosity * (f * *area / tree.node_area(leaf));
+            let node = &mut tree.nodes[leaf as usize];
+            node.pending[side] += h;
+            tree.power[node.patch as usize][side] += luminance(node.rho_area * h);
+        }
     }
 
     /// Every tree receives from `source` (a shooter's own tree too: its other patches lie in the
@@ -552,7 +622,12 @@ impl Solver<'_> {
                 || (coarse && (t.share > NEGLIGIBLE || t.partial))
         };
         let room = !node.is_leaf() || tree.nodes.len() + 4 <= tree.max_nodes;
-        if node.level < tree.max_level && room && t.iter().any(wants) {
+        // With a hemicube the elements are fixed: go down to them, split nothing.
+        let split = match self.hemicube {
+            Some(_) => !node.is_leaf(),
+            None => node.level < tree.max_level && room && t.iter().any(wants),
+        };
+        if split {
             if node.is_leaf() {
                 tree.subdivide(i, |b| reflectance(self.scene, tri, b));
             }
@@ -709,6 +784,9 @@ fn centre(tri: &InputTriangle, node: &Node) -> (Vec3, [Vec3; 3]) {
 fn leaf_area(tri: &InputTriangle, node: &Node) -> f64 {
     tri.area / 4f64.powi(node.level as i32)
 }
+
+/// What a hemicube pixel sees: surface triangle, element, side.
+type Seen = (u32, u32, usize);
 
 /// What a node received from a shot, front and back.
 type Received = (u32, [Vec3; 2]);
