@@ -37,6 +37,8 @@ pub(crate) enum VisibilityArg {
     Zbuffer,
     /// The BSP-tree painter's algorithm.
     Bsp,
+    /// The scan-line algorithm (a depth buffer of one row, an active triangle list).
+    Scanline,
 }
 
 #[derive(Args)]
@@ -125,6 +127,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         visibility: match a.visibility {
             VisibilityArg::Zbuffer => Visibility::ZBuffer,
             VisibilityArg::Bsp => Visibility::Bsp,
+            VisibilityArg::Scanline => Visibility::Scanline,
         },
     };
     crate::check_memory(alhazen_raster::pipeline::memory_estimate(&scene, &opts), "previewing this scene")?;
@@ -162,9 +165,9 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
             match (opts.shadows, opts.visibility, &a.radiosity) {
                 (_, _, Some(_)) => " from the radiosity solution",
                 (true, Visibility::Bsp, None) => ", shadow maps and BSP tree built",
-                (true, Visibility::ZBuffer, None) => " and shadow maps rendered",
+                (true, _, None) => " and shadow maps rendered",
                 (false, Visibility::Bsp, None) => " and BSP tree built",
-                (false, Visibility::ZBuffer, None) => "",
+                (false, _, None) => "",
             },
             tessellation,
             stats.culled,

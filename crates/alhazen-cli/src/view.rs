@@ -252,7 +252,8 @@ fn handle_input(window: &Window, orbit: &mut Orbit, opts: &mut RasterOptions, la
     if window.is_key_pressed(Key::B, KeyRepeat::No) {
         opts.visibility = match opts.visibility {
             Visibility::ZBuffer => Visibility::Bsp,
-            Visibility::Bsp => Visibility::ZBuffer,
+            Visibility::Bsp => Visibility::Scanline,
+            Visibility::Scanline => Visibility::ZBuffer,
         };
     }
     let pos = window.get_mouse_pos(MouseMode::Pass);

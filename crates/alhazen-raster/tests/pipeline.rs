@@ -667,3 +667,34 @@ material = { color = [0.9, 0.1, 0.1] }
     let want = [0.96 * 0.9 + 0.04 * 0.2, 0.96 * 0.1 + 0.04 * 0.3, 0.96 * 0.1 + 0.04 * 0.9];
     assert!((0..3).all(|c| (centre[c] as f64 - want[c]).abs() < 2e-3), "{centre:?} vs {want:?}");
 }
+
+/// The scan-line algorithm gives the z-buffer's frame and depth pixel for pixel on every scene
+/// of `scenes/` and `scenes/cameras/` but the panorama (see below), with their cameras.
+#[test]
+fn the_scanline_algorithm_draws_every_scene_as_the_z_buffer_does() {
+    use alhazen_raster::pipeline::Visibility;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut files: Vec<_> = std::fs::read_dir(&root)
+        .unwrap()
+        .chain(std::fs::read_dir(root.join("cameras")).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        // The panorama's cylinder mirror takes ~20 s a frame in its cube faces (the reflex
+        // split recurses far too deep there; noted in the issue), not a visibility matter.
+        .filter(|p| !p.ends_with("cameras/panorama.toml"))
+        .collect();
+    files.sort();
+    assert!(files.len() > 30, "{} scenes", files.len());
+    for path in files {
+        let mut scene = alhazen_scene::load_scene(&path).unwrap();
+        // A quarter of the size keeps the test short; odd sizes exercise partial bands.
+        scene.render.width = (scene.render.width / 4).max(9) | 1;
+        scene.render.height = (scene.render.height / 4).max(9) | 1;
+        let z = RasterOptions::default();
+        let scan = RasterOptions { visibility: Visibility::Scanline, ..Default::default() };
+        let prepared = alhazen_raster::pipeline::prepare(&scene, &z);
+        let (a, _) = alhazen_raster::pipeline::render_prepared(&scene, &prepared, &z).unwrap();
+        let (b, _) = alhazen_raster::pipeline::render_prepared(&scene, &prepared, &scan).unwrap();
+        assert!(a.color == b.color && a.depth == b.depth, "{}", path.display());
+    }
+}

@@ -20,6 +20,7 @@ pub mod geometry;
 pub mod ibl;
 pub mod mirrors;
 pub mod raster;
+pub mod scanline;
 pub mod shade;
 pub mod shadow;
 pub mod stencil;
@@ -50,6 +51,9 @@ pub enum Visibility {
     ZBuffer,
     /// The painter's algorithm over a BSP tree (built once by [`prepare`]).
     Bsp,
+    /// The scan-line algorithm: one row at a time, a depth buffer of one row and the triangles
+    /// crossing it ([`scanline`]).
+    Scanline,
 }
 
 /// Options of a raster render.
@@ -650,14 +654,22 @@ fn render_view_in(
             let (y0, y1) = (band * BAND, ((band + 1) * BAND).min(h));
             let n = ((y1 - y0) * w) as usize;
             let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; ATTRIBUTES]); n]);
-            for t in bins[band as usize].iter().map(|&i| &screen[i as usize]) {
-                rasterize(t, w, y0, y1, |f| {
-                    let k = ((f.y - y0) * w + f.x) as usize;
-                    if (painter || f.depth < depth[k]) && f.depth >= -1.0 {
-                        depth[k] = f.depth;
-                        owner[k] = (t.source, f.attr);
-                    }
+            let bin = &bins[band as usize];
+            if opts.visibility == Visibility::Scanline {
+                scanline::band(&screen, bin, w, (y0, y1), |k, t, f| {
+                    depth[k] = f.depth;
+                    owner[k] = (t.source, f.attr);
                 });
+            } else {
+                for t in bin.iter().map(|&i| &screen[i as usize]) {
+                    rasterize(t, w, y0, y1, |f| {
+                        let k = ((f.y - y0) * w + f.x) as usize;
+                        if (painter || f.depth < depth[k]) && f.depth >= -1.0 {
+                            depth[k] = f.depth;
+                            owner[k] = (t.source, f.attr);
+                        }
+                    });
+                }
             }
             // Stencil shadow volumes: per light, a count per pixel of this band.
             let mut blocked = vec![0u64; n];
