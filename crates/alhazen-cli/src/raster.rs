@@ -39,6 +39,8 @@ pub(crate) enum VisibilityArg {
     Bsp,
     /// The scan-line algorithm (a depth buffer of one row, an active triangle list).
     Scanline,
+    /// The depth-sort painter's algorithm (Newell's overlap tests, splitting cycles).
+    DepthSort,
 }
 
 #[derive(Args)]
@@ -128,6 +130,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
             VisibilityArg::Zbuffer => Visibility::ZBuffer,
             VisibilityArg::Bsp => Visibility::Bsp,
             VisibilityArg::Scanline => Visibility::Scanline,
+            VisibilityArg::DepthSort => Visibility::DepthSort,
         },
     };
     crate::check_memory(alhazen_raster::pipeline::memory_estimate(&scene, &opts), "previewing this scene")?;

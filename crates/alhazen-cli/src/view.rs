@@ -253,7 +253,8 @@ fn handle_input(window: &Window, orbit: &mut Orbit, opts: &mut RasterOptions, la
         opts.visibility = match opts.visibility {
             Visibility::ZBuffer => Visibility::Bsp,
             Visibility::Bsp => Visibility::Scanline,
-            Visibility::Scanline => Visibility::ZBuffer,
+            Visibility::Scanline => Visibility::DepthSort,
+            Visibility::DepthSort => Visibility::ZBuffer,
         };
     }
     let pos = window.get_mouse_pos(MouseMode::Pass);

@@ -15,6 +15,7 @@ pub mod bsp;
 pub mod cameras;
 pub mod clip;
 pub mod csg;
+pub mod depth_sort;
 pub mod emitters;
 pub mod geometry;
 pub mod ibl;
@@ -54,6 +55,9 @@ pub enum Visibility {
     /// The scan-line algorithm: one row at a time, a depth buffer of one row and the triangles
     /// crossing it ([`scanline`]).
     Scanline,
+    /// The depth-sort painter's algorithm with Newell's overlap tests, splitting where no order
+    /// exists ([`depth_sort`]).
+    DepthSort,
 }
 
 /// Options of a raster render.
@@ -632,7 +636,11 @@ fn render_view_in(
         })
         .collect();
     let culled = processed.iter().map(|p| p.0).sum();
-    let screen: Vec<ScreenTriangle> = processed.into_iter().flat_map(|p| p.1).collect();
+    let mut screen: Vec<ScreenTriangle> = processed.into_iter().flat_map(|p| p.1).collect();
+    let painter = painter || opts.visibility == Visibility::DepthSort;
+    if opts.visibility == Visibility::DepthSort {
+        screen = depth_sort::depth_sort(screen).0;
+    }
     // Each band's triangles, in drawing order.
     let band_count = h.div_ceil(BAND) as usize;
     let mut bins: Vec<Vec<u32>> = vec![vec![]; band_count];
