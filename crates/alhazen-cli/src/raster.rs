@@ -41,6 +41,8 @@ pub(crate) enum VisibilityArg {
     Scanline,
     /// The depth-sort painter's algorithm (Newell's overlap tests, splitting cycles).
     DepthSort,
+    /// Warnock's area subdivision.
+    Warnock,
 }
 
 #[derive(Args)]
@@ -131,6 +133,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
             VisibilityArg::Bsp => Visibility::Bsp,
             VisibilityArg::Scanline => Visibility::Scanline,
             VisibilityArg::DepthSort => Visibility::DepthSort,
+            VisibilityArg::Warnock => Visibility::Warnock,
         },
     };
     crate::check_memory(alhazen_raster::pipeline::memory_estimate(&scene, &opts), "previewing this scene")?;

@@ -254,7 +254,8 @@ fn handle_input(window: &Window, orbit: &mut Orbit, opts: &mut RasterOptions, la
             Visibility::ZBuffer => Visibility::Bsp,
             Visibility::Bsp => Visibility::Scanline,
             Visibility::Scanline => Visibility::DepthSort,
-            Visibility::DepthSort => Visibility::ZBuffer,
+            Visibility::DepthSort => Visibility::Warnock,
+            Visibility::Warnock => Visibility::ZBuffer,
         };
     }
     let pos = window.get_mouse_pos(MouseMode::Pass);

@@ -670,10 +670,10 @@ material = { color = [0.9, 0.1, 0.1] }
 
 /// The course's other visibility algorithms against the z-buffer on every scene of `scenes/`
 /// and `scenes/cameras/` but the panorama (see below), with their cameras: the scan-line
-/// algorithm gives its frame and depth bit for bit, the depth-sort painter its frame but on at
-/// most one pixel in a thousand.
+/// algorithm and Warnock's area subdivision give its frame and depth bit for bit, the
+/// depth-sort painter its frame but on at most one pixel in a thousand.
 #[test]
-fn the_scanline_and_depth_sort_algorithms_draw_every_scene_as_the_z_buffer_does() {
+fn the_scanline_warnock_and_depth_sort_algorithms_draw_every_scene_as_the_z_buffer_does() {
     use alhazen_raster::pipeline::Visibility;
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let mut files: Vec<_> = std::fs::read_dir(&root)
@@ -698,6 +698,9 @@ fn the_scanline_and_depth_sort_algorithms_draw_every_scene_as_the_z_buffer_does(
         let (a, _) = alhazen_raster::pipeline::render_prepared(&scene, &prepared, &z).unwrap();
         let (b, _) = alhazen_raster::pipeline::render_prepared(&scene, &prepared, &scan).unwrap();
         assert!(a.color == b.color && a.depth == b.depth, "{}", path.display());
+        let warnock = RasterOptions { visibility: Visibility::Warnock, ..Default::default() };
+        let (d, _) = alhazen_raster::pipeline::render_prepared(&scene, &prepared, &warnock).unwrap();
+        assert!(a.color == d.color && a.depth == d.depth, "Warnock: {}", path.display());
         let sorted = RasterOptions { visibility: Visibility::DepthSort, ..Default::default() };
         let (c, _) = alhazen_raster::pipeline::render_prepared(&scene, &prepared, &sorted).unwrap();
         let differ = a.color.iter().zip(&c.color).filter(|(p, q)| (0..3).any(|k| (p[k] - q[k]).abs() > 1e-3)).count();

@@ -25,6 +25,7 @@ pub mod scanline;
 pub mod shade;
 pub mod shadow;
 pub mod stencil;
+pub mod warnock;
 
 use alhazen_math::viewing::{Frustum, ViewFrame};
 use alhazen_math::{Mat4, Vec2, Vec3, Vec4};
@@ -58,6 +59,8 @@ pub enum Visibility {
     /// The depth-sort painter's algorithm with Newell's overlap tests, splitting where no order
     /// exists ([`depth_sort`]).
     DepthSort,
+    /// Warnock's area subdivision ([`warnock`]).
+    Warnock,
 }
 
 /// Options of a raster render.
@@ -663,11 +666,14 @@ fn render_view_in(
             let n = ((y1 - y0) * w) as usize;
             let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; ATTRIBUTES]); n]);
             let bin = &bins[band as usize];
+            let set = |k: usize, t: &ScreenTriangle, f: raster::Fragment| {
+                depth[k] = f.depth;
+                owner[k] = (t.source, f.attr);
+            };
             if opts.visibility == Visibility::Scanline {
-                scanline::band(&screen, bin, w, (y0, y1), |k, t, f| {
-                    depth[k] = f.depth;
-                    owner[k] = (t.source, f.attr);
-                });
+                scanline::band(&screen, bin, w, (y0, y1), set);
+            } else if opts.visibility == Visibility::Warnock {
+                warnock::band(&screen, bin, w, (y0, y1), set);
             } else {
                 for t in bin.iter().map(|&i| &screen[i as usize]) {
                     rasterize(t, w, y0, y1, |f| {
