@@ -416,6 +416,14 @@ struct Transfer {
     share: f64,
 }
 
+impl Transfer {
+    /// What a light or the sky gives: irradiance `h`, the radiosity `potential` it would give
+    /// unoccluded, and `seen` of `tried` shadow probes lit.
+    fn of_light(h: Vec3, potential: f64, seen: usize, tried: usize) -> Self {
+        Self { h, potential, partial: seen > 0 && seen < tried, uneven: false, factor: 0.0, share: 1.0 }
+    }
+}
+
 struct Solver<'a> {
     scene: &'a Scene,
     world: &'a World,
@@ -719,14 +727,7 @@ impl Solver<'_> {
                     seen += (lit && (!occlusion || self.world.unoccluded(p + n * eps, d / dist, dist))) as usize;
                 }
                 let v = seen as f64 / probes.len() as f64;
-                Transfer {
-                    h: *intensity * (g * v),
-                    potential: luminance(rho * *intensity) * g,
-                    partial: seen > 0 && seen < 4,
-                    uneven: false,
-                    factor: 0.0,
-                    share: 1.0,
-                }
+                Transfer::of_light(*intensity * (g * v), luminance(rho * *intensity) * g, seen, probes.len())
             }
             Source::Directional { towards, irradiance } => {
                 let cos = n.dot(*towards);
@@ -739,14 +740,7 @@ impl Solver<'_> {
                     .filter(|p| !occlusion || self.world.unoccluded(**p + n * eps, *towards, f64::INFINITY))
                     .count();
                 let v = seen as f64 / probes.len() as f64;
-                Transfer {
-                    h: *irradiance * (cos * v),
-                    potential: luminance(rho * *irradiance) * cos,
-                    partial: seen > 0 && seen < 4,
-                    uneven: false,
-                    factor: 0.0,
-                    share: 1.0,
-                }
+                Transfer::of_light(*irradiance * (cos * v), luminance(rho * *irradiance) * cos, seen, probes.len())
             }
             Source::Sky => {
                 let (s, t) = alhazen_math::orthonormal_basis(n);
@@ -762,14 +756,7 @@ impl Solver<'_> {
                     }
                 }
                 let w = PI / SKY_RAYS as f64;
-                Transfer {
-                    h: sum * w,
-                    potential: luminance(rho * open) * w,
-                    partial: seen > 0 && seen < SKY_RAYS,
-                    uneven: false,
-                    factor: 0.0,
-                    share: 1.0,
-                }
+                Transfer::of_light(sum * w, luminance(rho * open) * w, seen, SKY_RAYS)
             }
         }
     }
