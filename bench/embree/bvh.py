@@ -3,7 +3,7 @@
 same incoherent rays.
 
     python3 bench/mitsuba/suite/make_data.py     # the 1,001,108-triangle displaced sphere (once)
-    python3 bench/embree/bvh.py [--rays 1000000] [--threads 1]
+    python3 bench/embree/bvh.py [--rays 1000000] [--threads 1] [--build sah|morton]
 
 Rays: origins uniform in a ball of radius 3 around the mesh's centre (outside and inside it),
 directions towards points uniform in its bounding box: every ray starts somewhere else and
@@ -72,6 +72,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--rays", type=int, default=1_000_000)
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--build", choices=["sah", "morton"], default="sah",
+                    help="how alhazen builds the mesh's BVH (Embree builds its own)")
     a = ap.parse_args()
     if not os.path.exists(MESH):
         sys.exit(f"{MESH} is missing: run python3 bench/mitsuba/suite/make_data.py")
@@ -83,7 +85,7 @@ def main():
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "alhazen-render", "--example", "trace_rays"],
                    cwd=ROOT, check=True)
     exe = os.path.join(ROOT, "target/release/examples/trace_rays")
-    ours = subprocess.run([exe, MESH, rays_bin, hits_bin, str(a.threads)], check=True, capture_output=True,
+    ours = subprocess.run([exe, MESH, rays_bin, hits_bin, str(a.threads), a.build], check=True, capture_output=True,
                           text=True).stdout.strip()
     print(ours)
     t_ours = np.fromfile(hits_bin, dtype="<f4")

@@ -3,13 +3,14 @@
 //! rays with Embree 4.
 //!
 //! ```sh
-//! cargo run --release -p alhazen-render --example trace_rays -- MESH.ply RAYS.bin HITS.bin [THREADS]
+//! cargo run --release -p alhazen-render --example trace_rays -- MESH.ply RAYS.bin HITS.bin [THREADS] [sah|morton]
 //! ```
 //!
 //! `RAYS.bin`: little-endian `f32` records `ox oy oz dx dy dz` (directions need not be unit).
 //! `HITS.bin`: one `f32` per ray, the hit distance along the ray's unit direction (infinity
 //! for a miss). Prints the world's build time (the mesh already loaded) and rays per second,
-//! best of three passes, on `THREADS` threads (default: all).
+//! best of three passes, on `THREADS` threads (default: all; 0 for all), the mesh's BVH built by
+//! the surface area heuristic (default) or in Morton order.
 
 use alhazen_math::{Ray, Vec3};
 use alhazen_render::World;
@@ -19,9 +20,14 @@ use std::time::Instant;
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [mesh, rays, hits, rest @ ..] = args.as_slice() else {
-        return Err("usage: trace_rays MESH.ply RAYS.bin HITS.bin [THREADS]".into());
+        return Err("usage: trace_rays MESH.ply RAYS.bin HITS.bin [THREADS] [sah|morton]".into());
     };
     let threads = rest.first().map(|t| t.parse()).transpose()?.unwrap_or(0);
+    let method = match rest.get(1).map(String::as_str) {
+        None | Some("sah") => alhazen_render::bvh::BuildMethod::Sah,
+        Some("morton") => alhazen_render::bvh::BuildMethod::Morton,
+        Some(other) => return Err(format!("unknown BVH build {other:?}: sah or morton").into()),
+    };
     rayon::ThreadPoolBuilder::new().num_threads(threads).build_global()?;
     let mesh = std::path::absolute(mesh)?;
     let text = format!(
@@ -39,7 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect();
     let t0 = Instant::now();
-    let world = World::build(&scene);
+    let world = World::build_by(&scene, alhazen_render::shape::VectorUnit::detect(), method);
     let build = t0.elapsed().as_secs_f64();
     let mut best = f64::INFINITY;
     let mut t: Vec<f32> = vec![];

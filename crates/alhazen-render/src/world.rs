@@ -235,8 +235,14 @@ impl World {
     /// [`Self::build`] testing packets with `unit`'s kernel (one this processor runs: see
     /// [`VectorUnit::available`]). Every kernel gives the same hits.
     pub fn build_with(scene: &scene::Scene, unit: VectorUnit) -> Self {
+        Self::build_by(scene, unit, crate::bvh::BuildMethod::Sah)
+    }
+
+    /// [`Self::build_with`], the meshes' own hierarchies built by `method` (the same hits by
+    /// either; Morton order builds faster, the surface area heuristic traces faster).
+    pub fn build_by(scene: &scene::Scene, unit: VectorUnit, method: crate::bvh::BuildMethod) -> Self {
         let meshes: Vec<Arc<MeshAccel>> =
-            scene.meshes.iter().map(|m| Arc::new(MeshAccel::with_unit(m.clone(), unit))).collect();
+            scene.meshes.iter().map(|m| Arc::new(MeshAccel::with_build(m.clone(), unit, method))).collect();
         let objects: Vec<WorldObject> = scene
             .objects
             .iter()

@@ -38,9 +38,14 @@ impl MeshAccel {
 
     /// [`Self::new`] for `vectors`' kernel.
     pub fn with_unit(mesh: Arc<TriangleMesh>, vectors: VectorUnit) -> Self {
+        Self::with_build(mesh, vectors, crate::bvh::BuildMethod::Sah)
+    }
+
+    /// [`Self::with_unit`] with the hierarchy built by `method`.
+    pub fn with_build(mesh: Arc<TriangleMesh>, vectors: VectorUnit, method: crate::bvh::BuildMethod) -> Self {
         let flats = flat_primitives(&mesh);
         let bounds: Vec<Bounds3> = flats.iter().map(|f| f.2).collect();
-        let bvh = Bvh::build_packed(&bounds, |_| true);
+        let bvh = Bvh::build_packed_by(&bounds, |_| true, method);
         let (mut packets, mut leaf_packets) = (PackedFlats::default(), vec![0..0; bvh.leaf_order().len()]);
         for range in bvh.leaves() {
             let leaf: Vec<_> =
