@@ -681,8 +681,9 @@ fn the_scanline_warnock_and_depth_sort_algorithms_draw_every_scene_as_the_z_buff
         .chain(std::fs::read_dir(root.join("cameras")).unwrap())
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        // The panorama's cylinder mirror takes ~20 s a frame in its cube faces (the reflex
-        // split recurses far too deep there; noted in the issue), not a visibility matter.
+        // The panorama's cylinder mirror still takes ~6 s a frame at this size in the cube face
+        // that sees it (the reflex split recurses deep there; noted in the issue), not a
+        // visibility matter.
         .filter(|p| !p.ends_with("cameras/panorama.toml"))
         .collect();
     files.sort();

@@ -34,6 +34,8 @@ const FINEST_PX: f64 = 4.0;
 /// Largest distance on screen, in pixels, between the reflex of an edge's midpoint and the
 /// chord's midpoint before the triangle is split.
 const TOLERANCE_PX: f64 = 0.5;
+/// Levels a piece whose reflex crosses the eye's plane is split before it is left out.
+const ACROSS_EYE_LEVELS: u32 = 6;
 
 /// A curved mirror's surface: a sphere, or the side of a finite cylinder.
 #[derive(Clone, Copy, Debug)]
@@ -250,6 +252,28 @@ pub struct MirrorImage {
     pub drawn: usize,
 }
 
+/// False when the mirror lies wholly outside the view volume of `proj`: all eight corners of a
+/// cube around its bounding sphere beyond one of the clip planes.
+fn in_view(surface: &Curved, proj: &Projection) -> bool {
+    let (centre, size) = surface.centre_and_size();
+    // `size` is the larger of radius and half height: √2 times it bounds a cylinder.
+    let r = size * std::f64::consts::SQRT_2;
+    let corners: Vec<Vec4> = (0..8)
+        .map(|i| {
+            let pick = |bit: u32| if i & bit == 0 { -r } else { r };
+            let p = centre + Vec3::new(pick(1), pick(2), pick(4));
+            proj.world_to_clip * Vec4::new(p.x, p.y, p.z, 1.0)
+        })
+        .collect();
+    let outside = |f: fn(&Vec4) -> bool| corners.iter().all(f);
+    !(outside(|c| c.x > c.w)
+        || outside(|c| c.x < -c.w)
+        || outside(|c| c.y > c.w)
+        || outside(|c| c.y < -c.w)
+        || outside(|c| c.z < -c.w)
+        || outside(|c| c.w <= 0.0))
+}
+
 /// The screen position of world point `p`.
 fn to_screen(proj: &Projection, p: Vec3, (w, h): (u32, u32)) -> Vec2 {
     let c = proj.world_to_clip * Vec4::new(p.x, p.y, p.z, 1.0);
@@ -268,6 +292,10 @@ pub fn mirror_image(
 ) -> MirrorImage {
     let eye = proj.frame.eye;
     let surface = mirror.surface;
+    if !in_view(&surface, proj) {
+        // Nothing of the mirror is in this view (a cube face of a panorama looking away).
+        return MirrorImage { object: mirror.object, color: vec![None; (w * h) as usize], drawn: 0 };
+    }
     // Unbounded planes are re-meshed in rings around the mirror (their large squares would
     // need splitting twenty times over to resolve what lies near it).
     let planes = plane_rings(tris, surface.centre_and_size());
@@ -440,11 +468,18 @@ impl Reflexes<'_> {
     /// Emits the reflex of triangle `v` (corner reflexes `r`), split until each piece's edges
     /// are within the tolerance.
     fn split(&self, v: [Vertex; 3], r: [Option<Vec3>; 3], source: u32, level: u32, out: &mut Vec<ScreenTriangle>) {
+        // Reflexes behind the eye are not in this view: a piece wholly behind is left out, one
+        // across the eye's plane is split a few times and then left out too (screen positions
+        // behind the eye mean nothing to the tolerance, which would split it to the last level).
+        let behind = r.iter().flatten().filter(|p| (self.proj.world_to_clip * p.extend(1.0)).w <= 0.0).count();
+        if behind > 0 && (behind == r.iter().flatten().count() || level >= ACROSS_EYE_LEVELS) {
+            return;
+        }
         // Pieces a pixel across are done: drawn when every corner has a reflex, else (deeper
         // down) left out: they lie on the border of the region without reflexes.
         let present: Vec<Vec2> = r.iter().flatten().map(|p| to_screen(self.proj, *p, self.size)).collect();
         let span = present.iter().map(|p| (*p - present[0]).length()).fold(0.0, f64::max);
-        if present.len() == 3 && span <= 1.0 {
+        if behind == 0 && present.len() == 3 && span <= 1.0 {
             // Most triangles of a fine mesh: their reflex is smaller than a pixel (a convex
             // mirror shrinks), no midpoint needs solving.
             self.emit(v, r.map(|x| x.expect("three reflexes")), source, out);
@@ -468,6 +503,7 @@ impl Reflexes<'_> {
         }
         let screen = |p: Vec3| to_screen(self.proj, p, self.size);
         let fits = match (r, rm) {
+            _ if behind > 0 => false,
             ([Some(a), Some(b), Some(c)], [Some(ma), Some(mb), Some(mc)]) => {
                 let (sa, sb, sc) = (screen(a), screen(b), screen(c));
                 let off = [(ma, sb, sc), (mb, sc, sa), (mc, sa, sb)]
@@ -482,7 +518,7 @@ impl Reflexes<'_> {
             let s: Vec<Vec2> = r.iter().flatten().map(|p| screen(*p)).collect();
             s.len() == 3 && s.iter().all(|p| (*p - s[0]).length() <= FINEST_PX)
         };
-        if fits || (level == MAX_LEVEL && small()) {
+        if fits || (level == MAX_LEVEL && behind == 0 && small()) {
             self.emit(v, r.map(|x| x.expect("three reflexes")), source, out);
         } else if level < MAX_LEVEL {
             for (tri, refl) in [
