@@ -49,6 +49,10 @@ pub(crate) struct RenderArgs {
     /// the same image; this is for measuring their speed.
     #[arg(long, value_enum)]
     kernel: Option<KernelArg>,
+    /// How meshes' bounding volume hierarchies are built: the surface area heuristic (traces
+    /// faster) or Morton order (builds faster). The hits are the same but for exact ties.
+    #[arg(long, value_enum, default_value = "sah")]
+    bvh: BvhArg,
     /// Render band I of N of the film's tiles (0 ≤ I < N) into a film part (-o NAME.film), to
     /// be joined with `alhazen merge`: e.g. one band per machine or per job of an array.
     #[arg(long, value_name = "I/N", value_parser = parse_split)]
@@ -81,6 +85,15 @@ enum KernelArg {
     Avx2,
     /// AVX-512 F, DQ, VL and BW (x86-64).
     Avx512,
+}
+
+/// `--bvh`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum BvhArg {
+    /// The surface area heuristic.
+    Sah,
+    /// Morton order (a linear BVH).
+    Morton,
 }
 
 /// `--integrator`.
@@ -396,7 +409,7 @@ fn render_plan(
         clamped: 0,
     });
     let every = Duration::from_secs_f64(a.checkpoint_every);
-    render_tiles(scene, unit, solution, &job, &|t| {
+    render_tiles(scene, unit, a.bvh, solution, &job, &|t| {
         let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
         s.unusable += t.unusable_samples;
         s.clamped += t.clamped_pixels;
@@ -434,6 +447,7 @@ fn render_plan(
 fn render_tiles(
     scene: &Scene,
     unit: VectorUnit,
+    bvh: BvhArg,
     solution: Option<&alhazen_radiosity::Solution>,
     job: &Job,
     done: &(dyn Fn(TileResult) + Sync),
@@ -443,7 +457,13 @@ fn render_tiles(
             let (w, h) = alhazen_render::film_size(scene);
             alhazen_render::film::render_tiles(w, h, &alhazen_radiosity::FinalGather::new(s), job, &STOP, done)
         }
-        None => alhazen_render::render_tiles_with(scene, unit, job, &STOP, done),
+        None => {
+            let method = match bvh {
+                BvhArg::Sah => alhazen_render::bvh::BuildMethod::Sah,
+                BvhArg::Morton => alhazen_render::bvh::BuildMethod::Morton,
+            };
+            alhazen_render::render_tiles_by(scene, unit, method, job, &STOP, done)
+        }
     }
 }
 

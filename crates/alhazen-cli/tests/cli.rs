@@ -1021,3 +1021,32 @@ fn radiosity_options_and_solution_files_are_checked() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("binary"), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(!out.exists());
 }
+
+/// `--bvh morton` builds meshes' hierarchies in Morton order: the same image as the surface
+/// area heuristic's (a mesh of more than 256 triangles, so it keeps its own hierarchy).
+#[test]
+fn a_morton_bvh_renders_the_same_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/teapot.toml");
+    let image = |bvh: &str| {
+        let out = dir.path().join(format!("{bvh}.pfm"));
+        let o = alhazen(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--quiet",
+            "--bvh",
+            bvh,
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--spp",
+            "1",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(out).unwrap()
+    };
+    assert_eq!(image("sah"), image("morton"));
+}

@@ -67,7 +67,9 @@ pub fn render(scene: &Scene, progress: &(dyn Fn(usize, usize) + Sync)) -> Image 
 /// the same image from every kernel.
 pub fn render_with(scene: &Scene, unit: shape::VectorUnit, progress: &(dyn Fn(usize, usize) + Sync)) -> Image {
     let (w, h) = film_size(scene);
-    with_estimator(scene, unit, &|estimator| film::render_image(w, h, estimator, scene.render.spp, progress))
+    with_estimator(scene, unit, bvh::BuildMethod::Sah, &|estimator| {
+        film::render_image(w, h, estimator, scene.render.spp, progress)
+    })
 }
 
 /// About how many bytes rendering `scene` takes beyond the scene itself: the film (its
@@ -99,13 +101,32 @@ pub fn render_tiles_with(
     stop: &std::sync::atomic::AtomicBool,
     done: &(dyn Fn(film::TileResult) + Sync),
 ) {
+    render_tiles_by(scene, unit, bvh::BuildMethod::Sah, job, stop, done)
+}
+
+/// [`render_tiles_with`], the meshes' hierarchies built by `method` (Morton order builds
+/// faster, the surface area heuristic traces faster; the hits are the same but for exact
+/// ties).
+pub fn render_tiles_by(
+    scene: &Scene,
+    unit: shape::VectorUnit,
+    method: bvh::BuildMethod,
+    job: &film::Job,
+    stop: &std::sync::atomic::AtomicBool,
+    done: &(dyn Fn(film::TileResult) + Sync),
+) {
     let (w, h) = film_size(scene);
-    with_estimator(scene, unit, &|estimator| film::render_tiles(w, h, estimator, job, stop, done))
+    with_estimator(scene, unit, method, &|estimator| film::render_tiles(w, h, estimator, job, stop, done))
 }
 
 /// Calls `work` with the scene's integrator over its world.
-fn with_estimator<T>(scene: &Scene, unit: shape::VectorUnit, work: &dyn Fn(&dyn film::PixelEstimator) -> T) -> T {
-    let world = World::build_with(scene, unit);
+fn with_estimator<T>(
+    scene: &Scene,
+    unit: shape::VectorUnit,
+    method: bvh::BuildMethod,
+    work: &dyn Fn(&dyn film::PixelEstimator) -> T,
+) -> T {
+    let world = World::build_by(scene, unit, method);
     let s = &scene.render;
     let camera = Camera::new(&scene.camera, s.width, s.height);
     match s.integrator {
