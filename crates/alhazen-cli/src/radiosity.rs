@@ -80,7 +80,8 @@ impl RadiosityArgs {
 /// Solves `scene` with a progress bar, warns about what radiosity leaves out, and writes the
 /// export if asked.
 pub(crate) fn solve(scene: &Scene, a: &RadiosityArgs, quiet: bool) -> Result<Solution, Failure> {
-    crate::check_memory(alhazen_radiosity::memory_estimate(scene), "solving this scene's radiosity")?;
+    let settings = a.settings();
+    crate::check_memory(alhazen_radiosity::memory_estimate(scene, &settings), "solving this scene's radiosity")?;
     let export = a.export.as_deref().map(open_output).transpose()?;
     let triangles = alhazen_raster::pipeline::geometry::scene_triangles(scene).triangles.len();
     if triangles > MANY_TRIANGLES && !quiet {
@@ -94,7 +95,6 @@ pub(crate) fn solve(scene: &Scene, a: &RadiosityArgs, quiet: bool) -> Result<Sol
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> "),
     );
-    let settings = a.settings();
     let tolerance = settings.tolerance;
     // Progress on a log scale from everything unshot to the tolerance.
     let solution = alhazen_radiosity::solve(scene, &settings, &|shots, unshot| {

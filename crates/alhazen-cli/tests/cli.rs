@@ -1005,6 +1005,10 @@ fn radiosity_options_and_solution_files_are_checked() {
     let (code, err, exists) = render(&floor, &["--integrator", "radiosity"]);
     assert_eq!((code, exists), (0, true), "{err}");
     assert!(err.contains("cut to squares"), "{err}");
+    // A solve that would not fit the memory budget is refused before it starts.
+    let (code, err, exists) = render(OK, &["--integrator", "radiosity", "--max-memory", "100M"]);
+    assert_eq!((code, exists), (2, false), "{err}");
+    assert!(err.contains("radiosity needs about"), "{err}");
     // Not a solution: refused with the reason, nothing written.
     let scene = scene_file(dir.path(), OK);
     std::fs::write(&ply, b"ply\nformat ascii 1.0\nend_header\n").unwrap();

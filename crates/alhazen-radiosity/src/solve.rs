@@ -61,16 +61,20 @@ pub const MAX_PATCHES: usize = 1 << 20;
 /// About how many nodes the quadtrees may hold in all (each tree its share by area, at least
 /// 64 per patch; a node and its display values take about [`NODE_BYTES`]); refinement stops
 /// there.
-pub const MAX_NODES: usize = 1 << 22;
+pub const MAX_NODES: usize = 1 << 21;
 
 /// Bytes per node, with its corners' display values.
 pub const NODE_BYTES: u64 = 320;
 
-/// An upper bound of the bytes a solve of `scene` may take with `settings` (the quadtrees at
-/// their cap, the triangles twice: elements and ray-cast world).
-pub fn memory_estimate(scene: &Scene) -> u64 {
-    let triangles = alhazen_raster::pipeline::geometry::scene_triangles(scene).triangles.len() as u64;
-    2 * MAX_NODES as u64 * NODE_BYTES + triangles * (64 * NODE_BYTES + 1000)
+/// An upper bound of the bytes a solve of `scene` may take with `settings`: the quadtrees at
+/// their caps (the scene's budget of [`MAX_NODES`] plus 64 elements under every patch, a
+/// third more for the nodes above them) and each surface triangle twice (elements and the
+/// ray-cast world). Tessellates the scene to count its patches, allocating nothing big.
+pub fn memory_estimate(scene: &Scene, settings: &Settings) -> u64 {
+    let tris = surfaces(scene).triangles;
+    let size = patch_size_for(&tris, settings);
+    let patches: u64 = tris.iter().map(|t| 1u64 << (2 * patch_level(t.longest_edge(), size, 10))).sum();
+    (MAX_NODES as u64 + patches * 86) * NODE_BYTES + tris.len() as u64 * 1000
 }
 
 impl Default for Settings {
@@ -169,8 +173,7 @@ pub fn solve(
     let triangles = surf.triangles;
     let scene = Arc::new(scene.clone());
     let world = World::build(&triangle_scene(&scene, &triangles));
-    let patch_size = settings.patch_size.unwrap_or_else(|| auto_patch_size(&triangles));
-    let patch_size = fit_patch_size(&triangles, patch_size);
+    let patch_size = patch_size_for(&triangles, settings);
     let area: f64 = triangles.iter().map(|t| t.area).sum();
     let trees: Vec<Tree> = triangles
         .par_iter()
@@ -219,6 +222,12 @@ pub fn solve(
     };
     let corners = crate::display::average_at_vertices(&triangles, &trees);
     Ok(Solution { scene, triangles, trees, world, corners, stats })
+}
+
+/// The patch size `settings` ask for (or the automatic one), grown to keep the patch count
+/// within [`MAX_PATCHES`].
+fn patch_size_for(tris: &[InputTriangle], settings: &Settings) -> f64 {
+    fit_patch_size(tris, settings.patch_size.unwrap_or_else(|| auto_patch_size(tris)))
 }
 
 /// The patch size giving about [`TARGET_PATCHES`] patches.
