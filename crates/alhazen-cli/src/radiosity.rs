@@ -145,10 +145,7 @@ fn write_solution(s: &Solution, file: alhazen_render::output::PendingFile, path:
     let triangles = ply::lit_triangles(s);
     let fingerprint = ply::scene_fingerprint(&s.scene);
     let shown = |t: &ply::LitTriangle, k: usize| {
-        let m = &s.scene.materials[t.material as usize];
-        let rho = alhazen_scene::texture::eval(&m.color, t.uv[k], &s.scene.images) * m.diffuse;
-        let emitted = if t.front { m.emission } else { alhazen_math::Vec3::ZERO };
-        emitted + rho * t.irradiance[k]
+        alhazen_radiosity::display::shown(&s.scene, t.material, t.uv[k], t.irradiance[k], t.front)
     };
     file.finish(|f| ply::write(&mut BufWriter::new(f), &triangles, fingerprint, shown))
         .map_err(|e| Failure::work(format!("cannot write {}: {e}", path.display())))

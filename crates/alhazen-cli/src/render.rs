@@ -274,9 +274,7 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
     let mut plan = Plan::new(&scene, a)?;
     if radiosity && plan.fingerprint != 0 {
         // Parts of renders with other radiosity settings must not merge.
-        let settings = format!("radiosity {:?}", a.radiosity.settings());
-        plan.fingerprint ^=
-            settings.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+        plan.fingerprint ^= part::hash_debug(&("radiosity", a.radiosity.settings()));
     }
     let what = format!("rendering this {}×{} film", plan.width, plan.height);
     crate::check_memory(alhazen_render::memory_estimate(&scene), &what)?;

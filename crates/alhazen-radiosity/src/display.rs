@@ -87,11 +87,18 @@ impl Solution {
     /// surface triangle `t` from its front or back: emission (front only) plus the diffuse
     /// reflection `ρ(uv) Ẽ/π`.
     pub fn radiance(&self, t: usize, b: [f64; 2], uv: Vec2, side: usize) -> Vec3 {
-        let m = &self.scene.materials[self.triangles[t].material as usize];
-        let rho = alhazen_scene::texture::eval(&m.color, uv, &self.scene.images) * m.diffuse;
-        let emitted = if side == 0 { m.emission } else { Vec3::ZERO };
-        emitted + rho.clamp(Vec3::ZERO, Vec3::ONE) * self.irradiance(t, b, side) / PI
+        let material = self.triangles[t].material;
+        shown(&self.scene, material, uv, self.irradiance(t, b, side) / PI, side == 0)
     }
+}
+
+/// The radiance shown where material `material` (texture coordinates `uv`) receives the
+/// irradiance `e_over_pi · π`: its emission on the front, and `ρ(uv) · e_over_pi`.
+pub fn shown(scene: &alhazen_scene::Scene, material: u32, uv: Vec2, e_over_pi: Vec3, front: bool) -> Vec3 {
+    let m = &scene.materials[material as usize];
+    let rho = alhazen_scene::texture::eval(&m.color, uv, &scene.images) * m.diffuse;
+    let emitted = if front { m.emission } else { Vec3::ZERO };
+    emitted + rho.clamp(Vec3::ZERO, Vec3::ONE) * e_over_pi
 }
 
 /// The image of a solution through the scene's camera.

@@ -69,19 +69,13 @@ const FACE_BYTES: usize = 1 + 12 + 4 + 4 + 1;
 /// A hash of what a solution depends on in `scene`: its surfaces, materials, lights and
 /// background (not the camera or the image settings).
 pub fn scene_fingerprint(scene: &alhazen_scene::Scene) -> u64 {
-    struct Fnv(u64);
-    impl std::fmt::Write for Fnv {
-        fn write_str(&mut self, s: &str) -> std::fmt::Result {
-            for b in s.bytes() {
-                self.0 = (self.0 ^ b as u64).wrapping_mul(0x100_0000_01b3);
-            }
-            Ok(())
-        }
-    }
-    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
-    let what = (&scene.objects, &scene.meshes, &scene.materials, &scene.lights, &scene.background);
-    std::fmt::write(&mut h, format_args!("{what:?}")).expect("hashing never fails");
-    h.0
+    alhazen_render::film::part::hash_debug(&(
+        &scene.objects,
+        &scene.meshes,
+        &scene.materials,
+        &scene.lights,
+        &scene.background,
+    ))
 }
 
 /// The triangles of `solution` (see the module doc).

@@ -42,8 +42,14 @@ pub struct Part {
 /// options applied (size, spp, seed, integrator…). Parts of different renders have different
 /// fingerprints (FNV-1a over the scene's `Debug` text, streamed: nothing is allocated).
 pub fn fingerprint(scene: &alhazen_scene::Scene) -> u64 {
+    hash_debug(scene)
+}
+
+/// The FNV-1a hash of `value`'s `Debug` form, streamed (no string is built): a fingerprint of
+/// plain data.
+pub fn hash_debug(value: &impl fmt::Debug) -> u64 {
     let mut h = Fnv::default();
-    fmt::write(&mut h, format_args!("{scene:?}")).expect("hashing never fails");
+    fmt::write(&mut h, format_args!("{value:?}")).expect("hashing never fails");
     h.0
 }
 
