@@ -996,7 +996,16 @@ fn radiosity_options_and_solution_files_are_checked() {
     let (code, err, exists) = render(OK, &["--integrator", "radiosity", "--export", "s.obj"]);
     assert_eq!((code, exists), (2, false), "{err}");
     assert!(err.contains(".ply"), "{err}");
-    for bad in [["--patch-size", "0"], ["--radiosity-tolerance", "1.5"], ["--levels", "9"]] {
+    for bad in [
+        ["--patch-size", "0"],
+        ["--patch-size", "NaN"],
+        ["--patch-size", "-1"],
+        ["--radiosity-tolerance", "1.5"],
+        ["--radiosity-tolerance", "nan"],
+        ["--levels", "9"],
+        ["--hemicube", "4"],
+        ["--export", "/no/such/dir/s.ply"],
+    ] {
         let (code, err, _) = render(OK, &[&["--integrator", "radiosity"][..], &bad[..]].concat());
         assert_eq!(code, 2, "{bad:?}: {err}");
     }
