@@ -186,14 +186,148 @@ impl<P: ControlPoint> BSpline<P> {
     }
 }
 
+impl<P: ControlPoint> BSpline<P> {
+    /// The clamped spline joining Bézier arcs `arcs[i]` (all of one degree `n`) on
+    /// `[breaks[i], breaks[i + 1]]`: end knots of multiplicity `n + 1`, interior knots of
+    /// multiplicity `n` (the arcs' shared end points are the joints).
+    pub fn from_bezier(arcs: &[Bezier<P>], breaks: &[f64]) -> Result<Self, SplineError> {
+        let n = arcs.first().map_or(0, |a| a.degree());
+        if arcs.is_empty() || breaks.len() != arcs.len() + 1 || arcs.iter().any(|a| a.degree() != n) {
+            return Err(SplineError::Count);
+        }
+        let mut knots = vec![breaks[0]; n + 1];
+        let mut points = arcs[0].points().to_vec();
+        for (arc, &u) in arcs[1..].iter().zip(&breaks[1..]) {
+            knots.extend(std::iter::repeat_n(u, n));
+            points.extend_from_slice(&arc.points()[1..]);
+        }
+        knots.extend(std::iter::repeat_n(breaks[breaks.len() - 1], n + 1));
+        Self::new(n, knots, points)
+    }
+
+    /// The distinct knots of the domain, in order: the ends of the polynomial arcs.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let (a, b) = self.domain();
+        let mut distinct: Vec<f64> = self.knots.iter().copied().filter(|u| *u >= a && *u <= b).collect();
+        distinct.dedup();
+        distinct
+    }
+
+    /// Degree elevation (course: "the same curve one degree higher"): every Bézier arc is
+    /// elevated and the arcs are joined again ([`Self::from_bezier`]), so the result is the same
+    /// curve, clamped, on the same domain.
+    pub fn elevate(&self) -> BSpline<P> {
+        let arcs: Vec<Bezier<P>> = self.to_bezier().iter().map(Bezier::elevate).collect();
+        Self::from_bezier(&arcs, &self.breakpoints()).expect("arcs of one degree on the spline's own breakpoints")
+    }
+
+    /// Whether the end knots have multiplicity `n + 1` (the curve starts and ends at its end
+    /// control points).
+    pub fn is_clamped(&self) -> bool {
+        let (n, u) = (self.degree, &self.knots);
+        u[..=n].iter().all(|k| *k == u[0]) && u[u.len() - 1 - n..].iter().all(|k| *k == u[u.len() - 1])
+    }
+
+    /// The same curve, clamped, with its knots mapped affinely so that the domain is `[0, 1]`.
+    pub fn normalized(&self) -> BSpline<P> {
+        let c = self.clamped();
+        let (a, b) = c.domain();
+        let knots = c.knots.iter().map(|u| ((u - a) / (b - a)).clamp(0.0, 1.0)).collect();
+        BSpline { knots, ..c }
+    }
+
+    /// The same curve on the same domain with clamped ends (joined from its Bézier arcs if it was
+    /// not clamped).
+    pub fn clamped(&self) -> BSpline<P> {
+        if self.is_clamped() {
+            return self.clone();
+        }
+        Self::from_bezier(&self.to_bezier(), &self.breakpoints()).expect("the spline's own arcs")
+    }
+
+    /// One step of subdivision: a knot at the middle of every span of the domain. On uniform
+    /// knots this is the Lane–Riesenfeld step (doubling and `n` averagings, on knots of half the
+    /// spacing); otherwise Boehm's insertion, one knot at a time. The control polygon converges
+    /// to the curve as the steps repeat — the course's way to display a spline.
+    pub fn subdivided(&self) -> BSpline<P> {
+        let n = self.degree;
+        let gaps: Vec<f64> = self.knots.windows(2).map(|w| w[1] - w[0]).collect();
+        let uniform = gaps.iter().all(|g| (g - gaps[0]).abs() <= 1e-12 * gaps[0].abs().max(1e-300)) && gaps[0] > 0.0;
+        if uniform && n > 0 {
+            let points = lane_riesenfeld(&self.points, n);
+            let h = gaps[0] / 2.0;
+            let start = self.knots[n] - n as f64 * h;
+            let knots = (0..points.len() + n + 1).map(|i| start + i as f64 * h).collect();
+            return BSpline { degree: n, knots, points };
+        }
+        let mids: Vec<f64> = self.breakpoints().windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+        mids.iter().fold(self.clone(), |s, &t| s.insert_knot(t))
+    }
+
+    /// The same curve with every knot of `knots` (sorted, within the domain) present at least as
+    /// often as there: the missing ones inserted by Boehm's algorithm.
+    pub fn with_knots(&self, knots: &[f64]) -> BSpline<P> {
+        let mut s = self.clone();
+        let mut i = 0;
+        while i < knots.len() {
+            let u = knots[i];
+            let want = knots[i..].iter().take_while(|k| **k == u).count();
+            let have = s.knots.iter().filter(|k| **k == u).count();
+            for _ in have..want {
+                s = s.insert_knot(u);
+            }
+            i += want;
+        }
+        s
+    }
+}
+
+/// Curves made compatible for lofting and sweeping (course: "all curves must have the same
+/// degree and the same knots"): each is clamped and mapped to the domain `[0, 1]`, raised to the
+/// highest degree among them by degree elevation, and given the union of all knots (each with
+/// its largest multiplicity) by knot insertion. Every curve stays the same point set with the
+/// same parametrisation up to the affine map of its domain.
+pub fn make_compatible<P: ControlPoint>(curves: &[BSpline<P>]) -> Vec<BSpline<P>> {
+    let degree = curves.iter().map(|c| c.degree).max().unwrap_or(0);
+    let raised: Vec<BSpline<P>> = curves
+        .iter()
+        .map(|c| {
+            let mut c = c.normalized();
+            while c.degree < degree {
+                c = c.elevate();
+            }
+            c
+        })
+        .collect();
+    // Knots closer than this are one knot (they differ only by the rounding of the domain map).
+    const SAME_KNOT: f64 = 1e-12;
+    let mut values: Vec<f64> = raised.iter().flat_map(|c| c.knots.iter().copied()).collect();
+    values.sort_by(f64::total_cmp);
+    values.dedup_by(|a, b| (*a - *b).abs() <= SAME_KNOT);
+    let snap = |c: &BSpline<P>| -> BSpline<P> {
+        let knots = c
+            .knots
+            .iter()
+            .map(|u| *values.iter().find(|v| (*v - u).abs() <= SAME_KNOT).expect("every knot is among the values"))
+            .collect();
+        BSpline { knots, ..c.clone() }
+    };
+    let snapped: Vec<BSpline<P>> = raised.iter().map(snap).collect();
+    let merged: Vec<f64> = values
+        .iter()
+        .flat_map(|&v| {
+            let mult = snapped.iter().map(|c| c.knots.iter().filter(|k| **k == v).count()).max().unwrap_or(0);
+            std::iter::repeat_n(v, mult)
+        })
+        .collect();
+    snapped.iter().map(|c| c.with_knots(&merged)).collect()
+}
+
 /// The `k` with `t ∈ [u_k, u_{k+1})`, `n ≤ k < N − n` (the last span for the right end).
 pub(crate) fn span(knots: &[f64], n: usize, t: f64) -> usize {
     let last = knots.len() - 2 - n;
-    let mut k = n;
-    while k < last && t >= knots[k + 1] {
-        k += 1;
-    }
-    k
+    // Knots do not decrease: those ≤ t among u_{n+1} … u_last are a prefix.
+    n + knots[n + 1..=last].partition_point(|u| *u <= t)
 }
 
 /// De Boor's algorithm: the point at `t` (clamped to the domain) of the B-spline of degree `n`
@@ -350,6 +484,52 @@ mod tests {
             for (arc, w) in arcs.iter().zip(distinct.windows(2)) {
                 let t = w[0] + (w[1] - w[0]) * g;
                 prop_assert!(close(arc.eval(g), s.eval(t)));
+            }
+        }
+
+        #[test]
+        fn degree_elevation_keeps_the_curve(s in arb_spline(), g in 0.0..1.0f64) {
+            let e = s.elevate();
+            prop_assert_eq!(e.degree(), s.degree() + 1);
+            prop_assert!(e.is_clamped());
+            prop_assert_eq!(e.domain(), s.domain());
+            let (a, b) = s.domain();
+            let t = a + (b - a) * g;
+            prop_assert!(close(e.eval(t), s.eval(t)), "{} vs {}", e.eval(t), s.eval(t));
+        }
+
+        #[test]
+        fn subdivision_keeps_the_curve_and_halves_the_spans(s in arb_spline(), g in 0.0..1.0f64) {
+            let r = s.subdivided();
+            let (a, b) = s.domain();
+            prop_assert_eq!(r.domain(), (a, b));
+            prop_assert_eq!(r.breakpoints().len() - 1, 2 * (s.breakpoints().len() - 1));
+            let t = a + (b - a) * g;
+            prop_assert!(close(r.eval(t), s.eval(t)));
+        }
+
+        #[test]
+        fn lane_riesenfeld_is_midpoint_knot_insertion_on_uniform_knots(n in 1usize..5, len in 6usize..10, g in 0.0..1.0f64) {
+            let pts: Vec<Vec3> = (0..len).map(|k| Vec3::new(k as f64, ((k * 7) % 5) as f64, ((k * 3) % 4) as f64)).collect();
+            let s = BSpline::new(n, (0..len + n + 1).map(|i| i as f64 * 0.5).collect(), pts).unwrap();
+            let lr = s.subdivided();
+            let boehm = s.breakpoints().windows(2).fold(s.clone(), |c, w| c.insert_knot(0.5 * (w[0] + w[1])));
+            let (a, b) = s.domain();
+            let t = a + (b - a) * g;
+            prop_assert!(close(lr.eval(t), boehm.eval(t)) && close(lr.eval(t), s.eval(t)));
+            // One new control point per span of the domain either way.
+            prop_assert_eq!(lr.points().len(), boehm.points().len());
+        }
+
+        #[test]
+        fn compatible_curves_share_degree_and_knots_and_keep_their_shape(a in arb_spline(), b in arb_spline(), g in 0.0..1.0f64) {
+            let c = make_compatible(&[a.clone(), b.clone()]);
+            prop_assert_eq!(c[0].degree(), a.degree().max(b.degree()));
+            prop_assert_eq!(c[0].knots(), c[1].knots());
+            prop_assert_eq!(c[0].domain(), (0.0, 1.0));
+            for (orig, comp) in [a, b].iter().zip(&c) {
+                let (lo, hi) = orig.domain();
+                prop_assert!(close(comp.eval(g), orig.eval(lo + (hi - lo) * g)));
             }
         }
 

@@ -3,7 +3,7 @@
 //! spherical products (surfaces of revolution) of rational curves.
 
 use crate::bezier::ControlPoint;
-use crate::bspline::BSpline;
+use crate::bspline::{BSpline, make_compatible};
 use crate::patch::{BSplinePatch, Net};
 use alhazen_math::{Vec3, Vec4};
 
@@ -79,16 +79,15 @@ pub fn chord_lengths<P: ControlPoint>(q: &[P]) -> Vec<f64> {
     t
 }
 
-/// Lofting (skinning): the bicubic-by-`m` B-spline patch through the curves `curves[i]` at
-/// `u = t[i]`. All curves must share degree and knots (the course's assumption); each column of
-/// the control net is interpolated like a point.
-pub fn loft(curves: &[BSpline<Vec3>], t: &[f64]) -> Option<BSplinePatch<Vec3>> {
+/// Lofting (skinning): the cubic-by-`m` B-spline patch through the curves `curves[i]` at
+/// `u = t[i]`. The course assumes all curves share degree and knots; curves that do not are made
+/// so first ([`make_compatible`]: degree elevation and knot insertion, domains mapped to
+/// `[0, 1]`). Each column of the control net is then interpolated like a point.
+pub fn loft<P: ControlPoint>(curves: &[BSpline<P>], t: &[f64]) -> Option<BSplinePatch<P>> {
+    let curves = make_compatible(curves);
     let first = curves.first()?;
-    if curves.iter().any(|c| c.degree() != first.degree() || c.knots() != first.knots()) {
-        return None;
-    }
     let cols = first.points().len();
-    let columns: Vec<BSpline<Vec3>> = (0..cols)
+    let columns: Vec<BSpline<P>> = (0..cols)
         .map(|j| interpolate_cubic(&curves.iter().map(|c| c.points()[j]).collect::<Vec<_>>(), t))
         .collect::<Option<_>>()?;
     let rows = columns[0].points().len();
@@ -103,17 +102,23 @@ pub fn loft(curves: &[BSpline<Vec3>], t: &[f64]) -> Option<BSplinePatch<Vec3>> {
     .ok()
 }
 
-/// The swept surface with guide `p` and auxiliary guides `x1, x2, x3` (same degree and knots) and
-/// cross-section `q`: control points `d_ij = x1_i x_q_j + x2_i y_q_j + x3_i z_q_j + p_i`.
-pub fn sweep(p: &BSpline<Vec3>, x: [&BSpline<Vec3>; 3], q: &BSpline<Vec3>) -> Option<BSplinePatch<Vec3>> {
+/// The swept surface (course, §"Swept surfaces") with guide `p(u)`, auxiliary guides
+/// `x1, x2, x3` (the frame, of `p`'s degree and knots) and cross-section `q(v)`:
+/// `s(u, v) = p(u) + x1(u) q_x(v) + x2(u) q_y(v) + x3(u) q_z(v)`, so the control points are the
+/// course's `d_ij = x1_i x_q_j + x2_i y_q_j + x3_i z_q_j + p_i`. Guide and section may be rational
+/// (homogeneous control points); the frame then shares the guide's weights, which keeps the
+/// surface a tensor product: `D_ij = (W_j P_i + w_i Σ_k x_k,i Q_j,k, w_i W_j)`.
+pub fn sweep(p: &BSpline<Vec4>, x: [&BSpline<Vec3>; 3], q: &BSpline<Vec4>) -> Option<BSplinePatch<Vec4>> {
     if x.iter().any(|g| g.knots() != p.knots() || g.degree() != p.degree()) {
         return None;
     }
     let (rows, cols) = (p.points().len(), q.points().len());
     let mut pts = Vec::with_capacity(rows * cols);
-    for i in 0..rows {
+    for (i, gp) in p.points().iter().enumerate() {
+        let frame = [x[0].points()[i], x[1].points()[i], x[2].points()[i]];
         for qj in q.points() {
-            pts.push(x[0].points()[i] * qj.x + x[1].points()[i] * qj.y + x[2].points()[i] * qj.z + p.points()[i]);
+            let offset = frame[0] * qj.x + frame[1] * qj.y + frame[2] * qj.z;
+            pts.push((gp.truncate() * qj.w + offset * gp.w).extend(gp.w * qj.w));
         }
     }
     BSplinePatch::new(p.degree(), q.degree(), p.knots().to_vec(), q.knots().to_vec(), Net::new(rows, cols, pts)?).ok()
@@ -151,35 +156,126 @@ pub fn revolution(profile: &[(f64, f64)]) -> Option<BSplinePatch<Vec4>> {
     let meridian = interpolate_cubic(&q, &chord_lengths(&q))?;
     let homogeneous =
         BSpline::new(3, meridian.knots().to_vec(), meridian.points().iter().map(|p| p.extend(1.0)).collect()).ok()?;
-    spherical_product(&crate::bspline::nurbs_circle(Vec3::ZERO, 1.0), &homogeneous)
+    revolution_of(&homogeneous)
 }
 
-/// A tube swept along the cubic interpolant of `guide` with a circular cross-section of
-/// `radius`: the auxiliary guides are a rotation-minimising frame carried along the guide's
-/// control polygon, the cross-section a 16-gon (a linear B-spline), so the result is the
-/// course's swept B-spline surface.
-pub fn swept_tube(guide: &[Vec3], radius: f64) -> Option<BSplinePatch<Vec3>> {
-    let p = interpolate_cubic(guide, &chord_lengths(guide))?;
-    let cp = p.points();
-    let tangent = |i: usize| (cp[(i + 1).min(cp.len() - 1)] - cp[i.saturating_sub(1)]).normalize_or(Vec3::Z);
-    let mut n = alhazen_math::orthonormal_basis(tangent(0)).0;
-    let (mut x1, mut x2, mut x3) = (vec![], vec![], vec![]);
-    for i in 0..cp.len() {
-        let t = tangent(i);
-        n = (n - t * n.dot(t)).normalize_or(alhazen_math::orthonormal_basis(t).0);
-        x1.push(n * radius);
-        x2.push(t.cross(n) * radius);
-        x3.push(t * 0.0);
+/// The surface of revolution about the `z` axis of a rational profile `(r w, h w, 0, w)` (radius
+/// `r`, height `h`): the spherical product with the exact NURBS circle.
+pub fn revolution_of(profile: &BSpline<Vec4>) -> Option<BSplinePatch<Vec4>> {
+    spherical_product(&crate::bspline::nurbs_circle(Vec3::ZERO, 1.0), profile)
+}
+
+/// A swept surface whose frame follows its guide, and how far it is from the ideal one.
+#[derive(Clone, Debug)]
+pub struct FramedSweep {
+    /// The rational B-spline surface.
+    pub surface: BSplinePatch<Vec4>,
+    /// The largest deviation measured (in the section's units) of the placed section from a
+    /// rigid copy in the guide's normal plane: `R · max(|‖x₁‖ − 1|, |‖x₂‖ − 1|, |x₁·x₂|, |x₁·t|,
+    /// |x₂·t|)` with `R` the section's extent, over samples of every span.
+    pub error: f64,
+    /// How many times the guide was subdivided to reach it.
+    pub subdivisions: usize,
+}
+
+/// Control points beyond which [`framed_sweep`] stops subdividing the guide.
+pub const MAX_GUIDE_POINTS: usize = 1 << 14;
+
+/// The course's swept surface with the auxiliary guides computed: a rotation-minimising frame
+/// (double reflection, Wang et al. 2008) at the Greville abscissae of the guide, from its exact
+/// tangents, is the frame's control points. Between them the frame is a spline, slightly
+/// stretched and skewed; the guide is subdivided ([`BSpline::subdivided`]: Lane–Riesenfeld or
+/// Boehm's knot insertion) until that deviation is within `tolerance`, so the section —
+/// by default the exact rational circle — is placed as precisely as asked. `section` is a planar
+/// rational curve in the frame's `(normal, binormal)` plane.
+pub fn framed_sweep(guide: &BSpline<Vec4>, section: &BSpline<Vec4>, tolerance: f64) -> Option<FramedSweep> {
+    let extent = section.points().iter().map(|q| (q.truncate() / q.w).length()).fold(0.0, f64::max);
+    let mut guide = guide.clone();
+    let mut subdivisions = 0;
+    loop {
+        let frame = rotation_minimising_frame(&guide)?;
+        let error = extent * frame_deviation(&guide, &frame)?;
+        let [n, b, t] = frame.map(|f| BSpline::new(guide.degree(), guide.knots().to_vec(), f).expect("guide's knots"));
+        let surface = sweep(&guide, [&n, &b, &t], section)?;
+        if error <= tolerance || guide.points().len() * 2 > MAX_GUIDE_POINTS || !error.is_finite() {
+            return Some(FramedSweep { surface, error, subdivisions });
+        }
+        guide = guide.subdivided();
+        subdivisions += 1;
     }
-    let guide_of = |pts: Vec<Vec3>| BSpline::new(3, p.knots().to_vec(), pts).ok();
-    let (g1, g2, g3) = (guide_of(x1)?, guide_of(x2)?, guide_of(x3)?);
-    let ring: Vec<Vec3> = (0..=16)
-        .map(|k| {
-            let a = std::f64::consts::TAU * k as f64 / 16.0;
-            Vec3::new(a.cos(), a.sin(), 0.0)
-        })
-        .collect();
-    sweep(&p, [&g1, &g2, &g3], &BSpline::clamped_uniform(1, ring).ok()?)
+}
+
+/// A tube of `radius` around `guide`: [`framed_sweep`] of the exact NURBS circle.
+pub fn swept_tube(guide: &BSpline<Vec4>, radius: f64, tolerance: f64) -> Option<FramedSweep> {
+    framed_sweep(guide, &crate::bspline::nurbs_circle(Vec3::ZERO, radius), tolerance)
+}
+
+/// The point and unit tangent of a rational curve at `t` (`None` where the derivative vanishes).
+fn point_and_tangent(c: &BSpline<Vec4>, dc: &BSpline<Vec4>, t: f64) -> (Vec3, Option<Vec3>) {
+    let (h, dh) = (c.eval(t), dc.eval(t));
+    let p = h.truncate() / h.w;
+    (p, ((dh.truncate() - p * dh.w) / h.w).try_normalize())
+}
+
+/// The Greville abscissae `ξ_i = (u_{i+1} + … + u_{i+n}) / n` (the parameters the control
+/// points belong to).
+fn greville(c: &BSpline<Vec4>) -> Vec<f64> {
+    let (n, u) = (c.degree().max(1), c.knots());
+    (0..c.points().len()).map(|i| u[i + 1..=i + n].iter().sum::<f64>() / n as f64).collect()
+}
+
+/// Normal, binormal and tangent at the Greville abscissae, transported by double reflection.
+fn rotation_minimising_frame(c: &BSpline<Vec4>) -> Option<[Vec<Vec3>; 3]> {
+    let dc = c.derivative()?;
+    let samples: Vec<(Vec3, Option<Vec3>)> = greville(c).iter().map(|&t| point_and_tangent(c, &dc, t)).collect();
+    let first = samples.iter().find_map(|s| s.1)?;
+    let (mut x, mut t) = (samples[0].0, first);
+    let mut r = alhazen_math::orthonormal_basis(t).0;
+    let mut frame = [vec![], vec![], vec![]];
+    for &(xn, tn) in &samples {
+        let tn = tn.unwrap_or(t);
+        let v1 = xn - x;
+        let c1 = v1.dot(v1);
+        let (rl, tl) =
+            if c1 > 0.0 { (r - v1 * (2.0 / c1 * v1.dot(r)), t - v1 * (2.0 / c1 * v1.dot(t))) } else { (r, t) };
+        let v2 = tn - tl;
+        let c2 = v2.dot(v2);
+        let rn = if c2 > 0.0 { rl - v2 * (2.0 / c2 * v2.dot(rl)) } else { rl };
+        r = (rn - tn * rn.dot(tn)).normalize_or(alhazen_math::orthonormal_basis(tn).0);
+        (x, t) = (xn, tn);
+        frame[0].push(r);
+        frame[1].push(t.cross(r));
+        frame[2].push(t);
+    }
+    Some(frame)
+}
+
+/// The largest deviation of the spline frame from an orthonormal frame perpendicular to the
+/// guide, over eight samples in every span.
+fn frame_deviation(c: &BSpline<Vec4>, frame: &[Vec<Vec3>; 3]) -> Option<f64> {
+    let dc = c.derivative()?;
+    // The frame's splines carry the guide's weights: x(u) = Σ N_i w_i x_i / w(u).
+    let weighted = |f: &Vec<Vec3>| {
+        let pts = f.iter().zip(c.points()).map(|(x, h)| (*x * h.w).extend(h.w)).collect();
+        BSpline::new(c.degree(), c.knots().to_vec(), pts).expect("guide's knots")
+    };
+    let (xn, xb) = (weighted(&frame[0]), weighted(&frame[1]));
+    let at = |s: &BSpline<Vec4>, u: f64| {
+        let h = s.eval(u);
+        h.truncate() / h.w
+    };
+    let mut worst = 0.0f64;
+    for w in c.breakpoints().windows(2) {
+        for k in 0..=8 {
+            let u = w[0] + (w[1] - w[0]) * k as f64 / 8.0;
+            let Some(t) = point_and_tangent(c, &dc, u).1 else { continue };
+            let (n, b) = (at(&xn, u), at(&xb, u));
+            let dev =
+                [(n.length() - 1.0).abs(), (b.length() - 1.0).abs(), n.dot(b).abs(), n.dot(t).abs(), b.dot(t).abs()];
+            worst = dev.into_iter().fold(worst, f64::max);
+        }
+    }
+    Some(worst)
 }
 
 #[cfg(test)]
@@ -213,23 +309,26 @@ mod tests {
         }
     }
 
+    fn homogeneous(c: &BSpline<Vec3>) -> BSpline<Vec4> {
+        BSpline::new(c.degree(), c.knots().to_vec(), c.points().iter().map(|p| p.extend(1.0)).collect()).unwrap()
+    }
+
+    fn point(h: Vec4) -> Vec3 {
+        h.truncate() / h.w
+    }
+
     #[test]
     fn sweeping_a_circle_along_a_line_gives_a_cylinder() {
         let line = |a: Vec3, b: Vec3| BSpline::clamped_uniform(1, vec![a, b]).unwrap();
-        let guide = line(Vec3::ZERO, Vec3::new(0.0, 0.0, 3.0));
+        let guide = homogeneous(&line(Vec3::ZERO, Vec3::new(0.0, 0.0, 3.0)));
         let (x1, x2, x3) = (line(Vec3::X, Vec3::X), line(Vec3::Y, Vec3::Y), line(Vec3::Z, Vec3::Z));
-        // The cross-section: a polygonal approximation of a circle is enough to check the frame.
-        let ring: Vec<Vec3> = (0..=8)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / 8.0;
-                Vec3::new(a.cos(), a.sin(), 0.0)
-            })
-            .collect();
-        let section = BSpline::clamped_uniform(1, ring).unwrap();
-        let s = sweep(&guide, [&x1, &x2, &x3], &section).unwrap();
-        for k in 0..=8 {
-            let p = s.net.points[s.net.cols + k];
-            assert!(((p.x * p.x + p.y * p.y).sqrt() - 1.0).abs() < 1e-12 && (p.z - 3.0).abs() < 1e-12);
+        let s = sweep(&guide, [&x1, &x2, &x3], &nurbs_circle(Vec3::ZERO, 1.0)).unwrap();
+        let ((u0, u1), (v0, v1)) = s.domain();
+        for i in 0..=10 {
+            for j in 0..=60 {
+                let p = point(s.eval(u0 + (u1 - u0) * i as f64 / 10.0, v0 + (v1 - v0) * j as f64 / 60.0));
+                assert!((p.truncate().length() - 1.0).abs() < 1e-12 && (p.z - 0.3 * i as f64).abs() < 1e-12, "{p}");
+            }
         }
     }
 
@@ -249,14 +348,58 @@ mod tests {
         }
     }
 
+    /// The largest `| |s(u, v) − c(u)| − r |` over a fine sampling of a tube around `c`.
+    fn radial_error(tube: &FramedSweep, c: &BSpline<Vec4>, r: f64) -> f64 {
+        let ((u0, u1), (v0, v1)) = tube.surface.domain();
+        let (a, b) = c.domain();
+        let mut worst = 0.0f64;
+        for i in 0..=200 {
+            let f = i as f64 / 200.0;
+            let centre = point(c.eval(a + (b - a) * f));
+            for j in 0..=24 {
+                let p = point(tube.surface.eval(u0 + (u1 - u0) * f, v0 + (v1 - v0) * j as f64 / 24.0));
+                worst = worst.max(((p - centre).length() - r).abs());
+            }
+        }
+        worst
+    }
+
     #[test]
-    fn swept_tube_has_constant_radius_at_the_control_frames() {
+    fn a_swept_tube_is_as_round_as_its_tolerance_asks() {
         let guide = [Vec3::ZERO, Vec3::new(1.0, 0.5, 0.0), Vec3::new(2.0, 0.0, 1.0), Vec3::new(3.0, 1.0, 1.0)];
-        let s = swept_tube(&guide, 0.2).unwrap();
-        s.net.points.chunks(s.net.cols).for_each(|row| {
-            let c = row[0] - (row[0] - row[8]) * 0.5;
-            assert!(row[..16].iter().all(|p| ((*p - c).length() - 0.2).abs() < 1e-9));
-        });
+        let c = homogeneous(&interpolate_cubic(&guide, &chord_lengths(&guide)).unwrap());
+        let mut last = f64::INFINITY;
+        for tol in [1e-2, 1e-3, 1e-4, 1e-5] {
+            let tube = swept_tube(&c, 0.2, tol).unwrap();
+            assert!(tube.error <= tol, "{tol}: {}", tube.error);
+            let measured = radial_error(&tube, &c, 0.2);
+            assert!(measured <= 2.0 * tol, "tolerance {tol}: measured radial error {measured}");
+            assert!(measured <= last);
+            last = measured;
+        }
+        assert!(swept_tube(&c, 0.2, 1e-5).unwrap().subdivisions >= 2);
+    }
+
+    #[test]
+    fn a_tube_around_a_rational_guide_follows_it() {
+        // A quarter of a circle of radius 2 as guide: the tube is a piece of a torus.
+        let guide = crate::bspline::conic_arc(
+            Vec3::X * 2.0,
+            Vec3::new(2.0, 2.0, 0.0),
+            Vec3::Y * 2.0,
+            std::f64::consts::FRAC_1_SQRT_2,
+        );
+        let tube = swept_tube(&guide, 0.5, 1e-4).unwrap();
+        assert!(radial_error(&tube, &guide, 0.5) <= 2e-4);
+        // Every point lies on the torus: distance from the guide circle is the tube radius.
+        let ((u0, u1), (v0, v1)) = tube.surface.domain();
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let p = point(tube.surface.eval(u0 + (u1 - u0) * i as f64 / 20.0, v0 + (v1 - v0) * j as f64 / 20.0));
+                let ring = Vec3::new(p.x, p.y, 0.0).normalize() * 2.0;
+                assert!(((p - ring).length() - 0.5).abs() <= 2e-4, "{p}");
+            }
+        }
     }
 
     #[test]
@@ -270,8 +413,39 @@ mod tests {
         let (v0, v1) = curves[0].domain();
         for (c, ti) in curves.iter().zip(t) {
             for j in 0..=10 {
-                let v = v0 + (v1 - v0) * j as f64 / 10.0;
-                assert!((s.eval(ti, v) - c.eval(v)).length() < 1e-9);
+                let f = j as f64 / 10.0;
+                assert!((s.eval(ti, f) - c.eval(v0 + (v1 - v0) * f)).length() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn curves_of_different_degrees_and_knots_are_lofted_exactly() {
+        // A line (degree 1, 2 points), a cubic on uneven knots and a rational circle arc.
+        let line = homogeneous(&BSpline::clamped_uniform(1, vec![Vec3::ZERO, Vec3::new(3.0, 0.0, 0.0)]).unwrap());
+        let cubic = homogeneous(
+            &BSpline::new(
+                3,
+                vec![0.0, 0.0, 0.0, 0.0, 0.3, 1.7, 2.0, 2.0, 2.0, 2.0],
+                (0..6).map(|k| Vec3::new(k as f64 * 0.6, 1.0, (k as f64).sin())).collect(),
+            )
+            .unwrap(),
+        );
+        let arc = crate::bspline::conic_arc(
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(1.5, 2.0, 1.5),
+            Vec3::new(3.0, 2.0, 0.0),
+            0.7,
+        );
+        let curves = [line, cubic, arc];
+        let t = [0.0, 1.0, 2.0];
+        let s = loft(&curves, &t).unwrap();
+        for (c, ti) in curves.iter().zip(t) {
+            let (a, b) = c.domain();
+            for j in 0..=40 {
+                let f = j as f64 / 40.0;
+                let (on_surface, on_curve) = (point(s.eval(ti, f)), point(c.eval(a + (b - a) * f)));
+                assert!((on_surface - on_curve).length() < 1e-9, "{ti} {f}: {on_surface} vs {on_curve}");
             }
         }
     }

@@ -147,36 +147,47 @@ impl<P: ControlPoint> BSplinePatch<P> {
         } else {
             (k, k)
         };
-        let (mut q, mut qv) = (vec![zero; self.net.rows], vec![zero; self.net.rows]);
+        // Only rows lo..=hi matter: a sub-spline on the knots u_lo … u_{hi+n+1} has the same span.
+        let sub = &uk[lo..=hi + n + 1];
+        let (mut q, mut qv) = (Vec::with_capacity(hi + 1 - lo), Vec::with_capacity(hi + 1 - lo));
         let (mut scratch, mut hod) = (Vec::new(), Vec::new());
         for i in lo..=hi {
             let row = &self.net.points[i * cols..(i + 1) * cols];
-            q[i] = de_boor(vk, m, row, v, &mut scratch);
-            if m > 0 {
+            q.push(de_boor(vk, m, row, v, &mut scratch));
+            qv.push(if m > 0 {
                 hodograph(vk, m, row, &mut hod);
-                qv[i] = de_boor(vk1, m - 1, &hod, v, &mut scratch);
-            }
+                de_boor(vk1, m - 1, &hod, v, &mut scratch)
+            } else {
+                zero
+            });
         }
         let du = if n > 0 {
-            hodograph(uk, n, &q, &mut hod);
-            de_boor(uk1, n - 1, &hod, u, &mut scratch)
+            hodograph(sub, n, &q, &mut hod);
+            de_boor(&sub[1..sub.len() - 1], n - 1, &hod, uc, &mut scratch)
         } else {
             zero
         };
-        (de_boor(uk, n, &q, u, &mut scratch), du, de_boor(uk, n, &qv, u, &mut scratch))
+        (de_boor(sub, n, &q, uc, &mut scratch), du, de_boor(sub, n, &qv, uc, &mut scratch))
     }
 
     /// `s(u, v)` (the first of [`Self::partials`], without the derivatives).
     pub fn eval(&self, u: f64, v: f64) -> P {
         let (n, uk) = (self.n, &self.u_knots[..]);
-        let k = span(uk, n, u.clamp(uk[n], uk[uk.len() - 1 - n]));
-        let mut q = vec![self.net.points[0] * 0.0; self.net.rows];
+        let uc = u.clamp(uk[n], uk[uk.len() - 1 - n]);
+        let k = span(uk, n, uc);
         let mut scratch = Vec::new();
-        for (i, q) in q.iter_mut().enumerate().take(k + 1).skip(k - n) {
-            let row = &self.net.points[i * self.net.cols..(i + 1) * self.net.cols];
-            *q = de_boor(&self.v_knots, self.m, row, v, &mut scratch);
-        }
-        de_boor(uk, n, &q, u, &mut scratch)
+        let q: Vec<P> = (k - n..=k)
+            .map(|i| {
+                de_boor(
+                    &self.v_knots,
+                    self.m,
+                    &self.net.points[i * self.net.cols..(i + 1) * self.net.cols],
+                    v,
+                    &mut scratch,
+                )
+            })
+            .collect();
+        de_boor(&uk[k - n..=k + n + 1], n, &q, uc, &mut scratch)
     }
 
     /// `∂s/∂u`.

@@ -87,49 +87,87 @@ impl Surface for BSplinePatch<Vec4> {
     }
 }
 
-/// The largest distance between the surface at cell centres and edge midpoints and the
-/// triangles of a `k × k` grid.
-fn chordal_error<S: Surface>(s: &S, k: usize) -> f64 {
-    let h = 1.0 / k as f64;
-    let corners: Vec<Vec3> =
-        (0..=k).flat_map(|i| (0..=k).map(move |j| (i, j))).map(|(i, j)| s.point(i as f64 * h, j as f64 * h)).collect();
-    let corner = |i: usize, j: usize| corners[i * (k + 1) + j];
-    let mut worst = 0.0f64;
-    for i in 0..k {
-        for j in 0..k {
-            let (u, v) = (i as f64 * h, j as f64 * h);
-            let (p00, p10, p01, p11) = (corner(i, j), corner(i + 1, j), corner(i, j + 1), corner(i + 1, j + 1));
-            for (su, sv, approx) in
-                [(0.5, 0.5, (p00 + p11) * 0.5), (0.5, 0.0, (p00 + p10) * 0.5), (0.0, 0.5, (p00 + p01) * 0.5)]
-            {
-                worst = worst.max((s.point(u + su * h, v + sv * h) - approx).length());
+/// The chordal errors of a `ku × kv` grid: the largest distance between the surface and the
+/// grid's segments at the midpoints of `u`-edges, of `v`-edges, and between the surface and the
+/// diagonals at cell centres.
+fn chordal_errors<S: Surface>(s: &S, ku: usize, kv: usize) -> [f64; 3] {
+    let (hu, hv) = (1.0 / ku as f64, 1.0 / kv as f64);
+    let corners: Vec<Vec3> = (0..=ku)
+        .flat_map(|i| (0..=kv).map(move |j| (i, j)))
+        .map(|(i, j)| s.point(i as f64 * hu, j as f64 * hv))
+        .collect();
+    let corner = |i: usize, j: usize| corners[i * (kv + 1) + j];
+    let mut worst = [0.0f64; 3];
+    for i in 0..=ku {
+        for j in 0..=kv {
+            let (u, v) = (i as f64 * hu, j as f64 * hv);
+            let p00 = corner(i, j);
+            if i < ku {
+                let e = (s.point(u + 0.5 * hu, v) - (p00 + corner(i + 1, j)) * 0.5).length();
+                worst[0] = worst[0].max(e);
+            }
+            if j < kv {
+                let e = (s.point(u, v + 0.5 * hv) - (p00 + corner(i, j + 1)) * 0.5).length();
+                worst[1] = worst[1].max(e);
+            }
+            if i < ku && j < kv {
+                let e = (s.point(u + 0.5 * hu, v + 0.5 * hv) - (p00 + corner(i + 1, j + 1)) * 0.5).length();
+                worst[2] = worst[2].max(e);
             }
         }
     }
     worst
 }
 
-/// A triangle mesh of `s` whose grid is doubled until the chordal error (measured at cell
-/// centres and edge midpoints) is below `tolerance`, up to 256 × 256 cells. Texture coordinates
-/// are the parameters.
-pub fn tessellate<S: Surface>(s: &S, tolerance: f64) -> TriangleMesh {
-    let mut k = 2;
-    while k < 256 && chordal_error(s, k) > tolerance {
-        k *= 2;
+/// Cells per direction beyond which [`tessellate`] stops refining.
+pub const MAX_CELLS_PER_SIDE: usize = 1024;
+
+/// The grid `(ku, kv)` [`tessellate`] uses for `s` at `tolerance`, and its chordal error: each
+/// direction doubled on its own while the chordal error along it (or across the cells'
+/// diagonals) exceeds the tolerance, up to [`MAX_CELLS_PER_SIDE`] (where the error may stay
+/// above the tolerance). A long thin tube gets many cells along and few around.
+pub fn grid_for<S: Surface>(s: &S, tolerance: f64) -> (usize, usize, f64) {
+    let (mut ku, mut kv) = (2, 2);
+    loop {
+        let [eu, ev, diagonal] = chordal_errors(s, ku, kv);
+        let (mut refine_u, mut refine_v) = (eu > tolerance, ev > tolerance);
+        if diagonal > tolerance && !refine_u && !refine_v {
+            (refine_u, refine_v) = (true, true);
+        }
+        let (nu, nv) = (
+            if refine_u { (ku * 2).min(MAX_CELLS_PER_SIDE) } else { ku },
+            if refine_v { (kv * 2).min(MAX_CELLS_PER_SIDE) } else { kv },
+        );
+        if (nu, nv) == (ku, kv) {
+            return (ku, kv, eu.max(ev).max(diagonal));
+        }
+        (ku, kv) = (nu, nv);
     }
+}
+
+/// A triangle mesh of `s` on the grid of [`grid_for`]: within `tolerance` of the surface at the
+/// edges' midpoints and the cells' centres. Texture coordinates are the parameters.
+pub fn tessellate<S: Surface>(s: &S, tolerance: f64) -> TriangleMesh {
+    let (ku, kv, _) = grid_for(s, tolerance);
+    tessellate_grid(s, ku, kv)
+}
+
+/// A triangle mesh of `s` on a `ku × kv` grid of the unit square (two triangles a cell).
+pub fn tessellate_grid<S: Surface>(s: &S, ku: usize, kv: usize) -> TriangleMesh {
+    let (ku, kv) = (ku.max(1), kv.max(1));
     let mut m = TriangleMesh::default();
-    for i in 0..=k {
-        for j in 0..=k {
-            let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
+    for i in 0..=ku {
+        for j in 0..=kv {
+            let (u, v) = (i as f64 / ku as f64, j as f64 / kv as f64);
             let (p, n) = s.sample(u, v);
             m.positions.push(p);
             m.normals.push(n);
             m.uvs.push(Vec2::new(u, v));
         }
     }
-    let at = |i: usize, j: usize| (i * (k + 1) + j) as u32;
-    for i in 0..k {
-        for j in 0..k {
+    let at = |i: usize, j: usize| (i * (kv + 1) + j) as u32;
+    for i in 0..ku {
+        for j in 0..kv {
             m.triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
             m.triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
         }
@@ -185,10 +223,23 @@ mod tests {
         for tol in [0.1, 0.01, 0.001] {
             let m = tessellate(&p, tol);
             m.validate().unwrap();
-            // Independent check on a finer sampling: distance to the nearest vertex plane is
-            // bounded by the chordal error at random interior points of the triangles.
-            let k = ((m.positions.len() as f64).sqrt() as usize) - 1;
-            assert!(chordal_error(&p, k) <= tol, "k = {k}");
+            let (ku, kv, error) = grid_for(&p, tol);
+            assert!(error <= tol);
+            assert_eq!(m.positions.len(), (ku + 1) * (kv + 1));
+            assert!(chordal_errors(&p, ku, kv).iter().all(|e| *e <= tol), "{ku} × {kv}");
+            // Independent check: the surface at random parameters against the mesh's triangle there.
+            for k in 0..200 {
+                let (u, v) = ((k as f64 * 0.618_034).fract(), (k as f64 * 0.414_214).fract());
+                let (i, j) = (((u * ku as f64) as usize).min(ku - 1), ((v * kv as f64) as usize).min(kv - 1));
+                let (fu, fv) = (u * ku as f64 - i as f64, v * kv as f64 - j as f64);
+                let at = |i: usize, j: usize| m.positions[i * (kv + 1) + j];
+                let flat = if fu >= fv {
+                    at(i, j) + (at(i + 1, j) - at(i, j)) * fu + (at(i + 1, j + 1) - at(i + 1, j)) * fv
+                } else {
+                    at(i, j) + (at(i, j + 1) - at(i, j)) * fv + (at(i + 1, j + 1) - at(i, j + 1)) * fu
+                };
+                assert!((p.point(u, v) - flat).length() <= 2.0 * tol, "{u} {v}");
+            }
             assert!(m.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-9));
         }
     }

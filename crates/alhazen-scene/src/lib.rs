@@ -24,6 +24,7 @@ pub mod import;
 pub mod model;
 mod parse;
 mod parse_bsdf;
+mod parse_freeform;
 mod reader;
 pub mod texture;
 pub mod write;

@@ -94,9 +94,9 @@ pub(crate) struct Parser<'a> {
     /// Mesh files already loaded (a group instanced many times shares its meshes).
     mesh_files: HashMap<std::path::PathBuf, (usize, Vec<MaterialId>)>,
     /// Bytes that generated geometry may take.
-    memory_budget: u64,
+    pub(crate) memory_budget: u64,
     /// What was read only in part.
-    warnings: Vec<String>,
+    pub(crate) warnings: Vec<String>,
 }
 
 impl Parser<'_> {
@@ -415,9 +415,9 @@ impl Parser<'_> {
             "subdivision" => &["base", "file", "mesh", "scheme", "levels", "smooth"],
             "patch" => &["rows", "points", "weights", "tolerance", "degree", "knots_u", "knots_v"],
             "loft" => &["curves", "tolerance", "smooth"],
-            "curve" => &["kind", "degree", "points", "radius"],
+            "curve" => &["kind", "degree", "points", "weights", "knots", "radius", "tolerance", "smooth"],
             "revolution" => &["profile", "tolerance", "smooth"],
-            "sweep" => &["guide", "radius", "tolerance", "smooth"],
+            "sweep" => &["guide", "radius", "section", "guides", "tolerance", "smooth"],
             "rectangle" => &[],
             _ => &["op", "a", "b"],
         };
@@ -464,11 +464,11 @@ impl Parser<'_> {
                 let mesh = match kind {
                     "rectangle" => rectangle(),
                     "subdivision" => self.subdivision(&t)?,
-                    "patch" => patch(&t)?,
-                    "revolution" => revolution(&t)?,
-                    "sweep" => sweep(&t)?,
-                    "loft" => loft(&t)?,
-                    _ => curve(&t)?,
+                    "patch" => self.patch(&t)?,
+                    "revolution" => self.revolution(&t)?,
+                    "sweep" => self.sweep(&t)?,
+                    "loft" => self.loft(&t)?,
+                    _ => self.curve(&t)?,
                 };
                 self.scene.meshes.push(Arc::new(mesh));
                 Shape::Mesh { mesh: self.scene.meshes.len() - 1, smooth: t.opt_bool("smooth", true)? }
@@ -524,67 +524,6 @@ impl Parser<'_> {
     }
 }
 
-/// `shape = "patch"`: a (rational) Bézier patch — or, with `degree = [n, m]`, `knots_u` and
-/// `knots_v`, a (rational) B-spline patch — control points row-major, tessellated to the chordal
-/// `tolerance`.
-fn patch(t: &Table) -> R<alhazen_geom::TriangleMesh> {
-    use alhazen_geom::patch::{BSplinePatch, BezierPatch, Net};
-    use alhazen_geom::tessellate::tessellate;
-    let pts_node = t.req("points")?;
-    let points: Vec<Vec3> = pts_node.array()?.iter().map(|p| p.vec3()).collect::<R<_>>()?;
-    let rows = t.req("rows")?.integer(1, 256)? as usize;
-    if points.len() < 2 * rows || !points.len().is_multiple_of(rows) {
-        return Err(pts_node.err(format!("{} points do not form {rows} rows of at least 2", points.len())));
-    }
-    let cols = points.len() / rows;
-    let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
-    let weights: Option<Vec<f64>> = match t.get("weights") {
-        None => None,
-        Some(w) => {
-            let ws: Vec<f64> = w.array()?.iter().map(|x| x.positive()).collect::<R<_>>()?;
-            if ws.len() != points.len() {
-                return Err(w.err(format!("{} weights for {} points", ws.len(), points.len())));
-            }
-            Some(ws)
-        }
-    };
-    let knots = |key: &str| -> R<Option<Vec<f64>>> {
-        t.get(key).map(|k| k.array()?.iter().map(|x| x.f64()).collect::<R<Vec<f64>>>()).transpose()
-    };
-    let spline = match (t.get("degree"), knots("knots_u")?, knots("knots_v")?) {
-        (None, None, None) => None,
-        (Some(d), Some(ku), Some(kv)) => {
-            let [n, m] = d.numbers::<2>()?;
-            if n < 1.0 || m < 1.0 || n.fract() != 0.0 || m.fract() != 0.0 || n > 10.0 || m > 10.0 {
-                return Err(d.err("`degree`: expected two integers from 1 to 10"));
-            }
-            Some((n as usize, m as usize, ku, kv, d))
-        }
-        _ => return Err(pts_node.err("a B-spline patch needs all of `degree`, `knots_u` and `knots_v`")),
-    };
-    // Rational patches live in homogeneous coordinates (w p, w).
-    let homogeneous = weights.map(|ws| points.iter().zip(&ws).map(|(p, w)| (*p * *w).extend(*w)).collect::<Vec<_>>());
-    let mesh = match (spline, homogeneous) {
-        (None, None) => tessellate(&BezierPatch { net: Net::new(rows, cols, points).expect("sizes checked") }, tol),
-        (None, Some(hom)) => tessellate(&BezierPatch { net: Net::new(rows, cols, hom).expect("sizes checked") }, tol),
-        (Some((n, m, ku, kv, d)), hom) => {
-            let bad = |e: alhazen_geom::bspline::SplineError| d.err(format!("B-spline patch: {e}"));
-            match hom {
-                None => tessellate(
-                    &BSplinePatch::new(n, m, ku, kv, Net::new(rows, cols, points).expect("sizes checked"))
-                        .map_err(bad)?,
-                    tol,
-                ),
-                Some(hom) => tessellate(
-                    &BSplinePatch::new(n, m, ku, kv, Net::new(rows, cols, hom).expect("sizes checked")).map_err(bad)?,
-                    tol,
-                ),
-            }
-        }
-    };
-    Ok(mesh)
-}
-
 /// `shape = "rectangle"`: the square `[−1, 1]²` in the plane `z = 0`, facing `+z` (as Mitsuba's
 /// `rectangle`); place and size it with `transform`.
 pub fn rectangle() -> alhazen_geom::TriangleMesh {
@@ -601,96 +540,6 @@ pub fn rectangle() -> alhazen_geom::TriangleMesh {
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         ..Default::default()
     }
-}
-
-/// `shape = "loft"`: the surface through `curves` (each a list of control points of a clamped
-/// uniform cubic B-spline, all of the same length), interpolated across by chord length.
-fn loft(t: &Table) -> R<alhazen_geom::TriangleMesh> {
-    use alhazen_geom::bspline::BSpline;
-    let node = t.req("curves")?;
-    let lists: Vec<Vec<Vec3>> = node
-        .array()?
-        .iter()
-        .map(|c| c.array()?.iter().map(|p| p.vec3()).collect::<R<Vec<Vec3>>>())
-        .collect::<R<_>>()?;
-    if lists.len() < 2 || lists.iter().any(|l| l.len() != lists[0].len() || l.len() < 2) {
-        return Err(node.err("`curves`: expected at least 2 curves with the same number (≥ 2) of control points"));
-    }
-    let degree = (lists[0].len() - 1).min(3);
-    let curves: Vec<BSpline<Vec3>> =
-        lists.into_iter().map(|l| BSpline::clamped_uniform(degree, l).expect("valid")).collect();
-    // Parameters across the curves: chord lengths between their first control points' centroids.
-    let centroids: Vec<Vec3> =
-        curves.iter().map(|c| c.points().iter().sum::<Vec3>() / c.points().len() as f64).collect();
-    let params = alhazen_geom::construct::chord_lengths(&centroids);
-    let surface =
-        alhazen_geom::construct::loft(&curves, &params).ok_or_else(|| node.err("the curves cannot be lofted"))?;
-    let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
-    Ok(alhazen_geom::tessellate::tessellate(&surface, tol))
-}
-
-/// `shape = "revolution"`: the NURBS surface of revolution about the `y` axis of the cubic
-/// interpolant of `profile = [[radius, height], …]`.
-fn revolution(t: &Table) -> R<alhazen_geom::TriangleMesh> {
-    let node = t.req("profile")?;
-    let points = node.array()?;
-    let profile: Vec<(f64, f64)> = points.iter().map(|p| p.numbers::<2>().map(|[r, h]| (r, h))).collect::<R<_>>()?;
-    if let Some(k) = profile.iter().position(|&(r, _)| r < 0.0) {
-        return Err(points[k].err("a profile point's radius (its distance from the axis) cannot be negative"));
-    }
-    if let Some(k) = profile.windows(2).position(|w| w[0] == w[1]) {
-        return Err(points[k + 1].err(format!("profile points {} and {} coincide", k + 1, k + 2)));
-    }
-    let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
-    let surface = alhazen_geom::construct::revolution(&profile)
-        .ok_or_else(|| node.err("a profile needs at least 2 points with distinct consecutive positions"))?;
-    let mut mesh = alhazen_geom::tessellate::tessellate(&surface, tol);
-    // The construction revolves about z; scenes are y-up: rotate by −90° about x.
-    for p in mesh.positions.iter_mut().chain(mesh.normals.iter_mut()) {
-        *p = Vec3::new(p.x, p.z, -p.y);
-    }
-    Ok(mesh)
-}
-
-/// `shape = "sweep"`: a tube of `radius` swept along the cubic interpolant of `guide`.
-fn sweep(t: &Table) -> R<alhazen_geom::TriangleMesh> {
-    let node = t.req("guide")?;
-    let points = node.array()?;
-    let guide: Vec<Vec3> = points.iter().map(|p| p.vec3()).collect::<R<_>>()?;
-    if let Some(k) = guide.windows(2).position(|w| w[0] == w[1]) {
-        return Err(points[k + 1].err(format!("guide points {} and {} coincide", k + 1, k + 2)));
-    }
-    let radius = t.get("radius").map_or(Ok(0.1), |n| n.positive())?;
-    let tol = t.get("tolerance").map_or(Ok(1e-3), |n| n.positive())?;
-    let surface = alhazen_geom::construct::swept_tube(&guide, radius)
-        .ok_or_else(|| node.err("a guide needs at least 2 distinct points"))?;
-    Ok(alhazen_geom::tessellate::tessellate(&surface, tol))
-}
-
-/// `shape = "curve"`: a Bézier or clamped uniform B-spline curve drawn as a tube.
-fn curve(t: &Table) -> R<alhazen_geom::TriangleMesh> {
-    use alhazen_geom::bezier::Bezier;
-    use alhazen_geom::bspline::BSpline;
-    let pts_node = t.req("points")?;
-    let points: Vec<Vec3> = pts_node.array()?.iter().map(|p| p.vec3()).collect::<R<_>>()?;
-    if points.len() < 2 {
-        return Err(pts_node.err("a curve needs at least 2 control points"));
-    }
-    let radius = t.get("radius").map_or(Ok(0.02), |n| n.positive())?;
-    let bspline = match t.get("kind") {
-        Some(k) => k.choice(&["bezier", "bspline"])? == "bspline",
-        None => false,
-    };
-    let line: Vec<Vec3> = if bspline {
-        let degree = t.get("degree").map_or(Ok(3), |n| n.integer(1, 10))? as usize;
-        let s =
-            BSpline::clamped_uniform(degree.min(points.len() - 1), points).map_err(|e| pts_node.err(e.to_string()))?;
-        let (a, b) = s.domain();
-        (0..=400).map(|k| s.eval(a + (b - a) * k as f64 / 400.0)).collect()
-    } else {
-        Bezier::new(points).expect("non-empty").flatten(radius * 0.05)
-    };
-    Ok(alhazen_geom::tessellate::tube(&line, radius, 16))
 }
 
 fn distinct(t: &Table, key: &str, a: Vec3, b: Vec3) -> R<()> {
