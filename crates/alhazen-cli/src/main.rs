@@ -13,6 +13,7 @@ use std::process::ExitCode;
 mod anamorph;
 mod lines;
 mod mirror;
+mod photon;
 mod radiosity;
 mod raster;
 mod render;

@@ -38,7 +38,7 @@ pub(crate) struct RadiosityArgs {
     export: Option<PathBuf>,
 }
 
-fn parse_length(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_length(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
         _ => Err(format!("`{s}` is not a positive length")),

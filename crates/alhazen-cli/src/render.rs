@@ -74,6 +74,8 @@ pub(crate) struct RenderArgs {
     resume: bool,
     #[command(flatten)]
     radiosity: crate::radiosity::RadiosityArgs,
+    #[command(flatten)]
+    photon: crate::photon::PhotonArgs,
 }
 
 /// `--kernel`.
@@ -106,6 +108,9 @@ enum IntegratorArg {
     /// The course's radiosity (diffuse interreflection, solved once), then an image by ray
     /// casting the solution (mirrors and glass followed).
     Radiosity,
+    /// Path tracing with caustics (light through mirrors and glass onto diffuse surfaces) from
+    /// a photon map: point lights' caustics appear, area lights' converge.
+    Photon,
 }
 
 /// `--sampler`.
@@ -128,6 +133,7 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
             IntegratorArg::Path => alhazen_scene::IntegratorKind::Path,
             // The scene keeps its own; the solution's image is made by the CLI.
             IntegratorArg::Radiosity => r.integrator,
+            IntegratorArg::Photon => alhazen_scene::IntegratorKind::Path,
         };
     }
     if a.no_mirror_connections {
@@ -268,6 +274,8 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
     apply_overrides(&mut scene, a);
     let radiosity = matches!(a.integrator, Some(IntegratorArg::Radiosity));
     a.radiosity.check(radiosity)?;
+    let photon = matches!(a.integrator, Some(IntegratorArg::Photon));
+    a.photon.check(photon, &scene)?;
     if scene.render.integrator == alhazen_scene::IntegratorKind::Whitted && !radiosity {
         warn_unsampled_emitters(&scene);
     }
@@ -276,8 +284,12 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         // Parts of renders with other radiosity settings must not merge.
         plan.fingerprint ^= part::hash_debug(&("radiosity", a.radiosity.settings()));
     }
+    if photon && plan.fingerprint != 0 {
+        plan.fingerprint ^= part::hash_debug(&("photon", a.photon.settings(scene.render.seed)));
+    }
     let what = format!("rendering this {}×{} film", plan.width, plan.height);
-    crate::check_memory(alhazen_render::memory_estimate(&scene), &what)?;
+    let photons = if photon { a.photon.memory_estimate() } else { 0 };
+    crate::check_memory(alhazen_render::memory_estimate(&scene) + photons, &what)?;
     let resumed = match &a.checkpoint {
         Some(c) => open_checkpoint(c, a.resume, &plan)?,
         None => plan.empty_part(),
@@ -298,7 +310,19 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         true => Some(pool.install(|| crate::radiosity::solve(&scene, &a.radiosity, a.image.quiet))?),
         false => None,
     };
-    let (part, stopped) = pool.install(|| render_plan(&scene, unit, &plan, resumed, a, solution.as_ref()));
+    let world_and_map = match photon {
+        true => Some(pool.install(|| {
+            let world = alhazen_render::World::build_by(&scene, unit, bvh_method(a.bvh));
+            crate::photon::build(&scene, &world, &a.photon, a.image.quiet).map(|map| (world, map))
+        })?),
+        false => None,
+    };
+    let source = match (&solution, &world_and_map) {
+        (Some(s), _) => Source::Radiosity(s),
+        (None, Some((world, map))) => Source::Photons(world, map),
+        (None, None) => Source::Scene,
+    };
+    let (part, stopped) = pool.install(|| render_plan(&scene, unit, &plan, resumed, a, &source));
     let elapsed = start.elapsed();
     let total = plan.band.len();
     if stopped {
@@ -325,7 +349,7 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         let _ = std::fs::remove_file(c); // its work is in the output now
     }
     if !a.image.quiet {
-        summary(&scene, a, &plan, elapsed, pool.current_num_threads(), solution.as_ref());
+        summary(&scene, a, &plan, elapsed, pool.current_num_threads(), &source);
     }
     Ok(())
 }
@@ -382,7 +406,7 @@ fn render_plan(
     plan: &Plan,
     resumed: Part,
     a: &RenderArgs,
-    solution: Option<&alhazen_radiosity::Solution>,
+    source: &Source,
 ) -> (Part, bool) {
     let done: Vec<bool> = {
         let mut d = vec![false; plan.band.end];
@@ -407,7 +431,7 @@ fn render_plan(
         clamped: 0,
     });
     let every = Duration::from_secs_f64(a.checkpoint_every);
-    render_tiles(scene, unit, a.bvh, solution, &job, &|t| {
+    render_tiles(scene, unit, a.bvh, source, &job, &|t| {
         let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
         s.unusable += t.unusable_samples;
         s.clamped += t.clamped_pixels;
@@ -441,27 +465,44 @@ fn render_plan(
     (part, stopped)
 }
 
-/// The job's tiles by the scene's integrator, or from a radiosity solution.
+/// What the image is made from besides the scene.
+enum Source<'a> {
+    /// The scene's integrator.
+    Scene,
+    /// A radiosity solution.
+    Radiosity(&'a alhazen_radiosity::Solution),
+    /// The world and its caustic photon map (the path tracer takes caustics from it).
+    Photons(&'a alhazen_render::World, &'a alhazen_photon::CausticMap),
+}
+
+fn bvh_method(bvh: BvhArg) -> alhazen_render::bvh::BuildMethod {
+    match bvh {
+        BvhArg::Sah => alhazen_render::bvh::BuildMethod::Sah,
+        BvhArg::Morton => alhazen_render::bvh::BuildMethod::Morton,
+    }
+}
+
+/// The job's tiles by the scene's integrator, from a radiosity solution, or with a photon map.
 fn render_tiles(
     scene: &Scene,
     unit: VectorUnit,
     bvh: BvhArg,
-    solution: Option<&alhazen_radiosity::Solution>,
+    source: &Source,
     job: &Job,
     done: &(dyn Fn(TileResult) + Sync),
 ) {
-    match solution {
-        Some(s) => {
-            let (w, h) = alhazen_render::film_size(scene);
+    let (w, h) = alhazen_render::film_size(scene);
+    match source {
+        Source::Radiosity(s) => {
             alhazen_render::film::render_tiles(w, h, &alhazen_radiosity::FinalGather::new(s), job, &STOP, done)
         }
-        None => {
-            let method = match bvh {
-                BvhArg::Sah => alhazen_render::bvh::BuildMethod::Sah,
-                BvhArg::Morton => alhazen_render::bvh::BuildMethod::Morton,
-            };
-            alhazen_render::render_tiles_by(scene, unit, method, job, &STOP, done)
+        Source::Photons(world, map) => {
+            let r = &scene.render;
+            let camera = alhazen_render::Camera::new(&scene.camera, r.width, r.height);
+            let tracer = alhazen_render::path::PathTracer::new(scene, world, &camera).with_caustics(*map);
+            alhazen_render::film::render_tiles(w, h, &tracer, job, &STOP, done)
         }
+        Source::Scene => alhazen_render::render_tiles_by(scene, unit, bvh_method(bvh), job, &STOP, done),
     }
 }
 
@@ -496,17 +537,19 @@ impl Progress {
     }
 }
 
-fn summary(
-    scene: &Scene,
-    a: &RenderArgs,
-    plan: &Plan,
-    elapsed: Duration,
-    threads: usize,
-    solution: Option<&alhazen_radiosity::Solution>,
-) {
+fn summary(scene: &Scene, a: &RenderArgs, plan: &Plan, elapsed: Duration, threads: usize, source: &Source) {
     let r = &scene.render;
-    let integrator = match (r.integrator, solution) {
-        (_, Some(s)) => {
+    let integrator = match (r.integrator, source) {
+        (_, Source::Photons(_, map)) => format!(
+            "path tracing, {:?} sampler, caustics from {} photons shot ({} stored, gathered within {:.3})",
+            r.sampler,
+            map.shot,
+            map.photons().len(),
+            map.radius()
+        )
+        .replacen("Sobol", "sobol", 1)
+        .replacen("Independent", "independent", 1),
+        (_, Source::Radiosity(s)) => {
             let st = &s.stats;
             format!(
                 "radiosity: {} patches of at most {:.3}, {} elements, {} shots, {:.2} % left unshot",
@@ -517,8 +560,10 @@ fn summary(
                 100.0 * st.unshot
             )
         }
-        (alhazen_scene::IntegratorKind::Whitted, None) => "Whitted ray tracing".to_string(),
-        (alhazen_scene::IntegratorKind::Path, None) => format!("path tracing, {:?} sampler", r.sampler).to_lowercase(),
+        (alhazen_scene::IntegratorKind::Whitted, Source::Scene) => "Whitted ray tracing".to_string(),
+        (alhazen_scene::IntegratorKind::Path, Source::Scene) => {
+            format!("path tracing, {:?} sampler", r.sampler).to_lowercase()
+        }
     };
     let what = match (a.tile, a.pass) {
         (None, None) => String::new(),

@@ -1035,6 +1035,51 @@ fn radiosity_options_and_solution_files_are_checked() {
     assert!(!out.exists());
 }
 
+/// `--integrator photon`: a glass ball's caustic under a point light, rendered in two bands
+/// merged to the bits of one render (the map is the same in every process); its options are
+/// checked, and refused without the integrator.
+#[test]
+fn photon_mapping_renders_in_parts_and_checks_its_options() {
+    let glass = format!(
+        "{OK}[[object]]\nshape = \"plane\"\npoint = [0, -1, 0]\n[[object]]\nshape = \"sphere\"\ncenter = [1, 0, 2]\nradius = 0.5\nmaterial = {{ transparency = 1, diffuse = 0, color = 0 }}\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), &glass);
+    let photon = ["--integrator", "photon", "--photons", "20000", "--width", "64", "--height", "48", "--quiet"];
+    let run = |out: &str, extra: &[&str]| {
+        let out = dir.path().join(out);
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend_from_slice(&photon);
+        args.extend_from_slice(extra);
+        let o = alhazen(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        out
+    };
+    let whole = run("whole.pfm", &[]);
+    let (a, b) = (run("a.film", &["--tile", "0/2"]), run("b.film", &["--tile", "1/2"]));
+    let merged = dir.path().join("merged.pfm");
+    let o = alhazen(&["merge", a.to_str().unwrap(), b.to_str().unwrap(), "-o", merged.to_str().unwrap(), "--quiet"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(&whole).unwrap(), std::fs::read(&merged).unwrap());
+    for bad in [&["--photons", "10"][..], &["--photon-nearest", "8"], &["--photon-radius", "0.1"]] {
+        let (code, err, exists) = render(OK, bad);
+        assert_eq!((code, exists), (2, false), "{bad:?}: {err}");
+        assert!(err.contains("add --integrator photon"), "{err}");
+    }
+    for bad in
+        [&["--photons", "0"][..], &["--photon-radius", "-1"], &["--photon-radius", "nan"], &["--photon-nearest", "0"]]
+    {
+        let (code, err, _) = render(OK, &[&["--integrator", "photon"][..], bad].concat());
+        assert_eq!(code, 2, "{bad:?}: {err}");
+    }
+    let prism = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/prism.toml");
+    let out = dir.path().join("prism.png");
+    let o = alhazen(&["render", prism.to_str().unwrap(), "-o", out.to_str().unwrap(), "--integrator", "photon"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("disperses"), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.exists());
+}
+
 /// `--bvh morton` builds meshes' hierarchies in Morton order: the same image as the surface
 /// area heuristic's (a mesh of more than 256 triangles, so it keeps its own hierarchy).
 #[test]

@@ -15,6 +15,12 @@
 //! lights to itself through them exactly (`mirrors`, specular connections), MIS-weighted against
 //! BSDF paths that reach an area light after the mirror.
 //!
+//! With a caustic estimate ([`CausticEstimate`], e.g. a photon map), light that reached a
+//! non-specular vertex through specular (delta) surfaces is taken from it instead: the estimate
+//! is added at every non-specular vertex, and emission reached from a non-specular vertex
+//! through specular bounces only is left out (it is what the estimate holds). Mirror connections
+//! are then off (the estimate holds their paths too).
+//!
 //! Where the world tests eight rays at once faster than one by one (`World::traces_rays_together`),
 //! eight samples are traced side by side (`lanes`), each with the same arithmetic ([`PathTracer::vertex`]),
 //! so the same samples, whatever the materials.
@@ -54,6 +60,17 @@ pub struct PathTracer<'a> {
     lambert_kernel: Vec<bool>,
     /// Specular connections through the scene's sphere, cylinder and plane mirrors, if any.
     mirrors: Option<mirrors::MirrorConnections>,
+    /// Light through specular surfaces onto non-specular ones, estimated elsewhere.
+    caustics: Option<&'a dyn CausticEstimate>,
+}
+
+/// Light that reached non-specular surfaces through specular (delta) ones only, from the lights
+/// (paths `L S+ D` of Heckbert's notation): what a caustic photon map estimates.
+pub trait CausticEstimate: Sync {
+    /// Radiance leaving `p` (geometric normal `ng`, on the side the viewer is) towards the viewer:
+    /// the sum over the light arriving near `p` from directions `wi` (unit, towards where it
+    /// came from) of `f(wi)` times its power per area, `f` being the BSDF towards the viewer.
+    fn radiance(&self, p: Vec3, ng: Vec3, f: &dyn Fn(Vec3) -> Vec3) -> Vec3;
 }
 
 /// Power heuristic with β = 2.
@@ -107,6 +124,10 @@ struct PathState {
     /// of a mirror reached from a non-specular vertex (for the next emission's MIS weight).
     prev_object: u32,
     visit: Option<mirrors::MirrorVisit>,
+    /// A non-specular bounce was taken somewhere before; and every bounce since the last of
+    /// them was specular (emission reached now is a caustic's, left to a caustic estimate).
+    seen_diffuse: bool,
+    caustic_chain: bool,
 }
 
 impl PathState {
@@ -122,6 +143,8 @@ impl PathState {
             prev,
             prev_object: u32::MAX,
             visit: None,
+            seen_diffuse: false,
+            caustic_chain: false,
         }
     }
 
@@ -188,11 +211,26 @@ impl<'a> PathTracer<'a> {
             lane_lights: None,
             lambert_kernel: vec![],
             mirrors,
+            caustics: None,
         };
         tracer.lane_lights = lanes::lane_lights(&tracer.lights);
         tracer.lambert_kernel = lanes::lambert_kernel(&tracer);
         tracer.in_lanes = tracer.lanes_apply();
         tracer
+    }
+
+    /// The tracer taking caustics (light through specular surfaces onto non-specular ones) from
+    /// `caustics`: mirror connections off, samples traced one path at a time.
+    pub fn with_caustics(mut self, caustics: &'a dyn CausticEstimate) -> Self {
+        self.caustics = Some(caustics);
+        self.mirrors = None;
+        self.in_lanes = false;
+        self
+    }
+
+    /// Whether the scene's glass disperses (rendered spectrally).
+    pub fn is_spectral(&self) -> bool {
+        self.spectral
     }
 
     /// Radiance along `ray` in the channels of `mode`.
@@ -234,7 +272,9 @@ impl<'a> PathTracer<'a> {
             }
             return;
         };
-        path.l += path.beta * self.emitted(&HitPoint::from(wh), &path.ray, &path.prev, path.visit.as_ref(), mode);
+        if !(path.caustic_chain && self.caustics.is_some()) {
+            path.l += path.beta * self.emitted(&HitPoint::from(wh), &path.ray, &path.prev, path.visit.as_ref(), mode);
+        }
         if path.depth == max_depth {
             return;
         }
@@ -261,6 +301,10 @@ impl<'a> PathTracer<'a> {
             if let Some(c) = self.mirrors.as_ref().filter(|_| path.depth + 2 <= max_depth) {
                 out.mirrored = Some(self.mirror_connections(c, &bsdf, &frame, wh.hit.p, ng, v, wh.object, mode, s));
             }
+            if let Some(c) = self.caustics {
+                // RGB only: photon mapping refuses dispersive scenes.
+                path.l += path.beta * c.radiance(wh.hit.p, ng, &|wi| bsdf.eval(v, frame.to_local(wi)));
+            }
         }
         let Some(bs) = bsdf.sample(v, choices.y, s.next_2d()) else { return };
         let dir = frame.to_world(bs.l);
@@ -283,6 +327,8 @@ impl<'a> PathTracer<'a> {
                 reflected.then(|| c.visit(path.prev.p, path.prev_object, path.prev.pdf, &HitPoint::from(wh))).flatten();
             path.prev_object = wh.object;
         }
+        path.caustic_chain = bs.delta && path.seen_diffuse;
+        path.seen_diffuse |= !bs.delta;
         path.prev = Previous { p: wh.hit.p, pdf: bs.pdf, delta: bs.delta };
         path.ray = Ray::new(offset(wh.hit.p, ng, dir), dir);
         path.depth += 1;

@@ -358,6 +358,11 @@ impl World {
         self.vectors
     }
 
+    /// The objects, in the scene's order.
+    pub fn objects(&self) -> &[WorldObject] {
+        &self.objects
+    }
+
     /// Bounds of the bounded objects.
     pub fn bounds(&self) -> Bounds3 {
         self.bvh.bounds()

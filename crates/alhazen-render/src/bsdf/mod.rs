@@ -117,6 +117,17 @@ impl Bsdf {
         }
     }
 
+    /// True when some lobe is a delta (a smooth metal's or glass's): light can leave along one
+    /// direction only.
+    pub fn has_delta_lobe(&self) -> bool {
+        match self {
+            Bsdf::Conductor(c) => c.facets.is_none(),
+            Bsdf::Dielectric(d) => d.facets.is_none(),
+            Bsdf::Mix(m) => m.a.has_delta_lobe() || m.b.has_delta_lobe(),
+            _ => false,
+        }
+    }
+
     /// The weight of the mirror lobe (a smooth metal's delta reflection) at incidence cosine
     /// `cos`: what a specular connection through this surface carries; zero without one.
     pub fn mirror_reflectance(&self, cos: f64) -> Vec3 {
