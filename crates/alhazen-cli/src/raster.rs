@@ -75,6 +75,10 @@ pub(crate) struct RasterArgs {
     /// With a stereo camera: one red–cyan anaglyph instead of the two views side by side.
     #[arg(long)]
     anaglyph: bool,
+    /// Draw every triangle, without the octree's view-frustum culling (the same image; for
+    /// measuring what the culling saves).
+    #[arg(long)]
+    no_frustum_culling: bool,
     /// Hidden-surface removal: depth buffer, or the painter's algorithm over a BSP tree.
     #[arg(long, value_enum, default_value = "zbuffer")]
     visibility: VisibilityArg,
@@ -121,6 +125,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
         ibl: a.ibl,
         hemispherical: a.hemispherical,
         anaglyph: a.anaglyph,
+        frustum_culling: !a.no_frustum_culling,
         clip_planes: a.clip_plane.clone(),
         cull_planes: a.cull_plane.clone(),
         shadow_method: match a.shadow_method {

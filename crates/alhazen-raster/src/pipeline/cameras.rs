@@ -14,6 +14,7 @@ pub fn sum(a: RasterStats, b: RasterStats) -> RasterStats {
     RasterStats {
         triangles: a.triangles,
         culled: a.culled + b.culled,
+        outside: a.outside + b.outside,
         drawn: a.drawn + b.drawn,
         skipped_objects: a.skipped_objects,
         reflexes: a.reflexes + b.reflexes,

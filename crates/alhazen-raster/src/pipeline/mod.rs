@@ -20,6 +20,7 @@ pub mod emitters;
 pub mod geometry;
 pub mod ibl;
 pub mod mirrors;
+pub mod octree;
 pub mod raster;
 pub mod scanline;
 pub mod shade;
@@ -93,6 +94,9 @@ pub struct RasterOptions {
     pub hemispherical: bool,
     /// A stereo camera's eyes as one red–cyan anaglyph instead of side by side.
     pub anaglyph: bool,
+    /// Skip the triangles of octree nodes outside the view volume ([`octree`]) before they are
+    /// transformed; the image is the same either way (off only to measure it).
+    pub frustum_culling: bool,
 }
 
 /// Shadow algorithm.
@@ -118,6 +122,7 @@ impl Default for RasterOptions {
             shadow_method: ShadowMethod::Maps,
             hemispherical: false,
             anaglyph: false,
+            frustum_culling: true,
         }
     }
 }
@@ -144,6 +149,8 @@ pub struct Prepared {
     /// Light computed elsewhere (a radiosity solution), one per triangle: the triangles are
     /// drawn with it alone ([`prepare_lit`]).
     pub prelit: Option<Vec<Prelit>>,
+    /// The triangles' octree, for frustum culling.
+    pub octree: octree::Octree,
 }
 
 /// The light of one triangle of a solved scene: the irradiance over π at its corners, which
@@ -210,14 +217,17 @@ pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
         bsp::BspTree::build(&geometry.triangles, 1e-9 * (1.0 + b.extent().length()))
     });
     let csg = csg::CsgBodies::of(scene);
-    Prepared { geometry, shadows, ibl, bsp, emitters, csg, prelit: None }
+    let octree = octree::Octree::build(&geometry.triangles);
+    Prepared { geometry, shadows, ibl, bsp, emitters, csg, prelit: None, octree }
 }
 
 /// Triangles whose light is already known (a radiosity solution: `lit[i]` for
 /// `triangles[i]`), drawn with it alone: no lights, shadows, mirrors, glass or CSG passes, and
 /// always by the depth buffer.
 pub fn prepare_lit(triangles: Vec<Triangle>, lit: Vec<Prelit>) -> Prepared {
+    let octree = octree::Octree::build(&triangles);
     Prepared {
+        octree,
         geometry: geometry::SceneTriangles { triangles, skipped: 0 },
         shadows: None,
         ibl: None,
@@ -235,6 +245,8 @@ pub struct RasterStats {
     pub triangles: usize,
     /// Triangles culled as back faces.
     pub culled: usize,
+    /// Triangles left out whole by the octree's frustum test.
+    pub outside: usize,
     /// Triangles (after clipping and fan triangulation) rasterised.
     pub drawn: usize,
     /// Objects without a triangle form (CSG).
@@ -590,8 +602,14 @@ fn render_view_in(
                 if proj.perspective { bsp::Viewer::At(proj.frame.eye) } else { bsp::Viewer::Towards(proj.frame.w) };
             (&tree.triangles, tree.back_to_front(viewer))
         }
+        _ if opts.frustum_culling => {
+            let mut visible = vec![false; geometry.triangles.len()];
+            prepared.octree.mark_visible(&proj.world_to_clip, &mut visible);
+            (&geometry.triangles, (0..visible.len() as u32).filter(|&i| visible[i as usize]).collect())
+        }
         _ => (&geometry.triangles, (0..geometry.triangles.len() as u32).collect()),
     };
+    let outside = tris.len() - order.len();
     let painter = opts.visibility == Visibility::Bsp && prepared.bsp.is_some();
     // A lit scene's light is all in its triangles: no second passes.
     let in_mirror = in_mirror || prelit.is_some();
@@ -764,6 +782,7 @@ fn render_view_in(
     let stats = RasterStats {
         triangles: tris.len(),
         culled,
+        outside,
         drawn: screen.len(),
         skipped_objects: if prepared.csg.is_some() { 0 } else { geometry.skipped },
         reflexes,
