@@ -150,8 +150,11 @@ fn raster_print(a: &AnamorphArgs, paper: Vec2, out: &str) -> Result<Vec<u8>, Fai
     });
     bar.finish_and_clear();
     let (w, h) = (w as u32, fine_h / n as u32);
-    let guides =
-        Drawing { size: at.paper, lines: footprint(&an, &at).into_iter().map(|p| (Layer::Hidden, p)).collect() };
+    let guides = Drawing {
+        size: at.paper,
+        lines: footprint(&an, &at).into_iter().map(|p| (Layer::Hidden, p)).collect(),
+        fills: vec![],
+    };
     match out {
         "pdf" => Ok(guides.to_pdf_over(guide_stroke, Some(&Backdrop { width: w, height: h, rgb }))),
         "png" => {
@@ -199,8 +202,11 @@ fn vector_print(a: &AnamorphArgs, paper: Vec2, out: &str) -> Result<Vec<u8>, Fai
     let text = std::fs::read_to_string(&a.image).map_err(|e| Failure::input(format!("{}: {e}", a.image.display())))?;
     let (size, lines) = parse_svg_lines(&text).map_err(|e| Failure::input(format!("{}: {e}", a.image.display())))?;
     let (an, at) = setup(a, size.x / size.y, paper)?;
-    let mut d =
-        Drawing { size: at.paper, lines: footprint(&an, &at).into_iter().map(|p| (Layer::Hidden, p)).collect() };
+    let mut d = Drawing {
+        size: at.paper,
+        lines: footprint(&an, &at).into_iter().map(|p| (Layer::Hidden, p)).collect(),
+        fills: vec![],
+    };
     for l in &lines {
         let uv: Vec<Vec2> = l.iter().map(|p| *p / size).collect();
         for run in an.print_polyline(&uv, 0.25) {

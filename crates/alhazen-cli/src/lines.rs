@@ -32,6 +32,11 @@ pub struct LinesArgs {
     /// Leave out the reflections in mirrors.
     #[arg(long)]
     no_reflections: bool,
+    /// Fill the reflexes of the scene's polygons in spherical, cylindrical and plane mirrors
+    /// with their colours, farthest first, under the lines; polygons whose reflexes would fold
+    /// over are split first (Glaeser's Theorems 7–9).
+    #[arg(long, conflicts_with_all = ["no_reflections", "optimize"])]
+    fill: bool,
     /// Mesh edges whose faces meet at more than this angle (degrees) are drawn.
     #[arg(long, default_value_t = 30.0, value_parser = angle)]
     feature_angle: f64,
@@ -155,6 +160,7 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
                 hidden: a.hidden,
                 reflections: !a.no_reflections,
                 sampled: a.sampled,
+                fill: a.fill,
                 ..Options::default()
             };
             let progress = StageBar::new(a.quiet);
@@ -170,6 +176,9 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
             }
             if s.skipped > 0 {
                 summary += &format!("; {} CSG objects have no lines", s.skipped);
+            }
+            if a.fill {
+                summary += &format!("; {} filled reflex polygons", s.fills);
             }
             (d, summary)
         }
@@ -284,6 +293,7 @@ fn graph_drawing(g: GraphFunction, a: &LinesArgs) -> (Drawing, String) {
     let drawing = Drawing {
         size: Vec2::new(a.width_mm, 0.75 * a.width_mm),
         lines: lines.into_iter().map(|l| (Layer::Visible, l.into_iter().map(|p| p * 0.05).collect())).collect(),
+        fills: vec![],
     };
     (drawing, format!("{g:?} graph, {n}×{n} net → {count} visible polylines"))
 }

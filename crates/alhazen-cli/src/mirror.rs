@@ -22,7 +22,12 @@ Output, one line per input line:
   {"reflexes":[[x,y,z]],"all":[{"point":[x,y,z],"kind":"outside"},…]}
 "reflexes" holds the visible reflection on the outside (empty in the forbidden region); "all" every
 real solution of the reflection condition ("outside", "inside", "virtual"), plus "circle" when a
-point on a sphere's axis reflects in a whole circle (Theorem 2). A bad line gives
+point on a sphere's axis reflects in a whole circle (Theorem 2).
+A "polygon" instead of a "point" asks whether its reflex overlaps itself (Theorems 7–9):
+  {"mirror":"cylinder","center":[0,0,0],"axis":[0,1,0],"radius":1,"eye":[4,1,1],"polygon":[[…],…]}
+gives {"projecting_lines":[{"point":[x,y,z],"direction":[x,y,z]}],"pieces":[[[x,y,z],…],…]}: the
+lines of the polygon's plane that the eye sees as points in the mirror (its "contour"), and the
+polygon split along those that cross it, whose reflexes do not overlap. A bad line gives
   {"line":N,"error":"…"}
 and processing continues; the exit code is 2 if any line was bad."#)]
     Reflex {
@@ -179,6 +184,7 @@ struct Query {
     point: Option<[f64; 3]>,
     point_direction: Option<[f64; 3]>,
     axis: Option<[f64; 3]>,
+    polygon: Option<Vec<[f64; 3]>>,
 }
 
 /// The site a query names by `at` (a point) or `toward` (a direction to infinity): exactly one.
@@ -256,6 +262,48 @@ fn answer((r, back): &(Reflexes, Unscale)) -> serde_json::Value {
     serde_json::json!({"reflexes": r.visible().map(|v| vec![p(back.point(v.point))]).unwrap_or_default(), "all": all})
 }
 
+/// A polygon's overlap test (Glaeser §4, Theorems 7–9): its plane's projecting lines on the
+/// mirror seen from the eye, and the pieces it splits into along them.
+fn overlap(q: &Query) -> Result<serde_json::Value, String> {
+    use alhazen_mirror::overlap::{Plane, split_polygon};
+    if q.point.is_some() || q.point_direction.is_some() {
+        return Err("give \"point\" (a reflex) or \"polygon\" (an overlap test), not both".into());
+    }
+    let Some(eye) = q.eye.map(Vec3::from_array) else {
+        return Err("a polygon's overlap test needs a finite \"eye\" (the paper's (22) and (27))".into());
+    };
+    let poly: Vec<Vec3> = q.polygon.iter().flatten().map(|p| Vec3::from_array(*p)).collect();
+    if poly.len() < 3 || !poly.iter().all(|p| p.is_finite()) || !eye.is_finite() {
+        return Err("\"polygon\" needs at least 3 finite points".into());
+    }
+    let plane = Plane::of_polygon(&poly).ok_or("the polygon has no area (its points are collinear)")?;
+    if poly.iter().any(|p| (plane.normal.dot(*p) - plane.offset).abs() > 1e-9 * (1.0 + p.length())) {
+        return Err("the polygon's points do not lie in one plane".into());
+    }
+    let center = Vec3::from_array(q.center);
+    if !(q.radius.is_finite() && q.radius > 0.0) {
+        return Err(format!("\"radius\" must be positive, not {}", q.radius));
+    }
+    let lines = match (q.mirror.as_str(), q.axis) {
+        ("sphere", None) => Sphere { center, radius: q.radius }.projecting_lines(eye, plane),
+        ("cylinder", Some(axis)) => {
+            Cylinder { center, axis: Vec3::from_array(axis), radius: q.radius }.projecting_lines(eye, plane)
+        }
+        ("sphere", Some(_)) => return Err("a sphere takes no \"axis\"".into()),
+        ("cylinder", None) => return Err("a cylinder needs \"axis\"".into()),
+        (other, _) => return Err(format!("unknown mirror \"{other}\": expected \"sphere\" or \"cylinder\"")),
+    }
+    .map_err(|e| e.to_string())?;
+    let p = |v: Vec3| serde_json::json!([v.x, v.y, v.z]);
+    let pieces: Vec<serde_json::Value> = split_polygon(&poly, &lines)
+        .iter()
+        .map(|piece| serde_json::Value::Array(piece.iter().map(|v| p(*v)).collect()))
+        .collect();
+    let lines: Vec<serde_json::Value> =
+        lines.iter().map(|l| serde_json::json!({"point": p(l.mirror_point), "direction": p(l.direction)})).collect();
+    Ok(serde_json::json!({"projecting_lines": lines, "pieces": pieces}))
+}
+
 /// serde's message without its position inside the one line (the reply's `line` field says
 /// which line), with the column kept: `column 2: expected ident`.
 fn json_error(e: serde_json::Error) -> String {
@@ -279,8 +327,10 @@ fn run_reflex(input: Option<&Path>) -> Result<(), Failure> {
         if line.trim().is_empty() {
             continue;
         }
-        let reply =
-            serde_json::from_str::<Query>(&line).map_err(json_error).and_then(|q| solve(&q)).map(|r| answer(&r));
+        let reply = serde_json::from_str::<Query>(&line).map_err(json_error).and_then(|q| match q.polygon {
+            Some(_) => overlap(&q),
+            None => solve(&q).map(|r| answer(&r)),
+        });
         let value = reply.unwrap_or_else(|e| {
             bad += 1;
             serde_json::json!({"line": no + 1, "error": e})

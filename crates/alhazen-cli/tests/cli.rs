@@ -416,6 +416,26 @@ mod mirror {
         assert_eq!(lines[1]["reflexes"].as_array().unwrap().len(), 1);
     }
 
+    /// A polygon's overlap test (Theorems 7–9): a panel across a mirror cylinder splits along
+    /// its plane's projecting lines; bad polygons and an eye at infinity are refused per line.
+    #[test]
+    fn a_polygon_across_a_mirror_is_split_along_its_projecting_lines() {
+        let panel = r#""polygon":[[-2,0.6,-1],[2,0.6,-1],[2,1.6,1.5],[-2,1.6,1.5]]"#;
+        let (code, lines) = reflex(&format!(
+            "{{\"mirror\":\"cylinder\",\"center\":[0,0,0],\"axis\":[0,1,0],\"radius\":0.7,\"eye\":[1.5,3.5,7],{panel}}}\n\
+             {{\"mirror\":\"sphere\",\"center\":[0,0,0],\"radius\":1,\"eye_direction\":[0,0,1],{panel}}}\n\
+             {{\"mirror\":\"sphere\",\"center\":[0,0,0],\"radius\":1,\"eye\":[0,0,5],\"polygon\":[[0,0,0],[1,1,1],[2,2,2]]}}\n\
+             {{\"mirror\":\"sphere\",\"center\":[0,0,0],\"radius\":1,\"eye\":[0,0,5],\"polygon\":[[0,0,0],[1,0,0],[0,1,0],[0,0,1]]}}\n"
+        ));
+        assert_eq!(code, 2);
+        let projecting = lines[0]["projecting_lines"].as_array().unwrap();
+        assert_eq!(projecting.len(), 2, "{}", lines[0]);
+        assert!(lines[0]["pieces"].as_array().unwrap().len() >= 3, "{}", lines[0]);
+        assert!(lines[1]["error"].as_str().unwrap().contains("finite \"eye\""));
+        assert!(lines[2]["error"].as_str().unwrap().contains("no area"));
+        assert!(lines[3]["error"].as_str().unwrap().contains("one plane"));
+    }
+
     #[test]
     fn reflexes_do_not_depend_on_the_scale() {
         // The same configuration at radius 1, 1e-300 and 1e150: the answers scale with it
@@ -1078,6 +1098,22 @@ fn photon_mapping_renders_in_parts_and_checks_its_options() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("disperses"), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(!out.exists());
+}
+
+/// `lines --fill`: the reflexes in the mirror are filled under the lines (SVG polygons, PDF
+/// fills); with nothing to reflect in, the option is refused rather than ignored.
+#[test]
+fn lines_fill_the_reflexes_in_mirrors() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/lines/fig17-polygon-overlap.toml");
+    let svg = dir.path().join("f.svg");
+    let o = alhazen(&["lines", scene.to_str().unwrap(), "--fill", "-o", svg.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("filled reflex polygons"));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("<g id=\"fills\"") && text.contains("<polygon"));
+    let o = alhazen(&["lines", scene.to_str().unwrap(), "--fill", "--no-reflections", "-o", svg.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
 }
 
 /// `--bvh morton` builds meshes' hierarchies in Morton order: the same image as the surface

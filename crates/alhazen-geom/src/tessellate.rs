@@ -29,6 +29,12 @@ pub trait Surface {
     fn point(&self, u: f64, v: f64) -> Vec3 {
         self.sample(u, v).0
     }
+
+    /// Where the surface's polynomial pieces meet, in the unit square, per direction: `0` and
+    /// `1` and the inner knots of a B-spline patch (where it may crease).
+    fn breaks(&self) -> [Vec<f64>; 2] {
+        [vec![0.0, 1.0], vec![0.0, 1.0]]
+    }
 }
 
 impl Surface for BezierPatch<Vec3> {
@@ -54,6 +60,17 @@ impl Surface for BezierPatch<Vec4> {
     }
 }
 
+/// A B-spline patch's distinct domain knots in each direction, mapped to `[0, 1]`.
+fn knot_breaks<P: ControlPoint>(s: &BSplinePatch<P>) -> [Vec<f64>; 2] {
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let unit = |knots: &[f64], a: f64, b: f64| {
+        let mut k: Vec<f64> = knots.iter().filter(|x| **x >= a && **x <= b).map(|x| (x - a) / (b - a)).collect();
+        k.dedup();
+        k
+    };
+    [unit(&s.u_knots, u0, u1), unit(&s.v_knots, v0, v1)]
+}
+
 /// The parameters of `s` at `(u, v)` in the unit square.
 fn in_domain<P: ControlPoint>(s: &BSplinePatch<P>, u: f64, v: f64) -> (f64, f64) {
     let ((u0, u1), (v0, v1)) = s.domain();
@@ -71,6 +88,10 @@ impl Surface for BSplinePatch<Vec3> {
         let (uu, vv) = in_domain(self, u, v);
         self.eval(uu, vv)
     }
+
+    fn breaks(&self) -> [Vec<f64>; 2] {
+        knot_breaks(self)
+    }
 }
 
 impl Surface for BSplinePatch<Vec4> {
@@ -85,33 +106,35 @@ impl Surface for BSplinePatch<Vec4> {
         let h = self.eval(uu, vv);
         h.truncate() / h.w
     }
+
+    fn breaks(&self) -> [Vec<f64>; 2] {
+        knot_breaks(self)
+    }
 }
 
-/// The chordal errors of a `ku × kv` grid: the largest distance between the surface and the
-/// grid's segments at the midpoints of `u`-edges, of `v`-edges, and between the surface and the
-/// diagonals at cell centres.
-fn chordal_errors<S: Surface>(s: &S, ku: usize, kv: usize) -> [f64; 3] {
-    let (hu, hv) = (1.0 / ku as f64, 1.0 / kv as f64);
-    let corners: Vec<Vec3> = (0..=ku)
-        .flat_map(|i| (0..=kv).map(move |j| (i, j)))
-        .map(|(i, j)| s.point(i as f64 * hu, j as f64 * hv))
-        .collect();
+/// The chordal errors of the grid on parameters `us × vs`: the largest distance between the
+/// surface and the grid's segments at the midpoints of `u`-edges, of `v`-edges, and between the
+/// surface and the diagonals at cell centres.
+fn chordal_errors<S: Surface>(s: &S, us: &[f64], vs: &[f64]) -> [f64; 3] {
+    let corners: Vec<Vec3> =
+        us.iter().flat_map(|&u| vs.iter().map(move |&v| (u, v))).map(|(u, v)| s.point(u, v)).collect();
+    let kv = vs.len() - 1;
     let corner = |i: usize, j: usize| corners[i * (kv + 1) + j];
     let mut worst = [0.0f64; 3];
-    for i in 0..=ku {
-        for j in 0..=kv {
-            let (u, v) = (i as f64 * hu, j as f64 * hv);
+    for (i, &u) in us.iter().enumerate() {
+        for (j, &v) in vs.iter().enumerate() {
             let p00 = corner(i, j);
-            if i < ku {
-                let e = (s.point(u + 0.5 * hu, v) - (p00 + corner(i + 1, j)) * 0.5).length();
+            let (next_u, next_v) = (us.get(i + 1), vs.get(j + 1));
+            if let Some(&u1) = next_u {
+                let e = (s.point(0.5 * (u + u1), v) - (p00 + corner(i + 1, j)) * 0.5).length();
                 worst[0] = worst[0].max(e);
             }
-            if j < kv {
-                let e = (s.point(u, v + 0.5 * hv) - (p00 + corner(i, j + 1)) * 0.5).length();
+            if let Some(&v1) = next_v {
+                let e = (s.point(u, 0.5 * (v + v1)) - (p00 + corner(i, j + 1)) * 0.5).length();
                 worst[1] = worst[1].max(e);
             }
-            if i < ku && j < kv {
-                let e = (s.point(u + 0.5 * hu, v + 0.5 * hv) - (p00 + corner(i + 1, j + 1)) * 0.5).length();
+            if let (Some(&u1), Some(&v1)) = (next_u, next_v) {
+                let e = (s.point(0.5 * (u + u1), 0.5 * (v + v1)) - (p00 + corner(i + 1, j + 1)) * 0.5).length();
                 worst[2] = worst[2].max(e);
             }
         }
@@ -119,46 +142,81 @@ fn chordal_errors<S: Surface>(s: &S, ku: usize, kv: usize) -> [f64; 3] {
     worst
 }
 
+/// Parameters dividing each piece between consecutive `breaks` into `per_piece` equal steps.
+fn divided(breaks: &[f64], per_piece: usize) -> Vec<f64> {
+    let mut out = vec![breaks[0]];
+    for w in breaks.windows(2) {
+        out.extend((1..=per_piece).map(|k| w[0] + (w[1] - w[0]) * k as f64 / per_piece as f64));
+    }
+    out
+}
+
 /// Cells per direction beyond which [`tessellate`] stops refining.
 pub const MAX_CELLS_PER_SIDE: usize = 1024;
 
-/// The grid `(ku, kv)` [`tessellate`] uses for `s` at `tolerance`, and its chordal error: each
-/// direction doubled on its own while the chordal error along it (or across the cells'
-/// diagonals) exceeds the tolerance, up to [`MAX_CELLS_PER_SIDE`] (where the error may stay
-/// above the tolerance). A long thin tube gets many cells along and few around.
-pub fn grid_for<S: Surface>(s: &S, tolerance: f64) -> (usize, usize, f64) {
-    let (mut ku, mut kv) = (2, 2);
+/// A tessellation grid: the parameters of its lines in each direction, in the unit square.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grid {
+    /// Parameters of the lines across `u`.
+    pub us: Vec<f64>,
+    /// Parameters of the lines across `v`.
+    pub vs: Vec<f64>,
+    /// Its chordal error.
+    pub error: f64,
+}
+
+impl Grid {
+    /// Cells along `u` and `v`.
+    pub fn cells(&self) -> (usize, usize) {
+        (self.us.len() - 1, self.vs.len() - 1)
+    }
+}
+
+/// The grid [`tessellate`] uses for `s` at `tolerance`. The patch is first subdivided where its
+/// polynomial pieces meet (its knots, as inserting them to full multiplicity would split it
+/// into Bézier patches) so that creases lie on grid lines; then each piece is divided into
+/// equal steps, their number doubled in each direction on its own while the chordal error along
+/// it (or across the cells' diagonals) exceeds the tolerance, up to [`MAX_CELLS_PER_SIDE`] cells
+/// a side (where the error may stay above the tolerance; a direction with more pieces than that
+/// is divided evenly, without regard to its knots). A long thin tube gets many cells along and
+/// few around.
+pub fn grid_for<S: Surface>(s: &S, tolerance: f64) -> Grid {
+    let breaks =
+        s.breaks().map(|b| if b.len() >= 2 && b.len() - 1 <= MAX_CELLS_PER_SIDE / 2 { b } else { vec![0.0, 1.0] });
+    let pieces = [breaks[0].len() - 1, breaks[1].len() - 1];
+    let most = pieces.map(|p| (MAX_CELLS_PER_SIDE / p).max(1));
+    // At least two cells a side.
+    let mut per = pieces.map(|p| if p >= 2 { 1 } else { 2 });
     loop {
-        let [eu, ev, diagonal] = chordal_errors(s, ku, kv);
+        let (us, vs) = (divided(&breaks[0], per[0]), divided(&breaks[1], per[1]));
+        let [eu, ev, diagonal] = chordal_errors(s, &us, &vs);
         let (mut refine_u, mut refine_v) = (eu > tolerance, ev > tolerance);
         if diagonal > tolerance && !refine_u && !refine_v {
             (refine_u, refine_v) = (true, true);
         }
-        let (nu, nv) = (
-            if refine_u { (ku * 2).min(MAX_CELLS_PER_SIDE) } else { ku },
-            if refine_v { (kv * 2).min(MAX_CELLS_PER_SIDE) } else { kv },
-        );
-        if (nu, nv) == (ku, kv) {
-            return (ku, kv, eu.max(ev).max(diagonal));
+        let next = [
+            if refine_u { (per[0] * 2).min(most[0]) } else { per[0] },
+            if refine_v { (per[1] * 2).min(most[1]) } else { per[1] },
+        ];
+        if next == per {
+            return Grid { us, vs, error: eu.max(ev).max(diagonal) };
         }
-        (ku, kv) = (nu, nv);
+        per = next;
     }
 }
 
 /// A triangle mesh of `s` on the grid of [`grid_for`]: within `tolerance` of the surface at the
 /// edges' midpoints and the cells' centres. Texture coordinates are the parameters.
 pub fn tessellate<S: Surface>(s: &S, tolerance: f64) -> TriangleMesh {
-    let (ku, kv, _) = grid_for(s, tolerance);
-    tessellate_grid(s, ku, kv)
+    tessellate_grid(s, &grid_for(s, tolerance))
 }
 
-/// A triangle mesh of `s` on a `ku × kv` grid of the unit square (two triangles a cell).
-pub fn tessellate_grid<S: Surface>(s: &S, ku: usize, kv: usize) -> TriangleMesh {
-    let (ku, kv) = (ku.max(1), kv.max(1));
+/// A triangle mesh of `s` on `grid` (two triangles a cell).
+pub fn tessellate_grid<S: Surface>(s: &S, grid: &Grid) -> TriangleMesh {
+    let (ku, kv) = grid.cells();
     let mut m = TriangleMesh::default();
-    for i in 0..=ku {
-        for j in 0..=kv {
-            let (u, v) = (i as f64 / ku as f64, j as f64 / kv as f64);
+    for &u in &grid.us {
+        for &v in &grid.vs {
             let (p, n) = s.sample(u, v);
             m.positions.push(p);
             m.normals.push(n);
@@ -223,10 +281,11 @@ mod tests {
         for tol in [0.1, 0.01, 0.001] {
             let m = tessellate(&p, tol);
             m.validate().unwrap();
-            let (ku, kv, error) = grid_for(&p, tol);
-            assert!(error <= tol);
+            let grid = grid_for(&p, tol);
+            let (ku, kv) = grid.cells();
+            assert!(grid.error <= tol);
             assert_eq!(m.positions.len(), (ku + 1) * (kv + 1));
-            assert!(chordal_errors(&p, ku, kv).iter().all(|e| *e <= tol), "{ku} × {kv}");
+            assert!(chordal_errors(&p, &grid.us, &grid.vs).iter().all(|e| *e <= tol), "{ku} × {kv}");
             // Independent check: the surface at random parameters against the mesh's triangle there.
             for k in 0..200 {
                 let (u, v) = ((k as f64 * 0.618_034).fract(), (k as f64 * 0.414_214).fract());
@@ -242,6 +301,29 @@ mod tests {
             }
             assert!(m.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-9));
         }
+    }
+
+    #[test]
+    fn a_crease_at_a_knot_lies_on_a_grid_line() {
+        // A linear-by-quadratic B-spline patch, folded along u = 0.3 (a double knot of the
+        // quadratic direction): a roof with its ridge off the grid's even divisions.
+        let u_knots = vec![0.0, 0.0, 0.0, 0.3, 0.3, 1.0, 1.0, 1.0];
+        let ridge = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.15, 0.0, 0.5),
+            Vec3::new(0.3, 0.0, 1.0),
+            Vec3::new(0.65, 0.0, 0.5),
+            Vec3::new(1.0, 0.0, 0.0),
+        ];
+        let points: Vec<Vec3> = ridge.iter().flat_map(|p| [*p, *p + Vec3::Y]).collect();
+        let patch =
+            BSplinePatch::new(2, 1, u_knots, vec![0.0, 0.0, 1.0, 1.0], Net::new(5, 2, points).unwrap()).unwrap();
+        let grid = grid_for(&patch, 1e-3);
+        assert!(grid.us.contains(&0.3), "{:?}", grid.us);
+        // The roof is two planes: the first grid meets the tolerance exactly with its ridge line.
+        assert_eq!(grid.cells().0, 2, "{:?}", grid.us);
+        let m = tessellate(&patch, 1e-3);
+        assert!(m.positions.iter().any(|p| (p.z - 1.0).abs() < 1e-12), "the ridge is in the mesh");
     }
 
     #[test]

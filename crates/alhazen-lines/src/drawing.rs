@@ -59,6 +59,17 @@ pub struct Drawing {
     pub size: Vec2,
     /// `(layer, points)` in drawing order.
     pub lines: Vec<(Layer, Vec<Vec2>)>,
+    /// Filled polygons under the lines, in painter's order (the first is covered by the later).
+    pub fills: Vec<Fill>,
+}
+
+/// A filled polygon on paper (its outline closes itself).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fill {
+    /// Corners in millimetres.
+    pub points: Vec<Vec2>,
+    /// Linear-free display RGB in `[0, 1]`.
+    pub rgb: [f64; 3],
 }
 
 /// Default strokes: visible 0.35 mm black, hidden 0.18 mm grey dashed, reflected 0.25 mm.
@@ -136,7 +147,7 @@ impl Drawing {
             }
             lines.push((layer, chain));
         }
-        Drawing { size: self.size, lines }
+        Drawing { size: self.size, lines, fills: self.fills }
     }
 
     /// The drawing cut to its paper by the course's Liang–Barsky clipping: polylines leaving
@@ -169,7 +180,7 @@ impl Drawing {
                 lines.push((layer, cur));
             }
         }
-        Drawing { size: self.size, lines }
+        Drawing { size: self.size, lines, fills: self.fills }
     }
 
     /// SVG in millimetres, a group per layer, coordinates to 0.001 mm.
@@ -182,6 +193,18 @@ impl Drawing {
             s,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" width=\"{w:.3}mm\" height=\"{h:.3}mm\" viewBox=\"0 0 {w:.3} {h:.3}\" style=\"background-color:white\">"
         );
+        if !self.fills.is_empty() {
+            s.push_str("<g id=\"fills\" inkscape:groupmode=\"layer\" inkscape:label=\"fills\" stroke=\"none\">\n");
+            for f in &self.fills {
+                let [r, g, b] = f.rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+                s.push_str("<polygon points=\"");
+                for (i, p) in f.points.iter().enumerate() {
+                    let _ = write!(s, "{}{:.3},{:.3}", if i > 0 { " " } else { "" }, p.x, p.y);
+                }
+                let _ = writeln!(s, "\" fill=\"rgb({r},{g},{b})\"/>");
+            }
+            s.push_str("</g>\n");
+        }
         for layer in Layer::ALL {
             let st = stroke(layer);
             let grey = (st.grey.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -223,6 +246,14 @@ impl Drawing {
         let mut content = String::new();
         if backdrop.is_some() {
             let _ = writeln!(content, "q {w:.3} 0 0 {h:.3} 0 0 cm /Im0 Do Q");
+        }
+        for f in &self.fills {
+            let [r, g, b] = f.rgb.map(|c| c.clamp(0.0, 1.0));
+            let _ = write!(content, "{r:.4} {g:.4} {b:.4} rg ");
+            for (i, p) in f.points.iter().enumerate() {
+                let _ = write!(content, "{:.3} {:.3} {} ", p.x * PT, h - p.y * PT, if i == 0 { "m" } else { "l" });
+            }
+            content.push_str("h f\n");
         }
         for (k, layer) in Layer::ALL.iter().enumerate() {
             let st = stroke(*layer);
@@ -304,6 +335,11 @@ impl Drawing {
         let scale = px as f64 / self.size.x.max(1e-9);
         let (w, h) = (px, ((self.size.y * scale).round() as u32).max(1));
         let mut ink = vec![0.0f32; (w * h) as usize];
+        for f in &self.fills {
+            let grey = 0.2126 * f.rgb[0] + 0.7152 * f.rgb[1] + 0.0722 * f.rgb[2];
+            let pts: Vec<Vec2> = f.points.iter().map(|p| *p * scale).collect();
+            fill_polygon(&mut ink, (w, h), &pts, (1.0 - grey.clamp(0.0, 1.0)) as f32);
+        }
         for (layer, pts) in &self.lines {
             let st = stroke(*layer);
             let half = (0.5 * st.width * scale).max(0.5);
@@ -348,6 +384,35 @@ impl Drawing {
     }
 }
 
+/// Paints `ink` (darkness) inside polygon `pts` (pixels; even–odd rule at pixel centres), over
+/// what was there.
+fn fill_polygon(ink: &mut [f32], (w, h): (u32, u32), pts: &[Vec2], darkness: f32) {
+    if pts.len() < 3 {
+        return;
+    }
+    let (lo, hi) = pts.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+    let (y0, y1) = ((lo - 0.5).ceil().max(0.0) as u32, ((hi - 0.5).floor().min(h as f64 - 1.0)).max(-1.0) as i64);
+    let mut xs = vec![];
+    for y in y0 as i64..=y1 {
+        let yc = y as f64 + 0.5;
+        xs.clear();
+        for (i, a) in pts.iter().enumerate() {
+            let b = pts[(i + 1) % pts.len()];
+            if (a.y <= yc) != (b.y <= yc) {
+                xs.push(a.x + (yc - a.y) / (b.y - a.y) * (b.x - a.x));
+            }
+        }
+        xs.sort_by(f64::total_cmp);
+        for pair in xs.chunks_exact(2) {
+            let (x0, x1) =
+                ((pair[0] - 0.5).ceil().max(0.0) as i64, ((pair[1] - 0.5).floor()).min(w as f64 - 1.0) as i64);
+            for x in x0..=x1 {
+                ink[(y as u32 * w + x as u32) as usize] = darkness;
+            }
+        }
+    }
+}
+
 /// An 8-bit RGB raster to put under a PDF's lines.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Backdrop {
@@ -387,7 +452,11 @@ mod tests {
 
     fn square() -> Drawing {
         let p = |x, y| Vec2::new(x, y);
-        Drawing { size: p(20.0, 10.0), lines: vec![(Layer::Visible, vec![p(2.0, 2.0), p(18.0, 2.0), p(18.0, 8.0)])] }
+        Drawing {
+            size: p(20.0, 10.0),
+            lines: vec![(Layer::Visible, vec![p(2.0, 2.0), p(18.0, 2.0), p(18.0, 8.0)])],
+            fills: vec![],
+        }
     }
 
     #[test]
@@ -424,6 +493,7 @@ mod tests {
                 (Layer::Visible, vec![p(3.0, 3.0), p(0.0, 0.0)]),
                 (Layer::Reflected, vec![p(2.0, 0.0), p(5.0, 5.0)]),
             ],
+            fills: vec![],
         };
         let length = d.length(Layer::Visible);
         let j = d.joined();

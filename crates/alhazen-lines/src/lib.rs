@@ -29,6 +29,7 @@
 pub mod contour;
 pub mod curves;
 pub mod drawing;
+pub mod fill;
 pub mod horizon;
 pub mod intersect;
 pub mod plotter;
@@ -59,6 +60,8 @@ pub struct Options {
     /// Decide visibility by sampling every this many film pixels instead of exactly (the
     /// baseline of the benchmark, as fogleman/ln does).
     pub sampled: Option<f64>,
+    /// Fill the reflexes of the scene's polygons in the mirrors, in painter's order ([`fill`]).
+    pub fill: bool,
 }
 
 impl Default for Options {
@@ -70,6 +73,7 @@ impl Default for Options {
             hidden: false,
             reflections: true,
             sampled: None,
+            fill: false,
         }
     }
 }
@@ -87,6 +91,8 @@ pub struct Stats {
     pub reflected: usize,
     /// Mirrors found.
     pub mirrors: usize,
+    /// Filled reflex polygons.
+    pub fills: usize,
     /// Round objects drawn from their tessellation (their transform is not a similarity).
     pub tessellated: usize,
     /// Objects without lines (CSG; planes in parallel views).
@@ -131,11 +137,18 @@ pub fn draw_reporting(scene: &Scene, opts: &Options, progress: &dyn Progress) ->
     let shift = alhazen_math::Vec2::new(left.size.x, 0.0);
     left.lines
         .extend(right.lines.into_iter().map(|(layer, pts)| (layer, pts.into_iter().map(|p| p + shift).collect())));
+    left.fills.extend(
+        right
+            .fills
+            .into_iter()
+            .map(|f| drawing::Fill { points: f.points.into_iter().map(|p| p + shift).collect(), ..f }),
+    );
     left.size.x += right.size.x;
     let stats = Stats {
         visible: l.visible + r.visible,
         hidden: l.hidden + r.hidden,
         reflected: l.reflected + r.reflected,
+        fills: l.fills + r.fills,
         ..l
     };
     Ok((left, stats))
@@ -157,7 +170,7 @@ fn draw_view(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(
         Some(step) => visibility::pieces_sampled(&lines, &chords, &view, &world, step, progress),
         None => visibility::pieces(&lines, &chords, &view, &world, progress),
     };
-    let mut drawing = Drawing { size: view.paper(), lines: vec![] };
+    let mut drawing = Drawing { size: view.paper(), lines: vec![], fills: vec![] };
     for p in &pieces {
         if !p.visible && !opts.hidden {
             continue;
@@ -185,6 +198,10 @@ fn draw_view(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(
     for run in reflected.into_iter().flatten() {
         drawing.lines.push((Layer::Reflected, run.iter().map(|p| view.to_paper(*p)).collect()));
     }
+    if opts.fill {
+        progress.stage("filling reflexes", 0);
+        drawing.fills = fill::reflex_fills(scene, &mirrors, &view);
+    }
     progress.stage("joining lines", 0);
     let drawing = drawing.clipped().joined();
     let stats = Stats {
@@ -193,6 +210,7 @@ fn draw_view(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(
         hidden: drawing.count(Layer::Hidden),
         reflected: drawing.count(Layer::Reflected),
         mirrors: mirrors.len(),
+        fills: drawing.fills.len(),
         tessellated,
         skipped,
     };

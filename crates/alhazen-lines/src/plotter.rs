@@ -59,7 +59,7 @@ pub fn optimize(d: Drawing, join_mm: f64) -> Optimized {
         improve(&strokes, &mut order);
         lines.extend(chain(&strokes, &order, join_mm).into_iter().map(|p| (layer, p)));
     }
-    let drawing = Drawing { size: joined.size, lines };
+    let drawing = Drawing { size: joined.size, lines, fills: vec![] };
     let after = travel(&drawing);
     Optimized { drawing, before, after }
 }
@@ -359,7 +359,7 @@ mod tests {
             .into_iter()
             .map(|(k, pts)| (layer(k), pts.into_iter().map(|(x, y)| Vec2::new(x, y)).collect()))
             .collect();
-        Drawing { size: Vec2::new(100.0, 80.0), lines }
+        Drawing { size: Vec2::new(100.0, 80.0), lines, fills: vec![] }
     }
 
     fn strokes() -> impl Strategy<Value = Vec<(u8, Vec<(f64, f64)>)>> {
@@ -476,7 +476,7 @@ mod tests {
             let (x, y) = ((m % 20) as f64 * 4.0 + 5.0, (m / 20) as f64 * 3.0 + 5.0);
             lines.push((Layer::Visible, vec![Vec2::new(x, y), Vec2::new(x + 2.0, y)]));
         }
-        let d = Drawing { size: Vec2::new(100.0, 80.0), lines };
+        let d = Drawing { size: Vec2::new(100.0, 80.0), lines, fills: vec![] };
         let o = optimize(d, 0.0);
         assert!(o.after.pen_up_mm < 0.15 * o.before.pen_up_mm, "{:?} → {:?}", o.before, o.after);
         // A tour of the lattice rows needs at least 400 moves of 2 mm.
@@ -489,7 +489,7 @@ mod tests {
         let p = |x, y| Vec2::new(x, y);
         let lines =
             vec![(Layer::Visible, vec![p(1.0, 1.0), p(5.0, 1.0)]), (Layer::Visible, vec![p(5.03, 1.0), p(9.0, 1.0)])];
-        let d = Drawing { size: p(10.0, 10.0), lines };
+        let d = Drawing { size: p(10.0, 10.0), lines, fills: vec![] };
         assert_eq!(optimize(d.clone(), 0.05).after.polylines, 1);
         assert_eq!(optimize(d, 0.01).after.polylines, 2);
     }

@@ -18,6 +18,8 @@
 //! * [`caustic`] gives the catacaustic (12), (13), its rational form (15), kernel points (16),
 //!   double points (17) and the catacaustic surfaces as triangle meshes.
 //! * [`anamorph`] prints cylinder anamorphoses (§2.4, Theorem 4).
+//! * [`overlap`] finds where a polygon's reflex folds over (§4, Theorems 6–9: the projecting
+//!   lines of its plane, from the quartic (22) or the linear (27)) and splits it there.
 //!
 //! All solutions satisfy the law of reflection to about 1e-13 rad (tests check 1e-12 against a
 //! brute-force search), and no input makes the solver panic: degenerate input is a
@@ -44,6 +46,7 @@ pub mod batch;
 pub mod caustic;
 pub mod circle;
 pub mod figures;
+pub mod overlap;
 mod poly;
 mod solids;
 

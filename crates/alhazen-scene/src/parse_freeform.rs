@@ -255,7 +255,8 @@ impl Parser<'_> {
     /// `surface` tessellated to `tol`, refused (at the shape) if the grid would not fit in the
     /// memory budget.
     fn tessellated<S: Surface>(&mut self, t: &Table, surface: &S, tol: f64) -> R<TriangleMesh> {
-        let (ku, kv, error) = grid_for(surface, tol);
+        let grid = grid_for(surface, tol);
+        let ((ku, kv), error) = (grid.cells(), grid.error);
         let needed = ((ku + 1) * (kv + 1)) as u64 * BYTES_PER_GRID_VERTEX;
         if needed > self.memory_budget {
             let at = t.get("tolerance").unwrap_or(t.req("shape")?);
@@ -275,7 +276,7 @@ impl Parser<'_> {
                 alhazen_geom::tessellate::MAX_CELLS_PER_SIDE
             ));
         }
-        Ok(tessellate_grid(surface, ku, kv))
+        Ok(tessellate_grid(surface, &grid))
     }
 }
 
@@ -296,7 +297,7 @@ fn points_of(n: &Node, dim: Dim) -> R<Vec<Vec3>> {
         .collect::<R<_>>()?;
     if points.len() < 2 {
         return Err(n.err(format!(
-            "`{}`: a curve needs at least 2 control points (or points to pass through), found {}",
+            "`{}`: a curve needs at least 2 points — at least 2 control points, or 2 points to pass through — found {}",
             n.key,
             points.len()
         )));
