@@ -129,28 +129,48 @@ impl TriangleMesh {
 
     /// True when the mesh bounds a solid: every edge, matched by its end points' positions (so
     /// vertices split at texture seams still join), is used exactly once in each direction.
-    /// Degenerate triangles (two equal corners) are ignored.
+    /// Degenerate triangles (two equal corners) are ignored. By sorting, not hashing: vertices
+    /// get one id per distinct position, then the directed edges are sorted (stably) by their
+    /// undirected key and each edge's uses are counted in triangle order.
     pub fn is_closed(&self) -> bool {
-        use std::collections::HashMap;
         let key = |i: u32| self.positions[i as usize].to_array().map(f64::to_bits);
-        let mut edges: HashMap<([u64; 3], [u64; 3]), i32> = HashMap::with_capacity(3 * self.triangles.len());
+        let mut by_position: Vec<u32> = (0..self.positions.len() as u32).collect();
+        by_position.sort_unstable_by_key(|&i| key(i));
+        let mut id = vec![0u32; self.positions.len()];
+        let mut next = 0u32;
+        for (k, &i) in by_position.iter().enumerate() {
+            if k > 0 && key(by_position[k - 1]) != key(i) {
+                next += 1;
+            }
+            id[i as usize] = next;
+        }
+        let mut edges: Vec<(u64, i8)> = Vec::with_capacity(3 * self.triangles.len());
         for t in &self.triangles {
-            let k = t.map(key);
+            let k = t.map(|i| id[i as usize] as u64);
             if k[0] == k[1] || k[1] == k[2] || k[0] == k[2] {
                 continue;
             }
             for (a, b) in [(k[0], k[1]), (k[1], k[2]), (k[2], k[0])] {
                 // +1 for a → b, −1 for b → a, on the edge's canonical key.
-                let (edge, sign) = if a < b { ((a, b), 1) } else { ((b, a), -1) };
-                let count = edges.entry(edge).or_insert(0);
-                *count += sign;
-                // A second use in the same direction: not a solid's boundary.
-                if count.abs() > 1 {
-                    return false;
-                }
+                edges.push(if a < b { (a << 32 | b, 1) } else { (b << 32 | a, -1) });
             }
         }
-        !edges.is_empty() && edges.values().all(|&c| c == 0)
+        edges.sort_by_key(|e| e.0);
+        let mut count = 0i32;
+        for (k, e) in edges.iter().enumerate() {
+            if k > 0 && edges[k - 1].0 != e.0 {
+                if count != 0 {
+                    return false;
+                }
+                count = 0;
+            }
+            count += e.1 as i32;
+            // A second use in the same direction: not a solid's boundary.
+            if count.abs() > 1 {
+                return false;
+            }
+        }
+        !edges.is_empty() && count == 0
     }
 
     /// Number of triangles.
@@ -185,6 +205,60 @@ impl TriangleMesh {
 
 #[cfg(test)]
 mod tests {
+
+    /// The definition, by hashing directed edges in triangle order.
+    fn closed_by_hashing(m: &TriangleMesh) -> bool {
+        use std::collections::HashMap;
+        let key = |i: u32| m.positions[i as usize].to_array().map(f64::to_bits);
+        let mut edges: HashMap<([u64; 3], [u64; 3]), i32> = HashMap::new();
+        for t in &m.triangles {
+            let k = t.map(key);
+            if k[0] == k[1] || k[1] == k[2] || k[0] == k[2] {
+                continue;
+            }
+            for (a, b) in [(k[0], k[1]), (k[1], k[2]), (k[2], k[0])] {
+                let (edge, sign) = if a < b { ((a, b), 1) } else { ((b, a), -1) };
+                let count = edges.entry(edge).or_insert(0);
+                *count += sign;
+                if count.abs() > 1 {
+                    return false;
+                }
+            }
+        }
+        !edges.is_empty() && edges.values().all(|&c| c == 0)
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn closedness_by_sorting_is_the_definition(
+            tris in proptest::collection::vec((0u32..6, 0u32..6, 0u32..6), 0..24),
+            duplicate in 0usize..6,
+        ) {
+            // Six positions, one of them twice (a seam), and triangles over them.
+            let mut positions: Vec<Vec3> = (0..6).map(|i| Vec3::new((i % 2) as f64, (i / 2 % 2) as f64, (i / 4) as f64)).collect();
+            positions.push(positions[duplicate]);
+            let triangles = tris.iter().map(|&(a, b, c)| [a, b, if c == 5 { 6 } else { c }]).collect();
+            let m = TriangleMesh { positions, triangles, ..TriangleMesh::default() };
+            proptest::prop_assert_eq!(m.is_closed(), closed_by_hashing(&m));
+        }
+
+        #[test]
+        fn closedness_by_sorting_is_the_definition_near_closed_meshes(
+            extra in proptest::collection::vec((0usize..12, proptest::bool::ANY, proptest::bool::ANY), 0..6),
+        ) {
+            // The cube, with some of its triangles added again, reversed or not, and in pairs.
+            let mut m = TriangleMesh::cuboid(Vec3::ZERO, Vec3::ONE);
+            for &(k, reversed, pair) in &extra {
+                let t = m.triangles[k];
+                let r = [t[0], t[2], t[1]];
+                m.triangles.push(if reversed { r } else { t });
+                if pair {
+                    m.triangles.push(if reversed { t } else { r });
+                }
+            }
+            proptest::prop_assert_eq!(m.is_closed(), closed_by_hashing(&m));
+        }
+    }
 
     #[test]
     fn closedness_is_measured_from_the_edges() {
