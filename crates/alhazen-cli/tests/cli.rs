@@ -1076,6 +1076,9 @@ fn photon_mapping_renders_in_parts_and_checks_its_options() {
         out
     };
     let whole = run("whole.pfm", &[]);
+    // Paths traced eight at a time in lanes (the default kernel here) or one by one: the same.
+    let portable = run("portable.pfm", &["--kernel", "portable"]);
+    assert_eq!(std::fs::read(&whole).unwrap(), std::fs::read(&portable).unwrap());
     let (a, b) = (run("a.film", &["--tile", "0/2"]), run("b.film", &["--tile", "1/2"]));
     let merged = dir.path().join("merged.pfm");
     let o = alhazen(&["merge", a.to_str().unwrap(), b.to_str().unwrap(), "-o", merged.to_str().unwrap(), "--quiet"]);

@@ -19,7 +19,7 @@
 //! non-specular vertex through specular (delta) surfaces is taken from it instead: the estimate
 //! is added at every non-specular vertex, and emission reached from a non-specular vertex
 //! through specular bounces only is left out (it is what the estimate holds). Mirror connections
-//! are then off (the estimate holds their paths too).
+//! are then off (the estimate holds their paths too), and so is the lanes' Lambert kernel.
 //!
 //! Where the world tests eight rays at once faster than one by one (`World::traces_rays_together`),
 //! eight samples are traced side by side (`lanes`), each with the same arithmetic ([`PathTracer::vertex`]),
@@ -220,11 +220,12 @@ impl<'a> PathTracer<'a> {
     }
 
     /// The tracer taking caustics (light through specular surfaces onto non-specular ones) from
-    /// `caustics`: mirror connections off, samples traced one path at a time.
+    /// `caustics`: mirror connections off; in lanes every vertex takes the general kernel
+    /// (`vertex`, which gathers the estimate).
     pub fn with_caustics(mut self, caustics: &'a dyn CausticEstimate) -> Self {
         self.caustics = Some(caustics);
         self.mirrors = None;
-        self.in_lanes = false;
+        self.lambert_kernel.iter_mut().for_each(|k| *k = false);
         self
     }
 
