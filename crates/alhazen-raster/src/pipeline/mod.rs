@@ -657,7 +657,12 @@ fn render_view_in(
         })
         .collect();
     let culled = processed.iter().map(|p| p.0).sum();
-    let mut screen: Vec<ScreenTriangle> = processed.into_iter().flat_map(|p| p.1).collect();
+    // The frame's screen triangles go into the last frame's buffer: a big mesh's hundreds of MB
+    // are not mapped afresh (and page-faulted) every frame.
+    let mut screen = SCREEN_BUFFER.with(|b| std::mem::take(&mut *b.borrow_mut()));
+    screen.clear();
+    screen.reserve(processed.iter().map(|p| p.1.len()).sum());
+    processed.into_iter().for_each(|p| screen.extend(p.1));
     let painter = painter || opts.visibility == Visibility::DepthSort;
     if opts.visibility == Visibility::DepthSort {
         screen = depth_sort::depth_sort(screen).0;
@@ -787,7 +792,13 @@ fn render_view_in(
         skipped_objects: if prepared.csg.is_some() { 0 } else { geometry.skipped },
         reflexes,
     };
+    SCREEN_BUFFER.with(|b| *b.borrow_mut() = screen);
     Ok((fb, stats))
+}
+
+thread_local! {
+    /// The screen-triangle buffer of the last frame drawn on this thread, for the next.
+    static SCREEN_BUFFER: std::cell::RefCell<Vec<ScreenTriangle>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Triangle edges by Bresenham, in white, over the image.
