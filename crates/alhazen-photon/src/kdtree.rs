@@ -68,11 +68,19 @@ impl<T: Located> KdTree<T> {
         if k == 0 || self.items.is_empty() {
             return;
         }
-        let mut heap = BinaryHeap::with_capacity(k + 1);
-        let mut search = Search { tree: self, p, k, r2: radius * radius, heap: &mut heap, keep: &keep };
-        search.visit(0, self.items.len());
-        out.extend(heap.into_iter().map(|(bits, index)| Neighbour { index, dist2: f64::from_bits(bits) }));
+        HEAP.with(|cell| {
+            // One heap per thread, reused: a query at every diffuse vertex allocates nothing.
+            let mut heap = cell.borrow_mut();
+            heap.clear();
+            let mut search = Search { tree: self, p, k, r2: radius * radius, heap: &mut heap, keep: &keep };
+            search.visit(0, self.items.len());
+            out.extend(heap.drain().map(|(bits, index)| Neighbour { index, dist2: f64::from_bits(bits) }));
+        });
     }
+}
+
+thread_local! {
+    static HEAP: std::cell::RefCell<BinaryHeap<(u64, u32)>> = const { std::cell::RefCell::new(BinaryHeap::new()) };
 }
 
 /// Sorts `keyed` into tree order: the median (by the axis of largest extent) in the middle,

@@ -241,8 +241,7 @@ impl Parser<'_> {
     /// A warning when a sweep's frame stopped short of `tolerance`.
     fn check_sweep(&mut self, t: &Table, swept: &FramedSweep, tol: f64) {
         if swept.error > tol {
-            let name =
-                t.get("name").and_then(|n| n.str().ok().map(str::to_string)).unwrap_or_else(|| "a swept shape".into());
+            let name = shape_name(t, "a swept shape");
             self.warnings.push(format!(
                 "{name}: the sweep's frame is within {:.2e} of its guide's normal planes, not the `tolerance` {tol:.2e} (the guide was subdivided {} times, to {} control points)",
                 swept.error,
@@ -267,10 +266,7 @@ impl Parser<'_> {
             )));
         }
         if error > tol {
-            let name = t
-                .get("name")
-                .and_then(|n| n.str().ok().map(str::to_string))
-                .unwrap_or_else(|| "a free-form surface".into());
+            let name = shape_name(t, "a free-form surface");
             self.warnings.push(format!(
                 "{name}: tessellated within {error:.2e}, not the `tolerance` {tol:.2e} ({} cells a side at most)",
                 alhazen_geom::tessellate::MAX_CELLS_PER_SIDE
@@ -278,6 +274,11 @@ impl Parser<'_> {
         }
         Ok(tessellate_grid(surface, &grid))
     }
+}
+
+/// A shape's `name` for messages, or `otherwise`.
+fn shape_name(t: &Table, otherwise: &str) -> String {
+    t.get("name").and_then(|n| n.str().ok().map(str::to_string)).unwrap_or_else(|| otherwise.into())
 }
 
 /// A shape's `tolerance` (chordal, in scene units).
