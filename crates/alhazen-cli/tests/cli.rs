@@ -1095,6 +1095,9 @@ fn photon_mapping_renders_in_parts_and_checks_its_options() {
         let (code, err, _) = render(OK, &[&["--integrator", "photon"][..], bad].concat());
         assert_eq!(code, 2, "{bad:?}: {err}");
     }
+    // A photon map that would not fit in memory is refused before it is shot.
+    let (code, err, exists) = render(OK, &["--integrator", "photon", "--photons", "100000000", "--max-memory", "200M"]);
+    assert_eq!((code, exists), (2, false), "{err}");
     let prism = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/prism.toml");
     let out = dir.path().join("prism.png");
     let o = alhazen(&["render", prism.to_str().unwrap(), "-o", out.to_str().unwrap(), "--integrator", "photon"]);
