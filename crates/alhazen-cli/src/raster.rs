@@ -168,7 +168,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
     if !a.image.quiet {
         let per_frame = elapsed / a.frames as f64;
         eprintln!(
-            "rasterised {} ({}×{}, {} triangles tessellated{} in {:.3} s, {} culled, {} drawn{}) in {:.4} s per frame ({:.1} fps, {:.2} M triangles/s) on {} threads → {}",
+            "rasterised {} ({}×{}, {} triangles tessellated{} in {:.3} s, {} culled, {} drawn, {} between pixel centres or clipped away{}) in {:.4} s per frame ({:.1} fps, {:.2} M triangles/s) on {} threads → {}",
             a.image.scene.display(),
             image.width,
             image.height,
@@ -183,6 +183,7 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
             tessellation,
             stats.culled,
             stats.drawn,
+            stats.missed,
             if stats.skipped_objects > 0 {
                 format!(", {} CSG objects skipped", stats.skipped_objects)
             } else {

@@ -16,6 +16,7 @@ pub fn sum(a: RasterStats, b: RasterStats) -> RasterStats {
         culled: a.culled + b.culled,
         outside: a.outside + b.outside,
         drawn: a.drawn + b.drawn,
+        missed: a.missed + b.missed,
         skipped_objects: a.skipped_objects,
         reflexes: a.reflexes + b.reflexes,
     }

@@ -4,9 +4,13 @@
 
 use alhazen_math::Vec4;
 
-/// Attributes per vertex: world position (3), normal (3), texture coordinates (2), and the
-/// Gouraud light factors (diffuse 3, highlight 3).
-pub const ATTRIBUTES: usize = 14;
+/// Attributes per vertex: world position (3, for user clip planes) and the weights of the
+/// source triangle's corners 1 and 2 (from [`BARY`]; everything else is interpolated from the
+/// source triangle for the visible pixel alone).
+pub const ATTRIBUTES: usize = 5;
+
+/// Where the corner weights start among the attributes.
+pub const BARY: usize = 3;
 
 /// A clip-space vertex with its attributes (linear in clip space, so they interpolate with the
 /// same parameter as the position).
@@ -16,6 +20,15 @@ pub struct ClipVertex {
     pub pos: Vec4,
     /// Attributes, see [`ATTRIBUTES`].
     pub attr: [f64; ATTRIBUTES],
+}
+
+impl ClipVertex {
+    /// Corner `k` of a source triangle: world position `p`, projected to `pos`, with the
+    /// corner's weights (1 for itself).
+    pub fn corner(pos: Vec4, p: alhazen_math::Vec3, k: usize) -> Self {
+        let b = [(k == 1) as u8 as f64, (k == 2) as u8 as f64];
+        ClipVertex { pos, attr: [p.x, p.y, p.z, b[0], b[1]] }
+    }
 }
 
 fn lerp(a: &ClipVertex, b: &ClipVertex, t: f64) -> ClipVertex {

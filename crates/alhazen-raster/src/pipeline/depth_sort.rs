@@ -16,7 +16,6 @@
 //! planar, and a split point interpolates `z/w`, `1/w` and the attributes over `w` linearly —
 //! exactly as the rasteriser interpolates them — so the pieces are drawn as the whole was.
 
-use super::clip::ATTRIBUTES;
 use super::raster::ScreenTriangle;
 use alhazen_math::Vec3;
 use std::collections::VecDeque;
@@ -104,8 +103,8 @@ fn split(t: &ScreenTriangle, (n, o): (Vec3, Vec3)) -> Vec<ScreenTriangle> {
     if d.iter().all(|&x| x >= 0.0) || d.iter().all(|&x| x <= 0.0) {
         return vec![*t];
     }
-    let vertex = |k: usize| (t.x[k], t.y[k], t.z[k], t.inv_w[k], t.attr_w[k]);
-    type V = (f64, f64, f64, f64, [f64; ATTRIBUTES]);
+    let vertex = |k: usize| (t.x[k], t.y[k], t.z[k], t.inv_w[k], t.bary_w[k]);
+    type V = (f64, f64, f64, f64, [f64; 2]);
     let lerp = |a: V, b: V, s: f64| -> V {
         (
             a.0 + (b.0 - a.0) * s,
@@ -140,7 +139,7 @@ fn split(t: &ScreenTriangle, (n, o): (Vec3, Vec3)) -> Vec<ScreenTriangle> {
                 y: c.map(|v| v.1),
                 z: c.map(|v| v.2),
                 inv_w: c.map(|v| v.3),
-                attr_w: c.map(|v| v.4),
+                bary_w: c.map(|v| v.4),
                 source: t.source,
             });
         }
@@ -215,7 +214,7 @@ mod tests {
             y: p.map(|v| v.1),
             z: p.map(|v| v.2),
             inv_w: [1.0; 3],
-            attr_w: [[0.0; ATTRIBUTES]; 3],
+            bary_w: [[0.0; 2]; 3],
             source,
         }
     }

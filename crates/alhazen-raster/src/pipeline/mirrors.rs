@@ -15,9 +15,8 @@
 //! reflection in the mirror's plane, clipped to the half-space in front of it, and shown on the
 //! mirror's pixels.
 
-use super::clip::ATTRIBUTES;
 use super::geometry::{Triangle, Vertex};
-use super::raster::{ScreenTriangle, rasterize};
+use super::raster::{Bary, ScreenTriangle, rasterize};
 use super::{Projection, RasterOptions, shade};
 use alhazen_math::{Vec2, Vec3, Vec4};
 use alhazen_mirror::batch::{PointsSoA, ReflexesSoA};
@@ -300,13 +299,6 @@ pub fn mirror_image(
     // need splitting twenty times over to resolve what lies near it).
     let planes = plane_rings(tris, surface.centre_and_size());
     let all: Vec<&Triangle> = tris.iter().filter(|t| !t.unbounded).chain(planes.iter().map(|p| &p.0)).collect();
-    let source: Vec<u32> = tris
-        .iter()
-        .enumerate()
-        .filter(|(_, t)| !t.unbounded)
-        .map(|(i, _)| i as u32)
-        .chain(planes.iter().map(|p| p.1))
-        .collect();
     let others: Vec<u32> = (0..all.len() as u32).filter(|&i| all[i as usize].object != mirror.object).collect();
     let reflexes = corner_reflexes(&all, &others, &surface, eye);
     let pieces: Vec<ScreenTriangle> = others
@@ -323,7 +315,7 @@ pub fn mirror_image(
             });
             if facing {
                 let job = Reflexes { surface: &surface, eye, proj, size: (w, h) };
-                job.split(t.v, corners, source[i as usize], 0, &mut out);
+                job.split(t.v, CORNER_WEIGHTS, corners, i, 0, &mut out);
             }
             out
         })
@@ -335,7 +327,7 @@ pub fn mirror_image(
         .flat_map_iter(|b| {
             let (y0, y1) = (b * band, ((b + 1) * band).min(h));
             let n = ((y1 - y0) * w) as usize;
-            let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; ATTRIBUTES]); n]);
+            let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; 2]); n]);
             for t in pieces.iter().filter(|t| {
                 let (lo, hi) = (
                     t.y.iter().copied().fold(f64::INFINITY, f64::min),
@@ -347,7 +339,7 @@ pub fn mirror_image(
                     let k = ((f.y - y0) * w + f.x) as usize;
                     if f.depth < depth[k] {
                         depth[k] = f.depth;
-                        owner[k] = (t.source, f.attr);
+                        owner[k] = (t.source, f.bary);
                     }
                 });
             }
@@ -355,12 +347,12 @@ pub fn mirror_image(
                 .map(|k| {
                     let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
                     let d = proj.near_ray(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64).dir;
-                    let (_, n) = surface.hit(eye, d)?;
-                    let (src, attr) = &owner[k];
-                    Some(if *src == u32::MAX {
+                    let (at, n) = surface.hit(eye, d)?;
+                    let (src, b) = owner[k];
+                    Some(if src == u32::MAX {
                         scene.sky(d - 2.0 * d.dot(n) * n)
                     } else {
-                        reflected_color(scene, &tris[*src as usize], attr, light)
+                        reflected_color(scene, all[src as usize], b, at, light)
                     })
                 })
                 .collect::<Vec<_>>()
@@ -442,15 +434,15 @@ fn corner_reflexes(tris: &[&Triangle], which: &[u32], surface: &Curved, eye: Vec
     solved.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
 }
 
-/// A reflected point lit as the mirror sees it: the attributes hold the point, its normal, its
-/// texture coordinates and the mirror point it is seen at.
-fn reflected_color(scene: &Scene, t: &Triangle, attr: &[f64; ATTRIBUTES], light: &shade::Lighting) -> Vec3 {
+/// The point of `t` at corner weights `b`, lit as the mirror sees it from mirror point `at`.
+fn reflected_color(scene: &Scene, t: &Triangle, b: Bary, at: Vec3, light: &shade::Lighting) -> Vec3 {
     let m = &scene.materials[t.material as usize];
-    let p = Vec3::new(attr[0], attr[1], attr[2]);
-    let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
-    let at = Vec3::new(attr[8], attr[9], attr[10]);
-    shade::shade(scene, m, p, n, (at - p).normalize_or_zero(), Vec2::new(attr[6], attr[7]), light)
+    let (p, n, uv) = super::surface_at(t, b);
+    shade::shade(scene, m, p, n, (at - p).normalize_or_zero(), uv, light)
 }
+
+/// The weights of a triangle's own corners.
+const CORNER_WEIGHTS: [Bary; 3] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
 
 /// The reflexes of one mirror seen from one eye, to split triangles into.
 struct Reflexes<'a> {
@@ -467,7 +459,17 @@ impl Reflexes<'_> {
 
     /// Emits the reflex of triangle `v` (corner reflexes `r`), split until each piece's edges
     /// are within the tolerance.
-    fn split(&self, v: [Vertex; 3], r: [Option<Vec3>; 3], source: u32, level: u32, out: &mut Vec<ScreenTriangle>) {
+    /// `b` are the corners' weights in the source triangle, which the pieces carry.
+    #[allow(clippy::too_many_arguments)]
+    fn split(
+        &self,
+        v: [Vertex; 3],
+        b: [Bary; 3],
+        r: [Option<Vec3>; 3],
+        source: u32,
+        level: u32,
+        out: &mut Vec<ScreenTriangle>,
+    ) {
         // Reflexes behind the eye are not in this view: a piece wholly behind is left out, one
         // across the eye's plane is split a few times and then left out too (screen positions
         // behind the eye mean nothing to the tolerance, which would split it to the last level).
@@ -482,7 +484,7 @@ impl Reflexes<'_> {
         if behind == 0 && present.len() == 3 && span <= 1.0 {
             // Most triangles of a fine mesh: their reflex is smaller than a pixel (a convex
             // mirror shrinks), no midpoint needs solving.
-            self.emit(v, r.map(|x| x.expect("three reflexes")), source, out);
+            self.emit(v, b, r.map(|x| x.expect("three reflexes")), source, out);
             return;
         }
         if level >= 3 && present.len() == 2 && span <= 1.0 {
@@ -494,6 +496,8 @@ impl Reflexes<'_> {
             uv: (a.uv + b.uv) / 2.0,
         };
         let m = [mid(&v[1], &v[2]), mid(&v[2], &v[0]), mid(&v[0], &v[1])];
+        let half = |x: Bary, y: Bary| [(x[0] + y[0]) / 2.0, (x[1] + y[1]) / 2.0];
+        let mb = [half(b[1], b[2]), half(b[2], b[0]), half(b[0], b[1])];
         let rm = m.map(|x| self.reflex(x.p));
         // Without a reflex at any corner or midpoint the piece lies in the region the mirror
         // does not show; with one, deep down, on its border.
@@ -519,20 +523,20 @@ impl Reflexes<'_> {
             s.len() == 3 && s.iter().all(|p| (*p - s[0]).length() <= FINEST_PX)
         };
         if fits || (level == MAX_LEVEL && behind == 0 && small()) {
-            self.emit(v, r.map(|x| x.expect("three reflexes")), source, out);
+            self.emit(v, b, r.map(|x| x.expect("three reflexes")), source, out);
         } else if level < MAX_LEVEL {
-            for (tri, refl) in [
-                ([v[0], m[2], m[1]], [r[0], rm[2], rm[1]]),
-                ([m[2], v[1], m[0]], [rm[2], r[1], rm[0]]),
-                ([m[1], m[0], v[2]], [rm[1], rm[0], r[2]]),
-                ([m[0], m[1], m[2]], [rm[0], rm[1], rm[2]]),
+            for (tri, w, refl) in [
+                ([v[0], m[2], m[1]], [b[0], mb[2], mb[1]], [r[0], rm[2], rm[1]]),
+                ([m[2], v[1], m[0]], [mb[2], b[1], mb[0]], [rm[2], r[1], rm[0]]),
+                ([m[1], m[0], v[2]], [mb[1], mb[0], b[2]], [rm[1], rm[0], r[2]]),
+                ([m[0], m[1], m[2]], [mb[0], mb[1], mb[2]], [rm[0], rm[1], rm[2]]),
             ] {
-                self.split(tri, refl, source, level + 1, out);
+                self.split(tri, w, refl, source, level + 1, out);
             }
         }
     }
 
-    fn emit(&self, v: [Vertex; 3], r: [Vec3; 3], source: u32, out: &mut Vec<ScreenTriangle>) {
+    fn emit(&self, v: [Vertex; 3], b: [Bary; 3], r: [Vec3; 3], source: u32, out: &mut Vec<ScreenTriangle>) {
         let s = r.map(|p| to_screen(self.proj, p, self.size));
         let (w, h) = (self.size.0 as f64, self.size.1 as f64);
         if s.iter().all(|p| p.x < 0.0)
@@ -542,16 +546,12 @@ impl Reflexes<'_> {
         {
             return;
         }
-        let attr = |k: usize| {
-            let (p, n, uv, at) = (v[k].p, v[k].n, v[k].uv, r[k]);
-            [p.x, p.y, p.z, n.x, n.y, n.z, uv.x, uv.y, at.x, at.y, at.z, 0.0, 0.0, 0.0]
-        };
         out.push(ScreenTriangle {
             x: s.map(|p| p.x),
             y: s.map(|p| p.y),
             z: std::array::from_fn(|k| (r[k] - self.eye).length() + (v[k].p - r[k]).length()),
             inv_w: [1.0; 3],
-            attr_w: std::array::from_fn(attr),
+            bary_w: b,
             source,
         });
     }

@@ -5,8 +5,9 @@
 //! only); polygons are clipped in homogeneous coordinates; the perspective division and the
 //! viewport transform give screen triangles, which are rasterised with a z-buffer (or painted
 //! back to front over a BSP tree), in parallel horizontal bands. Visibility fills a G-buffer —
-//! per pixel the winning triangle and its interpolated world position, normal, texture
-//! coordinates and Gouraud light — and a deferred pass shades each visible pixel once. Shading is
+//! per pixel the winning triangle and the weights of its corners there — and a deferred pass
+//! interpolates the triangle's position, normal, texture coordinates (and Gouraud's corner
+//! light) for each visible pixel and shades it once. Shading is
 //! flat (one colour per triangle), Gouraud (light at the vertices, interpolated) or Phong
 //! (normals interpolated, lighting per pixel) with the course's local models, shadows (maps or
 //! stencil volumes), image-based and hemispherical light. The camera and the sample position (pixel centres) match `alhazen render`'s.
@@ -31,9 +32,9 @@ pub mod warnock;
 use alhazen_math::viewing::{Frustum, ViewFrame};
 use alhazen_math::{Mat4, Vec2, Vec3, Vec4};
 use alhazen_scene::{CameraDesc, Scene};
-use clip::{ATTRIBUTES, ClipVertex, clip_polygon};
+use clip::{ClipVertex, clip_polygon};
 use geometry::{Triangle, scene_triangles};
-use raster::{ScreenTriangle, rasterize};
+use raster::{Bary, ScreenTriangle, interpolate, rasterize};
 use rayon::prelude::*;
 
 /// How colours are computed over a triangle.
@@ -149,8 +150,12 @@ pub struct Prepared {
     /// Light computed elsewhere (a radiosity solution), one per triangle: the triangles are
     /// drawn with it alone ([`prepare_lit`]).
     pub prelit: Option<Vec<Prelit>>,
-    /// The triangles' octree, for frustum culling.
+    /// The triangles' octree, for frustum culling and the drawing order.
     pub octree: octree::Octree,
+    /// The flat mirrors among the triangles.
+    pub plane_mirrors: Vec<mirrors::PlaneMirror>,
+    /// Some triangle is transparent (glass needs a second pass).
+    pub transparent: bool,
 }
 
 /// The light of one triangle of a solved scene: the irradiance over π at its corners, which
@@ -203,7 +208,8 @@ impl Prepared {
 /// Tessellates `scene` and, as `opts` ask, renders its shadow maps, computes its environment's
 /// lighting and builds its BSP tree.
 pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
-    let geometry = scene_triangles(scene);
+    let mut geometry = scene_triangles(scene);
+    let (octree, _) = in_tree_order(&mut geometry.triangles);
     let emitters = emitters::emitter_lights(scene, &geometry.triangles);
     let maps = opts.shadows && opts.shadow_method == ShadowMethod::Maps;
     let shadows = maps.then(|| shadow::Shadows::build(scene, &geometry.triangles, &emitters, SHADOW_MAP_SIZE));
@@ -217,15 +223,27 @@ pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
         bsp::BspTree::build(&geometry.triangles, 1e-9 * (1.0 + b.extent().length()))
     });
     let csg = csg::CsgBodies::of(scene);
-    let octree = octree::Octree::build(&geometry.triangles);
-    Prepared { geometry, shadows, ibl, bsp, emitters, csg, prelit: None, octree }
+    let plane_mirrors = mirrors::plane_mirrors(scene, &geometry.triangles);
+    let transparent =
+        geometry.triangles.iter().any(|t| scene.materials[t.material as usize].transparency != Vec3::ZERO);
+    Prepared { geometry, shadows, ibl, bsp, emitters, csg, prelit: None, octree, plane_mirrors, transparent }
+}
+
+/// The octree of `triangles`, which are put in its order (see [`octree::Octree::renumber`]),
+/// and the permutation: new triangle `k` was `order[k]`.
+fn in_tree_order(triangles: &mut Vec<Triangle>) -> (octree::Octree, Vec<u32>) {
+    let mut octree = octree::Octree::build(triangles);
+    let order = octree.renumber();
+    *triangles = order.iter().map(|&i| triangles[i as usize]).collect();
+    (octree, order)
 }
 
 /// Triangles whose light is already known (a radiosity solution: `lit[i]` for
 /// `triangles[i]`), drawn with it alone: no lights, shadows, mirrors, glass or CSG passes, and
 /// always by the depth buffer.
-pub fn prepare_lit(triangles: Vec<Triangle>, lit: Vec<Prelit>) -> Prepared {
-    let octree = octree::Octree::build(&triangles);
+pub fn prepare_lit(mut triangles: Vec<Triangle>, lit: Vec<Prelit>) -> Prepared {
+    let (octree, order) = in_tree_order(&mut triangles);
+    let lit = order.iter().map(|&i| lit[i as usize]).collect();
     Prepared {
         octree,
         geometry: geometry::SceneTriangles { triangles, skipped: 0 },
@@ -235,6 +253,8 @@ pub fn prepare_lit(triangles: Vec<Triangle>, lit: Vec<Prelit>) -> Prepared {
         emitters: vec![],
         csg: None,
         prelit: Some(lit),
+        plane_mirrors: vec![],
+        transparent: false,
     }
 }
 
@@ -249,6 +269,9 @@ pub struct RasterStats {
     pub outside: usize,
     /// Triangles (after clipping and fan triangulation) rasterised.
     pub drawn: usize,
+    /// Triangles not rasterised because they were clipped away or cover no pixel centre
+    /// (most of a mesh finer than the pixels).
+    pub missed: usize,
     /// Objects without a triangle form (CSG).
     pub skipped_objects: usize,
     /// Triangles (pieces of them in spherical mirrors) drawn as mirrors show them.
@@ -385,55 +408,67 @@ impl Projection {
     }
 }
 
-fn attributes(v: &geometry::Vertex, (d, s): (Vec3, Vec3)) -> [f64; ATTRIBUTES] {
-    [v.p.x, v.p.y, v.p.z, v.n.x, v.n.y, v.n.z, v.uv.x, v.uv.y, d.x, d.y, d.z, s.x, s.y, s.z]
+/// What a triangle looks like at corner weights `b`: position, unit normal (interpolated) and
+/// texture coordinates.
+pub(crate) fn surface_at(t: &Triangle, b: Bary) -> (Vec3, Vec3, Vec2) {
+    let p = interpolate(t.v.map(|v| v.p), b);
+    let n = interpolate(t.v.map(|v| v.n), b).normalize_or_zero();
+    (p, n, interpolate(t.v.map(|v| v.uv), b))
 }
 
-/// Vertex processing of one triangle: shading at the vertices (Gouraud), culling, clipping,
-/// division, viewport.
+/// What became of a triangle in vertex processing.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Fate {
+    /// Culled (back face or user culling plane).
+    Culled,
+    /// On screen as one or more screen triangles.
+    Kept,
+    /// Clipped away, or on screen without covering a pixel centre.
+    Missed,
+}
+
+/// Vertex processing of one triangle: culling, clipping, division, viewport. Screen
+/// triangles that cannot cover a pixel centre are not kept (but for wireframes).
 fn process(
-    scene: &Scene,
     proj: &Projection,
     t: &Triangle,
     index: u32,
-    lit: Option<&Prelit>,
     opts: &RasterOptions,
-    shadows: &shade::Lighting,
     (w, h): (u32, u32),
     out: &mut Vec<ScreenTriangle>,
-) -> bool {
+) -> Fate {
     let [a, b, c] = t.v;
     let face = (b.p - a.p).cross(c.p - a.p);
     let centroid = (a.p + b.p + c.p) / 3.0;
     if opts.cull && t.closed && face.dot(proj.to_viewer(centroid)) < 0.0 {
-        return true;
+        return Fate::Culled;
     }
     let below = |pl: &Vec4, p: Vec3| pl.truncate().dot(p) + pl.w < 0.0;
     if opts.cull_planes.iter().any(|pl| t.v.iter().all(|v| below(pl, v.p))) {
-        return true;
+        return Fate::Culled;
     }
-    let m = &scene.materials[t.material as usize];
-    let color = |v: &geometry::Vertex| match opts.shading {
-        Shading::Gouraud if !t.unbounded => shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), shadows),
-        _ => (Vec3::ZERO, Vec3::ZERO),
-    };
     let corners: [ClipVertex; 3] = std::array::from_fn(|k| {
-        let v = t.v[k];
-        let light = lit.map_or_else(|| color(&v), |l| (l.irradiance[k], Vec3::ZERO));
-        ClipVertex { pos: proj.world_to_clip * v.p.extend(1.0), attr: attributes(&v, light) }
+        let p = t.v[k].p;
+        ClipVertex::corner(proj.world_to_clip * p.extend(1.0), p, k)
     });
+    let keep = |s: &ScreenTriangle| opts.wireframe || raster::may_cover_a_pixel(s, (w, h));
     // Inside the view volume and no user planes: clipping would return the corners as they are.
     let inside = |c: &ClipVertex| {
         let q = c.pos;
         q.w > 0.0 && q.x.abs() <= q.w && q.y.abs() <= q.w && q.z.abs() <= q.w
     };
     if opts.clip_planes.is_empty() && corners.iter().all(inside) {
-        out.push(raster::triangle_to_screen(&corners, (w, h), index));
-        return false;
+        let s = raster::triangle_to_screen(&corners, (w, h), index);
+        if !keep(&s) {
+            return Fate::Missed;
+        }
+        out.push(s);
+        return Fate::Kept;
     }
     let clipped = clip::clip_user_planes(clip_polygon(&corners), &opts.clip_planes);
-    out.extend(raster::to_screen(&clipped, (w, h), index));
-    false
+    let before = out.len();
+    out.extend(raster::to_screen(&clipped, (w, h), index).into_iter().filter(keep));
+    if out.len() > before { Fate::Kept } else { Fate::Missed }
 }
 
 /// The normal bent by the material's bump map, with the triangle's `∂p/∂u`, `∂p/∂v` from its
@@ -447,23 +482,44 @@ fn bumped(scene: &Scene, m: &alhazen_scene::Material, t: &Triangle, uv: Vec2, n:
 /// The colour of a fragment of a lit triangle: its emission on the front, and the material's
 /// `ρ(uv)` times the irradiance over π interpolated from the corners (the course's display of a
 /// radiosity solution, with the texture per pixel).
-fn lit_color(scene: &Scene, t: &Triangle, lit: &Prelit, attr: &[f64; ATTRIBUTES]) -> Vec3 {
+fn lit_color(scene: &Scene, t: &Triangle, lit: &Prelit, b: Bary) -> Vec3 {
     let m = &scene.materials[t.material as usize];
-    let rho = alhazen_scene::texture::eval(&m.color, Vec2::new(attr[6], attr[7]), &scene.images) * m.diffuse;
-    let e = Vec3::new(attr[8], attr[9], attr[10]).max(Vec3::ZERO);
+    let rho = alhazen_scene::texture::eval(&m.color, interpolate(t.v.map(|v| v.uv), b), &scene.images) * m.diffuse;
+    let e = interpolate(lit.irradiance, b).max(Vec3::ZERO);
     let emitted = if lit.front { m.emission } else { Vec3::ZERO };
     emitted + rho.clamp(Vec3::ZERO, Vec3::ONE) * e
 }
 
-/// The colour of a fragment.
+/// Gouraud's light at the corners of the last triangle asked for: neighbouring pixels mostly
+/// show the same triangle, whose corners are lit once.
+#[derive(Default)]
+struct CornerLight {
+    last: Option<(u32, [(Vec3, Vec3); 3])>,
+}
+
+impl CornerLight {
+    fn of(&mut self, src: u32, light: impl FnOnce() -> [(Vec3, Vec3); 3]) -> [(Vec3, Vec3); 3] {
+        match self.last {
+            Some((s, l)) if s == src => l,
+            _ => {
+                let l = light();
+                self.last = Some((src, l));
+                l
+            }
+        }
+    }
+}
+
+/// The colour of a fragment of triangle `src` at its corner weights `b`.
+#[allow(clippy::too_many_arguments)]
 fn fragment_color(
     scene: &Scene,
     proj: &Projection,
     tris: &[Triangle],
-    src: u32,
-    attr: &[f64; ATTRIBUTES],
+    (src, b): (u32, Bary),
     opts: &RasterOptions,
     shadows: &shade::Lighting,
+    corner_light: &mut CornerLight,
 ) -> Vec3 {
     let t = &tris[src as usize];
     let m = &scene.materials[t.material as usize];
@@ -475,10 +531,13 @@ fn fragment_color(
     let shading = if t.unbounded { Shading::Phong } else { opts.shading };
     match shading {
         Shading::Gouraud => {
-            let p = Vec3::new(attr[0], attr[1], attr[2]);
-            let n = Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero();
-            let light = (Vec3::new(attr[8], attr[9], attr[10]), Vec3::new(attr[11], attr[12], attr[13]));
-            shade::combine(scene, m, light, n, proj.to_viewer(p), Vec2::new(attr[6], attr[7]), shadows)
+            // The corners are lit without the pixel's stencil mask, as vertices are.
+            let frame = shade::Lighting { blocked: 0, ..*shadows };
+            let corners =
+                corner_light.of(src, || t.v.map(|v| shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), &frame)));
+            let (p, n, uv) = surface_at(t, b);
+            let light = (interpolate(corners.map(|c| c.0), b), interpolate(corners.map(|c| c.1), b));
+            shade::combine(scene, m, light, n, proj.to_viewer(p), uv, shadows)
         }
         Shading::Flat => {
             let [a, b, c] = t.v;
@@ -489,9 +548,8 @@ fn fragment_color(
             shade::shade(scene, m, centroid, n, proj.to_viewer(centroid), uv, shadows)
         }
         Shading::Phong => {
-            let p = Vec3::new(attr[0], attr[1], attr[2]);
-            let uv = Vec2::new(attr[6], attr[7]);
-            let n = bumped(scene, m, t, uv, Vec3::new(attr[3], attr[4], attr[5]).normalize_or_zero());
+            let (p, n, uv) = surface_at(t, b);
+            let n = bumped(scene, m, t, uv, n);
             shade::shade(scene, m, p, n, proj.to_viewer(p), uv, shadows)
         }
     }
@@ -602,12 +660,11 @@ fn render_view_in(
                 if proj.perspective { bsp::Viewer::At(proj.frame.eye) } else { bsp::Viewer::Towards(proj.frame.w) };
             (&tree.triangles, tree.back_to_front(viewer))
         }
-        _ if opts.frustum_culling => {
-            let mut visible = vec![false; geometry.triangles.len()];
-            prepared.octree.mark_visible(&proj.world_to_clip, &mut visible);
-            (&geometry.triangles, (0..visible.len() as u32).filter(|&i| visible[i as usize]).collect())
+        _ => {
+            let mut order = Vec::with_capacity(geometry.triangles.len());
+            prepared.octree.visible_items(opts.frustum_culling.then_some(&proj.world_to_clip), &mut order);
+            (&geometry.triangles, order)
         }
-        _ => (&geometry.triangles, (0..geometry.triangles.len() as u32).collect()),
     };
     let outside = tris.len() - order.len();
     let painter = opts.visibility == Visibility::Bsp && prepared.bsp.is_some();
@@ -626,7 +683,7 @@ fn render_view_in(
     }
     // Plane mirrors: the scene once more through the reflected projection, clipped to the
     // mirror's front.
-    for plane in mirrors::plane_mirrors(scene, &geometry.triangles).iter().filter(|_| !in_mirror) {
+    for plane in prepared.plane_mirrors.iter().filter(|_| !in_mirror) {
         let Some((reflected, front)) = plane.reflected(&proj) else { continue };
         let mut seen = opts.clone();
         seen.clip_planes.push(front);
@@ -636,27 +693,28 @@ fn render_view_in(
     }
     // Glass: the frame once more without transparent objects, what they let through.
     let clear = |t: &Triangle| scene.materials[t.material as usize].transparency == Vec3::ZERO;
-    let behind_glass = if pass == Pass::Main && !tris.iter().all(clear) {
+    let behind_glass = if pass == Pass::Main && prepared.transparent {
         Some(render_view_in(scene, prepared, opts, &proj, (w, h), Pass::BehindGlass)?.0)
     } else {
         None
     };
-    let processed: Vec<(usize, Vec<ScreenTriangle>)> = order
+    let processed: Vec<([usize; 2], Vec<ScreenTriangle>)> = order
         .par_chunks(4096)
         .map(|chunk| {
             let mut out = Vec::with_capacity(chunk.len());
-            let culled = chunk
-                .iter()
-                .filter(|&&i| pass != Pass::BehindGlass || clear(&tris[i as usize]))
-                .filter(|&&i| {
-                    let lit = prelit.map(|l| &l[i as usize]);
-                    process(scene, &proj, &tris[i as usize], i, lit, opts, shadows, (w, h), &mut out)
-                })
-                .count();
-            (culled, out)
+            let mut count = [0; 2];
+            for &i in chunk.iter().filter(|&&i| pass != Pass::BehindGlass || clear(&tris[i as usize])) {
+                match process(&proj, &tris[i as usize], i, opts, (w, h), &mut out) {
+                    Fate::Culled => count[0] += 1,
+                    Fate::Missed => count[1] += 1,
+                    Fate::Kept => {}
+                }
+            }
+            (count, out)
         })
         .collect();
-    let culled = processed.iter().map(|p| p.0).sum();
+    let culled = processed.iter().map(|p| p.0[0]).sum();
+    let missed = processed.iter().map(|p| p.0[1]).sum();
     // The frame's screen triangles go into the last frame's buffer: a big mesh's hundreds of MB
     // are not mapped afresh (and page-faulted) every frame.
     let mut screen = SCREEN_BUFFER.with(|b| std::mem::take(&mut *b.borrow_mut()));
@@ -687,11 +745,11 @@ fn render_view_in(
         .map(|band| {
             let (y0, y1) = (band * BAND, ((band + 1) * BAND).min(h));
             let n = ((y1 - y0) * w) as usize;
-            let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; ATTRIBUTES]); n]);
+            let (mut depth, mut owner) = (vec![f64::INFINITY; n], vec![(u32::MAX, [0.0; 2]); n]);
             let bin = &bins[band as usize];
             let set = |k: usize, t: &ScreenTriangle, f: raster::Fragment| {
                 depth[k] = f.depth;
-                owner[k] = (t.source, f.attr);
+                owner[k] = (t.source, f.bary);
             };
             if opts.visibility == Visibility::Scanline {
                 scanline::band(&screen, bin, w, (y0, y1), set);
@@ -703,7 +761,7 @@ fn render_view_in(
                         let k = ((f.y - y0) * w + f.x) as usize;
                         if (painter || f.depth < depth[k]) && f.depth >= -1.0 {
                             depth[k] = f.depth;
-                            owner[k] = (t.source, f.attr);
+                            owner[k] = (t.source, f.bary);
                         }
                     });
                 }
@@ -734,12 +792,14 @@ fn render_view_in(
                 None => vec![],
             };
             // Deferred: each visible pixel is shaded once.
+            let mut corner_light = CornerLight::default();
             let color = (0..n)
                 .map(|k| {
                     if let Some(Some((_, c))) = bodies.get(k) {
                         return [c.x as f32, c.y as f32, c.z as f32];
                     }
-                    let (src, attr) = &owner[k];
+                    let (src, b) = owner[k];
+                    let src = &src;
                     let global = (y0 * w) as usize + k;
                     let reflected = (*src != u32::MAX)
                         .then(|| tris[*src as usize].object)
@@ -755,8 +815,8 @@ fn render_view_in(
                         scene.background.radiance(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
                     } else {
                         match prelit {
-                            Some(lit) => lit_color(scene, &tris[*src as usize], &lit[*src as usize], attr),
-                            None => fragment_color(scene, &proj, tris, *src, attr, opts, shadows),
+                            Some(lit) => lit_color(scene, &tris[*src as usize], &lit[*src as usize], b),
+                            None => fragment_color(scene, &proj, tris, (*src, b), opts, shadows, &mut corner_light),
                         }
                     };
                     [c.x as f32, c.y as f32, c.z as f32]
@@ -789,6 +849,7 @@ fn render_view_in(
         culled,
         outside,
         drawn: screen.len(),
+        missed,
         skipped_objects: if prepared.csg.is_some() { 0 } else { geometry.skipped },
         reflexes,
     };

@@ -121,36 +121,47 @@ impl Octree {
         self.nodes[n].subtree = start..self.items.len() as u32;
     }
 
-    /// Marks in `visible` (one flag per triangle) the triangles that may show through
-    /// `world_to_clip`: all but those in nodes entirely outside the view volume. Returns how
-    /// many were marked.
-    pub fn mark_visible(&self, world_to_clip: &Mat4, visible: &mut [bool]) -> usize {
-        visible.iter_mut().for_each(|v| *v = false);
-        let mut count = 0;
-        let mut mark = |range: std::ops::Range<u32>, visible: &mut [bool]| {
-            for &i in &self.items[range.start as usize..range.end as usize] {
-                visible[i as usize] = true;
-                count += 1;
-            }
-        };
-        for &i in &self.unbounded {
-            visible[i as usize] = true;
+    /// Renumbers the triangles in the tree's order (the unbounded ones first) and returns the
+    /// permutation: new triangle `k` is old triangle `order[k]`. A frame then reads the
+    /// triangles it keeps front to back in memory (a million triangles drawn in the tree's order
+    /// but stored in the file's took twice as long to transform).
+    pub fn renumber(&mut self) -> Vec<u32> {
+        let order: Vec<u32> = self.unbounded.iter().chain(&self.items).copied().collect();
+        let first = self.unbounded.len() as u32;
+        self.unbounded = (0..first).collect();
+        self.items = (first..order.len() as u32).collect();
+        order
+    }
+
+    /// Appends to `out` the triangles that may show through `world_to_clip` (all with `None`):
+    /// the unbounded ones, then the tree's in its own order, leaving out those of nodes entirely
+    /// outside the view volume. Culled or not, the triangles kept come in the same order, so
+    /// the frame is the same; the order is the frame's drawing order.
+    pub fn visible_items(&self, world_to_clip: Option<&Mat4>, out: &mut Vec<u32>) {
+        out.extend_from_slice(&self.unbounded);
+        match world_to_clip {
+            None => out.extend_from_slice(&self.items),
+            Some(m) if !self.nodes.is_empty() => self.append_visible(0, m, out),
+            Some(_) => {}
         }
-        let mut stack = if self.nodes.is_empty() { vec![] } else { vec![0usize] };
-        while let Some(n) = stack.pop() {
-            let node = &self.nodes[n];
-            match side(&node.bounds, world_to_clip) {
-                Side::Outside => {}
-                Side::Inside => mark(node.subtree.clone(), visible),
-                Side::Across => {
-                    mark(node.own.clone(), visible);
-                    if let Some(first) = node.children {
-                        stack.extend(first as usize..first as usize + 8);
+    }
+
+    /// [`Self::visible_items`] below node `n`, depth first as `items` is laid out.
+    fn append_visible(&self, n: usize, world_to_clip: &Mat4, out: &mut Vec<u32>) {
+        let node = &self.nodes[n];
+        let range = |r: &std::ops::Range<u32>| &self.items[r.start as usize..r.end as usize];
+        match side(&node.bounds, world_to_clip) {
+            Side::Outside => {}
+            Side::Inside => out.extend_from_slice(range(&node.subtree)),
+            Side::Across => {
+                out.extend_from_slice(range(&node.own));
+                if let Some(first) = node.children {
+                    for child in first as usize..first as usize + 8 {
+                        self.append_visible(child, world_to_clip, out);
                     }
                 }
             }
         }
-        count + self.unbounded.len()
     }
 }
 
@@ -180,7 +191,7 @@ pub fn side(b: &Bounds3, world_to_clip: &Mat4) -> Side {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pipeline::clip::{ATTRIBUTES, ClipVertex, clip_polygon};
+    use crate::pipeline::clip::{ClipVertex, clip_polygon};
     use crate::pipeline::geometry::Vertex;
     use alhazen_math::Vec2;
     use proptest::prelude::*;
@@ -226,17 +237,51 @@ mod tests {
             let up = if dir.normalize().cross(Vec3::Y).length() > 1e-3 { Vec3::Y } else { Vec3::X };
             let world_to_clip = clip_of(eye, eye + dir, up, fov);
             let tree = Octree::build(&triangles);
+            let (mut kept, mut all) = (vec![], vec![]);
+            tree.visible_items(Some(&world_to_clip), &mut kept);
+            tree.visible_items(None, &mut all);
+            // Every triangle once without culling; with it, a subsequence in the same order.
+            let mut sorted = all.clone();
+            sorted.sort_unstable();
+            prop_assert_eq!(sorted, (0..triangles.len() as u32).collect::<Vec<_>>());
+            let mut rest = all.iter();
+            prop_assert!(kept.iter().all(|k| rest.any(|a| a == k)), "not in the drawing order");
             let mut visible = vec![false; triangles.len()];
-            let count = tree.mark_visible(&world_to_clip, &mut visible);
-            prop_assert_eq!(count, visible.iter().filter(|v| **v).count());
+            kept.iter().for_each(|&i| visible[i as usize] = true);
             for (t, seen) in triangles.iter().zip(&visible) {
                 if !seen {
                     let poly: Vec<ClipVertex> =
-                        t.v.iter().map(|v| ClipVertex { pos: world_to_clip * v.p.extend(1.0), attr: [0.0; ATTRIBUTES] }).collect();
+                        t.v.iter().enumerate().map(|(k, v)| ClipVertex::corner(world_to_clip * v.p.extend(1.0), v.p, k)).collect();
                     prop_assert!(clip_polygon(&poly).is_empty(), "{:?}", t.v.map(|v| v.p));
                 }
             }
         }
+    }
+
+    #[test]
+    fn renumbered_triangles_are_kept_in_their_order() {
+        let triangles: Vec<Triangle> = (0..500)
+            .map(|k| {
+                let o = Vec3::new((k * 37 % 20) as f64, (k * 11 % 17) as f64, (k % 3) as f64);
+                triangle([o, o + Vec3::X * (0.3 + (k % 5) as f64), o + Vec3::Y * 0.5])
+            })
+            .collect();
+        let mut tree = Octree::build(&triangles);
+        let world_to_clip = clip_of(Vec3::new(3.0, 3.0, 9.0), Vec3::new(2.0, 2.0, 0.0), Vec3::Y, 40.0);
+        let mut before = vec![];
+        tree.visible_items(Some(&world_to_clip), &mut before);
+        let order = tree.renumber();
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..500).collect::<Vec<u32>>(), "a permutation");
+        let renumbered: Vec<Triangle> = order.iter().map(|&i| triangles[i as usize]).collect();
+        // The renumbered tree is the tree of the renumbered triangles, and keeps the same ones.
+        let rebuilt = Octree::build(&renumbered);
+        assert_eq!((rebuilt.items.clone(), rebuilt.unbounded.clone()), (tree.items.clone(), tree.unbounded.clone()));
+        let mut after = vec![];
+        tree.visible_items(Some(&world_to_clip), &mut after);
+        assert_eq!(after.iter().map(|&k| order[k as usize]).collect::<Vec<_>>(), before);
+        assert!(after.windows(2).all(|w| w[0] < w[1]), "kept in memory order");
     }
 
     #[test]
@@ -250,8 +295,8 @@ mod tests {
             .collect();
         let world_to_clip = clip_of(Vec3::new(0.5, 0.5, 3.0), Vec3::new(0.5, 0.5, 0.0), Vec3::Y, 30.0);
         let tree = Octree::build(&triangles);
-        let mut visible = vec![false; triangles.len()];
-        let count = tree.mark_visible(&world_to_clip, &mut visible);
-        assert!(visible[0] && count < 40, "{count} of 400 marked");
+        let mut kept = vec![];
+        tree.visible_items(Some(&world_to_clip), &mut kept);
+        assert!(kept.contains(&0) && kept.len() < 40, "{} of 400 kept", kept.len());
     }
 }

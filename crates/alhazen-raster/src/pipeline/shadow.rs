@@ -6,7 +6,7 @@
 //! compared after moving the point a texel and a half along its normal and with a one-texel
 //! tolerance, against self-shadowing ("shadow acne").
 
-use super::clip::{ATTRIBUTES, ClipVertex, clip_polygon};
+use super::clip::{ClipVertex, clip_polygon};
 use super::emitters::EmitterLight;
 use super::geometry::Triangle;
 use super::raster::{rasterize, to_screen};
@@ -71,16 +71,10 @@ fn face(
     let mut depth = vec![f64::INFINITY; (size * size) as usize];
     for t in tris.iter().filter(|t| Some(t.object) != skip) {
         let poly: Vec<ClipVertex> =
-            t.v.iter()
-                .map(|v| {
-                    let mut attr = [0.0; ATTRIBUTES];
-                    attr[..3].copy_from_slice(&v.p.to_array());
-                    ClipVertex { pos: world_to_clip * v.p.extend(1.0), attr }
-                })
-                .collect();
+            t.v.iter().enumerate().map(|(k, v)| ClipVertex::corner(world_to_clip * v.p.extend(1.0), v.p, k)).collect();
         for st in to_screen(&clip_polygon(&poly), (size, size), 0) {
             rasterize(&st, size, 0, size, |f| {
-                let d = metric.of(Vec3::new(f.attr[0], f.attr[1], f.attr[2]));
+                let d = metric.of(super::raster::interpolate(t.v.map(|v| v.p), f.bary));
                 let k = (f.y * size + f.x) as usize;
                 if d < depth[k] {
                     depth[k] = d;

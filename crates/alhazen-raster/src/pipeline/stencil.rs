@@ -12,7 +12,7 @@
 //! Only perspective cameras can see points at infinity this way; meshes that are not watertight
 //! cast no volume.
 
-use super::clip::{ATTRIBUTES, ClipVertex, clip_polygon};
+use super::clip::{ClipVertex, clip_polygon};
 use super::geometry::Triangle;
 use super::raster::{ScreenTriangle, rasterize, to_screen};
 use alhazen_math::{Mat4, Vec3, Vec4};
@@ -115,8 +115,6 @@ pub fn volumes(scene: &Scene, tris: &[Triangle], world_to_clip: Mat4, (w, h): (u
         .filter(|t| !t.unbounded)
         .fold(alhazen_math::Bounds3::EMPTY, |b, t| t.v.iter().fold(b, |b, v| b.grow(v.p)));
     let scale = if bounds.is_empty() { 1.0 } else { bounds.extent().length().max(1e-9) };
-    // Group closed triangles by object: consecutive runs with equal material and closedness are
-    // not enough, so objects are told apart by the geometry module's order: each closed run.
     let objects = closed_objects(tris);
     scene
         .lights
@@ -136,23 +134,18 @@ pub fn volumes(scene: &Scene, tris: &[Triangle], world_to_clip: Mat4, (w, h): (u
         .collect()
 }
 
-/// Runs of closed triangles belonging to one object.
+/// The closed triangles of each object, objects in index order.
 fn closed_objects(tris: &[Triangle]) -> Vec<Vec<&Triangle>> {
-    let mut out: Vec<Vec<&Triangle>> = vec![];
-    let mut last = None;
+    let mut by_object: std::collections::BTreeMap<u32, Vec<&Triangle>> = Default::default();
     for t in tris.iter().filter(|t| t.closed) {
-        if last != Some(t.object) {
-            out.push(vec![]);
-            last = Some(t.object);
-        }
-        out.last_mut().expect("pushed").push(t);
+        by_object.entry(t.object).or_default().push(t);
     }
-    out
+    by_object.into_values().collect()
 }
 
 fn project(q: &[Vec4; 4], world_to_clip: Mat4, (w, h): (u32, u32)) -> Vec<VolumeTriangle> {
     let poly: Vec<ClipVertex> =
-        q.iter().map(|p| ClipVertex { pos: world_to_clip * *p, attr: [0.0; ATTRIBUTES] }).collect();
+        q.iter().map(|p| ClipVertex { pos: world_to_clip * *p, attr: [0.0; super::clip::ATTRIBUTES] }).collect();
     to_screen(&clip_polygon(&poly), (w, h), 0)
         .into_iter()
         .filter_map(|tri| {
