@@ -156,6 +156,25 @@ pub struct Prepared {
     pub plane_mirrors: Vec<mirrors::PlaneMirror>,
     /// Some triangle is transparent (glass needs a second pass).
     pub transparent: bool,
+    /// What vertex processing reads of each triangle.
+    pub corners: Vec<Corners>,
+}
+
+/// What vertex processing reads of a triangle: its corners and whether its surface is closed
+/// (80 bytes of the triangle's 208 — a frame of a big mesh is bound by memory traffic).
+#[derive(Clone, Copy, Debug)]
+pub struct Corners {
+    /// Corner positions.
+    pub p: [Vec3; 3],
+    /// Part of a closed surface.
+    pub closed: bool,
+}
+
+impl Corners {
+    /// The corners of each triangle.
+    pub fn of(triangles: &[Triangle]) -> Vec<Corners> {
+        triangles.iter().map(|t| Corners { p: t.v.map(|v| v.p), closed: t.closed }).collect()
+    }
 }
 
 /// The light of one triangle of a solved scene: the irradiance over π at its corners, which
@@ -226,7 +245,8 @@ pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
     let plane_mirrors = mirrors::plane_mirrors(scene, &geometry.triangles);
     let transparent =
         geometry.triangles.iter().any(|t| scene.materials[t.material as usize].transparency != Vec3::ZERO);
-    Prepared { geometry, shadows, ibl, bsp, emitters, csg, prelit: None, octree, plane_mirrors, transparent }
+    let corners = Corners::of(&geometry.triangles);
+    Prepared { geometry, shadows, ibl, bsp, emitters, csg, prelit: None, octree, plane_mirrors, transparent, corners }
 }
 
 /// The octree of `triangles`, which are put in its order (see [`octree::Octree::renumber`]),
@@ -245,6 +265,7 @@ pub fn prepare_lit(mut triangles: Vec<Triangle>, lit: Vec<Prelit>) -> Prepared {
     let (octree, order) = in_tree_order(&mut triangles);
     let lit = order.iter().map(|&i| lit[i as usize]).collect();
     Prepared {
+        corners: Corners::of(&triangles),
         octree,
         geometry: geometry::SceneTriangles { triangles, skipped: 0 },
         shadows: None,
@@ -431,24 +452,24 @@ enum Fate {
 /// triangles that cannot cover a pixel centre are not kept (but for wireframes).
 fn process(
     proj: &Projection,
-    t: &Triangle,
+    t: &Corners,
     index: u32,
     opts: &RasterOptions,
     (w, h): (u32, u32),
     out: &mut Vec<ScreenTriangle>,
 ) -> Fate {
-    let [a, b, c] = t.v;
-    let face = (b.p - a.p).cross(c.p - a.p);
-    let centroid = (a.p + b.p + c.p) / 3.0;
+    let [a, b, c] = t.p;
+    let face = (b - a).cross(c - a);
+    let centroid = (a + b + c) / 3.0;
     if opts.cull && t.closed && face.dot(proj.to_viewer(centroid)) < 0.0 {
         return Fate::Culled;
     }
     let below = |pl: &Vec4, p: Vec3| pl.truncate().dot(p) + pl.w < 0.0;
-    if opts.cull_planes.iter().any(|pl| t.v.iter().all(|v| below(pl, v.p))) {
+    if opts.cull_planes.iter().any(|pl| t.p.iter().all(|&p| below(pl, p))) {
         return Fate::Culled;
     }
     let corners: [ClipVertex; 3] = std::array::from_fn(|k| {
-        let p = t.v[k].p;
+        let p = t.p[k];
         ClipVertex::corner(proj.world_to_clip * p.extend(1.0), p, k)
     });
     let keep = |s: &ScreenTriangle| opts.wireframe || raster::may_cover_a_pixel(s, (w, h));
@@ -565,7 +586,11 @@ pub fn memory_estimate(scene: &Scene, opts: &RasterOptions) -> u64 {
     let triangles: u64 = scene.objects.iter().map(|o| geometry::triangle_count(scene, &o.shape)).sum();
     let world = std::mem::size_of::<Triangle>() as u64;
     let screen = std::mem::size_of::<ScreenTriangle>() as u64;
-    let per_triangle = world + screen * 3 / 2 + 16 + if opts.visibility == Visibility::Bsp { 2 * world } else { 0 };
+    let per_triangle = world
+        + screen * 3 / 2
+        + std::mem::size_of::<Corners>() as u64
+        + 16
+        + if opts.visibility == Visibility::Bsp { 2 * world } else { 0 };
     let pixels = scene.render.width as u64 * scene.render.height as u64;
     const SHADOW_MAPS: u64 = 64 << 20;
     triangles * per_triangle + pixels * 32 + SHADOW_MAPS * scene.lights.len().min(16) as u64
@@ -654,16 +679,18 @@ fn render_view_in(
     };
     let shadows = &light;
     // The painter's algorithm draws the BSP tree's triangles back to front; the z-buffer any order.
-    let (tris, order): (&[Triangle], Vec<u32>) = match (&prepared.bsp, opts.visibility) {
+    let bsp_corners;
+    let (tris, corners, order): (&[Triangle], &[Corners], Vec<u32>) = match (&prepared.bsp, opts.visibility) {
         (Some(tree), Visibility::Bsp) => {
             let viewer =
                 if proj.perspective { bsp::Viewer::At(proj.frame.eye) } else { bsp::Viewer::Towards(proj.frame.w) };
-            (&tree.triangles, tree.back_to_front(viewer))
+            bsp_corners = Corners::of(&tree.triangles);
+            (&tree.triangles, &bsp_corners, tree.back_to_front(viewer))
         }
         _ => {
             let mut order = Vec::with_capacity(geometry.triangles.len());
             prepared.octree.visible_items(opts.frustum_culling.then_some(&proj.world_to_clip), &mut order);
-            (&geometry.triangles, order)
+            (&geometry.triangles, &prepared.corners, order)
         }
     };
     let outside = tris.len() - order.len();
@@ -704,7 +731,7 @@ fn render_view_in(
             let mut out = Vec::with_capacity(chunk.len());
             let mut count = [0; 2];
             for &i in chunk.iter().filter(|&&i| pass != Pass::BehindGlass || clear(&tris[i as usize])) {
-                match process(&proj, &tris[i as usize], i, opts, (w, h), &mut out) {
+                match process(&proj, &corners[i as usize], i, opts, (w, h), &mut out) {
                     Fate::Culled => count[0] += 1,
                     Fate::Missed => count[1] += 1,
                     Fate::Kept => {}
@@ -718,9 +745,7 @@ fn render_view_in(
     // The frame's screen triangles go into the last frame's buffer: a big mesh's hundreds of MB
     // are not mapped afresh (and page-faulted) every frame.
     let mut screen = SCREEN_BUFFER.with(|b| std::mem::take(&mut *b.borrow_mut()));
-    screen.clear();
-    screen.reserve(processed.iter().map(|p| p.1.len()).sum());
-    processed.into_iter().for_each(|p| screen.extend(p.1));
+    gather(processed.iter().map(|p| &p.1[..]).collect(), &mut screen);
     let painter = painter || opts.visibility == Visibility::DepthSort;
     if opts.visibility == Visibility::DepthSort {
         screen = depth_sort::depth_sort(screen).0;
@@ -855,6 +880,24 @@ fn render_view_in(
     };
     SCREEN_BUFFER.with(|b| *b.borrow_mut() = screen);
     Ok((fb, stats))
+}
+
+/// The chunks' screen triangles one after another in `screen` (whose old contents are
+/// overwritten, not cleared first), copied in parallel.
+fn gather(chunks: Vec<&[ScreenTriangle]>, screen: &mut Vec<ScreenTriangle>) {
+    let total = chunks.iter().map(|c| c.len()).sum();
+    screen.truncate(total);
+    let filler =
+        ScreenTriangle { x: [0.0; 3], y: [0.0; 3], z: [0.0; 3], inv_w: [0.0; 3], bary_w: [[0.0; 2]; 3], source: 0 };
+    screen.resize(total, filler);
+    let mut rest = &mut screen[..];
+    let mut parts = Vec::with_capacity(chunks.len());
+    for c in &chunks {
+        let (part, tail) = rest.split_at_mut(c.len());
+        parts.push(part);
+        rest = tail;
+    }
+    parts.into_par_iter().zip(chunks).for_each(|(part, c)| part.copy_from_slice(c));
 }
 
 thread_local! {
