@@ -68,6 +68,22 @@ impl Curve {
         }
     }
 
+    /// The part of the curve from parameter `s0` to `s1`, parametrised over `[0, 1]` again.
+    pub fn sub(&self, s0: f64, s1: f64) -> Curve {
+        let angle = |start: f64, end: f64| (start + (end - start) * s0, start + (end - start) * s1);
+        match *self {
+            Curve::Segment { .. } => Curve::Segment { a: self.point(s0), b: self.point(s1) },
+            Curve::Arc { center, u, v, radius, start, end } => {
+                let (start, end) = angle(start, end);
+                Curve::Arc { center, u, v, radius, start, end }
+            }
+            Curve::Ellipse { center, u, v, start, end } => {
+                let (start, end) = angle(start, end);
+                Curve::Ellipse { center, u, v, start, end }
+            }
+        }
+    }
+
     /// A full circle.
     pub fn circle(center: Vec3, axis: Vec3, radius: f64) -> Curve {
         let (u, v) = orthonormal_basis(axis.normalize());

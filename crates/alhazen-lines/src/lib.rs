@@ -10,6 +10,8 @@
 //!   piece is decided by one exact ray test;
 //! * [`intersect`] — intersection curves where objects meet (plane sections of spheres and
 //!   cylinders, sphere pairs, face pairs), exactly;
+//! * [`csg`] — CSG bodies: their operands' lines and intersection curves cut to the body's
+//!   boundary;
 //! * [`reflect`] — every line reflected in every mirror by the exact reflex solver, knots as in
 //!   the paper's Fig. 16, drawn where the eye sees the mirror point and the reflected ray
 //!   reaches the line;
@@ -27,6 +29,7 @@
 //! ```
 
 pub mod contour;
+pub mod csg;
 pub mod curves;
 pub mod drawing;
 pub mod fill;
@@ -95,7 +98,7 @@ pub struct Stats {
     pub fills: usize,
     /// Round objects drawn from their tessellation (their transform is not a similarity).
     pub tessellated: usize,
-    /// Objects without lines (CSG; planes in parallel views).
+    /// Objects without lines (planes in parallel views).
     pub skipped: usize,
 }
 
@@ -162,8 +165,7 @@ fn draw_view(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(
     let edge_opts = curves::EdgeOptions { feature_angle: opts.feature_angle_deg.to_radians() };
     progress.stage("finding edges, contours and intersections", 0);
     let polyhedra = curves::polyhedra(scene);
-    let (mut lines, tessellated, skipped) = curves::scene_lines(scene, &polyhedra, &view, &edge_opts);
-    lines.extend(intersect::intersection_lines(scene, &polyhedra));
+    let (lines, tessellated, skipped) = lines_in_space(scene, &polyhedra, &world, &view, &edge_opts);
     let chords = visibility::chords(&lines, &view, opts.tol_mm);
     progress.stage("deciding visibility", chords.len() as u64);
     let pieces = match opts.sampled {
@@ -215,6 +217,29 @@ fn draw_view(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(
         skipped,
     };
     Ok((drawing, stats))
+}
+
+/// Every line of the scene in space for this view — edges, contours, rims, horizons and
+/// intersection curves; CSG bodies' from their operands, cut to the body's boundary ([`csg`]) —
+/// with the counts of objects drawn from their tessellation and of objects without lines.
+pub fn lines_in_space(
+    scene: &Scene,
+    polyhedra: &[Option<Vec<[Vec3; 3]>>],
+    world: &World,
+    view: &view::View,
+    edge_opts: &curves::EdgeOptions,
+) -> (Vec<curves::SceneLine>, usize, usize) {
+    let expansion = csg::Expansion::of(scene);
+    let expanded_polyhedra;
+    let (line_scene, line_polyhedra) = if expansion.has_bodies() {
+        expanded_polyhedra = curves::polyhedra(&expansion.scene);
+        (&expansion.scene, &expanded_polyhedra[..])
+    } else {
+        (scene, polyhedra)
+    };
+    let (mut lines, tessellated, skipped) = curves::scene_lines(line_scene, line_polyhedra, view, edge_opts);
+    lines.extend(intersect::intersection_lines(line_scene, line_polyhedra));
+    (expansion.restrict(lines, world), tessellated, skipped)
 }
 
 /// The reflex contours (Theorem 10) of every sphere, cylinder and cone in every mirror.

@@ -94,3 +94,53 @@ impl Csg {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{AaBox, Cylinder, Placed, Shape, Sphere};
+    use super::*;
+    use alhazen_math::{Transform, Vec3};
+    use proptest::prelude::*;
+
+    /// A box minus a sphere, turned and moved: membership by crossings against the formulas.
+    fn body(op: CsgOp) -> (Placed, Transform) {
+        let to_world =
+            Transform::translate(Vec3::new(0.3, -0.2, 1.0)) * Transform::rotate(Vec3::new(1.0, 2.0, 0.5), 0.7);
+        let csg = Csg {
+            op,
+            a: Placed::new(Shape::Box(AaBox { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) }), Transform::IDENTITY),
+            b: Placed::new(
+                Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }),
+                Transform::translate(Vec3::new(0.8, 0.0, 0.0)),
+            ),
+        };
+        (Placed::new(Shape::Csg(Box::new(csg)), to_world), to_world)
+    }
+
+    proptest! {
+        #[test]
+        fn membership_follows_the_operation(x in -2.0..2.0f64, y in -2.0..2.0f64, z in -2.0..2.0f64) {
+            let local = Vec3::new(x, y, z);
+            let in_box = local.abs().max_element() < 1.0;
+            let in_ball = (local - Vec3::new(0.8, 0.0, 0.0)).length() < 1.0;
+            let margin = (local.abs().max_element() - 1.0).abs().min(((local - Vec3::new(0.8, 0.0, 0.0)).length() - 1.0).abs());
+            prop_assume!(margin > 1e-9);
+            for (op, want) in [
+                (CsgOp::Union, in_box || in_ball),
+                (CsgOp::Intersection, in_box && in_ball),
+                (CsgOp::Difference, in_box && !in_ball),
+            ] {
+                let (placed, to_world) = body(op);
+                prop_assert_eq!(placed.contains(to_world.point(local)), want, "{:?}", op);
+            }
+        }
+    }
+
+    #[test]
+    fn the_normal_near_a_surface_point_is_the_surface_normal() {
+        let c = Placed::new(Shape::Cylinder(Cylinder::new(Vec3::ZERO, Vec3::Y * 2.0, 0.5, true)), Transform::IDENTITY);
+        let n = c.normal_near(Vec3::new(0.5, 1.0, 0.0), 1e-9).unwrap();
+        assert!((n - Vec3::X).length() < 1e-9, "{n:?}");
+        assert!(c.normal_near(Vec3::new(0.2, 1.0, 0.0), 1e-3).is_none());
+    }
+}

@@ -249,6 +249,33 @@ impl Placed {
         self.hit(ray, t_max).map(|c| self.surface(ray, c))
     }
 
+    /// True when `p` lies inside the closed shape: the line through `p` along a fixed direction
+    /// (no axis, so that boxes are not met edge-on) is inside after its last crossing behind `p`.
+    /// Points within rounding of the surface may go either way; open shapes contain nothing.
+    pub fn contains(&self, p: Vec3) -> bool {
+        let dir = Vec3::new(0.5773, 0.6201, 0.5312).normalize();
+        let mut all = Vec::new();
+        self.crossings(&Ray::new(p, dir), &mut all);
+        all.iter().take_while(|c| c.hit.t < 0.0).last().is_some_and(|c| c.entering)
+    }
+
+    /// The unit normal of the surface at a point `p` on it (within `tol`), found as the
+    /// crossing nearest `p` along a few fixed lines through it; `None` when no crossing is that
+    /// near (not on the surface, or an open shape).
+    pub fn normal_near(&self, p: Vec3, tol: f64) -> Option<Vec3> {
+        let dirs = [Vec3::new(0.5773, 0.6201, 0.5312), Vec3::new(-0.7, 0.1, 0.71), Vec3::new(0.2, -0.9, 0.38)];
+        let mut all = Vec::new();
+        for d in dirs {
+            all.clear();
+            self.crossings(&Ray::new(p, d.normalize()), &mut all);
+            let near = all.iter().min_by(|a, b| a.hit.t.abs().total_cmp(&b.hit.t.abs()));
+            if let Some(c) = near.filter(|c| c.hit.t.abs() <= tol) {
+                return c.hit.n.try_normalize();
+            }
+        }
+        None
+    }
+
     /// World-space crossings (see [`Shape::crossings`]).
     pub fn crossings(&self, ray: &Ray, out: &mut Vec<Crossing>) {
         match &self.to_world {
