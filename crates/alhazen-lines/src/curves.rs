@@ -92,14 +92,49 @@ impl Curve {
 
     /// Parameters of the chords that approximate the curve on paper within `tol_mm`.
     pub fn knots(&self, view: &View, tol_mm: f64) -> Vec<f64> {
-        match *self {
+        let knots = match *self {
             Curve::Segment { .. } => vec![0.0, 1.0],
             Curve::Arc { radius, start, end, .. } => round_knots(view, tol_mm, self, radius, end - start),
             Curve::Ellipse { u, v, start, end, .. } => {
                 round_knots(view, tol_mm, self, u.length().max(v.length()), end - start)
             }
+        };
+        if view.is_projective() { knots } else { follow_film(self, &knots, view, tol_mm / view.mm_per_px) }
+    }
+}
+
+/// Deepest halving of a chord whose image strays from the curve's (2⁻³⁰ of the curve).
+const FILM_DEPTH: u32 = 30;
+
+/// `knots` refined for a film on which the curve's image is not its chords' (a panorama's):
+/// each chord halved until its image's midpoint is within `tol_px` of the curve's image there,
+/// and, where the film wraps around (the panorama's seam behind the eye), until the chord across
+/// it is as short as the depth allows (its image spans the film: [`crate::visibility::chords`]
+/// leaves it out).
+fn follow_film(curve: &Curve, knots: &[f64], view: &View, tol_px: f64) -> Vec<f64> {
+    let half_width = view.film.0 as f64 / 2.0;
+    let film = |s: f64| view.to_film(curve.point(s));
+    let mut out = vec![knots[0]];
+    let mut stack = vec![];
+    for w in knots.windows(2) {
+        stack.push((w[1], w[0], 0));
+        while let Some((s1, s0, depth)) = stack.pop() {
+            let (a, b) = (curve.point(s0), curve.point(s1));
+            let mid = 0.5 * (s0 + s1);
+            let split = depth < FILM_DEPTH && view.in_front(a) && view.in_front(b) && {
+                let (fa, fb) = (film(s0), film(s1));
+                (fa.x - fb.x).abs() > half_width || (film(mid) - (fa + fb) * 0.5).length() > tol_px
+            };
+            if split {
+                // Right half below the left: the left comes off the stack first.
+                stack.push((s1, mid, depth + 1));
+                stack.push((mid, s0, depth + 1));
+            } else {
+                out.push(s1);
+            }
         }
     }
+    out
 }
 
 /// Knots of an arc of radius (at most) `radius` spanning `angle`, chords within `tol_mm`: the

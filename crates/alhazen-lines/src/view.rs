@@ -1,19 +1,33 @@
 //! The drawing's camera: the scene camera as the course's viewing and projection matrices
-//! (shared with the raster preview), film pixels → millimetres on paper, and the one exact
-//! visibility question every line asks: does the ray from the eye reach this point?
+//! (shared with the raster preview) or as the ray tracer's panorama (central projection on a
+//! cylinder around the view's vertical axis, developed flat: straight lines become curves,
+//! which the curves' knots follow within the tolerance), film pixels → millimetres on paper, and
+//! the one exact visibility question every line asks: does the ray from the eye reach this
+//! point?
 
+use alhazen_math::viewing::ViewFrame;
 use alhazen_math::{Mat4, Ray, Vec2, Vec3, Vec4};
 use alhazen_mirror::Site;
 use alhazen_raster::pipeline::{Projection, RasterError, projection};
 use alhazen_render::World;
-use alhazen_scene::Scene;
+use alhazen_scene::{CameraDesc, Scene};
 
 /// Clip-space `w` below which a point counts as behind the eye (relative to the view's scale).
 const NEAR_W: f64 = 1e-6;
 
+/// How the camera maps space to the film.
+#[derive(Clone, Copy, Debug)]
+enum Mapping {
+    /// World → clip by the course's matrices: central or parallel projection.
+    Projective(Mat4),
+    /// The panorama camera: azimuth across the film (`angle` radians over its width), height
+    /// over horizontal distance up it, in the view frame.
+    Panorama { frame: ViewFrame, angle: f64 },
+}
+
 /// A camera that maps world points to the paper and answers visibility by ray casting.
 pub struct View {
-    world_to_clip: Mat4,
+    mapping: Mapping,
     /// Film size in pixels (the scene's image size).
     pub film: (u32, u32),
     /// Millimetres per film pixel.
@@ -31,12 +45,22 @@ impl View {
     /// The scene camera on paper `width_mm` wide.
     pub fn new(scene: &Scene, world: &World, width_mm: f64) -> Result<View, RasterError> {
         let (w, h) = (scene.render.width, scene.render.height);
-        let Projection { world_to_clip, frame, perspective, .. } = projection(&scene.camera, w, h)?;
+        let (mapping, frame, perspective) = match &scene.camera {
+            CameraDesc::Panorama { look, angle } => {
+                let frame = ViewFrame::look_at(look.eye, look.target, look.up)
+                    .ok_or(RasterError::UnsupportedCamera("a panorama whose eye, target and up do not make a frame"))?;
+                (Mapping::Panorama { frame, angle: *angle }, frame, true)
+            }
+            camera => {
+                let Projection { world_to_clip, frame, perspective, .. } = projection(camera, w, h)?;
+                (Mapping::Projective(world_to_clip), frame, perspective)
+            }
+        };
         let b = world.bounds();
         let scale = if b.is_empty() { 1.0 } else { (b.max - b.min).length().max(1e-9) + frame.eye.length() };
         let near_w = if perspective { NEAR_W * scale } else { f64::NEG_INFINITY };
         Ok(View {
-            world_to_clip,
+            mapping,
             film: (w, h),
             mm_per_px: width_mm / w as f64,
             eye: perspective.then_some(frame.eye),
@@ -46,9 +70,22 @@ impl View {
         })
     }
 
-    /// Clip-space `w` of a point: positive in front of the eye (1 for parallel views).
+    /// Clip-space `w` of a point: positive in front of the eye (1 for parallel views); for a
+    /// panorama the distance from the view's vertical axis through the eye (the projection
+    /// blows up on that axis alone).
     pub fn depth(&self, p: Vec3) -> f64 {
-        (self.world_to_clip * p.extend(1.0)).w
+        match self.mapping {
+            Mapping::Projective(m) => (m * p.extend(1.0)).w,
+            Mapping::Panorama { frame, .. } => {
+                let d = p - frame.eye;
+                d.dot(frame.u).hypot(d.dot(frame.w))
+            }
+        }
+    }
+
+    /// False for a panorama: straight lines in space are curves on its film.
+    pub fn is_projective(&self) -> bool {
+        matches!(self.mapping, Mapping::Projective(_))
     }
 
     /// True when `p` is in front of the eye (far enough not to blow up the projection).
@@ -58,10 +95,21 @@ impl View {
 
     /// Film position in pixels (`y` down) of a point in front of the eye.
     pub fn to_film(&self, p: Vec3) -> Vec2 {
-        let c: Vec4 = self.world_to_clip * p.extend(1.0);
-        let (x, y) = (c.x / c.w, c.y / c.w);
         let (w, h) = (self.film.0 as f64, self.film.1 as f64);
-        Vec2::new((x + 1.0) * 0.5 * w, (1.0 - y) * 0.5 * h)
+        match self.mapping {
+            Mapping::Projective(m) => {
+                let c: Vec4 = m * p.extend(1.0);
+                let (x, y) = (c.x / c.w, c.y / c.w);
+                Vec2::new((x + 1.0) * 0.5 * w, (1.0 - y) * 0.5 * h)
+            }
+            Mapping::Panorama { frame, angle } => {
+                // The ray tracer's panorama inverted: direction (sin φ, height, −cos φ).
+                let d = p - frame.eye;
+                let (x, y, z) = (d.dot(frame.u), d.dot(frame.v), d.dot(frame.w));
+                let (phi, height) = (x.atan2(-z), y / x.hypot(z));
+                Vec2::new((phi / angle + 0.5) * w, 0.5 * h - height * w / angle)
+            }
+        }
     }
 
     /// Paper position in millimetres (`y` down, origin top left).
@@ -85,7 +133,12 @@ impl View {
     /// The parameter along a 3D chord `a → b` of the point at parameter `t` of its projection:
     /// central projection is projective on a line, so equal steps on paper are not equal steps
     /// in space.
+    /// A panorama's chords are short enough (their knots follow the curved image within the
+    /// tolerance) for the film parameter to stand for the chord's own.
     pub fn chord_param(&self, a: Vec3, b: Vec3, t: f64) -> f64 {
+        if !self.is_projective() {
+            return t;
+        }
         let (wa, wb) = (self.depth(a), self.depth(b));
         let den = (1.0 - t) * wb + t * wa;
         if den.abs() < 1e-300 { t } else { t * wa / den }

@@ -66,6 +66,10 @@ pub fn chords(lines: &[SceneLine], view: &View, tol_mm: f64) -> Vec<Chord> {
             // Only what lies on the film (and a margin) is drawn, and only crossings there can
             // change it: cut the chord to that window on paper (projective on the chord).
             let (qa, qb) = (view.to_film(a), view.to_film(b));
+            // A chord across a panorama's seam: its ends are on either side of the film.
+            if !view.is_projective() && (qa.x - qb.x).abs() > view.film.0 as f64 / 2.0 {
+                continue;
+            }
             let margin = 2.0;
             let window = alhazen_raster::clip::Window {
                 xmin: -margin,

@@ -166,3 +166,14 @@ fn a_military_axonometry_with_a_mirror_agrees_with_the_ray_tracer() {
 fn intersection_curves_agree_with_the_ray_tracer() {
     assert_agrees("scenes/lines/intersections.toml");
 }
+
+#[test]
+fn csg_bodies_agree_with_the_ray_tracer() {
+    assert_agrees("scenes/lines/csg-bodies.toml");
+}
+
+#[test]
+fn a_panorama_with_a_mirror_agrees_with_the_ray_tracer() {
+    // Straight edges are curves on the panorama's film, followed within the tolerance.
+    assert_agrees("scenes/cameras/panorama.toml");
+}
