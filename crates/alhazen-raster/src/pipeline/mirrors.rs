@@ -20,6 +20,7 @@ use super::raster::{Bary, ScreenTriangle, rasterize};
 use super::{Projection, RasterOptions, shade};
 use alhazen_math::{Vec2, Vec3, Vec4};
 use alhazen_mirror::batch::{PointsSoA, ReflexesSoA};
+use alhazen_mirror::overlap::{Plane, split_polygon};
 use alhazen_mirror::{Cylinder, Site, Sphere};
 use alhazen_scene::{Scene, Shape};
 use rayon::prelude::*;
@@ -307,15 +308,18 @@ pub fn mirror_image(
         .flat_map_iter(|(k, &i)| {
             let t = all[i as usize];
             let mut out = vec![];
-            // Back faces seen from the mirror are culled as they are from the eye.
-            let corners = reflexes[k];
-            let facing = corners.iter().flatten().next().is_none_or(|r| {
-                let face = (t.v[1].p - t.v[0].p).cross(t.v[2].p - t.v[0].p);
-                !(opts.cull && t.closed) || face.dot(*r - t.v[0].p) >= 0.0
-            });
-            if facing {
-                let job = Reflexes { surface: &surface, eye, proj, size: (w, h) };
-                job.split(t.v, CORNER_WEIGHTS, corners, i, 0, &mut out);
+            let job = Reflexes { surface: &surface, eye, proj, size: (w, h) };
+            let face = (t.v[1].p - t.v[0].p).cross(t.v[2].p - t.v[0].p);
+            for (v, b, corners) in job.unfolded(t, reflexes[k]) {
+                // Back faces seen from the mirror are culled as they are from the eye.
+                let facing = corners
+                    .iter()
+                    .flatten()
+                    .next()
+                    .is_none_or(|r| !(opts.cull && t.closed) || face.dot(*r - v[0].p) >= 0.0);
+                if facing {
+                    job.split(v, b, corners, i, 0, &mut out);
+                }
             }
             out
         })
@@ -452,9 +456,63 @@ struct Reflexes<'a> {
     size: (u32, u32),
 }
 
+/// A piece of a triangle: corners, their weights in the triangle, their reflexes.
+type Piece = ([Vertex; 3], [Bary; 3], [Option<Vec3>; 3]);
+
 impl Reflexes<'_> {
     fn reflex(&self, p: Vec3) -> Option<Vec3> {
         self.surface.reflex(self.eye, p)
+    }
+
+    /// Glaeser's Theorems 6–10: where the plane of a triangle meets the mirror, the reflected
+    /// rays that lie in the plane (its projecting lines) may cross the triangle, and its reflex
+    /// folds over there (the mirror sees the plane from both sides); the triangle is cut along
+    /// them (`alhazen_mirror::overlap`) into pieces whose reflexes do not fold, each fanned
+    /// into triangles. Other triangles are returned whole.
+    fn unfolded(&self, t: &Triangle, corners: [Option<Vec3>; 3]) -> Vec<Piece> {
+        let whole = vec![(t.v, CORNER_WEIGHTS, corners)];
+        let p = t.v.map(|v| v.p);
+        let Some(plane) = Plane::of_polygon(&p) else { return whole };
+        // Projecting lines start on the curve where the plane meets the mirror.
+        let distance = |c: Vec3| (plane.normal.dot(c) - plane.offset).abs();
+        let lines = match self.surface {
+            Curved::Sphere(s) if distance(s.center) < s.radius => s.projecting_lines(self.eye, plane),
+            Curved::Cylinder { cylinder, .. }
+                if plane.normal.dot(cylinder.axis).abs() > 1e-12 * cylinder.axis.length()
+                    || distance(cylinder.center) < cylinder.radius =>
+            {
+                cylinder.projecting_lines(self.eye, plane)
+            }
+            _ => return whole,
+        };
+        let polygons = split_polygon(&p, &lines.unwrap_or_default());
+        if polygons.len() < 2 {
+            return whole;
+        }
+        // Weights in the triangle of a point of its plane (the pieces' corners).
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let det = d11 * d22 - d12 * d12;
+        let weights = |q: Vec3| {
+            let d = q - p[0];
+            let (a, b) = (d.dot(e1), d.dot(e2));
+            [(d22 * a - d12 * b) / det, (d11 * b - d12 * a) / det]
+        };
+        let corner = |q: Vec3| {
+            let b = weights(q);
+            let (_, n, uv) = super::surface_at(t, b);
+            let known = t.v.iter().position(|v| v.p == q).map(|k| corners[k]);
+            (Vertex { p: q, n, uv }, b, known.unwrap_or_else(|| self.reflex(q)))
+        };
+        let mut out = vec![];
+        for poly in polygons {
+            let c: Vec<_> = poly.iter().map(|&q| corner(q)).collect();
+            for k in 1..c.len().saturating_sub(1) {
+                let tri = [c[0], c[k], c[k + 1]];
+                out.push((tri.map(|x| x.0), tri.map(|x| x.1), tri.map(|x| x.2)));
+            }
+        }
+        out
     }
 
     /// Emits the reflex of triangle `v` (corner reflexes `r`), split until each piece's edges
@@ -554,5 +612,66 @@ impl Reflexes<'_> {
             bary_w: b,
             source,
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn vertex(p: Vec3) -> Vertex {
+        Vertex { p, n: Vec3::Y, uv: Vec2::new(p.x, p.z) }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// Glaeser's split: no piece of a triangle (clear of the mirror) is seen by the mirror
+        /// from both sides of its plane, and the pieces cover the triangle.
+        #[test]
+        fn no_piece_is_seen_from_both_sides(
+            c in prop::array::uniform3(prop::array::uniform3(-3.0..3.0f64)),
+            eye in prop::array::uniform3(-6.0..6.0f64),
+        ) {
+            let eye = Vec3::from_array(eye);
+            prop_assume!(eye.length() > 2.0);
+            let p = c.map(Vec3::from_array);
+            let area = |p: [Vec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]).length() / 2.0;
+            prop_assume!(area(p) > 0.05 && p.iter().all(|q| q.length() > 1.01));
+            let surface = Curved::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 });
+            let look = alhazen_scene::LookAt { eye, target: Vec3::ZERO, up: if eye.cross(Vec3::Y).length() > 0.1 { Vec3::Y } else { Vec3::X } };
+            let desc = alhazen_scene::CameraDesc::Perspective {
+                look,
+                opening: alhazen_scene::PerspectiveOpening::Fov { angle: 1.0, horizontal: true },
+            };
+            let proj = super::super::projection(&desc, 64, 64).unwrap();
+            let job = Reflexes { surface: &surface, eye, proj: &proj, size: (64, 64) };
+            let t = Triangle { v: p.map(vertex), material: 0, closed: false, unbounded: false, object: 0 };
+            // Triangles that pass through the mirror are not the theorem's: a projecting ray
+            // starts inside them.
+            let grid = (0..=40).flat_map(|i| (0..=40 - i).map(move |j| [i as f64 / 40.0, j as f64 / 40.0]));
+            prop_assume!(grid.clone().all(|b| super::super::surface_at(&t, b).0.length() > 1.05));
+            let pieces = job.unfolded(&t, p.map(|q| job.reflex(q)));
+            let covered: f64 = pieces.iter().map(|(v, _, _)| area(v.map(|x| x.p))).sum();
+            prop_assert!((covered - area(p)).abs() < 1e-9 * (1.0 + area(p)), "{covered} of {}", area(p));
+            let plane = Plane::of_polygon(&p).unwrap();
+            for (v, b, r) in &pieces {
+                // The corners' weights give back the corners.
+                for k in 0..3 {
+                    prop_assert!((super::super::surface_at(&t, b[k]).0 - v[k].p).length() < 1e-9);
+                }
+                // The corners' reflexes and those of points inside the piece, where the mirror
+                // shows all of them (across a region it does not show, the side may change).
+                let inside = (1..8).flat_map(|i| (1..8 - i).map(move |j| [i as f64 / 8.0, j as f64 / 8.0]));
+                let at = |w: [f64; 2]| v[0].p + (v[1].p - v[0].p) * w[0] + (v[2].p - v[0].p) * w[1];
+                let more: Option<Vec<Vec3>> = inside.map(|w| job.reflex(at(w))).collect();
+                let (Some(more), true) = (more, r.iter().all(|x| x.is_some())) else { continue };
+                let side: Vec<f64> =
+                    r.iter().flatten().chain(&more).map(|r| plane.normal.dot(*r) - plane.offset).collect();
+                let tol = 1e-9;
+                prop_assert!(side.iter().all(|&s| s >= -tol) || side.iter().all(|&s| s <= tol), "{side:?}");
+            }
+        }
     }
 }
