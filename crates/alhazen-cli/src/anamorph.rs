@@ -110,7 +110,7 @@ fn footprint(an: &Anamorphosis, at: &Placement) -> Vec<Vec<Vec2>> {
 
 fn guide_stroke(l: Layer) -> Stroke {
     match l {
-        Layer::Hidden => Stroke { width: 0.2, grey: 0.6, dash: 0.0 },
+        Layer::Hidden => Stroke { width: 0.2, rgb: [0.6; 3], dash: 0.0 },
         _ => default_stroke(l),
     }
 }
@@ -160,10 +160,8 @@ fn raster_print(a: &AnamorphArgs, paper: Vec2, out: &str) -> Result<Vec<u8>, Fai
         "png" => {
             // The guides darken the print where they pass.
             let (gw, gh, ink) = guides.to_pixels(w, guide_stroke);
-            for (i, k) in ink.iter().enumerate().take((gw * gh).min(w * h) as usize) {
-                for c in 0..3 {
-                    rgb[3 * i + c] = rgb[3 * i + c].min(*k);
-                }
+            for (i, k) in ink.iter().enumerate().take((3 * gw * gh).min(3 * w * h) as usize) {
+                rgb[i] = rgb[i].min(*k);
             }
             encode_png(w, h, &rgb)
         }

@@ -19,8 +19,8 @@ pub struct LinesArgs {
     #[arg(required_unless_present = "graph")]
     scene: Option<PathBuf>,
     /// Output: .svg (a layer per kind of line, read as layers by Inkscape and vpype), .pdf,
-    /// .hpgl or .plt (HP-GL for pen plotters: pen 1 visible, 2 reflected, 3 hidden) or .png
-    /// (an antialiased preview).
+    /// .hpgl or .plt (HP-GL for pen plotters: pen 1 visible, 2 reflected, 3 hidden; an
+    /// anaglyph's eyes 4 and 5) or .png (an antialiased preview).
     #[arg(short, long)]
     output: PathBuf,
     /// Paper width in millimetres (the height follows the scene's image aspect).
@@ -37,6 +37,10 @@ pub struct LinesArgs {
     /// over are split first (Glaeser's Theorems 7–9).
     #[arg(long, conflicts_with_all = ["no_reflections", "optimize"])]
     fill: bool,
+    /// With a stereo camera: one red–cyan anaglyph (left eye red, right eye cyan, on the
+    /// layers `4 left` and `5 right`) instead of the two drawings side by side.
+    #[arg(long, conflicts_with_all = ["fill", "hidden"])]
+    anaglyph: bool,
     /// Mesh edges whose faces meet at more than this angle (degrees) are drawn.
     #[arg(long, default_value_t = 30.0, value_parser = angle)]
     feature_angle: f64,
@@ -161,8 +165,15 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
                 reflections: !a.no_reflections,
                 sampled: a.sampled,
                 fill: a.fill,
+                anaglyph: a.anaglyph,
                 ..Options::default()
             };
+            if a.anaglyph && !matches!(scene.camera, alhazen_scene::CameraDesc::Stereo { .. }) {
+                return Err(Failure::input(format!(
+                    "{}: --anaglyph needs a stereo camera (`type = \"stereo\"`)",
+                    path.display()
+                )));
+            }
             let progress = StageBar::new(a.quiet);
             let drawn = pool.install(|| draw_reporting(&scene, &opts, &progress));
             progress.bar.finish_and_clear();
@@ -201,6 +212,7 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
             Layer::Visible => a.stroke,
             Layer::Hidden => a.stroke_hidden,
             Layer::Reflected => a.stroke_reflected,
+            Layer::Left | Layer::Right => a.stroke,
         };
         Stroke { width, ..default_stroke(l) }
     };
@@ -260,7 +272,7 @@ impl Progress for StageBar {
 /// The drawing's own words for a camera it cannot use.
 fn camera_error(e: alhazen_raster::pipeline::RasterError) -> String {
     let alhazen_raster::pipeline::RasterError::UnsupportedCamera(kind) = e;
-    format!("line drawings support perspective, orthographic, axonometric and stereo cameras, not {kind}")
+    format!("cannot draw the camera: {kind}")
 }
 
 /// A floating-horizon drawing of a built-in function on paper `width_mm` wide.

@@ -608,6 +608,19 @@ fn lines_writes_svg_pdf_and_png_and_refuses_bad_input() {
     let o = alhazen(&["lines", stereo.to_str().unwrap(), "-o", pair.to_str().unwrap(), "--width-mm", "100"]);
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(std::fs::read_to_string(&pair).unwrap().contains("width=\"200.000mm\""), "two 100 mm views side by side");
+    let glyph = dir.path().join("a.svg");
+    let o =
+        alhazen(&["lines", stereo.to_str().unwrap(), "-o", glyph.to_str().unwrap(), "--width-mm", "100", "--anaglyph"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let svg = std::fs::read_to_string(&glyph).unwrap();
+    assert!(
+        svg.contains("width=\"100.000mm\"")
+            && svg.contains("inkscape:label=\"4 left\" fill=\"none\" stroke=\"rgb(255,0,0)\"")
+    );
+    let mono = scene_file(dir.path(), "[camera]\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
+    let o = alhazen(&["lines", mono.to_str().unwrap(), "-o", glyph.to_str().unwrap(), "--anaglyph"]);
+    assert_eq!(o.status.code(), Some(2), "--anaglyph without a stereo camera");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs a stereo camera"));
     let pano = scene_file(dir.path(), "[camera]\ntype = \"panorama\"\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
     let o = alhazen(&["lines", pano.to_str().unwrap(), "-o", dir.path().join("p.svg").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "a panorama is drawn: {}", String::from_utf8_lossy(&o.stderr));

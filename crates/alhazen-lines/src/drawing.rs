@@ -15,19 +15,28 @@ pub enum Layer {
     Hidden,
     /// Lines seen in a mirror.
     Reflected,
+    /// The left eye's lines of a red–cyan anaglyph (visible and reflected).
+    Left,
+    /// The right eye's lines of a red–cyan anaglyph.
+    Right,
 }
 
 impl Layer {
     /// All layers, bottom to top.
-    pub const ALL: [Layer; 3] = [Layer::Hidden, Layer::Reflected, Layer::Visible];
+    pub const ALL: [Layer; 5] = [Layer::Hidden, Layer::Reflected, Layer::Visible, Layer::Left, Layer::Right];
+
+    /// All layers in the order of their pens.
+    pub const BY_PEN: [Layer; 5] = [Layer::Visible, Layer::Reflected, Layer::Hidden, Layer::Left, Layer::Right];
 
     /// The layer's number: its pen on a plotter, its layer in vpype and Inkscape (visible 1,
-    /// reflected 2, hidden 3).
+    /// reflected 2, hidden 3; an anaglyph's left eye 4, right eye 5).
     pub fn pen(self) -> u32 {
         match self {
             Layer::Visible => 1,
             Layer::Reflected => 2,
             Layer::Hidden => 3,
+            Layer::Left => 4,
+            Layer::Right => 5,
         }
     }
 
@@ -37,6 +46,8 @@ impl Layer {
             Layer::Visible => "visible",
             Layer::Hidden => "hidden",
             Layer::Reflected => "reflected",
+            Layer::Left => "left",
+            Layer::Right => "right",
         }
     }
 }
@@ -46,8 +57,8 @@ impl Layer {
 pub struct Stroke {
     /// Width in millimetres.
     pub width: f64,
-    /// Grey level 0 (black) … 1 (white).
-    pub grey: f64,
+    /// Colour, display RGB in `[0, 1]` (black `[0, 0, 0]`).
+    pub rgb: [f64; 3],
     /// Dash length in millimetres (0: solid).
     pub dash: f64,
 }
@@ -72,12 +83,15 @@ pub struct Fill {
     pub rgb: [f64; 3],
 }
 
-/// Default strokes: visible 0.35 mm black, hidden 0.18 mm grey dashed, reflected 0.25 mm.
+/// Default strokes: visible 0.35 mm black, hidden 0.18 mm grey dashed, reflected 0.25 mm; an
+/// anaglyph's eyes 0.35 mm red (left) and cyan (right).
 pub fn default_stroke(layer: Layer) -> Stroke {
     match layer {
-        Layer::Visible => Stroke { width: 0.35, grey: 0.0, dash: 0.0 },
-        Layer::Hidden => Stroke { width: 0.18, grey: 0.45, dash: 1.0 },
-        Layer::Reflected => Stroke { width: 0.25, grey: 0.1, dash: 0.0 },
+        Layer::Visible => Stroke { width: 0.35, rgb: [0.0; 3], dash: 0.0 },
+        Layer::Hidden => Stroke { width: 0.18, rgb: [0.45; 3], dash: 1.0 },
+        Layer::Reflected => Stroke { width: 0.25, rgb: [0.1; 3], dash: 0.0 },
+        Layer::Left => Stroke { width: 0.35, rgb: [1.0, 0.0, 0.0], dash: 0.0 },
+        Layer::Right => Stroke { width: 0.35, rgb: [0.0, 1.0, 1.0], dash: 0.0 },
     }
 }
 
@@ -206,8 +220,11 @@ impl Drawing {
             s.push_str("</g>\n");
         }
         for layer in Layer::ALL {
+            if layer >= Layer::Left && !self.lines.iter().any(|(l, _)| *l == layer) {
+                continue; // the eyes' layers only in anaglyphs
+            }
             let st = stroke(layer);
-            let grey = (st.grey.clamp(0.0, 1.0) * 255.0).round() as u8;
+            let [r, g, b] = st.rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
             let dash = if st.dash > 0.0 {
                 format!(" stroke-dasharray=\"{:.3} {:.3}\"", st.dash, st.dash)
             } else {
@@ -215,7 +232,7 @@ impl Drawing {
             };
             let _ = writeln!(
                 s,
-                "<g id=\"{0}\" inkscape:groupmode=\"layer\" inkscape:label=\"{1} {0}\" fill=\"none\" stroke=\"rgb({grey},{grey},{grey})\" stroke-width=\"{2:.3}\" stroke-linecap=\"round\" stroke-linejoin=\"round\"{dash}>",
+                "<g id=\"{0}\" inkscape:groupmode=\"layer\" inkscape:label=\"{1} {0}\" fill=\"none\" stroke=\"rgb({r},{g},{b})\" stroke-width=\"{2:.3}\" stroke-linecap=\"round\" stroke-linejoin=\"round\"{dash}>",
                 layer.name(),
                 layer.pen(),
                 st.width
@@ -260,7 +277,8 @@ impl Drawing {
             let _ = writeln!(content, "/OC /L{k} BDC");
             let dash =
                 if st.dash > 0.0 { format!("[{:.3} {:.3}] 0 d", st.dash * PT, st.dash * PT) } else { "[] 0 d".into() };
-            let _ = writeln!(content, "{:.3} G {:.3} w 1 J 1 j {dash}", st.grey.clamp(0.0, 1.0), st.width * PT);
+            let [r, g, b] = st.rgb.map(|c| c.clamp(0.0, 1.0));
+            let _ = writeln!(content, "{r:.3} {g:.3} {b:.3} RG {:.3} w 1 J 1 j {dash}", st.width * PT);
             for (_, pts) in self.lines.iter().filter(|(l, _)| l == layer) {
                 for (i, p) in pts.iter().enumerate() {
                     let _ = write!(content, "{:.3} {:.3} {} ", p.x * PT, h - p.y * PT, if i == 0 { "m" } else { "l" });
@@ -329,21 +347,23 @@ impl Drawing {
         out
     }
 
-    /// An antialiased greyscale preview `px` pixels wide: each pixel's coverage by each stroke
-    /// from the exact distance of its centre to the segment (round caps), darkest wins.
+    /// An antialiased RGB preview `px` pixels wide (three bytes a pixel): each pixel's coverage
+    /// by each stroke from the exact distance of its centre to the segment (round caps); inks
+    /// absorb per channel as on paper (a red and a cyan stroke crossing make black), the
+    /// darkest wins.
     pub fn to_pixels(&self, px: u32, stroke: impl Fn(Layer) -> Stroke) -> (u32, u32, Vec<u8>) {
         let scale = px as f64 / self.size.x.max(1e-9);
         let (w, h) = (px, ((self.size.y * scale).round() as u32).max(1));
-        let mut ink = vec![0.0f32; (w * h) as usize];
+        let mut ink = vec![[0.0f32; 3]; (w * h) as usize];
+        let absorbed = |rgb: [f64; 3]| rgb.map(|c| (1.0 - c.clamp(0.0, 1.0)) as f32);
         for f in &self.fills {
-            let grey = 0.2126 * f.rgb[0] + 0.7152 * f.rgb[1] + 0.0722 * f.rgb[2];
             let pts: Vec<Vec2> = f.points.iter().map(|p| *p * scale).collect();
-            fill_polygon(&mut ink, (w, h), &pts, (1.0 - grey.clamp(0.0, 1.0)) as f32);
+            fill_polygon(&mut ink, (w, h), &pts, absorbed(f.rgb));
         }
         for (layer, pts) in &self.lines {
             let st = stroke(*layer);
             let half = (0.5 * st.width * scale).max(0.5);
-            let darkness = (1.0 - st.grey.clamp(0.0, 1.0)) as f32;
+            let darkness = absorbed(st.rgb);
             let mut walked = 0.0;
             for seg in pts.windows(2) {
                 let (a, b) = (seg[0] * scale, seg[1] * scale);
@@ -368,25 +388,25 @@ impl Drawing {
                 walked += len;
             }
         }
-        let pixels = ink.iter().map(|&k| (255.0 * (1.0 - k.clamp(0.0, 1.0))).round() as u8).collect();
+        let pixels = ink.iter().flatten().map(|&k| (255.0 * (1.0 - k.clamp(0.0, 1.0))).round() as u8).collect();
         (w, h, pixels)
     }
 }
 
 impl Drawing {
-    /// The preview encoded as an 8-bit greyscale PNG.
+    /// The preview encoded as an 8-bit RGB PNG.
     pub fn to_png(&self, px: u32, stroke: impl Fn(Layer) -> Stroke) -> Result<Vec<u8>, image::ImageError> {
         use image::ImageEncoder;
         let (w, h, pixels) = self.to_pixels(px, stroke);
         let mut out = vec![];
-        image::codecs::png::PngEncoder::new(&mut out).write_image(&pixels, w, h, image::ExtendedColorType::L8)?;
+        image::codecs::png::PngEncoder::new(&mut out).write_image(&pixels, w, h, image::ExtendedColorType::Rgb8)?;
         Ok(out)
     }
 }
 
-/// Paints `ink` (darkness) inside polygon `pts` (pixels; even–odd rule at pixel centres), over
-/// what was there.
-fn fill_polygon(ink: &mut [f32], (w, h): (u32, u32), pts: &[Vec2], darkness: f32) {
+/// Paints `ink` (darkness per channel) inside polygon `pts` (pixels; even–odd rule at pixel
+/// centres), over what was there.
+fn fill_polygon(ink: &mut [[f32; 3]], (w, h): (u32, u32), pts: &[Vec2], darkness: [f32; 3]) {
     if pts.len() < 3 {
         return;
     }
@@ -426,7 +446,7 @@ pub struct Backdrop {
 
 /// Darkens the pixels near segment `a b` by their coverage (1 inside, a one-pixel ramp at
 /// distance `half`).
-fn stamp(ink: &mut [f32], (w, h): (u32, u32), a: Vec2, b: Vec2, half: f64, darkness: f32) {
+fn stamp(ink: &mut [[f32; 3]], (w, h): (u32, u32), a: Vec2, b: Vec2, half: f64, darkness: [f32; 3]) {
     let lo = (a.min(b) - Vec2::splat(half + 1.0)).max(Vec2::ZERO);
     let hi = (a.max(b) + Vec2::splat(half + 1.0)).min(Vec2::new(w as f64 - 1.0, h as f64 - 1.0));
     if lo.x > hi.x || lo.y > hi.y {
@@ -439,9 +459,11 @@ fn stamp(ink: &mut [f32], (w, h): (u32, u32), a: Vec2, b: Vec2, half: f64, darkn
             let p = Vec2::new(x as f64 + 0.5, y as f64 + 0.5);
             let t = if l2 > 0.0 { ((p - a).dot(d) / l2).clamp(0.0, 1.0) } else { 0.0 };
             let dist = (p - (a + d * t)).length();
-            let cover = (half + 0.5 - dist).clamp(0.0, 1.0) as f32 * darkness;
+            let cover = (half + 0.5 - dist).clamp(0.0, 1.0) as f32;
             let k = &mut ink[(y * w + x) as usize];
-            *k = k.max(cover);
+            for c in 0..3 {
+                k[c] = k[c].max(cover * darkness[c]);
+            }
         }
     }
 }
@@ -507,7 +529,8 @@ mod tests {
     fn preview_inks_the_line_and_nothing_far_from_it() {
         let (w, h, px) = square().to_pixels(200, default_stroke);
         assert_eq!((w, h), (200, 100));
-        assert!(px[(20 * w + 100) as usize] < 60, "on the line");
-        assert_eq!(px[(60 * w + 60) as usize], 255, "far from it");
+        let at = |x: u32, y: u32| &px[3 * (y * w + x) as usize..][..3];
+        assert!(at(100, 20).iter().all(|&c| c < 60), "on the line");
+        assert_eq!(at(60, 60), [255; 3], "far from it");
     }
 }

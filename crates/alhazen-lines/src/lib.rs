@@ -65,6 +65,9 @@ pub struct Options {
     pub sampled: Option<f64>,
     /// Fill the reflexes of the scene's polygons in the mirrors, in painter's order ([`fill`]).
     pub fill: bool,
+    /// A stereo camera's eyes as one red–cyan anaglyph (left eye red, right eye cyan, on one
+    /// paper, hidden lines left out) instead of side by side.
+    pub anaglyph: bool,
 }
 
 impl Default for Options {
@@ -77,6 +80,7 @@ impl Default for Options {
             reflections: true,
             sampled: None,
             fill: false,
+            anaglyph: false,
         }
     }
 }
@@ -137,6 +141,9 @@ pub fn draw_reporting(scene: &Scene, opts: &Options, progress: &dyn Progress) ->
     }
     let (right, r) = halves.pop().expect("two eyes");
     let (mut left, l) = halves.pop().expect("two eyes");
+    if opts.anaglyph {
+        return Ok(anaglyph(left, right, l, r));
+    }
     let shift = alhazen_math::Vec2::new(left.size.x, 0.0);
     left.lines
         .extend(right.lines.into_iter().map(|(layer, pts)| (layer, pts.into_iter().map(|p| p + shift).collect())));
@@ -157,7 +164,20 @@ pub fn draw_reporting(scene: &Scene, opts: &Options, progress: &dyn Progress) ->
     Ok((left, stats))
 }
 
-/// The drawing from one camera a projection matrix gives.
+/// Two eyes' drawings on one paper as a red–cyan anaglyph: each eye's visible and reflected
+/// lines on its own layer ([`Layer::Left`], [`Layer::Right`]), hidden lines and fills left out.
+fn anaglyph(left: Drawing, right: Drawing, l: Stats, r: Stats) -> (Drawing, Stats) {
+    let eye = |d: Drawing, layer: Layer| {
+        d.lines.into_iter().filter(|(k, _)| *k != Layer::Hidden).map(move |(_, pts)| (layer, pts))
+    };
+    let size = left.size;
+    let lines = eye(left, Layer::Left).chain(eye(right, Layer::Right)).collect();
+    let stats =
+        Stats { visible: l.visible + r.visible, hidden: 0, reflected: l.reflected + r.reflected, fills: 0, ..l };
+    (Drawing { size, lines, fills: vec![] }, stats)
+}
+
+/// The drawing from one camera.
 fn draw_view(scene: &Scene, opts: &Options, progress: &dyn Progress) -> Result<(Drawing, Stats), RasterError> {
     progress.stage("building the scene's index", 0);
     let world = World::build(scene);

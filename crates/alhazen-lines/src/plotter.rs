@@ -52,7 +52,7 @@ pub fn optimize(d: Drawing, join_mm: f64) -> Optimized {
     let before = travel(&d);
     let joined = d.joined();
     let mut lines = vec![];
-    for layer in [Layer::Visible, Layer::Reflected, Layer::Hidden] {
+    for layer in Layer::BY_PEN {
         let strokes: Vec<Vec<Vec2>> =
             joined.lines.iter().filter(|(l, _)| *l == layer).map(|(_, p)| p.clone()).collect();
         let mut order = nearest_end_tour(&strokes);
@@ -308,7 +308,7 @@ pub fn to_hpgl(d: &Drawing) -> String {
         let y = ((d.size.y - p.y) * HPGL_UNITS_PER_MM).round() as i64;
         (x, y)
     };
-    for layer in [Layer::Visible, Layer::Reflected, Layer::Hidden] {
+    for layer in Layer::BY_PEN {
         let mut strokes = d.lines.iter().filter(|(l, p)| *l == layer && !p.is_empty()).peekable();
         if strokes.peek().is_none() {
             continue;
