@@ -18,7 +18,8 @@ trap 'rm -rf "$work"' EXIT
 
 scenes=(scenes/raster-100k.toml scenes/raster-100k-mirror-ball.toml scenes/teapot.toml
         scenes/glass-balls.toml scenes/cornell-box.toml scenes/nurbs-design.toml
-        scenes/lofted-and-spline-surfaces.toml scenes/instancing.toml scenes/cameras/stereo.toml)
+        scenes/lofted-and-spline-surfaces.toml scenes/instancing.toml scenes/cameras/stereo.toml
+        scenes/cameras/panorama.toml)
 extra=()
 if [ -f bench/mitsuba/suite/data/displaced-1m.ply ]; then
     "$new" convert bench/mitsuba/suite/million.xml -o "$work/million.toml" 2>/dev/null
@@ -27,7 +28,10 @@ fi
 
 frame() { # binary scene output → seconds per frame
     local args=(--frames 10)
-    case "$2" in *million.toml) args+=(--no-shadows) ;; esac
+    case "$2" in
+        *million.toml) args+=(--no-shadows) ;;
+        *panorama.toml) args=(--frames 2) ;; # seconds a frame before session 17
+    esac
     "$1" raster "$2" "${args[@]}" -o "$3" 2>&1 | grep -o 'in [0-9.]* s per frame' | awk '{print $2}'
 }
 

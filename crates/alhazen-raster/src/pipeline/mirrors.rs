@@ -564,6 +564,13 @@ impl Reflexes<'_> {
             return;
         }
         let screen = |p: Vec3| to_screen(self.proj, p, self.size);
+        // A piece whose known reflexes all lie beyond one edge of the screen, farther than
+        // they lie apart, is not in this view (a panorama's cube faces that do not look at the
+        // mirror split such pieces to the pixel otherwise).
+        let known: Vec<Vec2> = r.iter().chain(&rm).flatten().map(|p| screen(*p)).collect();
+        if behind == 0 && self.off_screen(&known) {
+            return;
+        }
         let fits = match (r, rm) {
             _ if behind > 0 => false,
             ([Some(a), Some(b), Some(c)], [Some(ma), Some(mb), Some(mc)]) => {
@@ -592,6 +599,16 @@ impl Reflexes<'_> {
                 self.split(tri, w, refl, source, level + 1, out);
             }
         }
+    }
+
+    /// True when `pts` (screen positions) all lie beyond one edge of the screen by more than
+    /// their own extent.
+    fn off_screen(&self, pts: &[Vec2]) -> bool {
+        let Some(&first) = pts.first() else { return false };
+        let span = pts.iter().map(|p| (*p - first).length()).fold(0.0, f64::max);
+        let (w, h) = (self.size.0 as f64, self.size.1 as f64);
+        let all = |f: &dyn Fn(&Vec2) -> bool| pts.iter().all(f);
+        all(&|p| p.x < -span) || all(&|p| p.x > w + span) || all(&|p| p.y < -span) || all(&|p| p.y > h + span)
     }
 
     fn emit(&self, v: [Vertex; 3], b: [Bary; 3], r: [Vec3; 3], source: u32, out: &mut Vec<ScreenTriangle>) {
