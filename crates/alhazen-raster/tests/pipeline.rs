@@ -669,7 +669,7 @@ material = { color = [0.9, 0.1, 0.1] }
 }
 
 /// The course's other visibility algorithms against the z-buffer on every scene of `scenes/`
-/// and `scenes/cameras/` but the panorama (see below), with their cameras: the scan-line
+/// and `scenes/cameras/`, with their cameras: the scan-line
 /// algorithm and Warnock's area subdivision give its frame and depth bit for bit, the
 /// depth-sort painter its frame but on at most one pixel in a thousand.
 #[test]
@@ -700,7 +700,7 @@ fn the_scanline_warnock_and_depth_sort_algorithms_draw_every_scene_as_the_z_buff
     }
 }
 
-/// Every scene of `scenes/` and `scenes/cameras/` but the panorama (see below).
+/// Every scene of `scenes/` and `scenes/cameras/`.
 fn scene_files() -> Vec<std::path::PathBuf> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let mut files: Vec<_> = std::fs::read_dir(&root)
@@ -708,10 +708,6 @@ fn scene_files() -> Vec<std::path::PathBuf> {
         .chain(std::fs::read_dir(root.join("cameras")).unwrap())
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        // The panorama's cylinder mirror still takes ~6 s a frame at this size in the cube face
-        // that sees it (the reflex split recurses deep there; noted in the issue), not a
-        // visibility matter.
-        .filter(|p| !p.ends_with("cameras/panorama.toml"))
         .collect();
     files.sort();
     assert!(files.len() > 30, "{} scenes", files.len());
