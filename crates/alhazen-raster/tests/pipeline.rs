@@ -588,6 +588,47 @@ fn mirrors_show_in_the_preview_what_the_ray_tracer_shows() {
 }
 
 #[test]
+fn a_card_through_a_mirror_ball_shows_without_gaps() {
+    // A checkered strip passes through the ball: triangles whose corners lie inside the ball
+    // have no reflex there; the pieces along the curve where the strip leaves the ball are
+    // drawn up to the surface (each surface point is its own reflex), not left out.
+    let text = r#"
+background = [0.6, 0.7, 0.9]
+ambient = 0.3
+[render]
+width = 320
+height = 240
+spp = 4
+max_depth = 2
+integrator = "whitted"
+[camera]
+eye = [-0.8, 0.6, 5]
+target = [0, 0, 0]
+fov = 30
+[[light]]
+type = "directional"
+direction = [-0.3, -1, -0.5]
+[[object]]
+name = "mirror ball"
+shape = "sphere"
+radius = 1
+material = { color = 0, diffuse = 0, mirror = 0.9 }
+[[object]]
+shape = "rectangle"
+transform = [{ scale = [3, 0.25, 1] }, { rotate_y = 80 }, { translate = [0.4, 0, 0] }]
+material = { color = { checker = { even = 0.9, odd = 0.1, size = 0.1 } } }
+"#;
+    let scene = alhazen_scene::parse_scene("card.toml".as_ref(), text).unwrap();
+    let (err, sky) = mirror_error(&scene, "mirror ball");
+    eprintln!(
+        "card through the ball: mean absolute difference in the mirror {:.2} % (sky only: {:.2} %)",
+        err * 100.0,
+        sky * 100.0
+    );
+    assert!(err < 0.005, "{err} (0.86 % with the pieces along the curve left out)");
+}
+
+#[test]
 fn csg_bodies_show_in_the_preview_as_the_ray_tracer_shows_them() {
     // A box minus a sphere, lit from the eye's side: the per-pixel ray cast against Whitted on
     // the pixels that see the body (its self-shadows are the ray tracer's only).

@@ -108,6 +108,46 @@ impl Curved {
         }
     }
 
+    /// The offset of `p` from the mirror's axis (sphere: from its centre) and the radius.
+    fn radial(&self, p: Vec3) -> (Vec3, f64) {
+        match self {
+            Curved::Sphere(s) => (p - s.center, s.radius),
+            Curved::Cylinder { cylinder, .. } => {
+                let a = cylinder.axis.normalize();
+                let d = p - cylinder.center;
+                (d - a * d.dot(a), cylinder.radius)
+            }
+        }
+    }
+
+    /// Whether `p` lies inside the mirror's solid (a cylinder's between its rims): such points
+    /// have no reflex.
+    fn inside(&self, p: Vec3) -> bool {
+        let (d, r) = self.radial(p);
+        d.length_squared() < r * r && self.on_side(p)
+    }
+
+    /// Where the segment `a → b`, one end inside the solid and one outside, crosses the
+    /// mirror's surface, as a parameter in `[0, 1]`.
+    fn crossing(&self, a: Vec3, b: Vec3) -> Option<f64> {
+        let ((da, r), (db, _)) = (self.radial(a), self.radial(b));
+        // |da + t (db − da)|² = r²: the root in [0, 1].
+        let e = db - da;
+        let (qa, qb, qc) = (e.length_squared(), 2.0 * da.dot(e), da.length_squared() - r * r);
+        let disc = qb * qb - 4.0 * qa * qc;
+        if qa <= 0.0 || disc < 0.0 {
+            return None;
+        }
+        let s = disc.sqrt();
+        [(-qb - s) / (2.0 * qa), (-qb + s) / (2.0 * qa)].into_iter().find(|t| (0.0..=1.0).contains(t))
+    }
+
+    /// A point of the mirror's surface is its own reflex where the eye sees it.
+    fn shows_itself(&self, eye: Vec3, q: Vec3) -> bool {
+        let (n, _) = self.radial(q);
+        n.dot(eye - q) > 0.0 && self.on_side(q)
+    }
+
     /// Whether a point of the infinite cylinder lies between the rims.
     fn on_side(&self, r: Vec3) -> bool {
         match self {
@@ -546,6 +586,7 @@ impl Reflexes<'_> {
             return;
         }
         if level >= 3 && present.len() == 2 && span <= 1.0 {
+            self.rim(v, b, r, source, out);
             return;
         }
         let mid = |a: &Vertex, b: &Vertex| Vertex {
@@ -561,6 +602,9 @@ impl Reflexes<'_> {
         // does not show; with one, deep down, on its border.
         let known = present.len() + rm.iter().flatten().count();
         if known == 0 || (level >= 4 && known <= 1) {
+            if known == 1 && present.len() == 1 {
+                self.rim(v, b, r, source, out);
+            }
             return;
         }
         let screen = |p: Vec3| to_screen(self.proj, p, self.size);
@@ -598,6 +642,42 @@ impl Reflexes<'_> {
             ] {
                 self.split(tri, w, refl, source, level + 1, out);
             }
+        }
+    }
+
+    /// The last piece of a triangle that passes through the mirror: its corners inside the
+    /// mirror's solid (which have no reflex) are replaced by the points where its edges leave
+    /// the surface — a point of the surface is its own reflex — and the rest is drawn (without
+    /// this, the pieces along the curve where a mesh pierces the mirror were left out, and the
+    /// sky showed through there).
+    fn rim(&self, v: [Vertex; 3], b: [Bary; 3], r: [Option<Vec3>; 3], source: u32, out: &mut Vec<ScreenTriangle>) {
+        let missing = (0..3).filter(|&k| r[k].is_none());
+        if !missing.clone().all(|k| self.surface.inside(v[k].p)) {
+            return;
+        }
+        let mut poly: Vec<(Vertex, Bary, Vec3)> = vec![];
+        for k in 0..3 {
+            let j = (k + 1) % 3;
+            if let Some(rk) = r[k] {
+                poly.push((v[k], b[k], rk));
+            }
+            if r[k].is_some() != r[j].is_some() {
+                let Some(t) = self.surface.crossing(v[k].p, v[j].p) else { return };
+                let q = Vertex {
+                    p: v[k].p + (v[j].p - v[k].p) * t,
+                    n: (v[k].n + (v[j].n - v[k].n) * t).normalize_or_zero(),
+                    uv: v[k].uv + (v[j].uv - v[k].uv) * t,
+                };
+                if !self.surface.shows_itself(self.eye, q.p) {
+                    return;
+                }
+                let w = [0, 1].map(|i| b[k][i] + (b[j][i] - b[k][i]) * t);
+                poly.push((q, w, q.p));
+            }
+        }
+        for k in 1..poly.len().saturating_sub(1) {
+            let c = [poly[0], poly[k], poly[k + 1]];
+            self.emit(c.map(|x| x.0), c.map(|x| x.1), c.map(|x| x.2), source, out);
         }
     }
 
