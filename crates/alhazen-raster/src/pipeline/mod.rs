@@ -579,15 +579,18 @@ fn fragment_color(
 const BAND: u32 = 16;
 
 /// About how many bytes [`render_scene`] takes for `scene` at its size with `opts`: the world's
-/// triangles and their screen copies (one and a half per triangle, for clipping), the BSP
+/// triangles (twice while they are put in the octree's order), their corner records and screen
+/// copies (one and a half per triangle, for clipping), the BSP
 /// tree's when asked for, the frame and depth buffers, and room for shadow maps. Computed
 /// without tessellating, so a scene that would not fit is refused before allocating.
 pub fn memory_estimate(scene: &Scene, opts: &RasterOptions) -> u64 {
     let triangles: u64 = scene.objects.iter().map(|o| geometry::triangle_count(scene, &o.shape)).sum();
     let world = std::mem::size_of::<Triangle>() as u64;
     let screen = std::mem::size_of::<ScreenTriangle>() as u64;
+    // The triangles are copied once into the octree's order while preparing (two copies at
+    // that moment), and the frame's screen triangles come after.
     let per_triangle = world
-        + screen * 3 / 2
+        + (screen * 3 / 2).max(world)
         + std::mem::size_of::<Corners>() as u64
         + 16
         + if opts.visibility == Visibility::Bsp { 2 * world } else { 0 };
