@@ -113,6 +113,12 @@ pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
     let format = check_output(&a.image.output, a.image.half)?;
     let output = crate::open_output(&a.image.output)?;
     let scene = load_sized(&a.image)?;
+    if a.anaglyph && !matches!(scene.camera, alhazen_scene::CameraDesc::Stereo { .. }) {
+        return Err(Failure::input(format!(
+            "{}: --anaglyph needs a stereo camera (`type = \"stereo\"`)",
+            a.image.scene.display()
+        )));
+    }
     let opts = RasterOptions {
         shading: match a.shading {
             ShadingArg::Flat => Shading::Flat,

@@ -99,6 +99,12 @@ fn raster_preview_writes_an_image_and_refuses_unsupported_cameras() {
     let o =
         alhazen(&["raster", stereo.to_str().unwrap(), "-o", dir.path().join("s.png").to_str().unwrap(), "--anaglyph"]);
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let mono = scene_file(dir.path(), "[camera]\neye = [0, 0, 5]\n[[object]]\nshape = \"box\"\n");
+    let o =
+        alhazen(&["raster", mono.to_str().unwrap(), "-o", dir.path().join("a.png").to_str().unwrap(), "--anaglyph"]);
+    assert_eq!(o.status.code(), Some(2), "--anaglyph without a stereo camera");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs a stereo camera"));
+    assert!(!dir.path().join("a.png").exists());
 }
 
 #[test]
