@@ -45,7 +45,9 @@ impl PhotonArgs {
                 ("--photon-radius", self.photon_radius.is_some()),
             ];
             if let Some((option, _)) = given.iter().find(|g| g.1) {
-                return Err(Failure::input(format!("{option} sets the photon map: add --integrator photon")));
+                return Err(Failure::input(format!(
+                    "{option} sets the photon map: add --integrator photon (or `integrator = \"photon\"` in the scene's [render])"
+                )));
             }
             return Ok(());
         }

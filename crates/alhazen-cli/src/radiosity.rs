@@ -68,7 +68,9 @@ impl RadiosityArgs {
     pub(crate) fn check(&self, radiosity: bool) -> Result<(), Failure> {
         let Some(path) = &self.export else { return Ok(()) };
         if !radiosity {
-            return Err(Failure::input("--export writes a radiosity solution: add --integrator radiosity"));
+            return Err(Failure::input(
+                "--export writes a radiosity solution: add --integrator radiosity (or `integrator = \"radiosity\"` in the scene's [render])",
+            ));
         }
         if path.extension().and_then(|e| e.to_str()) != Some("ply") {
             return Err(Failure::input(format!("{}: the solution is written as a .ply mesh", path.display())));

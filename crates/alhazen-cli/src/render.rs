@@ -131,9 +131,8 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
         r.integrator = match i {
             IntegratorArg::Whitted => alhazen_scene::IntegratorKind::Whitted,
             IntegratorArg::Path => alhazen_scene::IntegratorKind::Path,
-            // The scene keeps its own; the solution's image is made by the CLI.
-            IntegratorArg::Radiosity => r.integrator,
-            IntegratorArg::Photon => alhazen_scene::IntegratorKind::Path,
+            IntegratorArg::Radiosity => alhazen_scene::IntegratorKind::Radiosity,
+            IntegratorArg::Photon => alhazen_scene::IntegratorKind::Photon,
         };
     }
     if a.no_mirror_connections {
@@ -272,9 +271,10 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
     let output = open_output(out)?;
     let mut scene = load_sized(&a.image)?;
     apply_overrides(&mut scene, a);
-    let radiosity = matches!(a.integrator, Some(IntegratorArg::Radiosity));
+    // `--integrator`, or the scene's `[render] integrator`.
+    let radiosity = scene.render.integrator == alhazen_scene::IntegratorKind::Radiosity;
     a.radiosity.check(radiosity)?;
-    let photon = matches!(a.integrator, Some(IntegratorArg::Photon));
+    let photon = scene.render.integrator == alhazen_scene::IntegratorKind::Photon;
     a.photon.check(photon, &scene)?;
     if scene.render.integrator == alhazen_scene::IntegratorKind::Whitted && !radiosity {
         warn_unsampled_emitters(&scene);
@@ -561,9 +561,8 @@ fn summary(scene: &Scene, a: &RenderArgs, plan: &Plan, elapsed: Duration, thread
             )
         }
         (alhazen_scene::IntegratorKind::Whitted, Source::Scene) => "Whitted ray tracing".to_string(),
-        (alhazen_scene::IntegratorKind::Path, Source::Scene) => {
-            format!("path tracing, {:?} sampler", r.sampler).to_lowercase()
-        }
+        // Photon and radiosity renders have their own source.
+        (_, Source::Scene) => format!("path tracing, {:?} sampler", r.sampler).to_lowercase(),
     };
     let what = match (a.tile, a.pass) {
         (None, None) => String::new(),

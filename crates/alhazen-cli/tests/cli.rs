@@ -1009,6 +1009,17 @@ fn a_radiosity_solution_is_rendered_exported_and_shown_by_the_preview() {
     args.extend(size);
     let o = alhazen(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The scene file may ask for radiosity itself: the same image.
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("integrator = \"path\""));
+    let in_file = dir.path().join("radiosity.toml");
+    std::fs::write(&in_file, text.replacen("integrator = \"path\"", "integrator = \"radiosity\"", 1)).unwrap();
+    let by_file = dir.path().join("f.pfm");
+    let mut args = vec!["render", in_file.to_str().unwrap(), "-o", by_file.to_str().unwrap(), "--quiet", "--spp", "1"];
+    args.extend(size);
+    let o = alhazen(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(&image).unwrap(), std::fs::read(&by_file).unwrap());
     let mut args = vec!["raster", scene.to_str().unwrap(), "-o", raster.to_str().unwrap(), "--quiet"];
     args.extend(["--radiosity", ply.to_str().unwrap()]);
     args.extend(size);
@@ -1095,6 +1106,16 @@ fn photon_mapping_renders_in_parts_and_checks_its_options() {
         out
     };
     let whole = run("whole.pfm", &[]);
+    // The scene file may ask for the photon map itself (`[render] integrator = "photon"`),
+    // with the options still on the command line: the same image.
+    let in_file = dir.path().join("photon.toml");
+    std::fs::write(&in_file, glass.replacen("[render]\n", "[render]\nintegrator = \"photon\"\n", 1)).unwrap();
+    let out = dir.path().join("file.pfm");
+    let mut args = vec!["render", in_file.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    args.extend_from_slice(&photon[2..]);
+    let o = alhazen(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(&whole).unwrap(), std::fs::read(&out).unwrap());
     // Paths traced eight at a time in lanes (the default kernel here) or one by one: the same.
     let portable = run("portable.pfm", &["--kernel", "portable"]);
     assert_eq!(std::fs::read(&whole).unwrap(), std::fs::read(&portable).unwrap());

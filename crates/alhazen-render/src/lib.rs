@@ -133,6 +133,11 @@ fn with_estimator<T>(
         IntegratorKind::Whitted => {
             work(&WhittedEstimator { whitted: Whitted::new(scene, &world), camera: &camera, spp: s.spp, seed: s.seed })
         }
-        IntegratorKind::Path => work(&PathTracer::new(scene, &world, &camera)),
+        // Photon mapping and radiosity live in crates above this one (`alhazen render` runs
+        // them); here the path tracer renders what the photon map converges to and radiosity
+        // approximates.
+        IntegratorKind::Path | IntegratorKind::Photon | IntegratorKind::Radiosity => {
+            work(&PathTracer::new(scene, &world, &camera))
+        }
     }
 }

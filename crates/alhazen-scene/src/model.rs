@@ -42,6 +42,12 @@ pub enum IntegratorKind {
     Whitted,
     /// Unidirectional path tracing of the rendering equation (course, §"Global lighting models").
     Path,
+    /// Path tracing with caustics from a photon map (the `alhazen-photon` crate; `alhazen
+    /// render` builds the map). Without it, the path tracer renders what it converges to.
+    Photon,
+    /// The course's radiosity method (the `alhazen-radiosity` crate; `alhazen render` solves
+    /// it). Without it, the path tracer renders the scene.
+    Radiosity,
 }
 
 /// Where the path tracer's random numbers come from.

@@ -570,8 +570,10 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
         max_depth: t.get("max_depth").map_or(Ok(d.max_depth as u64), |n| n.integer(0, 1000))? as u32,
         seed: t.get("seed").map_or(Ok(0), |n| n.integer(0, i64::MAX as u64))?,
         integrator: match t.get("integrator") {
-            Some(i) => match i.choice(&["whitted", "path"])? {
+            Some(i) => match i.choice(&["whitted", "path", "photon", "radiosity"])? {
                 "whitted" => IntegratorKind::Whitted,
+                "photon" => IntegratorKind::Photon,
+                "radiosity" => IntegratorKind::Radiosity,
                 _ => IntegratorKind::Path,
             },
             None => d.integrator,

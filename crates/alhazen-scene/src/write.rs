@@ -170,6 +170,8 @@ impl Writer<'_> {
         let integrator = match r.integrator {
             IntegratorKind::Whitted => "whitted",
             IntegratorKind::Path => "path",
+            IntegratorKind::Photon => "photon",
+            IntegratorKind::Radiosity => "radiosity",
         };
         self.line("integrator", string(integrator));
         let sampler = match r.sampler {

@@ -190,6 +190,12 @@ fn physically_based_mistakes_are_explained() {
     let env = err("[[light]]\ntype = \"environment\"\nfile = \"nowhere.hdr\"\n");
     assert!(env.contains("s.toml:3:8") && env.contains("cannot load image"), "{env}");
     assert!(err("[render]\nintegrator = \"bdpt\"\n").contains("expected one of"));
+    for (name, kind) in
+        [("photon", alhazen_scene::IntegratorKind::Photon), ("radiosity", alhazen_scene::IntegratorKind::Radiosity)]
+    {
+        let s = parse_scene("i.toml".as_ref(), &format!("[render]\nintegrator = \"{name}\"\n")).unwrap();
+        assert_eq!(s.render.integrator, kind);
+    }
     let bump = |b: &str| err(&format!("[materials.m]\nbump = {b}\n"));
     assert!(bump("{ height = 0.1 }").contains("exactly one of `waves = size`, `image = { file = … }` or `normal_map"));
     assert!(bump("{ waves = 0.5 }").contains("missing the required key `height`"));
