@@ -259,7 +259,8 @@ impl World {
         for (i, o) in objects.iter().enumerate() {
             let object = i as u32;
             if let Some(mesh) = flattenable(&o.placed) {
-                for (lane, flat, bounds) in flat_primitives(mesh) {
+                let (flats, bounds) = flat_primitives(mesh);
+                for ((lane, flat), bounds) in flats.into_iter().zip(bounds) {
                     primitives.push(Primitive::Flat { object, lane, flat });
                     prim_bounds.push(bounds);
                 }

@@ -107,10 +107,14 @@ impl FlatLane {
     }
 }
 
-/// The triangles of `mesh` as flats with their bounds: consecutive pairs that form a
-/// parallelogram become one; triangles without area are dropped.
-pub fn flat_primitives(mesh: &TriangleMesh) -> Vec<(FlatLane, Flat, Bounds3)> {
-    let mut out = vec![];
+/// The triangles of `mesh` as flats, and their bounds apart (a mesh's BVH needs them only while
+/// it is built): consecutive pairs that form a parallelogram become one; triangles without
+/// area are dropped.
+pub fn flat_primitives(mesh: &TriangleMesh) -> (Vec<(FlatLane, Flat)>, Vec<Bounds3>) {
+    // At most one flat per triangle: reserved once, so a big mesh's flats are not copied as the
+    // vectors grow (pages reserved and never written cost no memory).
+    let mut out = Vec::with_capacity(mesh.triangle_count());
+    let mut bounds = Vec::with_capacity(mesh.triangle_count());
     let mut t = 0;
     while t < mesh.triangle_count() {
         let corners = mesh.corners(t);
@@ -122,16 +126,18 @@ pub fn flat_primitives(mesh: &TriangleMesh) -> Vec<(FlatLane, Flat, Bounds3)> {
         if let Some([o, e1, e2]) = pair.flatten()
             && let Some(f) = Flat::new(o, e1, e2, true)
         {
-            out.push((lane, f, Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])));
+            out.push((lane, f));
+            bounds.push(Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2]));
             t += 2;
             continue;
         }
         if let Some(f) = Flat::triangle(corners) {
-            out.push((FlatLane { parallelogram: false, ..lane }, f, Bounds3::from_points(corners)));
+            out.push((FlatLane { parallelogram: false, ..lane }, f));
+            bounds.push(Bounds3::from_points(corners));
         }
         t += 1;
     }
-    out
+    (out, bounds)
 }
 
 #[cfg(test)]

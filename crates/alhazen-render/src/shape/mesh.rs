@@ -43,9 +43,9 @@ impl MeshAccel {
 
     /// [`Self::with_unit`] with the hierarchy built by `method`.
     pub fn with_build(mesh: Arc<TriangleMesh>, vectors: VectorUnit, method: crate::bvh::BuildMethod) -> Self {
-        let flats = flat_primitives(&mesh);
-        let bounds: Vec<Bounds3> = flats.iter().map(|f| f.2).collect();
+        let (flats, bounds) = flat_primitives(&mesh);
         let bvh = Bvh::build_packed_by(&bounds, |_| true, method);
+        drop(bounds);
         let (mut packets, mut leaf_packets) = (PackedFlats::default(), vec![0..0; bvh.leaf_order().len()]);
         for range in bvh.leaves() {
             let leaf: Vec<_> =
@@ -54,6 +54,7 @@ impl MeshAccel {
             leaf_packets[range.start] = r.start as u32..r.end as u32;
         }
         let prims = flats.iter().map(|f| f.0).collect();
+        drop(flats); // before the normals: the build's peak is the flats and their packets
         let face_normals: Vec<Vec3> = (0..mesh.triangle_count())
             .map(|i| {
                 let [a, b, c] = mesh.corners(i);
