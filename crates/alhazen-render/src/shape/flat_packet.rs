@@ -225,6 +225,13 @@ pub struct PackedFlats<L> {
 }
 
 impl<L: Copy + Default> PackedFlats<L> {
+    /// Room for `packets` more packets, reserved at once: a big mesh's packets are the largest
+    /// thing it builds, and a vector doubling as it grows holds both copies for a moment.
+    pub fn reserve(&mut self, packets: usize) {
+        self.packets.reserve_exact(packets);
+        self.lanes.reserve_exact(packets);
+    }
+
     /// Appends `flats`, in order, as packets of `width` ([`VectorUnit::lanes`]); returns the
     /// range of their packets.
     pub fn push_leaf(&mut self, flats: &[(L, Flat)], width: usize) -> std::ops::Range<usize> {

@@ -47,6 +47,7 @@ impl MeshAccel {
         let bvh = Bvh::build_packed_by(&bounds, |_| true, method);
         drop(bounds);
         let (mut packets, mut leaf_packets) = (PackedFlats::default(), vec![0..0; bvh.leaf_order().len()]);
+        packets.reserve(bvh.leaves().map(|r| r.len().div_ceil(vectors.lanes())).sum());
         for range in bvh.leaves() {
             let leaf: Vec<_> =
                 bvh.leaf_order()[range.clone()].iter().map(|&k| (flats[k as usize].0, flats[k as usize].1)).collect();
