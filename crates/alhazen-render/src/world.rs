@@ -259,8 +259,9 @@ impl World {
         for (i, o) in objects.iter().enumerate() {
             let object = i as u32;
             if let Some(mesh) = flattenable(&o.placed) {
-                let (flats, bounds) = flat_primitives(mesh);
-                for ((lane, flat), bounds) in flats.into_iter().zip(bounds) {
+                let (lanes, bounds) = flat_primitives(mesh);
+                for (lane, bounds) in lanes.into_iter().zip(bounds) {
+                    let flat = lane.flat(mesh);
                     primitives.push(Primitive::Flat { object, lane, flat });
                     prim_bounds.push(bounds);
                 }

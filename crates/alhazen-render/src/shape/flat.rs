@@ -107,37 +107,54 @@ impl FlatLane {
     }
 }
 
-/// The triangles of `mesh` as flats, and their bounds apart (a mesh's BVH needs them only while
-/// it is built): consecutive pairs that form a parallelogram become one; triangles without
-/// area are dropped.
-pub fn flat_primitives(mesh: &TriangleMesh) -> (Vec<(FlatLane, Flat)>, Vec<Bounds3>) {
-    // At most one flat per triangle: reserved once, so a big mesh's flats are not copied as the
-    // vectors grow (pages reserved and never written cost no memory).
-    let mut out = Vec::with_capacity(mesh.triangle_count());
+/// The flat of triangle `t` of `mesh` and its bounds: with `pair`, the parallelogram of `t`
+/// and `t + 1` (`None` when they do not form one); else the triangle (`None` without area).
+fn flat_at(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<(Flat, Bounds3)> {
+    let corners = mesh.corners(t);
+    if !pair {
+        return Flat::triangle(corners).map(|f| (f, Bounds3::from_points(corners)));
+    }
+    if t + 1 >= mesh.triangle_count() {
+        return None;
+    }
+    let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
+    let [o, e1, e2] = parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])?;
+    Flat::new(o, e1, e2, true).map(|f| (f, Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])))
+}
+
+impl FlatLane {
+    /// The flat this lane stands for in `mesh` (computed again: the same numbers as when the
+    /// lane was made by [`flat_primitives`]).
+    pub fn flat(self, mesh: &TriangleMesh) -> Flat {
+        flat_at(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh").0
+    }
+}
+
+/// The triangles of `mesh` as flats (their lanes: [`FlatLane::flat`] gives each flat again
+/// where it is needed, so a million-triangle mesh does not hold a hundred megabytes of them
+/// while it packs them) and their bounds: consecutive pairs that form a parallelogram become
+/// one; triangles without area are dropped.
+pub fn flat_primitives(mesh: &TriangleMesh) -> (Vec<FlatLane>, Vec<Bounds3>) {
+    // At most one flat per triangle: reserved once, so the vectors are not copied as they grow
+    // (pages reserved and never written cost no memory).
+    let mut lanes = Vec::with_capacity(mesh.triangle_count());
     let mut bounds = Vec::with_capacity(mesh.triangle_count());
     let mut t = 0;
     while t < mesh.triangle_count() {
-        let corners = mesh.corners(t);
-        let pair = (t + 1 < mesh.triangle_count()).then(|| {
-            let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
-            parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])
-        });
         let lane = FlatLane { triangle: t as u32, parallelogram: true };
-        if let Some([o, e1, e2]) = pair.flatten()
-            && let Some(f) = Flat::new(o, e1, e2, true)
-        {
-            out.push((lane, f));
-            bounds.push(Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2]));
+        if let Some((_, b)) = flat_at(mesh, t, true) {
+            lanes.push(lane);
+            bounds.push(b);
             t += 2;
             continue;
         }
-        if let Some(f) = Flat::triangle(corners) {
-            out.push((FlatLane { parallelogram: false, ..lane }, f));
-            bounds.push(Bounds3::from_points(corners));
+        if let Some((_, b)) = flat_at(mesh, t, false) {
+            lanes.push(FlatLane { parallelogram: false, ..lane });
+            bounds.push(b);
         }
         t += 1;
     }
-    (out, bounds)
+    (lanes, bounds)
 }
 
 #[cfg(test)]

@@ -43,19 +43,19 @@ impl MeshAccel {
 
     /// [`Self::with_unit`] with the hierarchy built by `method`.
     pub fn with_build(mesh: Arc<TriangleMesh>, vectors: VectorUnit, method: crate::bvh::BuildMethod) -> Self {
-        let (flats, bounds) = flat_primitives(&mesh);
+        let (prims, bounds) = flat_primitives(&mesh);
         let bvh = Bvh::build_packed_by(&bounds, |_| true, method);
         drop(bounds);
         let (mut packets, mut leaf_packets) = (PackedFlats::default(), vec![0..0; bvh.leaf_order().len()]);
         packets.reserve(bvh.leaves().map(|r| r.len().div_ceil(vectors.lanes())).sum());
         for range in bvh.leaves() {
-            let leaf: Vec<_> =
-                bvh.leaf_order()[range.clone()].iter().map(|&k| (flats[k as usize].0, flats[k as usize].1)).collect();
+            let leaf: Vec<_> = bvh.leaf_order()[range.clone()]
+                .iter()
+                .map(|&k| (prims[k as usize], prims[k as usize].flat(&mesh)))
+                .collect();
             let r = packets.push_leaf(&leaf, vectors.lanes());
             leaf_packets[range.start] = r.start as u32..r.end as u32;
         }
-        let prims = flats.iter().map(|f| f.0).collect();
-        drop(flats); // before the normals: the build's peak is the flats and their packets
         let face_normals: Vec<Vec3> = (0..mesh.triangle_count())
             .map(|i| {
                 let [a, b, c] = mesh.corners(i);
