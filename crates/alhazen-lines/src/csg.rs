@@ -52,7 +52,7 @@ pub struct Expansion {
     /// a CSG operand.
     leaf: Vec<Option<u32>>,
     /// The leaves alone as a world: their surface normals.
-    leaf_world: Option<World>,
+    leaf_world: World,
 }
 
 /// The leaf operands of `shape` placed by `to_world`, each an object with the body's material.
@@ -67,8 +67,11 @@ fn leaves(shape: &Shape, to_world: Transform, body: &Object, out: &mut Vec<Objec
 }
 
 impl Expansion {
-    /// `scene` expanded (itself, unchanged, when it has no CSG object).
-    pub fn of(scene: &Scene) -> Expansion {
+    /// `scene` expanded; `None` when it has no CSG object.
+    pub fn of(scene: &Scene) -> Option<Expansion> {
+        if !scene.objects.iter().any(|o| matches!(o.shape, Shape::Csg { .. })) {
+            return None;
+        }
         let (mut objects, mut origin, mut leaf) = (vec![], vec![], vec![]);
         let mut leaf_objects = vec![];
         for (i, o) in scene.objects.iter().enumerate() {
@@ -87,22 +90,13 @@ impl Expansion {
                 leaf.push(None);
             }
         }
-        let leaf_world =
-            (!leaf_objects.is_empty()).then(|| World::build(&Scene { objects: leaf_objects, ..scene.clone() }));
-        Expansion { scene: Scene { objects, ..scene.clone() }, origin, leaf, leaf_world }
-    }
-
-    /// True when the scene has CSG bodies.
-    pub fn has_bodies(&self) -> bool {
-        self.leaf_world.is_some()
+        let leaf_world = World::build(&Scene { objects: leaf_objects, ..scene.clone() });
+        Some(Expansion { scene: Scene { objects, ..scene.clone() }, origin, leaf, leaf_world })
     }
 
     /// The lines of the expanded scene as lines of `world`'s scene: those on operands cut to
     /// their body's boundary, every object index mapped back.
     pub fn restrict(&self, lines: Vec<SceneLine>, world: &World) -> Vec<SceneLine> {
-        if !self.has_bodies() {
-            return lines;
-        }
         use rayon::prelude::*;
         lines
             .into_par_iter()
@@ -146,7 +140,7 @@ impl Expansion {
 
     /// True when the body has a crease at `p` on the intersection of its leaves `pair`.
     fn creased(&self, body: &Placed, pair: [usize; 2], p: Vec3) -> bool {
-        let leaf_world = self.leaf_world.as_ref().expect("leaves");
+        let leaf_world = &self.leaf_world;
         let e = TRACED * size(body);
         let normal = |k: usize| leaf_world.objects()[self.leaf[k]? as usize].placed.normal_near(p, 100.0 * e);
         let (Some(n1), Some(n2)) = (normal(pair[0]), normal(pair[1])) else {

@@ -251,15 +251,20 @@ pub fn lines_in_space(
 ) -> (Vec<curves::SceneLine>, usize, usize) {
     let expansion = csg::Expansion::of(scene);
     let expanded_polyhedra;
-    let (line_scene, line_polyhedra) = if expansion.has_bodies() {
-        expanded_polyhedra = curves::polyhedra(&expansion.scene);
-        (&expansion.scene, &expanded_polyhedra[..])
-    } else {
-        (scene, polyhedra)
+    let (line_scene, line_polyhedra) = match &expansion {
+        Some(x) => {
+            expanded_polyhedra = curves::polyhedra(&x.scene);
+            (&x.scene, &expanded_polyhedra[..])
+        }
+        None => (scene, polyhedra),
     };
     let (mut lines, tessellated, skipped) = curves::scene_lines(line_scene, line_polyhedra, view, edge_opts);
     lines.extend(intersect::intersection_lines(line_scene, line_polyhedra));
-    (expansion.restrict(lines, world), tessellated, skipped)
+    let lines = match &expansion {
+        Some(x) => x.restrict(lines, world),
+        None => lines,
+    };
+    (lines, tessellated, skipped)
 }
 
 /// The reflex contours (Theorem 10) of every sphere, cylinder and cone in every mirror.

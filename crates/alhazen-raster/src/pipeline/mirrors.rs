@@ -421,14 +421,10 @@ fn plane_rings(tris: &[Triangle], (centre, size): (Vec3, f64)) -> Vec<(Triangle,
         let n = (b.p - a.p).cross(c.p - a.p).normalize_or_zero();
         let (e1, e2) = alhazen_math::orthonormal_basis(n);
         let foot = centre - n * n.dot(centre - a.p);
-        // uv(p) = uv_a + α (uv_b − uv_a) + β (uv_c − uv_a) with p − a = α (b − a) + β (c − a).
-        let (u, v) = (b.p - a.p, c.p - a.p);
-        let (uu, uv_, vv) = (u.dot(u), u.dot(v), v.dot(v));
-        let det = uu * vv - uv_ * uv_;
+        // Texture coordinates are affine in the position on the plane.
+        let weights = plane_weights(t.v.map(|v| v.p));
         let uv_at = |p: Vec3| {
-            let d = p - a.p;
-            let (du, dv) = (d.dot(u), d.dot(v));
-            let (al, be) = ((vv * du - uv_ * dv) / det, (uu * dv - uv_ * du) / det);
+            let [al, be] = weights(p);
             a.uv + (b.uv - a.uv) * al + (c.uv - a.uv) * be
         };
         let at = |r: f64, k: usize| {
@@ -454,6 +450,19 @@ fn plane_rings(tris: &[Triangle], (centre, size): (Vec3, f64)) -> Vec<(Triangle,
         }
     }
     out
+}
+
+/// The weights `(α, β)` of a point of the plane of triangle `p` with
+/// `point − p₀ = α (p₁ − p₀) + β (p₂ − p₀)` (by the normal equations).
+fn plane_weights(p: [Vec3; 3]) -> impl Fn(Vec3) -> Bary {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    move |q: Vec3| {
+        let d = q - p[0];
+        let (a, b) = (d.dot(e1), d.dot(e2));
+        [(d22 * a - d12 * b) / det, (d11 * b - d12 * a) / det]
+    }
 }
 
 /// The visible reflex of every corner of the triangles `which`, by the batch solver.
@@ -529,15 +538,7 @@ impl Reflexes<'_> {
         if polygons.len() < 2 {
             return whole;
         }
-        // Weights in the triangle of a point of its plane (the pieces' corners).
-        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-        let det = d11 * d22 - d12 * d12;
-        let weights = |q: Vec3| {
-            let d = q - p[0];
-            let (a, b) = (d.dot(e1), d.dot(e2));
-            [(d22 * a - d12 * b) / det, (d11 * b - d12 * a) / det]
-        };
+        let weights = plane_weights(p);
         let corner = |q: Vec3| {
             let b = weights(q);
             let (_, n, uv) = super::surface_at(t, b);

@@ -158,6 +158,8 @@ pub struct Prepared {
     pub transparent: bool,
     /// What vertex processing reads of each triangle.
     pub corners: Vec<Corners>,
+    /// The same of the BSP tree's triangles (empty without the tree).
+    pub bsp_corners: Vec<Corners>,
 }
 
 /// What vertex processing reads of a triangle: its corners and whether its surface is closed
@@ -246,7 +248,21 @@ pub fn prepare(scene: &Scene, opts: &RasterOptions) -> Prepared {
     let transparent =
         geometry.triangles.iter().any(|t| scene.materials[t.material as usize].transparency != Vec3::ZERO);
     let corners = Corners::of(&geometry.triangles);
-    Prepared { geometry, shadows, ibl, bsp, emitters, csg, prelit: None, octree, plane_mirrors, transparent, corners }
+    let bsp_corners = bsp.as_ref().map_or(vec![], |tree| Corners::of(&tree.triangles));
+    Prepared {
+        geometry,
+        shadows,
+        ibl,
+        bsp,
+        emitters,
+        csg,
+        prelit: None,
+        octree,
+        plane_mirrors,
+        transparent,
+        corners,
+        bsp_corners,
+    }
 }
 
 /// The octree of `triangles`, which are put in its order (see [`octree::Octree::renumber`]),
@@ -266,6 +282,7 @@ pub fn prepare_lit(mut triangles: Vec<Triangle>, lit: Vec<Prelit>) -> Prepared {
     let lit = order.iter().map(|&i| lit[i as usize]).collect();
     Prepared {
         corners: Corners::of(&triangles),
+        bsp_corners: vec![],
         octree,
         geometry: geometry::SceneTriangles { triangles, skipped: 0 },
         shadows: None,
@@ -682,13 +699,11 @@ fn render_view_in(
     };
     let shadows = &light;
     // The painter's algorithm draws the BSP tree's triangles back to front; the z-buffer any order.
-    let bsp_corners;
     let (tris, corners, order): (&[Triangle], &[Corners], Vec<u32>) = match (&prepared.bsp, opts.visibility) {
         (Some(tree), Visibility::Bsp) => {
             let viewer =
                 if proj.perspective { bsp::Viewer::At(proj.frame.eye) } else { bsp::Viewer::Towards(proj.frame.w) };
-            bsp_corners = Corners::of(&tree.triangles);
-            (&tree.triangles, &bsp_corners, tree.back_to_front(viewer))
+            (&tree.triangles, &prepared.bsp_corners, tree.back_to_front(viewer))
         }
         _ => {
             let mut order = Vec::with_capacity(geometry.triangles.len());
