@@ -64,9 +64,8 @@ struct Leaf {
 #[derive(Debug, Default)]
 pub struct World {
     objects: Vec<WorldObject>,
+    /// Over the objects; its leaves are labelled with their index in `leaves`.
     bvh: Bvh,
-    /// Leaf of the BVH by the start of its range in the BVH's leaf order.
-    leaf_at: Vec<u32>,
     leaves: Vec<Leaf>,
     flats: PackedFlats<Lane>,
     spheres: Vec<SpherePacket>,
@@ -282,11 +281,11 @@ impl World {
         // neither do the order of tests nor the hit chosen on a tie. Flats and untransformed
         // spheres are both tested in packets: a few spheres on a floor make one leaf, whose
         // rays the lanes trace together (the glossy suite scene 1.29 → 1.06 s).
-        let bvh = Bvh::build_packed(&prim_bounds, |k| {
+        let mut bvh = Bvh::build_packed(&prim_bounds, |k| {
             matches!(primitives[k], Primitive::Flat { .. } | Primitive::Sphere { .. })
         });
         let mut world = Self { objects, unbounded, vectors: unit, ..Self::default() };
-        world.fill_leaves(&bvh, &primitives);
+        world.fill_leaves(&mut bvh, &primitives);
         world.one_leaf = world.unbounded.is_empty() && world.leaves.len() == 1;
         world.flats_only = world.one_leaf
             && matches!(world.leaves.as_slice(), [leaf] if leaf.spheres.is_empty() && leaf.objects.is_empty());
@@ -318,14 +317,14 @@ impl World {
 
     /// Sorts each leaf's primitives into packets of flats, packets of spheres and a list of
     /// objects.
-    fn fill_leaves(&mut self, bvh: &Bvh, primitives: &[Primitive]) {
-        self.leaf_at = vec![0; bvh.leaf_order().len()];
-        for range in bvh.leaves() {
-            self.leaf_at[range.start] = self.leaves.len() as u32;
+    /// The tree's leaves are relabelled with their index in `leaves`.
+    fn fill_leaves(&mut self, bvh: &mut Bvh, primitives: &[Primitive]) {
+        let order = bvh.leaf_order().to_vec();
+        bvh.relabel_leaves(|range| {
             let first_object = self.leaf_objects.len();
             let mut flats: Vec<(Lane, Flat)> = vec![];
             let mut spheres: Vec<(u32, Sphere)> = vec![];
-            for &k in &bvh.leaf_order()[range] {
+            for &k in &order[range] {
                 match primitives[k as usize] {
                     Primitive::Object(i) => self.leaf_objects.push(i),
                     Primitive::Flat { object, lane, flat } => flats.push((Lane { object, flat: lane }, flat)),
@@ -345,7 +344,8 @@ impl World {
             }
             let (spheres, objects) = (first_sphere..self.spheres.len(), first_object..self.leaf_objects.len());
             self.leaves.push(Leaf { packets, spheres, objects });
-        }
+            self.leaves.len() - 1..self.leaves.len()
+        });
     }
 
     /// Eight rays are traced at once faster than one by one ([`Self::intersect_rays`]): the
@@ -384,7 +384,7 @@ impl World {
         // The nearest flat's packet and lane; made a candidate once, after the traversal.
         let mut best_flat: Option<(Lane, LaneHit)> = None;
         self.bvh.traverse_leaves(ray, t_best, |range, t_max| {
-            let leaf = &self.leaves[self.leaf_at[range.start] as usize];
+            let leaf = &self.leaves[range.start];
             let mut closer = None;
             let mut t_max = t_max;
             if let Some((lane, h)) = self.flats.nearest(leaf.packets.clone(), ray, t_max, self.vectors) {
@@ -549,7 +549,7 @@ impl World {
         }
         let mut blocked = false;
         self.bvh.traverse_leaves(&ray, dist, |range, t_max| {
-            let leaf = &self.leaves[self.leaf_at[range.start] as usize];
+            let leaf = &self.leaves[range.start];
             blocked = FlatPacket::any_of(&self.flats.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
                 || self.solid_blocks(leaf, &ray, t_max);
             blocked.then_some(0.0)

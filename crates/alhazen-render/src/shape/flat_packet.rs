@@ -232,6 +232,31 @@ impl<L: Copy + Default> PackedFlats<L> {
         self.lanes.reserve_exact(packets);
     }
 
+    /// Asks the processor to start loading packet `k` and what its lanes stand for.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub fn prefetch(&self, k: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if let (Some(p), Some(l)) = (self.packets.get(k), self.lanes.get(k)) {
+            // SAFETY: prefetching never faults; SSE is part of x86-64.
+            unsafe {
+                use std::arch::x86_64::*;
+                let p: *const i8 = (p as *const FlatPacket).cast();
+                for line in (0..std::mem::size_of::<FlatPacket>()).step_by(64) {
+                    _mm_prefetch(p.add(line), _MM_HINT_T0);
+                }
+                _mm_prefetch((l as *const [L; LANES]).cast(), _MM_HINT_T0);
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = k;
+    }
+
+    /// What the flats of packets `range` stand for, in order (the lanes in use).
+    pub fn lanes_of(&self, range: std::ops::Range<usize>) -> impl Iterator<Item = L> + '_ {
+        range.flat_map(move |k| self.lanes[k][..self.packets[k].used].iter().copied())
+    }
+
     /// Appends `flats`, in order, as packets of `width` ([`VectorUnit::lanes`]); returns the
     /// range of their packets.
     pub fn push_leaf(&mut self, flats: &[(L, Flat)], width: usize) -> std::ops::Range<usize> {

@@ -14,13 +14,10 @@ use std::sync::Arc;
 pub struct MeshAccel {
     /// The mesh.
     pub mesh: Arc<TriangleMesh>,
-    /// Over `prims`, the flats of the mesh.
+    /// Over the flats of the mesh; its leaves are labelled with their packets' range.
     bvh: Bvh,
-    prims: Vec<FlatLane>,
-    /// Each leaf's flats, tested in packets: a leaf starting at `s` in the BVH's leaf order
-    /// has packets `leaf_packets[s]`.
+    /// Each leaf's flats, tested in packets.
     packets: PackedFlats<FlatLane>,
-    leaf_packets: Vec<std::ops::Range<u32>>,
     vectors: VectorUnit,
     /// Unit geometric normal per triangle (zero for triangles without area).
     face_normals: Vec<Vec3>,
@@ -44,18 +41,18 @@ impl MeshAccel {
     /// [`Self::with_unit`] with the hierarchy built by `method`.
     pub fn with_build(mesh: Arc<TriangleMesh>, vectors: VectorUnit, method: crate::bvh::BuildMethod) -> Self {
         let (prims, bounds) = flat_primitives(&mesh);
-        let bvh = Bvh::build_packed_by(&bounds, |_| true, method);
+        let mut bvh = Bvh::build_packed_by(&bounds, |_| true, method);
         drop(bounds);
-        let (mut packets, mut leaf_packets) = (PackedFlats::default(), vec![0..0; bvh.leaf_order().len()]);
+        let mut packets = PackedFlats::default();
         packets.reserve(bvh.leaves().map(|r| r.len().div_ceil(vectors.lanes())).sum());
-        for range in bvh.leaves() {
-            let leaf: Vec<_> = bvh.leaf_order()[range.clone()]
-                .iter()
-                .map(|&k| (prims[k as usize], prims[k as usize].flat(&mesh)))
-                .collect();
-            let r = packets.push_leaf(&leaf, vectors.lanes());
-            leaf_packets[range.start] = r.start as u32..r.end as u32;
-        }
+        // Each leaf's packets are appended as the leaf is relabelled with them.
+        let order = bvh.leaf_order().to_vec();
+        bvh.relabel_leaves(|range| {
+            let leaf: Vec<_> =
+                order[range].iter().map(|&k| (prims[k as usize], prims[k as usize].flat(&mesh))).collect();
+            packets.push_leaf(&leaf, vectors.lanes())
+        });
+        drop((order, prims));
         let face_normals: Vec<Vec3> = (0..mesh.triangle_count())
             .map(|i| {
                 let [a, b, c] = mesh.corners(i);
@@ -70,7 +67,7 @@ impl MeshAccel {
                 mesh.normals.is_empty() || t.iter().all(|&i| (mesh.normals[i as usize] - *n).length() < 1e-12)
             })
             .collect();
-        Self { mesh, bvh, prims, packets, leaf_packets, vectors, face_normals, flat }
+        Self { mesh, bvh, packets, vectors, face_normals, flat }
     }
 }
 
@@ -160,9 +157,9 @@ impl MeshShape {
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let a = &*self.accel;
         let mut best = None;
-        a.bvh.traverse_leaves(ray, t_max, |leaf, t_max| {
-            let r = a.leaf_packets[leaf.start].clone();
-            let (lane, h) = a.packets.nearest(r.start as usize..r.end as usize, ray, t_max, a.vectors)?;
+        let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
+        a.bvh.traverse_leaves_prefetching(ray, t_max, prefetch, |packets, t_max| {
+            let (lane, h) = a.packets.nearest(packets, ray, t_max, a.vectors)?;
             best = Some((lane, h));
             Some(h.t)
         });
@@ -184,8 +181,8 @@ impl MeshShape {
         let back = back.min(0.0);
         let shifted = Ray::new(ray.at(back), ray.dir);
         let m = &self.accel.mesh;
-        self.accel.bvh.traverse(&shifted, f64::INFINITY, |k, _| {
-            for i in self.accel.prims[k as usize].triangles() {
+        self.accel.bvh.traverse_leaves(&shifted, f64::INFINITY, |packets, _| {
+            for i in self.accel.packets.lanes_of(packets).flat_map(|lane| lane.triangles()) {
                 if let Some((t, b1, b2)) = triangle_hit(&shifted, m.corners(i)).filter(|h| h.0 > 0.0) {
                     let hit = self.surface(ray, i, (t + back, b1, b2));
                     out.push(Crossing { hit, entering: hit.n.dot(ray.dir) < 0.0 });

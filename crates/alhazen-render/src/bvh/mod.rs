@@ -7,6 +7,9 @@
 //! of walls, boxes and balls becomes one leaf of packets rather than a tree of overlapping boxes.
 
 use alhazen_math::{Bounds3, Ray, Vec3};
+use wide::{Entry, Slab, WIDTH, Wide};
+
+mod wide;
 
 const BINS: usize = 12;
 /// Leaves that cost at most this many tests are not split.
@@ -17,6 +20,9 @@ const MAX_LEAF: usize = 4;
 pub const PACK: usize = 4;
 /// Deeper subtrees become leaves, so traversal's fixed stack never overflows.
 const MAX_DEPTH: usize = 48;
+/// Traversal's stack: each four-wide node on the way down leaves at most three children
+/// waiting (the collapsed tree is no deeper than the binary one).
+const STACK: usize = (WIDTH - 1) * (MAX_DEPTH + 2);
 /// Nodes over at least this many primitives build their two subtrees in parallel (the same
 /// tree as one thread builds: only who computes each subtree changes).
 const PARALLEL_ITEMS: usize = 1 << 14;
@@ -32,71 +38,37 @@ struct Node {
     axis: u8,
 }
 
-/// A node as traversal reads it: its box in `f32` rounded outward (it holds the exact box, so
-/// no ray that meets the exact box misses it, and the hits found are the same), and its
-/// offset, count and axis — 32 bytes where the build's node takes 64: traversal of a big mesh
-/// is bound by memory.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Packed {
-    min: [f32; 3],
-    max: [f32; 3],
-    /// Leaf: first primitive index; interior: index of the second child.
-    offset: u32,
-    /// `count << 2 | axis` (count 0 for interior nodes).
-    meta: u32,
-}
-
-/// The largest `f32` at or below `x`.
-fn down(x: f64) -> f32 {
-    let f = x as f32;
-    if f as f64 > x { f.next_down() } else { f }
-}
-
-/// The smallest `f32` at or above `x`.
-fn up(x: f64) -> f32 {
-    let f = x as f32;
-    if (f as f64) < x { f.next_up() } else { f }
-}
-
-impl Packed {
-    fn of(n: &Node) -> Self {
-        let (lo, hi) = (n.bounds.min.to_array(), n.bounds.max.to_array());
-        Packed { min: lo.map(down), max: hi.map(up), offset: n.offset, meta: n.count << 2 | n.axis as u32 }
-    }
-
-    #[inline]
-    fn bounds(&self) -> Bounds3 {
-        let v = |a: [f32; 3]| Vec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
-        Bounds3 { min: v(self.min), max: v(self.max) }
-    }
-
-    #[inline]
-    fn count(&self) -> u32 {
-        self.meta >> 2
-    }
-
-    #[inline]
-    fn axis(&self) -> usize {
-        (self.meta & 3) as usize
-    }
-}
-
 /// A BVH over primitives given by their bounds; it stores indices, not primitives.
 #[derive(Clone, Debug)]
 pub struct Bvh {
     /// The nodes while building (emptied when the tree is done).
     nodes: Vec<Node>,
-    /// The nodes for traversal, depth first.
-    packed: Vec<Packed>,
+    /// The nodes for traversal, four-wide, depth first.
+    wide: Vec<Wide>,
+    /// Where traversal starts: the first wide node, or the one leaf; `None` when empty.
+    start: Option<Entry>,
     /// The exact bounds of everything.
     root: Bounds3,
+    /// Per axis, the largest magnitude of a coordinate of any node's `f32` box.
+    reach: [f64; 3],
+    /// The leaves' labels were rewritten ([`Self::relabel_leaves`]): they no longer index
+    /// [`Self::leaf_order`].
+    relabeled: bool,
     /// Primitive indices in leaf order.
     order: Vec<u32>,
 }
 
 impl Default for Bvh {
     fn default() -> Self {
-        Bvh { nodes: vec![], packed: vec![], root: Bounds3::EMPTY, order: vec![] }
+        Bvh {
+            nodes: vec![],
+            wide: vec![],
+            start: None,
+            root: Bounds3::EMPTY,
+            reach: [0.0; 3],
+            relabeled: false,
+            order: vec![],
+        }
     }
 }
 
@@ -196,7 +168,11 @@ impl Bvh {
             bvh.build_node(&mut items, 0, split, parallel_from);
         }
         bvh.root = bvh.nodes.first().map_or(Bounds3::EMPTY, |n| n.bounds);
-        bvh.packed = bvh.nodes.iter().map(Packed::of).collect();
+        (bvh.wide, bvh.start) = wide::collapse(&bvh.nodes);
+        bvh.reach = std::array::from_fn(|a| {
+            let (lo, hi) = (wide::down(bvh.root.min[a]) as f64, wide::up(bvh.root.max[a]) as f64);
+            if bvh.nodes.is_empty() { 0.0 } else { lo.abs().max(hi.abs()) }
+        });
         bvh.nodes = vec![];
         bvh
     }
@@ -255,9 +231,10 @@ impl Bvh {
 
     /// Visits candidate primitives front to back. `visit(index, t_max)` returns a closer hit
     /// distance, which prunes the rest of the traversal; `Some(0.0)` ends it at once (for
-    /// any-hit queries such as shadow rays).
+    /// any-hit queries such as shadow rays). Not after [`Self::relabel_leaves`].
     #[inline]
     pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(u32, f64) -> Option<f64>) -> f64 {
+        assert!(!self.relabeled, "the leaves' labels no longer index the primitives");
         self.traverse_leaves(ray, t_max, |leaf, mut t_max| {
             let mut closer = None;
             for &prim in &self.order[leaf] {
@@ -273,57 +250,105 @@ impl Bvh {
         })
     }
 
-    /// Visits candidate leaves front to back: `visit(range, t_max)` gets the leaf's positions
-    /// in [`Self::leaf_order`] and returns a closer hit distance, or `Some(0.0)` to stop.
+    /// Visits candidate leaves nearest entry first: `visit(labels, t_max)` gets the leaf's
+    /// labels (its positions in [`Self::leaf_order`] unless relabelled) and returns a closer
+    /// hit distance, or `Some(0.0)` to stop. Leaves the ray enters beyond the closest hit so far
+    /// are skipped.
     #[inline]
     pub fn traverse_leaves(
         &self,
         ray: &Ray,
+        t_max: f64,
+        visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
+    ) -> f64 {
+        self.traverse_leaves_prefetching(ray, t_max, |_| {}, visit)
+    }
+
+    /// [`Self::traverse_leaves`], calling `prefetch(labels)` for each leaf as soon as the ray is
+    /// found to meet its box, before it is visited: the caller can start loading what the leaf
+    /// holds while the traversal goes on.
+    #[inline]
+    pub fn traverse_leaves_prefetching(
+        &self,
+        ray: &Ray,
         mut t_max: f64,
+        prefetch: impl Fn(std::ops::Range<usize>),
         mut visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
     ) -> f64 {
-        match self.packed.as_slice() {
-            [] => return t_max,
+        let Some(mut at) = self.start else { return t_max };
+        if at.is_leaf() {
             // A lone leaf is tested whole: its box test would only cost a division.
-            [leaf] => {
-                let first = leaf.offset as usize;
-                let t = visit(first..first + leaf.count() as usize, t_max);
-                return t.map_or(t_max, |t| t_max.min(t.max(0.0)));
-            }
-            _ => {}
+            return visit(at.labels(), t_max).map_or(t_max, |t| t_max.min(t.max(0.0)));
         }
-        let inv = 1.0 / ray.dir;
-        let neg = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
-        let mut stack = [0u32; MAX_DEPTH + 2];
+        let slab = Slab::new(ray, self.reach);
+        let mut limit = wide::up(t_max);
+        let mut stack = [Entry::default(); STACK];
         let mut sp = 0;
-        let mut at = 0usize;
         loop {
-            let node = &self.packed[at];
-            if node.bounds().hit_interval(ray, inv, t_max).is_some() {
-                if node.count() > 0 {
-                    let first = node.offset as usize;
-                    if let Some(t) = visit(first..first + node.count() as usize, t_max) {
-                        if t <= 0.0 {
-                            return 0.0;
-                        }
-                        t_max = t_max.min(t);
+            if at.is_leaf() {
+                if let Some(t) = visit(at.labels(), t_max) {
+                    if t <= 0.0 {
+                        return 0.0;
                     }
-                } else {
-                    // Near child first.
-                    let (near, far) =
-                        if neg[node.axis()] { (node.offset as usize, at + 1) } else { (at + 1, node.offset as usize) };
-                    stack[sp] = far as u32;
-                    sp += 1;
-                    at = near;
+                    t_max = t_max.min(t);
+                    limit = wide::up(t_max);
+                }
+            } else {
+                let node = &self.wide[at.offset as usize];
+                let (hits, near) = slab.test(node, limit);
+                if hits != 0 {
+                    // The children met, nearest first (ties in slot order); the rest wait.
+                    let mut met = [(0.0f32, 0usize); WIDTH];
+                    let mut n = 0;
+                    for k in (0..WIDTH).filter(|k| hits >> k & 1 == 1) {
+                        let mut i = n;
+                        while i > 0 && met[i - 1].0 > near[k] {
+                            met[i] = met[i - 1];
+                            i -= 1;
+                        }
+                        met[i] = (near[k], k);
+                        n += 1;
+                    }
+                    for &(t, k) in met[1..n].iter().rev() {
+                        stack[sp] = Slab::child(node, k, t);
+                        sp += 1;
+                    }
+                    // Load the nodes met while the nearest is descended into.
+                    for &(_, k) in &met[..n] {
+                        let child = Slab::child(node, k, 0.0);
+                        if child.is_leaf() {
+                            prefetch(child.labels());
+                        } else {
+                            Slab::prefetch(&self.wide[child.offset as usize]);
+                        }
+                    }
+                    at = Slab::child(node, met[0].1, met[0].0);
                     continue;
                 }
             }
-            if sp == 0 {
-                return t_max;
+            loop {
+                if sp == 0 {
+                    return t_max;
+                }
+                sp -= 1;
+                at = stack[sp];
+                if at.near as f64 <= t_max {
+                    break;
+                }
             }
-            sp -= 1;
-            at = stack[sp] as usize;
         }
+    }
+
+    /// Rewrites the labels traversal reports for each leaf: `relabel(labels)` for every leaf's
+    /// [`Self::leaf_order`] range, once (a mesh makes them its packets, the world its leaves).
+    /// Afterwards [`Self::traverse`] is refused and [`Self::leaves`] lists the new labels.
+    pub fn relabel_leaves(&mut self, mut relabel: impl FnMut(std::ops::Range<usize>) -> std::ops::Range<usize>) {
+        assert!(!self.relabeled, "leaves are relabelled once");
+        self.relabeled = true;
+        wide::relabel(&mut self.wide, &mut self.start, |e| {
+            let r = relabel(e.labels());
+            (r.start as u32, r.len() as u32)
+        });
     }
 
     /// Primitive indices in leaf order: leaf `k`'s primitives are `leaf_order()[range]` for
@@ -334,7 +359,8 @@ impl Bvh {
 
     /// Every leaf's range in [`Self::leaf_order`].
     pub fn leaves(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
-        self.packed.iter().filter(|n| n.count() > 0).map(|n| n.offset as usize..(n.offset + n.count()) as usize)
+        let wide = self.wide.iter().flat_map(|w| (0..WIDTH).map(|k| Slab::child(w, k, 0.0)));
+        self.start.into_iter().chain(wide).filter(|e| e.is_leaf() && e.count != u32::MAX).map(|e| e.labels())
     }
 
     /// The bounds of everything (empty for an empty BVH).
@@ -453,18 +479,6 @@ fn partition(items: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
 mod tests {
     use super::*;
 
-    proptest::proptest! {
-        /// A packed box holds the exact one: `f32` bounds rounded outward, as tight as `f32`
-        /// allows.
-        #[test]
-        fn packed_boxes_hold_the_exact_ones(x in -1e30..1e30f64, scale in -30i32..30) {
-            let x = x * 10f64.powi(scale);
-            let (lo, hi) = (down(x), up(x));
-            proptest::prop_assert!((lo as f64) <= x && x <= hi as f64);
-            proptest::prop_assert!(lo == hi || lo.next_up() == hi, "{lo} {hi}");
-        }
-    }
-
     /// Building subtrees on several threads lays out the very tree one thread builds.
     #[test]
     fn parallel_build_is_the_sequential_tree() {
@@ -486,8 +500,8 @@ mod tests {
             let sequential = Bvh::build_split_from(&bounds, |i| i % 3 == 0, usize::MAX, method);
             let parallel = Bvh::build_split_from(&bounds, |i| i % 3 == 0, 256, method);
             assert_eq!(sequential.order, parallel.order);
-            assert_eq!(sequential.packed, parallel.packed);
-            assert!(sequential.packed.len() > 1000);
+            assert_eq!(sequential.wide, parallel.wide);
+            assert!(sequential.wide.len() > 300);
         }
     }
 }

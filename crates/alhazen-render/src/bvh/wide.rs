@@ -1,0 +1,375 @@
+//! The tree traversal reads: the binary SAH tree collapsed into nodes of four children whose
+//! boxes are stored together in `f32`, rounded outward (Wald et al. 2008, "Getting Rid of
+//! Packets": multi-branching BVHs; Embree's BVH4). One node, two cache lines, gives a ray four
+//! boxes to test at once, so a descent takes half the dependent memory loads of the binary tree.
+//!
+//! The slab test runs in `f32` and is *conservative*: it never rejects a box the exact ray
+//! segment meets. Each child's entry distance is padded by a per-ray bound on every rounding
+//! the `f32` arithmetic makes (the origin's rounding to `f32`, the subtraction, the product with
+//! the rounded reciprocal, the padding's own subtraction), so the hits the exact leaf tests find
+//! are those the binary tree in `f64` found. A direction exactly along an axis's slabs tests the
+//! origin between their faces; the slabs of an axis along which it is nonzero but tiny (or
+//! huge) reject nothing. The test is plain `f32` arithmetic without fused multiply–add, so it
+//! gives the same bits on every processor and the visiting order, which decides between equally
+//! near hits, is the same everywhere.
+
+use super::Node;
+use alhazen_math::Ray;
+
+/// Children per node.
+pub(super) const WIDTH: usize = 4;
+/// A child slot holding nothing.
+const EMPTY: u32 = u32::MAX;
+/// The unit roundoff of `f32`.
+const ROUNDOFF: f64 = 1.0 / (1u64 << 24) as f64;
+/// Reciprocal directions beyond this (or below its inverse) make an axis not used to reject:
+/// `f32` keeps their relative error bounded without overflow or denormals.
+const STEEP: f64 = 1e18;
+
+/// Four children's boxes, axis by axis, and what each child is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub(super) struct Wide {
+    min: [[f32; WIDTH]; 3],
+    max: [[f32; WIDTH]; 3],
+    /// Leaf child: its first label; interior child: its node's index.
+    offset: [u32; WIDTH],
+    /// Leaf child: how many labels (at least one); interior child: 0; empty slot: [`EMPTY`].
+    count: [u32; WIDTH],
+}
+
+/// A child to visit: a leaf's labels `offset..offset + count` or, for `count == 0`, node
+/// `offset`; `near` is a lower bound of where the ray enters its box.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Entry {
+    pub offset: u32,
+    pub count: u32,
+    pub near: f32,
+}
+
+impl Entry {
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+
+    pub fn labels(&self) -> std::ops::Range<usize> {
+        self.offset as usize..(self.offset + self.count) as usize
+    }
+}
+
+/// The largest `f32` at or below `x`.
+pub(super) fn down(x: f64) -> f32 {
+    let f = x as f32;
+    if f as f64 > x { f.next_down() } else { f }
+}
+
+/// The smallest `f32` at or above `x`.
+pub(super) fn up(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) < x { f.next_up() } else { f }
+}
+
+/// The nodes of a binary tree (laid out depth first, a node's first child after it) as four-wide
+/// nodes, and the entry of its root: a leaf when the whole tree is one.
+pub(super) fn collapse(nodes: &[Node]) -> (Vec<Wide>, Option<Entry>) {
+    let Some(root) = nodes.first() else { return (vec![], None) };
+    if root.count > 0 {
+        return (vec![], Some(Entry { offset: root.offset, count: root.count, near: 0.0 }));
+    }
+    let mut wide = Vec::with_capacity(nodes.len() / 2);
+    let first = wide_node(nodes, 0, &mut wide);
+    (wide, Some(Entry { offset: first, count: 0, near: 0.0 }))
+}
+
+/// Adds the four-wide node of binary interior node `at` and those below it; returns its index.
+/// Its children are `at`'s two, the interior one of largest area replaced by its own two until
+/// there are four or only leaves.
+fn wide_node(nodes: &[Node], at: usize, out: &mut Vec<Wide>) -> u32 {
+    let mut kids = vec![at + 1, nodes[at].offset as usize];
+    while kids.len() < WIDTH {
+        let open = (0..kids.len())
+            .filter(|&k| nodes[kids[k]].count == 0)
+            .max_by(|&a, &b| nodes[kids[a]].bounds.surface_area().total_cmp(&nodes[kids[b]].bounds.surface_area()));
+        let Some(k) = open else { break };
+        let n = kids[k];
+        kids[k] = n + 1;
+        kids.insert(k + 1, nodes[n].offset as usize);
+    }
+    let me = out.len();
+    out.push(Wide {
+        min: [[f32::MAX; WIDTH]; 3],
+        max: [[-f32::MAX; WIDTH]; 3],
+        offset: [0; WIDTH],
+        count: [EMPTY; WIDTH],
+    });
+    for (slot, &k) in kids.iter().enumerate() {
+        let n = &nodes[k];
+        let (offset, count) = if n.count > 0 { (n.offset, n.count) } else { (wide_node(nodes, k, out), 0) };
+        let w = &mut out[me];
+        for axis in 0..3 {
+            w.min[axis][slot] = down(n.bounds.min[axis]);
+            w.max[axis][slot] = up(n.bounds.max[axis]);
+        }
+        (w.offset[slot], w.count[slot]) = (offset, count);
+    }
+    me as u32
+}
+
+/// Rewrites every leaf's labels with `relabel`.
+pub(super) fn relabel(wide: &mut [Wide], root: &mut Option<Entry>, mut relabel: impl FnMut(Entry) -> (u32, u32)) {
+    for w in wide.iter_mut() {
+        for slot in 0..WIDTH {
+            if w.count[slot] != EMPTY && w.count[slot] > 0 {
+                let (offset, count) = relabel(Entry { offset: w.offset[slot], count: w.count[slot], near: 0.0 });
+                assert!(count > 0, "a leaf keeps at least one label");
+                (w.offset[slot], w.count[slot]) = (offset, count);
+            }
+        }
+    }
+    if let Some(e) = root.as_mut().filter(|e| e.is_leaf()) {
+        (e.offset, e.count) = relabel(*e);
+    }
+}
+
+/// A ray prepared for the `f32` slab test: per axis its origin and reciprocal direction in
+/// `f32`, the padding that bounds their rounding, which face of a box it meets first, and
+/// whether it runs exactly parallel to the axis's slabs.
+pub(super) struct Slab {
+    origin: [f32; 3],
+    inv: [f32; 3],
+    pad: [f32; 3],
+    neg: [bool; 3],
+    parallel: [bool; 3],
+}
+
+impl Slab {
+    /// The ray, for boxes within `reach` of the origin along each axis (the largest magnitude
+    /// of any box coordinate).
+    pub fn new(ray: &Ray, reach: [f64; 3]) -> Self {
+        let mut s =
+            Slab { origin: [0.0; 3], inv: [0.0; 3], pad: [f32::INFINITY; 3], neg: [false; 3], parallel: [false; 3] };
+        for axis in 0..3 {
+            let (o, inv) = (ray.origin[axis], 1.0 / ray.dir[axis]);
+            s.origin[axis] = o as f32;
+            // A ray parallel to the slabs meets a box only if its origin lies between them,
+            // which rounding to `f32` keeps (rounding is monotonic).
+            s.parallel[axis] = ray.dir[axis] == 0.0;
+            if !(inv.abs() < STEEP && inv.abs() > 1.0 / STEEP) {
+                continue; // the slabs reject nothing: entry −∞, exit +∞ (the reciprocal 0).
+            }
+            let o32 = s.origin[axis] as f64;
+            // |fl(b − o32)·fl(inv) − (b − o)·inv| over boxes within reach, plus the padding's
+            // own rounding: at most (reach + |o32|)·|inv|·(4u + …) + |o − o32|·|inv|·(1 + 3u).
+            let err = ((reach[axis] + o32.abs()) * 6.0 * ROUNDOFF + (o - o32).abs() * 1.01) * inv.abs() * 1.01 + 1e-30;
+            (s.inv[axis], s.pad[axis], s.neg[axis]) = (inv as f32, up(err), inv < 0.0);
+        }
+        s
+    }
+
+    /// Which of `w`'s children the ray may meet within `[0, t_max]` (bit `k` for child `k`)
+    /// and lower bounds of where it enters each.
+    #[inline(always)]
+    pub fn test(&self, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            self.test_sse(w, t_max)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            self.test_portable(w, t_max)
+        }
+    }
+
+    /// [`Self::test`] one child at a time: the same arithmetic in the same order.
+    #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+    fn test_portable(&self, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
+        let mut near = [0.0f32; WIDTH];
+        let mut far = [t_max; WIDTH];
+        let mut beside = [false; WIDTH];
+        for axis in 0..3 {
+            let (entry, exit) =
+                if self.neg[axis] { (&w.max[axis], &w.min[axis]) } else { (&w.min[axis], &w.max[axis]) };
+            let (o, inv, pad) = (self.origin[axis], self.inv[axis], self.pad[axis]);
+            if self.parallel[axis] {
+                for k in 0..WIDTH {
+                    beside[k] |= !(w.min[axis][k] <= o && o <= w.max[axis][k]);
+                }
+            }
+            for k in 0..WIDTH {
+                // `a > b ? a : b` keeps the accumulator when the new value is NaN (0·∞ on an
+                // axis not used to reject), as the processors' max and min instructions do.
+                let t0 = (entry[k] - o) * inv - pad;
+                let t1 = (exit[k] - o) * inv + pad;
+                near[k] = if t0 > near[k] { t0 } else { near[k] };
+                far[k] = if t1 < far[k] { t1 } else { far[k] };
+            }
+        }
+        let mut hits = 0;
+        for k in 0..WIDTH {
+            hits |= u32::from(near[k] <= far[k] && w.count[k] != EMPTY && !beside[k]) << k;
+        }
+        (hits, near)
+    }
+
+    /// [`Self::test`] with SSE, which every x86-64 processor has: four children at once.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn test_sse(&self, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE and SSE2 are part of x86-64; the loads read whole `[f32; 4]` and
+        // `[u32; 4]` arrays of a 64-byte aligned node.
+        unsafe {
+            let mut near = _mm_setzero_ps();
+            let mut far = _mm_set1_ps(t_max);
+            let mut beside =
+                _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_load_si128(w.count.as_ptr().cast()), _mm_set1_epi32(-1)));
+            for axis in 0..3 {
+                let (entry, exit) =
+                    if self.neg[axis] { (&w.max[axis], &w.min[axis]) } else { (&w.min[axis], &w.max[axis]) };
+                let (o, inv, pad) =
+                    (_mm_set1_ps(self.origin[axis]), _mm_set1_ps(self.inv[axis]), _mm_set1_ps(self.pad[axis]));
+                if self.parallel[axis] {
+                    let inside = _mm_and_ps(
+                        _mm_cmple_ps(_mm_load_ps(w.min[axis].as_ptr()), o),
+                        _mm_cmple_ps(o, _mm_load_ps(w.max[axis].as_ptr())),
+                    );
+                    beside = _mm_or_ps(beside, _mm_andnot_ps(inside, _mm_castsi128_ps(_mm_set1_epi32(-1))));
+                }
+                let t0 = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(entry.as_ptr()), o), inv), pad);
+                let t1 = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(exit.as_ptr()), o), inv), pad);
+                // MAXPS/MINPS return their second operand when either is NaN: the accumulator.
+                near = _mm_max_ps(t0, near);
+                far = _mm_min_ps(t1, far);
+            }
+            // Empty slots count as beside the ray.
+            let hits = _mm_movemask_ps(_mm_andnot_ps(beside, _mm_cmple_ps(near, far))) as u32;
+            let mut out = [0.0f32; WIDTH];
+            _mm_storeu_ps(out.as_mut_ptr(), near);
+            (hits, out)
+        }
+    }
+
+    /// Asks the processor to start loading node `w` (its two cache lines).
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub fn prefetch(w: &Wide) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: prefetching never faults; SSE is part of x86-64.
+        unsafe {
+            use std::arch::x86_64::*;
+            let p: *const i8 = (w as *const Wide).cast();
+            _mm_prefetch(p, _MM_HINT_T0);
+            _mm_prefetch(p.add(64), _MM_HINT_T0);
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = w;
+    }
+
+    /// `w`'s child `k`.
+    #[inline]
+    pub fn child(w: &Wide, k: usize, near: f32) -> Entry {
+        Entry { offset: w.offset[k], count: w.count[k], near }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alhazen_math::{Bounds3, Vec3};
+
+    fn one_box(b: Bounds3) -> Wide {
+        let mut w = Wide { min: [[f32::MAX; 4]; 3], max: [[-f32::MAX; 4]; 3], offset: [0; 4], count: [EMPTY; 4] };
+        for axis in 0..3 {
+            (w.min[axis][0], w.max[axis][0]) = (down(b.min[axis]), up(b.max[axis]));
+        }
+        w.count[0] = 1;
+        w
+    }
+
+    proptest::proptest! {
+        /// A rounded box holds the exact one, as tightly as `f32` allows.
+        #[test]
+        fn rounded_boxes_hold_the_exact_ones(x in -1e30..1e30f64, scale in -30i32..30) {
+            let x = x * 10f64.powi(scale);
+            let (lo, hi) = (down(x), up(x));
+            proptest::prop_assert!((lo as f64) <= x && x <= hi as f64);
+            proptest::prop_assert!(lo == hi || lo.next_up() == hi, "{lo} {hi}");
+        }
+
+        /// Whatever the exact ray segment meets, the `f32` test keeps, and its entry bound is
+        /// below the exact entry: rays grazing faces, starting on them, along the axes, far away.
+        #[test]
+        fn the_f32_test_never_rejects_a_box_the_ray_meets(
+            lo in proptest::array::uniform3(-1e3..1e3f64),
+            size in proptest::array::uniform3(0.0..1e2f64),
+            scale in -12i32..12,
+            u in proptest::array::uniform3(0.0..1.0f64),
+            from in proptest::array::uniform3(-1e4..1e4f64),
+            zero in 0usize..5,
+        ) {
+            let s = 10f64.powi(scale);
+            let lo = Vec3::from_array(lo) * s;
+            let b = Bounds3 { min: lo, max: lo + Vec3::from_array(size) * s };
+            // A point of the box (on its faces for u at 0 or 1) and a ray through it.
+            let target = b.min + (b.max - b.min) * Vec3::from_array(u);
+            let origin = Vec3::from_array(from) * s;
+            let mut dir = target - origin;
+            if zero < 3 {
+                dir[zero] = 0.0;
+            }
+            proptest::prop_assume!(dir.length() > 0.0);
+            let ray = Ray::new(origin, dir);
+            let reach: [f64; 3] = std::array::from_fn(|a| (b.min[a].abs()).max(b.max[a].abs()));
+            let slab = Slab::new(&ray, reach.map(|r| up(r) as f64));
+            let w = one_box(b);
+            let exact = b.hit_interval(&ray, 1.0 / ray.dir, f64::INFINITY);
+            let (hits, near) = slab.test(&w, f32::INFINITY);
+            if let Some((t_near, _)) = exact {
+                proptest::prop_assert!(hits & 1 == 1, "rejected {b:?} for {ray:?}");
+                proptest::prop_assert!(near[0] as f64 <= t_near);
+            }
+            // The exact point of entry is kept with the segment ending there.
+            if let Some((t_near, _)) = exact {
+                let (hits, _) = slab.test(&w, up(t_near));
+                proptest::prop_assert!(hits & 1 == 1);
+            }
+            proptest::prop_assert!(hits & !1 == 0, "empty slots are never met");
+        }
+    }
+
+    /// The SSE test gives the portable test's bits.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn sse_and_portable_tests_agree() {
+        let mut w = one_box(Bounds3 { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) });
+        (w.min[0][1], w.max[0][1], w.count[1]) = (f32::NEG_INFINITY, 3.0, 2);
+        (w.min[1][2], w.max[1][2], w.count[2]) = (0.5, f32::INFINITY, 0);
+        for (o, d) in [
+            (Vec3::new(-5.0, 0.0, 0.0), Vec3::X),
+            (Vec3::new(0.3, -7.0, 2.0), Vec3::new(0.0, 1.0, -0.2)),
+            (Vec3::new(1e20, 0.5, 0.5), Vec3::new(-1.0, 1e-30, 0.0)),
+            (Vec3::new(2.0, 2.0, 2.0), Vec3::new(-1.0, -1.0, -1.0)),
+        ] {
+            let slab = Slab::new(&Ray::new(o, d), [1e20, 1e20, 1e20]);
+            for t_max in [f32::INFINITY, 1.0, 0.0] {
+                let (a, b) = (slab.test_sse(&w, t_max), slab.test_portable(&w, t_max));
+                assert_eq!(a.0, b.0);
+                assert_eq!(a.1.map(f32::to_bits), b.1.map(f32::to_bits));
+            }
+        }
+    }
+
+    #[test]
+    fn boxes_behind_beside_and_beyond_are_rejected() {
+        let b = Bounds3 { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) };
+        let w = one_box(b);
+        let reach = [1.0; 3];
+        let test = |o: Vec3, d: Vec3, t_max: f32| Slab::new(&Ray::new(o, d), reach).test(&w, t_max).0 & 1;
+        assert_eq!(test(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, f32::INFINITY), 1);
+        assert_eq!(test(Vec3::new(5.0, 0.0, 0.0), Vec3::X, f32::INFINITY), 0, "behind");
+        assert_eq!(test(Vec3::new(-5.0, 2.0, 0.0), Vec3::X, f32::INFINITY), 0, "beside");
+        assert_eq!(test(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, 3.9), 0, "beyond the segment");
+        assert_eq!(test(Vec3::new(-5.0, 0.0, 0.0), Vec3::new(1.0, 0.5, 0.0), f32::INFINITY), 0, "passes above");
+    }
+}
