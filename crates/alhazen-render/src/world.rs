@@ -433,6 +433,14 @@ impl World {
                 .any(|&i| self.objects[i as usize].placed.hit(ray, t_max).is_some())
     }
 
+    /// The nearest hit in `(0, t_max)` without its surface: the distance, the triangle and its
+    /// barycentric coordinates for a mesh (see [`Candidate`]) and the object's index — what a
+    /// ray query of Embree (`rtcIntersect1`) reports. [`Self::intersect`] adds the surface.
+    #[inline]
+    pub fn nearest_hit(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
+        self.nearest(ray, t_max)
+    }
+
     /// The nearest hit in `(0, t_max)` with its surface and material.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<WorldHit> {

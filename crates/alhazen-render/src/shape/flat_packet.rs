@@ -242,7 +242,7 @@ impl<L: Copy + Default> PackedFlats<L> {
             unsafe {
                 use std::arch::x86_64::*;
                 let p: *const i8 = (p as *const FlatPacket).cast();
-                for line in (0..std::mem::size_of::<FlatPacket>()).step_by(64) {
+                for line in (0..std::mem::size_of::<FlatPacket>().min(256)).step_by(64) {
                     _mm_prefetch(p.add(line), _MM_HINT_T0);
                 }
                 _mm_prefetch((l as *const [L; LANES]).cast(), _MM_HINT_T0);
