@@ -282,7 +282,8 @@ impl Bvh {
         }
         let slab = Slab::new(ray, self.reach);
         let mut limit = wide::up(t_max);
-        let mut stack = [Entry::default(); STACK];
+        // Not zeroed: a traversal of a small tree would spend longer clearing it than using it.
+        let mut stack = [const { std::mem::MaybeUninit::<Entry>::uninit() }; STACK];
         let mut sp = 0;
         loop {
             if at.is_leaf() {
@@ -310,7 +311,7 @@ impl Bvh {
                         n += 1;
                     }
                     for &(t, k) in met[1..n].iter().rev() {
-                        stack[sp] = Slab::child(node, k, t);
+                        stack[sp].write(Slab::child(node, k, t));
                         sp += 1;
                     }
                     // Load the nodes met while the nearest is descended into.
@@ -331,7 +332,11 @@ impl Bvh {
                     return t_max;
                 }
                 sp -= 1;
-                at = stack[sp];
+                // SAFETY: every slot below `sp` was written before `sp` passed it.
+                #[allow(unsafe_code)]
+                {
+                    at = unsafe { stack[sp].assume_init() };
+                }
                 if at.near as f64 <= t_max {
                     break;
                 }

@@ -145,23 +145,28 @@ pub(super) struct Slab {
 impl Slab {
     /// The ray, for boxes within `reach` of the origin along each axis (the largest magnitude
     /// of any box coordinate).
+    #[inline]
     pub fn new(ray: &Ray, reach: [f64; 3]) -> Self {
+        let inv = 1.0 / ray.dir;
         let mut s =
             Slab { origin: [0.0; 3], inv: [0.0; 3], pad: [f32::INFINITY; 3], neg: [false; 3], parallel: [false; 3] };
         for axis in 0..3 {
-            let (o, inv) = (ray.origin[axis], 1.0 / ray.dir[axis]);
-            s.origin[axis] = o as f32;
+            let (o, a) = (ray.origin[axis], inv[axis].abs());
+            let o32 = o as f32;
+            // |fl(b − o32)·fl(inv) − (b − o)·inv| over boxes within reach, plus the padding's
+            // own rounding, is at most (reach + |o32|)·|inv|·(4u + …) + |o − o32|·|inv|·(1 + 3u);
+            // the 1 % margins also cover rounding the bound itself to `f32`.
+            let err = ((reach[axis] + (o32 as f64).abs()) * (6.0 * ROUNDOFF) + (o - o32 as f64).abs() * 1.01) * a * 1.01
+                + 1e-30;
+            // Where the reciprocal is huge or tiny the slabs reject nothing: entry −∞, exit +∞.
+            let usable = a < STEEP && a > 1.0 / STEEP;
+            s.origin[axis] = o32;
+            s.inv[axis] = if usable { inv[axis] as f32 } else { 0.0 };
+            s.pad[axis] = if usable { err as f32 } else { f32::INFINITY };
+            s.neg[axis] = inv[axis] < 0.0;
             // A ray parallel to the slabs meets a box only if its origin lies between them,
             // which rounding to `f32` keeps (rounding is monotonic).
             s.parallel[axis] = ray.dir[axis] == 0.0;
-            if !(inv.abs() < STEEP && inv.abs() > 1.0 / STEEP) {
-                continue; // the slabs reject nothing: entry −∞, exit +∞ (the reciprocal 0).
-            }
-            let o32 = s.origin[axis] as f64;
-            // |fl(b − o32)·fl(inv) − (b − o)·inv| over boxes within reach, plus the padding's
-            // own rounding: at most (reach + |o32|)·|inv|·(4u + …) + |o − o32|·|inv|·(1 + 3u).
-            let err = ((reach[axis] + o32.abs()) * 6.0 * ROUNDOFF + (o - o32).abs() * 1.01) * inv.abs() * 1.01 + 1e-30;
-            (s.inv[axis], s.pad[axis], s.neg[axis]) = (inv as f32, up(err), inv < 0.0);
         }
         s
     }
