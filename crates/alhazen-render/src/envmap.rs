@@ -58,13 +58,24 @@ impl EnvMap {
         if pdf_uv <= 0.0 || sin <= 0.0 {
             return None;
         }
-        let dir = self.to_dir(uv);
-        Some((dir, self.radiance(dir), pdf_uv / (2.0 * PI * PI * sin)))
+        // The radiance of the texel sampled (not looked up again from the direction: the same
+        // texel but for rounding on its edges, without the inverse trigonometry).
+        let radiance = alhazen_scene::texture::equirect_texel_at(&self.image, uv) * self.scale;
+        Some((self.to_dir(uv), radiance, pdf_uv / (2.0 * PI * PI * sin)))
     }
 
     /// Solid-angle density of [`Self::sample`] choosing `dir`.
     pub fn pdf(&self, dir: Vec3) -> f64 {
+        self.pdf_at(self.to_uv(dir))
+    }
+
+    /// [`Self::radiance`] and [`Self::pdf`] of `dir`, mapped to the image once.
+    pub fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f64) {
         let uv = self.to_uv(dir);
+        (alhazen_scene::texture::equirect_texel_at(&self.image, uv) * self.scale, self.pdf_at(uv))
+    }
+
+    fn pdf_at(&self, uv: Vec2) -> f64 {
         let sin = (uv.y * PI).sin();
         if sin <= 0.0 { 0.0 } else { self.distribution.pdf(uv) / (2.0 * PI * PI * sin) }
     }
@@ -105,6 +116,7 @@ mod tests {
             let (d, l, pdf) = m.sample(u).unwrap();
             assert!((m.pdf(d) - pdf).abs() < 1e-9 * pdf.max(1.0), "{k}");
             assert_eq!(m.radiance(d), l);
+            assert_eq!(m.radiance_and_pdf(d), (l, m.pdf(d)));
         }
     }
 }

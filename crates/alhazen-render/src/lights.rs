@@ -251,21 +251,17 @@ impl Lights {
         all.collect::<Option<Vec<_>>>().filter(|v| !v.is_empty())
     }
 
-    /// Radiance of the sky (environment or background) in direction `dir`.
-    pub fn sky_radiance(&self, dir: Vec3) -> Vec3 {
+    /// Radiance arriving from the sky along `-dir` (`dir` pointing away from the scene) and the
+    /// density of sampling `dir` among the lights (an environment map's direction is mapped to
+    /// its image once).
+    pub fn sky(&self, dir: Vec3) -> (Vec3, f64) {
         match self.sky.map(|i| &self.lights[i as usize]) {
-            Some(PathLight::Environment(m)) => m.radiance(dir),
-            Some(PathLight::Background(b)) => b.radiance(dir),
-            _ => Vec3::ZERO,
-        }
-    }
-
-    /// Density of sampling the sky in direction `dir`.
-    pub fn sky_pdf(&self, dir: Vec3) -> f64 {
-        match self.sky.map(|i| &self.lights[i as usize]) {
-            Some(PathLight::Environment(m)) => m.pdf(dir) * self.choice_pdf(),
-            Some(PathLight::Background(_)) => self.choice_pdf() / (4.0 * PI),
-            _ => 0.0,
+            Some(PathLight::Environment(m)) => {
+                let (radiance, pdf) = m.radiance_and_pdf(dir);
+                (radiance, pdf * self.choice_pdf())
+            }
+            Some(PathLight::Background(b)) => (b.radiance(dir), self.choice_pdf() / (4.0 * PI)),
+            _ => (Vec3::ZERO, 0.0),
         }
     }
 

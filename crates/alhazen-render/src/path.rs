@@ -341,11 +341,11 @@ impl<'a> PathTracer<'a> {
     /// `radiance`, it pushed `Lights::sample` out (cornell-rough 7 % slower).
     #[inline(never)]
     fn escaped(&self, ray: &Ray, prev: &Previous, beta: Vec3, mode: ColorMode) -> Option<Vec3> {
-        let le = self.lights.sky_radiance(ray.dir);
+        let (le, pdf) = self.lights.sky(ray.dir);
         if le == Vec3::ZERO {
             return None;
         }
-        let w = if prev.delta { 1.0 } else { power_heuristic(prev.pdf, self.lights.sky_pdf(ray.dir)) };
+        let w = if prev.delta { 1.0 } else { power_heuristic(prev.pdf, pdf) };
         Some(beta * mode.color(le) * w)
     }
 

@@ -28,7 +28,11 @@ pub fn equirect_uv(dir: Vec3, rotation: f64) -> Vec2 {
 
 /// The texel of an equirectangular image seen in direction `dir` (nearest lookup).
 pub fn equirect_texel(img: &ImageData, dir: Vec3, rotation: f64) -> Vec3 {
-    let uv = equirect_uv(dir, rotation);
+    equirect_texel_at(img, equirect_uv(dir, rotation))
+}
+
+/// The texel of an equirectangular image at `uv` ([`equirect_uv`]'s coordinates).
+pub fn equirect_texel_at(img: &ImageData, uv: Vec2) -> Vec3 {
     let (w, h) = (img.width as usize, img.height as usize);
     let (x, y) = (((uv.x * w as f64) as usize).min(w - 1), ((uv.y * h as f64) as usize).min(h - 1));
     let p = img.pixels[y * w + x];

@@ -156,8 +156,9 @@ impl Slab {
             // |fl(b − o32)·fl(inv) − (b − o)·inv| over boxes within reach, plus the padding's
             // own rounding, is at most (reach + |o32|)·|inv|·(4u + …) + |o − o32|·|inv|·(1 + 3u);
             // the 1 % margins also cover rounding the bound itself to `f32`.
-            let err = ((reach[axis] + (o32 as f64).abs()) * (6.0 * ROUNDOFF) + (o - o32 as f64).abs() * 1.01) * a * 1.01
-                + 1e-30;
+            let err =
+                ((reach[axis] + (o32 as f64).abs()) * (6.0 * ROUNDOFF) + (o - o32 as f64).abs() * 1.01) * a * 1.01
+                    + 1e-30;
             // Where the reciprocal is huge or tiny the slabs reject nothing: entry −∞, exit +∞.
             let usable = a < STEEP && a > 1.0 / STEEP;
             s.origin[axis] = o32;
