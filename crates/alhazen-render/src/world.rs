@@ -4,14 +4,14 @@
 //! BVH's leaves test four or eight at a time ([`FlatPacket`]); a leaf's untransformed spheres,
 //! three or more, are one [`SpherePacket`]; other objects are tested one by one. Eight rays
 //! can be traced in one call ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path
-//! tracer's lanes); when the world is one leaf, each flat is tested against the eight at once,
-//! then each ray's spheres and other objects.
+//! tracer's lanes); when the world is one leaf, each flat and each packed sphere is tested
+//! against the eight at once, then each ray's other objects.
 
 use crate::bvh::Bvh;
 use crate::shape::{
     AaBox, Candidate, Cone, Csg, Cylinder, Disk, FLAT_LANES as LANES, Flat, FlatLane, FlatPacket, LaneHit, MeshAccel,
-    MeshShape, PackedFlats, Placed, Plane, RayPacket, SPHERE_LANES, Shape, Sphere, SpherePacket, SurfaceHit,
-    VectorUnit, flat_primitives,
+    MeshShape, PackedFlats, Placed, Plane, RayPacket, RaysSphereHits, SPHERE_LANES, Shape, Sphere, SpherePacket,
+    SurfaceHit, VectorUnit, flat_primitives,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -403,13 +403,42 @@ impl World {
     /// The nearest of `leaf`'s spheres and other objects before `t_max` (its flats tested
     /// already): the candidate and its object.
     #[inline]
-    fn nearest_solid(&self, leaf: &Leaf, ray: &Ray, mut t_max: f64) -> Option<(Candidate, u32)> {
-        let mut best = None;
+    fn nearest_solid(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
         let spheres = &self.spheres[leaf.spheres.clone()];
         // Most leaves hold no sphere packet: skip the kernel's call.
-        if !spheres.is_empty()
-            && let Some((k, lane, t)) = SpherePacket::nearest_of(spheres, ray, t_max, self.vectors)
-        {
+        let sphere =
+            if spheres.is_empty() { None } else { SpherePacket::nearest_of(spheres, ray, t_max, self.vectors) };
+        self.nearest_solid_after(leaf, ray, t_max, sphere)
+    }
+
+    /// The nearest sphere hit of each of eight rays in `leaf` ([`SpherePacket::nearest_of_rays`]).
+    #[inline]
+    fn spheres_of_rays(
+        &self,
+        leaf: &Leaf,
+        rays: &RayPacket,
+        t_max: &[f64; LANES],
+        live: [bool; LANES],
+    ) -> RaysSphereHits {
+        let spheres = &self.spheres[leaf.spheres.clone()];
+        if spheres.is_empty() {
+            return [None; LANES];
+        }
+        SpherePacket::nearest_of_rays(spheres, rays, t_max, live, self.vectors)
+    }
+
+    /// [`Self::nearest_solid`] with the leaf's nearest sphere hit already found (`sphere`: its
+    /// packet, lane and distance).
+    #[inline]
+    fn nearest_solid_after(
+        &self,
+        leaf: &Leaf,
+        ray: &Ray,
+        mut t_max: f64,
+        sphere: Option<(usize, usize, f64)>,
+    ) -> Option<(Candidate, u32)> {
+        let mut best = None;
+        if let Some((k, lane, t)) = sphere {
             let object = self.sphere_objects[leaf.spheres.start + k][lane];
             best = Some((Candidate { t, aux: 0, bary: [0.0; 2] }, object));
             t_max = t;
@@ -428,9 +457,16 @@ impl World {
     fn solid_blocks(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> bool {
         !leaf.spheres.is_empty()
             && SpherePacket::nearest_of(&self.spheres[leaf.spheres.clone()], ray, t_max, self.vectors).is_some()
-            || self.leaf_objects[leaf.objects.clone()]
-                .iter()
-                .any(|&i| self.objects[i as usize].placed.hit(ray, t_max).is_some())
+            || self.objects_block(leaf, ray, t_max)
+    }
+
+    /// True when one of `leaf`'s other objects (not flats, not packed spheres) lies on `ray`
+    /// before `t_max`.
+    #[inline]
+    fn objects_block(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> bool {
+        self.leaf_objects[leaf.objects.clone()]
+            .iter()
+            .any(|&i| self.objects[i as usize].placed.hit(ray, t_max).is_some())
     }
 
     /// The nearest hit in `(0, t_max)` without its surface: the distance, the triangle and its
@@ -474,10 +510,11 @@ impl World {
             flat[r] = Some((k, h));
         });
         let leaf = &self.leaves[0];
+        let t_max = flat.map(|f| f.map_or(f64::INFINITY, |(_, h)| h.t));
+        let spheres = self.spheres_of_rays(leaf, rays, &t_max, live);
         for (r, slot) in out.iter_mut().enumerate() {
             let ray = rays.ray(r);
-            let t_max = flat[r].map_or(f64::INFINITY, |(_, h)| h.t);
-            let solid = if live[r] { self.nearest_solid(leaf, &ray, t_max) } else { None };
+            let solid = if live[r] { self.nearest_solid_after(leaf, &ray, t_max[r], spheres[r]) } else { None };
             *slot = match (solid, flat[r]) {
                 (Some((c, i)), _) => Some(self.surface_of(&ray, c, i)),
                 (None, Some((k, h))) => Some(self.flat_hit(&ray, k, h)),
@@ -508,8 +545,10 @@ impl World {
         if self.one_leaf {
             let blocked = FlatPacket::any_of_rays(&self.flats.packets, rays, dist, live, self.vectors);
             let leaf = &self.leaves[0];
+            let open = std::array::from_fn(|r| live[r] && !blocked[r]);
+            let spheres = if self.flats_only { [None; LANES] } else { self.spheres_of_rays(leaf, rays, dist, open) };
             return std::array::from_fn(|r| {
-                live[r] && !blocked[r] && (self.flats_only || !self.solid_blocks(leaf, &rays.ray(r), dist[r]))
+                open[r] && (self.flats_only || spheres[r].is_none() && !self.objects_block(leaf, &rays.ray(r), dist[r]))
             });
         }
         std::array::from_fn(|r| {

@@ -25,7 +25,7 @@ pub use flat_packet::{FlatPacket, LANES as FLAT_LANES, LaneHit, PackedFlats, Ray
 pub use mesh::{MeshAccel, MeshShape, triangle_hit};
 pub use plane::{Disk, Plane};
 pub use sphere::Sphere;
-pub use sphere_packet::{SPHERE_LANES, SpherePacket};
+pub use sphere_packet::{RaysSphereHits, SPHERE_LANES, SpherePacket};
 
 use alhazen_math::{Bounds3, Ray, Transform, Vec2, Vec3};
 

@@ -4,10 +4,16 @@
 //!
 //! Each lane does exactly [`Sphere::hit`]'s arithmetic in the same order (Haines et al.'s
 //! discriminant, no fused multiply–add; `sqrt` and division are exact in IEEE arithmetic), so
-//! the AVX-512 kernel and the portable loop give the same bits as the one-sphere test.
+//! the AVX-512 kernel and the portable loop give the same bits as the one-sphere test. For
+//! eight rays at once ([`RayPacket`], the path tracer's lanes) the kernel turns round, as the
+//! flat packets' does: the rays are the lanes and each sphere in turn is broadcast against them,
+//! so a packet of four balls costs four tests of eight useful lanes, not eight half-empty ones.
 
-use super::{Sphere, VectorUnit};
+use super::{RayPacket, Sphere, VectorUnit};
 use alhazen_math::Ray;
+
+/// Per ray of a [`RayPacket`], its nearest sphere hit: `(packet, lane, t)`.
+pub type RaysSphereHits = [Option<(usize, usize, f64)>; SPHERE_LANES];
 
 /// Spheres per packet.
 pub const SPHERE_LANES: usize = 8;
@@ -53,6 +59,10 @@ impl SpherePacket {
             return unsafe { avx512::nearest(packets, ray, t_max) };
         }
         let _ = unit;
+        Self::nearest_portable(packets, ray, t_max)
+    }
+
+    fn nearest_portable(packets: &[Self], ray: &Ray, t_max: f64) -> Option<(usize, usize, f64)> {
         let (mut best, mut t_max) = (None, t_max);
         for (k, p) in packets.iter().enumerate() {
             for lane in 0..p.used {
@@ -63,13 +73,34 @@ impl SpherePacket {
         }
         best
     }
+
+    /// [`Self::nearest_of`] for each of eight rays, `rays[r]` before `t_max[r]` (`None` where
+    /// not `live`): the same hits, the same bits.
+    #[inline]
+    #[allow(unsafe_code)]
+    pub fn nearest_of_rays(
+        packets: &[Self],
+        rays: &RayPacket,
+        t_max: &[f64; SPHERE_LANES],
+        live: [bool; SPHERE_LANES],
+        unit: VectorUnit,
+    ) -> RaysSphereHits {
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+            let hits = unsafe { avx512::nearest_rays(packets, rays, t_max) };
+            return std::array::from_fn(|r| hits[r].filter(|_| live[r]));
+        }
+        let _ = unit;
+        std::array::from_fn(|r| if live[r] { Self::nearest_portable(packets, &rays.ray(r), t_max[r]) } else { None })
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod avx512 {
     use super::super::avx512::{NearestLanes, dot, load, ray_lanes};
-    use super::SpherePacket;
+    use super::{RayPacket, RaysSphereHits, SPHERE_LANES, SpherePacket};
     use alhazen_math::Ray;
     use std::arch::x86_64::*;
 
@@ -77,15 +108,20 @@ mod avx512 {
     /// the nearer root in front of the origin and the lanes hit before `t_max`.
     #[inline]
     #[target_feature(enable = "avx512f")]
-    fn lanes(p: &SpherePacket, o: [__m512d; 3], d: [__m512d; 3], t_max: __m512d) -> (__m512d, __mmask8) {
-        let f = [0, 1, 2].map(|i| _mm512_sub_pd(o[i], load(&p.center[i])));
+    fn lanes(
+        center: [__m512d; 3],
+        r: __m512d,
+        o: [__m512d; 3],
+        d: [__m512d; 3],
+        t_max: __m512d,
+    ) -> (__m512d, __mmask8) {
+        let f = [0, 1, 2].map(|i| _mm512_sub_pd(o[i], center[i]));
         let a = dot(d, d);
         let sign = _mm512_set1_pd(-0.0);
         // `−(f·d)` by flipping the sign bit (`0 − x` would turn −0 into +0).
         let beta = bits(dot(f, d), sign, _mm512_xor_si512);
         let s = _mm512_div_pd(beta, a);
         let perp = [0, 1, 2].map(|i| _mm512_add_pd(f[i], _mm512_mul_pd(d[i], s)));
-        let r = load(&p.radius);
         let r2 = _mm512_mul_pd(r, r);
         let disc = _mm512_mul_pd(a, _mm512_sub_pd(r2, dot(perp, perp)));
         let zero = _mm512_setzero_pd();
@@ -141,11 +177,42 @@ mod avx512 {
         let limit = _mm512_set1_pd(t_max);
         let mut best = NearestLanes::new(limit);
         for (k, p) in packets.iter().enumerate() {
-            let (t, inside) = lanes(p, r.origin, r.dir, limit);
+            let center = [0, 1, 2].map(|i| load(&p.center[i]));
+            let (t, inside) = lanes(center, load(&p.radius), r.origin, r.dir, limit);
             best.update(k, t, inside);
         }
         let (lane, k, t) = best.nearest()?;
         Some((k, lane, t))
+    }
+
+    /// [`SpherePacket::nearest_of_rays`]: the rays in lanes, each sphere in order broadcast
+    /// against them; strictly nearer replaces, so the first of equally near spheres is kept.
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn nearest_rays(
+        packets: &[SpherePacket],
+        rays: &RayPacket,
+        t_max: &[f64; SPHERE_LANES],
+    ) -> RaysSphereHits {
+        let (o, d) = ([0, 1, 2].map(|i| load(&rays.origin[i])), [0, 1, 2].map(|i| load(&rays.dir[i])));
+        let mut best = load(t_max);
+        let (mut which, mut hit) = ([(0usize, 0usize); SPHERE_LANES], 0u8);
+        for (k, p) in packets.iter().enumerate() {
+            for lane in 0..p.used {
+                let center = [0, 1, 2].map(|i| _mm512_set1_pd(p.center[i][lane]));
+                let (t, closer) = lanes(center, _mm512_set1_pd(p.radius[lane]), o, d, best);
+                if closer != 0 {
+                    best = _mm512_mask_blend_pd(closer, best, t);
+                    hit |= closer;
+                    for r in (0..SPHERE_LANES).filter(|r| closer >> r & 1 == 1) {
+                        which[r] = (k, lane);
+                    }
+                }
+            }
+        }
+        let mut t = [0.0; SPHERE_LANES];
+        // SAFETY: `t` is eight writable f64s; `storeu` needs no alignment.
+        unsafe { _mm512_storeu_pd(t.as_mut_ptr(), best) };
+        std::array::from_fn(|r| (hit >> r & 1 == 1).then(|| (which[r].0, which[r].1, t[r])))
     }
 }
 
@@ -186,6 +253,36 @@ mod tests {
             let packets: Vec<SpherePacket> = spheres.chunks(fill).map(SpherePacket::new).collect();
             for unit in VectorUnit::available() {
                 prop_assert_eq!(SpherePacket::nearest_of(&packets, &ray, t_max, unit), expected, "{:?}", unit);
+            }
+        }
+    }
+
+    proptest! {
+        /// Eight rays at once find, ray by ray, what each finds alone (ties included: the
+        /// spheres repeat, so equally near hits occur).
+        #[test]
+        fn eight_rays_equal_one_by_one(
+            spheres in prop::collection::vec(sphere(), 1..=2 * SPHERE_LANES + 3),
+            fill in 1..=SPHERE_LANES,
+            rays in prop::collection::vec((vec3(4.0), vec3(1.0), prop_oneof![Just(f64::INFINITY), 0.1..8.0f64]), SPHERE_LANES),
+            live in prop::array::uniform8(prop::bool::ANY),
+        ) {
+            let mut spheres = spheres;
+            spheres.push(spheres[0]);
+            let packets: Vec<SpherePacket> = spheres.chunks(fill).map(SpherePacket::new).collect();
+            let mut packet = RayPacket::default();
+            let mut t_max = [0.0; SPHERE_LANES];
+            for (r, (o, d, t)) in rays.iter().enumerate() {
+                let d = if d.length() > 1e-3 { d.normalize() } else { Vec3::X };
+                packet.set(r, &Ray::new(*o, d));
+                t_max[r] = *t;
+            }
+            for unit in VectorUnit::available() {
+                let together = SpherePacket::nearest_of_rays(&packets, &packet, &t_max, live, unit);
+                for r in 0..SPHERE_LANES {
+                    let alone = SpherePacket::nearest_of(&packets, &packet.ray(r), t_max[r], unit).filter(|_| live[r]);
+                    prop_assert_eq!(together[r], alone, "ray {} {:?}", r, unit);
+                }
             }
         }
     }
