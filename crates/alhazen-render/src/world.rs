@@ -1,8 +1,8 @@
 //! The renderable world: every object of the scene placed, with a top-level BVH over the
 //! bounded ones and a plain list of unbounded ones (planes). Small meshes, rectangles and
 //! untextured boxes are flattened into world-space triangles and parallelograms, which the
-//! BVH's leaves test four or eight at a time ([`FlatPacket`]); a leaf's untransformed spheres,
-//! three or more, are one [`SpherePacket`]; other objects are tested one by one. Eight rays
+//! BVH's leaves test four or eight at a time ([`FlatPacket`]); a leaf's untransformed spheres
+//! are [`SpherePacket`]s; other objects are tested one by one. Eight rays
 //! can be traced in one call ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path
 //! tracer's lanes); when the world is one leaf, each flat and each packed sphere is tested
 //! against the eight at once, then each ray's other objects.
@@ -177,10 +177,6 @@ fn uses_uv(o: &scene::Object, s: &scene::Scene) -> bool {
     })
 }
 
-/// Leaves with fewer spheres test them one by one: a lone sphere's scalar test, with its
-/// early exits, beats the packet's (measured on `bubble.toml`, two spheres).
-const MIN_SPHERE_PACKET: usize = 3;
-
 /// Meshes up to this size are copied into world space when placed, so their rays need no
 /// transform; larger ones are shared between instances.
 const BAKE_TRIANGLES: usize = 256;
@@ -332,9 +328,6 @@ impl World {
                 }
             }
             let packets = self.flats.push_leaf(&flats, self.vectors.lanes());
-            if spheres.len() < MIN_SPHERE_PACKET {
-                self.leaf_objects.extend(spheres.drain(..).map(|s| s.0));
-            }
             let first_sphere = self.spheres.len();
             for chunk in spheres.chunks(SPHERE_LANES) {
                 self.spheres.push(SpherePacket::new(&chunk.iter().map(|s| s.1).collect::<Vec<_>>()));
@@ -630,8 +623,9 @@ pub fn shading_normal(hit: &SurfaceHit, m: &scene::Material, images: &[Arc<scene
 mod tests {
     use super::*;
 
-    /// Rays into one-leaf worlds of flats and solids (a sphere packet; spheres and a cylinder
-    /// tested one by one), eight at a time and one by one: the same hits and the same shadows.
+    /// Rays into one-leaf worlds of flats and solids (a packet of three spheres; a packet of two
+    /// and a cylinder tested alone), eight at a time and one by one: the same hits and the same
+    /// shadows.
     #[test]
     fn eight_rays_meet_a_leaf_of_flats_and_solids_as_one_does() {
         let rectangle = "[[object]]\nshape = \"rectangle\"\ntransform = [{ scale = 3 }, { rotate_x = -90 }, { translate = [0, -1, 0] }]\n";
@@ -639,7 +633,7 @@ mod tests {
         let packet = format!("{rectangle}{}{}{}", sphere(-1.5), sphere(0.0), sphere(1.5));
         let cylinder = "[[object]]\nshape = \"cylinder\"\nradius = 0.3\nbase = [0, -1, 0]\ntop = [0, 0.8, 0]\n";
         let singles = format!("{rectangle}{}{}{cylinder}", sphere(-1.5), sphere(1.5));
-        for (text, packets) in [(packet, 1), (singles, 0)] {
+        for (text, packets) in [(packet, 1), (singles, 1)] {
             let world = World::build(&scene::parse_scene("leaf.toml".as_ref(), &text).unwrap());
             assert!(world.one_leaf && !world.flats_only, "one leaf of flats and solids");
             assert_eq!(world.spheres.len(), packets);
