@@ -743,7 +743,7 @@ impl Importer {
                 BsdfDesc::Conductor { facets, eta, k, tint, fresnel: FresnelMode::Exact }
             }
             "dielectric" | "roughdielectric" | "thindielectric" => {
-                let ior = self.ior(ctx, &p)?;
+                let ior = self.ior(ctx, &p, 1.5046)?;
                 for key in ["specular_reflectance", "specular_transmittance"] {
                     if let Some(n) = self.prop(&p, key) {
                         self.warn(
@@ -763,12 +763,22 @@ impl Importer {
             }
             "plastic" | "roughplastic" => {
                 let albedo = self.color(ctx, &p, "diffuse_reflectance", Vec3::splat(0.5))?;
-                let ior = self.ior(ctx, &p)?;
-                let facets = self.facets(ctx, &p, true)?.unwrap_or(common::ggx(0.01, 0.01));
-                self.boolean(ctx, &p, "nonlinear", false)?;
-                self.warn(ctx, node, format!("{kind} is approximated by Cook–Torrance: Lambert weighted by 1 − F(0) under a microfacet coat of the same index"));
-                let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
-                BsdfDesc::CookTorrance { albedo, kd: 1.0 - f0, ks: 1.0, facets, ior, fresnel: FresnelMode::Exact }
+                // Mitsuba's default coat is polypropylene.
+                let ior = self.ior(ctx, &p, 1.49)?;
+                if ior <= 1.0 {
+                    return Err(
+                        ctx.err(node, format!("{kind}: the coat's index must exceed the outside's (got {ior})"))
+                    );
+                }
+                let facets = self.facets(ctx, &p, kind == "roughplastic")?;
+                if facets.is_some_and(|f| f.alpha_u != f.alpha_v) {
+                    return Err(ctx.err(node, "roughplastic takes one alpha, not alpha_u and alpha_v (as Mitsuba)"));
+                }
+                if self.prop(&p, "specular_reflectance").is_some() {
+                    self.warn(ctx, node, "specular_reflectance is not supported: the coat is clear (1)");
+                }
+                let nonlinear = self.boolean(ctx, &p, "nonlinear", false)?;
+                BsdfDesc::Plastic { albedo, ior, facets, nonlinear }
             }
             "principled" => {
                 let base = self.color(ctx, &p, "base_color", Vec3::splat(0.8))?;
@@ -891,8 +901,9 @@ impl Importer {
         }
     }
 
-    /// `int_ior / ext_ior`, each a number or a name.
-    fn ior(&mut self, ctx: &Ctx, p: &Plugin) -> R<f64> {
+    /// `int_ior / ext_ior` (numbers or material names), or `eta`; `default_int` when neither
+    /// is given.
+    fn ior(&mut self, ctx: &Ctx, p: &Plugin, default_int: f64) -> R<f64> {
         let one = |imp: &mut Self, key: &str, default: f64| -> R<f64> {
             let Some(n) = imp.prop(p, key) else { return Ok(default) };
             let v = imp.req_attr(ctx, n, "value")?;
@@ -907,7 +918,7 @@ impl Importer {
                 _ => Err(ctx.err(n, format!("`{key}` must be a positive number or a material name"))),
             }
         };
-        let int = one(self, "int_ior", 1.5046)?;
+        let int = one(self, "int_ior", default_int)?;
         let ext = one(self, "ext_ior", 1.000277)?;
         if self.prop(p, "eta").is_some() {
             return self.float(ctx, p, "eta", 1.5);

@@ -90,6 +90,16 @@ fn catalogue() -> Vec<(String, Bsdf)> {
             schlick: true,
         }),
     ));
+    list.push(("rough plastic ggx m=0.2".into(), Bsdf::Plastic(Plastic::new(albedo, 1.49, Some(ggx(0.2)), false))));
+    list.push((
+        "rough plastic beckmann m=0.35 nonlinear".into(),
+        Bsdf::Plastic(Plastic::new(
+            albedo,
+            1.6,
+            Some(facets(Distribution::Beckmann, 0.35, 0.35, Shadowing::Smith)),
+            true,
+        )),
+    ));
     list.push((
         "mix lambert + rough conductor".into(),
         Bsdf::Mix(Box::new(Mix {
@@ -306,6 +316,17 @@ fn smooth_dielectric_splits_energy_without_loss() {
             }
             assert!((total / n as f64 - 1.0).abs() < 1e-9, "η = {eta}, v = {v}: {}", total / n as f64);
         }
+    }
+}
+
+#[test]
+fn white_smooth_plastic_reflects_all_it_receives() {
+    // The coat's mirror F plus the base's closed-form bounces: exactly 1 in theory; the
+    // tabulated transmittance leaves a small error.
+    let b = Bsdf::Plastic(Plastic::new(Vec3::ONE, 1.5, None, false));
+    for theta in [0.0, 40.0, 75.0] {
+        let (a, err) = albedo(&b, direction(theta, 0.2), 200_000);
+        assert!((a.x - 1.0).abs() < 4.0 * err + 3e-3, "at {theta}°: {a} ± {err}");
     }
 }
 

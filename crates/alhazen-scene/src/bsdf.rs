@@ -147,6 +147,20 @@ pub enum BsdfDesc {
         /// Exact or Schlick.
         fresnel: FresnelMode,
     },
+    /// Plastic: a diffuse base under a dielectric coat of index `ior`, smooth when `facets` is
+    /// `None`, the light bouncing between base and coat summed in closed form (Mitsuba 3's
+    /// `plastic` and `roughplastic`).
+    Plastic {
+        /// The base's albedo.
+        albedo: Texture,
+        /// The coat's index relative to the outside.
+        ior: f64,
+        /// The coat's roughness, or smooth.
+        facets: Option<Microfacets>,
+        /// Colour-dependent inner bounces (`albedo / (1 − albedo·R)` rather than
+        /// `albedo / (1 − R)`): more saturated colours.
+        nonlinear: bool,
+    },
     /// A metal: Fresnel with a complex index `η + iκ` per RGB channel; smooth when `facets` is `None`.
     Conductor {
         /// Roughness, or a perfect mirror.
@@ -197,6 +211,20 @@ impl crate::model::Material {
         match bsdf {
             BsdfDesc::Lambert { albedo } | BsdfDesc::OrenNayar { albedo, .. } => self.color = albedo.clone(),
             BsdfDesc::CookTorrance { albedo, kd, .. } => (self.color, self.diffuse) = (albedo.clone(), *kd),
+            BsdfDesc::Plastic { albedo, ior, facets, .. } => {
+                // The diffuse base as colour, the coat's normal-incidence reflectance as a
+                // highlight (as sharp as its roughness) or a faint mirror.
+                let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+                self.color = albedo.clone();
+                self.diffuse = 1.0 - f0;
+                match facets.map(|f| f.alpha_u.max(f.alpha_v)) {
+                    Some(alpha) => {
+                        self.specular = Vec3::splat(f0);
+                        self.shininess = (2.0 / (alpha * alpha) - 2.0).max(1.0);
+                    }
+                    None => self.mirror = Vec3::splat(f0),
+                }
+            }
             BsdfDesc::Phong { albedo, kd, ks, exponent } | BsdfDesc::BlinnPhong { albedo, kd, ks, exponent, .. } => {
                 (self.color, self.diffuse) = (albedo.clone(), *kd);
                 (self.specular, self.shininess) = (Vec3::splat(*ks), *exponent);
@@ -234,7 +262,8 @@ impl BsdfDesc {
             BsdfDesc::Lambert { albedo } | BsdfDesc::OrenNayar { albedo, .. } => t(albedo),
             BsdfDesc::Phong { albedo, .. }
             | BsdfDesc::BlinnPhong { albedo, .. }
-            | BsdfDesc::CookTorrance { albedo, .. } => t(albedo),
+            | BsdfDesc::CookTorrance { albedo, .. }
+            | BsdfDesc::Plastic { albedo, .. } => t(albedo),
             BsdfDesc::Mix { a, b, .. } => a.is_textured() || b.is_textured(),
             BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } => false,
         }

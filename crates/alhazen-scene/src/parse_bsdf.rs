@@ -25,6 +25,7 @@ impl Parser<'_> {
             "phong",
             "blinn-phong",
             "cook-torrance",
+            "plastic",
             "conductor",
             "dielectric",
             "mix",
@@ -35,6 +36,7 @@ impl Parser<'_> {
             "phong" => vec!["color", "kd", "ks", "exponent"],
             "blinn-phong" => vec!["color", "kd", "ks", "exponent", "anisotropy", "scratches"],
             "cook-torrance" => [&["color", "kd", "ks", "ior", "fresnel"][..], MICROFACET_KEYS].concat(),
+            "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
             _ => vec!["a", "b", "weight"],
@@ -96,6 +98,18 @@ impl Parser<'_> {
                 };
                 let facets = microfacets(&t)?;
                 BsdfDesc::Conductor { facets, eta, k, tint: t.opt_rgb("tint", Vec3::ONE)?, fresnel: fresnel(&t)? }
+            }
+            "plastic" => {
+                let facets = microfacets(&t)?;
+                if facets.is_some_and(|f| f.alpha_u != f.alpha_v) {
+                    return Err(t.req("roughness")?.err("a plastic's coat takes one roughness, not two"));
+                }
+                BsdfDesc::Plastic {
+                    albedo,
+                    ior: t.get("ior").map_or(Ok(1.49), |n| n.in_range(1.0 + 1e-6, 10.0))?,
+                    facets,
+                    nonlinear: t.opt_bool("nonlinear", false)?,
+                }
             }
             "dielectric" => BsdfDesc::Dielectric { facets: microfacets(&t)?, ior: ior(&t)?, fresnel: fresnel(&t)? },
             _ => BsdfDesc::Mix {

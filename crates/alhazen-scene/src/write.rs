@@ -388,6 +388,12 @@ impl Writer<'_> {
                 fresnel(*fr),
                 facets(&Some(*f))
             ),
+            BsdfDesc::Plastic { albedo, ior, facets: f, nonlinear } => format!(
+                "{{ type = \"plastic\", color = {}, ior = {}, nonlinear = {nonlinear}, {} }}",
+                self.texture(albedo),
+                num(*ior),
+                facets(f)
+            ),
             BsdfDesc::Conductor { facets: f, eta, k, tint, fresnel: fr } => format!(
                 "{{ type = \"conductor\", eta = {}, k = {}, tint = {}, fresnel = \"{}\", {} }}",
                 vec3(*eta),

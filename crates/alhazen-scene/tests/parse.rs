@@ -173,6 +173,32 @@ material = "lamp"
     assert_eq!(s.meshes[mesh].triangle_count(), 2);
 }
 
+/// Plastic: smooth by default (Mitsuba's polypropylene coat), rough with a roughness, and the
+/// same after writing the scene back out.
+#[test]
+fn plastic_reads_and_writes_back() {
+    use alhazen_scene::bsdf::{BsdfDesc, Distribution};
+    let text = r#"
+[materials.smooth]
+bsdf = { type = "plastic", color = [0.8, 0.1, 0.1] }
+[materials.rough]
+bsdf = { type = "plastic", color = [0.1, 0.3, 0.6], ior = 1.6, roughness = 0.15, distribution = "ggx", nonlinear = true }
+"#;
+    let s = parse_scene("plastic.toml".as_ref(), text).unwrap();
+    let mat = |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().bsdf.clone();
+    let Some(BsdfDesc::Plastic { ior, facets: None, nonlinear: false, .. }) = mat(&s, "smooth") else { panic!() };
+    assert_eq!(ior, 1.49);
+    let Some(BsdfDesc::Plastic { ior, facets: Some(f), nonlinear: true, .. }) = mat(&s, "rough") else { panic!() };
+    assert_eq!((ior, f.distribution, f.alpha_u), (1.6, Distribution::TrowbridgeReitz, 0.15));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&path).unwrap();
+    for name in ["smooth", "rough"] {
+        assert_eq!(format!("{:?}", mat(&s, name)), format!("{:?}", mat(&again, name)));
+    }
+}
+
 #[test]
 fn physically_based_mistakes_are_explained() {
     let m = |bsdf: &str| err(&format!("[materials.m]\nbsdf = {bsdf}\n"));
@@ -183,6 +209,8 @@ fn physically_based_mistakes_are_explained() {
             .contains("Smith shadowing has no closed form")
     );
     assert!(m(r#"{ type = "dielectric", ior = 1.5, glass = "bk7" }"#).contains("give one of"));
+    assert!(m(r#"{ type = "plastic", roughness = [0.1, 0.3] }"#).contains("takes one roughness"));
+    assert!(m(r#"{ type = "plastic", ior = 1.0 }"#).contains("ior"));
     assert!(m(r#"{ type = "dielectric", glass = "bk8" }"#).contains("did you mean \"bk7\"?"));
     assert!(m(r#"{ type = "dielectric", cauchy = [1.5, -1] }"#).contains("index of refraction at 360 nm"));
     assert!(m(r#"{ type = "conductor", metal = "gold", eta = [1, 1, 1] }"#).contains("either `metal` or `eta`"));

@@ -92,6 +92,9 @@ fn from_desc(desc: &BsdfDesc, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mod
                 schlick: *fresnel == FresnelMode::Schlick,
             },
         }),
+        BsdfDesc::Plastic { albedo, ior, facets, nonlinear } => {
+            Bsdf::Plastic(Plastic::new(tex(albedo), *ior, facets.as_ref().map(Microfacet::new), *nonlinear))
+        }
         BsdfDesc::Conductor { facets, eta, k, tint, fresnel } => Bsdf::Conductor(Conductor {
             facets: facets.as_ref().map(Microfacet::new),
             eta: mode.color(*eta),

@@ -18,6 +18,7 @@ pub mod microfacet;
 mod mix;
 mod oren_nayar;
 mod phong;
+mod plastic;
 
 pub use blinn_phong::{BlinnPhong, BlinnPhongLobe};
 pub use build::{ColorMode, bsdf_at, tangent_hint};
@@ -29,6 +30,7 @@ pub use microfacet::Microfacet;
 pub use mix::Mix;
 pub use oren_nayar::OrenNayar;
 pub use phong::{Phong, PhongLobe};
+pub use plastic::Plastic;
 
 use alhazen_math::{Vec2, Vec3};
 use std::f64::consts::PI;
@@ -63,6 +65,8 @@ pub enum Bsdf {
     BlinnPhong(BlinnPhong),
     /// Cook–Torrance.
     CookTorrance(CookTorrance),
+    /// A diffuse base under a dielectric coat.
+    Plastic(Plastic),
     /// Metal.
     Conductor(Conductor),
     /// Glass.
@@ -79,6 +83,7 @@ macro_rules! dispatch {
             Bsdf::Phong($b) => $e,
             Bsdf::BlinnPhong($b) => $e,
             Bsdf::CookTorrance($b) => $e,
+            Bsdf::Plastic($b) => $e,
             Bsdf::Conductor($b) => $e,
             Bsdf::Dielectric($b) => $e,
             Bsdf::Mix($b) => $e,
@@ -122,6 +127,7 @@ impl Bsdf {
     pub fn has_delta_lobe(&self) -> bool {
         match self {
             Bsdf::Conductor(c) => c.facets.is_none(),
+            Bsdf::Plastic(p) => p.has_mirror(),
             Bsdf::Dielectric(d) => d.facets.is_none(),
             Bsdf::Mix(m) => m.a.has_delta_lobe() || m.b.has_delta_lobe(),
             _ => false,

@@ -1,0 +1,344 @@
+//! Plastic: a diffuse base under a clear dielectric coat, the model of Mitsuba 3's `plastic`
+//! and `roughplastic` (after Weidlich and Wilkie 2007, "Arbitrarily layered micro-facet
+//! surfaces"). Light either reflects off the coat — a mirror weighted by Fresnel's `F`, or the
+//! Cook–Torrance microfacet lobe `D G F / (4⟨l,n⟩⟨v,n⟩)` of the course when rough — or enters,
+//! scatters diffusely off the base and bounces between base and coat until it leaves; the
+//! bounces sum to a geometric series:
+//!
+//! `ρ_d(l, v) = albedo / (1 − R_in) · t(v) t(l) / (π η²)`,
+//!
+//! `t(μ)` the coat's transmittance at incidence cosine `μ` (`1 − F(μ)` when smooth; for a rough
+//! coat the microfacet transmission lobe's albedo, found by quadrature and tabulated), `R_in`
+//! the coat's reflectance seen from inside averaged over the cosine-weighted hemisphere (the
+//! base's light comes back diffusely), `1/η²` the radiance's dilution across the interface.
+//! With `nonlinear`, `R_in` is weighted by the albedo (`albedo / (1 − albedo·R_in)`).
+//! Sampling picks the coat or the base by their shares of the light, as Mitsuba does.
+
+use super::microfacet::Microfacet;
+use super::{BsdfSample, cosine_hemisphere, cosine_pdf, half_vector, lobe_probability, reflect, refract, same_side};
+use crate::optics::fresnel_dielectric;
+use alhazen_math::{Vec2, Vec3};
+use std::cell::RefCell;
+use std::f64::consts::FRAC_1_PI;
+use std::sync::Mutex;
+
+/// Entries of the transmittance table, cosines `0, 1/(n−1), …, 1`.
+const TABLE: usize = 64;
+/// Gauss–Legendre nodes per dimension of the quadratures over microfacet normals.
+const NODES: usize = 48;
+
+/// A coat's transmittance table and inner reflectance.
+#[derive(Debug, PartialEq)]
+pub struct Coat {
+    transmittance: [f64; TABLE],
+    inner_reflectance: f64,
+}
+
+/// Plastic at one surface point.
+#[derive(Clone, Copy, Debug)]
+pub struct Plastic {
+    /// The base's albedo.
+    pub albedo: Vec3,
+    /// The coat's index relative to the outside.
+    pub eta: f64,
+    /// The coat's microfacets, or a smooth coat.
+    pub facets: Option<Microfacet>,
+    /// Albedo-weighted inner bounces.
+    pub nonlinear: bool,
+    /// The coat's tables.
+    pub coat: &'static Coat,
+}
+
+impl Plastic {
+    /// Plastic of `albedo` under a coat of index `eta` and roughness `facets`.
+    pub fn new(albedo: Vec3, eta: f64, facets: Option<Microfacet>, nonlinear: bool) -> Self {
+        Self { albedo, eta, facets, nonlinear, coat: Coat::of(eta, facets.as_ref()) }
+    }
+
+    /// `t(μ)` by linear interpolation in the table.
+    fn transmittance(&self, mu: f64) -> f64 {
+        let x = mu.abs().min(1.0) * (TABLE - 1) as f64;
+        let i = (x as usize).min(TABLE - 2);
+        let t = &self.coat.transmittance;
+        t[i] + (t[i + 1] - t[i]) * (x - i as f64)
+    }
+
+    /// The probability of sampling the coat rather than the base, seen from `v`: their shares
+    /// of the light (`1 − t(v)` and `t(v)`), weighted by the coat's (white) and the base's mean
+    /// colours.
+    fn p_coat(&self, v: Vec3) -> f64 {
+        let t = self.transmittance(v.z);
+        let base = (self.albedo.x + self.albedo.y + self.albedo.z) / 3.0;
+        lobe_probability((1.0 - t) / (1.0 + base), t * base / (1.0 + base))
+    }
+
+    fn base(&self, v: Vec3, l: Vec3) -> Vec3 {
+        let inner = if self.nonlinear {
+            self.albedo * self.coat.inner_reflectance
+        } else {
+            Vec3::splat(self.coat.inner_reflectance)
+        };
+        let t = self.transmittance(v.z) * self.transmittance(l.z);
+        self.albedo / (Vec3::ONE - inner) * (t * FRAC_1_PI / (self.eta * self.eta))
+    }
+
+    /// The rough coat's lobe `D G F / (4⟨l,n⟩⟨v,n⟩)` and its sampling density.
+    fn coat_lobe(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (f64, f64) {
+        let Some(h) = half_vector(v, l) else { return (0.0, 0.0) };
+        let f = fresnel_dielectric(h.dot(v), self.eta);
+        let value = facets.d(h) * facets.g(v, l, h) * f / (4.0 * l.z.abs() * v.z.abs());
+        (value, facets.pdf_h(h) / (4.0 * h.dot(v).abs()))
+    }
+
+    /// `ρ(l, v)` (the smooth coat's mirror only through `sample`).
+    pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
+        if !same_side(v, l) {
+            return Vec3::ZERO;
+        }
+        let coat = self.facets.map_or(0.0, |f| self.coat_lobe(&f, v, l).0);
+        self.base(v, l) + Vec3::splat(coat)
+    }
+
+    /// The mixture of the coat's and the base's densities (the smooth coat's mirror excluded).
+    pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
+        if !same_side(v, l) {
+            return 0.0;
+        }
+        let p = self.p_coat(v);
+        let coat = self.facets.map_or(0.0, |f| self.coat_lobe(&f, v, l).1);
+        p * coat + (1.0 - p) * cosine_pdf(v, l)
+    }
+
+    /// The coat or the base by `uc`, then a direction from it.
+    pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
+        let p = self.p_coat(v);
+        if uc < p {
+            let Some(facets) = self.facets else {
+                // The smooth coat's mirror: weight F, chosen with probability p.
+                let l = Vec3::new(-v.x, -v.y, v.z);
+                let f = Vec3::splat(fresnel_dielectric(v.z, self.eta) / l.z.abs());
+                return Some(BsdfSample { l, f, pdf: p, delta: true, eta: 1.0, dispersive: false });
+            };
+            let h = facets.sample_h(u)?;
+            let l = reflect(v, h * v.z.signum());
+            let pdf = self.pdf(v, l);
+            return (pdf > 0.0).then(|| BsdfSample {
+                l,
+                f: self.eval(v, l),
+                pdf,
+                delta: false,
+                eta: 1.0,
+                dispersive: false,
+            });
+        }
+        let l = cosine_hemisphere(u, v);
+        let pdf = self.pdf(v, l);
+        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+
+    /// True for a smooth coat (a mirror lobe).
+    pub fn has_mirror(&self) -> bool {
+        self.facets.is_none()
+    }
+}
+
+/// A coat's identity for the cache: index, and distribution, roughness and shadowing.
+type CoatKey = (u64, Option<(u8, u64, u8)>);
+
+fn key(eta: f64, facets: Option<&Microfacet>) -> CoatKey {
+    (eta.to_bits(), facets.map(|f| (f.distribution as u8, f.alpha_u.to_bits(), f.shadowing as u8)))
+}
+
+/// Every coat computed in this process: a few per scene, kept for the process's life so a
+/// surface point's BSDF can point at its tables without counting references.
+static COATS: Mutex<Vec<(CoatKey, &'static Coat)>> = Mutex::new(vec![]);
+
+thread_local! {
+    /// This thread's view of [`COATS`]: textured plastic builds its BSDF at every hit, and the
+    /// lookup should not take a lock.
+    static SEEN: RefCell<Vec<(CoatKey, &'static Coat)>> = const { RefCell::new(vec![]) };
+}
+
+impl Coat {
+    /// The tables of a coat of index `eta` and roughness `facets`, computed once per process.
+    pub fn of(eta: f64, facets: Option<&Microfacet>) -> &'static Coat {
+        let k = key(eta, facets);
+        if let Some(c) = SEEN.with_borrow(|seen| seen.iter().find(|e| e.0 == k).map(|e| e.1)) {
+            return c;
+        }
+        let coat = {
+            let mut all = COATS.lock().unwrap_or_else(|e| e.into_inner());
+            match all.iter().find(|e| e.0 == k) {
+                Some(e) => e.1,
+                None => {
+                    let c: &'static Coat = Box::leak(Box::new(Coat::compute(eta, facets)));
+                    all.push((k, c));
+                    c
+                }
+            }
+        };
+        SEEN.with_borrow_mut(|seen| seen.push((k, coat)));
+        coat
+    }
+
+    fn compute(eta: f64, facets: Option<&Microfacet>) -> Coat {
+        let mut transmittance = [0.0; TABLE];
+        for (i, t) in transmittance.iter_mut().enumerate() {
+            let mu = (i as f64 / (TABLE - 1) as f64).max(1e-6);
+            *t = match facets {
+                None => 1.0 - fresnel_dielectric(mu, eta),
+                Some(f) => rough_transmittance(f, mu, eta),
+            };
+        }
+        // R_in = 2 ∫₀¹ R(μ) μ dμ, R the reflectance from inside (index 1/η).
+        let inner_reflectance = gauss_legendre(NODES)
+            .iter()
+            .map(|&(mu, w)| {
+                let r = match facets {
+                    None => fresnel_dielectric(mu, 1.0 / eta),
+                    Some(f) => rough_reflectance(f, mu, 1.0 / eta),
+                };
+                2.0 * w * r * mu
+            })
+            .sum();
+        Coat { transmittance, inner_reflectance }
+    }
+}
+
+/// The incident direction at cosine `mu` in the `xz` plane.
+fn incident(mu: f64) -> Vec3 {
+    Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu)
+}
+
+/// The albedo of a rough interface's lobe seen from `v`: `∫ w(h) G(v, l, h) ⟨v,h⟩/(⟨v,n⟩⟨h,n⟩)`
+/// over facet normals `h` drawn with density `D(h)⟨h,n⟩`, by Gauss–Legendre quadrature over
+/// the sampler's unit square; `lobe(h)` gives the outgoing direction and the facet's weight.
+fn lobe_albedo(f: &Microfacet, v: Vec3, lobe: impl Fn(Vec3) -> Option<(Vec3, f64)>) -> f64 {
+    let nodes = gauss_legendre(NODES);
+    let mut sum = 0.0;
+    for &(x, wx) in &nodes {
+        for &(y, wy) in &nodes {
+            let Some(h) = f.sample_h(Vec2::new(x, y)) else { continue };
+            let Some((l, weight)) = lobe(h) else { continue };
+            let vh = v.dot(h);
+            if vh <= 0.0 || h.z <= 0.0 {
+                continue;
+            }
+            sum += wx * wy * weight * f.g(v, l, h) * vh / (v.z * h.z);
+        }
+    }
+    sum
+}
+
+/// A rough coat's transmittance at incidence cosine `mu`: the light refracted into it.
+fn rough_transmittance(f: &Microfacet, mu: f64, eta: f64) -> f64 {
+    let v = incident(mu);
+    lobe_albedo(f, v, |h| {
+        let (l, _) = refract(v, h, eta)?;
+        (l.z < 0.0).then(|| (l, 1.0 - fresnel_dielectric(v.dot(h), eta)))
+    })
+}
+
+/// A rough interface's reflectance at incidence cosine `mu` for the relative index `eta`.
+fn rough_reflectance(f: &Microfacet, mu: f64, eta: f64) -> f64 {
+    let v = incident(mu);
+    lobe_albedo(f, v, |h| {
+        let l = reflect(v, h);
+        (l.z > 0.0).then(|| (l, fresnel_dielectric(v.dot(h), eta)))
+    })
+}
+
+/// The `n`-point Gauss–Legendre rule on `[0, 1]`: nodes and weights (Newton's iteration on the
+/// Legendre polynomial from Chebyshev's guesses).
+fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 1.0;
+            for _ in 0..100 {
+                // P_n(x) and P_n'(x) by the three-term recurrence.
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    (p0, p1) = (p1, ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64);
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let step = p1 / dp;
+                x -= step;
+                if step.abs() < 1e-15 {
+                    break;
+                }
+            }
+            let w = 2.0 / ((1.0 - x * x) * dp * dp);
+            ((1.0 - x) / 2.0, w / 2.0)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alhazen_scene::bsdf::{Distribution, Microfacets, Shadowing};
+
+    fn ggx(alpha: f64) -> Microfacet {
+        Microfacet::new(&Microfacets {
+            distribution: Distribution::TrowbridgeReitz,
+            alpha_u: alpha,
+            alpha_v: alpha,
+            shadowing: Shadowing::Smith,
+        })
+    }
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        let rule = gauss_legendre(8);
+        assert!((rule.iter().map(|e| e.1).sum::<f64>() - 1.0).abs() < 1e-14);
+        // ∫₀¹ x^15 = 1/16: exact for degree ≤ 2n − 1.
+        assert!((rule.iter().map(|&(x, w)| w * x.powi(15)).sum::<f64>() - 1.0 / 16.0).abs() < 1e-14);
+    }
+
+    /// A nearly smooth rough coat has the smooth coat's tables; a rough one lets more light in
+    /// at grazing angles (its facets face the light) and conserves energy.
+    #[test]
+    fn rough_coats_tend_to_the_smooth_one() {
+        let smooth = Coat::compute(1.5, None);
+        let nearly = Coat::compute(1.5, Some(&ggx(0.002)));
+        for i in [8, 32, 63] {
+            assert!((smooth.transmittance[i] - nearly.transmittance[i]).abs() < 2e-3, "{i}");
+        }
+        assert!((smooth.inner_reflectance - nearly.inner_reflectance).abs() < 5e-3);
+        // The smooth inner reflectance from 1.5 is about 0.596 (the diffuse Fresnel
+        // reflectance of an index-1/1.5 interface).
+        assert!((smooth.inner_reflectance - 0.596).abs() < 2e-3, "{}", smooth.inner_reflectance);
+        let rough = Coat::compute(1.5, Some(&ggx(0.3)));
+        assert!(rough.transmittance.iter().all(|&t| (0.0..=1.0).contains(&t)));
+        assert!(rough.transmittance[4] > smooth.transmittance[4]);
+    }
+
+    /// A white base under a smooth coat reflects everything that arrives (`ρ = 1`): the
+    /// albedo at every angle is 1, by quadrature over the hemisphere plus the coat's mirror.
+    #[test]
+    fn white_plastic_conserves_energy() {
+        for facets in [None, Some(ggx(0.05))] {
+            let p = Plastic::new(Vec3::ONE, 1.5, facets, false);
+            for mu in [0.3, 0.7, 1.0] {
+                let v = incident(mu);
+                let (n, mut sum) = (400, 0.0);
+                for i in 0..n {
+                    let z = (i as f64 + 0.5) / n as f64;
+                    for j in 0..n {
+                        let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / n as f64;
+                        let r = (1.0 - z * z).sqrt();
+                        let l = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                        sum += p.eval(v, l).x * z;
+                    }
+                }
+                let mut albedo = sum * 2.0 * std::f64::consts::PI / (n * n) as f64;
+                if facets.is_none() {
+                    albedo += fresnel_dielectric(mu, 1.5);
+                }
+                // The base conserves energy exactly; the single-scattering rough coat loses a little.
+                assert!(albedo <= 1.0 + 5e-3 && albedo > 0.93, "{facets:?} μ {mu}: {albedo}");
+            }
+        }
+    }
+}
