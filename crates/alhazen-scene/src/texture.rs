@@ -46,8 +46,18 @@ fn bilinear(img: &ImageData, uv: Vec2) -> Vec3 {
     let y = (1.0 - uv.y.rem_euclid(1.0)) * h as f64 - 0.5;
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
+    // The coordinates lie in [−1, size]: wrapped by a comparison, not an integer division.
+    let wrap = |k: i64, size: i64| {
+        if k < 0 {
+            k + size
+        } else if k >= size {
+            k - size
+        } else {
+            k
+        }
+    };
     let px = |i: i64, j: i64| {
-        let p = img.pixels[(j.rem_euclid(h) * w + i.rem_euclid(w)) as usize];
+        let p = img.pixels[(wrap(j, h) * w + wrap(i, w)) as usize];
         Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
     };
     let (i, j) = (x0 as i64, y0 as i64);
@@ -59,6 +69,29 @@ fn bilinear(img: &ImageData, uv: Vec2) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    proptest::proptest! {
+        /// Wrapping by comparison reads the texels wrapping by `rem_euclid` reads, anywhere:
+        /// negative, on the edges, far away.
+        #[test]
+        fn bilinear_wraps_like_rem_euclid(u in -1e6..1e6f64, v in -1e6..1e6f64, edge in 0usize..4) {
+            let img = ImageData { width: 5, height: 3, pixels: (0..15).map(|i| [i as f32, (i * i) as f32, 1.0]).collect() };
+            let uv = match edge { 0 => Vec2::new(u, v), 1 => Vec2::new(-1e-20, v), 2 => Vec2::new(u, 1.0), _ => Vec2::new(u.fract(), v.fract()) };
+            let (w, h) = (5i64, 3i64);
+            let x = uv.x.rem_euclid(1.0) * w as f64 - 0.5;
+            let y = (1.0 - uv.y.rem_euclid(1.0)) * h as f64 - 0.5;
+            let (x0, y0) = (x.floor(), y.floor());
+            let (fx, fy) = (x - x0, y - y0);
+            let px = |i: i64, j: i64| {
+                let p = img.pixels[(j.rem_euclid(h) * w + i.rem_euclid(w)) as usize];
+                Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+            };
+            let (i, j) = (x0 as i64, y0 as i64);
+            let top = px(i, j) * (1.0 - fx) + px(i + 1, j) * fx;
+            let bottom = px(i, j + 1) * (1.0 - fx) + px(i + 1, j + 1) * fx;
+            proptest::prop_assert_eq!(bilinear(&img, uv), top * (1.0 - fy) + bottom * fy);
+        }
+    }
 
     #[test]
     fn checker_alternates_with_unit_squares() {
