@@ -974,7 +974,10 @@ impl Importer {
                 } else {
                     alhazen_scene::import::load_image(&path)
                 };
-                let img = img.map_err(|e| ctx.err(node, e))?;
+                // Mitsuba reads texture coordinate v = 0 at the image's top row, alhazen at its
+                // bottom (as OpenGL and glTF's flipped convention do): turned upside down, the
+                // image shows each coordinate the texel Mitsuba shows it.
+                let img = upside_down(img.map_err(|e| ctx.err(node, e))?);
                 if let Some(w) = self.string(ctx, &p, "wrap_mode")?.filter(|w| w != "repeat") {
                     self.warn(ctx, node, format!("wrap_mode \"{w}\": alhazen's image textures repeat"));
                 }
@@ -1224,6 +1227,14 @@ impl Importer {
 }
 
 /// Turns a mesh inside out: reversed winding and normals.
+/// The image with its rows in reverse order.
+fn upside_down(mut img: alhazen_scene::ImageData) -> alhazen_scene::ImageData {
+    let w = img.width as usize;
+    let rows: Vec<&[[f32; 3]]> = img.pixels.chunks_exact(w.max(1)).rev().collect();
+    img.pixels = rows.concat();
+    img
+}
+
 pub(crate) fn flip_mesh(mesh: &mut alhazen_geom::TriangleMesh) {
     for t in &mut mesh.triangles {
         t.swap(1, 2);

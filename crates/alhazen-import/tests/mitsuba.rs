@@ -164,6 +164,28 @@ fn old_scenes_have_their_names_upgraded() {
     );
 }
 
+/// Mitsuba reads `v = 0` at a bitmap's top row: a texture red on top and blue below shows red
+/// at `v = 1/4` after import (alhazen's own convention puts `v = 0` at the bottom).
+#[test]
+fn bitmap_textures_keep_mitsubas_orientation() {
+    let dir = tempfile::tempdir().unwrap();
+    let png =
+        image::RgbImage::from_fn(1, 2, |_, y| if y == 0 { image::Rgb([255, 0, 0]) } else { image::Rgb([0, 0, 255]) });
+    png.save(dir.path().join("two.png")).unwrap();
+    let xml = scene(
+        "<shape type=\"sphere\">\n<bsdf type=\"diffuse\">\n<texture name=\"reflectance\" type=\"bitmap\">\n\
+         <string name=\"filename\" value=\"two.png\"/>\n<string name=\"filter_type\" value=\"nearest\"/>\n\
+         </texture>\n</bsdf>\n</shape>",
+    );
+    std::fs::write(dir.path().join("t.xml"), xml).unwrap();
+    let s = alhazen_import::load(&dir.path().join("t.xml")).unwrap().scene;
+    let Some(BsdfDesc::Lambert { albedo }) = &s.materials[s.objects[0].material as usize].bsdf else { panic!() };
+    let at = |v: f64| alhazen_scene::texture::eval(albedo, alhazen_math::Vec2::new(0.5, v), &s.images);
+    // At the texel centres (textures are filtered bilinearly).
+    assert_eq!(at(0.25), Vec3::new(1.0, 0.0, 0.0), "v = 1/4 is the top row's red");
+    assert_eq!(at(0.75), Vec3::new(0.0, 0.0, 1.0), "v = 3/4 is the bottom row's blue");
+}
+
 #[test]
 fn what_is_approximated_is_said_with_its_line() {
     let s = import(&[(

@@ -291,25 +291,27 @@ impl<'a> PathTracer<'a> {
         }
         out.beta = path.beta;
         let wo = -path.ray.dir;
-        let (frame, ng) = self.shading_frame(wh, &bsdf, wo, tangent_hint(m));
+        let (frame, ng, terminator) = self.shading_frame(wh, &bsdf, wo, tangent_hint(m));
         let v = frame.to_local(wo);
         // One pair picks the light and the BSDF lobe, drawn only when there is a choice;
         // one pair each places the points.
         let choices = if self.lights.len() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
         if !bsdf.is_delta() {
-            let (light, shadow) = self.next_event(&bsdf, &frame, wh.hit.p, ng, v, mode, choices.x, s);
+            let (light, shadow) = self.next_event(&bsdf, &frame, terminator, wh.hit.p, ng, v, mode, choices.x, s);
             (out.light, out.shadow) = (Some(light), shadow);
             if let Some(c) = self.mirrors.as_ref().filter(|_| path.depth + 2 <= max_depth) {
-                out.mirrored = Some(self.mirror_connections(c, &bsdf, &frame, wh.hit.p, ng, v, wh.object, mode, s));
+                out.mirrored =
+                    Some(self.mirror_connections(c, &bsdf, &frame, terminator, wh.hit.p, ng, v, wh.object, mode, s));
             }
             if let Some(c) = self.caustics {
                 // RGB only: photon mapping refuses dispersive scenes.
-                path.l += path.beta * c.radiance(wh.hit.p, ng, &|wi| bsdf.eval(v, frame.to_local(wi)));
+                let f = |wi: Vec3| bsdf.eval(v, frame.to_local(wi)) * Terminator::shadowing(terminator, wi);
+                path.l += path.beta * c.radiance(wh.hit.p, ng, &f);
             }
         }
         let Some(bs) = bsdf.sample(v, choices.y, s.next_2d()) else { return };
         let dir = frame.to_world(bs.l);
-        let weight = bs.f * bs.l.z.abs() / bs.pdf;
+        let weight = bs.f * bs.l.z.abs() / bs.pdf * Terminator::shadowing(terminator, dir);
         if !weight.is_finite() || weight == Vec3::ZERO {
             return;
         }
@@ -373,20 +375,28 @@ impl<'a> PathTracer<'a> {
     }
 
     /// The local frame (normal on the viewer's side for opaque surfaces — the course's two-sided
-    /// reading of the same-side factor) and the geometric normal on the same side.
+    /// reading of the same-side factor), the geometric normal on the same side, and the shadowing
+    /// of a bump or normal map.
     #[inline(always)]
-    fn shading_frame(&self, wh: &WorldHit, bsdf: &Bsdf, wo: Vec3, tangent: Option<Vec3>) -> (Frame, Vec3) {
+    fn shading_frame(
+        &self,
+        wh: &WorldHit,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        tangent: Option<Vec3>,
+    ) -> (Frame, Vec3, Option<Terminator>) {
         let m = &self.scene.materials[wh.material as usize];
         let (mut ng, mut ns) = (wh.hit.n, crate::world::shading_normal(&wh.hit, m, &self.scene.images));
+        let mut n0 = wh.hit.ns;
         if !bsdf.transmits() && ng.dot(wo) < 0.0 {
-            ng = -ng;
-            ns = -ns;
+            (ng, ns, n0) = (-ng, -ns, -n0);
         }
         // A shading normal that puts the viewer on the other side than the geometry would leak.
         if ns.dot(wo) * ng.dot(wo) <= 0.0 {
             ns = ng;
         }
-        (tangent.map_or_else(|| Frame::around(ns), |t| Frame::new(ns, t)), ng)
+        let terminator = m.bump.as_ref().and_then(|_| Terminator::between(n0, ns));
+        (tangent.map_or_else(|| Frame::around(ns), |t| Frame::new(ns, t)), ng, terminator)
     }
 
     /// One light sample, weighted by the power heuristic against the BSDF's density: what it
@@ -397,6 +407,7 @@ impl<'a> PathTracer<'a> {
         &self,
         bsdf: &Bsdf,
         frame: &Frame,
+        terminator: Option<Terminator>,
         p: Vec3,
         ng: Vec3,
         v: Vec3,
@@ -409,7 +420,7 @@ impl<'a> PathTracer<'a> {
             return (Vec3::ZERO, None);
         }
         let l = frame.to_local(ls.dir);
-        let f = bsdf.eval(v, l) * l.z.abs();
+        let f = bsdf.eval(v, l) * l.z.abs() * Terminator::shadowing(terminator, ls.dir);
         // Light must leave from the side of the geometry the BSDF sends it to.
         if f == Vec3::ZERO || (ng.dot(ls.dir) > 0.0) != (l.z > 0.0) && !bsdf.transmits() {
             return (Vec3::ZERO, None);
@@ -466,5 +477,64 @@ impl PathTracer<'_> {
         } else {
             self.radiance(ray, ColorMode::Rgb, &mut s)
         }
+    }
+}
+
+/// The shadowing a bump or normal map casts on itself (Estevez et al. 2019, "A microfacet-based
+/// shadowing function to solve the bump terminator problem", Ray Tracing Gems ch. 12; what
+/// Mitsuba 3 applies to its `bumpmap` and `normalmap`): the bent normal read as the mean of a
+/// microfacet distribution of roughness `α² = min(tan²ϑ_b / 8, 1)`, `ϑ_b` its angle to the
+/// surface's own shading normal, whose Smith term `2 / (1 + √(1 + α² tan²ϑ))` dims light
+/// arriving at grazing angles to the unbent surface, which the bent normal would otherwise light
+/// too brightly, ending the shading abruptly at the terminator.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Terminator {
+    /// The unbent shading normal.
+    normal: Vec3,
+    /// `α²`.
+    alpha2: f64,
+}
+
+impl Terminator {
+    /// The shadowing of a surface of shading normal `n0` bent to `ns`; `None` where it is not
+    /// bent (or bent past the horizon, where the leak guard has replaced it).
+    fn between(n0: Vec3, ns: Vec3) -> Option<Self> {
+        let c = n0.dot(ns).clamp(-1.0, 1.0);
+        (c < 1.0 && c > 0.0).then(|| Self { normal: n0, alpha2: (0.125 * (1.0 - c * c) / (c * c)).min(1.0) })
+    }
+
+    /// The factor for light arriving from (or leaving towards) world direction `dir`; 1 without
+    /// a bent normal.
+    #[inline]
+    fn shadowing(t: Option<Self>, dir: Vec3) -> f64 {
+        let Some(t) = t else { return 1.0 };
+        let c2 = t.normal.dot(dir).powi(2);
+        if c2 <= 0.0 {
+            return 0.0;
+        }
+        2.0 / (1.0 + (1.0 + t.alpha2 * (1.0 - c2).max(0.0) / c2).sqrt())
+    }
+}
+
+#[cfg(test)]
+mod terminator_tests {
+    use super::*;
+
+    /// No bend, no shadowing; a bent normal dims light the more grazing it arrives to the
+    /// unbent surface, never at normal incidence, and light from below is dark.
+    #[test]
+    fn bump_shadowing_dims_grazing_light_only() {
+        let n0 = Vec3::Z;
+        assert!(Terminator::between(n0, n0).is_none());
+        let t = Terminator::between(n0, Vec3::new(0.5, 0.0, 1.0).normalize());
+        assert_eq!(Terminator::shadowing(t, Vec3::Z), 1.0);
+        let grazing = |deg: f64| {
+            let a = deg.to_radians();
+            Terminator::shadowing(t, Vec3::new(a.sin(), 0.0, a.cos()))
+        };
+        assert!(1.0 > grazing(30.0) && grazing(30.0) > grazing(60.0) && grazing(60.0) > grazing(89.0));
+        assert!(grazing(89.0) > 0.0 && grazing(60.0) > 0.9, "{} {}", grazing(60.0), grazing(89.0));
+        assert_eq!(Terminator::shadowing(t, Vec3::X), 0.0);
+        assert_eq!(Terminator::shadowing(None, Vec3::X), 1.0);
     }
 }

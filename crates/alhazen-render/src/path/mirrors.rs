@@ -8,7 +8,7 @@
 //! mirror; both strategies are weighted by the power heuristic, the connection's density
 //! expressed as a solid angle at `x`: `p_A / (G cos θ_y)`.
 
-use super::{PathTracer, epsilon, offset, power_heuristic};
+use super::{PathTracer, Terminator, epsilon, offset, power_heuristic};
 use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at};
 use crate::connect::{MirrorPath, MirrorShape, Source};
 use crate::lights::{Lights, PathLight};
@@ -117,6 +117,7 @@ impl PathTracer<'_> {
         c: &MirrorConnections,
         bsdf: &Bsdf,
         frame: &Frame,
+        terminator: Option<Terminator>,
         x: Vec3,
         ng: Vec3,
         v: Vec3,
@@ -134,7 +135,8 @@ impl PathTracer<'_> {
                     continue;
                 }
                 piece.shape.reflections(x, source, |path| {
-                    sum += self.connected_path(piece, light, area_point, bsdf, frame, x, ng, v, mode, &path);
+                    let at = (bsdf, frame, terminator);
+                    sum += self.connected_path(piece, light, area_point, at, x, ng, v, mode, &path);
                 });
             }
         }
@@ -161,8 +163,7 @@ impl PathTracer<'_> {
         piece: &MirrorPiece,
         light: usize,
         area_point: Option<(Vec3, f64)>,
-        bsdf: &Bsdf,
-        frame: &Frame,
+        (bsdf, frame, terminator): (&Bsdf, &Frame, Option<Terminator>),
         x: Vec3,
         ng: Vec3,
         v: Vec3,
@@ -170,7 +171,7 @@ impl PathTracer<'_> {
         path: &MirrorPath,
     ) -> Vec3 {
         let l = frame.to_local(path.to_mirror);
-        let f = bsdf.eval(v, l) * l.z.abs();
+        let f = bsdf.eval(v, l) * l.z.abs() * Terminator::shadowing(terminator, path.to_mirror);
         if f == Vec3::ZERO || (ng.dot(path.to_mirror) > 0.0) != (l.z > 0.0) && !bsdf.transmits() {
             return Vec3::ZERO;
         }
