@@ -80,23 +80,27 @@ impl Microfacet {
 
     /// A normal `h` with density `D(h) cos ϑ_h`; `None` only on rejection failure.
     pub fn sample_h(&self, u: Vec2) -> Option<Vec3> {
-        let (theta, phi) = match self.distribution {
-            Distribution::Gaussian => (self.sample_gaussian_theta(u.x)?, 2.0 * PI * u.y),
-            _ => {
-                // Azimuth of an elliptically stretched uniform direction.
-                let phi0 = 2.0 * PI * u.y;
-                let phi = (self.alpha_v * phi0.sin()).atan2(self.alpha_u * phi0.cos());
-                let inv_a2 = (phi.cos() / self.alpha_u).powi(2) + (phi.sin() / self.alpha_v).powi(2);
-                let u0 = u.x.min(1.0 - 1e-16);
-                let tan2 = match self.distribution {
-                    Distribution::Beckmann => -(1.0 - u0).ln() / inv_a2,
-                    _ => u0 / ((1.0 - u0) * inv_a2),
-                };
-                ((tan2.sqrt()).atan(), phi)
-            }
+        if self.distribution == Distribution::Gaussian {
+            let (theta, phi) = (self.sample_gaussian_theta(u.x)?, 2.0 * PI * u.y);
+            let (st, ct) = theta.sin_cos();
+            return Some(Vec3::new(st * phi.cos(), st * phi.sin(), ct));
+        }
+        // The azimuth of an elliptically stretched uniform direction: (m_u cos φ₀, m_v sin φ₀)
+        // has the azimuth φ, and its squared length r² is 1/(cos²φ/m_u² + sin²φ/m_v²), the
+        // factor tan²ϑ takes — no inverse trigonometry needed.
+        let (s0, c0) = alhazen_math::sin_cos_turns(u.y);
+        let (x, y) = (self.alpha_u * c0, self.alpha_v * s0);
+        let r2 = x * x + y * y;
+        let r = r2.sqrt();
+        let (cos_phi, sin_phi) = if r > 0.0 { (x / r, y / r) } else { (1.0, 0.0) };
+        let u0 = u.x.min(1.0 - 1e-16);
+        let tan2 = match self.distribution {
+            Distribution::Beckmann => -(1.0 - u0).ln() * r2,
+            _ => u0 / (1.0 - u0) * r2,
         };
-        let (st, ct) = theta.sin_cos();
-        Some(Vec3::new(st * phi.cos(), st * phi.sin(), ct))
+        let ct = 1.0 / (1.0 + tan2).sqrt();
+        let st = (tan2 / (1.0 + tan2)).sqrt();
+        Some(Vec3::new(st * cos_phi, st * sin_phi, ct))
     }
 
     /// ϑ with density ∝ `exp(−(ϑ/m)²) cos ϑ sin ϑ` by rejection from the Rayleigh density
