@@ -25,46 +25,24 @@ pub struct Conductor {
     pub schlick: bool,
 }
 
-/// Minimal complex arithmetic for the conductor Fresnel equations.
-#[derive(Clone, Copy, Debug)]
-struct C(f64, f64);
-
-impl C {
-    fn add(self, o: C) -> C {
-        C(self.0 + o.0, self.1 + o.1)
-    }
-    fn sub(self, o: C) -> C {
-        C(self.0 - o.0, self.1 - o.1)
-    }
-    fn mul(self, o: C) -> C {
-        C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
-    }
-    fn div(self, o: C) -> C {
-        let d = o.0 * o.0 + o.1 * o.1;
-        C((self.0 * o.0 + self.1 * o.1) / d, (self.1 * o.0 - self.0 * o.1) / d)
-    }
-    fn norm2(self) -> f64 {
-        self.0 * self.0 + self.1 * self.1
-    }
-    fn sqrt(self) -> C {
-        let r = self.norm2().sqrt();
-        let re = ((r + self.0) / 2.0).max(0.0).sqrt();
-        let im = ((r - self.0) / 2.0).max(0.0).sqrt();
-        C(re, if self.1 < 0.0 { -im } else { im })
-    }
-}
-
 /// Unpolarised reflectance of a conductor `η + iκ` at incidence cosine `cos_i`:
-/// `½(|r_∥|² + |r_⊥|²)` with the complex cosine of the transmitted angle.
+/// `½(|r_∥|² + |r_⊥|²)`, the complex cosine of the transmitted angle written through its real
+/// quantities (Born and Wolf §14.2): with `s² = 1 − c²`, `t₀ = η² − κ² − s²`,
+/// `a² + b² = √(t₀² + 4η²κ²)` and `a = √((a² + b² + t₀)/2)`,
+/// `R_⊥ = (a² + b² + c² − 2ac)/(a² + b² + c² + 2ac)` and
+/// `R_∥ = R_⊥ (c²(a² + b²) + s⁴ − 2acs²)/(c²(a² + b²) + s⁴ + 2acs²)` — two square roots and two
+/// divisions where complex arithmetic takes three complex divisions (test: the same values).
 pub fn fresnel_conductor(cos_i: f64, eta: f64, k: f64) -> f64 {
     let c = cos_i.abs().min(1.0);
-    let n = C(eta, k);
-    let sin2_t = C(1.0 - c * c, 0.0).div(n.mul(n));
-    let cos_t = C(1.0, 0.0).sub(sin2_t).sqrt();
-    let ci = C(c, 0.0);
-    let r_par = n.mul(ci).sub(cos_t).div(n.mul(ci).add(cos_t));
-    let r_perp = ci.sub(n.mul(cos_t)).div(ci.add(n.mul(cos_t)));
-    ((r_par.norm2() + r_perp.norm2()) / 2.0).min(1.0)
+    let (c2, s2) = (c * c, 1.0 - c * c);
+    let t0 = eta * eta - k * k - s2;
+    let ab2 = (t0 * t0 + 4.0 * eta * eta * k * k).sqrt();
+    let a = (0.5 * (ab2 + t0)).max(0.0).sqrt();
+    let (t1, t2) = (ab2 + c2, 2.0 * c * a);
+    let perp = (t1 - t2) / (t1 + t2);
+    let (t3, t4) = (c2 * ab2 + s2 * s2, t2 * s2);
+    let par = perp * (t3 - t4) / (t3 + t4);
+    ((par + perp) / 2.0).clamp(0.0, 1.0)
 }
 
 impl Conductor {
@@ -115,5 +93,60 @@ impl Conductor {
         let l = reflect(v, h * v.z.signum());
         let pdf = self.pdf(v, l);
         (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Complex arithmetic, for the reference form of the equations.
+    #[derive(Clone, Copy)]
+    struct C(f64, f64);
+
+    impl C {
+        fn add(self, o: C) -> C {
+            C(self.0 + o.0, self.1 + o.1)
+        }
+        fn sub(self, o: C) -> C {
+            C(self.0 - o.0, self.1 - o.1)
+        }
+        fn mul(self, o: C) -> C {
+            C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
+        }
+        fn div(self, o: C) -> C {
+            let d = o.0 * o.0 + o.1 * o.1;
+            C((self.0 * o.0 + self.1 * o.1) / d, (self.1 * o.0 - self.0 * o.1) / d)
+        }
+        fn norm2(self) -> f64 {
+            self.0 * self.0 + self.1 * self.1
+        }
+        fn sqrt(self) -> C {
+            let r = self.norm2().sqrt();
+            let re = ((r + self.0) / 2.0).max(0.0).sqrt();
+            let im = ((r - self.0) / 2.0).max(0.0).sqrt();
+            C(re, if self.1 < 0.0 { -im } else { im })
+        }
+    }
+
+    /// `½(|r_∥|² + |r_⊥|²)` with the complex transmitted cosine, term by term.
+    fn complex_form(c: f64, eta: f64, k: f64) -> f64 {
+        let n = C(eta, k);
+        let sin2_t = C(1.0 - c * c, 0.0).div(n.mul(n));
+        let cos_t = C(1.0, 0.0).sub(sin2_t).sqrt();
+        let ci = C(c, 0.0);
+        let r_par = n.mul(ci).sub(cos_t).div(n.mul(ci).add(cos_t));
+        let r_perp = ci.sub(n.mul(cos_t)).div(ci.add(n.mul(cos_t)));
+        ((r_par.norm2() + r_perp.norm2()) / 2.0).min(1.0)
+    }
+
+    proptest::proptest! {
+        /// The real form gives the complex form's reflectance for metals, dielectrics and
+        /// everything between, at every angle.
+        #[test]
+        fn real_form_is_the_complex_form(c in 0.0..=1.0f64, eta in 0.05..5.0f64, k in 0.0..10.0f64) {
+            let (a, b) = (fresnel_conductor(c, eta, k), complex_form(c, eta, k));
+            proptest::prop_assert!((a - b).abs() <= 1e-12 + 1e-9 * b, "c {} η {} κ {}: {} vs {}", c, eta, k, a, b);
+        }
     }
 }
