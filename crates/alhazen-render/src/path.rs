@@ -420,7 +420,9 @@ impl<'a> PathTracer<'a> {
             return (Vec3::ZERO, None);
         }
         let l = frame.to_local(ls.dir);
-        let f = bsdf.eval(v, l) * l.z.abs() * Terminator::shadowing(terminator, ls.dir);
+        // The density is needed only against a light that could also be hit.
+        let (f, bsdf_pdf) = if ls.delta { (bsdf.eval(v, l), 0.0) } else { bsdf.eval_pdf(v, l) };
+        let f = f * l.z.abs() * Terminator::shadowing(terminator, ls.dir);
         // Light must leave from the side of the geometry the BSDF sends it to.
         if f == Vec3::ZERO || (ng.dot(ls.dir) > 0.0) != (l.z > 0.0) && !bsdf.transmits() {
             return (Vec3::ZERO, None);
@@ -429,7 +431,7 @@ impl<'a> PathTracer<'a> {
         // Stop short of the light point by more than the origin moved, so the light does not
         // shadow itself.
         let dist = if ls.dist.is_finite() { ls.dist * (1.0 - 1e-7) - 4.0 * epsilon(p) } else { f64::INFINITY };
-        let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf.pdf(v, l)) };
+        let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf_pdf) };
         (f * mode.color(ls.radiance) * (w / ls.pdf), Some((Ray::new(origin, ls.dir), dist)))
     }
 }

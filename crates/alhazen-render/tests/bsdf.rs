@@ -320,6 +320,22 @@ fn smooth_dielectric_splits_energy_without_loss() {
 }
 
 #[test]
+fn eval_pdf_gives_eval_and_pdf_bit_for_bit() {
+    let mut rng = Rng::for_sample(3, 1, 4, 1);
+    let mut cases = catalogue();
+    cases.push(("smooth plastic".into(), Bsdf::Plastic(Plastic::new(Vec3::splat(0.5), 1.5, None, false))));
+    for (name, b) in cases {
+        for _ in 0..300 {
+            let v = direction(rng.uniform() * 180.0, rng.uniform() * 2.0 * PI);
+            let l = direction(rng.uniform() * 180.0, rng.uniform() * 2.0 * PI);
+            let (f, pdf) = b.eval_pdf(v, l);
+            assert_eq!(f.to_array().map(f64::to_bits), b.eval(v, l).to_array().map(f64::to_bits), "{name}");
+            assert_eq!(pdf.to_bits(), b.pdf(v, l).to_bits(), "{name}");
+        }
+    }
+}
+
+#[test]
 fn white_smooth_plastic_reflects_all_it_receives() {
     // The coat's mirror F plus the base's closed-form bounces: exactly 1 in theory; the
     // tabulated transmittance leaves a small error.

@@ -82,6 +82,18 @@ impl Conductor {
         f.pdf_h(h) / (4.0 * h.dot(v).abs())
     }
 
+    /// [`Self::eval`] and [`Self::pdf`] with the half vector and `D` found once (the same numbers).
+    pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let Some(f) = &self.facets else { return (Vec3::ZERO, 0.0) };
+        if !same_side(v, l) {
+            return (Vec3::ZERO, 0.0);
+        }
+        let Some(h) = half_vector(v, l) else { return (Vec3::ZERO, 0.0) };
+        let d = f.d(h);
+        let value = self.fresnel(h.dot(l)) * (d * f.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()));
+        (value, d * h.z.max(0.0) / (4.0 * h.dot(v).abs()))
+    }
+
     /// The mirror direction, or reflection about a sampled facet.
     pub fn sample(&self, v: Vec3, _uc: f64, u: Vec2) -> Option<BsdfSample> {
         let Some(facets) = &self.facets else {
@@ -91,8 +103,8 @@ impl Conductor {
         };
         let h = facets.sample_h(u)?;
         let l = reflect(v, h * v.z.signum());
-        let pdf = self.pdf(v, l);
-        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+        let (f, pdf) = self.eval_pdf(v, l);
+        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 }
 

@@ -88,6 +88,24 @@ impl Dielectric {
         }
     }
 
+    /// [`Self::eval`] and [`Self::pdf`] with the half vector, `F` and `D` found once (the same
+    /// numbers).
+    pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let Some(f) = &self.facets else { return (Vec3::ZERO, 0.0) };
+        let Some((h, etap)) = self.half(v, l) else { return (Vec3::ZERO, 0.0) };
+        let fr = self.fresnel(v.dot(h));
+        let d = f.d(h);
+        let (dg, pdf_h) = (d * f.g(v, l, h), d * h.z.max(0.0));
+        if etap == 1.0 {
+            (Vec3::splat(dg * fr / (4.0 * (l.z * v.z).abs())), pdf_h / (4.0 * v.dot(h).abs()) * fr)
+        } else {
+            let denom = (l.dot(h) + v.dot(h) / etap).powi(2) * (l.z * v.z).abs();
+            let value = dg * (1.0 - fr) * (l.dot(h) * v.dot(h)).abs() / denom / (etap * etap);
+            let jacobian = l.dot(h).abs() / (l.dot(h) + v.dot(h) / etap).powi(2);
+            (Vec3::splat(value), pdf_h * jacobian * (1.0 - fr))
+        }
+    }
+
     /// Reflects with probability `F`, else refracts (about the normal or a sampled facet).
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let h = match &self.facets {
@@ -108,15 +126,8 @@ impl Dielectric {
                 let f = Vec3::splat(fr / l.z.abs());
                 return Some(BsdfSample { l, f, pdf: fr, delta: true, eta: 1.0, dispersive: false });
             }
-            let pdf = self.pdf(v, l);
-            return (pdf > 0.0).then(|| BsdfSample {
-                l,
-                f: self.eval(v, l),
-                pdf,
-                delta: false,
-                eta: 1.0,
-                dispersive: false,
-            });
+            let (f, pdf) = self.eval_pdf(v, l);
+            return (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false });
         }
         let (l, etap) = refract(v, h, self.eta)?;
         if l.z * v.z >= 0.0 {
@@ -126,14 +137,7 @@ impl Dielectric {
             let f = Vec3::splat((1.0 - fr) / l.z.abs() / (etap * etap));
             return Some(BsdfSample { l, f, pdf: 1.0 - fr, delta: true, eta: etap, dispersive: self.dispersive });
         }
-        let pdf = self.pdf(v, l);
-        (pdf > 0.0).then(|| BsdfSample {
-            l,
-            f: self.eval(v, l),
-            pdf,
-            delta: false,
-            eta: etap,
-            dispersive: self.dispersive,
-        })
+        let (f, pdf) = self.eval_pdf(v, l);
+        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: etap, dispersive: self.dispersive })
     }
 }

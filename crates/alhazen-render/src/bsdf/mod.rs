@@ -102,6 +102,17 @@ impl Bsdf {
         dispatch!(self, b => b.pdf(v, l))
     }
 
+    /// `(eval(v, l), pdf(v, l))` — the same numbers, with the terms they share (half vector,
+    /// `D`, Fresnel) computed once where the model has them.
+    pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        match self {
+            Bsdf::Conductor(c) => c.eval_pdf(v, l),
+            Bsdf::Dielectric(d) => d.eval_pdf(v, l),
+            Bsdf::Plastic(p) => p.eval_pdf(v, l),
+            _ => (self.eval(v, l), self.pdf(v, l)),
+        }
+    }
+
     /// Chooses `l` from `v`; `uc` picks a lobe, `u` places the direction.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         dispatch!(self, b => b.sample(v, uc, u))

@@ -109,6 +109,16 @@ impl Plastic {
         p * coat + (1.0 - p) * cosine_pdf(v, l)
     }
 
+    /// [`Self::eval`] and [`Self::pdf`] with the coat's lobe evaluated once (the same numbers).
+    pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        if !same_side(v, l) {
+            return (Vec3::ZERO, 0.0);
+        }
+        let (coat, coat_pdf) = self.facets.map_or((0.0, 0.0), |f| self.coat_lobe(&f, v, l));
+        let p = self.p_coat(v);
+        (self.base(v, l) + Vec3::splat(coat), p * coat_pdf + (1.0 - p) * cosine_pdf(v, l))
+    }
+
     /// The coat or the base by `uc`, then a direction from it.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let p = self.p_coat(v);
@@ -121,19 +131,12 @@ impl Plastic {
             };
             let h = facets.sample_h(u)?;
             let l = reflect(v, h * v.z.signum());
-            let pdf = self.pdf(v, l);
-            return (pdf > 0.0).then(|| BsdfSample {
-                l,
-                f: self.eval(v, l),
-                pdf,
-                delta: false,
-                eta: 1.0,
-                dispersive: false,
-            });
+            let (f, pdf) = self.eval_pdf(v, l);
+            return (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false });
         }
         let l = cosine_hemisphere(u, v);
-        let pdf = self.pdf(v, l);
-        (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
+        let (f, pdf) = self.eval_pdf(v, l);
+        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 
     /// True for a smooth coat (a mirror lobe).
