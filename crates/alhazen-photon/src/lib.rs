@@ -15,7 +15,7 @@ pub mod emit;
 pub mod kdtree;
 
 use alhazen_math::{Ray, Vec2, Vec3};
-use alhazen_render::bsdf::{ColorMode, Frame, bsdf_at, tangent_hint};
+use alhazen_render::bsdf::{ColorMode, Frame, bsdf_at, tangent_at};
 use alhazen_render::lights::Lights;
 use alhazen_render::path::CausticEstimate;
 use alhazen_render::sampler::Rng;
@@ -239,7 +239,7 @@ impl Tracer<'_> {
             if !bsdf.has_delta_lobe() {
                 return;
             }
-            let frame = tangent_hint(m).map_or_else(|| Frame::around(ns), |t| Frame::new(ns, t));
+            let frame = tangent_at(m, wh.hit.dpduv[0]).map_or_else(|| Frame::around(ns), |t| Frame::new(ns, t));
             let Some(bs) = bsdf.sample(frame.to_local(wi), rng.uniform(), Vec2::new(rng.uniform(), rng.uniform()))
             else {
                 return;

@@ -25,7 +25,7 @@
 //! eight samples are traced side by side (`lanes`), each with the same arithmetic ([`PathTracer::vertex`]),
 //! so the same samples, whatever the materials.
 
-use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_hint};
+use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_at};
 use crate::camera::Camera;
 use crate::film::PixelEstimator;
 use crate::lights::Lights;
@@ -291,7 +291,7 @@ impl<'a> PathTracer<'a> {
         }
         out.beta = path.beta;
         let wo = -path.ray.dir;
-        let (frame, ng, terminator) = self.shading_frame(wh, &bsdf, wo, tangent_hint(m));
+        let (frame, ng, terminator) = self.shading_frame(wh, &bsdf, wo, tangent_at(m, wh.hit.dpduv[0]));
         let v = frame.to_local(wo);
         // One pair picks the light and the BSDF lobe, drawn only when there is a choice;
         // one pair each places the points.

@@ -27,8 +27,9 @@ pub struct WorldObject {
     pub material: u32,
     /// Per-slot materials of a mesh (empty: `material` everywhere).
     pub slot_materials: Vec<u32>,
-    /// Some material of the object has a bump map: hits need `∂p/∂u`, `∂p/∂v`.
-    pub bumpy: bool,
+    /// Some material of the object has a bump map or anisotropic lobes: hits need `∂p/∂u`,
+    /// `∂p/∂v`.
+    pub tangents: bool,
 }
 
 /// A primitive of the top-level BVH: a whole object, or one triangle of a small mesh placed
@@ -245,9 +246,10 @@ impl World {
                 placed: Placed { uv: uses_uv(o, scene), ..place(o, &meshes, scene, unit) },
                 material: o.material,
                 slot_materials: o.mesh_materials.clone(),
-                bumpy: std::iter::once(&o.material)
-                    .chain(&o.mesh_materials)
-                    .any(|&m| scene.materials[m as usize].bump.is_some()),
+                tangents: std::iter::once(&o.material).chain(&o.mesh_materials).any(|&m| {
+                    let m = &scene.materials[m as usize];
+                    m.bump.is_some() || crate::bsdf::is_anisotropic(m)
+                }),
             })
             .collect();
         let (mut primitives, mut prim_bounds, mut unbounded) = (vec![], vec![], vec![]);
@@ -296,7 +298,7 @@ impl World {
     fn flat_shading(&self, lane: Lane) -> Option<FlatShading> {
         let o = &self.objects[lane.object as usize];
         let Shape::Mesh(mesh) = &o.placed.shape else { return None };
-        if o.placed.uv || o.bumpy {
+        if o.placed.uv || o.tangents {
             return None;
         }
         let first = lane.flat.triangle as usize;
@@ -555,7 +557,7 @@ impl World {
     fn surface_of(&self, ray: &Ray, c: Candidate, i: u32) -> WorldHit {
         let o = &self.objects[i as usize];
         let mut hit = o.placed.surface(ray, c);
-        if o.bumpy {
+        if o.tangents {
             hit.dpduv = o.placed.tangents(ray, c);
         }
         let material = o.slot_materials.get(hit.slot as usize).copied().unwrap_or(o.material);
@@ -622,6 +624,29 @@ pub fn shading_normal(hit: &SurfaceHit, m: &scene::Material, images: &[Arc<scene
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Anisotropic microfacets turn with the surface's `∂p/∂u` (a sphere's is the azimuth about
+    /// +y), not with an arbitrary frame; isotropic ones need no tangent.
+    #[test]
+    fn anisotropic_lobes_follow_the_parametrisation() {
+        let text = |roughness: &str| {
+            format!(
+                "[materials.m]\nbsdf = {{ type = \"conductor\", metal = \"silver\", roughness = {roughness} }}\n\
+                 [[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"m\"\n"
+            )
+        };
+        for (roughness, anisotropic) in [("[0.05, 0.3]", true), ("0.2", false)] {
+            let scene = scene::parse_scene("aniso.toml".as_ref(), &text(roughness)).unwrap();
+            let world = World::build(&scene);
+            let ray = Ray::new(Vec3::new(0.3, 0.4, -5.0), Vec3::Z);
+            let hit = world.intersect(&ray, f64::INFINITY).unwrap().hit;
+            let tangent = crate::bsdf::tangent_at(&scene.materials[scene.objects[0].material as usize], hit.dpduv[0]);
+            assert_eq!(tangent.is_some(), anisotropic, "{roughness}");
+            if let Some(t) = tangent {
+                assert!(t.dot(hit.n).abs() < 1e-12 && t.y.abs() < 1e-12 && t.length() > 0.0, "{t}");
+            }
+        }
+    }
 
     /// Rays into one-leaf worlds of flats and solids (a packet of three spheres; a packet of two
     /// and a cylinder tested alone), eight at a time and one by one: the same hits and the same

@@ -114,11 +114,30 @@ fn from_desc(desc: &BsdfDesc, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mod
     }
 }
 
-/// The world-space tangent that anisotropic lobes align with; `None` for isotropic BSDFs, whose
-/// frame may turn freely about the normal.
-pub fn tangent_hint(m: &Material) -> Option<Vec3> {
+/// The world-space tangent that anisotropic lobes align with at a point whose `∂p/∂u` is
+/// `dpdu`: Blinn–Phong's scratches, else `∂p/∂u` for anisotropic microfacets (as pbrt and
+/// Mitsuba orient them); `None` for isotropic BSDFs, whose frame may turn freely about the
+/// normal, and where `∂p/∂u` is unknown (zero).
+pub fn tangent_at(m: &Material, dpdu: Vec3) -> Option<Vec3> {
     match &m.bsdf {
         Some(BsdfDesc::BlinnPhong { scratches, .. }) => Some(*scratches),
+        Some(desc) if anisotropic(desc) && dpdu != Vec3::ZERO => Some(dpdu),
         _ => None,
+    }
+}
+
+/// True when `m`'s lobes turn with the tangent (Blinn–Phong's scratches, microfacets of two
+/// roughnesses): its hits need `∂p/∂u`.
+pub fn is_anisotropic(m: &Material) -> bool {
+    m.bsdf.as_ref().is_some_and(|d| matches!(d, BsdfDesc::BlinnPhong { .. }) || anisotropic(d))
+}
+
+fn anisotropic(desc: &BsdfDesc) -> bool {
+    let two = |f: &alhazen_scene::bsdf::Microfacets| f.alpha_u != f.alpha_v;
+    match desc {
+        BsdfDesc::CookTorrance { facets, .. } => two(facets),
+        BsdfDesc::Conductor { facets: Some(f), .. } | BsdfDesc::Dielectric { facets: Some(f), .. } => two(f),
+        BsdfDesc::Mix { a, b, .. } => anisotropic(a) || anisotropic(b),
+        _ => false,
     }
 }

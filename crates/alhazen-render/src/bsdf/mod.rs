@@ -21,7 +21,7 @@ mod phong;
 mod plastic;
 
 pub use blinn_phong::{BlinnPhong, BlinnPhongLobe};
-pub use build::{ColorMode, bsdf_at, tangent_hint};
+pub use build::{ColorMode, bsdf_at, is_anisotropic, tangent_at};
 pub use conductor::Conductor;
 pub use cook_torrance::{CookTorrance, CookTorranceLobe};
 pub use dielectric::Dielectric;

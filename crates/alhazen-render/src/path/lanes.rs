@@ -172,10 +172,7 @@ pub(super) fn lambert_kernel(tracer: &PathTracer) -> Vec<bool> {
         .iter()
         .zip(&tracer.uniform_bsdfs)
         .map(|(m, b)| {
-            scene_allows
-                && matches!(b, Some(Bsdf::Lambert(_)))
-                && m.bump.is_none()
-                && crate::bsdf::tangent_hint(m).is_none()
+            scene_allows && matches!(b, Some(Bsdf::Lambert(_))) && m.bump.is_none() && !crate::bsdf::is_anisotropic(m)
         })
         .collect()
 }

@@ -44,9 +44,9 @@ pub struct SurfaceHit {
     pub uv: Vec2,
     /// Material slot of a mesh triangle (0 elsewhere).
     pub slot: u32,
-    /// `∂p/∂u` and `∂p/∂v` of the texture parametrisation, for bump mapping: filled in by
-    /// [`crate::World`] for objects whose material has a bump map (zero otherwise, and for shapes
-    /// without them).
+    /// `∂p/∂u` and `∂p/∂v` of the texture parametrisation, for bump mapping and anisotropic
+    /// lobes: filled in by [`crate::World`] for objects whose material has a bump map or
+    /// anisotropic microfacets (zero otherwise, and for shapes without them).
     pub dpduv: [Vec3; 2],
 }
 
