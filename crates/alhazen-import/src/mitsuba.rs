@@ -1113,8 +1113,24 @@ impl Importer {
         }
         self.unused(ctx, &p, "shape");
         let name = self.attr(ctx, node, "id")?;
-        let (shape, transform) = common::placed_sphere(shape, transform);
+        let (shape, transform) = match shape {
+            Shape::Sphere { center, radius } if self.parametrised(material) => {
+                // Mitsuba's sphere has its pole along local +z and u = 0 along +x; alhazen's its
+                // pole along +y and u = 0 along −x: turned a quarter about x (y → z, z → −y), the
+                // sphere carries Mitsuba's texture coordinates and tangents.
+                let quarter = Transform::rotate(Vec3::X, std::f64::consts::FRAC_PI_2);
+                (Shape::Sphere { center: Vec3::ZERO, radius }, transform * Transform::translate(center) * quarter)
+            }
+            shape => common::placed_sphere(shape, transform),
+        };
         Ok(vec![Object { name, shape, transform, material, mesh_materials: vec![] }])
+    }
+
+    /// True when material `m` looks at its surface's parametrisation (textures, bump maps,
+    /// anisotropic lobes), so a sphere must carry Mitsuba's.
+    fn parametrised(&self, m: u32) -> bool {
+        let m = &self.scene.materials[m as usize];
+        m.bump.is_some() || m.bsdf.as_ref().is_some_and(|b| b.is_textured() || b.is_anisotropic())
     }
 
     /// A mesh file, loaded once per file (and orientation).

@@ -186,6 +186,36 @@ fn bitmap_textures_keep_mitsubas_orientation() {
     assert_eq!(at(0.75), Vec3::new(0.0, 0.0, 1.0), "v = 3/4 is the bottom row's blue");
 }
 
+/// A textured Mitsuba sphere carries Mitsuba's parametrisation: its pole along +z (v = 0),
+/// u = 0 along +x and u = 1/4 along +y; an untextured one stays a plain (packed) sphere.
+#[test]
+fn textured_spheres_keep_mitsubas_texture_coordinates() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 128])).save(dir.path().join("t.png")).unwrap();
+    let sphere = |bsdf: &str, x: f64| {
+        format!(
+            "<shape type=\"sphere\">\n<point name=\"center\" value=\"{x}, 2, 3\"/>\n<float name=\"radius\" value=\"0.5\"/>\n{bsdf}\n</shape>"
+        )
+    };
+    let textured = "<bsdf type=\"diffuse\"><texture name=\"reflectance\" type=\"bitmap\"><string name=\"filename\" value=\"t.png\"/></texture></bsdf>";
+    let xml = scene(&(sphere(textured, 1.0) + &sphere("<bsdf type=\"diffuse\"/>", -9.0)));
+    std::fs::write(dir.path().join("s.xml"), xml).unwrap();
+    let s = alhazen_import::load(&dir.path().join("s.xml")).unwrap().scene;
+    assert!(!s.objects[0].transform.is_identity() && s.objects[1].transform.is_identity());
+    let world = alhazen_render::World::build(&s);
+    let centre = Vec3::new(1.0, 2.0, 3.0);
+    let uv_towards = |d: Vec3| {
+        let ray = alhazen_math::Ray::new(centre + d * 5.0, -d);
+        world.intersect(&ray, f64::INFINITY).unwrap().hit.uv
+    };
+    let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+    assert!(close(uv_towards(Vec3::Z).y, 0.0), "+z is the pole: {}", uv_towards(Vec3::Z));
+    let x = uv_towards(Vec3::X);
+    assert!((close(x.x, 0.0) || close(x.x, 1.0)) && close(x.y, 0.5), "+x: {x}");
+    let y = uv_towards(Vec3::Y);
+    assert!(close(y.x, 0.25) && close(y.y, 0.5), "+y: {y}");
+}
+
 #[test]
 fn what_is_approximated_is_said_with_its_line() {
     let s = import(&[(

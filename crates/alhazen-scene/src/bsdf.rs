@@ -269,6 +269,19 @@ impl BsdfDesc {
         }
     }
 
+    /// True when some lobe turns with the surface's tangent: Blinn–Phong's scratches, or
+    /// microfacets of two roughnesses.
+    pub fn is_anisotropic(&self) -> bool {
+        let two = |f: &Microfacets| f.alpha_u != f.alpha_v;
+        match self {
+            BsdfDesc::BlinnPhong { .. } => true,
+            BsdfDesc::CookTorrance { facets, .. } => two(facets),
+            BsdfDesc::Conductor { facets: Some(f), .. } | BsdfDesc::Dielectric { facets: Some(f), .. } => two(f),
+            BsdfDesc::Mix { a, b, .. } => a.is_anisotropic() || b.is_anisotropic(),
+            _ => false,
+        }
+    }
+
     /// True when some part of it refracts with a wavelength-dependent index.
     pub fn is_dispersive(&self) -> bool {
         match self {

@@ -121,7 +121,7 @@ fn from_desc(desc: &BsdfDesc, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mod
 pub fn tangent_at(m: &Material, dpdu: Vec3) -> Option<Vec3> {
     match &m.bsdf {
         Some(BsdfDesc::BlinnPhong { scratches, .. }) => Some(*scratches),
-        Some(desc) if anisotropic(desc) && dpdu != Vec3::ZERO => Some(dpdu),
+        Some(desc) if desc.is_anisotropic() && dpdu != Vec3::ZERO => Some(dpdu),
         _ => None,
     }
 }
@@ -129,15 +129,5 @@ pub fn tangent_at(m: &Material, dpdu: Vec3) -> Option<Vec3> {
 /// True when `m`'s lobes turn with the tangent (Blinn–Phong's scratches, microfacets of two
 /// roughnesses): its hits need `∂p/∂u`.
 pub fn is_anisotropic(m: &Material) -> bool {
-    m.bsdf.as_ref().is_some_and(|d| matches!(d, BsdfDesc::BlinnPhong { .. }) || anisotropic(d))
-}
-
-fn anisotropic(desc: &BsdfDesc) -> bool {
-    let two = |f: &alhazen_scene::bsdf::Microfacets| f.alpha_u != f.alpha_v;
-    match desc {
-        BsdfDesc::CookTorrance { facets, .. } => two(facets),
-        BsdfDesc::Conductor { facets: Some(f), .. } | BsdfDesc::Dielectric { facets: Some(f), .. } => two(f),
-        BsdfDesc::Mix { a, b, .. } => anisotropic(a) || anisotropic(b),
-        _ => false,
-    }
+    m.bsdf.as_ref().is_some_and(BsdfDesc::is_anisotropic)
 }
