@@ -40,6 +40,7 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
         ids: HashMap::new(),
         meshes: HashMap::new(),
         default_material: None,
+        black_material: None,
         camera_seen: false,
         version_major: 3,
     };
@@ -74,6 +75,8 @@ struct Importer {
     ids: HashMap<String, Named>,
     meshes: HashMap<(PathBuf, bool), usize>,
     default_material: Option<MaterialId>,
+    /// The black BSDF of emitting shapes without one, once made.
+    black_material: Option<MaterialId>,
     camera_seen: bool,
     version_major: u32,
 }
@@ -663,6 +666,20 @@ impl Importer {
 
     // ---- materials -----------------------------------------------------------------------
 
+    /// The black diffuse BSDF Mitsuba gives an emitting shape without one.
+    fn black_material(&mut self) -> MaterialId {
+        if let Some(id) = self.black_material {
+            return id;
+        }
+        let m = alhazen_scene::Material::from_bsdf(
+            "mitsuba emitter default",
+            BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::ZERO) },
+        );
+        let id = common::add_material(&mut self.scene, m);
+        self.black_material = Some(id);
+        id
+    }
+
     fn default_material(&mut self) -> MaterialId {
         if let Some(id) = self.default_material {
             return id;
@@ -1107,7 +1124,13 @@ impl Importer {
                 _ => {}
             }
         }
-        let mut material = material.unwrap_or_else(|| self.default_material());
+        // Mitsuba gives a shape without a BSDF a diffuse one of reflectance 0.5, and an emitting
+        // shape one of reflectance 0: a bare light does not reflect.
+        let mut material = match (material, emission) {
+            (Some(m), _) => m,
+            (None, None) => self.default_material(),
+            (None, Some(_)) => self.black_material(),
+        };
         if let Some(e) = emission {
             material = common::emissive(&mut self.scene, material, e);
         }

@@ -216,6 +216,20 @@ fn textured_spheres_keep_mitsubas_texture_coordinates() {
     assert!(close(y.x, 0.25) && close(y.y, 0.5), "+y: {y}");
 }
 
+/// As in Mitsuba, a bare shape reflects 0.5 and a bare light nothing (Mitsuba's default BSDF
+/// of an emitting shape is black: lit by its own scene, a grey light would brighten it).
+#[test]
+fn bare_lights_reflect_nothing() {
+    let xml = scene(
+        "<shape type=\"rectangle\"/>\n<shape type=\"rectangle\">\n<emitter type=\"area\">\n\
+         <rgb name=\"radiance\" value=\"1, 1, 1\"/>\n</emitter>\n</shape>",
+    );
+    let s = import(&[("l.xml", &xml)]).unwrap().scene;
+    assert_eq!(albedo(&s, s.objects[0].material), Vec3::splat(0.5));
+    assert_eq!(albedo(&s, s.objects[1].material), Vec3::ZERO);
+    assert_eq!(s.materials[s.objects[1].material as usize].emission, Vec3::ONE);
+}
+
 #[test]
 fn what_is_approximated_is_said_with_its_line() {
     let s = import(&[(
