@@ -782,7 +782,7 @@ impl Importer {
                 let albedo = self.color(ctx, &p, "diffuse_reflectance", Vec3::splat(0.5))?;
                 // Mitsuba's default coat is polypropylene.
                 let ior = self.ior(ctx, &p, 1.49)?;
-                if ior <= 1.0 {
+                if !(ior > 1.0 && ior.is_finite()) {
                     return Err(
                         ctx.err(node, format!("{kind}: the coat's index must exceed the outside's (got {ior})"))
                     );

@@ -216,6 +216,19 @@ fn textured_spheres_keep_mitsubas_texture_coordinates() {
     assert!(close(y.x, 0.25) && close(y.y, 0.5), "+y: {y}");
 }
 
+/// Plastic's refusals: a coat no denser than the outside, two roughnesses.
+#[test]
+fn plastic_mistakes_are_located_errors() {
+    let bad =
+        |bsdf: &str| import(&[("p.xml", &scene(&format!("<shape type=\"sphere\">\n{bsdf}\n</shape>")))]).unwrap_err();
+    let e = bad("<bsdf type=\"plastic\"><float name=\"int_ior\" value=\"1.0\"/></bsdf>");
+    assert!(e.contains("p.xml:3") && e.contains("index must exceed"), "{e}");
+    let e = bad(
+        "<bsdf type=\"roughplastic\"><float name=\"alpha_u\" value=\"0.1\"/><float name=\"alpha_v\" value=\"0.3\"/></bsdf>",
+    );
+    assert!(e.contains("p.xml:3") && e.contains("one alpha"), "{e}");
+}
+
 /// As in Mitsuba, a bare shape reflects 0.5 and a bare light nothing (Mitsuba's default BSDF
 /// of an emitting shape is black: lit by its own scene, a grey light would brighten it).
 #[test]

@@ -314,15 +314,13 @@ impl World {
     }
 
     /// Sorts each leaf's primitives into packets of flats, packets of spheres and a list of
-    /// objects.
-    /// The tree's leaves are relabelled with their index in `leaves`.
+    /// objects; the tree's leaves are relabelled with their index in `leaves`.
     fn fill_leaves(&mut self, bvh: &mut Bvh, primitives: &[Primitive]) {
-        let order = bvh.leaf_order().to_vec();
-        bvh.relabel_leaves(|range| {
+        bvh.relabel_leaves(|leaf| {
             let first_object = self.leaf_objects.len();
             let mut flats: Vec<(Lane, Flat)> = vec![];
             let mut spheres: Vec<(u32, Sphere)> = vec![];
-            for &k in &order[range] {
+            for &k in leaf {
                 match primitives[k as usize] {
                     Primitive::Object(i) => self.leaf_objects.push(i),
                     Primitive::Flat { object, lane, flat } => flats.push((Lane { object, flat: lane }, flat)),

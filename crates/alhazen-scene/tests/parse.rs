@@ -211,6 +211,9 @@ fn physically_based_mistakes_are_explained() {
     assert!(m(r#"{ type = "dielectric", ior = 1.5, glass = "bk7" }"#).contains("give one of"));
     assert!(m(r#"{ type = "plastic", roughness = [0.1, 0.3] }"#).contains("takes one roughness"));
     assert!(m(r#"{ type = "plastic", ior = 1.0 }"#).contains("ior"));
+    assert!(m(r#"{ type = "plastic", ior = nan }"#).contains("ior"));
+    assert!(m(r#"{ type = "plastic", ior = 1e300 }"#).contains("ior"));
+    assert!(m(r#"{ type = "plastic", nonlinear = 1 }"#).contains("nonlinear"));
     assert!(m(r#"{ type = "dielectric", glass = "bk8" }"#).contains("did you mean \"bk7\"?"));
     assert!(m(r#"{ type = "dielectric", cauchy = [1.5, -1] }"#).contains("index of refraction at 360 nm"));
     assert!(m(r#"{ type = "conductor", metal = "gold", eta = [1, 1, 1] }"#).contains("either `metal` or `eta`"));

@@ -344,14 +344,15 @@ impl Bvh {
         }
     }
 
-    /// Rewrites the labels traversal reports for each leaf: `relabel(labels)` for every leaf's
-    /// [`Self::leaf_order`] range, once (a mesh makes them its packets, the world its leaves).
+    /// Rewrites the labels traversal reports for each leaf: `relabel(primitives)` for every
+    /// leaf's primitive indices, once (a mesh makes them its packets, the world its leaves).
     /// Afterwards [`Self::traverse`] is refused and [`Self::leaves`] lists the new labels.
-    pub fn relabel_leaves(&mut self, mut relabel: impl FnMut(std::ops::Range<usize>) -> std::ops::Range<usize>) {
+    pub fn relabel_leaves(&mut self, mut relabel: impl FnMut(&[u32]) -> std::ops::Range<usize>) {
         assert!(!self.relabeled, "leaves are relabelled once");
         self.relabeled = true;
+        let order = &self.order;
         wide::relabel(&mut self.wide, &mut self.start, |e| {
-            let r = relabel(e.labels());
+            let r = relabel(&order[e.labels()]);
             (r.start as u32, r.len() as u32)
         });
     }

@@ -85,16 +85,19 @@ pub(super) fn collapse(nodes: &[Node]) -> (Vec<Wide>, Option<Entry>) {
 /// Its children are `at`'s two, the interior one of largest area replaced by its own two until
 /// there are four or only leaves.
 fn wide_node(nodes: &[Node], at: usize, out: &mut Vec<Wide>) -> u32 {
-    let mut kids = vec![at + 1, nodes[at].offset as usize];
-    while kids.len() < WIDTH {
-        let open = (0..kids.len())
+    let (mut kids, mut len) = ([at + 1, nodes[at].offset as usize, 0, 0], 2);
+    while len < WIDTH {
+        let open = (0..len)
             .filter(|&k| nodes[kids[k]].count == 0)
             .max_by(|&a, &b| nodes[kids[a]].bounds.surface_area().total_cmp(&nodes[kids[b]].bounds.surface_area()));
         let Some(k) = open else { break };
         let n = kids[k];
-        kids[k] = n + 1;
-        kids.insert(k + 1, nodes[n].offset as usize);
+        // Its two children take its place, the later ones moving up one slot.
+        kids.copy_within(k + 1..len, k + 2);
+        (kids[k], kids[k + 1]) = (n + 1, nodes[n].offset as usize);
+        len += 1;
     }
+    let kids = &kids[..len];
     let me = out.len();
     out.push(Wide {
         min: [[f32::MAX; WIDTH]; 3],

@@ -46,13 +46,11 @@ impl MeshAccel {
         let mut packets = PackedFlats::default();
         packets.reserve(bvh.leaves().map(|r| r.len().div_ceil(vectors.lanes())).sum());
         // Each leaf's packets are appended as the leaf is relabelled with them.
-        let order = bvh.leaf_order().to_vec();
-        bvh.relabel_leaves(|range| {
-            let leaf: Vec<_> =
-                order[range].iter().map(|&k| (prims[k as usize], prims[k as usize].flat(&mesh))).collect();
+        bvh.relabel_leaves(|leaf| {
+            let leaf: Vec<_> = leaf.iter().map(|&k| (prims[k as usize], prims[k as usize].flat(&mesh))).collect();
             packets.push_leaf(&leaf, vectors.lanes())
         });
-        drop((order, prims));
+        drop(prims);
         let face_normals: Vec<Vec3> = (0..mesh.triangle_count())
             .map(|i| {
                 let [a, b, c] = mesh.corners(i);
