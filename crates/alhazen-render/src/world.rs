@@ -148,7 +148,7 @@ pub struct WorldHit {
 
 fn build_shape(s: &scene::Shape, meshes: &[Arc<MeshAccel>]) -> Shape {
     match s {
-        scene::Shape::Sphere { center, radius } => Shape::Sphere(Sphere { center: *center, radius: *radius }),
+        scene::Shape::Sphere { center, radius } => Shape::Sphere(Sphere::new(*center, *radius)),
         scene::Shape::Cylinder { base, top, radius, capped } => {
             Shape::Cylinder(Cylinder::new(*base, *top, *radius, *capped))
         }
@@ -203,6 +203,11 @@ fn flattenable(p: &Placed) -> Option<&alhazen_geom::TriangleMesh> {
     }
 }
 
+fn turned_sphere(shape: &scene::Shape, t: &alhazen_math::Transform) -> Option<Sphere> {
+    let scene::Shape::Sphere { center, radius } = shape else { return None };
+    Sphere::placed(*center, *radius, t)
+}
+
 fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene, unit: VectorUnit) -> Placed {
     let small = match &o.shape {
         scene::Shape::Mesh { mesh, smooth } if !o.transform.is_identity() => {
@@ -218,6 +223,10 @@ fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene, uni
     if let Some((m, smooth)) = small {
         let accel = Arc::new(MeshAccel::with_unit(Arc::new(baked(&m, &o.transform)), unit));
         return Placed::new(Shape::Mesh(MeshShape { accel, smooth }), alhazen_math::Transform::IDENTITY);
+    }
+    if let Some(sphere) = turned_sphere(&o.shape, &o.transform) {
+        // Tested in packets like any other sphere; only its parametrisation keeps the turn.
+        return Placed::new(Shape::Sphere(sphere), alhazen_math::Transform::IDENTITY);
     }
     Placed::new(build_shape(&o.shape, meshes), o.transform)
 }

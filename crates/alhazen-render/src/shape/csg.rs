@@ -109,10 +109,7 @@ mod tests {
         let csg = Csg {
             op,
             a: Placed::new(Shape::Box(AaBox { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) }), Transform::IDENTITY),
-            b: Placed::new(
-                Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }),
-                Transform::translate(Vec3::new(0.8, 0.0, 0.0)),
-            ),
+            b: Placed::new(Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0)), Transform::translate(Vec3::new(0.8, 0.0, 0.0))),
         };
         (Placed::new(Shape::Csg(Box::new(csg)), to_world), to_world)
     }

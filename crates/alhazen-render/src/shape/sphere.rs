@@ -1,7 +1,7 @@
 //! Sphere `|p − c| = r`: the quadratic `|o + t d − c|² = r²`.
 
 use super::{Candidate, Crossing, SurfaceHit, convex_crossings};
-use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
+use alhazen_math::{Bounds3, Mat3, Ray, Transform, Vec2, Vec3};
 use std::f64::consts::{PI, TAU};
 
 /// A sphere.
@@ -11,9 +11,33 @@ pub struct Sphere {
     pub center: Vec3,
     /// Radius (> 0).
     pub radius: f64,
+    /// The rotation from world directions to the sphere's own frame (pole +y, `u = 0` towards
+    /// −x), when it was placed turned: only its texture coordinates and tangents see it.
+    pub turn: Option<Mat3>,
 }
 
 impl Sphere {
+    /// The sphere of `center` and `radius`, its pole along +y.
+    pub const fn new(center: Vec3, radius: f64) -> Self {
+        Self { center, radius, turn: None }
+    }
+
+    /// The sphere of `center` and `radius` placed by `t`, when `t` is a similarity (rotation,
+    /// uniform scale, translation, perhaps a reflection): a sphere in world space, whose
+    /// parametrisation alone keeps the rotation.
+    pub fn placed(center: Vec3, radius: f64, t: &Transform) -> Option<Self> {
+        let scale = crate::connect::similarity_scale(t)?;
+        let rotation = Mat3::from_cols(t.vector(Vec3::X), t.vector(Vec3::Y), t.vector(Vec3::Z)) / scale;
+        let turn = (rotation != Mat3::IDENTITY).then(|| rotation.transpose());
+        Some(Self { center: t.point(center), radius: radius * scale, turn })
+    }
+
+    /// A unit direction from the centre in the sphere's own frame.
+    #[inline]
+    fn own(&self, n: Vec3) -> Vec3 {
+        self.turn.map_or(n, |r| r * n)
+    }
+
     /// Both roots of `a t² − 2βt + c = 0` (`f = o − c`, `β = −f·d`), ascending. The
     /// discriminant is taken as `a (r² − |f − (f·d/a) d|²)` — from the ray's closest approach to
     /// the centre — instead of `β² − ac`, which cancels catastrophically for rays from far away
@@ -37,9 +61,10 @@ impl Sphere {
     pub fn hit_at(&self, ray: &Ray, t: f64) -> SurfaceHit {
         let p = ray.at(t);
         let n = (p - self.center) / self.radius;
-        // Texture coordinates: longitude around +y, latitude from the north pole.
-        let u = (n.z.atan2(-n.x) + PI) / TAU;
-        let v = n.y.clamp(-1.0, 1.0).acos() / PI;
+        // Texture coordinates: longitude around the pole, latitude from the north pole.
+        let n_own = self.own(n);
+        let u = (n_own.z.atan2(-n_own.x) + PI) / TAU;
+        let v = n_own.y.clamp(-1.0, 1.0).acos() / PI;
         SurfaceHit::flat(t, p, n.normalize(), Vec2::new(u, v))
     }
 
@@ -50,13 +75,14 @@ impl Sphere {
         SurfaceHit::flat(t, p, ((p - self.center) / self.radius).normalize(), Vec2::ZERO)
     }
 
-    /// `∂p/∂u` around +y (longitude) and `∂p/∂v` towards the south (latitude) at a hit.
+    /// `∂p/∂u` around the pole (longitude) and `∂p/∂v` towards the south (latitude) at a hit.
     pub fn tangents(&self, hit: &SurfaceHit) -> [Vec3; 2] {
-        let (n, r) = (hit.n, self.radius);
+        let (n, r) = (self.own(hit.n), self.radius);
         let dpdu = Vec3::new(n.z, 0.0, -n.x) * (TAU * r);
         let rho = (n.x * n.x + n.z * n.z).sqrt();
         let dpdv = if rho > 0.0 { Vec3::new(n.x * n.y / rho, -rho, n.z * n.y / rho) * (PI * r) } else { Vec3::ZERO };
-        [dpdu, dpdv]
+        // The inverse of a rotation is its transpose.
+        self.turn.map_or([dpdu, dpdv], |r| [dpdu, dpdv].map(|d| r.transpose() * d))
     }
 
     /// Nearest hit in `(0, t_max)`.

@@ -45,7 +45,7 @@ impl SpherePacket {
 
     fn lane(&self, lane: usize) -> Sphere {
         let c = &self.center;
-        Sphere { center: alhazen_math::Vec3::new(c[0][lane], c[1][lane], c[2][lane]), radius: self.radius[lane] }
+        Sphere::new(alhazen_math::Vec3::new(c[0][lane], c[1][lane], c[2][lane]), self.radius[lane])
     }
 
     /// The nearest hit with `0 < t < t_max` among `packets`: the packet, its lane and `t` (on a
@@ -227,7 +227,7 @@ mod tests {
     }
 
     fn sphere() -> impl Strategy<Value = Sphere> {
-        (vec3(3.0), 0.05..1.5f64).prop_map(|(center, radius)| Sphere { center, radius })
+        (vec3(3.0), 0.05..1.5f64).prop_map(|(center, radius)| Sphere::new(center, radius))
     }
 
     proptest! {
@@ -291,9 +291,9 @@ mod tests {
     #[test]
     fn inside_tangent_and_far_rays_agree() {
         let spheres = [
-            Sphere { center: Vec3::ZERO, radius: 1.0 },
-            Sphere { center: Vec3::new(0.0, 1.0, 5.0), radius: 1.0 },
-            Sphere { center: Vec3::new(0.0, 0.0, -1e6), radius: 2.0 },
+            Sphere::new(Vec3::ZERO, 1.0),
+            Sphere::new(Vec3::new(0.0, 1.0, 5.0), 1.0),
+            Sphere::new(Vec3::new(0.0, 0.0, -1e6), 2.0),
         ];
         let packet = [SpherePacket::new(&spheres)];
         let rays = [

@@ -33,7 +33,7 @@ fn shapes_with_implicit() -> Vec<(Shape, Implicit)> {
     let cyl_axis = |p: Vec3| Vec2::new(p.x, p.z).length();
     vec![
         (
-            Shape::Sphere(Sphere { center: Vec3::new(0.1, 0.2, 0.0), radius: 1.0 }),
+            Shape::Sphere(Sphere::new(Vec3::new(0.1, 0.2, 0.0), 1.0)),
             Box::new(|p: Vec3| (p - Vec3::new(0.1, 0.2, 0.0)).length() - 1.0),
         ),
         (
@@ -125,14 +125,39 @@ proptest! {
     fn transforms_preserve_hits(ray in arb_ray(), t in arb_point(2.0), angle in 0.0..6.0f64, axis in arb_dir(), s in 0.5..2.0f64) {
         // A unit sphere transformed equals the sphere with transformed centre and radius.
         let tf = Transform::translate(t) * Transform::rotate(axis, angle) * Transform::scale(Vec3::splat(s));
-        let placed = Placed::new(Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }), tf);
-        let direct = Sphere { center: t, radius: s };
+        let placed = Placed::new(Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0)), tf);
+        let direct = Sphere::new(t, s);
         let a = placed.intersect(&ray, f64::INFINITY);
         let b = Shape::Sphere(direct).intersect(&ray, f64::INFINITY);
         prop_assert_eq!(a.is_some(), b.is_some());
         if let (Some(a), Some(b)) = (a, b) {
             prop_assert!((a.t - b.t).abs() < 1e-9);
             prop_assert!((a.n - b.n).length() < 1e-9);
+        }
+    }
+
+    /// A sphere placed by a similarity in world space (`Sphere::placed`, packed like any other)
+    /// has the transformed sphere's hits, texture coordinates and tangents.
+    #[test]
+    fn placed_spheres_keep_their_parametrisation(
+        ray in arb_ray(), t in arb_point(2.0), angle in 0.0..6.0f64, axis in arb_dir(), s in 0.5..2.0f64, c in arb_point(0.5),
+    ) {
+        let tf = Transform::translate(t) * Transform::rotate(axis, angle) * Transform::scale(Vec3::splat(s));
+        let transformed = Placed::new(Shape::Sphere(Sphere::new(c, 0.7)), tf);
+        let world = Placed::new(Shape::Sphere(Sphere::placed(c, 0.7, &tf).unwrap()), Transform::IDENTITY);
+        prop_assert!(world.to_world.is_none());
+        let (Some(a), Some(b)) = (transformed.hit(&ray, f64::INFINITY), world.hit(&ray, f64::INFINITY)) else {
+            prop_assert_eq!(transformed.hit(&ray, f64::INFINITY).is_some(), world.hit(&ray, f64::INFINITY).is_some());
+            return Ok(());
+        };
+        let (sa, sb) = (transformed.surface(&ray, a), world.surface(&ray, b));
+        prop_assert!((sa.p - sb.p).length() < 1e-9 && (sa.n - sb.n).length() < 1e-9);
+        // u wraps at the seam; away from the poles, where it is defined.
+        let du = (sa.uv.x - sb.uv.x).abs();
+        prop_assume!(sa.n.dot(tf.vector(Vec3::Y)).abs() < 0.99 * s);
+        prop_assert!(du.min(1.0 - du) < 1e-7 && (sa.uv.y - sb.uv.y).abs() < 1e-7, "{:?} vs {:?}", sa.uv, sb.uv);
+        for (da, db) in transformed.tangents(&ray, a).into_iter().zip(world.tangents(&ray, b)) {
+            prop_assert!((da - db).length() < 1e-7 * (1.0 + da.length()), "{da} vs {db}");
         }
     }
 
@@ -162,8 +187,8 @@ proptest! {
     fn csg_difference_is_a_minus_b(ray in arb_ray()) {
         // Unit sphere minus a sphere of radius 0.6 centred at (0.7, 0, 0): a hit belongs to the
         // boundary of A − B: on A's surface outside B, or on B's surface inside A.
-        let a = Placed::new(Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }), Transform::IDENTITY);
-        let b = Placed::new(Shape::Sphere(Sphere { center: Vec3::new(0.7, 0.0, 0.0), radius: 0.6 }), Transform::IDENTITY);
+        let a = Placed::new(Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0)), Transform::IDENTITY);
+        let b = Placed::new(Shape::Sphere(Sphere::new(Vec3::new(0.7, 0.0, 0.0), 0.6)), Transform::IDENTITY);
         let csg = Csg { op: CsgOp::Difference, a, b };
         if let Some(h) = csg.intersect(&ray, f64::INFINITY) {
             let (da, db) = (h.p.length(), (h.p - Vec3::new(0.7, 0.0, 0.0)).length());
@@ -186,9 +211,7 @@ proptest! {
 
 #[test]
 fn csg_union_and_intersection_of_overlapping_balls() {
-    let ball = |x: f64| {
-        Placed::new(Shape::Sphere(Sphere { center: Vec3::new(x, 0.0, 0.0), radius: 1.0 }), Transform::IDENTITY)
-    };
+    let ball = |x: f64| Placed::new(Shape::Sphere(Sphere::new(Vec3::new(x, 0.0, 0.0), 1.0)), Transform::IDENTITY);
     let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
     let union = Csg { op: CsgOp::Union, a: ball(-0.5), b: ball(0.5) };
     let inter = Csg { op: CsgOp::Intersection, a: ball(-0.5), b: ball(0.5) };
@@ -217,7 +240,7 @@ fn open_cylinder_is_seen_from_inside() {
 #[test]
 fn tangents_are_the_derivatives_of_the_texture_parametrisation() {
     // Two nearby hits: p₂ − p₁ ≈ ∂p/∂u Δu + ∂p/∂v Δv.
-    let sphere = Shape::Sphere(Sphere { center: Vec3::new(0.1, 0.2, -0.3), radius: 1.3 });
+    let sphere = Shape::Sphere(Sphere::new(Vec3::new(0.1, 0.2, -0.3), 1.3));
     let plane = Shape::Plane(Plane { point: Vec3::new(0.0, -1.0, 0.0), normal: Vec3::new(0.2, 1.0, 0.1).normalize() });
     let mesh = Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false });
     for shape in [sphere, plane, mesh] {
@@ -241,7 +264,7 @@ fn tangents_are_the_derivatives_of_the_texture_parametrisation() {
 fn spheres_seen_from_far_away_are_hit_on_their_surface() {
     // β² − ac would cancel: rays from 10⁴–10⁶ away used to land 10⁻⁸ off the surface (shadow
     // acne in axonometric views, whose rays start 10⁴ units back).
-    let s = Sphere { center: Vec3::new(0.3, 0.8, -0.2), radius: 0.8 };
+    let s = Sphere::new(Vec3::new(0.3, 0.8, -0.2), 0.8);
     for dist in [1e4, 1e5, 1e6] {
         for k in 0..50 {
             let off = Vec3::new((k as f64 * 0.37).sin(), (k as f64 * 0.71).cos(), (k as f64 * 0.13).sin()) * 0.5;
