@@ -11,8 +11,8 @@
 //! * panorama — central projection on a cylinder around the view's vertical axis (course,
 //!   §"Nonlinear projections"), developed flat.
 
-use alhazen_math::viewing::{Frustum, ViewFrame, homogenize, stereo_frusta};
-use alhazen_math::{Mat3, Mat4, Ray, Vec3, Vec4};
+use alhazen_math::viewing::{Frustum, ViewFrame, stereo_frusta};
+use alhazen_math::{Mat3, Ray, Vec3, Vec4};
 use alhazen_scene::CameraDesc;
 
 /// A camera ready to generate rays for a film of `film_width × film_height` pixels.
@@ -35,23 +35,48 @@ enum Kind {
     Stereo { left: Pinhole, right: Pinhole },
 }
 
-/// A perspective camera as frame + `P⁻¹`.
+/// A perspective camera as frame + `P⁻¹`, composed once with the film's pixel scale: the
+/// homogeneous point `P⁻¹ (x, y, −1, 1)` behind a pixel is affine in the pixel's coordinates,
+/// and the ray's direction is its world part, normalised (no division by `w`, only its sign).
 #[derive(Clone, Debug)]
 struct Pinhole {
-    frame: ViewFrame,
-    p_inv: Mat4,
+    eye: Vec3,
+    /// The world part and `w` at pixel (0, 0), and their steps per pixel along x and y.
+    at_origin: (Vec3, f64),
+    per_x: (Vec3, f64),
+    per_y: (Vec3, f64),
+    /// Straight ahead, where `w` is zero.
+    ahead: Vec3,
 }
 
 impl Pinhole {
-    fn new(frame: ViewFrame, frustum: Frustum) -> Self {
-        Self { frame, p_inv: frustum.perspective_inverse() }
+    /// The camera for a film of `width × height` pixels (`y` down) spanning the standard
+    /// square `[−1, 1]²` (`y` up).
+    fn new(frame: ViewFrame, frustum: Frustum, width: f64, height: f64) -> Self {
+        let p_inv = frustum.perspective_inverse();
+        let world = |q: Vec4| (frame.to_world_dir(q.truncate()), q.w);
+        // x = 2 fx / width − 1, y = 1 − 2 fy / height.
+        let at_origin = world(p_inv * Vec4::new(-1.0, 1.0, -1.0, 1.0));
+        let per_x = world(p_inv * Vec4::new(2.0 / width, 0.0, 0.0, 0.0));
+        let per_y = world(p_inv * Vec4::new(0.0, -2.0 / height, 0.0, 0.0));
+        Self { eye: frame.eye, at_origin, per_x, per_y, ahead: frame.to_world_dir(Vec3::NEG_Z) }
     }
 
-    /// `(x, y)` in the standard square `[−1, 1]²`, `y` up.
+    /// The ray through film position `(fx, fy)` in pixels.
     #[inline]
-    fn ray(&self, x: f64, y: f64) -> Ray {
-        let p = homogenize(self.p_inv * Vec4::new(x, y, -1.0, 1.0)).unwrap_or(Vec3::NEG_Z);
-        Ray::new(self.frame.eye, self.frame.to_world_dir(p).normalize())
+    fn ray(&self, fx: f64, fy: f64) -> Ray {
+        let (d, w) = (
+            self.at_origin.0 + self.per_x.0 * fx + self.per_y.0 * fy,
+            self.at_origin.1 + self.per_x.1 * fx + self.per_y.1 * fy,
+        );
+        let dir = if w == 0.0 || !w.is_finite() {
+            self.ahead
+        } else if w < 0.0 {
+            -d
+        } else {
+            d
+        };
+        Ray::new(self.eye, dir.normalize())
     }
 }
 
@@ -72,7 +97,7 @@ impl Camera {
         let (kind, film_width) = match desc {
             CameraDesc::Perspective { look, opening } => {
                 let frustum = opening.frustum(aspect, None);
-                (Kind::Perspective(Pinhole::new(frame(look), frustum)), width)
+                (Kind::Perspective(Pinhole::new(frame(look), frustum, width as f64, height as f64)), width)
             }
             CameraDesc::Orthographic { look, width: w } => {
                 let f = frame(look);
@@ -88,7 +113,13 @@ impl Camera {
                 let (l, r) =
                     stereo_frusta(*eye_distance, *screen_distance, *screen_width, screen_width / aspect, 1.0, 1000.0);
                 let eye = |s: f64| ViewFrame { eye: f.eye + f.u * (s * eye_distance / 2.0), ..f };
-                (Kind::Stereo { left: Pinhole::new(eye(-1.0), l), right: Pinhole::new(eye(1.0), r) }, width * 2)
+                (
+                    Kind::Stereo {
+                        left: Pinhole::new(eye(-1.0), l, width as f64, height as f64),
+                        right: Pinhole::new(eye(1.0), r, width as f64, height as f64),
+                    },
+                    width * 2,
+                )
             }
             CameraDesc::Panorama { look, angle } => (Kind::Panorama { frame: frame(look), angle: *angle }, width),
         };
@@ -100,7 +131,7 @@ impl Camera {
     pub fn ray(&self, fx: f64, fy: f64) -> Ray {
         let (w, h) = (self.film_width as f64, self.film_height as f64);
         match &self.kind {
-            Kind::Perspective(p) => p.ray(2.0 * fx / w - 1.0, 1.0 - 2.0 * fy / h),
+            Kind::Perspective(p) => p.ray(fx, fy),
             Kind::Parallel { corner, dx, dy, dir } => Ray::new(*corner + *dx * fx + *dy * fy, *dir),
             Kind::Panorama { frame, angle } => {
                 let phi = (fx / w - 0.5) * angle;
@@ -110,7 +141,7 @@ impl Camera {
             Kind::Stereo { left, right } => {
                 let half = w / 2.0;
                 let (cam, x) = if fx < half { (left, fx) } else { (right, fx - half) };
-                cam.ray(2.0 * x / half - 1.0, 1.0 - 2.0 * fy / h)
+                cam.ray(x, fy)
             }
         }
     }
