@@ -17,6 +17,8 @@ pub struct EnvMap {
     image: Arc<ImageData>,
     scale: f64,
     rotation: f64,
+    /// The rotation in turns.
+    turns: f64,
     distribution: Distribution2D,
 }
 
@@ -33,17 +35,18 @@ impl EnvMap {
             }
         }
         let distribution = Distribution2D::new(&weights, w, h);
-        Self { image, scale, rotation, distribution }
+        Self { image, scale, rotation, turns: rotation / (2.0 * PI), distribution }
     }
 
     fn to_uv(&self, dir: Vec3) -> Vec2 {
         alhazen_scene::texture::equirect_uv(dir, self.rotation)
     }
 
-    fn to_dir(&self, uv: Vec2) -> Vec3 {
-        let (theta, phi) = (uv.y * PI, uv.x * 2.0 * PI - self.rotation);
-        let (st, ct) = theta.sin_cos();
-        Vec3::new(st * phi.sin(), ct, -st * phi.cos())
+    /// The direction of `uv` and its polar angle's sine.
+    fn to_dir(&self, uv: Vec2) -> (Vec3, f64) {
+        let (st, ct) = alhazen_math::sin_cos_turns(uv.y / 2.0);
+        let (sp, cp) = alhazen_math::sin_cos_turns(uv.x - self.turns);
+        (Vec3::new(st * sp, ct, -st * cp), st)
     }
 
     /// Radiance arriving from direction `dir` (unit, pointing away from the scene).
@@ -54,31 +57,36 @@ impl EnvMap {
     /// A direction with density ∝ power, its radiance and solid-angle density.
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, Vec3, f64)> {
         let (uv, pdf_uv) = self.distribution.sample(u);
-        let sin = (uv.y * PI).sin();
+        let (dir, sin) = self.to_dir(uv);
         if pdf_uv <= 0.0 || sin <= 0.0 {
             return None;
         }
         // The radiance of the texel sampled (not looked up again from the direction: the same
         // texel but for rounding on its edges, without the inverse trigonometry).
         let radiance = alhazen_scene::texture::equirect_texel_at(&self.image, uv) * self.scale;
-        Some((self.to_dir(uv), radiance, pdf_uv / (2.0 * PI * PI * sin)))
+        Some((dir, radiance, pdf_uv / (2.0 * PI * PI * sin)))
     }
 
     /// Solid-angle density of [`Self::sample`] choosing `dir`.
     pub fn pdf(&self, dir: Vec3) -> f64 {
-        self.pdf_at(self.to_uv(dir))
+        self.pdf_at(self.to_uv(dir), polar_sine(dir))
     }
 
     /// [`Self::radiance`] and [`Self::pdf`] of `dir`, mapped to the image once.
     pub fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f64) {
         let uv = self.to_uv(dir);
-        (alhazen_scene::texture::equirect_texel_at(&self.image, uv) * self.scale, self.pdf_at(uv))
+        (alhazen_scene::texture::equirect_texel_at(&self.image, uv) * self.scale, self.pdf_at(uv, polar_sine(dir)))
     }
 
-    fn pdf_at(&self, uv: Vec2) -> f64 {
-        let sin = (uv.y * PI).sin();
+    /// The density at `uv`, whose polar angle has sine `sin`.
+    fn pdf_at(&self, uv: Vec2, sin: f64) -> f64 {
         if sin <= 0.0 { 0.0 } else { self.distribution.pdf(uv) / (2.0 * PI * PI * sin) }
     }
+}
+
+/// The sine of unit direction `dir`'s angle from +y, without trigonometry.
+fn polar_sine(dir: Vec3) -> f64 {
+    (dir.x * dir.x + dir.z * dir.z).sqrt()
 }
 
 #[cfg(test)]
@@ -101,7 +109,7 @@ mod tests {
                 let phi = 2.0 * PI * (j as f64 + 0.5) / n as f64;
                 let r = (1.0 - z * z).sqrt();
                 let d = Vec3::new(r * phi.cos(), z, r * phi.sin());
-                assert!((m.to_dir(m.to_uv(d)) - d).length() < 1e-9);
+                assert!((m.to_dir(m.to_uv(d)).0 - d).length() < 1e-9);
                 sum += m.pdf(d);
             }
         }

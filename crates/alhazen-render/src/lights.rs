@@ -178,8 +178,8 @@ fn parallelogram(indices: &[[u32; 3]], corners: &[[Vec3; 3]]) -> Option<Emitter>
 fn uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
+    Vec3::new(r * cos, r * sin, z)
 }
 
 impl Lights {
@@ -417,8 +417,9 @@ fn point_by_area(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f64) {
         }
         Emitter::Disk { center, normal, radius } => {
             let (s, t) = orthonormal_basis(*normal);
-            let (r, phi) = (radius * u.x.sqrt(), 2.0 * PI * u.y);
-            (*center + (s * phi.cos() + t * phi.sin()) * r, *normal, 1.0 / (PI * radius * radius))
+            let r = radius * u.x.sqrt();
+            let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
+            (*center + (s * cos + t * sin) * r, *normal, 1.0 / (PI * radius * radius))
         }
     }
 }
@@ -432,9 +433,9 @@ fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<Li
         // Uniform in the cone, then the near intersection with the sphere.
         let cos = 1.0 - u.x * one_minus_cos;
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
-        let phi = 2.0 * PI * u.y;
+        let (sin_phi, cos_phi) = alhazen_math::sin_cos_turns(u.y);
         let (s, t) = orthonormal_basis(axis);
-        let dir = (s * phi.cos() + t * phi.sin()) * sin + axis * cos;
+        let dir = (s * cos_phi + t * sin_phi) * sin + axis * cos;
         let d = (*center - p).length();
         let disc = (radius * radius - d * d * sin * sin).max(0.0);
         let dist = d * cos - disc.sqrt();
