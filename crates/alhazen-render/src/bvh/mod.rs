@@ -100,10 +100,6 @@ struct Tests {
 }
 
 impl Tests {
-    fn of(items: &[Item]) -> Self {
-        items.iter().fold(Self::default(), |t, it| t.add(it))
-    }
-
     fn add(self, it: &Item) -> Self {
         Self { packed: self.packed + usize::from(it.packed), single: self.single + usize::from(!it.packed) }
     }
@@ -178,13 +174,13 @@ impl Bvh {
     }
 
     fn build_node(&mut self, items: &mut [Item], depth: usize, how: Split, parallel_from: usize) -> usize {
-        let bounds = items.iter().fold(Bounds3::EMPTY, |b, it| b.union(it.bounds));
+        let node = Summary::of(items);
         let me = self.nodes.len();
-        self.nodes.push(Node { bounds, offset: 0, count: 0, axis: 0 });
-        let small = items.len() == 1 || Tests::of(items).cost() <= MAX_LEAF as f64;
+        self.nodes.push(Node { bounds: node.bounds, offset: 0, count: 0, axis: 0 });
+        let small = items.len() == 1 || node.tests.cost() <= MAX_LEAF as f64;
         let split = match how {
             _ if small || depth >= MAX_DEPTH => None,
-            Split::Sah { traversal } => sah_split(items, &bounds, traversal),
+            Split::Sah { traversal } => sah_split(items, &node, traversal),
             Split::Morton => Some(morton_split(items)),
         };
         match split {
@@ -376,8 +372,27 @@ impl Bvh {
 }
 
 /// The best binned SAH split `(axis, position in items)`, or `None` when a leaf is cheaper.
-fn sah_split(items: &mut [Item], bounds: &Bounds3, traversal: f64) -> Option<(usize, usize)> {
-    let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.grow(it.centroid));
+/// What one pass over a node's items finds: their bounds, their centroids' bounds and the
+/// tests a leaf of them would cost.
+struct Summary {
+    bounds: Bounds3,
+    centroids: Bounds3,
+    tests: Tests,
+}
+
+impl Summary {
+    fn of(items: &[Item]) -> Self {
+        let empty = Self { bounds: Bounds3::EMPTY, centroids: Bounds3::EMPTY, tests: Tests::default() };
+        items.iter().fold(empty, |s, it| Self {
+            bounds: s.bounds.union(it.bounds),
+            centroids: s.centroids.grow(it.centroid),
+            tests: s.tests.add(it),
+        })
+    }
+}
+
+fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usize, usize)> {
+    let (cb, bounds) = (&node.centroids, &node.bounds);
     let extent = cb.extent();
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
         0
@@ -393,7 +408,8 @@ fn sah_split(items: &mut [Item], bounds: &Bounds3, traversal: f64) -> Option<(us
         }
         return None;
     }
-    let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) / extent[axis] * BINS as f64) as usize).min(BINS - 1);
+    let per_unit = BINS as f64 / extent[axis];
+    let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) * per_unit) as usize).min(BINS - 1);
     let mut bins = [(Bounds3::EMPTY, Tests::default()); BINS];
     for it in items.iter() {
         let b = &mut bins[bin_of(it.centroid)];
@@ -416,7 +432,7 @@ fn sah_split(items: &mut [Item], bounds: &Bounds3, traversal: f64) -> Option<(us
             best = i;
         }
     }
-    let leaf_cost = Tests::of(items).cost() * bounds.surface_area();
+    let leaf_cost = node.tests.cost() * bounds.surface_area();
     let split_cost = traversal * bounds.surface_area() + best_cost;
     if split_cost >= leaf_cost && items.len() <= 255 {
         return None;
