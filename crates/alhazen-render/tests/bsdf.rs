@@ -186,22 +186,24 @@ fn cell_of(l: Vec3) -> usize {
 }
 
 /// Expected fraction of samples per cell: the pdf integrated by a 12×12 midpoint rule per cell
-/// in (ϑ, φ), `dω = sin ϑ dϑ dφ`.
+/// in (ϑ, φ), `dω = sin ϑ dϑ dφ` — 96 × 12 in the two rows of cells along the horizon, where
+/// rough refraction at grazing incidence peaks (visible-normal sampling sends samples there).
 fn expected_fractions(b: &Bsdf, v: Vec3) -> Vec<f64> {
     let sub = 12;
     let (dt, dp) = (PI / CELLS_THETA as f64, 2.0 * PI / CELLS_PHI as f64);
     let mut out = vec![0.0; CELLS_THETA * CELLS_PHI];
     for ti in 0..CELLS_THETA {
+        let sub_t = if ti + 1 == CELLS_THETA / 2 || ti == CELLS_THETA / 2 { 8 * sub } else { sub };
         for pi in 0..CELLS_PHI {
             let mut sum = 0.0;
-            for a in 0..sub {
-                let (st, ct) = (dt * (ti as f64 + (a as f64 + 0.5) / sub as f64)).sin_cos();
+            for a in 0..sub_t {
+                let (st, ct) = (dt * (ti as f64 + (a as f64 + 0.5) / sub_t as f64)).sin_cos();
                 for c in 0..sub {
                     let phi = dp * (pi as f64 + (c as f64 + 0.5) / sub as f64);
                     sum += b.pdf(v, Vec3::new(st * phi.cos(), st * phi.sin(), ct)) * st;
                 }
             }
-            out[ti * CELLS_PHI + pi] = sum * dt * dp / (sub * sub) as f64;
+            out[ti * CELLS_PHI + pi] = sum * dt * dp / (sub_t * sub) as f64;
         }
     }
     out

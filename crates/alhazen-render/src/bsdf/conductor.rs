@@ -72,14 +72,14 @@ impl Conductor {
         self.fresnel(h.dot(l)) * (f.d(h) * f.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()))
     }
 
-    /// `D(h) cos ϑ_h / (4⟨h,v⟩)`.
+    /// The facet's density over `4⟨h,v⟩`.
     pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
         let Some(f) = &self.facets else { return 0.0 };
         if !same_side(v, l) {
             return 0.0;
         }
         let Some(h) = half_vector(v, l) else { return 0.0 };
-        f.pdf_h(h) / (4.0 * h.dot(v).abs())
+        f.pdf_h_from(v, h, f.d(h)) / (4.0 * h.dot(v).abs())
     }
 
     /// [`Self::eval`] and [`Self::pdf`] with the half vector and `D` found once (the same numbers).
@@ -91,7 +91,7 @@ impl Conductor {
         let Some(h) = half_vector(v, l) else { return (Vec3::ZERO, 0.0) };
         let d = f.d(h);
         let value = self.fresnel(h.dot(l)) * (d * f.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()));
-        (value, d * h.z.max(0.0) / (4.0 * h.dot(v).abs()))
+        (value, f.pdf_h_from(v, h, d) / (4.0 * h.dot(v).abs()))
     }
 
     /// The mirror direction, or reflection about a sampled facet.
@@ -101,7 +101,7 @@ impl Conductor {
             let f = self.fresnel(v.z) / v.z.abs();
             return Some(BsdfSample { l, f, pdf: 1.0, delta: true, eta: 1.0, dispersive: false });
         };
-        let h = facets.sample_h(u)?;
+        let h = facets.sample_h_from(v, u)?;
         let l = reflect(v, h * v.z.signum());
         let (f, pdf) = self.eval_pdf(v, l);
         (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })

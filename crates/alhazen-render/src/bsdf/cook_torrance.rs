@@ -34,15 +34,15 @@ impl SpecularLobe for CookTorranceLobe {
         self.facets.d(h) * self.facets.g(v, l, h) * f / (4.0 * l.z.abs() * v.z.abs())
     }
 
-    /// `D(h) cos ϑ_h / (4⟨h,v⟩)`.
+    /// The facet's density over `4⟨h,v⟩`.
     fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
         let Some(h) = half_vector(v, l) else { return 0.0 };
-        self.facets.pdf_h(h) / (4.0 * h.dot(v).abs())
+        self.facets.pdf_h_from(v, h, self.facets.d(h)) / (4.0 * h.dot(v).abs())
     }
 
     /// `v` reflected about a sampled facet normal.
     fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
-        let h = self.facets.sample_h(u)?;
+        let h = self.facets.sample_h_from(v, u)?;
         Some(reflect(v, h * v.z.signum()))
     }
 }

@@ -80,11 +80,12 @@ impl Dielectric {
         let Some(f) = &self.facets else { return 0.0 };
         let Some((h, etap)) = self.half(v, l) else { return 0.0 };
         let fr = self.fresnel(v.dot(h));
+        let pdf_h = f.pdf_h_from(v, h, f.d(h));
         if etap == 1.0 {
-            f.pdf_h(h) / (4.0 * v.dot(h).abs()) * fr
+            pdf_h / (4.0 * v.dot(h).abs()) * fr
         } else {
             let jacobian = l.dot(h).abs() / (l.dot(h) + v.dot(h) / etap).powi(2);
-            f.pdf_h(h) * jacobian * (1.0 - fr)
+            pdf_h * jacobian * (1.0 - fr)
         }
     }
 
@@ -95,7 +96,7 @@ impl Dielectric {
         let Some((h, etap)) = self.half(v, l) else { return (Vec3::ZERO, 0.0) };
         let fr = self.fresnel(v.dot(h));
         let d = f.d(h);
-        let (dg, pdf_h) = (d * f.g(v, l, h), d * h.z.max(0.0));
+        let (dg, pdf_h) = (d * f.g(v, l, h), f.pdf_h_from(v, h, d));
         if etap == 1.0 {
             (Vec3::splat(dg * fr / (4.0 * (l.z * v.z).abs())), pdf_h / (4.0 * v.dot(h).abs()) * fr)
         } else {
@@ -110,7 +111,7 @@ impl Dielectric {
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let h = match &self.facets {
             None => Vec3::Z,
-            Some(f) => f.sample_h(u)?,
+            Some(f) => f.sample_h_from(v, u)?,
         };
         if v.dot(h) * v.z <= 0.0 {
             return None; // the facet is seen from behind: `pdf` gives such `l` no density

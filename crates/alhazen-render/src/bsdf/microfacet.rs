@@ -9,7 +9,10 @@
 //!   that `∫ D cos ϑ dω = 1` (the "rather troublesome" constant of the course).
 //!
 //! `G` is the course's V-groove term or Smith's separable `G₁(l) G₁(v)` (Walter et al. 2007).
-//! Normals are sampled with density `D(h) cos ϑ_h`.
+//! Normals are sampled as seen from the viewer: Trowbridge–Reitz's visible normals
+//! (`G₁(v) ⟨v,h⟩⁺ D(h) / ⟨v,n⟩`, Heitz 2018, "Sampling the GGX Distribution of Visible
+//! Normals", as pbrt-v4 and Mitsuba 3 do: each sample's weight is at most `G₁(l)`), the other
+//! distributions with density `D(h) cos ϑ_h`.
 
 use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::bsdf::{Distribution, Microfacets, Shadowing};
@@ -119,6 +122,47 @@ impl Microfacet {
         None
     }
 
+    /// A normal for reflecting or refracting `v` (either side: the normal is in the upper
+    /// hemisphere, as seen from `v` mirrored to `+z`): visible normals for Trowbridge–Reitz,
+    /// [`Self::sample_h`] otherwise. Density [`Self::pdf_h_from`].
+    pub fn sample_h_from(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
+        if self.distribution != Distribution::TrowbridgeReitz {
+            return self.sample_h(u);
+        }
+        let v = v * v.z.signum();
+        // The view in the stretched configuration, where the distribution is the unit
+        // hemisphere's; a point of the disk under it, warped to its visible half.
+        let vs = Vec3::new(self.alpha_u * v.x, self.alpha_v * v.y, v.z).normalize_or_zero();
+        if vs.z <= 0.0 {
+            return None;
+        }
+        let len2 = vs.x * vs.x + vs.y * vs.y;
+        let t1 = if len2 > 0.0 { Vec3::new(-vs.y, vs.x, 0.0) / len2.sqrt() } else { Vec3::X };
+        let t2 = vs.cross(t1);
+        let r = u.x.sqrt();
+        let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
+        let (p1, p2) = (r * cos, r * sin);
+        let s = 0.5 * (1.0 + vs.z);
+        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
+        let n = t1 * p1 + t2 * p2 + vs * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+        let h = Vec3::new(self.alpha_u * n.x, self.alpha_v * n.y, n.z.max(0.0)).normalize_or_zero();
+        (h.z > 0.0).then_some(h)
+    }
+
+    /// Density of [`Self::sample_h_from`] choosing `h` (upper hemisphere) for `v`, where
+    /// `d = D(h)`.
+    pub fn pdf_h_from(&self, v: Vec3, h: Vec3, d: f64) -> f64 {
+        if self.distribution != Distribution::TrowbridgeReitz {
+            return d * h.z.max(0.0);
+        }
+        let v = v * v.z.signum();
+        let vh = v.dot(h);
+        if vh <= 0.0 || v.z <= 0.0 {
+            return 0.0;
+        }
+        d * vh / (v.z * (1.0 + self.lambda(v)))
+    }
+
     /// Density of [`Self::sample_h`].
     pub fn pdf_h(&self, h: Vec3) -> f64 {
         self.d(h) * h.z.max(0.0)
@@ -183,6 +227,34 @@ mod tests {
             }
         }
         sum * (1.0 / nt as f64) * (2.0 * PI / np as f64)
+    }
+
+    /// The visible normals' density `G₁(v) ⟨v,h⟩⁺ D(h) / ⟨v,n⟩` integrates to one over the
+    /// hemisphere for every view (it needs Smith's exact Λ), and its samples are all visible.
+    #[test]
+    fn visible_normals_have_unit_density_and_face_the_viewer() {
+        let m = facets(Distribution::TrowbridgeReitz, 0.15, 0.5);
+        for (theta, phi) in [(0.1f64, 0.3f64), (1.0, 2.0), (1.45, -0.7), (2.2, 1.0)] {
+            let v = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+            let (nt, np) = (3000, 256);
+            let mut sum = 0.0;
+            for i in 0..nt {
+                let z = (i as f64 + 0.5) / nt as f64;
+                let r = (1.0 - z * z).sqrt();
+                for j in 0..np {
+                    let a = 2.0 * PI * (j as f64 + 0.5) / np as f64;
+                    let h = Vec3::new(r * a.cos(), r * a.sin(), z);
+                    sum += m.pdf_h_from(v, h, m.d(h));
+                }
+            }
+            let total = sum * (1.0 / nt as f64) * (2.0 * PI / np as f64);
+            assert!((total - 1.0).abs() < 5e-3, "θ = {theta}: {total}");
+            for k in 0..64 {
+                let u = Vec2::new((k % 8) as f64 / 8.0 + 0.03, (k / 8) as f64 / 8.0 + 0.05);
+                let h = m.sample_h_from(v, u).unwrap();
+                assert!(h.z > 0.0 && h.dot(v) * v.z > 0.0, "{h} for {v}");
+            }
+        }
     }
 
     #[test]

@@ -87,7 +87,7 @@ impl Plastic {
         let Some(h) = half_vector(v, l) else { return (0.0, 0.0) };
         let f = fresnel_dielectric(h.dot(v), self.eta);
         let value = facets.d(h) * facets.g(v, l, h) * f / (4.0 * l.z.abs() * v.z.abs());
-        (value, facets.pdf_h(h) / (4.0 * h.dot(v).abs()))
+        (value, facets.pdf_h_from(v, h, facets.d(h)) / (4.0 * h.dot(v).abs()))
     }
 
     /// `ρ(l, v)` (the smooth coat's mirror only through `sample`).
@@ -129,7 +129,7 @@ impl Plastic {
                 let f = Vec3::splat(fresnel_dielectric(v.z, self.eta) / l.z.abs());
                 return Some(BsdfSample { l, f, pdf: p, delta: true, eta: 1.0, dispersive: false });
             };
-            let h = facets.sample_h(u)?;
+            let h = facets.sample_h_from(v, u)?;
             let l = reflect(v, h * v.z.signum());
             let (f, pdf) = self.eval_pdf(v, l);
             return (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false });
