@@ -11,7 +11,8 @@
 //! `G` is the course's V-groove term or Smith's separable `G₁(l) G₁(v)` (Walter et al. 2007).
 //! Normals are sampled as seen from the viewer: Trowbridge–Reitz's visible normals
 //! (`G₁(v) ⟨v,h⟩⁺ D(h) / ⟨v,n⟩`, Heitz 2018, "Sampling the GGX Distribution of Visible
-//! Normals", as pbrt-v4 and Mitsuba 3 do: each sample's weight is at most `G₁(l)`), the other
+//! Normals", as pbrt-v4 and Mitsuba 3 do: each sample's weight is at most `G₁(l)`; drawn by
+//! Dupuy and Benyoub's spherical caps), the other
 //! distributions with density `D(h) cos ϑ_h`.
 
 use alhazen_math::{Vec2, Vec3};
@@ -130,21 +131,18 @@ impl Microfacet {
             return self.sample_h(u);
         }
         let v = v * v.z.signum();
-        // The view in the stretched configuration, where the distribution is the unit
-        // hemisphere's; a point of the disk under it, warped to its visible half.
+        // In the stretched configuration, where the distribution is the unit hemisphere's, the
+        // visible normals are `v` plus a uniform point of the unit sphere's cap `z ≥ −v_z`
+        // (Dupuy and Benyoub 2023, "Sampling Visible GGX Normals with Spherical Caps": the
+        // density of Heitz 2018 in fewer operations).
         let vs = Vec3::new(self.alpha_u * v.x, self.alpha_v * v.y, v.z).normalize_or_zero();
         if vs.z <= 0.0 {
             return None;
         }
-        let len2 = vs.x * vs.x + vs.y * vs.y;
-        let t1 = if len2 > 0.0 { Vec3::new(-vs.y, vs.x, 0.0) / len2.sqrt() } else { Vec3::X };
-        let t2 = vs.cross(t1);
-        let r = u.x.sqrt();
+        let z = (1.0 - u.x) * (1.0 + vs.z) - vs.z;
+        let r = (1.0 - z * z).max(0.0).sqrt();
         let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
-        let (p1, p2) = (r * cos, r * sin);
-        let s = 0.5 * (1.0 + vs.z);
-        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
-        let n = t1 * p1 + t2 * p2 + vs * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+        let n = Vec3::new(r * cos, r * sin, z) + vs;
         let h = Vec3::new(self.alpha_u * n.x, self.alpha_v * n.y, n.z.max(0.0)).normalize_or_zero();
         (h.z > 0.0).then_some(h)
     }
