@@ -212,19 +212,25 @@ mod tests {
         Microfacet::new(&Microfacets { distribution, alpha_u: au, alpha_v: av, shadowing: Shadowing::Smith })
     }
 
-    /// `∫ D(h) cos ϑ dω` over the hemisphere by a fine midpoint rule in (cos ϑ, φ).
-    fn projected_area(m: &Microfacet) -> f64 {
-        let (nt, np) = (4000, 256);
+    /// `∫ f(h) dω` over the upper hemisphere by a midpoint rule in (cos ϑ, φ), `nt` steps in
+    /// cos ϑ and 256 in φ.
+    fn over_hemisphere(nt: usize, f: impl Fn(Vec3) -> f64) -> f64 {
+        let np = 256;
         let mut sum = 0.0;
         for i in 0..nt {
             let z = (i as f64 + 0.5) / nt as f64;
             let r = (1.0 - z * z).sqrt();
             for j in 0..np {
                 let phi = 2.0 * PI * (j as f64 + 0.5) / np as f64;
-                sum += m.d(Vec3::new(r * phi.cos(), r * phi.sin(), z)) * z;
+                sum += f(Vec3::new(r * phi.cos(), r * phi.sin(), z));
             }
         }
         sum * (1.0 / nt as f64) * (2.0 * PI / np as f64)
+    }
+
+    /// `∫ D(h) cos ϑ dω` over the hemisphere.
+    fn projected_area(m: &Microfacet) -> f64 {
+        over_hemisphere(4000, |h| m.d(h) * h.z)
     }
 
     /// The visible normals' density `G₁(v) ⟨v,h⟩⁺ D(h) / ⟨v,n⟩` integrates to one over the
@@ -234,18 +240,7 @@ mod tests {
         let m = facets(Distribution::TrowbridgeReitz, 0.15, 0.5);
         for (theta, phi) in [(0.1f64, 0.3f64), (1.0, 2.0), (1.45, -0.7), (2.2, 1.0)] {
             let v = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
-            let (nt, np) = (3000, 256);
-            let mut sum = 0.0;
-            for i in 0..nt {
-                let z = (i as f64 + 0.5) / nt as f64;
-                let r = (1.0 - z * z).sqrt();
-                for j in 0..np {
-                    let a = 2.0 * PI * (j as f64 + 0.5) / np as f64;
-                    let h = Vec3::new(r * a.cos(), r * a.sin(), z);
-                    sum += m.pdf_h_from(v, h, m.d(h));
-                }
-            }
-            let total = sum * (1.0 / nt as f64) * (2.0 * PI / np as f64);
+            let total = over_hemisphere(3000, |h| m.pdf_h_from(v, h, m.d(h)));
             assert!((total - 1.0).abs() < 5e-3, "θ = {theta}: {total}");
             for k in 0..64 {
                 let u = Vec2::new((k % 8) as f64 / 8.0 + 0.03, (k / 8) as f64 / 8.0 + 0.05);
