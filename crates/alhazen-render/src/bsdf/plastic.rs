@@ -184,18 +184,21 @@ impl Coat {
         coat
     }
 
+    /// The tables, their entries computed in parallel (each on its own, so the same bits on
+    /// any number of threads; the reflectance's sum is taken in order).
     fn compute(eta: f64, facets: Option<&Microfacet>) -> Coat {
+        use rayon::prelude::*;
         let mut transmittance = [0.0; TABLE];
-        for (i, t) in transmittance.iter_mut().enumerate() {
+        transmittance.par_iter_mut().enumerate().for_each(|(i, t)| {
             let mu = (i as f64 / (TABLE - 1) as f64).max(1e-6);
             *t = match facets {
                 None => 1.0 - fresnel_dielectric(mu, eta),
                 Some(f) => rough_transmittance(f, mu, eta),
             };
-        }
+        });
         // R_in = 2 ∫₀¹ R(μ) μ dμ, R the reflectance from inside (index 1/η).
-        let inner_reflectance = gauss_legendre(NODES)
-            .iter()
+        let terms: Vec<f64> = gauss_legendre(NODES)
+            .par_iter()
             .map(|&(mu, w)| {
                 let r = match facets {
                     None => fresnel_dielectric(mu, 1.0 / eta),
@@ -203,7 +206,8 @@ impl Coat {
                 };
                 2.0 * w * r * mu
             })
-            .sum();
+            .collect();
+        let inner_reflectance = terms.iter().sum();
         Coat { transmittance, inner_reflectance }
     }
 }
