@@ -197,7 +197,7 @@ impl Coat {
             };
         });
         // R_in = 2 ∫₀¹ R(μ) μ dμ, R the reflectance from inside (index 1/η).
-        let terms: Vec<f64> = gauss_legendre(NODES)
+        let terms: Vec<f64> = RULE
             .par_iter()
             .map(|&(mu, w)| {
                 let r = match facets {
@@ -221,10 +221,10 @@ fn incident(mu: f64) -> Vec3 {
 /// over facet normals `h` drawn with density `D(h)⟨h,n⟩`, by Gauss–Legendre quadrature over
 /// the sampler's unit square; `lobe(h)` gives the outgoing direction and the facet's weight.
 fn lobe_albedo(f: &Microfacet, v: Vec3, lobe: impl Fn(Vec3) -> Option<(Vec3, f64)>) -> f64 {
-    let nodes = gauss_legendre(NODES);
+    let nodes = &*RULE;
     let mut sum = 0.0;
-    for &(x, wx) in &nodes {
-        for &(y, wy) in &nodes {
+    for &(x, wx) in nodes {
+        for &(y, wy) in nodes {
             let Some(h) = f.sample_h(Vec2::new(x, y)) else { continue };
             let Some((l, weight)) = lobe(h) else { continue };
             let vh = v.dot(h);
@@ -257,6 +257,9 @@ fn rough_reflectance(f: &Microfacet, mu: f64, eta: f64) -> f64 {
 
 /// The `n`-point Gauss–Legendre rule on `[0, 1]`: nodes and weights (Newton's iteration on the
 /// Legendre polynomial from Chebyshev's guesses).
+/// The `NODES`-point Gauss–Legendre rule, computed once.
+static RULE: std::sync::LazyLock<Vec<(f64, f64)>> = std::sync::LazyLock::new(|| gauss_legendre(NODES));
+
 fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     (0..n)
         .map(|i| {
