@@ -51,6 +51,16 @@ impl Transform {
         Mat3::from_mat4(self.m).determinant() < 0.0
     }
 
+    /// The uniform scale of a similarity (rotation, reflection, uniform scale and translation);
+    /// `None` for shears and unequal scales.
+    pub fn similarity_scale(&self) -> Option<f64> {
+        let (a, b, c) = (self.vector(Vec3::X), self.vector(Vec3::Y), self.vector(Vec3::Z));
+        let s = a.length();
+        let same = |v: Vec3| (v.length() - s).abs() < 1e-9 * s;
+        let orthogonal = a.dot(b).abs() + b.dot(c).abs() + a.dot(c).abs() < 1e-9 * s * s;
+        (s > 0.0 && same(b) && same(c) && orthogonal).then_some(s)
+    }
+
     /// Checks invertibility and affinity of a user matrix.
     pub fn from_matrix(m: Mat4) -> Result<Self, TransformError> {
         if m.row(3) != crate::Vec4::new(0.0, 0.0, 0.0, 1.0) {

@@ -125,7 +125,7 @@ pub struct Lights {
 /// The world-space geometry of an emitting object, when it can be sampled.
 fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
     let t = &o.transform;
-    let similarity = || crate::connect::similarity_scale(t);
+    let similarity = || t.similarity_scale();
     let mirroring = t.is_mirroring();
     let triangles = |tris: Vec<[Vec3; 3]>| {
         let areas: Vec<f64> = tris.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();

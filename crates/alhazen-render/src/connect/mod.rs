@@ -86,23 +86,13 @@ pub struct MirrorPath {
     pub geometry: f64,
 }
 
-/// The uniform scale of a similarity transform (rotation, reflection, uniform scale and
-/// translation); `None` for shears and unequal scales.
-pub fn similarity_scale(t: &Transform) -> Option<f64> {
-    let (a, b, c) = (t.vector(Vec3::X), t.vector(Vec3::Y), t.vector(Vec3::Z));
-    let s = a.length();
-    let same = |v: Vec3| (v.length() - s).abs() < 1e-9 * s;
-    let orthogonal = a.dot(b).abs() + b.dot(c).abs() + a.dot(c).abs() < 1e-9 * s * s;
-    (s > 0.0 && same(b) && same(c) && orthogonal).then_some(s)
-}
-
 impl MirrorShape {
     /// The mirror surfaces of a scene shape placed by `t`: a sphere, a cylinder's side (and its
     /// caps), a disk or a plane; empty for other shapes and for spheres, cylinders and disks
     /// under transforms that are not similarities (they would be ellipsoids).
     pub fn pieces(shape: &alhazen_scene::Shape, t: &Transform) -> Vec<MirrorShape> {
         use alhazen_scene::Shape;
-        let s = similarity_scale(t);
+        let s = t.similarity_scale();
         match (shape, s) {
             (Shape::Sphere { center, radius }, Some(s)) => {
                 vec![MirrorShape::Sphere { center: t.point(*center), radius: radius * s }]

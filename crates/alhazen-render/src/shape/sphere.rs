@@ -26,8 +26,8 @@ impl Sphere {
     /// uniform scale, translation, perhaps a reflection): a sphere in world space, whose
     /// parametrisation alone keeps the rotation.
     pub fn placed(center: Vec3, radius: f64, t: &Transform) -> Option<Self> {
-        let scale = crate::connect::similarity_scale(t)?;
-        let rotation = Mat3::from_cols(t.vector(Vec3::X), t.vector(Vec3::Y), t.vector(Vec3::Z)) / scale;
+        let scale = t.similarity_scale()?;
+        let rotation = Mat3::from_mat4(t.matrix()) / scale;
         let turn = (rotation != Mat3::IDENTITY).then(|| rotation.transpose());
         Some(Self { center: t.point(center), radius: radius * scale, turn })
     }
