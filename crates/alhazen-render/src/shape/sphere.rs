@@ -41,19 +41,21 @@ impl Sphere {
     /// Both roots of `a t² − 2βt + c = 0` (`f = o − c`, `β = −f·d`), ascending. The
     /// discriminant is taken as `a (r² − |f − (f·d/a) d|²)` — from the ray's closest approach to
     /// the centre — instead of `β² − ac`, which cancels catastrophically for rays from far away
-    /// (Haines et al., "Precision Improvements for Ray/Sphere Intersection", 2019).
+    /// (Haines et al., "Precision Improvements for Ray/Sphere Intersection", 2019). `1/a` is
+    /// the ray's alone: packets compute it once for all their spheres.
     fn roots(&self, ray: &Ray) -> [f64; 2] {
         let (d, f) = (ray.dir, ray.origin - self.center);
         let a = d.length_squared();
+        let inv_a = 1.0 / a;
         let beta = -f.dot(d);
-        let perp = f + d * (beta / a);
+        let perp = f + d * (beta * inv_a);
         let disc = a * (self.radius * self.radius - perp.length_squared());
         if disc < 0.0 || disc.is_nan() || a == 0.0 {
             return [f64::NAN; 2];
         }
         let c = f.length_squared() - self.radius * self.radius;
         let q = beta + disc.sqrt().copysign(beta);
-        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q / a) };
+        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q * inv_a) };
         [t0.min(t1), t0.max(t1)]
     }
 

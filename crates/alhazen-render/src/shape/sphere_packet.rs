@@ -108,19 +108,13 @@ mod avx512 {
     /// the nearer root in front of the origin and the lanes hit before `t_max`.
     #[inline]
     #[target_feature(enable = "avx512f")]
-    fn lanes(
-        center: [__m512d; 3],
-        r: __m512d,
-        o: [__m512d; 3],
-        d: [__m512d; 3],
-        t_max: __m512d,
-    ) -> (__m512d, __mmask8) {
+    fn lanes(center: [__m512d; 3], r: __m512d, ray: &RayLanes, t_max: __m512d) -> (__m512d, __mmask8) {
+        let (o, d, a, inv_a) = (ray.origin, ray.dir, ray.a, ray.inv_a);
         let f = [0, 1, 2].map(|i| _mm512_sub_pd(o[i], center[i]));
-        let a = dot(d, d);
         let sign = _mm512_set1_pd(-0.0);
         // `−(f·d)` by flipping the sign bit (`0 − x` would turn −0 into +0).
         let beta = bits(dot(f, d), sign, _mm512_xor_si512);
-        let s = _mm512_div_pd(beta, a);
+        let s = _mm512_mul_pd(beta, inv_a);
         let perp = [0, 1, 2].map(|i| _mm512_add_pd(f[i], _mm512_mul_pd(d[i], s)));
         let r2 = _mm512_mul_pd(r, r);
         let disc = _mm512_mul_pd(a, _mm512_sub_pd(r2, dot(perp, perp)));
@@ -129,7 +123,7 @@ mod avx512 {
         let real = _mm512_cmp_pd_mask::<_CMP_NLT_UQ>(disc, zero)
             & _mm512_cmp_pd_mask::<_CMP_ORD_Q>(disc, disc)
             & _mm512_cmp_pd_mask::<_CMP_NEQ_UQ>(a, zero);
-        // Most rays pass every sphere of a packet: skip the square root and two divisions.
+        // Most rays pass every sphere of a packet: skip the square root and the division.
         if real == 0 {
             return (zero, 0);
         }
@@ -140,11 +134,28 @@ mod avx512 {
         let q = _mm512_add_pd(beta, root);
         let q_zero = _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(q, zero);
         let t0 = _mm512_mask_blend_pd(q_zero, _mm512_div_pd(c, q), zero);
-        let t1 = _mm512_mask_blend_pd(q_zero, _mm512_div_pd(q, a), zero);
+        let t1 = _mm512_mask_blend_pd(q_zero, _mm512_mul_pd(q, inv_a), zero);
         let (lo, hi) = (min(t0, t1), max(t0, t1));
         let t = _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_GT_OQ>(lo, zero), hi, lo);
         let inside = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(t, zero) & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, t_max);
         (t, real & inside)
+    }
+
+    /// Rays in lanes with `a = d·d` and `1/a`, which every sphere's test takes.
+    struct RayLanes {
+        origin: [__m512d; 3],
+        dir: [__m512d; 3],
+        a: __m512d,
+        inv_a: __m512d,
+    }
+
+    impl RayLanes {
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn new(origin: [__m512d; 3], dir: [__m512d; 3]) -> Self {
+            let a = dot(dir, dir);
+            Self { origin, dir, a, inv_a: _mm512_div_pd(_mm512_set1_pd(1.0), a) }
+        }
     }
 
     /// A bitwise operation of AVX-512F on the lanes' bits.
@@ -174,11 +185,12 @@ mod avx512 {
     #[target_feature(enable = "avx512f")]
     pub(super) fn nearest(packets: &[SpherePacket], ray: &Ray, t_max: f64) -> Option<(usize, usize, f64)> {
         let r = ray_lanes(ray);
+        let r = RayLanes::new(r.origin, r.dir);
         let limit = _mm512_set1_pd(t_max);
         let mut best = NearestLanes::new(limit);
         for (k, p) in packets.iter().enumerate() {
             let center = [0, 1, 2].map(|i| load(&p.center[i]));
-            let (t, inside) = lanes(center, load(&p.radius), r.origin, r.dir, limit);
+            let (t, inside) = lanes(center, load(&p.radius), &r, limit);
             best.update(k, t, inside);
         }
         let (lane, k, t) = best.nearest()?;
@@ -193,13 +205,13 @@ mod avx512 {
         rays: &RayPacket,
         t_max: &[f64; SPHERE_LANES],
     ) -> RaysSphereHits {
-        let (o, d) = ([0, 1, 2].map(|i| load(&rays.origin[i])), [0, 1, 2].map(|i| load(&rays.dir[i])));
+        let ray = RayLanes::new([0, 1, 2].map(|i| load(&rays.origin[i])), [0, 1, 2].map(|i| load(&rays.dir[i])));
         let mut best = load(t_max);
         let (mut which, mut hit) = ([(0usize, 0usize); SPHERE_LANES], 0u8);
         for (k, p) in packets.iter().enumerate() {
             for lane in 0..p.used {
                 let center = [0, 1, 2].map(|i| _mm512_set1_pd(p.center[i][lane]));
-                let (t, closer) = lanes(center, _mm512_set1_pd(p.radius[lane]), o, d, best);
+                let (t, closer) = lanes(center, _mm512_set1_pd(p.radius[lane]), &ray, best);
                 if closer != 0 {
                     best = _mm512_mask_blend_pd(closer, best, t);
                     hit |= closer;
