@@ -5,8 +5,6 @@
 //! few cells a slice spans — the very cell a search of the whole CDF finds, in about one step
 //! instead of log₂ n dependent loads.
 
-use alhazen_math::Vec2;
-
 /// Distributions of at most this many cells are searched without a guide table.
 const GUIDED_FROM: usize = 16;
 
@@ -16,11 +14,9 @@ pub struct Distribution1D {
     func: Vec<f64>,
     cdf: Vec<f64>,
     integral: f64,
-    /// `guide[j]`: how many CDF entries are at most [`Self::edge`]`(j)`, for `j` in `0..=n`;
+    /// `guide[j]`: how many CDF entries are at most [`slice_start`]`(j, n)`, for `j` in `0..=n`;
     /// empty for few cells, which are searched whole.
     guide: Vec<u32>,
-    /// `1 / n`.
-    slice: f64,
 }
 
 impl Distribution1D {
@@ -42,28 +38,12 @@ impl Distribution1D {
         } else {
             cdf.iter_mut().for_each(|c| *c /= integral);
         }
-        let mut d = Self { func, cdf, integral, guide: vec![], slice: 1.0 / n as f64 };
+        let mut d = Self { func, cdf, integral, guide: vec![] };
         if n <= GUIDED_FROM {
             return d;
         }
-        let mut at = 0;
-        d.guide = (0..=n)
-            .map(|j| {
-                let edge = d.edge(j);
-                while at < d.cdf.len() && d.cdf[at] <= edge {
-                    at += 1;
-                }
-                at as u32
-            })
-            .collect();
+        d.guide = guide_table(n, |i| d.cdf[i]).map(|g| g as u32).collect();
         d
-    }
-
-    /// The start of slice `j` of the guide table (about `j / n`, the same bits wherever
-    /// computed, which is all the table needs).
-    #[inline]
-    fn edge(&self, j: usize) -> f64 {
-        j as f64 * self.slice
     }
 
     /// Number of cells.
@@ -81,25 +61,10 @@ impl Distribution1D {
         self.integral
     }
 
-    /// The cell of the last CDF entry `≤ u`: the entries `≤ u` are those up to slice
-    /// `j`'s start (`guide[j]`) and some of those before its end (`guide[j + 1]`).
+    /// The cell of the last CDF entry `≤ u` ([`search_cdf`] with this distribution's table).
     fn cell(&self, u: f64) -> usize {
-        let n = self.func.len();
-        if self.guide.is_empty() {
-            return self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(n - 1);
-        }
-        // The slice holding u, mended where u·n rounds across a slice's edge.
-        let mut j = ((u * n as f64) as usize).min(n - 1);
-        while j > 0 && u < self.edge(j) {
-            j -= 1;
-        }
-        while j + 1 < n && u >= self.edge(j + 1) {
-            j += 1;
-        }
-        let lo = if j == 0 { 0 } else { self.guide[j] as usize };
-        let hi = if j + 1 < n { self.guide[j + 1] as usize } else { self.cdf.len() };
-        let i = lo + self.cdf[lo..hi].partition_point(|&c| c <= u);
-        i.saturating_sub(1).min(n - 1)
+        let guide = (!self.guide.is_empty()).then_some(|j: usize| self.guide[j] as usize);
+        search_cdf(u, self.func.len(), guide, |i| self.cdf[i])
     }
 
     /// A cell with probability proportional to its weight, and that probability.
@@ -115,48 +80,80 @@ impl Distribution1D {
 
     /// A point in `[0, 1)` with density `f/∫f`, its density and cell.
     pub fn sample_continuous(&self, u: f64) -> (f64, f64, usize) {
+        let (x, i) = self.sample_point(u);
+        (x, self.cell_density(i), i)
+    }
+
+    /// The density `f/∫f` on cell `i`.
+    pub fn cell_density(&self, i: usize) -> f64 {
+        self.func[i] / self.integral
+    }
+
+    /// [`Self::sample_continuous`]'s point and cell without its density (the CDF alone is read:
+    /// callers that keep densities beside their own data save a cache line).
+    pub fn sample_point(&self, u: f64) -> (f64, usize) {
         let i = self.cell(u);
         let width = self.cdf[i + 1] - self.cdf[i];
         let du = if width > 0.0 { (u - self.cdf[i]) / width } else { 0.5 };
-        let x = ((i as f64 + du.clamp(0.0, 1.0)) / self.func.len() as f64).min(1.0 - 1e-16);
-        (x, self.func[i] / self.integral, i)
+        ((((i as f64 + du.clamp(0.0, 1.0)) / self.func.len() as f64).min(1.0 - 1e-16)), i)
     }
 
     /// Density at `x ∈ [0, 1)`.
     pub fn pdf(&self, x: f64) -> f64 {
-        let i = ((x * self.func.len() as f64) as usize).min(self.func.len() - 1);
-        self.func[i] / self.integral
+        self.cell_density(((x * self.func.len() as f64) as usize).min(self.func.len() - 1))
     }
 }
 
-/// A piecewise-constant density on `[0, 1)²`: a marginal over rows and a conditional per row.
-#[derive(Clone, Debug)]
-pub struct Distribution2D {
-    rows: Vec<Distribution1D>,
-    marginal: Distribution1D,
+/// The start of slice `j` of `n` equal slices of `[0, 1)` (about `j / n`, the same bits
+/// wherever computed, which is all a guide table needs).
+#[inline]
+fn slice_start(j: usize, n: usize) -> f64 {
+    j as f64 * (1.0 / n as f64)
 }
 
-impl Distribution2D {
-    /// From `width × height` weights, rows top to bottom.
-    pub fn new(weights: &[f64], width: usize, height: usize) -> Self {
-        let rows: Vec<Distribution1D> =
-            (0..height).map(|y| Distribution1D::new(&weights[y * width..(y + 1) * width])).collect();
-        let marginal = Distribution1D::new(&rows.iter().map(|r| r.integral()).collect::<Vec<_>>());
-        Self { rows, marginal }
-    }
+/// The guide table of a non-decreasing CDF of `n + 1` entries read by `entry`: for each slice
+/// start `j` in `0..=n`, how many entries are at most it.
+pub(crate) fn guide_table(n: usize, entry: impl Fn(usize) -> f64) -> impl Iterator<Item = usize> {
+    let mut at = 0;
+    (0..=n).map(move |j| {
+        let edge = slice_start(j, n);
+        while at <= n && entry(at) <= edge {
+            at += 1;
+        }
+        at
+    })
+}
 
-    /// A point `(x, y)` and its density.
-    pub fn sample(&self, u: Vec2) -> (Vec2, f64) {
-        let (y, pdf_y, row) = self.marginal.sample_continuous(u.y);
-        let (x, pdf_x, _) = self.rows[row].sample_continuous(u.x);
-        (Vec2::new(x, y), pdf_x * pdf_y)
+/// The cell (in `0..n`) of the last of a CDF's `n + 1` entries `≤ u`, the entries read by
+/// `entry`. With a guide table ([`guide_table`], read by `guide`) the entries `≤ u` are those
+/// up to the start of `u`'s slice and some of those before its end, so only the few cells the
+/// slice spans are searched; without one, the whole CDF.
+#[inline]
+pub(crate) fn search_cdf(
+    u: f64,
+    n: usize,
+    guide: Option<impl Fn(usize) -> usize>,
+    entry: impl Fn(usize) -> f64,
+) -> usize {
+    let (mut lo, mut hi) = (0, n + 1);
+    if let Some(guide) = guide {
+        // The slice holding u, mended where u·n rounds across a slice's edge.
+        let mut j = ((u * n as f64) as usize).min(n - 1);
+        while j > 0 && u < slice_start(j, n) {
+            j -= 1;
+        }
+        while j + 1 < n && u >= slice_start(j + 1, n) {
+            j += 1;
+        }
+        lo = if j == 0 { 0 } else { guide(j) };
+        hi = if j + 1 < n { guide(j + 1) } else { n + 1 };
     }
-
-    /// Density at `p`.
-    pub fn pdf(&self, p: Vec2) -> f64 {
-        let row = ((p.y * self.rows.len() as f64) as usize).min(self.rows.len() - 1);
-        self.marginal.pdf(p.y) * self.rows[row].pdf(p.x)
+    // The first entry in lo..hi above u (or hi).
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if entry(mid) <= u { lo = mid + 1 } else { hi = mid }
     }
+    lo.saturating_sub(1).min(n - 1)
 }
 
 #[cfg(test)]
@@ -190,27 +187,12 @@ mod tests {
         ) {
             let d = Distribution1D::new(&weights);
             let mut us = us;
-            us.extend(d.cdf.iter().copied().chain((0..=d.len()).map(|j| d.edge(j))));
+            us.extend(d.cdf.iter().copied().chain((0..=d.len()).map(|j| slice_start(j, d.len()))));
             us.extend([0.0, 1.0, 1.0 - 1e-16, f64::NAN, f64::INFINITY, -0.0]);
             for u in us {
                 let whole = d.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(d.len() - 1);
                 proptest::prop_assert_eq!(d.cell(u), whole, "u = {}", u);
             }
         }
-    }
-
-    #[test]
-    fn two_dimensional_density_integrates_to_one() {
-        let w: Vec<f64> = (0..12).map(|i| (i % 5) as f64).collect();
-        let d = Distribution2D::new(&w, 4, 3);
-        let mut sum = 0.0;
-        for y in 0..30 {
-            for x in 0..40 {
-                sum += d.pdf(Vec2::new((x as f64 + 0.5) / 40.0, (y as f64 + 0.5) / 30.0));
-            }
-        }
-        assert!((sum / 1200.0 - 1.0).abs() < 1e-9);
-        let (p, pdf) = d.sample(Vec2::new(0.3, 0.7));
-        assert!((d.pdf(p) - pdf).abs() < 1e-9);
     }
 }

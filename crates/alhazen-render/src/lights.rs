@@ -198,7 +198,7 @@ impl Lights {
                 }
                 Light::Environment { image, scale, rotation } => {
                     sky = Some(lights.len() as u32);
-                    PathLight::Environment(Box::new(EnvMap::new(scene.images[image].clone(), scale, rotation)))
+                    PathLight::Environment(Box::new(EnvMap::new(&scene.images[image], scale, rotation)))
                 }
             });
         }
