@@ -510,7 +510,7 @@ fn scaled(img: &ImageData, factor: Vec3) -> ImageData {
         return img.clone();
     }
     let f = factor.to_array().map(|x| x as f32);
-    ImageData { pixels: img.pixels.iter().map(|p| [p[0] * f[0], p[1] * f[1], p[2] * f[2]]).collect(), ..img.clone() }
+    ImageData::new(img.width, img.height, img.pixels.iter().map(|p| [p[0] * f[0], p[1] * f[1], p[2] * f[2]]).collect())
 }
 
 /// Decoded glTF image data as linear RGB.
@@ -547,5 +547,5 @@ fn decode(data: &gltf::image::Data, srgb: bool) -> Option<ImageData> {
             if channels < 3 { [c(0), c(0), c(0)] } else { [c(0), c(1), c(2)] }
         })
         .collect();
-    (data.width > 0 && data.height > 0).then_some(ImageData { width: data.width, height: data.height, pixels })
+    (data.width > 0 && data.height > 0).then_some(ImageData::new(data.width, data.height, pixels))
 }

@@ -1265,15 +1265,14 @@ impl Importer {
     }
 }
 
-/// Turns a mesh inside out: reversed winding and normals.
 /// The image with its rows in reverse order.
-fn upside_down(mut img: alhazen_scene::ImageData) -> alhazen_scene::ImageData {
+fn upside_down(img: alhazen_scene::ImageData) -> alhazen_scene::ImageData {
     let w = img.width as usize;
     let rows: Vec<&[[f32; 3]]> = img.pixels.chunks_exact(w.max(1)).rev().collect();
-    img.pixels = rows.concat();
-    img
+    alhazen_scene::ImageData::new(img.width, img.height, rows.concat())
 }
 
+/// Turns a mesh inside out: reversed winding and normals.
 pub(crate) fn flip_mesh(mesh: &mut alhazen_geom::TriangleMesh) {
     for t in &mut mesh.triangles {
         t.swap(1, 2);

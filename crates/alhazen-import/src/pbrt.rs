@@ -1439,7 +1439,7 @@ impl Importer {
                 pixels.push(img.pixels[j * n + i]);
             }
         }
-        self.scene.images.push(Arc::new(ImageData { width: w as u32, height: h as u32, pixels }));
+        self.scene.images.push(Arc::new(ImageData::new(w as u32, h as u32, pixels)));
         self.scene.lights.push(Light::Environment { image: self.scene.images.len() - 1, scale, rotation: 0.0 });
     }
 }

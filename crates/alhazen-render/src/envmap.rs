@@ -183,7 +183,7 @@ mod tests {
     fn test_map() -> EnvMap {
         let (w, h) = (16u32, 8u32);
         let pixels = (0..w * h).map(|i| [(i % 7) as f32 + 0.5, 1.0, (i % 3) as f32]).collect();
-        EnvMap::new(&ImageData { width: w, height: h, pixels }, 2.0, 0.4)
+        EnvMap::new(&ImageData::new(w, h, pixels), 2.0, 0.4)
     }
 
     #[test]

@@ -416,12 +416,8 @@ pub fn parse_bpt(text: &str) -> Result<TriangleMesh, String> {
 pub fn load_image(path: &Path) -> Result<ImageData, String> {
     let img = image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))?.to_rgb8();
     has_pixels(path, img.width(), img.height())?;
-    let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f64 / 255.0) as f32).collect();
-    Ok(ImageData {
-        width: img.width(),
-        height: img.height(),
-        pixels: img.pixels().map(|p| [lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]]).collect(),
-    })
+    let table = std::array::from_fn(|i| srgb_to_linear(i as f64 / 255.0) as f32);
+    Ok(ImageData::from_codes(img.width(), img.height(), table, img.pixels().map(|p| p.0).collect()))
 }
 
 /// Refuses an image of no pixels (a header saying 0 × 2: found by fuzzing, it made texture
@@ -442,7 +438,7 @@ pub fn load_hdr_image(path: &Path) -> Result<ImageData, String> {
     if pixels.iter().flatten().any(|v| !v.is_finite() || *v < 0.0) {
         return Err(format!("{}: the image has negative, infinite or NaN values", path.display()));
     }
-    Ok(ImageData { width: img.width(), height: img.height(), pixels })
+    Ok(ImageData::new(img.width(), img.height(), pixels))
 }
 
 #[cfg(test)]

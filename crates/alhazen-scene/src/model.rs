@@ -657,7 +657,9 @@ pub struct Object {
     pub mesh_materials: Vec<MaterialId>,
 }
 
-/// A decoded image in linear RGB, rows top to bottom.
+/// A decoded image in linear RGB, rows top to bottom. Made by [`ImageData::new`] (or
+/// [`ImageData::from_codes`]), which also keeps the pixels as one-byte codes when they take at
+/// most 256 values: change `pixels` only through a new `ImageData`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageData {
     /// Width in pixels.
@@ -666,4 +668,77 @@ pub struct ImageData {
     pub height: u32,
     /// `width × height` linear RGB values.
     pub pixels: Vec<[f32; 3]>,
+    /// The pixels as codes into a table of their values, for texture lookups.
+    codes: Option<PixelCodes>,
+}
+
+/// An image's pixels as one byte per channel into a table of at most 256 values: what every
+/// 8-bit image decodes to. A lookup reads 3 bytes instead of 12, so a 512² texture is 0.75 MB
+/// instead of 3 — a texture's cost in a render is its cache footprint — and decodes to the
+/// very values of `pixels`.
+#[derive(Clone, Debug, PartialEq)]
+struct PixelCodes {
+    table: Box<[f32; 256]>,
+    codes: Vec<[u8; 3]>,
+}
+
+impl ImageData {
+    /// The image of `pixels` (`width × height`, rows top to bottom).
+    pub fn new(width: u32, height: u32, pixels: Vec<[f32; 3]>) -> Self {
+        let codes = PixelCodes::of(&pixels);
+        Self { width, height, pixels, codes }
+    }
+
+    /// The image whose pixel channels are `table[code]`: an 8-bit image and its decoding.
+    pub fn from_codes(width: u32, height: u32, table: [f32; 256], codes: Vec<[u8; 3]>) -> Self {
+        let pixels = codes.iter().map(|c| c.map(|k| table[k as usize])).collect();
+        Self { width, height, pixels, codes: Some(PixelCodes { table: Box::new(table), codes }) }
+    }
+
+    /// True when lookups read the pixels as one-byte codes (at most 256 distinct values).
+    pub fn has_codes(&self) -> bool {
+        self.codes.is_some()
+    }
+
+    /// Pixel `i` (row by row), as texture lookups read it: the same values as `pixels[i]`.
+    #[inline]
+    pub fn texel(&self, i: usize) -> [f32; 3] {
+        match &self.codes {
+            Some(c) => c.codes[i].map(|k| c.table[k as usize]),
+            None => self.pixels[i],
+        }
+    }
+}
+
+impl PixelCodes {
+    /// The codes of `pixels` when their channels take at most 256 distinct values (found by a
+    /// small open-addressed table of the values' bits; an image of more gives up early).
+    fn of(pixels: &[[f32; 3]]) -> Option<Self> {
+        const SLOTS: usize = 1024;
+        let mut slots = [(0u32, u16::MAX); SLOTS];
+        let mut table = [0.0f32; 256];
+        let mut used = 0usize;
+        let mut code = |v: f32| -> Option<u8> {
+            let bits = v.to_bits();
+            let mut at = (bits.wrapping_mul(0x9E37_79B1) >> 22) as usize;
+            loop {
+                let (b, k) = slots[at];
+                if k == u16::MAX {
+                    if used == 256 {
+                        return None;
+                    }
+                    slots[at] = (bits, used as u16);
+                    table[used] = v;
+                    used += 1;
+                    return Some((used - 1) as u8);
+                }
+                if b == bits {
+                    return Some(k as u8);
+                }
+                at = (at + 1) % SLOTS;
+            }
+        };
+        let codes = pixels.iter().map(|p| Some([code(p[0])?, code(p[1])?, code(p[2])?])).collect::<Option<Vec<_>>>()?;
+        Some(Self { table: Box::new(table), codes })
+    }
 }

@@ -35,7 +35,7 @@ pub fn equirect_texel(img: &ImageData, dir: Vec3, rotation: f64) -> Vec3 {
 pub fn equirect_texel_at(img: &ImageData, uv: Vec2) -> Vec3 {
     let (w, h) = (img.width as usize, img.height as usize);
     let (x, y) = (((uv.x * w as f64) as usize).min(w - 1), ((uv.y * h as f64) as usize).min(h - 1));
-    let p = img.pixels[y * w + x];
+    let p = img.texel(y * w + x);
     Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 
@@ -57,7 +57,7 @@ fn bilinear(img: &ImageData, uv: Vec2) -> Vec3 {
         }
     };
     let px = |i: i64, j: i64| {
-        let p = img.pixels[(wrap(j, h) * w + wrap(i, w)) as usize];
+        let p = img.texel((wrap(j, h) * w + wrap(i, w)) as usize);
         Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
     };
     let (i, j) = (x0 as i64, y0 as i64);
@@ -71,11 +71,29 @@ mod tests {
     use super::*;
 
     proptest::proptest! {
+        /// Lookups read the pixels' own bits whether the image keeps codes (at most 256
+        /// distinct channel values, in any order, NaN and −0 included) or not (more).
+        #[test]
+        fn texels_are_the_pixels(
+            values in proptest::collection::vec(proptest::prelude::any::<f32>(), 1..300),
+            picks in proptest::collection::vec(proptest::prelude::any::<proptest::sample::Index>(), 3..600),
+        ) {
+            let n = picks.len() / 3;
+            let pixels: Vec<[f32; 3]> =
+                (0..n).map(|i| std::array::from_fn(|c| values[picks[3 * i + c].index(values.len())])).collect();
+            let distinct = pixels.iter().flatten().map(|v| v.to_bits()).collect::<std::collections::HashSet<_>>().len();
+            let img = ImageData::new(n as u32, 1, pixels.clone());
+            proptest::prop_assert_eq!(img.has_codes(), distinct <= 256);
+            for (i, p) in pixels.iter().enumerate() {
+                proptest::prop_assert_eq!(img.texel(i).map(f32::to_bits), p.map(f32::to_bits));
+            }
+        }
+
         /// Wrapping by comparison reads the texels wrapping by `rem_euclid` reads, anywhere:
         /// negative, on the edges, far away.
         #[test]
         fn bilinear_wraps_like_rem_euclid(u in -1e6..1e6f64, v in -1e6..1e6f64, edge in 0usize..4) {
-            let img = ImageData { width: 5, height: 3, pixels: (0..15).map(|i| [i as f32, (i * i) as f32, 1.0]).collect() };
+            let img = ImageData::new(5, 3, (0..15).map(|i| [i as f32, (i * i) as f32, 1.0]).collect());
             let uv = match edge { 0 => Vec2::new(u, v), 1 => Vec2::new(-1e-20, v), 2 => Vec2::new(u, 1.0), _ => Vec2::new(u.fract(), v.fract()) };
             let (w, h) = (5i64, 3i64);
             let x = uv.x.rem_euclid(1.0) * w as f64 - 0.5;
@@ -121,7 +139,7 @@ mod tests {
 
     #[test]
     fn image_lookup_hits_pixel_centres() {
-        let img = ImageData { width: 2, height: 1, pixels: vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]] };
+        let img = ImageData::new(2, 1, vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
         let t = Texture::Image { image: 0, scale: Vec2::ONE };
         let imgs = [std::sync::Arc::new(img)];
         assert_eq!(eval(&t, Vec2::new(0.25, 0.5), &imgs), Vec3::X);
@@ -223,7 +241,7 @@ mod bump_tests {
         }
         // A flat normal map (texel (½, ½, 1)) leaves the normal alone; a tilted texel tilts it
         // towards ∂p/∂u, by its strength.
-        let img = |c: [f32; 3]| std::sync::Arc::new(ImageData { width: 1, height: 1, pixels: vec![c] });
+        let img = |c: [f32; 3]| std::sync::Arc::new(ImageData::new(1, 1, vec![c]));
         let map = Bump { height: 1.0, pattern: BumpPattern::NormalMap { image: 0, scale: Vec2::ONE } };
         let flat = bumped_normal(&map, Vec2::new(0.3, 0.3), Vec3::Z, Vec3::X * 2.0, Vec3::Y, &[img([0.5, 0.5, 1.0])]);
         assert!((flat - Vec3::Z).length() < 1e-12, "{flat}");
