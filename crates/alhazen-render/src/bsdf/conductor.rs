@@ -32,17 +32,30 @@ pub struct Conductor {
 /// `R_⊥ = (a² + b² + c² − 2ac)/(a² + b² + c² + 2ac)` and
 /// `R_∥ = R_⊥ (c²(a² + b²) + s⁴ − 2acs²)/(c²(a² + b²) + s⁴ + 2acs²)` — two square roots and two
 /// divisions where complex arithmetic takes three complex divisions (test: the same values).
-pub fn fresnel_conductor(cos_i: f64, eta: f64, k: f64) -> f64 {
+#[cfg(test)]
+fn fresnel_conductor(cos_i: f64, eta: f64, k: f64) -> f64 {
+    fresnel_conductor_channels(cos_i, [eta; 4], [k; 4])[0]
+}
+
+/// [`fresnel_conductor`] for four channels at once, each with the same operations in the same
+/// order (so the same bits): written lane by lane, the square roots and divisions of all
+/// channels go through the vector unit together instead of one after another.
+#[inline]
+fn fresnel_conductor_channels(cos_i: f64, eta: [f64; 4], k: [f64; 4]) -> [f64; 4] {
     let c = cos_i.abs().min(1.0);
     let (c2, s2) = (c * c, 1.0 - c * c);
-    let t0 = eta * eta - k * k - s2;
-    let ab2 = (t0 * t0 + 4.0 * eta * eta * k * k).sqrt();
-    let a = (0.5 * (ab2 + t0)).max(0.0).sqrt();
-    let (t1, t2) = (ab2 + c2, 2.0 * c * a);
-    let perp = (t1 - t2) / (t1 + t2);
-    let (t3, t4) = (c2 * ab2 + s2 * s2, t2 * s2);
-    let par = perp * (t3 - t4) / (t3 + t4);
-    ((par + perp) / 2.0).clamp(0.0, 1.0)
+    let mut out = [0.0; 4];
+    for i in 0..4 {
+        let t0 = eta[i] * eta[i] - k[i] * k[i] - s2;
+        let ab2 = (t0 * t0 + 4.0 * eta[i] * eta[i] * k[i] * k[i]).sqrt();
+        let a = (0.5 * (ab2 + t0)).max(0.0).sqrt();
+        let (t1, t2) = (ab2 + c2, 2.0 * c * a);
+        let perp = (t1 - t2) / (t1 + t2);
+        let (t3, t4) = (c2 * ab2 + s2 * s2, t2 * s2);
+        let par = perp * (t3 - t4) / (t3 + t4);
+        out[i] = ((par + perp) / 2.0).clamp(0.0, 1.0);
+    }
+    out
 }
 
 impl Conductor {
@@ -51,15 +64,14 @@ impl Conductor {
         if self.eta == Vec3::ZERO && self.k == Vec3::ZERO {
             return self.tint;
         }
-        let f = |i: usize| {
-            if self.schlick {
-                let f0 = fresnel_conductor(1.0, self.eta[i], self.k[i]);
-                f0 + (1.0 - f0) * (1.0 - cos.abs().min(1.0)).powi(5)
-            } else {
-                fresnel_conductor(cos, self.eta[i], self.k[i])
-            }
-        };
-        Vec3::new(f(0), f(1), f(2)) * self.tint
+        let channels = |v: Vec3| [v.x, v.y, v.z, 0.0];
+        if self.schlick {
+            let f0 = fresnel_conductor_channels(1.0, channels(self.eta), channels(self.k));
+            let f = |i: usize| f0[i] + (1.0 - f0[i]) * (1.0 - cos.abs().min(1.0)).powi(5);
+            return Vec3::new(f(0), f(1), f(2)) * self.tint;
+        }
+        let f = fresnel_conductor_channels(cos, channels(self.eta), channels(self.k));
+        Vec3::new(f[0], f[1], f[2]) * self.tint
     }
 
     /// `D G F / (4⟨l,n⟩⟨v,n⟩)`; 0 for a smooth metal.
