@@ -214,4 +214,25 @@ mod tests {
             assert_eq!(m.radiance_and_pdf(d), (l, m.pdf(d)));
         }
     }
+
+    /// A single lit texel among black rows (whose CDFs fall back to uniform) takes every
+    /// sample, with the density its lookups report; narrow maps (searched without guide
+    /// tables) and black maps give finite densities.
+    #[test]
+    fn one_lit_texel_takes_every_sample() {
+        for (w, h) in [(40u32, 20u32), (8, 4)] {
+            let lit = (h / 3 * w + w / 4) as usize;
+            let pixels = (0..(w * h) as usize).map(|i| if i == lit { [5.0, 4.0, 3.0] } else { [0.0; 3] }).collect();
+            let m = EnvMap::new(&ImageData::new(w, h, pixels), 1.0, 0.0);
+            for k in 0..100 {
+                let u = Vec2::new((k as f64 * 0.618).fract(), (k as f64 * 0.377 + 0.1).fract());
+                let (d, l, pdf) = m.sample(u).unwrap();
+                assert_eq!(l, Vec3::new(5.0, 4.0, 3.0), "{w}×{h} sample {k}");
+                assert!((m.pdf(d) - pdf).abs() < 1e-9 * pdf, "{w}×{h} sample {k}");
+            }
+            let black = EnvMap::new(&ImageData::new(w, h, vec![[0.0; 3]; (w * h) as usize]), 1.0, 0.0);
+            let (_, l, pdf) = black.sample(Vec2::new(0.3, 0.6)).unwrap();
+            assert!(l == Vec3::ZERO && pdf.is_finite() && pdf > 0.0);
+        }
+    }
 }
