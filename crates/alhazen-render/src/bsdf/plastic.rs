@@ -266,7 +266,6 @@ static RULE: std::sync::LazyLock<Vec<(f64, f64)>> = std::sync::LazyLock::new(|| 
 
 /// The `n`-point Gauss–Legendre rule on `[0, 1]`: nodes and weights (Newton's iteration on the
 /// Legendre polynomial from Chebyshev's guesses).
-
 fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     (0..n)
         .map(|i| {
