@@ -89,6 +89,20 @@ impl EnvMap {
         m
     }
 
+    /// The bytes the environment maps of `scene`'s lights will take (records, guide tables
+    /// and the marginal over rows), for refusing a render before anything is allocated.
+    pub fn memory_estimate(scene: &alhazen_scene::Scene) -> u64 {
+        let maps = scene.lights.iter().filter_map(|l| match l {
+            alhazen_scene::Light::Environment { image, .. } => scene.images.get(*image),
+            _ => None,
+        });
+        maps.map(|i| {
+            let (w, h) = (i.width as u64, i.height as u64);
+            h * (w + 1) * (std::mem::size_of::<Texel>() as u64 + 2) + h * 24
+        })
+        .sum()
+    }
+
     /// Row `y`'s CDF entry `i` (`0..=width`).
     #[inline]
     fn cdf(&self, y: usize, i: usize) -> f64 {
@@ -234,5 +248,18 @@ mod tests {
             let (_, l, pdf) = black.sample(Vec2::new(0.3, 0.6)).unwrap();
             assert!(l == Vec3::ZERO && pdf.is_finite() && pdf > 0.0);
         }
+    }
+
+    /// A render is refused before its maps are built: the estimate grows by at least each
+    /// map's records and guide tables.
+    #[test]
+    fn memory_estimate_counts_each_map() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        let mut scene = alhazen_scene::load_scene(&root.join("cornell-box.toml")).unwrap();
+        let before = crate::memory_estimate(&scene);
+        scene.images.push(std::sync::Arc::new(ImageData::new(64, 32, vec![[1.0; 3]; 64 * 32])));
+        let image = scene.images.len() - 1;
+        scene.lights.push(alhazen_scene::Light::Environment { image, scale: 1.0, rotation: 0.0 });
+        assert!(crate::memory_estimate(&scene) >= before + 64 * 32 * 18);
     }
 }

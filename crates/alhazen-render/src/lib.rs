@@ -81,7 +81,7 @@ pub fn memory_estimate(scene: &Scene) -> u64 {
     let (w, h) = film_size(scene);
     let film = w as u64 * h as u64 * 28;
     let triangles: u64 = scene.meshes.iter().map(|m| m.triangles.len() as u64).sum();
-    film + triangles * 450 + scene.objects.len() as u64 * 300
+    film + triangles * 450 + scene.objects.len() as u64 * 300 + envmap::EnvMap::memory_estimate(scene)
 }
 
 /// The film's size for `scene`: its image size, or twice its width for a side-by-side stereo
