@@ -659,8 +659,9 @@ pub struct Object {
 
 /// A decoded image in linear RGB, rows top to bottom. Made by [`ImageData::new`] (or
 /// [`ImageData::from_codes`]), which also keeps the pixels as one-byte codes when they take at
-/// most 256 values: change `pixels` only through a new `ImageData`.
-#[derive(Clone, Debug, PartialEq)]
+/// most 256 values: change `pixels` only through a new `ImageData`. Two images are equal when
+/// their sizes and pixels are (the codes are derived from the pixels).
+#[derive(Clone)]
 pub struct ImageData {
     /// Width in pixels.
     pub width: u32,
@@ -676,10 +677,27 @@ pub struct ImageData {
 /// 8-bit image decodes to. A lookup reads 3 bytes instead of 12, so a 512² texture is 0.75 MB
 /// instead of 3 — a texture's cost in a render is its cache footprint — and decodes to the
 /// very values of `pixels`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone)]
 struct PixelCodes {
     table: Box<[f32; 256]>,
     codes: Vec<[u8; 3]>,
+}
+
+impl PartialEq for ImageData {
+    fn eq(&self, other: &Self) -> bool {
+        (self.width, self.height) == (other.width, other.height) && self.pixels == other.pixels
+    }
+}
+
+impl std::fmt::Debug for ImageData {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ImageData")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("pixels", &self.pixels)
+            .field("has_codes", &self.has_codes())
+            .finish()
+    }
 }
 
 impl ImageData {
