@@ -510,7 +510,11 @@ fn scaled(img: &ImageData, factor: Vec3) -> ImageData {
         return img.clone();
     }
     let f = factor.to_array().map(|x| x as f32);
-    ImageData::new(img.width, img.height, img.pixels.iter().map(|p| [p[0] * f[0], p[1] * f[1], p[2] * f[2]]).collect())
+    ImageData::new(
+        img.width,
+        img.height,
+        img.pixels().iter().map(|p| [p[0] * f[0], p[1] * f[1], p[2] * f[2]]).collect(),
+    )
 }
 
 /// Decoded glTF image data as linear RGB.

@@ -1268,7 +1268,7 @@ impl Importer {
 /// The image with its rows in reverse order.
 fn upside_down(img: alhazen_scene::ImageData) -> alhazen_scene::ImageData {
     let w = img.width as usize;
-    let rows: Vec<&[[f32; 3]]> = img.pixels.chunks_exact(w.max(1)).rev().collect();
+    let rows: Vec<&[[f32; 3]]> = img.pixels().chunks_exact(w.max(1)).rev().collect();
     alhazen_scene::ImageData::new(img.width, img.height, rows.concat())
 }
 

@@ -659,7 +659,7 @@ pub struct Object {
 
 /// A decoded image in linear RGB, rows top to bottom. Made by [`ImageData::new`] (or
 /// [`ImageData::from_codes`]), which also keeps the pixels as one-byte codes when they take at
-/// most 256 values: change `pixels` only through a new `ImageData`. Two images are equal when
+/// most 256 values; the pixels are read-only, so the codes stay theirs. Two images are equal when
 /// their sizes and pixels are (the codes are derived from the pixels).
 #[derive(Clone)]
 pub struct ImageData {
@@ -668,7 +668,7 @@ pub struct ImageData {
     /// Height in pixels.
     pub height: u32,
     /// `width × height` linear RGB values.
-    pub pixels: Vec<[f32; 3]>,
+    pixels: Vec<[f32; 3]>,
     /// The pixels as codes into a table of their values, for texture lookups.
     codes: Option<PixelCodes>,
 }
@@ -711,6 +711,16 @@ impl ImageData {
     pub fn from_codes(width: u32, height: u32, table: [f32; 256], codes: Vec<[u8; 3]>) -> Self {
         let pixels = codes.iter().map(|c| c.map(|k| table[k as usize])).collect();
         Self { width, height, pixels, codes: Some(PixelCodes { table: Box::new(table), codes }) }
+    }
+
+    /// The `width × height` linear RGB values, row by row.
+    pub fn pixels(&self) -> &[[f32; 3]] {
+        &self.pixels
+    }
+
+    /// The pixels, given up (to build another image from them).
+    pub fn into_pixels(self) -> Vec<[f32; 3]> {
+        self.pixels
     }
 
     /// True when lookups read the pixels as one-byte codes (at most 256 distinct values).

@@ -101,7 +101,7 @@ mod tests {
             let (x0, y0) = (x.floor(), y.floor());
             let (fx, fy) = (x - x0, y - y0);
             let px = |i: i64, j: i64| {
-                let p = img.pixels[(j.rem_euclid(h) * w + i.rem_euclid(w)) as usize];
+                let p = img.pixels()[(j.rem_euclid(h) * w + i.rem_euclid(w)) as usize];
                 Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
             };
             let (i, j) = (x0 as i64, y0 as i64);
