@@ -60,12 +60,13 @@ impl EnvMap {
                 let w = luminance(Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)) * sin;
                 if w.is_finite() { w.max(0.0) } else { 0.0 }
             };
-            let total: f64 = row.iter().map(power).sum();
+            let powers: Vec<f64> = row.iter().map(power).collect();
+            let total: f64 = powers.iter().sum();
             let mut before = 0.0;
-            for (x, p) in row.iter().enumerate() {
+            for (x, (p, w)) in row.iter().zip(&powers).enumerate() {
                 let cdf = if total > 0.0 { before / total } else { x as f64 / width as f64 };
                 texels.push(Texel { radiance: *p, cdf: cdf as f32 });
-                before += power(p);
+                before += w;
             }
             row_power.push(total);
         }

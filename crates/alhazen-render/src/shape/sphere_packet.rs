@@ -99,7 +99,7 @@ impl SpherePacket {
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod avx512 {
-    use super::super::avx512::{NearestLanes, dot, load, ray_lanes};
+    use super::super::avx512::{NearestLanes, RayLanes, dot, load, load3, ray_lanes};
     use super::{RayPacket, RaysSphereHits, SPHERE_LANES, SpherePacket};
     use alhazen_math::Ray;
     use std::arch::x86_64::*;
@@ -108,8 +108,8 @@ mod avx512 {
     /// the nearer root in front of the origin and the lanes hit before `t_max`.
     #[inline]
     #[target_feature(enable = "avx512f")]
-    fn lanes(center: [__m512d; 3], r: __m512d, ray: &RayLanes, t_max: __m512d) -> (__m512d, __mmask8) {
-        let (o, d, a, inv_a) = (ray.origin, ray.dir, ray.a, ray.inv_a);
+    fn lanes(center: [__m512d; 3], r: __m512d, ray: &SphereRays, t_max: __m512d) -> (__m512d, __mmask8) {
+        let (o, d, a, inv_a) = (ray.rays.origin, ray.rays.dir, ray.a, ray.inv_a);
         let f = [0, 1, 2].map(|i| _mm512_sub_pd(o[i], center[i]));
         let sign = _mm512_set1_pd(-0.0);
         // `−(f·d)` by flipping the sign bit (`0 − x` would turn −0 into +0).
@@ -142,19 +142,18 @@ mod avx512 {
     }
 
     /// Rays in lanes with `a = d·d` and `1/a`, which every sphere's test takes.
-    struct RayLanes {
-        origin: [__m512d; 3],
-        dir: [__m512d; 3],
+    struct SphereRays {
+        rays: RayLanes,
         a: __m512d,
         inv_a: __m512d,
     }
 
-    impl RayLanes {
+    impl SphereRays {
         #[inline]
         #[target_feature(enable = "avx512f")]
-        fn new(origin: [__m512d; 3], dir: [__m512d; 3]) -> Self {
-            let a = dot(dir, dir);
-            Self { origin, dir, a, inv_a: _mm512_div_pd(_mm512_set1_pd(1.0), a) }
+        fn new(rays: RayLanes) -> Self {
+            let a = dot(rays.dir, rays.dir);
+            Self { rays, a, inv_a: _mm512_div_pd(_mm512_set1_pd(1.0), a) }
         }
     }
 
@@ -184,8 +183,7 @@ mod avx512 {
     /// nearer replaces), compared once at the end.
     #[target_feature(enable = "avx512f")]
     pub(super) fn nearest(packets: &[SpherePacket], ray: &Ray, t_max: f64) -> Option<(usize, usize, f64)> {
-        let r = ray_lanes(ray);
-        let r = RayLanes::new(r.origin, r.dir);
+        let r = SphereRays::new(ray_lanes(ray));
         let limit = _mm512_set1_pd(t_max);
         let mut best = NearestLanes::new(limit);
         for (k, p) in packets.iter().enumerate() {
@@ -205,7 +203,7 @@ mod avx512 {
         rays: &RayPacket,
         t_max: &[f64; SPHERE_LANES],
     ) -> RaysSphereHits {
-        let ray = RayLanes::new([0, 1, 2].map(|i| load(&rays.origin[i])), [0, 1, 2].map(|i| load(&rays.dir[i])));
+        let ray = SphereRays::new(RayLanes { origin: load3(&rays.origin), dir: load3(&rays.dir) });
         let mut best = load(t_max);
         let (mut which, mut hit) = ([(0usize, 0usize); SPHERE_LANES], 0u8);
         for (k, p) in packets.iter().enumerate() {
