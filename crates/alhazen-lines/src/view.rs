@@ -10,6 +10,7 @@ use alhazen_math::{Mat4, Ray, Vec2, Vec3, Vec4};
 use alhazen_mirror::Site;
 use alhazen_raster::pipeline::{Projection, RasterError, projection};
 use alhazen_render::World;
+use alhazen_render::shape::ray_epsilon;
 use alhazen_scene::{CameraDesc, Scene};
 
 /// Clip-space `w` below which a point counts as behind the eye (relative to the view's scale).
@@ -190,6 +191,15 @@ impl Leeway<'_> {
     pub const NONE: Leeway<'static> = Leeway { objects: &[], near: 0.0 };
 }
 
+/// True when hit `h` of `ray` is the point `dist` along it itself, as far as the hit's
+/// precision tells: flats are tested in single precision ([`alhazen_render::shape::FlatPacket`]),
+/// their plane distances good to the tracers' guard ([`ray_epsilon`]), which along a ray
+/// meeting the surface at a cosine `c` is a distance `ε / c`.
+fn reaches(ray: &Ray, h: &alhazen_render::world::WorldHit, dist: f64) -> bool {
+    let cos = (h.hit.n.dot(ray.dir) / ray.dir.length()).abs().max(1e-3);
+    (dist - h.hit.t) * ray.dir.length() < ray_epsilon(h.hit.p) / cos
+}
+
 /// True when the ray reaches `dist` with no hit except those `own` allows.
 pub fn clear_path(world: &World, ray: Ray, dist: f64, own: &Leeway) -> bool {
     let end = dist * (1.0 - 1e-6);
@@ -199,8 +209,10 @@ pub fn clear_path(world: &World, ray: Ray, dist: f64, own: &Leeway) -> bool {
         match world.intersect(&from, end - t) {
             None => return true,
             Some(h) if own.objects.contains(&h.object) && t + h.hit.t >= dist * (1.0 - own.near) => {
-                t += h.hit.t + 1e-9 * dist;
+                // Past the hit by the tracers' own guard (flats are tested in single precision).
+                t += h.hit.t + ray_epsilon(h.hit.p) / ray.dir.length();
             }
+            Some(h) if reaches(&from, &h, dist - t) => return true,
             Some(_) => return false,
         }
         if t >= end {

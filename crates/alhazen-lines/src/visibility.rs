@@ -280,7 +280,8 @@ fn piercings(c: &Chord, own: u32, world: &World, ts: &mut Vec<f64>) {
         if h.object != own && t > 1e-9 * len && t < len * (1.0 - 1e-9) {
             ts.push(t / len);
         }
-        t0 = t + 1e-9 * len.max(1.0);
+        // Past the hit by the tracers' own guard (flats are tested in single precision).
+        t0 = t + alhazen_render::shape::ray_epsilon(h.hit.p);
         if t0 >= len {
             break;
         }

@@ -47,7 +47,7 @@ fn id_image(scene: &Scene) -> (Vec<Id>, u32, u32) {
                     return None;
                 }
                 let d = ray.dir - n * (2.0 * ray.dir.dot(n));
-                seen(scene, &world, &Ray::new(p + n * 1e-9, d))
+                seen(scene, &world, &Ray::new(p + n * alhazen_render::shape::ray_epsilon(p), d))
             });
             ids.push(Id { direct: direct.map(|d| (d.0, d.1)), reflected: reflected.map(|r| (r.0, r.1)) });
         }

@@ -261,7 +261,7 @@ impl Tracer<'_> {
                 power /= q;
             }
             let dir = frame.to_world(bs.l);
-            let eps = 1e-9 * (1.0 + wh.hit.p.abs().max_element());
+            let eps = alhazen_render::shape::ray_epsilon(wh.hit.p);
             ray = Ray::new(wh.hit.p + ng * if ng.dot(dir) >= 0.0 { eps } else { -eps }, dir);
         }
     }

@@ -131,7 +131,7 @@ impl<'a> FinalGather<'a> {
         let v = -ray.dir;
         let n = if hit.hit.ns.dot(v) < 0.0 { -hit.hit.ns } else { hit.hit.ns };
         let ng = if front { tri.normal } else { -tri.normal };
-        let eps = 1e-7 * (1.0 + hit.hit.p.abs().max_element());
+        let eps = alhazen_render::shape::ray_epsilon(hit.hit.p);
         let bounce = |d: Vec3, out: bool| {
             let o = hit.hit.p + ng * if out { eps } else { -eps };
             self.trace(&Ray::new(o, d), depth - 1)

@@ -541,7 +541,7 @@ impl Solver<'_> {
     /// (reciprocity). The delta form factors add up to at most 1: no energy is made.
     fn shoot_hemicube(&mut self, cube: &form_factor::Hemicube, source: &Source) {
         let Source::Patch { centre, normal, radiosity, area, .. } = source else { return };
-        let eps = 1e-7 * (1.0 + centre.abs().max_element());
+        let eps = alhazen_render::shape::ray_epsilon(*centre);
         let this = &*self;
         let seen = |o: Vec3, d: Vec3| -> Option<Seen> {
             let hit = this.world.intersect(&alhazen_math::Ray::new(o + *normal * eps, d), f64::INFINITY)?;
@@ -658,7 +658,7 @@ impl Solver<'_> {
     /// What the side with normal `n` of a node centred at `x` (corners `corners`, reflectance
     /// `rho`) receives from `source`; without visibility rays when `occlusion` is false.
     fn transfer(&self, source: &Source, x: Vec3, n: Vec3, corners: [Vec3; 3], rho: Vec3, occlusion: bool) -> Transfer {
-        let eps = 1e-7 * (1.0 + x.abs().max_element());
+        let eps = alhazen_render::shape::ray_epsilon(x);
         let from = x + n * eps;
         let sees = |to: Vec3, dist: f64| !occlusion || self.world.unoccluded(from, to, dist);
         match source {

@@ -30,6 +30,7 @@ use crate::camera::Camera;
 use crate::film::PixelEstimator;
 use crate::lights::Lights;
 use crate::sampler::{PixelSeeds, SampleStream, Sequence};
+use crate::shape::ray_epsilon;
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::world::{HitPoint, World, WorldHit};
 use alhazen_math::{Ray, Vec2, Vec3};
@@ -80,16 +81,10 @@ fn power_heuristic(a: f64, b: f64) -> f64 {
     if a2 + b2 > 0.0 { a2 / (a2 + b2) } else { 0.0 }
 }
 
-/// The self-intersection guard at `p`, scaled to the magnitude of its coordinates.
-#[inline(always)]
-fn epsilon(p: Vec3) -> f64 {
-    1e-9 * (1.0 + p.abs().max_element())
-}
-
 /// A point moved off its surface towards the side of `dir`.
 #[inline(always)]
 fn offset(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
-    let eps = epsilon(p);
+    let eps = ray_epsilon(p);
     p + ng * if ng.dot(dir) >= 0.0 { eps } else { -eps }
 }
 
@@ -430,7 +425,7 @@ impl<'a> PathTracer<'a> {
         let origin = offset(p, ng, ls.dir);
         // Stop short of the light point by more than the origin moved, so the light does not
         // shadow itself.
-        let dist = if ls.dist.is_finite() { ls.dist * (1.0 - 1e-7) - 4.0 * epsilon(p) } else { f64::INFINITY };
+        let dist = if ls.dist.is_finite() { ls.dist * (1.0 - 1e-7) - 4.0 * ray_epsilon(p) } else { f64::INFINITY };
         let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf_pdf) };
         (f * mode.color(ls.radiance) * (w / ls.pdf), Some((Ray::new(origin, ls.dir), dist)))
     }

@@ -19,6 +19,7 @@ use crate::lights::{Lights, PathLight};
 use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use crate::sampler::Rng;
 use crate::sampler::stratified_offset;
+use crate::shape::ray_epsilon;
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::texture;
 use crate::world::{ShadowHit, World, WorldHit};
@@ -73,12 +74,6 @@ struct Mirror {
     object: u32,
     shape: MirrorShape,
     reflectance: Vec3,
-}
-
-/// A self-intersection guard scaled to the magnitude of the coordinates.
-#[inline]
-fn epsilon(p: Vec3) -> f64 {
-    1e-9 * (1.0 + p.abs().max_element())
 }
 
 /// Fresnel reflectance for `cos` at a boundary with relative index `eta = η_T/η_I`.
@@ -140,7 +135,7 @@ impl Shading<'_> {
 
     /// Where shadow rays leave from.
     fn origin(&self) -> Vec3 {
-        self.p + self.ng * epsilon(self.p)
+        self.p + self.ng * ray_epsilon(self.p)
     }
 }
 
@@ -302,7 +297,7 @@ impl<'a> Whitted<'a> {
                 if s.pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                     continue;
                 }
-                let reach = s.dist * (1.0 - 1e-7) - 4.0 * epsilon(p + s.dir * s.dist);
+                let reach = s.dist * (1.0 - 1e-7) - 4.0 * ray_epsilon(p + s.dir * s.dist);
                 let through = self.transmittance(at.origin(), s.dir, reach, at.ch);
                 if through == Vec3::ZERO {
                     continue;
@@ -348,13 +343,13 @@ impl<'a> Whitted<'a> {
     /// What passes both legs of a mirror path: `p → m` short of the mirror, `m → light`.
     fn legs_transmittance(&self, p: Vec3, ng: Vec3, path: &MirrorPath, ch: Channels) -> Vec3 {
         let m = path.point;
-        let to_mirror = path.dist_to_mirror * (1.0 - 1e-7) - 4.0 * epsilon(m);
-        let first = self.transmittance(p + ng * epsilon(p), path.to_mirror, to_mirror, ch);
+        let to_mirror = path.dist_to_mirror * (1.0 - 1e-7) - 4.0 * ray_epsilon(m);
+        let first = self.transmittance(p + ng * ray_epsilon(p), path.to_mirror, to_mirror, ch);
         if first == Vec3::ZERO {
             return first;
         }
-        let to_light = path.dist_to_source * (1.0 - 1e-7) - 4.0 * epsilon(m);
-        first * self.transmittance(m + path.normal * epsilon(m), path.to_source, to_light, ch)
+        let to_light = path.dist_to_source * (1.0 - 1e-7) - 4.0 * ray_epsilon(m);
+        first * self.transmittance(m + path.normal * ray_epsilon(m), path.to_source, to_light, ch)
     }
 
     /// How much light passes from `origin` along `l` over `dist`: 0 at an opaque surface; at a
@@ -380,7 +375,7 @@ impl<'a> Whitted<'a> {
             if through.max_element() < 1e-6 {
                 return Vec3::ZERO;
             }
-            origin = wh.hit.p + wh.hit.n * (cos_n.signum() * epsilon(wh.hit.p));
+            origin = wh.hit.p + wh.hit.n * (cos_n.signum() * ray_epsilon(wh.hit.p));
             dist -= wh.hit.t;
         }
         Vec3::ZERO
@@ -421,7 +416,7 @@ impl<'a> Whitted<'a> {
             if let Some(t) = refract(v, n, eta) {
                 let w = weight * trans_w.max_element();
                 if w > MIN_WEIGHT {
-                    let origin = p - ng * epsilon(p);
+                    let origin = p - ng * ray_epsilon(p);
                     color += trans_w * self.trace_in(&Ray::new(origin, t.normalize()), depth + 1, w, refracted);
                 }
             }
@@ -429,7 +424,7 @@ impl<'a> Whitted<'a> {
         let w = weight * reflect_w.max_element();
         if w > MIN_WEIGHT {
             let r = reflect(v, n).normalize();
-            color += reflect_w * self.trace_in(&Ray::new(p + ng * epsilon(p), r), depth + 1, w, ch);
+            color += reflect_w * self.trace_in(&Ray::new(p + ng * ray_epsilon(p), r), depth + 1, w, ch);
         }
         color
     }

@@ -1,7 +1,7 @@
 //! The renderable world: every object of the scene placed, with a top-level BVH over the
 //! bounded ones and a plain list of unbounded ones (planes). Small meshes, rectangles and
 //! untextured boxes are flattened into world-space triangles and parallelograms, which the
-//! BVH's leaves test four or eight at a time ([`FlatPacket`]); a leaf's untransformed spheres
+//! BVH's leaves test eight at a time in single precision ([`FlatPacket`]); a leaf's untransformed spheres
 //! are [`SpherePacket`]s; other objects are tested one by one. Eight rays
 //! can be traced in one call ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path
 //! tracer's lanes); when the world is one leaf, each flat and each packed sphere is tested
@@ -11,7 +11,7 @@ use crate::bvh::Bvh;
 use crate::shape::{
     AaBox, Candidate, Cone, Csg, Cylinder, Disk, FLAT_LANES as LANES, Flat, FlatLane, FlatPacket, LaneHit, MeshAccel,
     MeshShape, PackedFlats, Placed, Plane, RayPacket, RaysSphereHits, SPHERE_LANES, Shape, Sphere, SpherePacket,
-    SurfaceHit, VectorUnit, flat_primitives,
+    SurfaceHit, VectorUnit, flat_primitives, on_triangle,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -92,6 +92,8 @@ pub struct World {
 struct FlatShading {
     normal: [Vec3; 2],
     material: [u32; 2],
+    /// Each triangle's corners (the hit point is interpolated on them, as the mesh does).
+    corners: [[Vec3; 3]; 2],
 }
 
 /// Where a ray meets the world, without texture coordinates or bump-map tangents (enough to
@@ -319,7 +321,8 @@ impl World {
             let (n, _, slot) = mesh.normals_and_slot(t, 0.0, 0.0);
             (n, o.slot_materials.get(slot as usize).copied().unwrap_or(o.material))
         });
-        Some(FlatShading { normal: [a.0, b.0], material: [a.1, b.1] })
+        let corners = triangles.map(|t| mesh.accel.mesh.corners(t));
+        Some(FlatShading { normal: [a.0, b.0], material: [a.1, b.1], corners })
     }
 
     /// Sorts each leaf's primitives into packets of flats, packets of spheres and a list of
@@ -336,7 +339,7 @@ impl World {
                     Primitive::Sphere { object, sphere } => spheres.push((object, sphere)),
                 }
             }
-            let packets = self.flats.push_leaf(&flats, self.vectors.lanes());
+            let packets = self.flats.push_leaf(&flats);
             let first_sphere = self.spheres.len();
             for chunk in spheres.chunks(SPHERE_LANES) {
                 self.spheres.push(SpherePacket::new(&chunk.iter().map(|s| s.1).collect::<Vec<_>>()));
@@ -532,14 +535,16 @@ impl World {
     #[inline(always)]
     fn flat_hit(&self, ray: &Ray, k: usize, h: LaneHit) -> WorldHit {
         let lane = self.flats.lanes[k][h.lane];
+        let c = lane.flat.candidate(h.t, h.b1, h.b2);
         if let Some(s) = &self.flat_shading[k][h.lane] {
             // The triangle `FlatLane::candidate` picks, chosen without a branch (it is random).
             let second = usize::from(lane.flat.parallelogram & (h.b1 < h.b2));
             let (n, material) = (s.normal[second], s.material[second]);
-            let hit = SurfaceHit::flat(h.t, ray.at(h.t), n, alhazen_math::Vec2::ZERO);
+            let p = on_triangle(s.corners[second], c.bary[0], c.bary[1]);
+            let hit = SurfaceHit::flat(h.t, p, n, alhazen_math::Vec2::ZERO);
             return WorldHit { hit, material, object: lane.object };
         }
-        self.surface_of(ray, lane.flat.candidate(h.t, h.b1, h.b2), lane.object)
+        self.surface_of(ray, c, lane.object)
     }
 
     /// [`Self::unoccluded`] for eight segments, `rays[r]` over `dist[r]` (false where not `live`).

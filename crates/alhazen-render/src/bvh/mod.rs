@@ -14,9 +14,9 @@ mod wide;
 const BINS: usize = 12;
 /// Leaves that cost at most this many tests are not split.
 const MAX_LEAF: usize = 4;
-/// Packed primitives the heuristic charges as one test: four, an AVX2 packet, on every
-/// processor, so the tree (and with it which of two equally near hits wins) is the same
-/// everywhere; the AVX-512 kernel fills its packets of eight from the same leaves.
+/// Packed primitives the heuristic charges as one test: four, on every processor, so the tree
+/// (and with it which of two equally near hits wins) is the same everywhere. (Packets of flats
+/// hold eight in `f32`, a test costing about what four in `f64` did; charging eight is untried.)
 pub const PACK: usize = 4;
 /// Deeper subtrees become leaves, so traversal's fixed stack never overflows.
 const MAX_DEPTH: usize = 48;

@@ -26,10 +26,11 @@
 //! bit-identical to the per-path tracer's on every processor (test
 //! `lanes_match_the_per_path_tracer`).
 
-use super::{PathState, PathTracer, RR_DEPTH, Vertex, epsilon, offset, power_heuristic};
+use super::{PathState, PathTracer, RR_DEPTH, Vertex, offset, power_heuristic};
 use crate::bsdf::{Bsdf, ColorMode, Frame, cosine_hemisphere, cosine_pdf, same_side};
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
+use crate::shape::ray_epsilon;
 use crate::shape::{RayPacket, VectorUnit};
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::world::{HitPoint, WorldHit};
@@ -472,7 +473,7 @@ fn shade_lane(v: &Vertices, out: &mut Shaded, i: usize) {
     out.shadow[i] = shadow;
     set(&mut out.shadow_origin, i, offset(p, ng, dir));
     let d = v.light_dist[i];
-    out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * epsilon(p) } else { f64::INFINITY };
+    out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * ray_epsilon(p) } else { f64::INFINITY };
     // The continuation (`sample_cosine`).
     let l = cosine_hemisphere(Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]), wv);
     let pdf = cosine_pdf(wv, l);

@@ -8,11 +8,12 @@
 //! mirror; both strategies are weighted by the power heuristic, the connection's density
 //! expressed as a solid angle at `x`: `p_A / (G cos θ_y)`.
 
-use super::{PathTracer, Terminator, epsilon, offset, power_heuristic};
+use super::{PathTracer, Terminator, offset, power_heuristic};
 use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at};
 use crate::connect::{MirrorPath, MirrorShape, Source};
 use crate::lights::{Lights, PathLight};
 use crate::sampler::SampleStream;
+use crate::shape::ray_epsilon;
 use crate::world::HitPoint;
 use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::Scene;
@@ -216,7 +217,7 @@ impl PathTracer<'_> {
 
     /// Both legs free: `x → m` short of the mirror, `m → source` short of the light.
     fn legs_unoccluded(&self, x: Vec3, ng: Vec3, path: &MirrorPath) -> bool {
-        let short = |d: f64, p: Vec3| d * (1.0 - 1e-7) - 4.0 * epsilon(p);
+        let short = |d: f64, p: Vec3| d * (1.0 - 1e-7) - 4.0 * ray_epsilon(p);
         let to_mirror = short(path.dist_to_mirror, x.abs().max(path.point.abs()));
         if !self.world.unoccluded(offset(x, ng, path.to_mirror), path.to_mirror, to_mirror) {
             return false;

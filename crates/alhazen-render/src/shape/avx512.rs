@@ -1,6 +1,6 @@
-//! AVX-512 building blocks shared by the packet kernels ([`super::FlatPacket`],
-//! [`super::SpherePacket`]): eight f64 lanes, glam's summation order, and the choice of the
-//! nearest lane with the packets' tie rule (first packet, then first lane).
+//! AVX-512 building blocks of the sphere packets' kernels ([`super::SpherePacket`]): eight f64
+//! lanes, glam's summation order, and the choice of the nearest lane with the packets' tie rule
+//! (first packet, then first lane).
 
 use alhazen_math::Ray;
 use std::arch::x86_64::*;
@@ -47,13 +47,6 @@ pub fn ray_lanes(ray: &Ray) -> RayLanes {
         origin: [_mm512_set1_pd(o.x), _mm512_set1_pd(o.y), _mm512_set1_pd(o.z)],
         dir: [_mm512_set1_pd(d.x), _mm512_set1_pd(d.y), _mm512_set1_pd(d.z)],
     }
-}
-
-/// Lane `lane` of `v`.
-#[inline]
-#[target_feature(enable = "avx512f")]
-pub fn lane_of(v: __m512d, lane: usize) -> f64 {
-    _mm512_cvtsd_f64(_mm512_permutexvar_pd(_mm512_set1_epi64(lane as i64), v))
 }
 
 /// Each lane's nearest hit so far over a leaf's packets: strictly nearer replaces, so an

@@ -5,7 +5,7 @@
 
 use super::Candidate;
 use alhazen_geom::TriangleMesh;
-use alhazen_math::{Bounds3, Ray, Vec3};
+use alhazen_math::{Bounds3, Vec3};
 
 /// A triangle `origin + b1·e1 + b2·e2` (`b1, b2 ≥ 0`, `b1 + b2 ≤ 1`) or a parallelogram
 /// (`b1, b2 ∈ [0, 1]`), ready for ray tests.
@@ -43,25 +43,6 @@ impl Flat {
     /// True for a parallelogram.
     pub fn is_parallelogram(&self) -> bool {
         self.parallelogram
-    }
-
-    /// The hit `(t, b1, b2)` with `0 < t < t_max`.
-    #[inline]
-    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, f64)> {
-        let to_flat = self.origin - ray.origin;
-        let t = self.normal.dot(to_flat) / self.normal.dot(ray.dir);
-        // Also rejects NaN and ±∞ (rays in or parallel to the plane).
-        if !(t > 0.0 && t < t_max) {
-            return None;
-        }
-        // `(ray(t) − origin)·u`, split so that only a product and a difference wait for `t`.
-        let b1 = t * ray.dir.dot(self.u) - to_flat.dot(self.u);
-        if !(0.0..=1.0).contains(&b1) {
-            return None;
-        }
-        let b2 = t * ray.dir.dot(self.v) - to_flat.dot(self.v);
-        let outside = if self.parallelogram { b2 > 1.0 } else { b1 + b2 > 1.0 };
-        (b2 >= 0.0 && !outside).then_some((t, b1, b2))
     }
 }
 
@@ -160,6 +141,7 @@ pub fn flat_primitives(mesh: &TriangleMesh) -> (Vec<FlatLane>, Vec<Bounds3>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use alhazen_math::Ray;
 
     #[test]
     fn triangle_barycentrics_reproduce_the_hit_point() {
@@ -168,8 +150,9 @@ mod tests {
         let target = corners[0] * 0.2 + corners[1] * 0.5 + corners[2] * 0.3;
         let ray = Ray::new(Vec3::new(0.1, -0.2, -3.0), (target - Vec3::new(0.1, -0.2, -3.0)).normalize());
         let (t, b1, b2) = f.hit(&ray, f64::INFINITY).unwrap();
-        assert!((ray.at(t) - target).length() < 1e-12);
-        assert!((b1 - 0.5).abs() < 1e-12 && (b2 - 0.3).abs() < 1e-12);
+        // Single precision (see `FlatPacket`): good to a few units of 2⁻²⁴ of the distances.
+        assert!((ray.at(t) - target).length() < 1e-6);
+        assert!((b1 - 0.5).abs() < 1e-6 && (b2 - 0.3).abs() < 1e-6);
         assert!(f.hit(&ray, t * 0.999).is_none(), "beyond t_max");
         let away = Ray::new(ray.origin, -ray.dir);
         assert!(f.hit(&away, f64::INFINITY).is_none(), "behind the origin");
@@ -188,8 +171,8 @@ mod tests {
             match (quad.hit(&ray, 10.0), direct) {
                 (Some((t, s, u)), Some((which, (t2, b1, b2)))) => {
                     let (k, c1, c2) = parallelogram_to_triangle(s, u);
-                    assert!((t - t2).abs() < 1e-12 && k == which, "({x}, {y})");
-                    assert!((c1 - b1).abs() < 1e-12 && (c2 - b2).abs() < 1e-12, "({x}, {y})");
+                    assert!((t - t2).abs() < 1e-6 && k == which, "({x}, {y})");
+                    assert!((c1 - b1).abs() < 1e-6 && (c2 - b2).abs() < 1e-6, "({x}, {y})");
                 }
                 (None, None) => {}
                 (q, t) => panic!("({x}, {y}): parallelogram {q:?}, triangles {t:?}"),

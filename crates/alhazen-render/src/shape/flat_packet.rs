@@ -1,35 +1,118 @@
 //! Up to eight planar primitives ([`Flat`]s) tested against one ray at once: the top-level
-//! BVH's leaves keep their triangles and parallelograms in such packets, structure of arrays
-//! (Wald et al. 2008, "Getting Rid of Packets", multi-primitive leaves; Embree's `Triangle4`).
+//! BVH's leaves and the meshes' keep their triangles and parallelograms in such packets,
+//! structure of arrays (Wald et al. 2008, "Getting Rid of Packets", multi-primitive leaves;
+//! Embree's `Triangle4`).
 //!
-//! Each lane does exactly [`Flat::hit`]'s arithmetic in the same order (no fused multiply–add),
-//! so the AVX-512 and AVX2 kernels, used where the processor has them, and the portable loop
-//! give the same bits as each other and as the one-primitive test. Packets hold eight flats for
-//! the AVX-512 kernel and four elsewhere ([`VectorUnit::lanes`]). The ray is tested against
+//! **Single precision.** A packet holds each flat as three planes in `f32`: its unit normal
+//! `n` and barycentric axes `u`, `v`, each with its offset (`n·origin`, `u·origin`,
+//! `v·origin`, taken in `f64` and rounded once). A ray meets it at
+//! `t = (n·origin − n·o) / (n·d)` with `b1 = (u·o − u·origin) + t·(u·d)` and `b2` alike, the
+//! ray rounded to `f32`. Eight lanes of `f32` are one AVX2 register, an operation where eight
+//! lanes of `f64` take two (or one AVX-512 operation that Zen 4 splits in two), and the packet
+//! is half the bytes: the flat tests of a Cornell box cost half as much, a million-triangle
+//! mesh's leaves read 52 bytes a flat instead of 104. The price is accuracy: a plane's
+//! distance from the ray's origin is good to about `8·2⁻²⁴·|o|` (the offsets make it
+//! independent of the flat's size), which the tracers' self-intersection guard
+//! ([`ray_epsilon`], `10⁻⁵·(1 + |p|)`) covers twentyfold, and barycentrics to
+//! `2⁻²⁴·|p|/edge`, the accuracy of Embree's and Mitsuba 3's tests. Spheres, cylinders and the
+//! BVH build stay in `f64`.
+//!
+//! Each lane does exactly [`Flat::hit`]'s `f32` arithmetic in the same order (no fused
+//! multiply–add), so the AVX2 kernel, which AVX-512 processors also run, and the portable loop
+//! give the same bits as each other and as the one-primitive test. The ray is tested against
 //! all lanes without branches, which is what makes the packet pay: a scalar test's early exits
-//! are unpredictable for rays in all directions. With AVX-512, a leaf's packets are tested in
-//! one call that keeps each lane's nearest hit in registers and compares lanes once at the end.
-//! For eight rays at once ([`RayPacket`], the path tracer's lanes) the AVX-512 kernel turns
-//! round: the rays are the lanes and each flat in turn is broadcast against them.
+//! are unpredictable for rays in all directions. A leaf's packets are tested in one call that
+//! keeps each lane's nearest hit in registers and compares lanes once at the end. For eight
+//! rays at once ([`RayPacket`], the path tracer's lanes) the kernel turns round: the rays are
+//! the lanes and each flat in turn is broadcast against them.
 
 use super::Flat;
 use alhazen_math::{Ray, Vec3};
 
 /// Primitives per packet.
 pub const LANES: usize = 8;
-/// Lanes per AVX2 register.
-const HALF: usize = 4;
 
-/// Up to eight flats, lane by lane; unused lanes never report a hit.
+/// How far a ray leaving a surface at `p` starts off it (along the geometric normal), scaled
+/// to the magnitude of its coordinates: twenty times the error of a flat's single-precision
+/// plane distance, a ninth of Mitsuba 3's `(1 + |p|)·1500·2⁻²⁴`. Every tracer spawns rays with
+/// it and shortens shadow rays by it.
+#[inline(always)]
+pub fn ray_epsilon(p: Vec3) -> f64 {
+    1e-5 * (1.0 + p.abs().max_element())
+}
+
+/// A ray in single precision, its origin and direction rounded to nearest.
+#[derive(Clone, Copy, Debug)]
+struct Ray32 {
+    origin: [f32; 3],
+    dir: [f32; 3],
+}
+
+impl Ray32 {
+    fn new(ray: &Ray) -> Self {
+        let round = |v: Vec3| [v.x as f32, v.y as f32, v.z as f32];
+        Self { origin: round(ray.origin), dir: round(ray.dir) }
+    }
+}
+
+/// `a·b` summed as glam's `dot`: `(x·x + y·y) + z·z`.
+#[inline(always)]
+fn dot32(a: [f32; 3], b: [f32; 3]) -> f32 {
+    (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]
+}
+
+/// One flat as the packets test it: three planes in `f32` (see the module's note).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct FlatPlanes {
+    /// Unit normal, `u`, `v`.
+    axes: [[f32; 3]; 3],
+    /// Each axis's dot product with the flat's origin.
+    offsets: [f32; 3],
+    /// 1 for a triangle (`b1 + b2 ≤ 1`), 0 for a parallelogram (`b2 ≤ 1`).
+    triangle: f32,
+}
+
+impl FlatPlanes {
+    /// `flat`'s planes: its axes rounded to `f32`, their offsets computed from those rounded
+    /// axes in `f64` and rounded once.
+    pub(super) fn of(flat: &Flat) -> Self {
+        let round = |v: Vec3| [v.x as f32, v.y as f32, v.z as f32];
+        let axes = [round(flat.normal.normalize()), round(flat.u), round(flat.v)];
+        let offsets = axes.map(|a| Vec3::new(a[0] as f64, a[1] as f64, a[2] as f64).dot(flat.origin) as f32);
+        Self { axes, offsets, triangle: if flat.parallelogram { 0.0 } else { 1.0 } }
+    }
+
+    /// The hit `(t, b1, b2)` with `0 < t < t_max`: the arithmetic every kernel repeats.
+    #[inline(always)]
+    fn hit(&self, r: &Ray32, t_max: f32) -> Option<(f32, f32, f32)> {
+        let [n, u, v] = self.axes;
+        let t = (self.offsets[0] - dot32(n, r.origin)) / dot32(n, r.dir);
+        let b1 = (dot32(u, r.origin) - self.offsets[1]) + t * dot32(u, r.dir);
+        let b2 = (dot32(v, r.origin) - self.offsets[2]) + t * dot32(v, r.dir);
+        let far = b2 + self.triangle * b1;
+        // Also rejects NaN (rays in or parallel to the plane, unused lanes).
+        let inside = t > 0.0 && t < t_max && (0.0..=1.0).contains(&b1) && b2 >= 0.0 && far <= 1.0;
+        inside.then_some((t, b1, b2))
+    }
+}
+
+impl Flat {
+    /// The hit `(t, b1, b2)` with `0 < t < t_max`, in single precision as the packets test
+    /// it (see [`crate::shape::FlatPacket`]).
+    pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64, f64)> {
+        let (t, b1, b2) = FlatPlanes::of(self).hit(&Ray32::new(ray), t_max as f32)?;
+        Some((t as f64, b1 as f64, b2 as f64))
+    }
+}
+
+/// Up to eight flats, lane by lane; unused lanes (all zero) never report a hit.
 #[derive(Clone, Debug)]
 #[repr(C, align(32))]
 pub struct FlatPacket {
-    origin: [[f64; LANES]; 3],
-    normal: [[f64; LANES]; 3],
-    u: [[f64; LANES]; 3],
-    v: [[f64; LANES]; 3],
-    /// 1 for a triangle (`b1 + b2 ≤ 1`), 0 for a parallelogram (`b2 ≤ 1`).
-    triangle: [f64; LANES],
+    /// Axis `a`'s coordinate `c` in `axes[a][c]`, lane by lane (normal, `u`, `v`).
+    axes: [[[f32; LANES]; 3]; 3],
+    offsets: [[f32; LANES]; 3],
+    triangle: [f32; LANES],
     /// Lanes in use (the first ones).
     used: usize,
 }
@@ -74,45 +157,50 @@ pub struct LaneHit {
     pub b2: f64,
 }
 
+impl LaneHit {
+    fn new(lane: usize, (t, b1, b2): (f32, f32, f32)) -> Self {
+        Self { lane, t: t as f64, b1: b1 as f64, b2: b2 as f64 }
+    }
+}
+
 impl FlatPacket {
     /// The packet of `flats` (at most [`LANES`]); lane `i` is `flats[i]`.
     pub fn new(flats: &[Flat]) -> Self {
         assert!(flats.len() <= LANES, "a packet holds at most {LANES} flats");
-        // An unused lane has a zero normal: its t is 0/0, which fails every comparison.
+        // An unused lane is all zero: its t is 0/0, which fails every comparison.
         let mut p = Self {
-            origin: [[0.0; LANES]; 3],
-            normal: [[0.0; LANES]; 3],
-            u: [[0.0; LANES]; 3],
-            v: [[0.0; LANES]; 3],
+            axes: [[[0.0; LANES]; 3]; 3],
+            offsets: [[0.0; LANES]; 3],
             triangle: [0.0; LANES],
             used: flats.len(),
         };
         for (lane, f) in flats.iter().enumerate() {
-            for axis in 0..3 {
-                p.origin[axis][lane] = f.origin[axis];
-                p.normal[axis][lane] = f.normal[axis];
-                p.u[axis][lane] = f.u[axis];
-                p.v[axis][lane] = f.v[axis];
+            let planes = FlatPlanes::of(f);
+            for a in 0..3 {
+                for c in 0..3 {
+                    p.axes[a][c][lane] = planes.axes[a][c];
+                }
+                p.offsets[a][lane] = planes.offsets[a];
             }
-            p.triangle[lane] = if f.is_parallelogram() { 0.0 } else { 1.0 };
+            p.triangle[lane] = planes.triangle;
         }
         p
+    }
+
+    /// Lane `lane`'s planes.
+    fn planes(&self, lane: usize) -> FlatPlanes {
+        FlatPlanes {
+            axes: self.axes.map(|a| a.map(|c| c[lane])),
+            offsets: self.offsets.map(|o| o[lane]),
+            triangle: self.triangle[lane],
+        }
     }
 
     /// The nearest hit with `0 < t < t_max` among the lanes (the first lane on a tie), by the
     /// kernel of `unit`.
     #[inline]
-    #[allow(unsafe_code)]
     pub fn hit(&self, ray: &Ray, t_max: f64, unit: VectorUnit) -> Option<LaneHit> {
-        match unit.0 {
-            Unit::Portable => self.hit_portable(ray, t_max),
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: a `VectorUnit` says AVX2 only where the processor has it (`available`).
-            Unit::Avx2 => unsafe { avx2::hit(self, ray, t_max) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
-            Unit::Avx512 => unsafe { avx512::nearest(std::slice::from_ref(self), ray, t_max) }.map(|(_, h)| h),
-        }
+        Self::nearest_of(std::slice::from_ref(self), ray, t_max, unit).map(|(_, h)| h)
     }
 
     /// The nearest hit with `0 < t < t_max` in `packets`: the packet's index and its lane's hit
@@ -120,16 +208,21 @@ impl FlatPacket {
     #[inline]
     #[allow(unsafe_code)]
     pub fn nearest_of(packets: &[Self], ray: &Ray, t_max: f64, unit: VectorUnit) -> Option<(usize, LaneHit)> {
+        let (r, t_max) = (Ray32::new(ray), t_max as f32);
         #[cfg(target_arch = "x86_64")]
-        if unit.is_avx512() {
-            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
-            return unsafe { avx512::nearest(packets, ray, t_max) };
+        if unit.is_simd() {
+            // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes AVX2) only where the
+            // processor has it.
+            return unsafe { simd::nearest(packets, &r, t_max) };
         }
+        let _ = unit;
         let mut best = None;
-        let mut t_max = t_max;
+        let mut limit = t_max;
         for (k, p) in packets.iter().enumerate() {
-            if let Some(h) = p.hit(ray, t_max, unit) {
-                (t_max, best) = (h.t, Some((k, h)));
+            for lane in 0..p.used {
+                if let Some(h) = p.planes(lane).hit(&r, limit) {
+                    (limit, best) = (h.0, Some((k, LaneHit::new(lane, h))));
+                }
             }
         }
         best
@@ -139,17 +232,19 @@ impl FlatPacket {
     #[inline]
     #[allow(unsafe_code)]
     pub fn any_of(packets: &[Self], ray: &Ray, t_max: f64, unit: VectorUnit) -> bool {
+        let (r, t_max) = (Ray32::new(ray), t_max as f32);
         #[cfg(target_arch = "x86_64")]
-        if unit.is_avx512() {
-            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
-            return unsafe { avx512::any(packets, ray, t_max) };
+        if unit.is_simd() {
+            // SAFETY: as in `nearest_of`.
+            return unsafe { simd::any(packets, &r, t_max) };
         }
-        packets.iter().any(|p| p.hit(ray, t_max, unit).is_some())
+        let _ = unit;
+        packets.iter().any(|p| (0..p.used).any(|lane| p.planes(lane).hit(&r, t_max).is_some()))
     }
 
     /// [`Self::nearest_of`] for eight rays at once: `found(r, k, hit)` for each `live` ray `r`
-    /// that hits, with the same hit. With AVX-512 the rays are the lanes and each flat is
-    /// broadcast against all eight, which needs no reduction across lanes and keeps eight
+    /// that hits, with the same hit. With AVX2 or AVX-512 the rays are the lanes and each flat
+    /// is broadcast against all eight, which needs no reduction across lanes and keeps eight
     /// independent tests in flight.
     #[allow(unsafe_code)]
     pub fn nearest_of_rays(
@@ -160,12 +255,12 @@ impl FlatPacket {
         mut found: impl FnMut(usize, usize, LaneHit),
     ) {
         #[cfg(target_arch = "x86_64")]
-        if unit.is_avx512() {
-            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
-            let hits = unsafe { avx512::nearest_rays(packets, rays) };
+        if unit.is_simd() {
+            // SAFETY: as in `nearest_of`.
+            let hits = unsafe { simd::nearest_rays(packets, rays) };
             for r in (0..LANES).filter(|&r| live[r] && hits.hit & (1 << r) != 0) {
                 let at = hits.at[r] as usize;
-                found(r, at / LANES, LaneHit { lane: at % LANES, t: hits.t[r], b1: hits.b1[r], b2: hits.b2[r] });
+                found(r, at / LANES, LaneHit::new(at % LANES, (hits.t[r], hits.b1[r], hits.b2[r])));
             }
             return;
         }
@@ -187,31 +282,12 @@ impl FlatPacket {
         unit: VectorUnit,
     ) -> [bool; LANES] {
         #[cfg(target_arch = "x86_64")]
-        if unit.is_avx512() {
-            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
-            let hit = unsafe { avx512::any_rays(packets, rays, t_max) };
+        if unit.is_simd() {
+            // SAFETY: as in `nearest_of`.
+            let hit = unsafe { simd::any_rays(packets, rays, t_max) };
             return std::array::from_fn(|r| live[r] && hit & (1 << r) != 0);
         }
         std::array::from_fn(|r| live[r] && Self::any_of(packets, &rays.ray(r), t_max[r], unit))
-    }
-
-    /// Lane `lane` as a [`Flat`] (an unused lane: one with a zero normal, which no ray hits).
-    fn lane(&self, lane: usize) -> Flat {
-        let at = |a: &[[f64; LANES]; 3]| Vec3::new(a[0][lane], a[1][lane], a[2][lane]);
-        let (origin, normal, u, v) = (at(&self.origin), at(&self.normal), at(&self.u), at(&self.v));
-        Flat { origin, normal, u, v, parallelogram: self.triangle[lane] == 0.0 }
-    }
-
-    /// [`Self::hit`] one lane after the other, each by [`Flat::hit`].
-    fn hit_portable(&self, ray: &Ray, mut t_max: f64) -> Option<LaneHit> {
-        let mut best = None;
-        for lane in 0..self.used {
-            if let Some((t, b1, b2)) = self.lane(lane).hit(ray, t_max) {
-                t_max = t;
-                best = Some(LaneHit { lane, t, b1, b2 });
-            }
-        }
-        best
     }
 }
 
@@ -242,7 +318,7 @@ impl<L: Copy + Default> PackedFlats<L> {
             unsafe {
                 use std::arch::x86_64::*;
                 let p: *const i8 = (p as *const FlatPacket).cast();
-                for line in (0..std::mem::size_of::<FlatPacket>().min(256)).step_by(64) {
+                for line in (0..std::mem::size_of::<FlatPacket>()).step_by(64) {
                     _mm_prefetch(p.add(line), _MM_HINT_T0);
                 }
                 _mm_prefetch((l as *const [L; LANES]).cast(), _MM_HINT_T0);
@@ -257,11 +333,10 @@ impl<L: Copy + Default> PackedFlats<L> {
         range.flat_map(move |k| self.lanes[k][..self.packets[k].used].iter().copied())
     }
 
-    /// Appends `flats`, in order, as packets of `width` ([`VectorUnit::lanes`]); returns the
-    /// range of their packets.
-    pub fn push_leaf(&mut self, flats: &[(L, Flat)], width: usize) -> std::ops::Range<usize> {
+    /// Appends `flats`, in order, as packets of [`LANES`]; returns the range of their packets.
+    pub fn push_leaf(&mut self, flats: &[(L, Flat)]) -> std::ops::Range<usize> {
         let first = self.packets.len();
-        for chunk in flats.chunks(width) {
+        for chunk in flats.chunks(LANES) {
             let packet: Vec<Flat> = chunk.iter().map(|(_, f)| *f).collect();
             self.packets.push(FlatPacket::new(&packet));
             let mut lanes = [L::default(); LANES];
@@ -298,7 +373,7 @@ enum Unit {
     /// One lane after the other (any processor).
     #[default]
     Portable,
-    /// Two halves of four lanes in AVX2 registers.
+    /// AVX2 registers (eight `f32` flats or four `f64` path lanes at a time).
     #[cfg(target_arch = "x86_64")]
     Avx2,
     /// All eight lanes in one AVX-512 register (F, DQ, VL and BW present).
@@ -336,10 +411,11 @@ impl VectorUnit {
         units
     }
 
-    /// Flats per packet for this kernel: eight fill an AVX-512 register; four an AVX2 one, and
-    /// a packet of eight would mostly test empty lanes there.
-    pub fn lanes(self) -> usize {
-        if self.is_avx512() { LANES } else { HALF }
+    /// The AVX2 kernels run, on an AVX2 or an AVX-512 processor (flats are tested eight
+    /// `f32` lanes at a time in AVX2 registers on both).
+    #[inline]
+    pub fn is_simd(self) -> bool {
+        self.is_avx2() || self.is_avx512()
     }
 
     /// `portable`, `avx2` or `avx512`.
@@ -380,234 +456,219 @@ impl VectorUnit {
     }
 }
 
+/// The kernels in AVX2 registers of eight `f32` lanes, run on AVX2 and AVX-512 processors
+/// alike: [`FlatPlanes::hit`]'s operations, in its order, without its early exits.
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
-mod avx2 {
-    use super::{FlatPacket, HALF, LANES, LaneHit};
-    use alhazen_math::Ray;
+mod simd {
+    use super::{FlatPacket, LANES, Ray32, RayPacket};
     use std::arch::x86_64::*;
 
-    /// Lanes `half·4 ..` of `a`, lane `i` of the register being lane `half·4 + i`.
+    /// Eight f32s into a register, lane `i` from `a[i]`.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn load(a: &[f64; LANES], half: usize) -> __m256d {
-        // SAFETY: `half` is 0 or 1, so four f64s from `half·4` are in `a`; `loadu` needs no
-        // alignment.
-        unsafe { _mm256_loadu_pd(a[half * HALF..].as_ptr()) }
+    fn load(a: &[f32; LANES]) -> __m256 {
+        // SAFETY: `a` is eight readable f32s; `loadu` needs no alignment.
+        unsafe { _mm256_loadu_ps(a.as_ptr()) }
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn load3(a: &[[f32; LANES]; 3]) -> [__m256; 3] {
+        [load(&a[0]), load(&a[1]), load(&a[2])]
     }
 
     /// `(a·b)` lane by lane, summed as glam's `dot`: `(x·x + y·y) + z·z`.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn dot(a: [__m256d; 3], b: [__m256d; 3]) -> __m256d {
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(a[0], b[0]), _mm256_mul_pd(a[1], b[1])), _mm256_mul_pd(a[2], b[2]))
+    fn dot(a: [__m256; 3], b: [__m256; 3]) -> __m256 {
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(a[0], b[0]), _mm256_mul_ps(a[1], b[1])), _mm256_mul_ps(a[2], b[2]))
     }
 
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn load3(a: &[[f64; LANES]; 3], half: usize) -> [__m256d; 3] {
-        [load(&a[0], half), load(&a[1], half), load(&a[2], half)]
+    /// A ray per lane (eight rays, or one in all lanes).
+    struct RayLanes {
+        origin: [__m256; 3],
+        dir: [__m256; 3],
     }
 
-    /// [`FlatPacket::hit_portable`] in AVX2 registers, four lanes at a time.
-    #[target_feature(enable = "avx2")]
-    pub(super) fn hit(p: &FlatPacket, ray: &Ray, t_max: f64) -> Option<LaneHit> {
-        let first = hit_half(p, ray, t_max, 0);
-        if p.used <= HALF {
-            return first;
-        }
-        hit_half(p, ray, first.map_or(t_max, |h| h.t), 1).or(first)
-    }
-
-    /// [`super::Flat::hit`]'s operations on four lanes, in its order, combined without its
-    /// early exits.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn hit_half(p: &FlatPacket, ray: &Ray, t_max: f64, half: usize) -> Option<LaneHit> {
-        let ro = [_mm256_set1_pd(ray.origin.x), _mm256_set1_pd(ray.origin.y), _mm256_set1_pd(ray.origin.z)];
-        let rd = [_mm256_set1_pd(ray.dir.x), _mm256_set1_pd(ray.dir.y), _mm256_set1_pd(ray.dir.z)];
-        let o = load3(&p.origin, half);
-        let to_flat = [_mm256_sub_pd(o[0], ro[0]), _mm256_sub_pd(o[1], ro[1]), _mm256_sub_pd(o[2], ro[2])];
-        let n = load3(&p.normal, half);
-        let t = _mm256_div_pd(dot(n, to_flat), dot(n, rd));
-        // As `Flat::hit`: `t·(d·u) − (o − r)·u`, the dot products independent of the division.
-        let (u, v) = (load3(&p.u, half), load3(&p.v, half));
-        let b1 = _mm256_sub_pd(_mm256_mul_pd(t, dot(rd, u)), dot(to_flat, u));
-        let b2 = _mm256_sub_pd(_mm256_mul_pd(t, dot(rd, v)), dot(to_flat, v));
-        let far = _mm256_add_pd(b2, _mm256_mul_pd(load(&p.triangle, half), b1));
-        let (zero, one) = (_mm256_setzero_pd(), _mm256_set1_pd(1.0));
-        let in_t =
-            _mm256_and_pd(_mm256_cmp_pd::<_CMP_GT_OQ>(t, zero), _mm256_cmp_pd::<_CMP_LT_OQ>(t, _mm256_set1_pd(t_max)));
-        let in_b1 = _mm256_and_pd(_mm256_cmp_pd::<_CMP_GE_OQ>(b1, zero), _mm256_cmp_pd::<_CMP_LE_OQ>(b1, one));
-        let in_b2 = _mm256_and_pd(_mm256_cmp_pd::<_CMP_GE_OQ>(b2, zero), _mm256_cmp_pd::<_CMP_LE_OQ>(far, one));
-        let inside = _mm256_and_pd(in_t, _mm256_and_pd(in_b1, in_b2));
-        if _mm256_movemask_pd(inside) == 0 {
-            return None;
-        }
-        // The smallest t of the lanes inside, then the first lane that has it.
-        let t = _mm256_blendv_pd(_mm256_set1_pd(f64::INFINITY), t, inside);
-        let min = _mm256_min_pd(t, _mm256_permute4x64_pd::<0b01_00_11_10>(t));
-        let min = _mm256_min_pd(min, _mm256_permute_pd::<0b0101>(min));
-        let lane = _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(t, min)).trailing_zeros() as usize;
-        let mut lanes = [[0.0; HALF]; 3];
-        for (dst, src) in lanes.iter_mut().zip([t, b1, b2]) {
-            // SAFETY: `dst` is four writable f64s; `storeu` needs no alignment.
-            unsafe { _mm256_storeu_pd(dst.as_mut_ptr(), src) };
-        }
-        Some(LaneHit { lane: half * HALF + lane, t: lanes[0][lane], b1: lanes[1][lane], b2: lanes[2][lane] })
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[allow(unsafe_code)]
-mod avx512 {
-    use super::super::avx512::{NearestLanes, RayLanes, dot, lane_of, load, load3, ray_lanes};
-    use super::{FlatPacket, LANES, LaneHit, RayPacket};
-    use alhazen_math::Ray;
-    use std::arch::x86_64::*;
-
-    /// [`super::Flat::hit`]'s operations on all eight lanes, in its order, without its early
-    /// exits: `(t, b1, b2)` and the lanes hit with `0 < t < t_max`.
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn lanes(p: &FlatPacket, r: &RayLanes, t_max: __m512d) -> (__m512d, __m512d, __m512d, __mmask8) {
-        let flat = FlatLanes {
-            origin: load3(&p.origin),
-            normal: load3(&p.normal),
-            u: load3(&p.u),
-            v: load3(&p.v),
-            triangle: load(&p.triangle),
-        };
-        flat_lanes(&flat, r, t_max)
-    }
-
-    /// A flat per lane (eight of a packet, or one in all lanes).
+    /// A flat per lane (a packet's eight, or one in all lanes).
     struct FlatLanes {
-        origin: [__m512d; 3],
-        normal: [__m512d; 3],
-        u: [__m512d; 3],
-        v: [__m512d; 3],
-        triangle: __m512d,
+        axes: [[__m256; 3]; 3],
+        offsets: [__m256; 3],
+        triangle: __m256,
     }
 
-    /// [`lanes`] for a flat and a ray per lane.
     #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn flat_lanes(p: &FlatLanes, r: &RayLanes, t_max: __m512d) -> (__m512d, __m512d, __m512d, __mmask8) {
-        let (ro, rd, o) = (&r.origin, r.dir, p.origin);
-        let to_flat = [_mm512_sub_pd(o[0], ro[0]), _mm512_sub_pd(o[1], ro[1]), _mm512_sub_pd(o[2], ro[2])];
-        let n = p.normal;
-        let t = _mm512_div_pd(dot(n, to_flat), dot(n, rd));
-        let (u, v) = (p.u, p.v);
-        let b1 = _mm512_sub_pd(_mm512_mul_pd(t, dot(rd, u)), dot(to_flat, u));
-        let b2 = _mm512_sub_pd(_mm512_mul_pd(t, dot(rd, v)), dot(to_flat, v));
-        let far = _mm512_add_pd(b2, _mm512_mul_pd(p.triangle, b1));
-        let (zero, one) = (_mm512_setzero_pd(), _mm512_set1_pd(1.0));
-        let in_t = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(t, zero) & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, t_max);
-        let in_b1 = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(b1, zero) & _mm512_cmp_pd_mask::<_CMP_LE_OQ>(b1, one);
-        let in_b2 = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(b2, zero) & _mm512_cmp_pd_mask::<_CMP_LE_OQ>(far, one);
-        (t, b1, b2, in_t & in_b1 & in_b2)
+    #[target_feature(enable = "avx2")]
+    fn ray_lanes(r: &Ray32) -> RayLanes {
+        RayLanes { origin: r.origin.map(|x| _mm256_set1_ps(x)), dir: r.dir.map(|x| _mm256_set1_ps(x)) }
     }
 
-    /// [`FlatPacket::nearest_of`] without a branch per packet: each lane keeps the nearest hit
-    /// it has seen (strictly nearer replaces, so earlier packets win ties), and the lanes are
-    /// compared once at the end.
-    #[target_feature(enable = "avx512f")]
-    pub(super) fn nearest(packets: &[FlatPacket], ray: &Ray, t_max: f64) -> Option<(usize, LaneHit)> {
-        let r = ray_lanes(ray);
-        let limit = _mm512_set1_pd(t_max);
-        let (mut best, mut best_b1, mut best_b2) = (NearestLanes::new(limit), _mm512_setzero_pd(), _mm512_setzero_pd());
-        for (k, p) in packets.iter().enumerate() {
-            let (t, b1, b2, inside) = lanes(p, &r, limit);
-            let closer = best.update(k, t, inside);
-            best_b1 = _mm512_mask_blend_pd(closer, best_b1, b1);
-            best_b2 = _mm512_mask_blend_pd(closer, best_b2, b2);
-        }
-        let (lane, k, t) = best.nearest()?;
-        Some((k, LaneHit { lane, t, b1: lane_of(best_b1, lane), b2: lane_of(best_b2, lane) }))
-    }
-
-    /// Eight rays, one per lane.
+    /// Eight rays, one per lane, rounded to `f32` as [`Ray32::new`] rounds them.
     #[inline]
-    #[target_feature(enable = "avx512f")]
+    #[target_feature(enable = "avx2")]
     fn rays_in_lanes(rays: &RayPacket) -> RayLanes {
-        RayLanes { origin: load3(&rays.origin), dir: load3(&rays.dir) }
+        // SAFETY: each row is eight readable f64s; `loadu` needs no alignment.
+        let row = |a: &[f64; LANES]| unsafe {
+            let (lo, hi) =
+                (_mm256_cvtpd_ps(_mm256_loadu_pd(a.as_ptr())), _mm256_cvtpd_ps(_mm256_loadu_pd(a[4..].as_ptr())));
+            _mm256_set_m128(hi, lo)
+        };
+        RayLanes { origin: rays.origin.each_ref().map(row), dir: rays.dir.each_ref().map(row) }
     }
 
-    /// Flat `lane` of `p` in every lane (against eight rays).
     #[inline]
-    #[target_feature(enable = "avx512f")]
+    #[target_feature(enable = "avx2")]
+    fn packet_lanes(p: &FlatPacket) -> FlatLanes {
+        FlatLanes { axes: p.axes.each_ref().map(|a| load3(a)), offsets: load3(&p.offsets), triangle: load(&p.triangle) }
+    }
+
+    /// Flat `lane` of `p` in every lane.
+    #[inline]
+    #[target_feature(enable = "avx2")]
     fn broadcast(p: &FlatPacket, lane: usize) -> FlatLanes {
-        let row = |a: &[[f64; LANES]; 3]| [0, 1, 2].map(|axis| _mm512_set1_pd(a[axis][lane]));
+        let row = |a: &[[f32; LANES]; 3]| [0, 1, 2].map(|c| _mm256_set1_ps(a[c][lane]));
         FlatLanes {
-            origin: row(&p.origin),
-            normal: row(&p.normal),
-            u: row(&p.u),
-            v: row(&p.v),
-            triangle: _mm512_set1_pd(p.triangle[lane]),
+            axes: p.axes.each_ref().map(row),
+            offsets: row(&p.offsets),
+            triangle: _mm256_set1_ps(p.triangle[lane]),
         }
     }
 
-    /// Eight rays' nearest hits, ray by lane: `hit` has bit `r` set when ray `r` hits flat
-    /// `at[r]` (packet × [`LANES`] + lane) at `t[r]`, `b1[r]`, `b2[r]`.
-    pub(super) struct RaysHits {
-        pub hit: u8,
-        pub at: [i64; LANES],
-        pub t: [f64; LANES],
-        pub b1: [f64; LANES],
-        pub b2: [f64; LANES],
+    /// `(t, b1, b2)` lane by lane and the lanes hit with `0 < t < t_max` (all ones there).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn hits(f: &FlatLanes, r: &RayLanes, t_max: __m256) -> (__m256, __m256, __m256, __m256) {
+        let [n, u, v] = f.axes;
+        let t = _mm256_div_ps(_mm256_sub_ps(f.offsets[0], dot(n, r.origin)), dot(n, r.dir));
+        let b1 = _mm256_add_ps(_mm256_sub_ps(dot(u, r.origin), f.offsets[1]), _mm256_mul_ps(t, dot(u, r.dir)));
+        let b2 = _mm256_add_ps(_mm256_sub_ps(dot(v, r.origin), f.offsets[2]), _mm256_mul_ps(t, dot(v, r.dir)));
+        let far = _mm256_add_ps(b2, _mm256_mul_ps(f.triangle, b1));
+        let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
+        let in_t = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(t, zero), _mm256_cmp_ps::<_CMP_LT_OQ>(t, t_max));
+        let in_b1 = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(b1, zero), _mm256_cmp_ps::<_CMP_LE_OQ>(b1, one));
+        let in_b2 = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(b2, zero), _mm256_cmp_ps::<_CMP_LE_OQ>(far, one));
+        (t, b1, b2, _mm256_and_ps(in_t, _mm256_and_ps(in_b1, in_b2)))
     }
 
-    /// [`FlatPacket::nearest_of_rays`]: every flat in order against the eight rays; strictly
-    /// nearer replaces, so ties keep the first packet, then the first lane, as
-    /// [`nearest`] does.
-    #[target_feature(enable = "avx512f")]
-    pub(super) fn nearest_rays(packets: &[FlatPacket], rays: &RayPacket) -> RaysHits {
+    /// Each lane's nearest hit so far: strictly nearer replaces, so the earlier flat keeps a
+    /// tie. `at` says which flat (`packet × LANES + lane`).
+    struct Nearest {
+        t: __m256,
+        b1: __m256,
+        b2: __m256,
+        at: __m256i,
+        /// All ones in the lanes with a hit.
+        hit: __m256,
+    }
+
+    impl Nearest {
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn new(t_max: __m256) -> Self {
+            let zero = _mm256_setzero_ps();
+            Self { t: t_max, b1: zero, b2: zero, at: _mm256_setzero_si256(), hit: zero }
+        }
+
+        /// Takes the lanes of `hit` (from [`hits`]) nearer than what they hold, from flats `at`.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn update(&mut self, (t, b1, b2, inside): (__m256, __m256, __m256, __m256), at: __m256i) {
+            // Without a branch: which lanes are nearer is as good as random.
+            let take = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(t, self.t), inside);
+            self.t = _mm256_blendv_ps(self.t, t, take);
+            self.b1 = _mm256_blendv_ps(self.b1, b1, take);
+            self.b2 = _mm256_blendv_ps(self.b2, b2, take);
+            self.at =
+                _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(self.at), _mm256_castsi256_ps(at), take));
+            self.hit = _mm256_or_ps(self.hit, take);
+        }
+
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn store(&self) -> Hits {
+            let hit = _mm256_movemask_ps(self.hit) as u8;
+            let mut out = Hits { hit, at: [0; LANES], t: [0.0; LANES], b1: [0.0; LANES], b2: [0.0; LANES] };
+            // SAFETY: each destination is eight writable f32s or i32s; `storeu` needs no
+            // alignment.
+            unsafe {
+                _mm256_storeu_ps(out.t.as_mut_ptr(), self.t);
+                _mm256_storeu_ps(out.b1.as_mut_ptr(), self.b1);
+                _mm256_storeu_ps(out.b2.as_mut_ptr(), self.b2);
+                _mm256_storeu_si256(out.at.as_mut_ptr().cast(), self.at);
+            }
+            out
+        }
+    }
+
+    /// Hits lane by lane: bit `i` of `hit` set where lane `i` hit flat `at[i]` (packet ×
+    /// [`LANES`] + lane) at `t[i]`, `b1[i]`, `b2[i]`.
+    pub(super) struct Hits {
+        pub hit: u8,
+        pub at: [i32; LANES],
+        pub t: [f32; LANES],
+        pub b1: [f32; LANES],
+        pub b2: [f32; LANES],
+    }
+
+    /// [`FlatPacket::nearest_of`]: each lane keeps the nearest hit it has seen, and the lanes
+    /// are compared once at the end (on a tie, the first flat).
+    #[target_feature(enable = "avx2")]
+    pub(super) fn nearest(packets: &[FlatPacket], r: &Ray32, t_max: f32) -> Option<(usize, super::LaneHit)> {
+        let r = ray_lanes(r);
+        let limit = _mm256_set1_ps(t_max);
+        let mut best = Nearest::new(limit);
+        let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        for (k, p) in packets.iter().enumerate() {
+            let at = _mm256_add_epi32(_mm256_set1_epi32((k * LANES) as i32), lane);
+            best.update(hits(&packet_lanes(p), &r, limit), at);
+        }
+        let h = best.store();
+        let nearest = (0..LANES)
+            .filter(|&l| h.hit & (1 << l) != 0)
+            .min_by(|&a, &b| h.t[a].total_cmp(&h.t[b]).then(h.at[a].cmp(&h.at[b])))?;
+        let at = h.at[nearest] as usize;
+        Some((at / LANES, super::LaneHit::new(at % LANES, (h.t[nearest], h.b1[nearest], h.b2[nearest]))))
+    }
+
+    /// [`FlatPacket::any_of`]: stops at the first packet with a lane hit.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn any(packets: &[FlatPacket], r: &Ray32, t_max: f32) -> bool {
+        let (r, limit) = (ray_lanes(r), _mm256_set1_ps(t_max));
+        packets.iter().any(|p| _mm256_movemask_ps(hits(&packet_lanes(p), &r, limit).3) != 0)
+    }
+
+    /// Eight rays' nearest hits, ray by lane.
+    #[target_feature(enable = "avx2")]
+    pub(super) fn nearest_rays(packets: &[FlatPacket], rays: &RayPacket) -> Hits {
         let r = rays_in_lanes(rays);
-        let limit = _mm512_set1_pd(f64::INFINITY);
-        let (mut best_t, mut best_at) = (limit, _mm512_setzero_si512());
-        let (mut best_b1, mut best_b2, mut hit) = (_mm512_setzero_pd(), _mm512_setzero_pd(), 0u8);
+        let limit = _mm256_set1_ps(f32::INFINITY);
+        let mut best = Nearest::new(limit);
         for (k, p) in packets.iter().enumerate() {
             for lane in 0..p.used {
-                let (t, b1, b2, inside) = flat_lanes(&broadcast(p, lane), &r, limit);
-                let closer = inside & _mm512_cmp_pd_mask::<_CMP_LT_OQ>(t, best_t);
-                best_t = _mm512_mask_blend_pd(closer, best_t, t);
-                best_at = _mm512_mask_blend_epi64(closer, best_at, _mm512_set1_epi64((k * LANES + lane) as i64));
-                best_b1 = _mm512_mask_blend_pd(closer, best_b1, b1);
-                best_b2 = _mm512_mask_blend_pd(closer, best_b2, b2);
-                hit |= closer;
+                let at = _mm256_set1_epi32((k * LANES + lane) as i32);
+                best.update(hits(&broadcast(p, lane), &r, limit), at);
             }
         }
-        let mut out = RaysHits { hit, at: [0; LANES], t: [0.0; LANES], b1: [0.0; LANES], b2: [0.0; LANES] };
-        // SAFETY: each destination is eight writable f64s or i64s; `storeu` needs no alignment.
-        unsafe {
-            _mm512_storeu_pd(out.t.as_mut_ptr(), best_t);
-            _mm512_storeu_pd(out.b1.as_mut_ptr(), best_b1);
-            _mm512_storeu_pd(out.b2.as_mut_ptr(), best_b2);
-            _mm512_storeu_si512(out.at.as_mut_ptr().cast(), best_at);
-        }
-        out
+        best.store()
     }
 
     /// [`FlatPacket::any_of_rays`]: the rays blocked by some flat, one bit per ray.
-    #[target_feature(enable = "avx512f")]
+    #[target_feature(enable = "avx2")]
     pub(super) fn any_rays(packets: &[FlatPacket], rays: &RayPacket, t_max: &[f64; LANES]) -> u8 {
-        let (r, limit) = (rays_in_lanes(rays), load(t_max));
-        let mut blocked = 0u8;
+        let r = rays_in_lanes(rays);
+        // SAFETY: `t_max` is eight readable f64s; `loadu` needs no alignment.
+        let limit = unsafe {
+            let (lo, hi) = (_mm256_loadu_pd(t_max.as_ptr()), _mm256_loadu_pd(t_max[4..].as_ptr()));
+            _mm256_set_m128(_mm256_cvtpd_ps(hi), _mm256_cvtpd_ps(lo))
+        };
+        let mut blocked = _mm256_setzero_ps();
         for p in packets {
             for lane in 0..p.used {
-                blocked |= flat_lanes(&broadcast(p, lane), &r, limit).3;
+                blocked = _mm256_or_ps(blocked, hits(&broadcast(p, lane), &r, limit).3);
             }
         }
-        blocked
-    }
-
-    /// [`FlatPacket::any_of`]: the lanes hit, gathered over every packet.
-    #[target_feature(enable = "avx512f")]
-    pub(super) fn any(packets: &[FlatPacket], ray: &Ray, t_max: f64) -> bool {
-        let r = ray_lanes(ray);
-        let limit = _mm512_set1_pd(t_max);
-        packets.iter().fold(0, |hit, p| hit | lanes(p, &r, limit).3) != 0
+        _mm256_movemask_ps(blocked) as u8
     }
 }
 

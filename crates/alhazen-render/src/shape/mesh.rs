@@ -44,11 +44,11 @@ impl MeshAccel {
         let mut bvh = Bvh::build_packed_by(&bounds, |_| true, method);
         drop(bounds);
         let mut packets = PackedFlats::default();
-        packets.reserve(bvh.leaves().map(|r| r.len().div_ceil(vectors.lanes())).sum());
+        packets.reserve(bvh.leaves().map(|r| r.len().div_ceil(crate::shape::FLAT_LANES)).sum());
         // Each leaf's packets are appended as the leaf is relabelled with them.
         bvh.relabel_leaves(|leaf| {
             let leaf: Vec<_> = leaf.iter().map(|&k| (prims[k as usize], prims[k as usize].flat(&mesh))).collect();
-            packets.push_leaf(&leaf, vectors.lanes())
+            packets.push_leaf(&leaf)
         });
         drop(prims);
         let face_normals: Vec<Vec3> = (0..mesh.triangle_count())
@@ -76,6 +76,14 @@ pub struct MeshShape {
     pub accel: Arc<MeshAccel>,
     /// Interpolate vertex normals when the mesh has them.
     pub smooth: bool,
+}
+
+/// The point with barycentrics `(b1, b2)` on the triangle with these corners: on its plane to
+/// double precision, where `ray.at(t)` from a single-precision `t` is off it by up to
+/// `2⁻²⁴·t·|d|` (far from a distant camera, more than the tracers' guard).
+#[inline]
+pub fn on_triangle([p0, p1, p2]: [Vec3; 3], b1: f64, b2: f64) -> Vec3 {
+    p0 * (1.0 - b1 - b2) + p1 * b1 + p2 * b2
 }
 
 /// Barycentric hit `(t, b1, b2)` of Möller–Trumbore, for any `t`.
@@ -126,7 +134,7 @@ impl MeshShape {
         (n, ns, m.material_slots.get(tri).copied().unwrap_or(0))
     }
 
-    fn surface(&self, ray: &Ray, tri: usize, (t, b1, b2): (f64, f64, f64)) -> SurfaceHit {
+    fn surface(&self, tri: usize, (t, b1, b2): (f64, f64, f64)) -> SurfaceHit {
         let m = &self.accel.mesh;
         let idx = m.triangles[tri].map(|i| i as usize);
         let (n, ns, slot) = self.normals_and_slot(tri, b1, b2);
@@ -136,7 +144,8 @@ impl MeshShape {
         } else {
             m.uvs[idx[0]] * b0 + m.uvs[idx[1]] * b1 + m.uvs[idx[2]] * b2
         };
-        SurfaceHit { t, p: ray.at(t), n, ns, uv, slot, dpduv: [Vec3::ZERO; 2] }
+        let p = on_triangle(idx.map(|i| m.positions[i]), b1, b2);
+        SurfaceHit { t, p, n, ns, uv, slot, dpduv: [Vec3::ZERO; 2] }
     }
 
     /// `∂p/∂u`, `∂p/∂v` of triangle `tri` from its texture coordinates (its barycentric
@@ -165,8 +174,8 @@ impl MeshShape {
     }
 
     /// The surface at a hit found by [`MeshShape::hit`].
-    pub fn surface_at(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
-        self.surface(ray, c.aux as usize, (c.t, c.bary[0], c.bary[1]))
+    pub fn surface_at(&self, c: Candidate) -> SurfaceHit {
+        self.surface(c.aux as usize, (c.t, c.bary[0], c.bary[1]))
     }
 
     /// Every triangle crossing of the whole line; entering where the ray meets the front.
@@ -182,7 +191,7 @@ impl MeshShape {
         self.accel.bvh.traverse_leaves(&shifted, f64::INFINITY, |packets, _| {
             for i in self.accel.packets.lanes_of(packets).flat_map(|lane| lane.triangles()) {
                 if let Some((t, b1, b2)) = triangle_hit(&shifted, m.corners(i)).filter(|h| h.0 > 0.0) {
-                    let hit = self.surface(ray, i, (t + back, b1, b2));
+                    let hit = self.surface(i, (t + back, b1, b2));
                     out.push(Crossing { hit, entering: hit.n.dot(ray.dir) < 0.0 });
                 }
             }

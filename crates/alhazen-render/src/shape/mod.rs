@@ -21,8 +21,8 @@ pub use aabox::AaBox;
 pub use csg::Csg;
 pub use cylinder::{Cone, Cylinder};
 pub use flat::{Flat, FlatLane, flat_primitives, parallelogram_of, parallelogram_to_triangle};
-pub use flat_packet::{FlatPacket, LANES as FLAT_LANES, LaneHit, PackedFlats, RayPacket, VectorUnit};
-pub use mesh::{MeshAccel, MeshShape, triangle_hit};
+pub use flat_packet::{FlatPacket, LANES as FLAT_LANES, LaneHit, PackedFlats, RayPacket, VectorUnit, ray_epsilon};
+pub use mesh::{MeshAccel, MeshShape, on_triangle, triangle_hit};
 pub use plane::{Disk, Plane};
 pub use sphere::Sphere;
 pub use sphere_packet::{RaysSphereHits, SPHERE_LANES, SpherePacket};
@@ -132,7 +132,7 @@ impl Shape {
             Shape::Disk(s) => s.surface(ray, c),
             Shape::Plane(s) => s.surface(ray, c),
             Shape::Box(s) => s.surface(ray, c),
-            Shape::Mesh(s) => s.surface_at(ray, c),
+            Shape::Mesh(s) => s.surface_at(c),
             Shape::Csg(s) => s.surface(ray, c),
         }
     }

@@ -100,9 +100,13 @@ proptest! {
     #[test]
     fn hits_lie_on_the_surface_with_unit_normals(ray in arb_ray()) {
         for (shape, f) in shapes_with_implicit() {
+            // Meshes' flats are tested in single precision (`FlatPacket`): their hits are good
+            // to a few units of 2⁻²⁴ of the ray's length.
+            let tolerance = if matches!(shape, Shape::Mesh(_)) { 1e-6 } else { 1e-9 };
             if let Some(h) = shape.intersect(&ray, f64::INFINITY) {
-                prop_assert!(f(h.p).abs() < 1e-9, "{shape:?}: f = {}", f(h.p));
-                prop_assert!((h.p - ray.at(h.t)).length() < 1e-12);
+                prop_assert!(f(h.p).abs() < tolerance, "{shape:?}: f = {}", f(h.p));
+                let along = if tolerance > 1e-9 { tolerance } else { 1e-12 };
+                prop_assert!((h.p - ray.at(h.t)).length() < along);
                 prop_assert!((h.n.length() - 1.0).abs() < 1e-9);
                 prop_assert!(h.t > 0.0);
             }
@@ -170,14 +174,30 @@ proptest! {
             .filter_map(|i| mesh::triangle_hit(&ray, mesh.corners(i)).filter(|h| h.0 > 0.0).map(|h| (h.0, i)))
             .min_by(|a, b| a.0.total_cmp(&b.0));
         let hit = shape.hit(&ray, f64::INFINITY);
-        prop_assert_eq!(hit.is_some(), brute.is_some());
+        // The packets test in single precision: they may differ from the double-precision test
+        // only where the ray passes within 2⁻¹⁶ of an edge (in barycentric units).
+        let near_edge = |i: usize| {
+            let [p0, p1, p2] = mesh.corners(i);
+            let (e1, e2, to) = (p1 - p0, p2 - p0, ray.origin - p0);
+            let det = e1.dot(ray.dir.cross(e2));
+            let (b1, b2) = (to.dot(ray.dir.cross(e2)) / det, ray.dir.dot(to.cross(e1)) / det);
+            b1.min(b2).min(1.0 - b1 - b2).abs() < 1.5e-5
+        };
+        if hit.is_some() != brute.is_some() {
+            let missed = brute.map_or_else(|| hit.unwrap().aux as usize, |(_, i)| i);
+            prop_assert!(near_edge(missed), "{:?} vs {:?}", hit, brute);
+            return Ok(());
+        }
         if let (Some(c), Some((t, i))) = (hit, brute) {
-            prop_assert!((c.t - t).abs() <= 1e-9 * (1.0 + t), "t {} vs {}", c.t, t);
-            let s = shape.surface_at(&ray, c);
-            prop_assert!((s.p - ray.at(t)).length() < 1e-8);
+            if c.aux as usize != i && near_edge(i) {
+                return Ok(());
+            }
+            prop_assert!((c.t - t).abs() <= 1e-5 * (1.0 + t), "t {} vs {}", c.t, t);
+            let s = shape.surface_at(c);
+            prop_assert!((s.p - ray.at(t)).length() < 1e-5);
             // The same triangle unless another lies (almost) as near.
             let near: Vec<usize> = (0..mesh.triangle_count())
-                .filter(|&j| mesh::triangle_hit(&ray, mesh.corners(j)).is_some_and(|h| (h.0 - t).abs() < 1e-9))
+                .filter(|&j| mesh::triangle_hit(&ray, mesh.corners(j)).is_some_and(|h| (h.0 - t).abs() < 1e-5 * (1.0 + t)))
                 .collect();
             prop_assert!(c.aux as usize == i || near.contains(&(c.aux as usize)));
         }
@@ -246,7 +266,8 @@ fn tangents_are_the_derivatives_of_the_texture_parametrisation() {
     for shape in [sphere, plane, mesh] {
         let origin = Vec3::new(0.3, 4.0, 3.0);
         let target = Vec3::new(0.2, -0.1, 0.15);
-        let d = 1e-5;
+        // A step the mesh's single-precision hits resolve (its parametrisation is linear).
+        let d = if matches!(shape, Shape::Mesh(_)) { 1e-3 } else { 1e-5 };
         let ray = Ray::new(origin, (target - origin).normalize());
         let c = shape.hit(&ray, f64::INFINITY).unwrap();
         let a = shape.surface(&ray, c);
