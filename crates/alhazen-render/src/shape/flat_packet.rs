@@ -508,13 +508,17 @@ mod simd {
     #[inline]
     #[target_feature(enable = "avx2")]
     fn rays_in_lanes(rays: &RayPacket) -> RayLanes {
-        // SAFETY: each row is eight readable f64s; `loadu` needs no alignment.
-        let row = |a: &[f64; LANES]| unsafe {
-            let (lo, hi) =
-                (_mm256_cvtpd_ps(_mm256_loadu_pd(a.as_ptr())), _mm256_cvtpd_ps(_mm256_loadu_pd(a[4..].as_ptr())));
-            _mm256_set_m128(hi, lo)
-        };
+        let row = |a: &[f64; LANES]| narrow(a);
         RayLanes { origin: rays.origin.each_ref().map(row), dir: rays.dir.each_ref().map(row) }
+    }
+
+    /// Eight f64s rounded to nearest f32s (as `as f32` rounds), lane `i` from `a[i]`.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn narrow(a: &[f64; LANES]) -> __m256 {
+        // SAFETY: `a` is eight readable f64s; `loadu` needs no alignment.
+        let (lo, hi) = unsafe { (_mm256_loadu_pd(a.as_ptr()), _mm256_loadu_pd(a[4..].as_ptr())) };
+        _mm256_set_m128(_mm256_cvtpd_ps(hi), _mm256_cvtpd_ps(lo))
     }
 
     #[inline]
@@ -657,11 +661,7 @@ mod simd {
     #[target_feature(enable = "avx2")]
     pub(super) fn any_rays(packets: &[FlatPacket], rays: &RayPacket, t_max: &[f64; LANES]) -> u8 {
         let r = rays_in_lanes(rays);
-        // SAFETY: `t_max` is eight readable f64s; `loadu` needs no alignment.
-        let limit = unsafe {
-            let (lo, hi) = (_mm256_loadu_pd(t_max.as_ptr()), _mm256_loadu_pd(t_max[4..].as_ptr()));
-            _mm256_set_m128(_mm256_cvtpd_ps(hi), _mm256_cvtpd_ps(lo))
-        };
+        let limit = narrow(t_max);
         let mut blocked = _mm256_setzero_ps();
         for p in packets {
             for lane in 0..p.used {
