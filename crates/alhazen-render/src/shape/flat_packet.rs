@@ -744,6 +744,37 @@ mod tests {
         }
     }
 
+    proptest! {
+        /// The tracers' guard covers the single-precision test: a ray leaving a flat from
+        /// `ray_epsilon` off it never meets that flat again, and one aimed back into it does,
+        /// at coordinates up to 10⁴ (and flats up to that size).
+        #[test]
+        fn the_guard_covers_single_precision(
+            corner in vec3(),
+            e1 in vec3(),
+            e2 in vec3(),
+            parallelogram in any::<bool>(),
+            at in (0.05..0.45f64, 0.05..0.45f64),
+            dir in vec3(),
+            scale in prop_oneof![Just(1.0), Just(100.0), Just(1e4)],
+        ) {
+            let Some(f) = Flat::new(corner * scale, e1 * scale, e2 * scale, parallelogram) else { return Ok(()) };
+            prop_assume!(dir.length() > 1e-3);
+            let n = f.normal.normalize();
+            let p = corner * scale + e1 * scale * at.0 + e2 * scale * at.1;
+            let origin = p + n * ray_epsilon(p);
+            let dir = dir.normalize();
+            // Away from the surface (not grazing it closer than 1 %), and back into it.
+            prop_assume!(dir.dot(n).abs() > 0.01);
+            let (away, into) = if dir.dot(n) > 0.0 { (dir, -dir) } else { (-dir, dir) };
+            let packet = [FlatPacket::new(&[f])];
+            for unit in VectorUnit::available() {
+                prop_assert!(FlatPacket::nearest_of(&packet, &Ray::new(origin, away), f64::INFINITY, unit).is_none());
+                prop_assert!(FlatPacket::nearest_of(&packet, &Ray::new(origin, into), f64::INFINITY, unit).is_some());
+            }
+        }
+    }
+
     /// Two flats in one plane: the first packet's wins, whatever lane the other is in.
     #[test]
     fn ties_go_to_the_first_packet_then_the_first_lane() {
