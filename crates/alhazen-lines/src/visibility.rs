@@ -11,6 +11,7 @@ use crate::curves::SceneLine;
 use crate::view::{Leeway, View};
 use alhazen_math::{Ray, Vec2, Vec3};
 use alhazen_render::World;
+use alhazen_render::shape::ray_epsilon;
 use rayon::prelude::*;
 
 /// A chord of a line between two curve parameters, with its image on paper (film pixels).
@@ -281,7 +282,7 @@ fn piercings(c: &Chord, own: u32, world: &World, ts: &mut Vec<f64>) {
             ts.push(t / len);
         }
         // Past the hit by the tracers' own guard (flats are tested in single precision).
-        t0 = t + alhazen_render::shape::ray_epsilon(h.hit.p);
+        t0 = t + ray_epsilon(h.hit.p);
         if t0 >= len {
             break;
         }

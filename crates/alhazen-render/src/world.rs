@@ -537,8 +537,8 @@ impl World {
         let lane = self.flats.lanes[k][h.lane];
         let c = lane.flat.candidate(h.t, h.b1, h.b2);
         if let Some(s) = &self.flat_shading[k][h.lane] {
-            // The triangle `FlatLane::candidate` picks, chosen without a branch (it is random).
-            let second = usize::from(lane.flat.parallelogram & (h.b1 < h.b2));
+            // The triangle of the pair the candidate picked.
+            let second = (c.aux - lane.flat.triangle) as usize;
             let (n, material) = (s.normal[second], s.material[second]);
             let p = on_triangle(s.corners[second], c.bary[0], c.bary[1]);
             let hit = SurfaceHit::flat(h.t, p, n, alhazen_math::Vec2::ZERO);

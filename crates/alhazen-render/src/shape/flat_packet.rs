@@ -50,9 +50,14 @@ struct Ray32 {
 
 impl Ray32 {
     fn new(ray: &Ray) -> Self {
-        let round = |v: Vec3| [v.x as f32, v.y as f32, v.z as f32];
-        Self { origin: round(ray.origin), dir: round(ray.dir) }
+        Self { origin: round32(ray.origin), dir: round32(ray.dir) }
     }
+}
+
+/// `v`'s coordinates rounded to nearest `f32`s.
+#[inline(always)]
+fn round32(v: Vec3) -> [f32; 3] {
+    [v.x as f32, v.y as f32, v.z as f32]
 }
 
 /// `a·b` summed as glam's `dot`: `(x·x + y·y) + z·z`.
@@ -76,8 +81,7 @@ impl FlatPlanes {
     /// `flat`'s planes: its axes rounded to `f32`, their offsets computed from those rounded
     /// axes in `f64` and rounded once.
     pub(super) fn of(flat: &Flat) -> Self {
-        let round = |v: Vec3| [v.x as f32, v.y as f32, v.z as f32];
-        let axes = [round(flat.normal.normalize()), round(flat.u), round(flat.v)];
+        let axes = [round32(flat.normal.normalize()), round32(flat.u), round32(flat.v)];
         let offsets = axes.map(|a| Vec3::new(a[0] as f64, a[1] as f64, a[2] as f64).dot(flat.origin) as f32);
         Self { axes, offsets, triangle: if flat.parallelogram { 0.0 } else { 1.0 } }
     }
