@@ -471,7 +471,7 @@ impl World {
     fn objects_block(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> bool {
         self.leaf_objects[leaf.objects.clone()]
             .iter()
-            .any(|&i| self.objects[i as usize].placed.hit(ray, t_max).is_some())
+            .any(|&i| self.objects[i as usize].placed.blocks(ray, t_max))
     }
 
     /// The nearest hit in `(0, t_max)` without its surface: the distance, the triangle and its
@@ -598,7 +598,7 @@ impl World {
     #[inline]
     pub fn unoccluded(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
         let ray = Ray::new(origin, dir);
-        if self.unbounded.iter().any(|&i| self.objects[i as usize].placed.hit(&ray, dist).is_some()) {
+        if self.unbounded.iter().any(|&i| self.objects[i as usize].placed.blocks(&ray, dist)) {
             return false;
         }
         let mut blocked = false;

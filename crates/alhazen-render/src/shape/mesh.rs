@@ -3,7 +3,7 @@
 //! use Möller–Trumbore. One [`MeshAccel`] is shared by every instance of the mesh (instancing =
 //! one mesh, many transforms).
 
-use super::{Candidate, Crossing, FlatLane, PackedFlats, SurfaceHit, VectorUnit, flat_primitives};
+use super::{Candidate, Crossing, FlatLane, FlatPacket, PackedFlats, SurfaceHit, VectorUnit, flat_primitives};
 use crate::bvh::Bvh;
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
@@ -171,6 +171,19 @@ impl MeshShape {
             Some(h.t)
         });
         best.map(|(lane, h)| lane.candidate(h.t, h.b1, h.b2))
+    }
+
+    /// True when some triangle lies on `ray` in `(0, t_max)`: [`MeshShape::hit`]`.is_some()`,
+    /// stopping at the first leaf that holds one (shadow rays need no nearest hit).
+    pub fn blocks(&self, ray: &Ray, t_max: f64) -> bool {
+        let a = &*self.accel;
+        let mut blocked = false;
+        let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
+        a.bvh.traverse_leaves_prefetching(ray, t_max, prefetch, |packets, t_max| {
+            blocked = FlatPacket::any_of(&a.packets.packets[packets], ray, t_max, a.vectors);
+            blocked.then_some(0.0)
+        });
+        blocked
     }
 
     /// The surface at a hit found by [`MeshShape::hit`].

@@ -116,6 +116,15 @@ impl Shape {
         }
     }
 
+    /// True when the shape lies on `ray` in `(0, t_max)`: `self.hit(ray, t_max).is_some()`,
+    /// found without looking for the nearest hit where that is cheaper (meshes).
+    pub fn blocks(&self, ray: &Ray, t_max: f64) -> bool {
+        match self {
+            Shape::Mesh(s) => s.blocks(ray, t_max),
+            _ => self.hit(ray, t_max).is_some(),
+        }
+    }
+
     /// The surface at a hit found by [`Shape::hit`] on the same ray.
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
         self.surface_with(ray, c, true)
@@ -232,6 +241,14 @@ impl Placed {
         match &self.to_world {
             None => self.shape.hit(ray, t_max),
             Some(tf) => self.shape.hit(&tf.inverse_ray(ray), t_max),
+        }
+    }
+
+    /// [`Shape::blocks`] in world space.
+    pub fn blocks(&self, ray: &Ray, t_max: f64) -> bool {
+        match &self.to_world {
+            None => self.shape.blocks(ray, t_max),
+            Some(tf) => self.shape.blocks(&tf.inverse_ray(ray), t_max),
         }
     }
 

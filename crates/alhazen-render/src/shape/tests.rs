@@ -165,6 +165,15 @@ proptest! {
         }
     }
 
+    /// A mesh blocks a segment exactly when its nearest hit lies on it, whatever the segment's
+    /// length (the any-hit traversal stops early but must not decide differently).
+    #[test]
+    fn mesh_blocks_where_it_is_hit(mesh in arb_soup(150), ray in arb_ray(), reach in 0.0..1.5f64) {
+        let shape = MeshShape { accel: Arc::new(MeshAccel::new(Arc::new(mesh))), smooth: false };
+        let t_max = shape.hit(&ray, f64::INFINITY).map_or(10.0, |c| c.t * 2.0 * reach);
+        prop_assert_eq!(shape.blocks(&ray, t_max), shape.hit(&ray, t_max).is_some(), "t_max {}", t_max);
+    }
+
     /// The mesh's packets of flats find what Möller–Trumbore over every triangle finds.
     #[test]
     fn mesh_packets_agree_with_every_triangle(mesh in arb_soup(150), ray in arb_ray()) {
