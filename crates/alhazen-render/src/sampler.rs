@@ -143,6 +143,7 @@ fn owen_scramble(x: u32, seed: u32) -> u32 {
 
 /// Column `k` of the generator matrix of the second Sobol dimension (primitive polynomial
 /// `x + 1`, all direction numbers 1): `v_k = v_{k−1} ⊕ (v_{k−1} ≫ 1)`, `v_0 = 2³¹`.
+#[cfg(test)]
 const fn sobol1_columns() -> [u32; 32] {
     let mut c = [0u32; 32];
     let mut v = 1u32 << 31;
@@ -155,44 +156,17 @@ const fn sobol1_columns() -> [u32; 32] {
     c
 }
 
-/// XOR of the bit-reversed generator columns selected by each byte value, per byte of the
-/// index: the second dimension with its bits reversed, ready for [`scramble_reversed`].
-const SOBOL1_REVERSED_BYTES: [[u32; 256]; 4] = {
-    let mut cols = sobol1_columns();
-    let mut k = 0;
-    while k < 32 {
-        cols[k] = cols[k].reverse_bits();
-        k += 1;
-    }
-    let mut t = [[0u32; 256]; 4];
-    let mut b = 0;
-    while b < 4 {
-        let mut v = 0;
-        while v < 256 {
-            let mut acc = 0u32;
-            let mut bit = 0;
-            while bit < 8 {
-                if v & (1 << bit) != 0 {
-                    acc ^= cols[b * 8 + bit];
-                }
-                bit += 1;
-            }
-            t[b][v] = acc;
-            v += 1;
-        }
-        b += 1;
-    }
-    t
-};
-
-/// The second Sobol dimension of point `i`, bits reversed.
-#[inline]
-fn sobol1_reversed(i: u32) -> u32 {
-    let t = &SOBOL1_REVERSED_BYTES;
-    t[0][(i & 0xff) as usize]
-        ^ t[1][(i >> 8 & 0xff) as usize]
-        ^ t[2][(i >> 16 & 0xff) as usize]
-        ^ t[3][(i >> 24) as usize]
+/// The second Sobol dimension of point `i`, bits reversed. Its generator columns reversed are
+/// the binomials `(1 + t)^k` over GF(2) (bit `j` the coefficient of `t^j`), so the point is the
+/// index read as a polynomial `I(t)` and evaluated at `1 + t`: splitting `I = A + t^h·B` gives
+/// `I(1 + t) = (A + B)(1 + t) + t^h·B(1 + t)`, one shift and XOR per halving.
+#[inline(always)]
+fn sobol1_reversed(mut i: u32) -> u32 {
+    i ^= i >> 16 & 0x0000_ffff;
+    i ^= i >> 8 & 0x00ff_00ff;
+    i ^= i >> 4 & 0x0f0f_0f0f;
+    i ^= i >> 2 & 0x3333_3333;
+    i ^ (i >> 1 & 0x5555_5555)
 }
 
 #[inline]
@@ -327,9 +301,11 @@ mod tests {
     }
 
     #[test]
-    fn sobol_tables_match_the_bitwise_definition() {
+    fn sobol_dimension_one_matches_the_bitwise_definition() {
         let cols = sobol1_columns();
-        for i in [0u32, 1, 2, 3, 77, 1 << 20, 0xdead_beef, u32::MAX] {
+        let mut rng = Rng(7);
+        let random = (0..1000).map(|_| rng.next_u64() as u32);
+        for i in [0u32, 1, 2, 3, 77, 1 << 20, 0xdead_beef, u32::MAX].into_iter().chain(random) {
             let y = (0..32).filter(|k| i >> k & 1 == 1).fold(0, |acc, k| acc ^ cols[k]);
             assert_eq!(sobol1_reversed(i).reverse_bits(), y, "{i}");
         }
