@@ -205,24 +205,28 @@ mod avx512 {
     ) -> RaysSphereHits {
         let ray = SphereRays::new(RayLanes { origin: load3(&rays.origin), dir: load3(&rays.dir) });
         let mut best = load(t_max);
-        let (mut which, mut hit) = ([(0usize, 0usize); SPHERE_LANES], 0u8);
+        // Per ray, the sphere of its nearest hit as `packet × SPHERE_LANES + lane`, taken
+        // without a branch: which rays a sphere is nearer for is data, not a pattern.
+        let (mut which, mut hit) = (_mm512_setzero_si512(), 0u8);
         for (k, p) in packets.iter().enumerate() {
             for lane in 0..p.used {
                 let center = [0, 1, 2].map(|i| _mm512_set1_pd(p.center[i][lane]));
                 let (t, closer) = lanes(center, _mm512_set1_pd(p.radius[lane]), &ray, best);
-                if closer != 0 {
-                    best = _mm512_mask_blend_pd(closer, best, t);
-                    hit |= closer;
-                    for r in (0..SPHERE_LANES).filter(|r| closer >> r & 1 == 1) {
-                        which[r] = (k, lane);
-                    }
-                }
+                best = _mm512_mask_blend_pd(closer, best, t);
+                which = _mm512_mask_blend_epi64(closer, which, _mm512_set1_epi64((k * SPHERE_LANES + lane) as i64));
+                hit |= closer;
             }
         }
-        let mut t = [0.0; SPHERE_LANES];
-        // SAFETY: `t` is eight writable f64s; `storeu` needs no alignment.
-        unsafe { _mm512_storeu_pd(t.as_mut_ptr(), best) };
-        std::array::from_fn(|r| (hit >> r & 1 == 1).then(|| (which[r].0, which[r].1, t[r])))
+        let (mut t, mut id) = ([0.0; SPHERE_LANES], [0i64; SPHERE_LANES]);
+        // SAFETY: `t` and `id` are eight writable f64s and i64s; `storeu` needs no alignment.
+        unsafe {
+            _mm512_storeu_pd(t.as_mut_ptr(), best);
+            _mm512_storeu_si512(id.as_mut_ptr().cast(), which);
+        }
+        std::array::from_fn(|r| {
+            let id = id[r] as usize;
+            (hit >> r & 1 == 1).then(|| (id / SPHERE_LANES, id % SPHERE_LANES, t[r]))
+        })
     }
 }
 
