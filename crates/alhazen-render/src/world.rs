@@ -469,9 +469,7 @@ impl World {
     /// before `t_max`.
     #[inline]
     fn objects_block(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> bool {
-        self.leaf_objects[leaf.objects.clone()]
-            .iter()
-            .any(|&i| self.objects[i as usize].placed.blocks(ray, t_max))
+        self.leaf_objects[leaf.objects.clone()].iter().any(|&i| self.objects[i as usize].placed.blocks(ray, t_max))
     }
 
     /// The nearest hit in `(0, t_max)` without its surface: the distance, the triangle and its
