@@ -21,7 +21,7 @@ pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Ve
 pub fn equirect_uv(dir: Vec3, rotation: f64) -> Vec2 {
     use std::f64::consts::PI;
     let phi = dir.x.atan2(-dir.z) + rotation;
-    let u = (phi / (2.0 * PI)).rem_euclid(1.0);
+    let u = wrap_unit(phi / (2.0 * PI));
     let v = dir.y.clamp(-1.0, 1.0).acos() / PI;
     Vec2::new(u.min(1.0 - 1e-16), v.min(1.0 - 1e-16))
 }
@@ -39,11 +39,27 @@ pub fn equirect_texel_at(img: &ImageData, uv: Vec2) -> Vec3 {
     Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 
+/// `x.rem_euclid(1.0)`, bit for bit, without the call to `fmod` it makes where `x` lies in
+/// `(−1, 2)` — where texture coordinates and azimuths almost always do. There the remainder is
+/// `x`, `x + 1` (the one rounding `rem_euclid` makes too) or `x − 1` (exact).
+#[inline]
+fn wrap_unit(x: f64) -> f64 {
+    if (0.0..1.0).contains(&x) {
+        x
+    } else if x > -1.0 && x < 0.0 {
+        x + 1.0
+    } else if (1.0..2.0).contains(&x) {
+        x - 1.0
+    } else {
+        x.rem_euclid(1.0)
+    }
+}
+
 fn bilinear(img: &ImageData, uv: Vec2) -> Vec3 {
     let (w, h) = (img.width as i64, img.height as i64);
     // v = 0 is the bottom row of the image.
-    let x = uv.x.rem_euclid(1.0) * w as f64 - 0.5;
-    let y = (1.0 - uv.y.rem_euclid(1.0)) * h as f64 - 0.5;
+    let x = wrap_unit(uv.x) * w as f64 - 0.5;
+    let y = (1.0 - wrap_unit(uv.y)) * h as f64 - 0.5;
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
     // The coordinates lie in [−1, size]: wrapped by a comparison, not an integer division.
@@ -86,6 +102,16 @@ mod tests {
             proptest::prop_assert_eq!(img.has_codes(), distinct <= 256);
             for (i, p) in pixels.iter().enumerate() {
                 proptest::prop_assert_eq!(img.texel(i).map(f32::to_bits), p.map(f32::to_bits));
+            }
+        }
+
+        /// `wrap_unit` is `rem_euclid(1.0)` to the bit, near the unit interval and far from it.
+        #[test]
+        fn wrap_unit_is_rem_euclid(x in -3.0..3.0f64, far in -1e300..1e300f64, tiny in -1e-300..1e-300f64) {
+            let edges = [-2.0, -1.0, -0.0, 0.0, 1.0, 2.0, f64::EPSILON / 4.0, -f64::EPSILON / 4.0, 1.0 - f64::EPSILON];
+            for x in [x, far, tiny, f64::NAN, f64::INFINITY].into_iter().chain(edges) {
+                let (a, b) = (wrap_unit(x), x.rem_euclid(1.0));
+                proptest::prop_assert!(a.to_bits() == b.to_bits() || a.is_nan() && b.is_nan(), "{x}: {a} vs {b}");
             }
         }
 
