@@ -160,12 +160,18 @@ impl MeshShape {
         alhazen_scene::texture::uv_tangents([p0, p1, p2], idx.map(|i| m.uvs[i]))
     }
 
+    /// The tree's leaves `ray` may meet, nearest first ([`Bvh::traverse_leaves_prefetching`]):
+    /// `visit(packets, t_max)`, each leaf's packets prefetched as soon as its box is met.
+    fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>) {
+        let a = &*self.accel;
+        a.bvh.traverse_leaves_prefetching(ray, t_max, |packets| a.packets.prefetch(packets.start), visit);
+    }
+
     /// Nearest hit in `(0, t_max)`; `aux` is the triangle.
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let a = &*self.accel;
         let mut best = None;
-        let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
-        a.bvh.traverse_leaves_prefetching(ray, t_max, prefetch, |packets, t_max| {
+        self.traverse(ray, t_max, |packets, t_max| {
             let (lane, h) = a.packets.nearest(packets, ray, t_max, a.vectors)?;
             best = Some((lane, h));
             Some(h.t)
@@ -178,8 +184,7 @@ impl MeshShape {
     pub fn blocks(&self, ray: &Ray, t_max: f64) -> bool {
         let a = &*self.accel;
         let mut blocked = false;
-        let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
-        a.bvh.traverse_leaves_prefetching(ray, t_max, prefetch, |packets, t_max| {
+        self.traverse(ray, t_max, |packets, t_max| {
             blocked = FlatPacket::any_of(&a.packets.packets[packets], ray, t_max, a.vectors);
             blocked.then_some(0.0)
         });
