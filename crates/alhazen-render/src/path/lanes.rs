@@ -13,8 +13,8 @@
 //!
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
-//! and specular connection. Vertices on untextured Lambert surfaces in RGB scenes without
-//! specular connections take the Lambert kernel instead: their random numbers and emission per
+//! and specular connection. Vertices on Lambert surfaces (textured, bump-mapped or plain) in
+//! RGB scenes without specular connections take the Lambert kernel instead: their random numbers and emission per
 //! lane ([`PathTracer::lambert_vertex`]), then light points on parallelogram lights
 //! ([`sample_lights`]) and the shading frame, next-event weights, cosine-weighted continuation
 //! and Russian roulette ([`shade`]) for all lanes at once, loops without branches the compiler
@@ -26,7 +26,7 @@
 //! bit-identical to the per-path tracer's on every processor (test
 //! `lanes_match_the_per_path_tracer`).
 
-use super::{PathState, PathTracer, RR_DEPTH, Vertex, offset, power_heuristic};
+use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic};
 use crate::bsdf::{Bsdf, ColorMode, Frame, cosine_hemisphere, cosine_pdf, same_side};
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
@@ -62,9 +62,12 @@ struct Vertices {
     /// Towards the viewer (`−ray.dir`).
     wo: Lanes3,
     p: Lanes3,
-    /// Geometric and shading normals as the surface reports them.
+    /// Geometric and shading normals as the surface reports them, the shading normal bent by
+    /// the bump or normal map where there is one (`bumped`), and the unbent one.
     ng: Lanes3,
     ns: Lanes3,
+    n0: Lanes3,
+    bumped: [bool; LANES],
     albedo: Lanes3,
     beta: Lanes3,
     /// The light sample, valid where `light` is set (it exists, has radiance and density).
@@ -163,19 +166,15 @@ enum Kernel {
     Lambert,
 }
 
-/// Per material: its vertices take the Lambert kernel (untextured Lambert without bump map or
-/// tangent), in a scene whose vertices may (RGB, no specular connections).
+/// Per material: its vertices take the Lambert kernel (Lambert, textured or not, bump-mapped or
+/// not, without tangent), in a scene whose vertices may (RGB, no specular connections). A
+/// material's kind of BSDF does not vary over its surface (textures vary colours only), so the
+/// BSDF at any point tells.
 pub(super) fn lambert_kernel(tracer: &PathTracer) -> Vec<bool> {
     let scene_allows = !tracer.spectral && tracer.mirrors.is_none();
-    tracer
-        .scene
-        .materials
-        .iter()
-        .zip(&tracer.uniform_bsdfs)
-        .map(|(m, b)| {
-            scene_allows && matches!(b, Some(Bsdf::Lambert(_))) && m.bump.is_none() && !crate::bsdf::is_anisotropic(m)
-        })
-        .collect()
+    let images = &tracer.scene.images;
+    let lambert = |m| matches!(crate::bsdf::bsdf_at(m, Vec2::ZERO, images, ColorMode::Rgb), Bsdf::Lambert(_));
+    tracer.scene.materials.iter().map(|m| scene_allows && lambert(m) && !crate::bsdf::is_anisotropic(m)).collect()
 }
 
 impl PathTracer<'_> {
@@ -294,15 +293,29 @@ impl PathTracer<'_> {
         if path.depth >= self.scene.render.max_depth {
             return false;
         }
-        let Some(Bsdf::Lambert(lambert)) = &self.uniform_bsdfs[wh.material as usize] else { return false };
+        let m = &self.scene.materials[wh.material as usize];
+        let albedo = match &self.uniform_bsdfs[wh.material as usize] {
+            Some(Bsdf::Lambert(lambert)) => lambert.albedo,
+            Some(_) => return false,
+            None => match crate::bsdf::bsdf_at(m, wh.hit.uv, &self.scene.images, ColorMode::Rgb) {
+                Bsdf::Lambert(lambert) => lambert.albedo,
+                _ => return false,
+            },
+        };
         let h = HitPoint::from(wh);
         path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, None, ColorMode::Rgb);
         v.roulette[i] = path.depth >= RR_DEPTH;
         set(&mut v.wo, i, -path.ray.dir);
         set(&mut v.p, i, h.p);
         set(&mut v.ng, i, h.n);
-        set(&mut v.ns, i, h.ns);
-        set(&mut v.albedo, i, lambert.albedo);
+        v.bumped[i] = m.bump.is_some();
+        if v.bumped[i] {
+            set(&mut v.ns, i, crate::world::shading_normal(&wh.hit, m, &self.scene.images));
+            set(&mut v.n0, i, h.ns);
+        } else {
+            set(&mut v.ns, i, h.ns);
+        }
+        set(&mut v.albedo, i, albedo);
         set(&mut v.beta, i, path.beta);
         path.prev.p = h.p;
         // The vertex's numbers in the per-path tracer's order: light choice when there is one,
@@ -437,10 +450,17 @@ unsafe fn shade_avx2(v: &Vertices, out: &mut Shaded) {
     shade_lanes(v, out)
 }
 
+/// All lanes, with the bump terminator's arithmetic only where a lane's normal may be bent.
 #[inline(always)]
 fn shade_lanes(v: &Vertices, out: &mut Shaded) {
-    for i in 0..LANES {
-        shade_lane(v, out, i);
+    if v.bumped.contains(&true) {
+        for i in 0..LANES {
+            shade_lane::<true>(v, out, i);
+        }
+    } else {
+        for i in 0..LANES {
+            shade_lane::<false>(v, out, i);
+        }
     }
 }
 
@@ -448,23 +468,27 @@ fn shade_lanes(v: &Vertices, out: &mut Shaded) {
 /// rule, [`Frame`], [`cosine_hemisphere`], [`offset`], [`epsilon`], [`power_heuristic`]) on one
 /// lane, inlined into the all-lane loop.
 #[inline(always)]
-fn shade_lane(v: &Vertices, out: &mut Shaded, i: usize) {
+fn shade_lane<const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i: usize) {
     let (wo, p) = (get(&v.wo, i), get(&v.p, i));
     // The shading frame (`PathTracer::shading_frame`; Lambert does not transmit).
-    let (mut ng, mut ns) = (get(&v.ng, i), get(&v.ns, i));
+    let (mut ng, mut ns, mut n0) = (get(&v.ng, i), get(&v.ns, i), get(&v.n0, i));
     if ng.dot(wo) < 0.0 {
-        (ng, ns) = (-ng, -ns);
+        (ng, ns, n0) = (-ng, -ns, -n0);
     }
     if ns.dot(wo) * ng.dot(wo) <= 0.0 {
         ns = ng;
     }
+    // The bump terminator's shadowing (`Terminator::shadowing`), chosen without branches.
+    let (bent, terminator) = Terminator::bent(n0, ns);
+    let bent = BUMPS && v.bumped[i] && bent;
+    let shadowing = |dir: Vec3| if bent { terminator.factor(dir) } else { 1.0 };
     let frame = Frame::around(ns);
     let wv = frame.to_local(wo);
     let rho = get(&v.albedo, i) * FRAC_1_PI;
     // Next event (`PathTracer::next_event`).
     let dir = get(&v.light_dir, i);
     let l = frame.to_local(dir);
-    let f = if same_side(wv, l) { rho } else { Vec3::ZERO } * l.z.abs();
+    let f = if same_side(wv, l) { rho } else { Vec3::ZERO } * l.z.abs() * shadowing(dir);
     let shadow = v.light[i] && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0));
     let pdf_light = v.light_pdf[i];
     let w = if v.light_delta[i] { 1.0 } else { power_heuristic(pdf_light, cosine_pdf(wv, l)) };
@@ -478,7 +502,7 @@ fn shade_lane(v: &Vertices, out: &mut Shaded, i: usize) {
     let l = cosine_hemisphere(Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]), wv);
     let pdf = cosine_pdf(wv, l);
     let dir = frame.to_world(l);
-    let weight = rho * l.z.abs() / pdf;
+    let weight = rho * l.z.abs() / pdf * shadowing(dir);
     let mut beta = get(&v.beta, i) * weight;
     let mut alive = pdf > 0.0 && weight.is_finite() && weight != Vec3::ZERO;
     if v.roulette[i] {
@@ -636,11 +660,15 @@ material = "glow"
                transform = [{ scale = 0.2 }, { rotate_y = 90 }, { translate = [0.9, 0.2, 0] }]\n";
         let mut two_lights = alhazen_scene::parse_scene("two-lights.toml".as_ref(), &text).unwrap();
         (two_lights.render.width, two_lights.render.height, two_lights.render.spp) = (16, 16, 9);
+        // Without specular connections its textured, bump-mapped plane takes the Lambert kernel.
+        let mut unconnected = mixed.clone();
+        unconnected.render.mirror_connections = false;
         let scenes = [
             ("cornell-box", small("cornell-box", (20, 20, 11))),
             ("cornell-rough", small("cornell-rough", (16, 16, 7))),
             ("prism", small("prism", (16, 12, 5))),
             ("mixed", mixed),
+            ("mixed, no specular connections", unconnected),
             ("two lights", two_lights),
         ];
         for (name, base) in scenes {
