@@ -70,6 +70,8 @@ struct Vertices {
     bumped: [bool; LANES],
     albedo: Lanes3,
     beta: Lanes3,
+    /// The path's product of squared relative indices so far (for roulette).
+    eta_scale: Lanes,
     /// The light sample, valid where `light` is set (it exists, has radiance and density).
     light: [bool; LANES],
     light_dir: Lanes3,
@@ -317,6 +319,7 @@ impl PathTracer<'_> {
         }
         set(&mut v.albedo, i, albedo);
         set(&mut v.beta, i, path.beta);
+        v.eta_scale[i] = path.eta_scale;
         path.prev.p = h.p;
         // The vertex's numbers in the per-path tracer's order: light choice when there is one,
         // light point, continuation, roulette from `RR_DEPTH` on. Roulette's is drawn before it
@@ -506,8 +509,7 @@ fn shade_lane<const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i: usize) {
     let mut beta = get(&v.beta, i) * weight;
     let mut alive = pdf > 0.0 && weight.is_finite() && weight != Vec3::ZERO;
     if v.roulette[i] {
-        // `eta_scale` is 1 on Lambertian paths.
-        let q = (beta.max_element() * 1.0).min(0.95);
+        let q = (beta.max_element() * v.eta_scale[i]).min(0.95);
         // `u ≥ q` ends the path (u is never NaN; a NaN q does not end it).
         alive &= v.u_roulette[i] < q || q.is_nan();
         beta /= q;
@@ -663,8 +665,17 @@ material = "glow"
         // Without specular connections its textured, bump-mapped plane takes the Lambert kernel.
         let mut unconnected = mixed.clone();
         unconnected.render.mirror_connections = false;
+        // Glass whose index and its inverse do not square to exactly 1 (1.52² · (1/1.52)²):
+        // Lambert vertices after it see a path's `eta_scale` off 1 in the last bit.
+        let mut glass = small("cornell-rough", (16, 16, 9));
+        for m in &mut glass.materials {
+            if let Some(alhazen_scene::bsdf::BsdfDesc::Dielectric { ior, .. }) = &mut m.bsdf {
+                *ior = alhazen_scene::bsdf::Ior::Constant(1.52);
+            }
+        }
         let scenes = [
             ("cornell-box", small("cornell-box", (20, 20, 11))),
+            ("cornell-rough, glass of index 1.52", glass),
             ("cornell-rough", small("cornell-rough", (16, 16, 7))),
             ("prism", small("prism", (16, 12, 5))),
             ("mixed", mixed),
