@@ -123,12 +123,12 @@ impl Bvh {
     /// [`Self::build`] for primitives some of which (`packed(i)`) are tested [`PACK`] at a time
     /// in a leaf: the surface area heuristic charges a leaf one test per started group of
     /// them plus one per other primitive, so leaves of such primitives grow large.
-    pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool) -> Self {
+    pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync) -> Self {
         Self::build_split_from(bounds, packed, PARALLEL_ITEMS, BuildMethod::Sah)
     }
 
     /// [`Self::build_packed`] by `method`.
-    pub fn build_packed_by(bounds: &[Bounds3], packed: impl Fn(usize) -> bool, method: BuildMethod) -> Self {
+    pub fn build_packed_by(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync, method: BuildMethod) -> Self {
         Self::build_split_from(bounds, packed, PARALLEL_ITEMS, method)
     }
 
@@ -136,15 +136,20 @@ impl Bvh {
     /// parallel.
     fn build_split_from(
         bounds: &[Bounds3],
-        packed: impl Fn(usize) -> bool,
+        packed: impl Fn(usize) -> bool + Sync,
         parallel_from: usize,
         method: BuildMethod,
     ) -> Self {
-        let mut items: Vec<Item> = bounds
-            .iter()
-            .enumerate()
-            .map(|(i, b)| Item { bounds: *b, centroid: b.centroid(), index: i as u32, packed: packed(i), code: 0 })
-            .collect();
+        use rayon::prelude::*;
+        let mut items: Vec<Item> = Vec::new();
+        let item = |(i, b): (usize, &Bounds3)| Item {
+            bounds: *b,
+            centroid: b.centroid(),
+            index: i as u32,
+            packed: packed(i),
+            code: 0,
+        };
+        bounds.par_iter().enumerate().map(item).collect_into_vec(&mut items);
         if method == BuildMethod::Morton {
             morton_order(&mut items);
         }
@@ -344,11 +349,17 @@ impl Bvh {
     /// leaf's primitive indices, once (a mesh makes them its packets, the world its leaves).
     /// Afterwards [`Self::traverse`] is refused and [`Self::leaves`] lists the new labels.
     pub fn relabel_leaves(&mut self, mut relabel: impl FnMut(&[u32]) -> std::ops::Range<usize>) {
+        let order = std::mem::take(&mut self.order);
+        self.relabel_leaf_ranges(|leaf| relabel(&order[leaf]));
+        self.order = order;
+    }
+
+    /// [`Self::relabel_leaves`] by each leaf's range in [`Self::leaf_order`]: `relabel(range)`.
+    pub fn relabel_leaf_ranges(&mut self, mut relabel: impl FnMut(std::ops::Range<usize>) -> std::ops::Range<usize>) {
         assert!(!self.relabeled, "leaves are relabelled once");
         self.relabeled = true;
-        let order = &self.order;
         wide::relabel(&mut self.wide, &mut self.start, |e| {
-            let r = relabel(&order[e.labels()]);
+            let r = relabel(e.labels());
             (r.start as u32, r.len() as u32)
         });
     }

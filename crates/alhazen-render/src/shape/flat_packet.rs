@@ -295,6 +295,17 @@ impl FlatPacket {
     }
 }
 
+/// One packet of up to [`LANES`] flats and what each stands for.
+fn pack<L: Copy + Default>(flats: impl Iterator<Item = (L, Flat)>) -> (FlatPacket, [L; LANES]) {
+    let mut lanes = [L::default(); LANES];
+    let mut packet = Vec::with_capacity(LANES);
+    for ((lane, f), slot) in flats.zip(&mut lanes) {
+        *slot = lane;
+        packet.push(f);
+    }
+    (FlatPacket::new(&packet), lanes)
+}
+
 /// Packets of flats with what each lane stands for (`L`), filled leaf by leaf.
 #[derive(Clone, Debug, Default)]
 pub struct PackedFlats<L> {
@@ -341,13 +352,32 @@ impl<L: Copy + Default> PackedFlats<L> {
     pub fn push_leaf(&mut self, flats: &[(L, Flat)]) -> std::ops::Range<usize> {
         let first = self.packets.len();
         for chunk in flats.chunks(LANES) {
-            let packet: Vec<Flat> = chunk.iter().map(|(_, f)| *f).collect();
-            self.packets.push(FlatPacket::new(&packet));
-            let mut lanes = [L::default(); LANES];
-            chunk.iter().zip(&mut lanes).for_each(|((lane, _), slot)| *slot = *lane);
+            let (packet, lanes) = pack(chunk.iter().copied());
+            self.packets.push(packet);
             self.lanes.push(lanes);
         }
         first..self.packets.len()
+    }
+
+    /// The packets [`Self::push_leaf`] makes of the leaves `leaves` one after the other (leaf
+    /// `i`'s `⌈len / LANES⌉` packets after leaf `i − 1`'s), each leaf the flats `flat(k)` for
+    /// the indices `k` of `order[leaf]`: built on all threads into vectors of exactly their
+    /// size, the same packets as one thread makes.
+    pub fn of_leaves(order: &[u32], leaves: &[std::ops::Range<usize>], flat: impl Fn(u32) -> (L, Flat) + Sync) -> Self
+    where
+        L: Send,
+    {
+        use rayon::prelude::*;
+        let chunks: Vec<_> = leaves
+            .iter()
+            .flat_map(|leaf| leaf.clone().step_by(LANES).map(|at| at..(at + LANES).min(leaf.end)))
+            .collect();
+        let mut packed = Self::default();
+        chunks
+            .par_iter()
+            .map(|chunk| pack(order[chunk.clone()].iter().map(|&k| flat(k))))
+            .unzip_into_vecs(&mut packed.packets, &mut packed.lanes);
+        packed
     }
 
     /// The nearest hit in packets `range` (see [`FlatPacket::nearest_of`]): what its lane

@@ -43,28 +43,32 @@ impl MeshAccel {
         let (prims, bounds) = flat_primitives(&mesh);
         let mut bvh = Bvh::build_packed_by(&bounds, |_| true, method);
         drop(bounds);
-        let mut packets = PackedFlats::default();
-        packets.reserve(bvh.leaves().map(|r| r.len().div_ceil(crate::shape::FLAT_LANES)).sum());
-        // Each leaf's packets are appended as the leaf is relabelled with them.
-        bvh.relabel_leaves(|leaf| {
-            let leaf: Vec<_> = leaf.iter().map(|&k| (prims[k as usize], prims[k as usize].flat(&mesh))).collect();
-            packets.push_leaf(&leaf)
+        // Each leaf is relabelled with the packets it will have, then all are packed at once.
+        let (mut leaves, mut packed) = (vec![], 0);
+        bvh.relabel_leaf_ranges(|leaf| {
+            let first = packed;
+            packed += leaf.len().div_ceil(crate::shape::FLAT_LANES);
+            leaves.push(leaf);
+            first..packed
         });
-        drop(prims);
-        let face_normals: Vec<Vec3> = (0..mesh.triangle_count())
+        let packets = PackedFlats::of_leaves(bvh.leaf_order(), &leaves, |k| {
+            let lane = prims[k as usize];
+            (lane, lane.flat(&mesh))
+        });
+        drop((prims, leaves));
+        use rayon::prelude::*;
+        let (mut face_normals, mut flat) = (Vec::new(), Vec::new());
+        (0..mesh.triangle_count())
+            .into_par_iter()
             .map(|i| {
                 let [a, b, c] = mesh.corners(i);
                 (b - a).cross(c - a).normalize_or_zero()
             })
-            .collect();
-        let flat = mesh
-            .triangles
-            .iter()
-            .zip(&face_normals)
-            .map(|(t, n): (&[u32; 3], &Vec3)| {
-                mesh.normals.is_empty() || t.iter().all(|&i| (mesh.normals[i as usize] - *n).length() < 1e-12)
-            })
-            .collect();
+            .collect_into_vec(&mut face_normals);
+        let flat_at = |(t, n): (&[u32; 3], &Vec3)| {
+            mesh.normals.is_empty() || t.iter().all(|&i| (mesh.normals[i as usize] - *n).length() < 1e-12)
+        };
+        mesh.triangles.par_iter().zip(&face_normals).map(flat_at).collect_into_vec(&mut flat);
         Self { mesh, bvh, packets, vectors, face_normals, flat }
     }
 }

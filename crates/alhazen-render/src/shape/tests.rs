@@ -330,3 +330,36 @@ fn cylinders_and_cones_seen_from_far_away_are_hit_on_their_surface() {
         }
     }
 }
+
+/// A mesh's tree and packets, built on several threads, are those one thread builds.
+#[test]
+fn mesh_packs_the_same_on_any_number_of_threads() {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    // Small triangles scattered in a cube, with parallelograms among them.
+    let mut positions = vec![];
+    for _ in 0..20_000 {
+        let a = alhazen_math::Vec3::new(next(), next(), next()) * 50.0;
+        let (b, d) =
+            (a + alhazen_math::Vec3::new(next(), next(), 0.1), a + alhazen_math::Vec3::new(0.1, next(), next()));
+        let c = if next() < 0.3 { b + d - a } else { a + alhazen_math::Vec3::new(next(), 0.2, next()) };
+        positions.extend([a, b, c, d]);
+    }
+    let triangles =
+        (0..20_000u32).flat_map(|k| [[4 * k, 4 * k + 1, 4 * k + 2], [4 * k, 4 * k + 2, 4 * k + 3]]).collect();
+    let mesh = Arc::new(alhazen_geom::TriangleMesh { positions, triangles, ..Default::default() });
+    let build = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let accel =
+            pool.install(|| crate::shape::MeshAccel::with_unit(mesh.clone(), crate::shape::VectorUnit::PORTABLE));
+        format!("{accel:?}")
+    };
+    let one = build(1);
+    assert!(one.len() > 1_000_000, "a mesh big enough to be built in parallel");
+    assert_eq!(one, build(3));
+}
