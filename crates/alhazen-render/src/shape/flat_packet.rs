@@ -217,7 +217,13 @@ impl FlatPacket {
         if unit.is_simd() {
             // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes AVX2) only where the
             // processor has it.
-            return unsafe { simd::nearest(packets, &r, t_max) };
+            return unsafe {
+                if unit.is_avx512() {
+                    simd::nearest_avx512(packets, &r, t_max)
+                } else {
+                    simd::nearest(packets, &r, t_max)
+                }
+            };
         }
         let _ = unit;
         let mut best = None;
@@ -240,7 +246,9 @@ impl FlatPacket {
         #[cfg(target_arch = "x86_64")]
         if unit.is_simd() {
             // SAFETY: as in `nearest_of`.
-            return unsafe { simd::any(packets, &r, t_max) };
+            return unsafe {
+                if unit.is_avx512() { simd::any_avx512(packets, &r, t_max) } else { simd::any(packets, &r, t_max) }
+            };
         }
         let _ = unit;
         packets.iter().any(|p| (0..p.used).any(|lane| p.planes(lane).hit(&r, t_max).is_some()))
@@ -261,7 +269,13 @@ impl FlatPacket {
         #[cfg(target_arch = "x86_64")]
         if unit.is_simd() {
             // SAFETY: as in `nearest_of`.
-            let hits = unsafe { simd::nearest_rays(packets, rays) };
+            let hits = unsafe {
+                if unit.is_avx512() {
+                    simd::nearest_rays_avx512(packets, rays)
+                } else {
+                    simd::nearest_rays(packets, rays)
+                }
+            };
             for r in (0..LANES).filter(|&r| live[r] && hits.hit & (1 << r) != 0) {
                 let at = hits.at[r] as usize;
                 found(r, at / LANES, LaneHit::new(at % LANES, (hits.t[r], hits.b1[r], hits.b2[r])));
@@ -288,7 +302,13 @@ impl FlatPacket {
         #[cfg(target_arch = "x86_64")]
         if unit.is_simd() {
             // SAFETY: as in `nearest_of`.
-            let hit = unsafe { simd::any_rays(packets, rays, t_max) };
+            let hit = unsafe {
+                if unit.is_avx512() {
+                    simd::any_rays_avx512(packets, rays, t_max)
+                } else {
+                    simd::any_rays(packets, rays, t_max)
+                }
+            };
             return std::array::from_fn(|r| live[r] && hit & (1 << r) != 0);
         }
         std::array::from_fn(|r| live[r] && Self::any_of(packets, &rays.ray(r), t_max[r], unit))
@@ -649,60 +669,76 @@ mod simd {
         pub b2: [f32; LANES],
     }
 
-    /// [`FlatPacket::nearest_of`]: each lane keeps the nearest hit it has seen, and the lanes
-    /// are compared once at the end (on a tie, the first flat).
-    #[target_feature(enable = "avx2")]
-    pub(super) fn nearest(packets: &[FlatPacket], r: &Ray32, t_max: f32) -> Option<(usize, super::LaneHit)> {
-        let r = ray_lanes(r);
-        let limit = _mm256_set1_ps(t_max);
-        let mut best = Nearest::new(limit);
-        let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        for (k, p) in packets.iter().enumerate() {
-            let at = _mm256_add_epi32(_mm256_set1_epi32((k * LANES) as i32), lane);
-            best.update(hits(&packet_lanes(p), &r, limit), at);
-        }
-        let h = best.store();
-        let nearest = (0..LANES)
-            .filter(|&l| h.hit & (1 << l) != 0)
-            .min_by(|&a, &b| h.t[a].total_cmp(&h.t[b]).then(h.at[a].cmp(&h.at[b])))?;
-        let at = h.at[nearest] as usize;
-        Some((at / LANES, super::LaneHit::new(at % LANES, (h.t[nearest], h.b1[nearest], h.b2[nearest]))))
+    /// Defines each kernel twice from one body: for AVX2 processors (16 vector registers) and,
+    /// named `…_avx512`, for AVX-512 ones, where the same AVX2 instructions (the same
+    /// arithmetic, the same bits) get 32 registers: the rays, the flats and the nearest hits
+    /// then stay in registers, where with 16 some spill to the stack — and where they spill
+    /// was at the mercy of inlining elsewhere in the program (the eight-ray kernel's time moved
+    /// by half with unrelated changes).
+    macro_rules! kernels {
+        ($($(#[$doc:meta])* fn $name:ident / $wide:ident ($($arg:ident: $ty:ty),*) -> $ret:ty $body:block)*) => {$(
+            $(#[$doc])*
+            #[target_feature(enable = "avx2")]
+            pub(super) fn $name($($arg: $ty),*) -> $ret $body
+
+            $(#[$doc])*
+            #[target_feature(enable = "avx2,avx512f,avx512vl")]
+            pub(super) fn $wide($($arg: $ty),*) -> $ret $body
+        )*};
     }
 
-    /// [`FlatPacket::any_of`]: stops at the first packet with a lane hit.
-    #[target_feature(enable = "avx2")]
-    pub(super) fn any(packets: &[FlatPacket], r: &Ray32, t_max: f32) -> bool {
-        let (r, limit) = (ray_lanes(r), _mm256_set1_ps(t_max));
-        packets.iter().any(|p| _mm256_movemask_ps(hits(&packet_lanes(p), &r, limit).3) != 0)
-    }
-
-    /// Eight rays' nearest hits, ray by lane.
-    #[target_feature(enable = "avx2")]
-    pub(super) fn nearest_rays(packets: &[FlatPacket], rays: &RayPacket) -> Hits {
-        let r = rays_in_lanes(rays);
-        let limit = _mm256_set1_ps(f32::INFINITY);
-        let mut best = Nearest::new(limit);
-        for (k, p) in packets.iter().enumerate() {
-            for lane in 0..p.used {
-                let at = _mm256_set1_epi32((k * LANES + lane) as i32);
-                best.update(hits(&broadcast(p, lane), &r, limit), at);
+    kernels! {
+        /// [`FlatPacket::nearest_of`]: each lane keeps the nearest hit it has seen, and the
+        /// lanes are compared once at the end (on a tie, the first flat).
+        fn nearest / nearest_avx512(packets: &[FlatPacket], r: &Ray32, t_max: f32) -> Option<(usize, super::LaneHit)> {
+            let r = ray_lanes(r);
+            let limit = _mm256_set1_ps(t_max);
+            let mut best = Nearest::new(limit);
+            let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+            for (k, p) in packets.iter().enumerate() {
+                let at = _mm256_add_epi32(_mm256_set1_epi32((k * LANES) as i32), lane);
+                best.update(hits(&packet_lanes(p), &r, limit), at);
             }
+            let h = best.store();
+            let nearest = (0..LANES)
+                .filter(|&l| h.hit & (1 << l) != 0)
+                .min_by(|&a, &b| h.t[a].total_cmp(&h.t[b]).then(h.at[a].cmp(&h.at[b])))?;
+            let at = h.at[nearest] as usize;
+            Some((at / LANES, super::LaneHit::new(at % LANES, (h.t[nearest], h.b1[nearest], h.b2[nearest]))))
         }
-        best.store()
-    }
 
-    /// [`FlatPacket::any_of_rays`]: the rays blocked by some flat, one bit per ray.
-    #[target_feature(enable = "avx2")]
-    pub(super) fn any_rays(packets: &[FlatPacket], rays: &RayPacket, t_max: &[f64; LANES]) -> u8 {
-        let r = rays_in_lanes(rays);
-        let limit = narrow(t_max);
-        let mut blocked = _mm256_setzero_ps();
-        for p in packets {
-            for lane in 0..p.used {
-                blocked = _mm256_or_ps(blocked, hits(&broadcast(p, lane), &r, limit).3);
-            }
+        /// [`FlatPacket::any_of`]: stops at the first packet with a lane hit.
+        fn any / any_avx512(packets: &[FlatPacket], r: &Ray32, t_max: f32) -> bool {
+            let (r, limit) = (ray_lanes(r), _mm256_set1_ps(t_max));
+            packets.iter().any(|p| _mm256_movemask_ps(hits(&packet_lanes(p), &r, limit).3) != 0)
         }
-        _mm256_movemask_ps(blocked) as u8
+
+        /// Eight rays' nearest hits, ray by lane.
+        fn nearest_rays / nearest_rays_avx512(packets: &[FlatPacket], rays: &RayPacket) -> Hits {
+            let r = rays_in_lanes(rays);
+            let limit = _mm256_set1_ps(f32::INFINITY);
+            let mut best = Nearest::new(limit);
+            for (k, p) in packets.iter().enumerate() {
+                for lane in 0..p.used {
+                    let at = _mm256_set1_epi32((k * LANES + lane) as i32);
+                    best.update(hits(&broadcast(p, lane), &r, limit), at);
+                }
+            }
+            best.store()
+        }
+
+        /// [`FlatPacket::any_of_rays`]: the rays blocked by some flat, one bit per ray.
+        fn any_rays / any_rays_avx512(packets: &[FlatPacket], rays: &RayPacket, t_max: &[f64; LANES]) -> u8 {
+            let r = rays_in_lanes(rays);
+            let limit = narrow(t_max);
+            let mut blocked = _mm256_setzero_ps();
+            for p in packets {
+                for lane in 0..p.used {
+                    blocked = _mm256_or_ps(blocked, hits(&broadcast(p, lane), &r, limit).3);
+                }
+            }
+            _mm256_movemask_ps(blocked) as u8
+        }
     }
 }
 
