@@ -243,7 +243,11 @@ impl PathTracer<'_> {
                 if self.lane_lights.is_some() {
                     sample_lights(&lights, &mut lambert, self.lights.choice_pdf(), unit);
                 }
-                shade(&lambert, &mut shaded, unit);
+                if lambert.bumped.contains(&true) {
+                    shade::<true>(&lambert, &mut shaded, unit);
+                } else {
+                    shade::<false>(&lambert, &mut shaded, unit);
+                }
                 for i in (0..LANES).filter(|&i| kernels[i] == Kernel::Lambert && shaded.shadow[i]) {
                     (tested[i], dist[i]) = (true, shaded.shadow_dist[i]);
                     shadows.set(i, &Ray::new(get(&shaded.shadow_origin, i), get(&lambert.light_dir, i)));
@@ -422,48 +426,43 @@ fn sample_light(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
     (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
 }
 
-/// The Lambertian vertex of every lane at once, with the per-path tracer's arithmetic.
+/// The Lambertian vertex of every lane at once, with the per-path tracer's arithmetic; with
+/// the bump terminator's arithmetic where some lane's normal may be bent (`BUMPS`: a kernel
+/// apiece, the plain one as lean as before bump maps took it).
 #[allow(unsafe_code)]
-fn shade(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
+fn shade<const BUMPS: bool>(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { shade_avx512(v, out) };
+        return unsafe { shade_avx512::<BUMPS>(v, out) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { shade_avx2(v, out) };
+        return unsafe { shade_avx2::<BUMPS>(v, out) };
     }
     let _ = unit;
-    shade_lanes(v, out)
+    shade_lanes::<BUMPS>(v, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx512(v: &Vertices, out: &mut Shaded) {
-    shade_lanes(v, out)
+unsafe fn shade_avx512<const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
+    shade_lanes::<BUMPS>(v, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx2(v: &Vertices, out: &mut Shaded) {
-    shade_lanes(v, out)
+unsafe fn shade_avx2<const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
+    shade_lanes::<BUMPS>(v, out)
 }
 
-/// All lanes, with the bump terminator's arithmetic only where a lane's normal may be bent.
 #[inline(always)]
-fn shade_lanes(v: &Vertices, out: &mut Shaded) {
-    if v.bumped.contains(&true) {
-        for i in 0..LANES {
-            shade_lane::<true>(v, out, i);
-        }
-    } else {
-        for i in 0..LANES {
-            shade_lane::<false>(v, out, i);
-        }
+fn shade_lanes<const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
+    for i in 0..LANES {
+        shade_lane::<BUMPS>(v, out, i);
     }
 }
 
