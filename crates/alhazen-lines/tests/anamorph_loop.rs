@@ -60,11 +60,9 @@ fn the_printed_anamorphosis_looks_like_the_picture_in_the_mirror() {
     };
 
     // The scene: the mirror cylinder alone, seen from the eye; the floor is the print.
-    let dir = tempfile_dir();
-    let scene_path = dir.join("loop.toml");
-    std::fs::write(
-        &scene_path,
-        format!(
+    let scene = alhazen_scene::parse_scene(
+        "loop.toml".as_ref(),
+        &format!(
             "[render]\nwidth = 240\nheight = 360\n[camera]\neye = [{}, {}, {}]\ntarget = [0, {}, 0]\nfov = 16\n\
              [[object]]\nshape = \"cylinder\"\nbase = [0, 0, 0]\ntop = [0, {height}, 0]\nradius = {radius}\ncapped = false\n\
              material = {{ mirror = 1 }}\n",
@@ -75,7 +73,6 @@ fn the_printed_anamorphosis_looks_like_the_picture_in_the_mirror() {
         ),
     )
     .unwrap();
-    let scene = alhazen_scene::load_scene(&scene_path).unwrap();
     let world = World::build(&scene);
     let (w, h) = (scene.render.width as usize, scene.render.height as usize);
     let cam = Camera::new(&scene.camera, w as u32, h as u32);
@@ -117,10 +114,4 @@ fn the_printed_anamorphosis_looks_like_the_picture_in_the_mirror() {
     eprintln!("SSIM {s:.4} over {windows} windows ({covered} pixels in the mirror show the picture)");
     assert!(covered > 3000, "{covered}");
     assert!(s >= 0.9, "SSIM {s}");
-}
-
-fn tempfile_dir() -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("alhazen-anamorph-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }

@@ -28,11 +28,7 @@ fn scene(objects: &[(u8, f64, f64, f64, f64)]) -> alhazen_scene::Scene {
             ),
         };
     }
-    let dir = std::env::temp_dir().join(format!("alhazen-vis-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("s{}.toml", objects.len()));
-    std::fs::write(&path, text).unwrap();
-    alhazen_scene::load_scene(&path).unwrap()
+    alhazen_scene::parse_scene(format!("s{}.toml", objects.len()).as_ref(), &text).unwrap()
 }
 
 proptest! {
