@@ -334,13 +334,8 @@ fn cylinders_and_cones_seen_from_far_away_are_hit_on_their_surface() {
 /// A mesh's tree and packets, built on several threads, are those one thread builds.
 #[test]
 fn mesh_packs_the_same_on_any_number_of_threads() {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = crate::sampler::Rng::for_sample(23, 0, 0, 0);
+    let mut next = || rng.uniform();
     // Small triangles scattered in a cube, with parallelograms among them.
     let mut positions = vec![];
     for _ in 0..20_000 {
