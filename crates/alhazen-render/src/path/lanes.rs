@@ -14,11 +14,11 @@
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
 //! and specular connection. Vertices on Lambert surfaces (textured, bump-mapped or plain) in
-//! RGB scenes without specular connections take the Lambert kernel instead: their random numbers and emission per
-//! lane ([`PathTracer::lambert_vertex`]), then light points on parallelogram lights
-//! ([`sample_lights`]) and the shading frame, next-event weights, cosine-weighted continuation
-//! and Russian roulette ([`shade`]) for all lanes at once, loops without branches the compiler
-//! turns into AVX-512 or AVX2 code.
+//! RGB scenes without specular connections take the Lambert kernel instead: their random
+//! numbers, emission, albedo and bent normal per lane ([`PathTracer::lambert_vertex`]), then
+//! light points on parallelogram lights ([`sample_lights`]) and the shading frame, next-event
+//! weights, bump shadowing, cosine-weighted continuation and Russian roulette ([`shade`]) for
+//! all lanes at once, loops without branches the compiler turns into AVX-512 or AVX2 code.
 //!
 //! Every lane performs exactly the floating-point operations of [`PathTracer::radiance`], in
 //! the same order (no fused multiply–adds, no reassociation), draws the same numbers from its
