@@ -336,13 +336,6 @@ pub struct PackedFlats<L> {
 }
 
 impl<L: Copy + Default> PackedFlats<L> {
-    /// Room for `packets` more packets, reserved at once: a big mesh's packets are the largest
-    /// thing it builds, and a vector doubling as it grows holds both copies for a moment.
-    pub fn reserve(&mut self, packets: usize) {
-        self.packets.reserve_exact(packets);
-        self.lanes.reserve_exact(packets);
-    }
-
     /// Asks the processor to start loading packet `k` and what its lanes stand for.
     #[inline(always)]
     #[allow(unsafe_code)]

@@ -7,6 +7,7 @@ use super::{Candidate, Crossing, FlatLane, FlatPacket, PackedFlats, SurfaceHit, 
 use crate::bvh::Bvh;
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// A mesh with its acceleration structure.
@@ -56,7 +57,6 @@ impl MeshAccel {
             (lane, lane.flat(&mesh))
         });
         drop((prims, leaves));
-        use rayon::prelude::*;
         let (mut face_normals, mut flat) = (Vec::new(), Vec::new());
         (0..mesh.triangle_count())
             .into_par_iter()
@@ -65,10 +65,10 @@ impl MeshAccel {
                 (b - a).cross(c - a).normalize_or_zero()
             })
             .collect_into_vec(&mut face_normals);
-        let flat_at = |(t, n): (&[u32; 3], &Vec3)| {
+        let shades_flat = |(t, n): (&[u32; 3], &Vec3)| {
             mesh.normals.is_empty() || t.iter().all(|&i| (mesh.normals[i as usize] - *n).length() < 1e-12)
         };
-        mesh.triangles.par_iter().zip(&face_normals).map(flat_at).collect_into_vec(&mut flat);
+        mesh.triangles.par_iter().zip(&face_normals).map(shades_flat).collect_into_vec(&mut flat);
         Self { mesh, bvh, packets, vectors, face_normals, flat }
     }
 }
