@@ -57,8 +57,8 @@ pub struct PathTracer<'a> {
     in_lanes: bool,
     /// The lights, when every one is a parallelogram, for the lanes' Lambert kernel to sample.
     lane_lights: Option<Vec<lanes::LaneLight>>,
-    /// Per material: the lanes shade its vertices with the Lambert kernel.
-    lambert_kernel: Vec<bool>,
+    /// Per material: the lanes' kernel for its vertices.
+    material_kernels: Vec<lanes::MaterialKernel>,
     /// Specular connections through the scene's sphere, cylinder and plane mirrors, if any.
     mirrors: Option<mirrors::MirrorConnections>,
     /// Light through specular surfaces onto non-specular ones, estimated elsewhere.
@@ -204,12 +204,12 @@ impl<'a> PathTracer<'a> {
             uniform_bsdfs,
             in_lanes: false,
             lane_lights: None,
-            lambert_kernel: vec![],
+            material_kernels: vec![],
             mirrors,
             caustics: None,
         };
         tracer.lane_lights = lanes::lane_lights(&tracer.lights);
-        tracer.lambert_kernel = lanes::lambert_kernel(&tracer);
+        tracer.material_kernels = lanes::material_kernels(&tracer);
         tracer.in_lanes = tracer.lanes_apply();
         tracer
     }
@@ -220,7 +220,7 @@ impl<'a> PathTracer<'a> {
     pub fn with_caustics(mut self, caustics: &'a dyn CausticEstimate) -> Self {
         self.caustics = Some(caustics);
         self.mirrors = None;
-        self.lambert_kernel.iter_mut().for_each(|k| *k = false);
+        self.material_kernels.iter_mut().for_each(|k| *k = lanes::MaterialKernel::General);
         self
     }
 

@@ -40,7 +40,7 @@ fn fresnel_conductor(cos_i: f64, eta: f64, k: f64) -> f64 {
 /// [`fresnel_conductor`] for four channels at once, each with the same operations in the same
 /// order (so the same bits): written lane by lane, the square roots and divisions of all
 /// channels go through the vector unit together instead of one after another.
-#[inline]
+#[inline(always)]
 fn fresnel_conductor_channels(cos_i: f64, eta: [f64; 4], k: [f64; 4]) -> [f64; 4] {
     let c = cos_i.abs().min(1.0);
     let (c2, s2) = (c * c, 1.0 - c * c);
@@ -60,18 +60,21 @@ fn fresnel_conductor_channels(cos_i: f64, eta: [f64; 4], k: [f64; 4]) -> [f64; 4
 
 impl Conductor {
     /// `F` per channel at `cos`; `η = κ = 0` stands for an ideal mirror of reflectance `tint`.
+    /// Computed whole, then chosen (no early return: the path tracer's lanes run it for eight
+    /// conductors at once).
+    #[inline(always)]
     pub fn fresnel(&self, cos: f64) -> Vec3 {
-        if self.eta == Vec3::ZERO && self.k == Vec3::ZERO {
-            return self.tint;
-        }
+        let mirror = self.eta == Vec3::ZERO && self.k == Vec3::ZERO;
         let channels = |v: Vec3| [v.x, v.y, v.z, 0.0];
-        if self.schlick {
+        let f = if self.schlick {
             let f0 = fresnel_conductor_channels(1.0, channels(self.eta), channels(self.k));
             let f = |i: usize| f0[i] + (1.0 - f0[i]) * (1.0 - cos.abs().min(1.0)).powi(5);
-            return Vec3::new(f(0), f(1), f(2)) * self.tint;
-        }
-        let f = fresnel_conductor_channels(cos, channels(self.eta), channels(self.k));
-        Vec3::new(f[0], f[1], f[2]) * self.tint
+            Vec3::new(f(0), f(1), f(2)) * self.tint
+        } else {
+            let f = fresnel_conductor_channels(cos, channels(self.eta), channels(self.k));
+            Vec3::new(f[0], f[1], f[2]) * self.tint
+        };
+        if mirror { self.tint } else { f }
     }
 
     /// `D G F / (4⟨l,n⟩⟨v,n⟩)`; 0 for a smooth metal.
@@ -97,13 +100,21 @@ impl Conductor {
     /// [`Self::eval`] and [`Self::pdf`] with the half vector and `D` found once (the same numbers).
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
         let Some(f) = &self.facets else { return (Vec3::ZERO, 0.0) };
-        if !same_side(v, l) {
-            return (Vec3::ZERO, 0.0);
-        }
-        let Some(h) = half_vector(v, l) else { return (Vec3::ZERO, 0.0) };
-        let d = f.d(h);
-        let value = self.fresnel(h.dot(l)) * (d * f.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()));
-        (value, f.pdf_h_from(v, h, d) / (4.0 * h.dot(v).abs()))
+        self.rough_eval_pdf(f, v, l)
+    }
+
+    /// [`Self::eval_pdf`] of the rough conductor of `facets` (this conductor's), computed whole
+    /// and then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
+    #[inline(always)]
+    pub(crate) fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let h = (v + l).normalize_or_zero();
+        let valid = same_side(v, l) && h != Vec3::ZERO;
+        // `half_vector`'s normal, turned to the upper hemisphere.
+        let h = h * h.z.signum();
+        let d = facets.d(h);
+        let value = self.fresnel(h.dot(l)) * (d * facets.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()));
+        let pdf = facets.pdf_h_from(v, h, d) / (4.0 * h.dot(v).abs());
+        if valid { (value, pdf) } else { (Vec3::ZERO, 0.0) }
     }
 
     /// The mirror direction, or reflection about a sampled facet.
@@ -113,10 +124,19 @@ impl Conductor {
             let f = self.fresnel(v.z) / v.z.abs();
             return Some(BsdfSample { l, f, pdf: 1.0, delta: true, eta: 1.0, dispersive: false });
         };
-        let h = facets.sample_h_from(v, u)?;
-        let l = reflect(v, h * v.z.signum());
-        let (f, pdf) = self.eval_pdf(v, l);
-        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+        let (sampled, l, f, pdf) = self.rough_sample(facets, v, u);
+        sampled.then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+
+    /// Reflection of `v` about a facet of `facets` (this conductor's) drawn with the numbers
+    /// `u`: whether there is one (a facet, and a positive density), the direction, the value
+    /// and the density. Computed whole and then chosen, for the lanes as for [`Self::sample`].
+    #[inline(always)]
+    pub(crate) fn rough_sample(&self, facets: &Microfacet, v: Vec3, u: Vec2) -> (bool, Vec3, Vec3, f64) {
+        let h = facets.sample_h_from(v, u);
+        let l = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
+        let (f, pdf) = self.rough_eval_pdf(facets, v, l);
+        (h.is_some() && pdf > 0.0, l, f, pdf)
     }
 }
 

@@ -60,15 +60,29 @@ impl Microfacet {
     }
 
     /// `tan²ϑ (c²/m_u² + s²/m_v²)` for the normal `h`.
+    #[inline(always)]
     fn slope2(&self, h: Vec3) -> f64 {
         (h.x / self.alpha_u).powi(2) / (h.z * h.z) + (h.y / self.alpha_v).powi(2) / (h.z * h.z)
     }
 
-    /// `D(h)` for `h` in the upper hemisphere (0 below).
+    /// A Trowbridge–Reitz distribution with Smith's shadowing: the one the path tracer's lanes
+    /// evaluate (its kind known to the compiler, the matches below fold away).
+    #[inline(always)]
+    pub fn trowbridge_reitz_smith(alpha_u: f64, alpha_v: f64) -> Self {
+        let (distribution, shadowing) = (Distribution::TrowbridgeReitz, Shadowing::Smith);
+        Self { distribution, alpha_u, alpha_v, shadowing, gaussian_a: 1.0 }
+    }
+
+    /// True for the distribution [`Self::trowbridge_reitz_smith`] makes.
+    pub fn is_trowbridge_reitz_smith(&self) -> bool {
+        self.distribution == Distribution::TrowbridgeReitz && self.shadowing == Shadowing::Smith
+    }
+
+    /// `D(h)` for `h` in the upper hemisphere (0 below). Here and below, values are computed
+    /// whole and then chosen, without early returns, so that the path tracer's lanes evaluate
+    /// the same function for eight normals at once.
+    #[inline(always)]
     pub fn d(&self, h: Vec3) -> f64 {
-        if h.z <= 0.0 {
-            return 0.0;
-        }
         let cos4 = h.z.powi(4);
         let e = self.slope2(h);
         let d = match self.distribution {
@@ -79,7 +93,7 @@ impl Microfacet {
                 self.gaussian_a * (-(theta / self.alpha_u).powi(2)).exp()
             }
         };
-        if d.is_finite() { d } else { 0.0 }
+        if h.z > 0.0 && d.is_finite() { d } else { 0.0 }
     }
 
     /// A normal `h` with density `D(h) cos ϑ_h`; `None` only on rejection failure.
@@ -126,6 +140,7 @@ impl Microfacet {
     /// A normal for reflecting or refracting `v` (either side: the normal is in the upper
     /// hemisphere, as seen from `v` mirrored to `+z`): visible normals for Trowbridge–Reitz,
     /// [`Self::sample_h`] otherwise. Density [`Self::pdf_h_from`].
+    #[inline(always)]
     pub fn sample_h_from(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
         if self.distribution != Distribution::TrowbridgeReitz {
             return self.sample_h(u);
@@ -134,31 +149,27 @@ impl Microfacet {
         // In the stretched configuration, where the distribution is the unit hemisphere's, the
         // visible normals are `v` plus a uniform point of the unit sphere's cap `z ≥ −v_z`
         // (Dupuy and Benyoub 2023, "Sampling Visible GGX Normals with Spherical Caps": the
-        // density of Heitz 2018 in fewer operations).
+        // density of Heitz 2018 in fewer operations). Nothing where `v` is at the horizon.
         let vs = Vec3::new(self.alpha_u * v.x, self.alpha_v * v.y, v.z).normalize_or_zero();
-        if vs.z <= 0.0 {
-            return None;
-        }
         let z = (1.0 - u.x) * (1.0 + vs.z) - vs.z;
         let r = (1.0 - z * z).max(0.0).sqrt();
         let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
         let n = Vec3::new(r * cos, r * sin, z) + vs;
         let h = Vec3::new(self.alpha_u * n.x, self.alpha_v * n.y, n.z.max(0.0)).normalize_or_zero();
-        (h.z > 0.0).then_some(h)
+        (vs.z > 0.0 && h.z > 0.0).then_some(h)
     }
 
     /// Density of [`Self::sample_h_from`] choosing `h` (upper hemisphere) for `v`, where
     /// `d = D(h)`.
+    #[inline(always)]
     pub fn pdf_h_from(&self, v: Vec3, h: Vec3, d: f64) -> f64 {
         if self.distribution != Distribution::TrowbridgeReitz {
             return d * h.z.max(0.0);
         }
         let v = v * v.z.signum();
         let vh = v.dot(h);
-        if vh <= 0.0 || v.z <= 0.0 {
-            return 0.0;
-        }
-        d * vh / (v.z * (1.0 + self.lambda(v)))
+        let pdf = d * vh / (v.z * (1.0 + self.lambda(v)));
+        if vh <= 0.0 || v.z <= 0.0 { 0.0 } else { pdf }
     }
 
     /// Density of [`Self::sample_h`].
@@ -167,28 +178,30 @@ impl Microfacet {
     }
 
     /// Smith's `Λ(w)` (Beckmann by Walter's rational fit, Trowbridge–Reitz exactly).
+    #[inline(always)]
     fn lambda(&self, w: Vec3) -> f64 {
         let sin2 = (1.0 - w.z * w.z).max(0.0);
-        if sin2 == 0.0 {
-            return 0.0;
-        }
         let tan2 = sin2 / (w.z * w.z);
         let alpha2 = (w.x * w.x * self.alpha_u * self.alpha_u + w.y * w.y * self.alpha_v * self.alpha_v) / sin2;
-        match self.distribution {
+        let lambda = match self.distribution {
             Distribution::Beckmann => {
                 let a = 1.0 / (alpha2 * tan2).sqrt();
                 if a >= 1.6 { 0.0 } else { (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a) }
             }
             _ => ((1.0 + alpha2 * tan2).sqrt() - 1.0) / 2.0,
-        }
+        };
+        if sin2 == 0.0 { 0.0 } else { lambda }
     }
 
     /// Smith's `G₁(w)` for a microfacet `h` (0 where `w` sees the facet's back).
+    #[inline(always)]
     fn g1(&self, w: Vec3, h: Vec3) -> f64 {
-        if w.dot(h) * w.z <= 0.0 { 0.0 } else { 1.0 / (1.0 + self.lambda(w)) }
+        let g1 = 1.0 / (1.0 + self.lambda(w));
+        if w.dot(h) * w.z <= 0.0 { 0.0 } else { g1 }
     }
 
     /// `G(l, v)` for the microfacet normal `h`.
+    #[inline(always)]
     pub fn g(&self, v: Vec3, l: Vec3, h: Vec3) -> f64 {
         match self.shadowing {
             Shadowing::Smith => self.g1(v, h) * self.g1(l, h),

@@ -13,12 +13,15 @@
 //!
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
-//! and specular connection. Vertices on Lambert surfaces (textured, bump-mapped or plain) in
-//! RGB scenes without specular connections take the Lambert kernel instead: their random
-//! numbers, emission, albedo and bent normal per lane ([`PathTracer::lambert_vertex`]), then
-//! light points on parallelogram lights ([`sample_lights`]) and the shading frame, next-event
-//! weights, bump shadowing, cosine-weighted continuation and Russian roulette ([`shade`]) for
-//! all lanes at once, loops without branches the compiler turns into AVX-512 or AVX2 code.
+//! and specular connection. In RGB scenes without specular connections, vertices on Lambert
+//! surfaces (textured, bump-mapped or plain) and on rough conductors of Trowbridge–Reitz
+//! facets (isotropic or not) take a material kernel instead: their random numbers, emission,
+//! material and bent normal per lane ([`PathTracer::kernel_vertex`]), then light points on
+//! parallelogram lights ([`sample_lights`]) and the shading frame, next-event weights, bump
+//! shadowing, sampled continuation and Russian roulette ([`shade`]) for all lanes at once,
+//! loops without branches the compiler turns into AVX-512 or AVX2 code. The kernels evaluate
+//! and sample the BSDFs through the per-path tracer's own functions ([`LaneBsdf`]), written to
+//! compute whole and then choose, so the two tracers share one implementation of each.
 //!
 //! Every lane performs exactly the floating-point operations of [`PathTracer::radiance`], in
 //! the same order (no fused multiply–adds, no reassociation), draws the same numbers from its
@@ -27,7 +30,7 @@
 //! `lanes_match_the_per_path_tracer`).
 
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic};
-use crate::bsdf::{Bsdf, ColorMode, Frame, cosine_hemisphere, cosine_pdf, same_side};
+use crate::bsdf::{Bsdf, ColorMode, Conductor, Frame, Microfacet, cosine_hemisphere, cosine_pdf, same_side};
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
 use crate::shape::ray_epsilon;
@@ -68,7 +71,16 @@ struct Vertices {
     ns: Lanes3,
     n0: Lanes3,
     bumped: [bool; LANES],
+    /// A Lambert surface's albedo.
     albedo: Lanes3,
+    /// A rough conductor's index `η + iκ`, tint, roughnesses `m_u, m_v`, and tangent where
+    /// it is anisotropic (`tangent_given`).
+    eta: Lanes3,
+    k: Lanes3,
+    tint: Lanes3,
+    alpha: [Lanes; 2],
+    tangent: Lanes3,
+    tangent_given: [bool; LANES],
     beta: Lanes3,
     /// The path's product of squared relative indices so far (for roulette).
     eta_scale: Lanes,
@@ -158,25 +170,57 @@ impl LanePath {
 }
 
 /// How lane `i`'s vertex of this bounce is shaded.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy, PartialEq, PartialOrd)]
 enum Kernel {
     /// No path in the lane.
     Idle,
     /// [`PathTracer::vertex`]: its result in the lane's [`Vertex`].
     General,
-    /// The Lambert kernel: its result in the lanes' [`Shaded`].
+    /// The Lambert kernel: its result in the lanes' first [`Shaded`].
     Lambert,
+    /// The rough-conductor kernel: its result in the lanes' second [`Shaded`].
+    Conductor,
 }
 
-/// Per material: its vertices take the Lambert kernel (Lambert, textured or not, bump-mapped or
-/// not, without tangent), in a scene whose vertices may (RGB, no specular connections). A
-/// material's kind of BSDF does not vary over its surface (textures vary colours only), so the
-/// BSDF at any point tells.
-pub(super) fn lambert_kernel(tracer: &PathTracer) -> Vec<bool> {
+impl Kernel {
+    /// Which of the lanes' [`Shaded`] a material kernel writes.
+    fn shaded(self) -> usize {
+        (self == Kernel::Conductor) as usize
+    }
+}
+
+/// Which kernel shades a material's vertices in lanes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum MaterialKernel {
+    /// The general one, [`PathTracer::vertex`].
+    General,
+    /// Lambert: textured or not, bump-mapped or not.
+    Lambert,
+    /// A rough conductor of Trowbridge–Reitz facets with Smith's shadowing and the exact
+    /// Fresnel term ([`takes_conductor_kernel`]): textured or not, bump-mapped or not,
+    /// anisotropic or not.
+    RoughConductor,
+}
+
+/// Per material: the kernel its vertices take, in a scene whose vertices may take material
+/// kernels (RGB, no specular connections). A material's kind of BSDF does not vary over its
+/// surface (textures vary colours and roughnesses only), so the BSDF at any point tells; the
+/// BSDF at each hit is checked again.
+pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<MaterialKernel> {
     let scene_allows = !tracer.spectral && tracer.mirrors.is_none();
     let images = &tracer.scene.images;
-    let lambert = |m| matches!(crate::bsdf::bsdf_at(m, Vec2::ZERO, images, ColorMode::Rgb), Bsdf::Lambert(_));
-    tracer.scene.materials.iter().map(|m| scene_allows && lambert(m) && !crate::bsdf::is_anisotropic(m)).collect()
+    let kernel = |m| match crate::bsdf::bsdf_at(m, Vec2::ZERO, images, ColorMode::Rgb) {
+        Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => MaterialKernel::Lambert,
+        Bsdf::Conductor(c) if takes_conductor_kernel(&c) => MaterialKernel::RoughConductor,
+        _ => MaterialKernel::General,
+    };
+    tracer.scene.materials.iter().map(|m| if scene_allows { kernel(m) } else { MaterialKernel::General }).collect()
+}
+
+/// A conductor the rough-conductor kernel evaluates: Trowbridge–Reitz facets with Smith's
+/// shadowing (the lanes' [`Microfacet::trowbridge_reitz_smith`]), the exact Fresnel term.
+fn takes_conductor_kernel(c: &Conductor) -> bool {
+    !c.schlick && c.facets.is_some_and(|f| f.is_trowbridge_reitz_smith())
 }
 
 impl PathTracer<'_> {
@@ -198,7 +242,8 @@ impl PathTracer<'_> {
         let mut rays = RayPacket::default();
         let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
         let mut general: [Vertex; LANES] = Default::default();
-        let (mut lambert, mut lights, mut shaded) = (Vertices::default(), LightLanes::default(), Shaded::default());
+        let (mut vertices, mut lights) = (Vertices::default(), LightLanes::default());
+        let mut shaded: [Shaded; 2] = Default::default();
         let (mut shadows, mut dist) = (RayPacket::default(), [0.0; LANES]);
         let unit = self.world.vector_unit();
         let together = self.world.traces_rays_together();
@@ -228,40 +273,44 @@ impl PathTracer<'_> {
                 // Traced here when not together: a local hit costs no copy into `hits`.
                 let alone = if together { None } else { self.world.intersect(&lane.path.ray, f64::INFINITY) };
                 let hit = if together { hit.as_ref() } else { alone.as_ref() };
-                if self.lambert_vertex(lane, hit, (&mut lambert, &mut lights), i) {
-                    kernels[i] = Kernel::Lambert;
+                kernels[i] = self.kernel_vertex(lane, hit, (&mut vertices, &mut lights), i);
+                if kernels[i] != Kernel::General {
                     continue;
                 }
-                kernels[i] = Kernel::General;
                 self.vertex(&mut lane.path, hit, lane.mode, &mut lane.stream, &mut general[i]);
                 if let Some((ray, d)) = general[i].shadow {
                     (tested[i], dist[i]) = (true, d);
                     shadows.set(i, &ray);
                 }
             }
-            if kernels.contains(&Kernel::Lambert) {
+            let (lambert, conductor) = (kernels.contains(&Kernel::Lambert), kernels.contains(&Kernel::Conductor));
+            if lambert || conductor {
                 if self.lane_lights.is_some() {
-                    sample_lights(&lights, &mut lambert, self.lights.choice_pdf(), unit);
+                    sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
                 }
-                if lambert.bumped.contains(&true) {
-                    shade::<true>(&lambert, &mut shaded, unit);
-                } else {
-                    shade::<false>(&lambert, &mut shaded, unit);
+                if lambert {
+                    shade::<Lambertian>(&vertices, &mut shaded[Kernel::Lambert.shaded()], unit);
                 }
-                for i in (0..LANES).filter(|&i| kernels[i] == Kernel::Lambert && shaded.shadow[i]) {
-                    (tested[i], dist[i]) = (true, shaded.shadow_dist[i]);
-                    shadows.set(i, &Ray::new(get(&shaded.shadow_origin, i), get(&lambert.light_dir, i)));
+                if conductor {
+                    shade::<RoughConductor>(&vertices, &mut shaded[Kernel::Conductor.shaded()], unit);
+                }
+                for (i, kernel) in kernels.iter().enumerate().filter(|(_, k)| **k > Kernel::General) {
+                    let s = &shaded[kernel.shaded()];
+                    if s.shadow[i] {
+                        (tested[i], dist[i]) = (true, s.shadow_dist[i]);
+                        shadows.set(i, &Ray::new(get(&s.shadow_origin, i), get(&vertices.light_dir, i)));
+                    }
                 }
             }
             let clear = self.world.unoccluded_rays(&shadows, &dist, tested);
             for (i, slot) in lanes.iter_mut().enumerate() {
                 let Some(lane) = slot.as_mut() else { continue };
                 let goes_on = match kernels[i] {
-                    Kernel::Lambert => finish_lambert(&mut lane.path, &shaded, !tested[i] || clear[i], i),
-                    _ => {
+                    Kernel::General | Kernel::Idle => {
                         lane.path.gather(&general[i], !tested[i] || clear[i]);
                         general[i].goes_on
                     }
+                    k => finish_kernel(&mut lane.path, &shaded[k.shaded()], !tested[i] || clear[i], i),
                 };
                 if goes_on {
                     rays.set(i, &lane.path.ray);
@@ -283,30 +332,49 @@ impl PathTracer<'_> {
         LanePath { job, path: PathState::new(ray), stream, mode }
     }
 
-    /// The per-path half of a Lambert kernel's vertex, as in [`Self::vertex`]: emission, the
-    /// vertex and its random numbers and light sample, written to lane `i`. False (nothing done)
-    /// when the vertex is not the Lambert kernel's: the ray missed, the path ends here, or the
-    /// material is another.
-    fn lambert_vertex(
+    /// The per-path half of a material kernel's vertex, as in [`Self::vertex`]: emission, the
+    /// vertex, its material and its random numbers and light sample, written to lane `i`; the
+    /// kernel. [`Kernel::General`] (nothing done) when the vertex is no material kernel's: the
+    /// ray missed, the path ends here, or the material takes the general kernel.
+    fn kernel_vertex(
         &self,
         lane: &mut LanePath,
         hit: Option<&WorldHit>,
         (v, lights): (&mut Vertices, &mut LightLanes),
         i: usize,
-    ) -> bool {
+    ) -> Kernel {
         let path = &mut lane.path;
-        let Some(wh) = hit.filter(|h| self.lambert_kernel[h.material as usize]) else { return false };
-        if path.depth >= self.scene.render.max_depth {
-            return false;
+        let Some(wh) = hit else { return Kernel::General };
+        let material = self.material_kernels[wh.material as usize];
+        if material == MaterialKernel::General || path.depth >= self.scene.render.max_depth {
+            return Kernel::General;
         }
         let m = &self.scene.materials[wh.material as usize];
-        let albedo = match &self.uniform_bsdfs[wh.material as usize] {
-            Some(Bsdf::Lambert(lambert)) => lambert.albedo,
-            Some(_) => return false,
-            None => match crate::bsdf::bsdf_at(m, wh.hit.uv, &self.scene.images, ColorMode::Rgb) {
-                Bsdf::Lambert(lambert) => lambert.albedo,
-                _ => return false,
-            },
+        let at_hit;
+        let bsdf = match &self.uniform_bsdfs[wh.material as usize] {
+            Some(bsdf) => bsdf,
+            None => {
+                at_hit = crate::bsdf::bsdf_at(m, wh.hit.uv, &self.scene.images, ColorMode::Rgb);
+                &at_hit
+            }
+        };
+        let kernel = match (bsdf, material) {
+            (Bsdf::Lambert(lambert), MaterialKernel::Lambert) => {
+                set(&mut v.albedo, i, lambert.albedo);
+                Kernel::Lambert
+            }
+            (Bsdf::Conductor(c), MaterialKernel::RoughConductor) if takes_conductor_kernel(c) => {
+                let Some(facets) = &c.facets else { return Kernel::General };
+                set(&mut v.eta, i, c.eta);
+                set(&mut v.k, i, c.k);
+                set(&mut v.tint, i, c.tint);
+                (v.alpha[0][i], v.alpha[1][i]) = (facets.alpha_u, facets.alpha_v);
+                let tangent = crate::bsdf::tangent_at(m, wh.hit.dpduv[0]);
+                v.tangent_given[i] = tangent.is_some();
+                set(&mut v.tangent, i, tangent.unwrap_or(Vec3::X));
+                Kernel::Conductor
+            }
+            _ => return Kernel::General,
         };
         let h = HitPoint::from(wh);
         path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, None, ColorMode::Rgb);
@@ -321,7 +389,6 @@ impl PathTracer<'_> {
         } else {
             set(&mut v.ns, i, h.ns);
         }
-        set(&mut v.albedo, i, albedo);
         set(&mut v.beta, i, path.beta);
         v.eta_scale[i] = path.eta_scale;
         path.prev.p = h.p;
@@ -360,14 +427,14 @@ impl PathTracer<'_> {
                 }
             }
         }
-        true
+        kernel
     }
 }
 
-/// The per-path half of a Lambert kernel's vertex after [`shade`] and the shadow ray (`clear`
+/// The per-path half of a material kernel's vertex after [`shade`] and the shadow ray (`clear`
 /// when it was not traced or met nothing): the light gathered, then the step to the next
 /// vertex. True when the path goes on.
-fn finish_lambert(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> bool {
+fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> bool {
     let light = if clear { get(&s.light, i) } else { Vec3::ZERO };
     path.l += path.beta * light;
     if s.alive[i] {
@@ -426,53 +493,126 @@ fn sample_light(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
     (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
 }
 
-/// The Lambertian vertex of every lane at once, with the per-path tracer's arithmetic; with
-/// the bump terminator's arithmetic where some lane's normal may be bent (`BUMPS`: a kernel
-/// apiece, the plain one as lean as before bump maps took it).
+/// A BSDF a material kernel evaluates and samples in lane `i` of [`Vertices`], through the
+/// per-path tracer's own functions (inlined into the all-lane loop, without branches).
+trait LaneBsdf {
+    /// The local frame around the shading normal `ns` ([`PathTracer::shading_frame`]'s).
+    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame;
+    /// `ρ` and the sampling density towards `l`, seen from `wv` (local): `Bsdf::eval_pdf`.
+    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64);
+    /// The continuation drawn with the numbers `u`, as `Bsdf::sample` draws it: whether there
+    /// is one, its direction (local), `ρ` and density.
+    fn sample(v: &Vertices, i: usize, wv: Vec3, u: Vec2) -> (bool, Vec3, Vec3, f64);
+}
+
+/// Lambert's BSDF ([`crate::bsdf::Lambert`]), cosine-weighted sampling (`sample_cosine`).
+struct Lambertian;
+
+impl LaneBsdf for Lambertian {
+    #[inline(always)]
+    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
+        Frame::around(ns)
+    }
+
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let rho = get(&v.albedo, i) * FRAC_1_PI;
+        (if same_side(wv, l) { rho } else { Vec3::ZERO }, cosine_pdf(wv, l))
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, i: usize, wv: Vec3, u: Vec2) -> (bool, Vec3, Vec3, f64) {
+        // `cosine_hemisphere` keeps `l` on the side of `wv`, where `ρ` is the albedo's.
+        let l = cosine_hemisphere(u, wv);
+        (true, l, get(&v.albedo, i) * FRAC_1_PI, cosine_pdf(wv, l))
+    }
+}
+
+/// A rough conductor: [`Conductor::rough_eval_pdf`] and [`Conductor::rough_sample`] on
+/// Trowbridge–Reitz facets with Smith's shadowing, a tangent frame where it is anisotropic.
+struct RoughConductor;
+
+impl RoughConductor {
+    /// Lane `i`'s conductor and its facets, their kinds constants the compiler folds.
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> (Conductor, Microfacet) {
+        let facets = Microfacet::trowbridge_reitz_smith(v.alpha[0][i], v.alpha[1][i]);
+        let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
+        (Conductor { facets: Some(facets), eta, k, tint, schlick: false }, facets)
+    }
+}
+
+impl LaneBsdf for RoughConductor {
+    #[inline(always)]
+    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
+        let (along, around) = (Frame::new(ns, get(&v.tangent, i)), Frame::around(ns));
+        if v.tangent_given[i] { along } else { around }
+    }
+
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (conductor, facets) = Self::at(v, i);
+        conductor.rough_eval_pdf(&facets, wv, l)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, i: usize, wv: Vec3, u: Vec2) -> (bool, Vec3, Vec3, f64) {
+        let (conductor, facets) = Self::at(v, i);
+        conductor.rough_sample(&facets, wv, u)
+    }
+}
+
+/// Every lane's vertex at once as material `M` shades it, with the per-path tracer's
+/// arithmetic; with the bump terminator's arithmetic where some lane's normal may be bent (a
+/// kernel apiece, the plain one as lean as before bump maps took it).
+fn shade<M: LaneBsdf>(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
+    if v.bumped.contains(&true) { shade_in::<M, true>(v, out, unit) } else { shade_in::<M, false>(v, out, unit) }
+}
+
 #[allow(unsafe_code)]
-fn shade<const BUMPS: bool>(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
+fn shade_in<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { shade_avx512::<BUMPS>(v, out) };
+        return unsafe { shade_avx512::<M, BUMPS>(v, out) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { shade_avx2::<BUMPS>(v, out) };
+        return unsafe { shade_avx2::<M, BUMPS>(v, out) };
     }
     let _ = unit;
-    shade_lanes::<BUMPS>(v, out)
+    shade_lanes::<M, BUMPS>(v, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx512<const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
-    shade_lanes::<BUMPS>(v, out)
+unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
+    shade_lanes::<M, BUMPS>(v, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx2<const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
-    shade_lanes::<BUMPS>(v, out)
+unsafe fn shade_avx2<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
+    shade_lanes::<M, BUMPS>(v, out)
 }
 
 #[inline(always)]
-fn shade_lanes<const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
+fn shade_lanes<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
     for i in 0..LANES {
-        shade_lane::<BUMPS>(v, out, i);
+        shade_lane::<M, BUMPS>(v, out, i);
     }
 }
 
-/// Lane `i` of the Lambertian vertices: the per-path tracer's own functions (`shading_frame`'s
-/// rule, [`Frame`], [`cosine_hemisphere`], [`offset`], [`epsilon`], [`power_heuristic`]) on one
-/// lane, inlined into the all-lane loop.
+/// Lane `i`'s vertex: the per-path tracer's own functions (`shading_frame`'s rule, `M`'s
+/// frame, evaluation and sampling, [`offset`], [`epsilon`], [`power_heuristic`]) on one lane,
+/// inlined into the all-lane loop.
 #[inline(always)]
-fn shade_lane<const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i: usize) {
+fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i: usize) {
     let (wo, p) = (get(&v.wo, i), get(&v.p, i));
-    // The shading frame (`PathTracer::shading_frame`; Lambert does not transmit).
+    // The shading frame (`PathTracer::shading_frame`; the kernels' BSDFs do not transmit).
     let (mut ng, mut ns, mut n0) = (get(&v.ng, i), get(&v.ns, i), get(&v.n0, i));
     if ng.dot(wo) < 0.0 {
         (ng, ns, n0) = (-ng, -ns, -n0);
@@ -484,29 +624,28 @@ fn shade_lane<const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i: usize) {
     let (bent, terminator) = Terminator::bent(n0, ns);
     let bent = BUMPS && v.bumped[i] && bent;
     let shadowing = |dir: Vec3| if bent { terminator.factor(dir) } else { 1.0 };
-    let frame = Frame::around(ns);
+    let frame = M::frame(v, i, ns);
     let wv = frame.to_local(wo);
-    let rho = get(&v.albedo, i) * FRAC_1_PI;
     // Next event (`PathTracer::next_event`).
     let dir = get(&v.light_dir, i);
     let l = frame.to_local(dir);
-    let f = if same_side(wv, l) { rho } else { Vec3::ZERO } * l.z.abs() * shadowing(dir);
+    let (f, pdf_bsdf) = M::eval_pdf(v, i, wv, l);
+    let f = f * l.z.abs() * shadowing(dir);
     let shadow = v.light[i] && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0));
     let pdf_light = v.light_pdf[i];
-    let w = if v.light_delta[i] { 1.0 } else { power_heuristic(pdf_light, cosine_pdf(wv, l)) };
+    let w = if v.light_delta[i] { 1.0 } else { power_heuristic(pdf_light, pdf_bsdf) };
     let c = if shadow { f * get(&v.light_radiance, i) * (w / pdf_light) } else { Vec3::ZERO };
     set(&mut out.light, i, c);
     out.shadow[i] = shadow;
     set(&mut out.shadow_origin, i, offset(p, ng, dir));
     let d = v.light_dist[i];
     out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * ray_epsilon(p) } else { f64::INFINITY };
-    // The continuation (`sample_cosine`).
-    let l = cosine_hemisphere(Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]), wv);
-    let pdf = cosine_pdf(wv, l);
+    // The continuation.
+    let (sampled, l, f, pdf) = M::sample(v, i, wv, Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
     let dir = frame.to_world(l);
-    let weight = rho * l.z.abs() / pdf * shadowing(dir);
+    let weight = f * l.z.abs() / pdf * shadowing(dir);
     let mut beta = get(&v.beta, i) * weight;
-    let mut alive = pdf > 0.0 && weight.is_finite() && weight != Vec3::ZERO;
+    let mut alive = sampled && pdf > 0.0 && weight.is_finite() && weight != Vec3::ZERO;
     if v.roulette[i] {
         let q = (beta.max_element() * v.eta_scale[i]).min(0.95);
         // `u ≥ q` ends the path (u is never NaN; a NaN q does not end it).
@@ -534,7 +673,8 @@ mod tests {
     use crate::{Camera, World};
 
     /// A scene of every kind of material and light: Lambert, Oren–Nayar, Cook–Torrance and
-    /// textured surfaces, a bump map, rough and smooth glass, a rough conductor and a mirror
+    /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
+    /// and bump-mapped) and a mirror
     /// (with specular connections), spheres, boxes and a plane, an emitting box (triangles)
     /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
@@ -575,6 +715,11 @@ shape = "sphere"
 center = [-1, 1, 0]
 radius = 1
 material = { bsdf = { type = "conductor", roughness = 0.2, distribution = "ggx", eta = [0.2, 0.4, 1.4], k = [3.9, 2.4, 1.6] } }
+[[object]]
+shape = "sphere"
+center = [2.4, 1.6, -1.5]
+radius = 0.7
+material = { bsdf = { type = "conductor", roughness = [0.05, 0.35], distribution = "ggx", eta = [0.14, 0.37, 1.4], k = [3.98, 2.39, 1.6] }, bump = { height = 0.03, waves = 0.4 } }
 [[object]]
 shape = "sphere"
 center = [0.3, 0.5, 1.2]
