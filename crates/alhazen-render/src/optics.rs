@@ -31,19 +31,17 @@ pub fn refract(i: Vec3, n: Vec3, eta: f64) -> Option<Vec3> {
 /// `g = √(η² + c² − 1)`, `η = η₂/η₁`. The seed prints `g = √(η² + c²) − 1`, which gives
 /// `F(0°) ≠ ((η−1)/(η+1))²`; the `−1` belongs under the root (see the tests). Returns 1 under
 /// total internal reflection (`g² < 0`).
+/// Computed whole and then chosen (no early return: the path tracer's lanes run it for eight
+/// rays at once).
+#[inline(always)]
 pub fn fresnel_dielectric(cos_theta: f64, eta: f64) -> f64 {
     let c = cos_theta.abs().min(1.0);
     let g2 = eta * eta + c * c - 1.0;
-    if g2 < 0.0 {
-        return 1.0;
-    }
     let g = g2.sqrt();
-    if g + c == 0.0 {
-        return 1.0;
-    }
     let a = (g - c) / (g + c);
     let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
-    (0.5 * a * a * (1.0 + b * b)).min(1.0)
+    let f = (0.5 * a * a * (1.0 + b * b)).min(1.0);
+    if g2 < 0.0 || g + c == 0.0 { 1.0 } else { f }
 }
 
 /// Schlick's approximation `F₀ + (1 − F₀)(1 − cos θ)⁵`, `F₀ = ((η−1)/(η+1))²`. For light going to

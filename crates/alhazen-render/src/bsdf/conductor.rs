@@ -124,19 +124,19 @@ impl Conductor {
             let f = self.fresnel(v.z) / v.z.abs();
             return Some(BsdfSample { l, f, pdf: 1.0, delta: true, eta: 1.0, dispersive: false });
         };
-        let (sampled, l, f, pdf) = self.rough_sample(facets, v, u);
-        sampled.then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+        let (sampled, sample) = self.rough_sample(facets, v, u);
+        sampled.then_some(sample)
     }
 
     /// Reflection of `v` about a facet of `facets` (this conductor's) drawn with the numbers
-    /// `u`: whether there is one (a facet, and a positive density), the direction, the value
-    /// and the density. Computed whole and then chosen, for the lanes as for [`Self::sample`].
+    /// `u`: whether there is one (a facet, and a positive density) and the sample. Computed
+    /// whole and then chosen, for the lanes as for [`Self::sample`].
     #[inline(always)]
-    pub(crate) fn rough_sample(&self, facets: &Microfacet, v: Vec3, u: Vec2) -> (bool, Vec3, Vec3, f64) {
+    pub(crate) fn rough_sample(&self, facets: &Microfacet, v: Vec3, u: Vec2) -> (bool, BsdfSample) {
         let h = facets.sample_h_from(v, u);
         let l = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
         let (f, pdf) = self.rough_eval_pdf(facets, v, l);
-        (h.is_some() && pdf > 0.0, l, f, pdf)
+        (h.is_some() && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 }
 

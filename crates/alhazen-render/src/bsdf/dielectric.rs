@@ -14,7 +14,7 @@
 //! dispersive), optional microfacets, Fresnel mode, `dispersive` (marks refracted samples).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, reflect, refract};
+use super::{BsdfSample, reflect, refract, refract_whole};
 use crate::optics::{fresnel_dielectric, fresnel_schlick};
 use alhazen_math::{Vec2, Vec3};
 
@@ -33,6 +33,7 @@ pub struct Dielectric {
 
 impl Dielectric {
     /// Reflectance for the cosine between `v` and the (micro)normal; `v` inside when negative.
+    #[inline(always)]
     fn fresnel(&self, cos_v: f64) -> f64 {
         let eta = if cos_v >= 0.0 { self.eta } else { 1.0 / self.eta };
         if self.schlick { fresnel_schlick(cos_v, eta) } else { fresnel_dielectric(cos_v, eta) }
@@ -40,6 +41,14 @@ impl Dielectric {
 
     /// The generalised half vector of `v, l` facing `+z`, and `η' = η_l/η_v`.
     fn half(&self, v: Vec3, l: Vec3) -> Option<(Vec3, f64)> {
+        let (valid, h, etap) = self.half_whole(v, l);
+        valid.then_some((h, etap))
+    }
+
+    /// [`Self::half`] computed whole and then chosen: whether there is one (both directions see
+    /// the facet from their own side), the half vector and `η'`.
+    #[inline(always)]
+    fn half_whole(&self, v: Vec3, l: Vec3) -> (bool, Vec3, f64) {
         let reflection = v.z * l.z > 0.0;
         let etap = if reflection {
             1.0
@@ -49,15 +58,10 @@ impl Dielectric {
             1.0 / self.eta
         };
         let h = (v + l * etap).normalize_or_zero();
-        if h == Vec3::ZERO || v.z == 0.0 || l.z == 0.0 {
-            return None;
-        }
+        let defined = !(h == Vec3::ZERO || v.z == 0.0 || l.z == 0.0);
         let h = h * h.z.signum();
-        // Both directions must see the facet from their own side.
-        if h.dot(l) * l.z <= 0.0 || h.dot(v) * v.z <= 0.0 {
-            return None;
-        }
-        Some((h, etap))
+        let facing = !(h.dot(l) * l.z <= 0.0 || h.dot(v) * v.z <= 0.0);
+        (defined && facing, h, etap)
     }
 
     /// `ρ_r + ρ_t` (0 when smooth).
@@ -93,52 +97,75 @@ impl Dielectric {
     /// numbers).
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
         let Some(f) = &self.facets else { return (Vec3::ZERO, 0.0) };
-        let Some((h, etap)) = self.half(v, l) else { return (Vec3::ZERO, 0.0) };
+        self.rough_eval_pdf(f, v, l)
+    }
+
+    /// [`Self::eval_pdf`] of the rough boundary of `facets` (this one's), computed whole and
+    /// then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
+    #[inline(always)]
+    pub(crate) fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (valid, h, etap) = self.half_whole(v, l);
         let fr = self.fresnel(v.dot(h));
-        let d = f.d(h);
-        let (dg, pdf_h) = (d * f.g(v, l, h), f.pdf_h_from(v, h, d));
-        if etap == 1.0 {
-            (Vec3::splat(dg * fr / (4.0 * (l.z * v.z).abs())), pdf_h / (4.0 * v.dot(h).abs()) * fr)
-        } else {
-            let denom = (l.dot(h) + v.dot(h) / etap).powi(2) * (l.z * v.z).abs();
-            let value = dg * (1.0 - fr) * (l.dot(h) * v.dot(h)).abs() / denom / (etap * etap);
-            let jacobian = l.dot(h).abs() / (l.dot(h) + v.dot(h) / etap).powi(2);
-            (Vec3::splat(value), pdf_h * jacobian * (1.0 - fr))
-        }
+        let d = facets.d(h);
+        let (dg, pdf_h) = (d * facets.g(v, l, h), facets.pdf_h_from(v, h, d));
+        let reflected = (Vec3::splat(dg * fr / (4.0 * (l.z * v.z).abs())), pdf_h / (4.0 * v.dot(h).abs()) * fr);
+        let denom = (l.dot(h) + v.dot(h) / etap).powi(2) * (l.z * v.z).abs();
+        let value = dg * (1.0 - fr) * (l.dot(h) * v.dot(h)).abs() / denom / (etap * etap);
+        let jacobian = l.dot(h).abs() / (l.dot(h) + v.dot(h) / etap).powi(2);
+        let refracted = (Vec3::splat(value), pdf_h * jacobian * (1.0 - fr));
+        let (value, pdf) = if etap == 1.0 { reflected } else { refracted };
+        if valid { (value, pdf) } else { (Vec3::ZERO, 0.0) }
     }
 
     /// Reflects with probability `F`, else refracts (about the normal or a sampled facet).
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
-        let h = match &self.facets {
-            None => Vec3::Z,
-            Some(f) => f.sample_h_from(v, u)?,
-        };
+        if let Some(facets) = &self.facets {
+            let (sampled, sample) = self.rough_sample(facets, v, uc, u);
+            return sampled.then_some(sample);
+        }
+        let h = Vec3::Z;
         if v.dot(h) * v.z <= 0.0 {
-            return None; // the facet is seen from behind: `pdf` gives such `l` no density
+            return None; // the normal is seen from behind
         }
         let fr = self.fresnel(v.dot(h));
-        let smooth = self.facets.is_none();
         if uc < fr {
             let l = reflect(v, h);
             if l.z * v.z <= 0.0 {
                 return None;
             }
-            if smooth {
-                let f = Vec3::splat(fr / l.z.abs());
-                return Some(BsdfSample { l, f, pdf: fr, delta: true, eta: 1.0, dispersive: false });
-            }
-            let (f, pdf) = self.eval_pdf(v, l);
-            return (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false });
+            let f = Vec3::splat(fr / l.z.abs());
+            return Some(BsdfSample { l, f, pdf: fr, delta: true, eta: 1.0, dispersive: false });
         }
         let (l, etap) = refract(v, h, self.eta)?;
         if l.z * v.z >= 0.0 {
             return None;
         }
-        if smooth {
-            let f = Vec3::splat((1.0 - fr) / l.z.abs() / (etap * etap));
-            return Some(BsdfSample { l, f, pdf: 1.0 - fr, delta: true, eta: etap, dispersive: self.dispersive });
-        }
-        let (f, pdf) = self.eval_pdf(v, l);
-        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: etap, dispersive: self.dispersive })
+        let f = Vec3::splat((1.0 - fr) / l.z.abs() / (etap * etap));
+        Some(BsdfSample { l, f, pdf: 1.0 - fr, delta: true, eta: etap, dispersive: self.dispersive })
+    }
+
+    /// Reflection (with probability `F`, when `uc < F`) or refraction of `v` about a facet of
+    /// `facets` (this boundary's) drawn with the numbers `u`: whether there is one (a facet
+    /// seen from the front, a direction on the right side, a positive density) and the sample.
+    /// Computed whole and then chosen, for the lanes as for [`Self::sample`].
+    #[inline(always)]
+    pub(crate) fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let h = facets.sample_h_from(v, u);
+        let (found, h) = (h.is_some(), h.unwrap_or(Vec3::Z));
+        // A facet seen from behind: `pdf` gives such `l` no density. (NaNs pass every test
+        // here, as in the early returns these tests replace.)
+        let front = v.dot(h) * v.z > 0.0 || (v.dot(h) * v.z).is_nan();
+        let fr = self.fresnel(v.dot(h));
+        let reflects = uc < fr;
+        let mirrored = reflect(v, h);
+        let (refracts, refracted, etap) = refract_whole(v, h, self.eta);
+        let (l, side_ok, eta) = if reflects {
+            (mirrored, mirrored.z * v.z > 0.0 || (mirrored.z * v.z).is_nan(), 1.0)
+        } else {
+            (refracted, refracts && (refracted.z * v.z < 0.0 || (refracted.z * v.z).is_nan()), etap)
+        };
+        let (f, pdf) = self.rough_eval_pdf(facets, v, l);
+        let dispersive = self.dispersive && !reflects;
+        (found && front && side_ok && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta, dispersive })
     }
 }

@@ -232,19 +232,21 @@ pub(crate) fn reflect(v: Vec3, n: Vec3) -> Vec3 {
 /// The direction `v` refracts into through a surface with normal `n` and relative index
 /// `eta = η_inside/η_outside` (inside is `−n`); `None` under total internal reflection. Returns
 /// the direction and the index ratio `η_l/η_v` crossed.
-pub(crate) fn refract(v: Vec3, mut n: Vec3, mut eta: f64) -> Option<(Vec3, f64)> {
-    let mut cos_i = n.dot(v);
-    if cos_i < 0.0 {
-        eta = 1.0 / eta;
-        cos_i = -cos_i;
-        n = -n;
-    }
+pub(crate) fn refract(v: Vec3, n: Vec3, eta: f64) -> Option<(Vec3, f64)> {
+    let (refracts, l, eta) = refract_whole(v, n, eta);
+    refracts.then_some((l, eta))
+}
+
+/// [`refract`] computed whole and then chosen, for the path tracer's lanes: whether `v`
+/// refracts, the direction (meaningless where it does not) and the index ratio.
+#[inline(always)]
+pub(crate) fn refract_whole(v: Vec3, n: Vec3, eta: f64) -> (bool, Vec3, f64) {
+    let cos_v = n.dot(v);
+    let inside = cos_v < 0.0;
+    let (eta, cos_i, n) = if inside { (1.0 / eta, -cos_v, -n) } else { (eta, cos_v, n) };
     let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return None;
-    }
     let cos_t = (1.0 - sin2_t).sqrt();
-    Some((-v / eta + (cos_i / eta - cos_t) * n, eta))
+    (sin2_t < 1.0 || sin2_t.is_nan(), -v / eta + (cos_i / eta - cos_t) * n, eta)
 }
 
 /// The half vector of `v` and `l`, turned to the upper hemisphere; `None` when they are opposite.

@@ -14,8 +14,8 @@
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
 //! and specular connection. In RGB scenes without specular connections, vertices on Lambert
-//! surfaces (textured, bump-mapped or plain) and on rough conductors of Trowbridge–Reitz
-//! facets (isotropic or not) take a material kernel instead: their random numbers, emission,
+//! surfaces (textured, bump-mapped or plain), on rough conductors and on rough dielectrics of
+//! Trowbridge–Reitz facets (isotropic or not) take a material kernel instead: their random numbers, emission,
 //! material and bent normal per lane ([`PathTracer::kernel_vertex`]), then light points on
 //! parallelogram lights ([`sample_lights`]) and the shading frame, next-event weights, bump
 //! shadowing, sampled continuation and Russian roulette ([`shade`]) for all lanes at once,
@@ -30,7 +30,9 @@
 //! `lanes_match_the_per_path_tracer`).
 
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic};
-use crate::bsdf::{Bsdf, ColorMode, Conductor, Frame, Microfacet, cosine_hemisphere, cosine_pdf, same_side};
+use crate::bsdf::{
+    Bsdf, BsdfSample, ColorMode, Conductor, Dielectric, Frame, Microfacet, cosine_hemisphere, cosine_pdf, same_side,
+};
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
 use crate::shape::ray_epsilon;
@@ -73,8 +75,10 @@ struct Vertices {
     bumped: [bool; LANES],
     /// A Lambert surface's albedo.
     albedo: Lanes3,
-    /// A rough conductor's index `η + iκ`, tint, roughnesses `m_u, m_v`, and tangent where
-    /// it is anisotropic (`tangent_given`).
+    /// A rough dielectric's relative index `η_inside/η_outside`.
+    ior: Lanes,
+    /// A rough conductor's index `η + iκ` and tint; the roughnesses `m_u, m_v` of a rough
+    /// conductor or dielectric, and its tangent where it is anisotropic (`tangent_given`).
     eta: Lanes3,
     k: Lanes3,
     tint: Lanes3,
@@ -91,7 +95,9 @@ struct Vertices {
     light_radiance: Lanes3,
     light_pdf: Lanes,
     light_delta: [bool; LANES],
-    /// The continuation's two numbers, and roulette's where `roulette` is set.
+    /// The continuation's lobe choice (where the BSDF has lobes to choose) and two numbers,
+    /// and roulette's where `roulette` is set.
+    u_lobe: Lanes,
     u_bsdf: [Lanes; 2],
     roulette: [bool; LANES],
     u_roulette: Lanes,
@@ -141,12 +147,13 @@ struct Shaded {
     shadow_origin: Lanes3,
     shadow_dist: Lanes,
     /// The path goes on (`alive`) from `origin` along `dir`, sampled with density `pdf`,
-    /// carrying `beta`.
+    /// carrying `beta` and `eta_scale`.
     alive: [bool; LANES],
     origin: Lanes3,
     dir: Lanes3,
     pdf: Lanes,
     beta: Lanes3,
+    eta_scale: Lanes,
 }
 
 /// One sample's path in a lane.
@@ -180,12 +187,18 @@ enum Kernel {
     Lambert,
     /// The rough-conductor kernel: its result in the lanes' second [`Shaded`].
     Conductor,
+    /// The rough-dielectric kernel: its result in the lanes' third [`Shaded`].
+    Dielectric,
 }
 
 impl Kernel {
     /// Which of the lanes' [`Shaded`] a material kernel writes.
     fn shaded(self) -> usize {
-        (self == Kernel::Conductor) as usize
+        match self {
+            Kernel::Conductor => 1,
+            Kernel::Dielectric => 2,
+            _ => 0,
+        }
     }
 }
 
@@ -200,6 +213,9 @@ pub(crate) enum MaterialKernel {
     /// Fresnel term ([`takes_conductor_kernel`]): textured or not, bump-mapped or not,
     /// anisotropic or not.
     RoughConductor,
+    /// A rough dielectric of Trowbridge–Reitz facets with Smith's shadowing, the exact
+    /// Fresnel term and an index that does not disperse ([`takes_dielectric_kernel`]).
+    RoughDielectric,
 }
 
 /// Per material: the kernel its vertices take, in a scene whose vertices may take material
@@ -212,6 +228,7 @@ pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<MaterialKernel> {
     let kernel = |m| match crate::bsdf::bsdf_at(m, Vec2::ZERO, images, ColorMode::Rgb) {
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => MaterialKernel::Lambert,
         Bsdf::Conductor(c) if takes_conductor_kernel(&c) => MaterialKernel::RoughConductor,
+        Bsdf::Dielectric(d) if takes_dielectric_kernel(&d) => MaterialKernel::RoughDielectric,
         _ => MaterialKernel::General,
     };
     tracer.scene.materials.iter().map(|m| if scene_allows { kernel(m) } else { MaterialKernel::General }).collect()
@@ -221,6 +238,12 @@ pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<MaterialKernel> {
 /// shadowing (the lanes' [`Microfacet::trowbridge_reitz_smith`]), the exact Fresnel term.
 fn takes_conductor_kernel(c: &Conductor) -> bool {
     !c.schlick && c.facets.is_some_and(|f| f.is_trowbridge_reitz_smith())
+}
+
+/// A dielectric the rough-dielectric kernel evaluates: Trowbridge–Reitz facets with Smith's
+/// shadowing, the exact Fresnel term, one index for every colour.
+fn takes_dielectric_kernel(d: &Dielectric) -> bool {
+    !d.schlick && !d.dispersive && d.facets.is_some_and(|f| f.is_trowbridge_reitz_smith())
 }
 
 impl PathTracer<'_> {
@@ -243,7 +266,7 @@ impl PathTracer<'_> {
         let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
         let mut general: [Vertex; LANES] = Default::default();
         let (mut vertices, mut lights) = (Vertices::default(), LightLanes::default());
-        let mut shaded: [Shaded; 2] = Default::default();
+        let mut shaded: [Shaded; 3] = Default::default();
         let (mut shadows, mut dist) = (RayPacket::default(), [0.0; LANES]);
         let unit = self.world.vector_unit();
         let together = self.world.traces_rays_together();
@@ -283,8 +306,9 @@ impl PathTracer<'_> {
                     shadows.set(i, &ray);
                 }
             }
-            let (lambert, conductor) = (kernels.contains(&Kernel::Lambert), kernels.contains(&Kernel::Conductor));
-            if lambert || conductor {
+            let [lambert, conductor, dielectric] =
+                [Kernel::Lambert, Kernel::Conductor, Kernel::Dielectric].map(|k| kernels.contains(&k));
+            if lambert || conductor || dielectric {
                 if self.lane_lights.is_some() {
                     sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
                 }
@@ -293,6 +317,9 @@ impl PathTracer<'_> {
                 }
                 if conductor {
                     shade::<RoughConductor>(&vertices, &mut shaded[Kernel::Conductor.shaded()], unit);
+                }
+                if dielectric {
+                    shade::<RoughDielectric>(&vertices, &mut shaded[Kernel::Dielectric.shaded()], unit);
                 }
                 for (i, kernel) in kernels.iter().enumerate().filter(|(_, k)| **k > Kernel::General) {
                     let s = &shaded[kernel.shaded()];
@@ -368,11 +395,14 @@ impl PathTracer<'_> {
                 set(&mut v.eta, i, c.eta);
                 set(&mut v.k, i, c.k);
                 set(&mut v.tint, i, c.tint);
-                (v.alpha[0][i], v.alpha[1][i]) = (facets.alpha_u, facets.alpha_v);
-                let tangent = crate::bsdf::tangent_at(m, wh.hit.dpduv[0]);
-                v.tangent_given[i] = tangent.is_some();
-                set(&mut v.tangent, i, tangent.unwrap_or(Vec3::X));
+                set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
                 Kernel::Conductor
+            }
+            (Bsdf::Dielectric(d), MaterialKernel::RoughDielectric) if takes_dielectric_kernel(d) => {
+                let Some(facets) = &d.facets else { return Kernel::General };
+                v.ior[i] = d.eta;
+                set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
+                Kernel::Dielectric
             }
             _ => return Kernel::General,
         };
@@ -397,7 +427,10 @@ impl PathTracer<'_> {
         // is known whether the path survives the continuation; a path that does not never draws
         // again, so the stream stays the per-path tracer's.
         let s = &mut lane.stream;
-        let choice = if self.lights.len() > 1 { s.next_2d().x } else { 0.0 };
+        // One pair picks the light and the lobe, drawn only when there is a choice.
+        let chooses = self.lights.len() > 1 || kernel == Kernel::Dielectric;
+        let (choice, u_lobe) = if chooses { s.next_2d().into() } else { (0.0, 0.0) };
+        v.u_lobe[i] = u_lobe;
         let u_light = s.next_2d();
         let u_bsdf = s.next_2d();
         (v.u_bsdf[0][i], v.u_bsdf[1][i]) = (u_bsdf.x, u_bsdf.y);
@@ -431,6 +464,13 @@ impl PathTracer<'_> {
     }
 }
 
+/// Lane `i`'s microfacets and tangent.
+fn set_facets(v: &mut Vertices, i: usize, facets: &Microfacet, tangent: Option<Vec3>) {
+    (v.alpha[0][i], v.alpha[1][i]) = (facets.alpha_u, facets.alpha_v);
+    v.tangent_given[i] = tangent.is_some();
+    set(&mut v.tangent, i, tangent.unwrap_or(Vec3::X));
+}
+
 /// The per-path half of a material kernel's vertex after [`shade`] and the shadow ray (`clear`
 /// when it was not traced or met nothing): the light gathered, then the step to the next
 /// vertex. True when the path goes on.
@@ -439,6 +479,7 @@ fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> boo
     path.l += path.beta * light;
     if s.alive[i] {
         path.beta = get(&s.beta, i);
+        path.eta_scale = s.eta_scale[i];
         path.prev.pdf = s.pdf[i];
         path.prev.delta = false;
         path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
@@ -496,13 +537,16 @@ fn sample_light(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
 /// A BSDF a material kernel evaluates and samples in lane `i` of [`Vertices`], through the
 /// per-path tracer's own functions (inlined into the all-lane loop, without branches).
 trait LaneBsdf {
+    /// The BSDF transmits: the shading frame is not turned to the viewer, and light may come
+    /// from either side of the geometry.
+    const TRANSMITS: bool = false;
     /// The local frame around the shading normal `ns` ([`PathTracer::shading_frame`]'s).
     fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame;
     /// `ρ` and the sampling density towards `l`, seen from `wv` (local): `Bsdf::eval_pdf`.
     fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64);
-    /// The continuation drawn with the numbers `u`, as `Bsdf::sample` draws it: whether there
-    /// is one, its direction (local), `ρ` and density.
-    fn sample(v: &Vertices, i: usize, wv: Vec3, u: Vec2) -> (bool, Vec3, Vec3, f64);
+    /// The continuation drawn with the numbers `uc, u`, as `Bsdf::sample` draws it: whether
+    /// there is one, and the sample.
+    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
 }
 
 /// Lambert's BSDF ([`crate::bsdf::Lambert`]), cosine-weighted sampling (`sample_cosine`).
@@ -521,10 +565,11 @@ impl LaneBsdf for Lambertian {
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, u: Vec2) -> (bool, Vec3, Vec3, f64) {
+    fn sample(v: &Vertices, i: usize, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
         // `cosine_hemisphere` keeps `l` on the side of `wv`, where `ρ` is the albedo's.
         let l = cosine_hemisphere(u, wv);
-        (true, l, get(&v.albedo, i) * FRAC_1_PI, cosine_pdf(wv, l))
+        let (f, pdf) = (get(&v.albedo, i) * FRAC_1_PI, cosine_pdf(wv, l));
+        (true, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 }
 
@@ -545,8 +590,7 @@ impl RoughConductor {
 impl LaneBsdf for RoughConductor {
     #[inline(always)]
     fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
-        let (along, around) = (Frame::new(ns, get(&v.tangent, i)), Frame::around(ns));
-        if v.tangent_given[i] { along } else { around }
+        facets_frame(v, i, ns)
     }
 
     #[inline(always)]
@@ -556,9 +600,51 @@ impl LaneBsdf for RoughConductor {
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, u: Vec2) -> (bool, Vec3, Vec3, f64) {
+    fn sample(v: &Vertices, i: usize, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
         let (conductor, facets) = Self::at(v, i);
         conductor.rough_sample(&facets, wv, u)
+    }
+}
+
+/// The frame of lane `i`'s microfacets: along its tangent where it is anisotropic
+/// (`Frame::new`), around the normal otherwise.
+#[inline(always)]
+fn facets_frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
+    let (along, around) = (Frame::new(ns, get(&v.tangent, i)), Frame::around(ns));
+    if v.tangent_given[i] { along } else { around }
+}
+
+/// A rough dielectric: [`Dielectric::rough_eval_pdf`] and [`Dielectric::rough_sample`] on
+/// Trowbridge–Reitz facets with Smith's shadowing.
+struct RoughDielectric;
+
+impl RoughDielectric {
+    /// Lane `i`'s boundary and its facets, their kinds constants the compiler folds.
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> (Dielectric, Microfacet) {
+        let facets = Microfacet::trowbridge_reitz_smith(v.alpha[0][i], v.alpha[1][i]);
+        (Dielectric { facets: Some(facets), eta: v.ior[i], schlick: false, dispersive: false }, facets)
+    }
+}
+
+impl LaneBsdf for RoughDielectric {
+    const TRANSMITS: bool = true;
+
+    #[inline(always)]
+    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
+        facets_frame(v, i, ns)
+    }
+
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (dielectric, facets) = Self::at(v, i);
+        dielectric.rough_eval_pdf(&facets, wv, l)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let (dielectric, facets) = Self::at(v, i);
+        dielectric.rough_sample(&facets, wv, uc, u)
     }
 }
 
@@ -612,9 +698,9 @@ fn shade_lanes<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
 #[inline(always)]
 fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i: usize) {
     let (wo, p) = (get(&v.wo, i), get(&v.p, i));
-    // The shading frame (`PathTracer::shading_frame`; the kernels' BSDFs do not transmit).
+    // The shading frame (`PathTracer::shading_frame`).
     let (mut ng, mut ns, mut n0) = (get(&v.ng, i), get(&v.ns, i), get(&v.n0, i));
-    if ng.dot(wo) < 0.0 {
+    if !M::TRANSMITS && ng.dot(wo) < 0.0 {
         (ng, ns, n0) = (-ng, -ns, -n0);
     }
     if ns.dot(wo) * ng.dot(wo) <= 0.0 {
@@ -631,7 +717,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i:
     let l = frame.to_local(dir);
     let (f, pdf_bsdf) = M::eval_pdf(v, i, wv, l);
     let f = f * l.z.abs() * shadowing(dir);
-    let shadow = v.light[i] && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0));
+    let shadow = v.light[i] && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0) && !M::TRANSMITS);
     let pdf_light = v.light_pdf[i];
     let w = if v.light_delta[i] { 1.0 } else { power_heuristic(pdf_light, pdf_bsdf) };
     let c = if shadow { f * get(&v.light_radiance, i) * (w / pdf_light) } else { Vec3::ZERO };
@@ -641,19 +727,22 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i:
     let d = v.light_dist[i];
     out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * ray_epsilon(p) } else { f64::INFINITY };
     // The continuation.
-    let (sampled, l, f, pdf) = M::sample(v, i, wv, Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
+    let (sampled, bs) = M::sample(v, i, wv, v.u_lobe[i], Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
+    let (l, pdf) = (bs.l, bs.pdf);
     let dir = frame.to_world(l);
-    let weight = f * l.z.abs() / pdf * shadowing(dir);
+    let weight = bs.f * l.z.abs() / pdf * shadowing(dir);
     let mut beta = get(&v.beta, i) * weight;
+    let eta_scale = v.eta_scale[i] * (bs.eta * bs.eta);
     let mut alive = sampled && pdf > 0.0 && weight.is_finite() && weight != Vec3::ZERO;
     if v.roulette[i] {
-        let q = (beta.max_element() * v.eta_scale[i]).min(0.95);
+        let q = (beta.max_element() * eta_scale).min(0.95);
         // `u ≥ q` ends the path (u is never NaN; a NaN q does not end it).
         alive &= v.u_roulette[i] < q || q.is_nan();
         beta /= q;
     }
     out.alive[i] = alive;
     out.pdf[i] = pdf;
+    out.eta_scale[i] = eta_scale;
     set(&mut out.beta, i, beta);
     set(&mut out.dir, i, dir);
     set(&mut out.origin, i, offset(p, ng, dir));
