@@ -30,7 +30,7 @@ pub use microfacet::Microfacet;
 pub use mix::Mix;
 pub use oren_nayar::OrenNayar;
 pub use phong::{Phong, PhongLobe};
-pub use plastic::Plastic;
+pub use plastic::{Coat, Plastic};
 
 use alhazen_math::{Vec2, Vec3};
 use std::f64::consts::PI;

@@ -21,7 +21,7 @@
 //! than Mitsuba's (its `plastic` uses a fit within 0.1 % of the integral; BENCHMARKS.md).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, cosine_hemisphere, cosine_pdf, half_vector, lobe_probability, reflect, refract, same_side};
+use super::{BsdfSample, cosine_hemisphere, cosine_pdf, lobe_probability, reflect, refract, same_side};
 use crate::optics::fresnel_dielectric;
 use alhazen_math::{Vec2, Vec3};
 use std::cell::RefCell;
@@ -38,6 +38,12 @@ const NODES: usize = 48;
 pub struct Coat {
     transmittance: [f64; TABLE],
     inner_reflectance: f64,
+}
+
+impl Coat {
+    /// A coat of no transmittance, where a coat is needed before one is known (the path
+    /// tracer's lanes without plastic).
+    pub(crate) const NONE: Coat = Coat { transmittance: [0.0; TABLE], inner_reflectance: 0.0 };
 }
 
 /// Plastic at one surface point.
@@ -62,6 +68,7 @@ impl Plastic {
     }
 
     /// `t(μ)` by linear interpolation in the table.
+    #[inline(always)]
     fn transmittance(&self, mu: f64) -> f64 {
         let x = mu.abs().min(1.0) * (TABLE - 1) as f64;
         let i = (x as usize).min(TABLE - 2);
@@ -72,12 +79,14 @@ impl Plastic {
     /// The probability of sampling the coat rather than the base, seen from `v`: their shares
     /// of the light (`1 − t(v)` and `t(v)`), weighted by the coat's (white) and the base's mean
     /// colours.
+    #[inline(always)]
     fn p_coat(&self, v: Vec3) -> f64 {
         let t = self.transmittance(v.z);
         let base = (self.albedo.x + self.albedo.y + self.albedo.z) / 3.0;
         lobe_probability((1.0 - t) / (1.0 + base), t * base / (1.0 + base))
     }
 
+    #[inline(always)]
     fn base(&self, v: Vec3, l: Vec3) -> Vec3 {
         let inner = if self.nonlinear {
             self.albedo * self.coat.inner_reflectance
@@ -89,11 +98,16 @@ impl Plastic {
     }
 
     /// The rough coat's lobe `D G F / (4⟨l,n⟩⟨v,n⟩)` and its sampling density.
+    #[inline(always)]
     fn coat_lobe(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (f64, f64) {
-        let Some(h) = half_vector(v, l) else { return (0.0, 0.0) };
+        // `half_vector`, computed whole and then chosen (for the path tracer's lanes).
+        let h = (v + l).normalize_or_zero();
+        let defined = h != Vec3::ZERO;
+        let h = h * h.z.signum();
         let f = fresnel_dielectric(h.dot(v), self.eta);
         let value = facets.d(h) * facets.g(v, l, h) * f / (4.0 * l.z.abs() * v.z.abs());
-        (value, facets.pdf_h_from(v, h, facets.d(h)) / (4.0 * h.dot(v).abs()))
+        let pdf = facets.pdf_h_from(v, h, facets.d(h)) / (4.0 * h.dot(v).abs());
+        if defined { (value, pdf) } else { (0.0, 0.0) }
     }
 
     /// `ρ(l, v)` (the smooth coat's mirror only through `sample`).
@@ -117,32 +131,55 @@ impl Plastic {
 
     /// [`Self::eval`] and [`Self::pdf`] with the coat's lobe evaluated once (the same numbers).
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
-        if !same_side(v, l) {
-            return (Vec3::ZERO, 0.0);
+        match &self.facets {
+            Some(facets) => self.rough_eval_pdf(facets, v, l),
+            None if same_side(v, l) => {
+                let p = self.p_coat(v);
+                (self.base(v, l) + Vec3::splat(0.0), p * 0.0 + (1.0 - p) * cosine_pdf(v, l))
+            }
+            None => (Vec3::ZERO, 0.0),
         }
-        let (coat, coat_pdf) = self.facets.map_or((0.0, 0.0), |f| self.coat_lobe(&f, v, l));
+    }
+
+    /// [`Self::eval_pdf`] of the rough coat of `facets` (this plastic's), computed whole and
+    /// then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
+    #[inline(always)]
+    pub(crate) fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (coat, coat_pdf) = self.coat_lobe(facets, v, l);
         let p = self.p_coat(v);
-        (self.base(v, l) + Vec3::splat(coat), p * coat_pdf + (1.0 - p) * cosine_pdf(v, l))
+        let value = (self.base(v, l) + Vec3::splat(coat), p * coat_pdf + (1.0 - p) * cosine_pdf(v, l));
+        if same_side(v, l) { value } else { (Vec3::ZERO, 0.0) }
     }
 
     /// The coat or the base by `uc`, then a direction from it.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
+        if let Some(facets) = &self.facets {
+            let (sampled, sample) = self.rough_sample(facets, v, uc, u);
+            return sampled.then_some(sample);
+        }
         let p = self.p_coat(v);
         if uc < p {
-            let Some(facets) = self.facets else {
-                // The smooth coat's mirror: weight F, chosen with probability p.
-                let l = Vec3::new(-v.x, -v.y, v.z);
-                let f = Vec3::splat(fresnel_dielectric(v.z, self.eta) / l.z.abs());
-                return Some(BsdfSample { l, f, pdf: p, delta: true, eta: 1.0, dispersive: false });
-            };
-            let h = facets.sample_h_from(v, u)?;
-            let l = reflect(v, h * v.z.signum());
-            let (f, pdf) = self.eval_pdf(v, l);
-            return (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false });
+            // The smooth coat's mirror: weight F, chosen with probability p.
+            let l = Vec3::new(-v.x, -v.y, v.z);
+            let f = Vec3::splat(fresnel_dielectric(v.z, self.eta) / l.z.abs());
+            return Some(BsdfSample { l, f, pdf: p, delta: true, eta: 1.0, dispersive: false });
         }
         let l = cosine_hemisphere(u, v);
         let (f, pdf) = self.eval_pdf(v, l);
         (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+
+    /// [`Self::sample`] with the rough coat of `facets` (this plastic's): whether there is a
+    /// sample (a facet where the coat is chosen, a positive density) and the sample. Computed
+    /// whole and then chosen, for the lanes as for [`Self::sample`].
+    #[inline(always)]
+    pub(crate) fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let coat = uc < self.p_coat(v);
+        let h = facets.sample_h_from(v, u);
+        let mirrored = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
+        let l = if coat { mirrored } else { cosine_hemisphere(u, v) };
+        let (f, pdf) = self.rough_eval_pdf(facets, v, l);
+        ((!coat || h.is_some()) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 
     /// True for a smooth coat (a mirror lobe).

@@ -14,8 +14,8 @@
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
 //! and specular connection. In RGB scenes without specular connections, vertices on Lambert
-//! surfaces (textured, bump-mapped or plain), on rough conductors and on rough dielectrics of
-//! Trowbridge–Reitz facets (isotropic or not) take a material kernel instead: their random numbers, emission,
+//! surfaces (textured, bump-mapped or plain) and on rough conductors, dielectrics and
+//! plastics of Trowbridge–Reitz facets take a material kernel instead: their random numbers, emission,
 //! material and bent normal per lane ([`PathTracer::kernel_vertex`]), then light points on
 //! parallelogram lights ([`sample_lights`]) and the shading frame, next-event weights, bump
 //! shadowing, sampled continuation and Russian roulette ([`shade`]) for all lanes at once,
@@ -31,7 +31,8 @@
 
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic};
 use crate::bsdf::{
-    Bsdf, BsdfSample, ColorMode, Conductor, Dielectric, Frame, Microfacet, cosine_hemisphere, cosine_pdf, same_side,
+    Bsdf, BsdfSample, Coat, ColorMode, Conductor, Dielectric, Frame, Microfacet, Plastic, cosine_hemisphere,
+    cosine_pdf, same_side,
 };
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
@@ -73,10 +74,13 @@ struct Vertices {
     ns: Lanes3,
     n0: Lanes3,
     bumped: [bool; LANES],
-    /// A Lambert surface's albedo.
+    /// A Lambert surface's or a plastic's albedo.
     albedo: Lanes3,
-    /// A rough dielectric's relative index `η_inside/η_outside`.
+    /// A rough dielectric's relative index `η_inside/η_outside`, or a plastic coat's.
     ior: Lanes,
+    /// A plastic's coat and colouring of its inner reflection.
+    coat: [Option<&'static Coat>; LANES],
+    nonlinear: [bool; LANES],
     /// A rough conductor's index `η + iκ` and tint; the roughnesses `m_u, m_v` of a rough
     /// conductor or dielectric, and its tangent where it is anisotropic (`tangent_given`).
     eta: Lanes3,
@@ -189,6 +193,8 @@ enum Kernel {
     Conductor,
     /// The rough-dielectric kernel: its result in the lanes' third [`Shaded`].
     Dielectric,
+    /// The rough-plastic kernel: its result in the lanes' fourth [`Shaded`].
+    Plastic,
 }
 
 impl Kernel {
@@ -197,6 +203,7 @@ impl Kernel {
         match self {
             Kernel::Conductor => 1,
             Kernel::Dielectric => 2,
+            Kernel::Plastic => 3,
             _ => 0,
         }
     }
@@ -216,6 +223,8 @@ pub(crate) enum MaterialKernel {
     /// A rough dielectric of Trowbridge–Reitz facets with Smith's shadowing, the exact
     /// Fresnel term and an index that does not disperse ([`takes_dielectric_kernel`]).
     RoughDielectric,
+    /// Plastic under a rough coat of Trowbridge–Reitz facets with Smith's shadowing.
+    RoughPlastic,
 }
 
 /// Per material: the kernel its vertices take, in a scene whose vertices may take material
@@ -229,6 +238,7 @@ pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<MaterialKernel> {
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => MaterialKernel::Lambert,
         Bsdf::Conductor(c) if takes_conductor_kernel(&c) => MaterialKernel::RoughConductor,
         Bsdf::Dielectric(d) if takes_dielectric_kernel(&d) => MaterialKernel::RoughDielectric,
+        Bsdf::Plastic(p) if takes_plastic_kernel(&p) => MaterialKernel::RoughPlastic,
         _ => MaterialKernel::General,
     };
     tracer.scene.materials.iter().map(|m| if scene_allows { kernel(m) } else { MaterialKernel::General }).collect()
@@ -244,6 +254,12 @@ fn takes_conductor_kernel(c: &Conductor) -> bool {
 /// shadowing, the exact Fresnel term, one index for every colour.
 fn takes_dielectric_kernel(d: &Dielectric) -> bool {
     !d.schlick && !d.dispersive && d.facets.is_some_and(|f| f.is_trowbridge_reitz_smith())
+}
+
+/// A plastic the rough-plastic kernel evaluates: a coat of isotropic Trowbridge–Reitz facets
+/// with Smith's shadowing.
+fn takes_plastic_kernel(p: &Plastic) -> bool {
+    p.facets.is_some_and(|f| f.is_trowbridge_reitz_smith() && f.alpha_u == f.alpha_v)
 }
 
 impl PathTracer<'_> {
@@ -266,7 +282,7 @@ impl PathTracer<'_> {
         let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
         let mut general: [Vertex; LANES] = Default::default();
         let (mut vertices, mut lights) = (Vertices::default(), LightLanes::default());
-        let mut shaded: [Shaded; 3] = Default::default();
+        let mut shaded: [Shaded; 4] = Default::default();
         let (mut shadows, mut dist) = (RayPacket::default(), [0.0; LANES]);
         let unit = self.world.vector_unit();
         let together = self.world.traces_rays_together();
@@ -306,9 +322,9 @@ impl PathTracer<'_> {
                     shadows.set(i, &ray);
                 }
             }
-            let [lambert, conductor, dielectric] =
-                [Kernel::Lambert, Kernel::Conductor, Kernel::Dielectric].map(|k| kernels.contains(&k));
-            if lambert || conductor || dielectric {
+            let [lambert, conductor, dielectric, plastic] =
+                [Kernel::Lambert, Kernel::Conductor, Kernel::Dielectric, Kernel::Plastic].map(|k| kernels.contains(&k));
+            if lambert || conductor || dielectric || plastic {
                 if self.lane_lights.is_some() {
                     sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
                 }
@@ -320,6 +336,9 @@ impl PathTracer<'_> {
                 }
                 if dielectric {
                     shade::<RoughDielectric>(&vertices, &mut shaded[Kernel::Dielectric.shaded()], unit);
+                }
+                if plastic {
+                    shade::<RoughPlastic>(&vertices, &mut shaded[Kernel::Plastic.shaded()], unit);
                 }
                 for (i, kernel) in kernels.iter().enumerate().filter(|(_, k)| **k > Kernel::General) {
                     let s = &shaded[kernel.shaded()];
@@ -404,6 +423,13 @@ impl PathTracer<'_> {
                 set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
                 Kernel::Dielectric
             }
+            (Bsdf::Plastic(p), MaterialKernel::RoughPlastic) if takes_plastic_kernel(p) => {
+                let Some(facets) = &p.facets else { return Kernel::General };
+                set(&mut v.albedo, i, p.albedo);
+                (v.ior[i], v.coat[i], v.nonlinear[i]) = (p.eta, Some(p.coat), p.nonlinear);
+                set_facets(v, i, facets, None);
+                Kernel::Plastic
+            }
             _ => return Kernel::General,
         };
         let h = HitPoint::from(wh);
@@ -428,7 +454,7 @@ impl PathTracer<'_> {
         // again, so the stream stays the per-path tracer's.
         let s = &mut lane.stream;
         // One pair picks the light and the lobe, drawn only when there is a choice.
-        let chooses = self.lights.len() > 1 || kernel == Kernel::Dielectric;
+        let chooses = self.lights.len() > 1 || matches!(kernel, Kernel::Dielectric | Kernel::Plastic);
         let (choice, u_lobe) = if chooses { s.next_2d().into() } else { (0.0, 0.0) };
         v.u_lobe[i] = u_lobe;
         let u_light = s.next_2d();
@@ -648,6 +674,39 @@ impl LaneBsdf for RoughDielectric {
     }
 }
 
+/// Plastic under a rough coat: [`Plastic::rough_eval_pdf`] and [`Plastic::rough_sample`].
+struct RoughPlastic;
+
+impl RoughPlastic {
+    /// Lane `i`'s plastic and its coat's facets, their kinds constants the compiler folds.
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> (Plastic, Microfacet) {
+        let facets = Microfacet::trowbridge_reitz_smith(v.alpha[0][i], v.alpha[1][i]);
+        let coat = v.coat[i].unwrap_or(&Coat::NONE);
+        let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear[i]);
+        (Plastic { albedo, eta, facets: Some(facets), nonlinear, coat }, facets)
+    }
+}
+
+impl LaneBsdf for RoughPlastic {
+    #[inline(always)]
+    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
+        Frame::around(ns)
+    }
+
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (plastic, facets) = Self::at(v, i);
+        plastic.rough_eval_pdf(&facets, wv, l)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let (plastic, facets) = Self::at(v, i);
+        plastic.rough_sample(&facets, wv, uc, u)
+    }
+}
+
 /// Every lane's vertex at once as material `M` shades it, with the per-path tracer's
 /// arithmetic; with the bump terminator's arithmetic where some lane's normal may be bent (a
 /// kernel apiece, the plain one as lean as before bump maps took it).
@@ -763,7 +822,7 @@ mod tests {
 
     /// A scene of every kind of material and light: Lambert, Oren–Nayar, Cook–Torrance and
     /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
-    /// and bump-mapped) and a mirror
+    /// and bump-mapped), rough plastics (one textured) and a mirror
     /// (with specular connections), spheres, boxes and a plane, an emitting box (triangles)
     /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
@@ -804,6 +863,16 @@ shape = "sphere"
 center = [-1, 1, 0]
 radius = 1
 material = { bsdf = { type = "conductor", roughness = 0.2, distribution = "ggx", eta = [0.2, 0.4, 1.4], k = [3.9, 2.4, 1.6] } }
+[[object]]
+shape = "sphere"
+center = [-0.6, 0.35, 2.2]
+radius = 0.35
+material = { bsdf = { type = "plastic", roughness = 0.15, distribution = "ggx", ior = 1.5, color = { checker = { even = [0.8, 0.2, 0.1], odd = [0.1, 0.3, 0.8], size = 0.2 } } } }
+[[object]]
+shape = "sphere"
+center = [-1.4, 0.3, 2.6]
+radius = 0.3
+material = { bsdf = { type = "plastic", roughness = 0.3, distribution = "ggx", ior = 1.6, nonlinear = true, color = [0.2, 0.6, 0.3] } }
 [[object]]
 shape = "sphere"
 center = [2.4, 1.6, -1.5]
