@@ -58,7 +58,7 @@ pub struct PathTracer<'a> {
     /// The lights, when every one is a parallelogram, for the lanes' Lambert kernel to sample.
     lane_lights: Option<Vec<lanes::LaneLight>>,
     /// Per material: the lanes' kernel for its vertices.
-    material_kernels: Vec<lanes::MaterialKernel>,
+    material_kernels: Vec<lanes::Kernel>,
     /// Specular connections through the scene's sphere, cylinder and plane mirrors, if any.
     mirrors: Option<mirrors::MirrorConnections>,
     /// Light through specular surfaces onto non-specular ones, estimated elsewhere.
@@ -220,7 +220,7 @@ impl<'a> PathTracer<'a> {
     pub fn with_caustics(mut self, caustics: &'a dyn CausticEstimate) -> Self {
         self.caustics = Some(caustics);
         self.mirrors = None;
-        self.material_kernels.iter_mut().for_each(|k| *k = lanes::MaterialKernel::General);
+        self.material_kernels.iter_mut().for_each(|k| *k = lanes::Kernel::General);
         self
     }
 

@@ -119,13 +119,17 @@ impl Conductor {
 
     /// The mirror direction, or reflection about a sampled facet.
     pub fn sample(&self, v: Vec3, _uc: f64, u: Vec2) -> Option<BsdfSample> {
-        let Some(facets) = &self.facets else {
-            let l = Vec3::new(-v.x, -v.y, v.z);
-            let f = self.fresnel(v.z) / v.z.abs();
-            return Some(BsdfSample { l, f, pdf: 1.0, delta: true, eta: 1.0, dispersive: false });
-        };
+        let Some(facets) = &self.facets else { return Some(self.smooth_sample(v)) };
         let (sampled, sample) = self.rough_sample(facets, v, u);
         sampled.then_some(sample)
+    }
+
+    /// The smooth conductor's mirror direction, weighted by the Fresnel term.
+    #[inline(always)]
+    pub(crate) fn smooth_sample(&self, v: Vec3) -> BsdfSample {
+        let l = Vec3::new(-v.x, -v.y, v.z);
+        let f = self.fresnel(v.z) / v.z.abs();
+        BsdfSample { l, f, pdf: 1.0, delta: true, eta: 1.0, dispersive: false }
     }
 
     /// Reflection of `v` about a facet of `facets` (this conductor's) drawn with the numbers

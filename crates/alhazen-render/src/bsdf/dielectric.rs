@@ -14,7 +14,7 @@
 //! dispersive), optional microfacets, Fresnel mode, `dispersive` (marks refracted samples).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, reflect, refract, refract_whole};
+use super::{BsdfSample, reflect, refract_whole};
 use crate::optics::{fresnel_dielectric, fresnel_schlick};
 use alhazen_math::{Vec2, Vec3};
 
@@ -123,25 +123,35 @@ impl Dielectric {
             let (sampled, sample) = self.rough_sample(facets, v, uc, u);
             return sampled.then_some(sample);
         }
+        let (sampled, sample) = self.smooth_sample(v, uc);
+        sampled.then_some(sample)
+    }
+
+    /// The smooth boundary's mirror direction (with probability `F`, when `uc < F`) or
+    /// refracted one: whether there is one (the normal seen from the front, the direction on
+    /// the right side) and the sample. Computed whole and then chosen, for the lanes as for
+    /// [`Self::sample`].
+    #[inline(always)]
+    pub(crate) fn smooth_sample(&self, v: Vec3, uc: f64) -> (bool, BsdfSample) {
         let h = Vec3::Z;
-        if v.dot(h) * v.z <= 0.0 {
-            return None; // the normal is seen from behind
-        }
+        let front = v.dot(h) * v.z > 0.0 || (v.dot(h) * v.z).is_nan();
         let fr = self.fresnel(v.dot(h));
-        if uc < fr {
-            let l = reflect(v, h);
-            if l.z * v.z <= 0.0 {
-                return None;
-            }
-            let f = Vec3::splat(fr / l.z.abs());
-            return Some(BsdfSample { l, f, pdf: fr, delta: true, eta: 1.0, dispersive: false });
-        }
-        let (l, etap) = refract(v, h, self.eta)?;
-        if l.z * v.z >= 0.0 {
-            return None;
-        }
-        let f = Vec3::splat((1.0 - fr) / l.z.abs() / (etap * etap));
-        Some(BsdfSample { l, f, pdf: 1.0 - fr, delta: true, eta: etap, dispersive: self.dispersive })
+        let reflects = uc < fr;
+        let mirrored = reflect(v, h);
+        let (refracts, refracted, etap) = refract_whole(v, h, self.eta);
+        let sample = if reflects {
+            let (l, f) = (mirrored, Vec3::splat(fr / mirrored.z.abs()));
+            BsdfSample { l, f, pdf: fr, delta: true, eta: 1.0, dispersive: false }
+        } else {
+            let (l, f) = (refracted, Vec3::splat((1.0 - fr) / refracted.z.abs() / (etap * etap)));
+            BsdfSample { l, f, pdf: 1.0 - fr, delta: true, eta: etap, dispersive: self.dispersive }
+        };
+        let side_ok = if reflects {
+            mirrored.z * v.z > 0.0 || (mirrored.z * v.z).is_nan()
+        } else {
+            refracts && (refracted.z * v.z < 0.0 || (refracted.z * v.z).is_nan())
+        };
+        (front && side_ok, sample)
     }
 
     /// Reflection (with probability `F`, when `uc < F`) or refraction of `v` about a facet of

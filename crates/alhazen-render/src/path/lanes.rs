@@ -150,9 +150,10 @@ struct Shaded {
     shadow: [bool; LANES],
     shadow_origin: Lanes3,
     shadow_dist: Lanes,
-    /// The path goes on (`alive`) from `origin` along `dir`, sampled with density `pdf`,
-    /// carrying `beta` and `eta_scale`.
+    /// The path goes on (`alive`) from `origin` along `dir`, sampled with density `pdf` (a
+    /// delta distribution's where `delta` is set), carrying `beta` and `eta_scale`.
     alive: [bool; LANES],
+    delta: [bool; LANES],
     origin: Lanes3,
     dir: Lanes3,
     pdf: Lanes,
@@ -180,39 +181,12 @@ impl LanePath {
     }
 }
 
-/// How lane `i`'s vertex of this bounce is shaded.
-#[derive(Clone, Copy, PartialEq, PartialOrd)]
-enum Kernel {
+/// How a vertex is shaded: per material, and per lane in each bounce.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Kernel {
     /// No path in the lane.
     Idle,
     /// [`PathTracer::vertex`]: its result in the lane's [`Vertex`].
-    General,
-    /// The Lambert kernel: its result in the lanes' first [`Shaded`].
-    Lambert,
-    /// The rough-conductor kernel: its result in the lanes' second [`Shaded`].
-    Conductor,
-    /// The rough-dielectric kernel: its result in the lanes' third [`Shaded`].
-    Dielectric,
-    /// The rough-plastic kernel: its result in the lanes' fourth [`Shaded`].
-    Plastic,
-}
-
-impl Kernel {
-    /// Which of the lanes' [`Shaded`] a material kernel writes.
-    fn shaded(self) -> usize {
-        match self {
-            Kernel::Conductor => 1,
-            Kernel::Dielectric => 2,
-            Kernel::Plastic => 3,
-            _ => 0,
-        }
-    }
-}
-
-/// Which kernel shades a material's vertices in lanes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum MaterialKernel {
-    /// The general one, [`PathTracer::vertex`].
     General,
     /// Lambert: textured or not, bump-mapped or not.
     Lambert,
@@ -225,23 +199,67 @@ pub(crate) enum MaterialKernel {
     RoughDielectric,
     /// Plastic under a rough coat of Trowbridge–Reitz facets with Smith's shadowing.
     RoughPlastic,
+    /// A smooth conductor (a mirror, coloured by its Fresnel term), exact Fresnel term.
+    SmoothConductor,
+    /// Smooth glass of an index that does not disperse, exact Fresnel term.
+    SmoothDielectric,
+}
+
+/// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
+/// [`Kernel`]).
+const MATERIAL_KERNELS: [Kernel; 6] = [
+    Kernel::Lambert,
+    Kernel::RoughConductor,
+    Kernel::RoughDielectric,
+    Kernel::RoughPlastic,
+    Kernel::SmoothConductor,
+    Kernel::SmoothDielectric,
+];
+
+impl Kernel {
+    /// Which of the lanes' [`Shaded`] a material kernel writes.
+    fn shaded(self) -> usize {
+        (self as usize).saturating_sub(Kernel::Lambert as usize)
+    }
+
+    /// A material kernel (not idle, not the general one).
+    fn is_material(self) -> bool {
+        !matches!(self, Kernel::Idle | Kernel::General)
+    }
+
+    /// The kernel's BSDF has lobes to choose between (it draws a number for the choice).
+    fn chooses_lobe(self) -> bool {
+        matches!(self, Kernel::RoughDielectric | Kernel::RoughPlastic | Kernel::SmoothDielectric)
+    }
+
+    /// The kernel's BSDF is a delta distribution: its vertices sample no light.
+    fn is_delta(self) -> bool {
+        matches!(self, Kernel::SmoothConductor | Kernel::SmoothDielectric)
+    }
 }
 
 /// Per material: the kernel its vertices take, in a scene whose vertices may take material
 /// kernels (RGB, no specular connections). A material's kind of BSDF does not vary over its
 /// surface (textures vary colours and roughnesses only), so the BSDF at any point tells; the
-/// BSDF at each hit is checked again.
-pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<MaterialKernel> {
+/// BSDF at each hit is checked again ([`kernel_of`]).
+pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<Kernel> {
     let scene_allows = !tracer.spectral && tracer.mirrors.is_none();
     let images = &tracer.scene.images;
-    let kernel = |m| match crate::bsdf::bsdf_at(m, Vec2::ZERO, images, ColorMode::Rgb) {
-        Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => MaterialKernel::Lambert,
-        Bsdf::Conductor(c) if takes_conductor_kernel(&c) => MaterialKernel::RoughConductor,
-        Bsdf::Dielectric(d) if takes_dielectric_kernel(&d) => MaterialKernel::RoughDielectric,
-        Bsdf::Plastic(p) if takes_plastic_kernel(&p) => MaterialKernel::RoughPlastic,
-        _ => MaterialKernel::General,
-    };
-    tracer.scene.materials.iter().map(|m| if scene_allows { kernel(m) } else { MaterialKernel::General }).collect()
+    let kernel = |m| kernel_of(&crate::bsdf::bsdf_at(m, Vec2::ZERO, images, ColorMode::Rgb), m);
+    tracer.scene.materials.iter().map(|m| if scene_allows { kernel(m) } else { Kernel::General }).collect()
+}
+
+/// The kernel of `bsdf`, material `m`'s at some point.
+fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
+    match bsdf {
+        Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
+        Bsdf::Conductor(c) if c.facets.is_none() && !c.schlick => Kernel::SmoothConductor,
+        Bsdf::Conductor(c) if takes_conductor_kernel(c) => Kernel::RoughConductor,
+        Bsdf::Dielectric(d) if d.facets.is_none() && !d.schlick && !d.dispersive => Kernel::SmoothDielectric,
+        Bsdf::Dielectric(d) if takes_dielectric_kernel(d) => Kernel::RoughDielectric,
+        Bsdf::Plastic(p) if takes_plastic_kernel(p) => Kernel::RoughPlastic,
+        _ => Kernel::General,
+    }
 }
 
 /// A conductor the rough-conductor kernel evaluates: Trowbridge–Reitz facets with Smith's
@@ -282,7 +300,7 @@ impl PathTracer<'_> {
         let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
         let mut general: [Vertex; LANES] = Default::default();
         let (mut vertices, mut lights) = (Vertices::default(), LightLanes::default());
-        let mut shaded: [Shaded; 4] = Default::default();
+        let mut shaded: [Shaded; MATERIAL_KERNELS.len()] = Default::default();
         let (mut shadows, mut dist) = (RayPacket::default(), [0.0; LANES]);
         let unit = self.world.vector_unit();
         let together = self.world.traces_rays_together();
@@ -322,25 +340,16 @@ impl PathTracer<'_> {
                     shadows.set(i, &ray);
                 }
             }
-            let [lambert, conductor, dielectric, plastic] =
-                [Kernel::Lambert, Kernel::Conductor, Kernel::Dielectric, Kernel::Plastic].map(|k| kernels.contains(&k));
-            if lambert || conductor || dielectric || plastic {
+            if kernels.iter().any(|k| k.is_material()) {
                 if self.lane_lights.is_some() {
                     sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
                 }
-                if lambert {
-                    shade::<Lambertian>(&vertices, &mut shaded[Kernel::Lambert.shaded()], unit);
+                for (kernel, out) in MATERIAL_KERNELS.into_iter().zip(&mut shaded) {
+                    if kernels.contains(&kernel) {
+                        shade_with(kernel, &vertices, out, unit);
+                    }
                 }
-                if conductor {
-                    shade::<RoughConductor>(&vertices, &mut shaded[Kernel::Conductor.shaded()], unit);
-                }
-                if dielectric {
-                    shade::<RoughDielectric>(&vertices, &mut shaded[Kernel::Dielectric.shaded()], unit);
-                }
-                if plastic {
-                    shade::<RoughPlastic>(&vertices, &mut shaded[Kernel::Plastic.shaded()], unit);
-                }
-                for (i, kernel) in kernels.iter().enumerate().filter(|(_, k)| **k > Kernel::General) {
+                for (i, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
                     let s = &shaded[kernel.shaded()];
                     if s.shadow[i] {
                         (tested[i], dist[i]) = (true, s.shadow_dist[i]);
@@ -392,46 +401,47 @@ impl PathTracer<'_> {
         let path = &mut lane.path;
         let Some(wh) = hit else { return Kernel::General };
         let material = self.material_kernels[wh.material as usize];
-        if material == MaterialKernel::General || path.depth >= self.scene.render.max_depth {
+        if !material.is_material() || path.depth >= self.scene.render.max_depth {
             return Kernel::General;
         }
         let m = &self.scene.materials[wh.material as usize];
         let at_hit;
-        let bsdf = match &self.uniform_bsdfs[wh.material as usize] {
-            Some(bsdf) => bsdf,
+        let (bsdf, kernel) = match &self.uniform_bsdfs[wh.material as usize] {
+            // The material's kernel is this BSDF's.
+            Some(bsdf) => (bsdf, material),
             None => {
                 at_hit = crate::bsdf::bsdf_at(m, wh.hit.uv, &self.scene.images, ColorMode::Rgb);
-                &at_hit
+                (&at_hit, kernel_of(&at_hit, m))
             }
         };
-        let kernel = match (bsdf, material) {
-            (Bsdf::Lambert(lambert), MaterialKernel::Lambert) => {
-                set(&mut v.albedo, i, lambert.albedo);
-                Kernel::Lambert
-            }
-            (Bsdf::Conductor(c), MaterialKernel::RoughConductor) if takes_conductor_kernel(c) => {
-                let Some(facets) = &c.facets else { return Kernel::General };
+        if kernel != material {
+            return Kernel::General;
+        }
+        match bsdf {
+            Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
+            Bsdf::Conductor(c) => {
                 set(&mut v.eta, i, c.eta);
                 set(&mut v.k, i, c.k);
                 set(&mut v.tint, i, c.tint);
-                set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
-                Kernel::Conductor
+                if let Some(facets) = &c.facets {
+                    set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
+                }
             }
-            (Bsdf::Dielectric(d), MaterialKernel::RoughDielectric) if takes_dielectric_kernel(d) => {
-                let Some(facets) = &d.facets else { return Kernel::General };
+            Bsdf::Dielectric(d) => {
                 v.ior[i] = d.eta;
-                set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
-                Kernel::Dielectric
+                if let Some(facets) = &d.facets {
+                    set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
+                }
             }
-            (Bsdf::Plastic(p), MaterialKernel::RoughPlastic) if takes_plastic_kernel(p) => {
-                let Some(facets) = &p.facets else { return Kernel::General };
+            Bsdf::Plastic(p) => {
                 set(&mut v.albedo, i, p.albedo);
                 (v.ior[i], v.coat[i], v.nonlinear[i]) = (p.eta, Some(p.coat), p.nonlinear);
-                set_facets(v, i, facets, None);
-                Kernel::Plastic
+                if let Some(facets) = &p.facets {
+                    set_facets(v, i, facets, None);
+                }
             }
             _ => return Kernel::General,
-        };
+        }
         let h = HitPoint::from(wh);
         path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, None, ColorMode::Rgb);
         v.roulette[i] = path.depth >= RR_DEPTH;
@@ -453,17 +463,19 @@ impl PathTracer<'_> {
         // is known whether the path survives the continuation; a path that does not never draws
         // again, so the stream stays the per-path tracer's.
         let s = &mut lane.stream;
-        // One pair picks the light and the lobe, drawn only when there is a choice.
-        let chooses = self.lights.len() > 1 || matches!(kernel, Kernel::Dielectric | Kernel::Plastic);
+        // One pair picks the light and the lobe, drawn only when there is a choice; a delta
+        // BSDF samples no light and draws no number for it.
+        let chooses = self.lights.len() > 1 || kernel.chooses_lobe();
         let (choice, u_lobe) = if chooses { s.next_2d().into() } else { (0.0, 0.0) };
         v.u_lobe[i] = u_lobe;
-        let u_light = s.next_2d();
+        let u_light = if kernel.is_delta() { Vec2::ZERO } else { s.next_2d() };
         let u_bsdf = s.next_2d();
         (v.u_bsdf[0][i], v.u_bsdf[1][i]) = (u_bsdf.x, u_bsdf.y);
         if v.roulette[i] {
             v.u_roulette[i] = s.next_1d();
         }
         match &self.lane_lights {
+            _ if kernel.is_delta() => v.light[i] = false,
             Some(all) => {
                 let k = &all[self.lights.choose(choice)];
                 set(&mut lights.corner, i, k.corner);
@@ -507,7 +519,7 @@ fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> boo
         path.beta = get(&s.beta, i);
         path.eta_scale = s.eta_scale[i];
         path.prev.pdf = s.pdf[i];
-        path.prev.delta = false;
+        path.prev.delta = s.delta[i];
         path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
         path.depth += 1;
     }
@@ -707,6 +719,62 @@ impl LaneBsdf for RoughPlastic {
     }
 }
 
+/// Smooth conductors: [`Conductor::smooth_sample`]; nothing to evaluate (a delta distribution).
+struct SmoothConductor;
+
+impl LaneBsdf for SmoothConductor {
+    #[inline(always)]
+    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
+        Frame::around(ns)
+    }
+
+    #[inline(always)]
+    fn eval_pdf(_: &Vertices, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
+        (Vec3::ZERO, 0.0)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
+        let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
+        (true, Conductor { facets: None, eta, k, tint, schlick: false }.smooth_sample(wv))
+    }
+}
+
+/// Smooth glass: [`Dielectric::smooth_sample`]; nothing to evaluate (a delta distribution).
+struct SmoothDielectric;
+
+impl LaneBsdf for SmoothDielectric {
+    const TRANSMITS: bool = true;
+
+    #[inline(always)]
+    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
+        Frame::around(ns)
+    }
+
+    #[inline(always)]
+    fn eval_pdf(_: &Vertices, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
+        (Vec3::ZERO, 0.0)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
+        Dielectric { facets: None, eta: v.ior[i], schlick: false, dispersive: false }.smooth_sample(wv, uc)
+    }
+}
+
+/// Every lane's vertex at once as `kernel` shades it.
+fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
+    match kernel {
+        Kernel::Lambert => shade::<Lambertian>(v, out, unit),
+        Kernel::RoughConductor => shade::<RoughConductor>(v, out, unit),
+        Kernel::RoughDielectric => shade::<RoughDielectric>(v, out, unit),
+        Kernel::RoughPlastic => shade::<RoughPlastic>(v, out, unit),
+        Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, unit),
+        Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, unit),
+        Kernel::Idle | Kernel::General => {}
+    }
+}
+
 /// Every lane's vertex at once as material `M` shades it, with the per-path tracer's
 /// arithmetic; with the bump terminator's arithmetic where some lane's normal may be bent (a
 /// kernel apiece, the plain one as lean as before bump maps took it).
@@ -801,6 +869,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i:
     }
     out.alive[i] = alive;
     out.pdf[i] = pdf;
+    out.delta[i] = bs.delta;
     out.eta_scale[i] = eta_scale;
     set(&mut out.beta, i, beta);
     set(&mut out.dir, i, dir);
@@ -822,7 +891,7 @@ mod tests {
 
     /// A scene of every kind of material and light: Lambert, Oren–Nayar, Cook–Torrance and
     /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
-    /// and bump-mapped), rough plastics (one textured) and a mirror
+    /// and bump-mapped) and a smooth one, rough plastics (one textured) and a mirror
     /// (with specular connections), spheres, boxes and a plane, an emitting box (triangles)
     /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
@@ -873,6 +942,11 @@ shape = "sphere"
 center = [-1.4, 0.3, 2.6]
 radius = 0.3
 material = { bsdf = { type = "plastic", roughness = 0.3, distribution = "ggx", ior = 1.6, nonlinear = true, color = [0.2, 0.6, 0.3] } }
+[[object]]
+shape = "sphere"
+center = [0.9, 0.25, 2.4]
+radius = 0.25
+material = { bsdf = { type = "conductor", eta = [0.2, 0.9, 1.1], k = [3.9, 2.4, 2.2] } }
 [[object]]
 shape = "sphere"
 center = [2.4, 1.6, -1.5]
@@ -1000,6 +1074,15 @@ material = "glow"
                     }
                 }
             }
+        }
+    }
+
+    /// Each material kernel writes a [`Shaded`] of its own.
+    #[test]
+    fn material_kernels_write_their_own_results() {
+        for (i, k) in MATERIAL_KERNELS.into_iter().enumerate() {
+            assert!(k.is_material());
+            assert_eq!(k.shaded(), i, "{k:?}");
         }
     }
 
