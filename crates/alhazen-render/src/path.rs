@@ -19,7 +19,7 @@
 //! non-specular vertex through specular (delta) surfaces is taken from it instead: the estimate
 //! is added at every non-specular vertex, and emission reached from a non-specular vertex
 //! through specular bounces only is left out (it is what the estimate holds). Mirror connections
-//! are then off (the estimate holds their paths too), and so is the lanes' Lambert kernel.
+//! are then off (the estimate holds their paths too), and so are the lanes' material kernels.
 //!
 //! Where the world tests eight rays at once faster than one by one (`World::traces_rays_together`),
 //! eight samples are traced side by side (`lanes`), each with the same arithmetic ([`PathTracer::vertex`]),
@@ -55,7 +55,7 @@ pub struct PathTracer<'a> {
     uniform_bsdfs: Vec<Option<Bsdf>>,
     /// Samples are traced eight at a time in lanes (module `lanes`): the same samples.
     in_lanes: bool,
-    /// The lights, when every one is a parallelogram, for the lanes' Lambert kernel to sample.
+    /// The lights, when every one is a parallelogram, for the lanes' material kernels to sample.
     lane_lights: Option<Vec<lanes::LaneLight>>,
     /// Per material: the lanes' kernel for its vertices.
     material_kernels: Vec<lanes::Kernel>,

@@ -133,12 +133,17 @@ impl Plastic {
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
         match &self.facets {
             Some(facets) => self.rough_eval_pdf(facets, v, l),
-            None if same_side(v, l) => {
-                let p = self.p_coat(v);
-                (self.base(v, l) + Vec3::splat(0.0), p * 0.0 + (1.0 - p) * cosine_pdf(v, l))
-            }
-            None => (Vec3::ZERO, 0.0),
+            None => self.smooth_eval_pdf(v, l),
         }
+    }
+
+    /// [`Self::eval_pdf`] of the smooth coat (the base alone: the coat is a delta lobe),
+    /// computed whole and then chosen.
+    #[inline(always)]
+    pub(crate) fn smooth_eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let p = self.p_coat(v);
+        let value = (self.base(v, l) + Vec3::splat(0.0), p * 0.0 + (1.0 - p) * cosine_pdf(v, l));
+        if same_side(v, l) { value } else { (Vec3::ZERO, 0.0) }
     }
 
     /// [`Self::eval_pdf`] of the rough coat of `facets` (this plastic's), computed whole and
@@ -157,16 +162,25 @@ impl Plastic {
             let (sampled, sample) = self.rough_sample(facets, v, uc, u);
             return sampled.then_some(sample);
         }
+        let (sampled, sample) = self.smooth_sample(v, uc, u);
+        sampled.then_some(sample)
+    }
+
+    /// [`Self::sample`] with the smooth coat: its mirror (weight `F`, chosen with probability
+    /// `p`), or the base. Whether there is a sample and the sample, computed whole and then
+    /// chosen, for the lanes as for [`Self::sample`].
+    #[inline(always)]
+    pub(crate) fn smooth_sample(&self, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let p = self.p_coat(v);
-        if uc < p {
-            // The smooth coat's mirror: weight F, chosen with probability p.
-            let l = Vec3::new(-v.x, -v.y, v.z);
-            let f = Vec3::splat(fresnel_dielectric(v.z, self.eta) / l.z.abs());
-            return Some(BsdfSample { l, f, pdf: p, delta: true, eta: 1.0, dispersive: false });
-        }
+        let mirrored = Vec3::new(-v.x, -v.y, v.z);
+        let f_mirror = Vec3::splat(fresnel_dielectric(v.z, self.eta) / mirrored.z.abs());
         let l = cosine_hemisphere(u, v);
-        let (f, pdf) = self.eval_pdf(v, l);
-        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+        let (f, pdf) = self.smooth_eval_pdf(v, l);
+        if uc < p {
+            (true, BsdfSample { l: mirrored, f: f_mirror, pdf: p, delta: true, eta: 1.0, dispersive: false })
+        } else {
+            (pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+        }
     }
 
     /// [`Self::sample`] with the rough coat of `facets` (this plastic's): whether there is a

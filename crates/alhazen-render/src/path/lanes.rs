@@ -14,9 +14,9 @@
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
 //! and specular connection. In RGB scenes without specular connections, vertices on Lambert
-//! surfaces (textured, bump-mapped or plain) and on rough conductors, dielectrics and
-//! plastics of Trowbridge–Reitz facets take a material kernel instead: their random numbers, emission,
-//! material and bent normal per lane ([`PathTracer::kernel_vertex`]), then light points on
+//! surfaces, on conductors and glass (smooth, or rough of Trowbridge–Reitz facets) and on
+//! plastic — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
+//! instead: their random numbers, emission, material and bent normal per lane ([`PathTracer::kernel_vertex`]), then light points on
 //! parallelogram lights ([`sample_lights`]) and the shading frame, next-event weights, bump
 //! shadowing, sampled continuation and Russian roulette ([`shade`]) for all lanes at once,
 //! loops without branches the compiler turns into AVX-512 or AVX2 code. The kernels evaluate
@@ -203,17 +203,20 @@ pub(crate) enum Kernel {
     SmoothConductor,
     /// Smooth glass of an index that does not disperse, exact Fresnel term.
     SmoothDielectric,
+    /// Plastic under a smooth coat.
+    SmoothPlastic,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 6] = [
+const MATERIAL_KERNELS: [Kernel; 7] = [
     Kernel::Lambert,
     Kernel::RoughConductor,
     Kernel::RoughDielectric,
     Kernel::RoughPlastic,
     Kernel::SmoothConductor,
     Kernel::SmoothDielectric,
+    Kernel::SmoothPlastic,
 ];
 
 impl Kernel {
@@ -229,7 +232,10 @@ impl Kernel {
 
     /// The kernel's BSDF has lobes to choose between (it draws a number for the choice).
     fn chooses_lobe(self) -> bool {
-        matches!(self, Kernel::RoughDielectric | Kernel::RoughPlastic | Kernel::SmoothDielectric)
+        matches!(
+            self,
+            Kernel::RoughDielectric | Kernel::RoughPlastic | Kernel::SmoothDielectric | Kernel::SmoothPlastic
+        )
     }
 
     /// The kernel's BSDF is a delta distribution: its vertices sample no light.
@@ -257,6 +263,7 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
         Bsdf::Conductor(c) if takes_conductor_kernel(c) => Kernel::RoughConductor,
         Bsdf::Dielectric(d) if d.facets.is_none() && !d.schlick && !d.dispersive => Kernel::SmoothDielectric,
         Bsdf::Dielectric(d) if takes_dielectric_kernel(d) => Kernel::RoughDielectric,
+        Bsdf::Plastic(p) if p.facets.is_none() => Kernel::SmoothPlastic,
         Bsdf::Plastic(p) if takes_plastic_kernel(p) => Kernel::RoughPlastic,
         _ => Kernel::General,
     }
@@ -282,7 +289,7 @@ fn takes_plastic_kernel(p: &Plastic) -> bool {
 
 impl PathTracer<'_> {
     /// True where the processor has a vector unit (AVX2 or AVX-512) for the kernels: the
-    /// lanes are then faster than paths one by one. (Portably the Lambert kernel's loops are
+    /// lanes are then faster than paths one by one. (Portably the material kernels' loops are
     /// exact but scalar, and slower than the per-path tracer.)
     pub(super) fn lanes_apply(&self) -> bool {
         let unit = self.world.vector_unit();
@@ -762,6 +769,37 @@ impl LaneBsdf for SmoothDielectric {
     }
 }
 
+/// Plastic under a smooth coat: [`Plastic::smooth_eval_pdf`] (its base) and
+/// [`Plastic::smooth_sample`] (the coat's mirror or the base).
+struct SmoothPlastic;
+
+impl SmoothPlastic {
+    /// Lane `i`'s plastic.
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> Plastic {
+        let coat = v.coat[i].unwrap_or(&Coat::NONE);
+        let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear[i]);
+        Plastic { albedo, eta, facets: None, nonlinear, coat }
+    }
+}
+
+impl LaneBsdf for SmoothPlastic {
+    #[inline(always)]
+    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
+        Frame::around(ns)
+    }
+
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        Self::at(v, i).smooth_eval_pdf(wv, l)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        Self::at(v, i).smooth_sample(wv, uc, u)
+    }
+}
+
 /// Every lane's vertex at once as `kernel` shades it.
 fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
     match kernel {
@@ -771,6 +809,7 @@ fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, unit: VectorUnit) 
         Kernel::RoughPlastic => shade::<RoughPlastic>(v, out, unit),
         Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, unit),
+        Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, out, unit),
         Kernel::Idle | Kernel::General => {}
     }
 }
@@ -891,7 +930,7 @@ mod tests {
 
     /// A scene of every kind of material and light: Lambert, Oren–Nayar, Cook–Torrance and
     /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
-    /// and bump-mapped) and a smooth one, rough plastics (one textured) and a mirror
+    /// and bump-mapped) and a smooth one, rough plastics (one textured) and a smooth one, a mirror
     /// (with specular connections), spheres, boxes and a plane, an emitting box (triangles)
     /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
@@ -942,6 +981,11 @@ shape = "sphere"
 center = [-1.4, 0.3, 2.6]
 radius = 0.3
 material = { bsdf = { type = "plastic", roughness = 0.3, distribution = "ggx", ior = 1.6, nonlinear = true, color = [0.2, 0.6, 0.3] } }
+[[object]]
+shape = "box"
+min = [1.8, 0, 1.6]
+max = [2.3, 0.5, 2.1]
+material = { bsdf = { type = "plastic", ior = 1.5, color = [0.7, 0.6, 0.2] } }
 [[object]]
 shape = "sphere"
 center = [0.9, 0.25, 2.4]
@@ -1038,7 +1082,8 @@ material = "glow"
                transform = [{ scale = 0.2 }, { rotate_y = 90 }, { translate = [0.9, 0.2, 0] }]\n";
         let mut two_lights = alhazen_scene::parse_scene("two-lights.toml".as_ref(), &text).unwrap();
         (two_lights.render.width, two_lights.render.height, two_lights.render.spp) = (16, 16, 9);
-        // Without specular connections its textured, bump-mapped plane takes the Lambert kernel.
+        // Without specular connections its textured, bump-mapped plane takes the Lambert
+        // kernel, its conductors, plastics and glass theirs.
         let mut unconnected = mixed.clone();
         unconnected.render.mirror_connections = false;
         // Glass whose index and its inverse do not square to exactly 1 (1.52² · (1/1.52)²):
