@@ -13,7 +13,8 @@
 //!   window→viewport, homogenisation, stereo frusta;
 //! * [`color`] — the course's sRGB transfer function and the XYZ→sRGB matrix;
 //! * [`poly`] — numerically careful real roots of low-degree polynomials;
-//! * [`exact_sum`] — order-independent exact sums of doubles (the film's pixel sums).
+//! * [`exact_sum`] — order-independent exact sums of doubles (the film's pixel sums);
+//! * [`elementary`] — `exp` and `ln` that vectorise (the material kernels' Beckmann facets).
 //!
 //! ```
 //! use alhazen_math::{Ray, Vec3, Transform};
@@ -24,6 +25,7 @@
 
 pub mod bounds;
 pub mod color;
+pub mod elementary;
 pub mod exact_sum;
 pub mod poly;
 pub mod ray;

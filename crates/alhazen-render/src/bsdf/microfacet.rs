@@ -15,6 +15,7 @@
 //! Dupuy and Benyoub's spherical caps), the other
 //! distributions with density `D(h) cos ϑ_h`.
 
+use alhazen_math::elementary::{exp, ln};
 use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::bsdf::{Distribution, Microfacets, Shadowing};
 use std::f64::consts::PI;
@@ -65,17 +66,24 @@ impl Microfacet {
         (h.x / self.alpha_u).powi(2) / (h.z * h.z) + (h.y / self.alpha_v).powi(2) / (h.z * h.z)
     }
 
-    /// A Trowbridge–Reitz distribution with Smith's shadowing: the one the path tracer's lanes
-    /// evaluate (its kind known to the compiler, the matches below fold away).
+    /// A Trowbridge–Reitz (or, with `BECKMANN`, Beckmann) distribution with Smith's
+    /// shadowing: the ones the path tracer's lanes evaluate (their kind known to the compiler,
+    /// the matches below fold away; Beckmann's `exp` and `ln` are [`alhazen_math::elementary`]'s,
+    /// which vectorise).
     #[inline(always)]
-    pub fn trowbridge_reitz_smith(alpha_u: f64, alpha_v: f64) -> Self {
-        let (distribution, shadowing) = (Distribution::TrowbridgeReitz, Shadowing::Smith);
-        Self { distribution, alpha_u, alpha_v, shadowing, gaussian_a: 1.0 }
+    pub fn smith<const BECKMANN: bool>(alpha_u: f64, alpha_v: f64) -> Self {
+        let distribution = if BECKMANN { Distribution::Beckmann } else { Distribution::TrowbridgeReitz };
+        Self { distribution, alpha_u, alpha_v, shadowing: Shadowing::Smith, gaussian_a: 1.0 }
     }
 
-    /// True for the distribution [`Self::trowbridge_reitz_smith`] makes.
-    pub fn is_trowbridge_reitz_smith(&self) -> bool {
-        self.distribution == Distribution::TrowbridgeReitz && self.shadowing == Shadowing::Smith
+    /// `Some(BECKMANN)` for the distributions [`Self::smith`] makes.
+    pub fn smith_kind(&self) -> Option<bool> {
+        let beckmann = match self.distribution {
+            Distribution::TrowbridgeReitz => false,
+            Distribution::Beckmann => true,
+            Distribution::Gaussian => return None,
+        };
+        (self.shadowing == Shadowing::Smith).then_some(beckmann)
     }
 
     /// `D(h)` for `h` in the upper hemisphere (0 below). Here and below, values are computed
@@ -86,7 +94,7 @@ impl Microfacet {
         let cos4 = h.z.powi(4);
         let e = self.slope2(h);
         let d = match self.distribution {
-            Distribution::Beckmann => (-e).exp() / (PI * self.alpha_u * self.alpha_v * cos4),
+            Distribution::Beckmann => exp(-e) / (PI * self.alpha_u * self.alpha_v * cos4),
             Distribution::TrowbridgeReitz => 1.0 / (PI * self.alpha_u * self.alpha_v * cos4 * (1.0 + e).powi(2)),
             Distribution::Gaussian => {
                 let theta = h.z.min(1.0).acos();
@@ -97,11 +105,10 @@ impl Microfacet {
     }
 
     /// A normal `h` with density `D(h) cos ϑ_h`; `None` only on rejection failure.
+    #[inline(always)]
     pub fn sample_h(&self, u: Vec2) -> Option<Vec3> {
         if self.distribution == Distribution::Gaussian {
-            let (theta, phi) = (self.sample_gaussian_theta(u.x)?, 2.0 * PI * u.y);
-            let (st, ct) = theta.sin_cos();
-            return Some(Vec3::new(st * phi.cos(), st * phi.sin(), ct));
+            return self.sample_gaussian_h(u);
         }
         // The azimuth of an elliptically stretched uniform direction: (m_u cos φ₀, m_v sin φ₀)
         // has the azimuth φ, and its squared length r² is 1/(cos²φ/m_u² + sin²φ/m_v²), the
@@ -113,12 +120,20 @@ impl Microfacet {
         let (cos_phi, sin_phi) = if r > 0.0 { (x / r, y / r) } else { (1.0, 0.0) };
         let u0 = u.x.min(1.0 - 1e-16);
         let tan2 = match self.distribution {
-            Distribution::Beckmann => -(1.0 - u0).ln() * r2,
+            Distribution::Beckmann => -ln(1.0 - u0) * r2,
             _ => u0 / (1.0 - u0) * r2,
         };
         let ct = 1.0 / (1.0 + tan2).sqrt();
         let st = (tan2 / (1.0 + tan2)).sqrt();
         Some(Vec3::new(st * cos_phi, st * sin_phi, ct))
+    }
+
+    /// [`Self::sample_h`] for the Gaussian (out of line: a rejection loop).
+    #[inline(never)]
+    fn sample_gaussian_h(&self, u: Vec2) -> Option<Vec3> {
+        let (theta, phi) = (self.sample_gaussian_theta(u.x)?, 2.0 * PI * u.y);
+        let (st, ct) = theta.sin_cos();
+        Some(Vec3::new(st * phi.cos(), st * phi.sin(), ct))
     }
 
     /// ϑ with density ∝ `exp(−(ϑ/m)²) cos ϑ sin ϑ` by rejection from the Rayleigh density

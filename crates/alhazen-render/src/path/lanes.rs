@@ -205,11 +205,16 @@ pub(crate) enum Kernel {
     SmoothDielectric,
     /// Plastic under a smooth coat.
     SmoothPlastic,
+    /// [`Kernel::RoughConductor`], [`Kernel::RoughDielectric`] and [`Kernel::RoughPlastic`]
+    /// with Beckmann facets.
+    BeckmannConductor,
+    BeckmannDielectric,
+    BeckmannPlastic,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 7] = [
+const MATERIAL_KERNELS: [Kernel; 10] = [
     Kernel::Lambert,
     Kernel::RoughConductor,
     Kernel::RoughDielectric,
@@ -217,6 +222,9 @@ const MATERIAL_KERNELS: [Kernel; 7] = [
     Kernel::SmoothConductor,
     Kernel::SmoothDielectric,
     Kernel::SmoothPlastic,
+    Kernel::BeckmannConductor,
+    Kernel::BeckmannDielectric,
+    Kernel::BeckmannPlastic,
 ];
 
 impl Kernel {
@@ -234,7 +242,12 @@ impl Kernel {
     fn chooses_lobe(self) -> bool {
         matches!(
             self,
-            Kernel::RoughDielectric | Kernel::RoughPlastic | Kernel::SmoothDielectric | Kernel::SmoothPlastic
+            Kernel::RoughDielectric
+                | Kernel::RoughPlastic
+                | Kernel::SmoothDielectric
+                | Kernel::SmoothPlastic
+                | Kernel::BeckmannDielectric
+                | Kernel::BeckmannPlastic
         )
     }
 
@@ -260,31 +273,42 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
     match bsdf {
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
         Bsdf::Conductor(c) if c.facets.is_none() && !c.schlick => Kernel::SmoothConductor,
-        Bsdf::Conductor(c) if takes_conductor_kernel(c) => Kernel::RoughConductor,
+        Bsdf::Conductor(c) => match conductor_facets(c) {
+            Some(false) => Kernel::RoughConductor,
+            Some(true) => Kernel::BeckmannConductor,
+            None => Kernel::General,
+        },
         Bsdf::Dielectric(d) if d.facets.is_none() && !d.schlick && !d.dispersive => Kernel::SmoothDielectric,
-        Bsdf::Dielectric(d) if takes_dielectric_kernel(d) => Kernel::RoughDielectric,
+        Bsdf::Dielectric(d) => match dielectric_facets(d) {
+            Some(false) => Kernel::RoughDielectric,
+            Some(true) => Kernel::BeckmannDielectric,
+            None => Kernel::General,
+        },
         Bsdf::Plastic(p) if p.facets.is_none() => Kernel::SmoothPlastic,
-        Bsdf::Plastic(p) if takes_plastic_kernel(p) => Kernel::RoughPlastic,
+        Bsdf::Plastic(p) => match plastic_facets(p) {
+            Some(false) => Kernel::RoughPlastic,
+            Some(true) => Kernel::BeckmannPlastic,
+            None => Kernel::General,
+        },
         _ => Kernel::General,
     }
 }
 
-/// A conductor the rough-conductor kernel evaluates: Trowbridge–Reitz facets with Smith's
-/// shadowing (the lanes' [`Microfacet::trowbridge_reitz_smith`]), the exact Fresnel term.
-fn takes_conductor_kernel(c: &Conductor) -> bool {
-    !c.schlick && c.facets.is_some_and(|f| f.is_trowbridge_reitz_smith())
+/// For a conductor a rough kernel evaluates — Trowbridge–Reitz or Beckmann facets with Smith's
+/// shadowing (the lanes' [`Microfacet::smith`]), the exact Fresnel term — whether its facets
+/// are Beckmann's.
+fn conductor_facets(c: &Conductor) -> Option<bool> {
+    c.facets.filter(|_| !c.schlick)?.smith_kind()
 }
 
-/// A dielectric the rough-dielectric kernel evaluates: Trowbridge–Reitz facets with Smith's
-/// shadowing, the exact Fresnel term, one index for every colour.
-fn takes_dielectric_kernel(d: &Dielectric) -> bool {
-    !d.schlick && !d.dispersive && d.facets.is_some_and(|f| f.is_trowbridge_reitz_smith())
+/// [`conductor_facets`] for a dielectric of one index for every colour.
+fn dielectric_facets(d: &Dielectric) -> Option<bool> {
+    d.facets.filter(|_| !d.schlick && !d.dispersive)?.smith_kind()
 }
 
-/// A plastic the rough-plastic kernel evaluates: a coat of isotropic Trowbridge–Reitz facets
-/// with Smith's shadowing.
-fn takes_plastic_kernel(p: &Plastic) -> bool {
-    p.facets.is_some_and(|f| f.is_trowbridge_reitz_smith() && f.alpha_u == f.alpha_v)
+/// [`conductor_facets`] for plastic: a coat of isotropic facets.
+fn plastic_facets(p: &Plastic) -> Option<bool> {
+    p.facets.filter(|f| f.alpha_u == f.alpha_v)?.smith_kind()
 }
 
 impl PathTracer<'_> {
@@ -620,19 +644,19 @@ impl LaneBsdf for Lambertian {
 
 /// A rough conductor: [`Conductor::rough_eval_pdf`] and [`Conductor::rough_sample`] on
 /// Trowbridge–Reitz facets with Smith's shadowing, a tangent frame where it is anisotropic.
-struct RoughConductor;
+struct RoughConductor<const BECKMANN: bool>;
 
-impl RoughConductor {
+impl<const BECKMANN: bool> RoughConductor<BECKMANN> {
     /// Lane `i`'s conductor and its facets, their kinds constants the compiler folds.
     #[inline(always)]
     fn at(v: &Vertices, i: usize) -> (Conductor, Microfacet) {
-        let facets = Microfacet::trowbridge_reitz_smith(v.alpha[0][i], v.alpha[1][i]);
+        let facets = Microfacet::smith::<BECKMANN>(v.alpha[0][i], v.alpha[1][i]);
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         (Conductor { facets: Some(facets), eta, k, tint, schlick: false }, facets)
     }
 }
 
-impl LaneBsdf for RoughConductor {
+impl<const BECKMANN: bool> LaneBsdf for RoughConductor<BECKMANN> {
     #[inline(always)]
     fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
         facets_frame(v, i, ns)
@@ -661,18 +685,18 @@ fn facets_frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
 
 /// A rough dielectric: [`Dielectric::rough_eval_pdf`] and [`Dielectric::rough_sample`] on
 /// Trowbridge–Reitz facets with Smith's shadowing.
-struct RoughDielectric;
+struct RoughDielectric<const BECKMANN: bool>;
 
-impl RoughDielectric {
+impl<const BECKMANN: bool> RoughDielectric<BECKMANN> {
     /// Lane `i`'s boundary and its facets, their kinds constants the compiler folds.
     #[inline(always)]
     fn at(v: &Vertices, i: usize) -> (Dielectric, Microfacet) {
-        let facets = Microfacet::trowbridge_reitz_smith(v.alpha[0][i], v.alpha[1][i]);
+        let facets = Microfacet::smith::<BECKMANN>(v.alpha[0][i], v.alpha[1][i]);
         (Dielectric { facets: Some(facets), eta: v.ior[i], schlick: false, dispersive: false }, facets)
     }
 }
 
-impl LaneBsdf for RoughDielectric {
+impl<const BECKMANN: bool> LaneBsdf for RoughDielectric<BECKMANN> {
     const TRANSMITS: bool = true;
 
     #[inline(always)]
@@ -694,20 +718,20 @@ impl LaneBsdf for RoughDielectric {
 }
 
 /// Plastic under a rough coat: [`Plastic::rough_eval_pdf`] and [`Plastic::rough_sample`].
-struct RoughPlastic;
+struct RoughPlastic<const BECKMANN: bool>;
 
-impl RoughPlastic {
+impl<const BECKMANN: bool> RoughPlastic<BECKMANN> {
     /// Lane `i`'s plastic and its coat's facets, their kinds constants the compiler folds.
     #[inline(always)]
     fn at(v: &Vertices, i: usize) -> (Plastic, Microfacet) {
-        let facets = Microfacet::trowbridge_reitz_smith(v.alpha[0][i], v.alpha[1][i]);
+        let facets = Microfacet::smith::<BECKMANN>(v.alpha[0][i], v.alpha[1][i]);
         let coat = v.coat[i].unwrap_or(&Coat::NONE);
         let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear[i]);
         (Plastic { albedo, eta, facets: Some(facets), nonlinear, coat }, facets)
     }
 }
 
-impl LaneBsdf for RoughPlastic {
+impl<const BECKMANN: bool> LaneBsdf for RoughPlastic<BECKMANN> {
     #[inline(always)]
     fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
         Frame::around(ns)
@@ -804,9 +828,12 @@ impl LaneBsdf for SmoothPlastic {
 fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
     match kernel {
         Kernel::Lambert => shade::<Lambertian>(v, out, unit),
-        Kernel::RoughConductor => shade::<RoughConductor>(v, out, unit),
-        Kernel::RoughDielectric => shade::<RoughDielectric>(v, out, unit),
-        Kernel::RoughPlastic => shade::<RoughPlastic>(v, out, unit),
+        Kernel::RoughConductor => shade::<RoughConductor<false>>(v, out, unit),
+        Kernel::RoughDielectric => shade::<RoughDielectric<false>>(v, out, unit),
+        Kernel::RoughPlastic => shade::<RoughPlastic<false>>(v, out, unit),
+        Kernel::BeckmannConductor => shade::<RoughConductor<true>>(v, out, unit),
+        Kernel::BeckmannDielectric => shade::<RoughDielectric<true>>(v, out, unit),
+        Kernel::BeckmannPlastic => shade::<RoughPlastic<true>>(v, out, unit),
         Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, out, unit),
@@ -930,7 +957,8 @@ mod tests {
 
     /// A scene of every kind of material and light: Lambert, Oren–Nayar, Cook–Torrance and
     /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
-    /// and bump-mapped) and a smooth one, rough plastics (one textured) and a smooth one, a mirror
+    /// and bump-mapped, one of Beckmann facets) and a smooth one, rough plastics (one textured,
+    /// one of Beckmann facets) and a smooth one, Beckmann glass, a mirror
     /// (with specular connections), spheres, boxes and a plane, an emitting box (triangles)
     /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
@@ -986,6 +1014,21 @@ shape = "box"
 min = [1.8, 0, 1.6]
 max = [2.3, 0.5, 2.1]
 material = { bsdf = { type = "plastic", ior = 1.5, color = [0.7, 0.6, 0.2] } }
+[[object]]
+shape = "sphere"
+center = [-2.6, 1.5, -0.5]
+radius = 0.45
+material = { bsdf = { type = "conductor", roughness = 0.12, distribution = "beckmann", eta = [0.2, 0.4, 1.4], k = [3.9, 2.4, 1.6] } }
+[[object]]
+shape = "sphere"
+center = [0.0, 1.9, 1.0]
+radius = 0.3
+material = { bsdf = { type = "dielectric", roughness = 0.2, distribution = "beckmann", ior = 1.33 } }
+[[object]]
+shape = "sphere"
+center = [1.3, 0.3, 3.0]
+radius = 0.3
+material = { bsdf = { type = "plastic", roughness = 0.25, distribution = "beckmann", ior = 1.5, color = [0.3, 0.3, 0.8] } }
 [[object]]
 shape = "sphere"
 center = [0.9, 0.25, 2.4]
