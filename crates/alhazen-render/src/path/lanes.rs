@@ -14,7 +14,8 @@
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
 //! and specular connection. In RGB scenes without specular connections, vertices on Lambert
-//! surfaces, on conductors and glass (smooth, or rough of Trowbridge–Reitz facets) and on
+//! surfaces, on conductors and glass (smooth, or rough of Trowbridge–Reitz or Beckmann
+//! facets) and on
 //! plastic — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
 //! instead: their random numbers, emission, material and bent normal per lane ([`PathTracer::kernel_vertex`]), then light points on
 //! parallelogram lights ([`sample_lights`]) and the shading frame, next-event weights, bump
@@ -191,11 +192,11 @@ pub(crate) enum Kernel {
     /// Lambert: textured or not, bump-mapped or not.
     Lambert,
     /// A rough conductor of Trowbridge–Reitz facets with Smith's shadowing and the exact
-    /// Fresnel term ([`takes_conductor_kernel`]): textured or not, bump-mapped or not,
-    /// anisotropic or not.
+    /// Fresnel term ([`conductor_facets`]): textured or not, bump-mapped or not, anisotropic
+    /// or not.
     RoughConductor,
     /// A rough dielectric of Trowbridge–Reitz facets with Smith's shadowing, the exact
-    /// Fresnel term and an index that does not disperse ([`takes_dielectric_kernel`]).
+    /// Fresnel term and an index that does not disperse ([`dielectric_facets`]).
     RoughDielectric,
     /// Plastic under a rough coat of Trowbridge–Reitz facets with Smith's shadowing.
     RoughPlastic,
@@ -643,7 +644,8 @@ impl LaneBsdf for Lambertian {
 }
 
 /// A rough conductor: [`Conductor::rough_eval_pdf`] and [`Conductor::rough_sample`] on
-/// Trowbridge–Reitz facets with Smith's shadowing, a tangent frame where it is anisotropic.
+/// Trowbridge–Reitz (or Beckmann) facets with Smith's shadowing, a tangent frame where it is
+/// anisotropic.
 struct RoughConductor<const BECKMANN: bool>;
 
 impl<const BECKMANN: bool> RoughConductor<BECKMANN> {
@@ -684,7 +686,7 @@ fn facets_frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
 }
 
 /// A rough dielectric: [`Dielectric::rough_eval_pdf`] and [`Dielectric::rough_sample`] on
-/// Trowbridge–Reitz facets with Smith's shadowing.
+/// Trowbridge–Reitz (or Beckmann) facets with Smith's shadowing.
 struct RoughDielectric<const BECKMANN: bool>;
 
 impl<const BECKMANN: bool> RoughDielectric<BECKMANN> {
