@@ -14,13 +14,13 @@
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
 //! and specular connection. In RGB scenes without specular connections, vertices on Lambert
-//! surfaces, on conductors and glass (smooth, or rough of Trowbridge–Reitz or Beckmann
-//! facets) and on
-//! plastic — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
-//! instead: their random numbers, emission, material and bent normal per lane ([`PathTracer::kernel_vertex`]), then light points on
-//! parallelogram lights ([`sample_lights`]) and the shading frame, next-event weights, bump
-//! shadowing, sampled continuation and Russian roulette ([`shade`]) for all lanes at once,
-//! loops without branches the compiler turns into AVX-512 or AVX2 code. The kernels evaluate
+//! surfaces, on conductors, glass and plastic (smooth, or rough of Trowbridge–Reitz or
+//! Beckmann facets) — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
+//! instead: their random numbers, emission, material and bent normal per lane
+//! ([`PathTracer::kernel_vertex`]), then light points on parallelogram lights
+//! ([`sample_lights`]) and the shading frame, next-event weights, bump shadowing, sampled
+//! continuation and Russian roulette ([`shade`]) for all lanes at once, loops without branches
+//! the compiler turns into AVX-512 or AVX2 code. The kernels evaluate
 //! and sample the BSDFs through the per-path tracer's own functions ([`LaneBsdf`]), written to
 //! compute whole and then choose, so the two tracers share one implementation of each.
 //!
