@@ -610,10 +610,18 @@ trait LaneBsdf {
     /// The BSDF transmits: the shading frame is not turned to the viewer, and light may come
     /// from either side of the geometry.
     const TRANSMITS: bool = false;
-    /// The local frame around the shading normal `ns` ([`PathTracer::shading_frame`]'s).
-    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame;
-    /// `ρ` and the sampling density towards `l`, seen from `wv` (local): `Bsdf::eval_pdf`.
-    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64);
+    /// The local frame around the shading normal `ns` ([`PathTracer::shading_frame`]'s):
+    /// around the normal unless the BSDF turns with a tangent.
+    #[inline(always)]
+    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
+        Frame::around(ns)
+    }
+    /// `ρ` and the sampling density towards `l`, seen from `wv` (local): `Bsdf::eval_pdf`;
+    /// nothing for a delta distribution (the default).
+    #[inline(always)]
+    fn eval_pdf(_: &Vertices, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
+        (Vec3::ZERO, 0.0)
+    }
     /// The continuation drawn with the numbers `uc, u`, as `Bsdf::sample` draws it: whether
     /// there is one, and the sample.
     fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
@@ -623,11 +631,6 @@ trait LaneBsdf {
 struct Lambertian;
 
 impl LaneBsdf for Lambertian {
-    #[inline(always)]
-    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
-        Frame::around(ns)
-    }
-
     #[inline(always)]
     fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let rho = get(&v.albedo, i) * FRAC_1_PI;
@@ -643,112 +646,114 @@ impl LaneBsdf for Lambertian {
     }
 }
 
-/// A rough conductor: [`Conductor::rough_eval_pdf`] and [`Conductor::rough_sample`] on
-/// Trowbridge–Reitz (or Beckmann) facets with Smith's shadowing, a tangent frame where it is
-/// anisotropic.
-struct RoughConductor<const BECKMANN: bool>;
+/// A BSDF of microfacets a rough kernel ([`Rough`]) evaluates: built for lane `i` with the
+/// lane's facets, then evaluated and sampled through its own functions
+/// (`Conductor::rough_eval_pdf`, `Dielectric::rough_sample`, …).
+trait RoughBsdf {
+    /// The BSDF transmits ([`LaneBsdf::TRANSMITS`]).
+    const TRANSMITS: bool = false;
+    /// The BSDF may be anisotropic: a tangent frame where the lane has a tangent.
+    const TANGENT: bool = true;
+    /// Lane `i`'s BSDF on `facets`, its Fresnel mode a constant the compiler folds.
+    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self;
+    fn eval_pdf(&self, facets: &Microfacet, wv: Vec3, l: Vec3) -> (Vec3, f64);
+    fn sample(&self, facets: &Microfacet, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
+}
 
-impl<const BECKMANN: bool> RoughConductor<BECKMANN> {
-    /// Lane `i`'s conductor and its facets, their kinds constants the compiler folds.
+impl RoughBsdf for Conductor {
     #[inline(always)]
-    fn at(v: &Vertices, i: usize) -> (Conductor, Microfacet) {
-        let facets = Microfacet::smith::<BECKMANN>(v.alpha[0][i], v.alpha[1][i]);
+    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        (Conductor { facets: Some(facets), eta, k, tint, schlick: false }, facets)
-    }
-}
-
-impl<const BECKMANN: bool> LaneBsdf for RoughConductor<BECKMANN> {
-    #[inline(always)]
-    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
-        facets_frame(v, i, ns)
+        Conductor { facets: Some(facets), eta, k, tint, schlick: false }
     }
 
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        let (conductor, facets) = Self::at(v, i);
-        conductor.rough_eval_pdf(&facets, wv, l)
+    fn eval_pdf(&self, facets: &Microfacet, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        self.rough_eval_pdf(facets, wv, l)
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
-        let (conductor, facets) = Self::at(v, i);
-        conductor.rough_sample(&facets, wv, u)
+    fn sample(&self, facets: &Microfacet, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
+        self.rough_sample(facets, wv, u)
     }
 }
 
-/// The frame of lane `i`'s microfacets: along its tangent where it is anisotropic
-/// (`Frame::new`), around the normal otherwise.
-#[inline(always)]
-fn facets_frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
-    let (along, around) = (Frame::new(ns, get(&v.tangent, i)), Frame::around(ns));
-    if v.tangent_given[i] { along } else { around }
-}
-
-/// A rough dielectric: [`Dielectric::rough_eval_pdf`] and [`Dielectric::rough_sample`] on
-/// Trowbridge–Reitz (or Beckmann) facets with Smith's shadowing.
-struct RoughDielectric<const BECKMANN: bool>;
-
-impl<const BECKMANN: bool> RoughDielectric<BECKMANN> {
-    /// Lane `i`'s boundary and its facets, their kinds constants the compiler folds.
-    #[inline(always)]
-    fn at(v: &Vertices, i: usize) -> (Dielectric, Microfacet) {
-        let facets = Microfacet::smith::<BECKMANN>(v.alpha[0][i], v.alpha[1][i]);
-        (Dielectric { facets: Some(facets), eta: v.ior[i], schlick: false, dispersive: false }, facets)
-    }
-}
-
-impl<const BECKMANN: bool> LaneBsdf for RoughDielectric<BECKMANN> {
+impl RoughBsdf for Dielectric {
     const TRANSMITS: bool = true;
 
     #[inline(always)]
-    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
-        facets_frame(v, i, ns)
+    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
+        Dielectric { facets: Some(facets), eta: v.ior[i], schlick: false, dispersive: false }
     }
 
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        let (dielectric, facets) = Self::at(v, i);
-        dielectric.rough_eval_pdf(&facets, wv, l)
+    fn eval_pdf(&self, facets: &Microfacet, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        self.rough_eval_pdf(facets, wv, l)
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        let (dielectric, facets) = Self::at(v, i);
-        dielectric.rough_sample(&facets, wv, uc, u)
+    fn sample(&self, facets: &Microfacet, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        self.rough_sample(facets, wv, uc, u)
     }
 }
 
-/// Plastic under a rough coat: [`Plastic::rough_eval_pdf`] and [`Plastic::rough_sample`].
-struct RoughPlastic<const BECKMANN: bool>;
+impl RoughBsdf for Plastic {
+    /// A plastic's coat takes one roughness.
+    const TANGENT: bool = false;
 
-impl<const BECKMANN: bool> RoughPlastic<BECKMANN> {
-    /// Lane `i`'s plastic and its coat's facets, their kinds constants the compiler folds.
     #[inline(always)]
-    fn at(v: &Vertices, i: usize) -> (Plastic, Microfacet) {
+    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
+        plastic_at(v, i, Some(facets))
+    }
+
+    #[inline(always)]
+    fn eval_pdf(&self, facets: &Microfacet, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        self.rough_eval_pdf(facets, wv, l)
+    }
+
+    #[inline(always)]
+    fn sample(&self, facets: &Microfacet, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        self.rough_sample(facets, wv, uc, u)
+    }
+}
+
+/// A rough conductor, dielectric or plastic (`B`) on Trowbridge–Reitz or, with `BECKMANN`,
+/// Beckmann facets with Smith's shadowing (their kind a constant the compiler folds), in a
+/// tangent frame where it is anisotropic.
+struct Rough<B, const BECKMANN: bool>(std::marker::PhantomData<B>);
+
+impl<B: RoughBsdf, const BECKMANN: bool> Rough<B, BECKMANN> {
+    /// Lane `i`'s BSDF and its facets.
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> (B, Microfacet) {
         let facets = Microfacet::smith::<BECKMANN>(v.alpha[0][i], v.alpha[1][i]);
-        let coat = v.coat[i].unwrap_or(&Coat::NONE);
-        let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear[i]);
-        (Plastic { albedo, eta, facets: Some(facets), nonlinear, coat }, facets)
+        (B::at(v, i, facets), facets)
     }
 }
 
-impl<const BECKMANN: bool> LaneBsdf for RoughPlastic<BECKMANN> {
+impl<B: RoughBsdf, const BECKMANN: bool> LaneBsdf for Rough<B, BECKMANN> {
+    const TRANSMITS: bool = B::TRANSMITS;
+
     #[inline(always)]
-    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
-        Frame::around(ns)
+    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
+        let around = Frame::around(ns);
+        if !B::TANGENT {
+            return around;
+        }
+        let along = Frame::new(ns, get(&v.tangent, i));
+        if v.tangent_given[i] { along } else { around }
     }
 
     #[inline(always)]
     fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        let (plastic, facets) = Self::at(v, i);
-        plastic.rough_eval_pdf(&facets, wv, l)
+        let (bsdf, facets) = Self::at(v, i);
+        bsdf.eval_pdf(&facets, wv, l)
     }
 
     #[inline(always)]
     fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        let (plastic, facets) = Self::at(v, i);
-        plastic.rough_sample(&facets, wv, uc, u)
+        let (bsdf, facets) = Self::at(v, i);
+        bsdf.sample(&facets, wv, uc, u)
     }
 }
 
@@ -756,16 +761,6 @@ impl<const BECKMANN: bool> LaneBsdf for RoughPlastic<BECKMANN> {
 struct SmoothConductor;
 
 impl LaneBsdf for SmoothConductor {
-    #[inline(always)]
-    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
-        Frame::around(ns)
-    }
-
-    #[inline(always)]
-    fn eval_pdf(_: &Vertices, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
-        (Vec3::ZERO, 0.0)
-    }
-
     #[inline(always)]
     fn sample(v: &Vertices, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
@@ -780,16 +775,6 @@ impl LaneBsdf for SmoothDielectric {
     const TRANSMITS: bool = true;
 
     #[inline(always)]
-    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
-        Frame::around(ns)
-    }
-
-    #[inline(always)]
-    fn eval_pdf(_: &Vertices, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
-        (Vec3::ZERO, 0.0)
-    }
-
-    #[inline(always)]
     fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
         Dielectric { facets: None, eta: v.ior[i], schlick: false, dispersive: false }.smooth_sample(wv, uc)
     }
@@ -799,30 +784,23 @@ impl LaneBsdf for SmoothDielectric {
 /// [`Plastic::smooth_sample`] (the coat's mirror or the base).
 struct SmoothPlastic;
 
-impl SmoothPlastic {
-    /// Lane `i`'s plastic.
-    #[inline(always)]
-    fn at(v: &Vertices, i: usize) -> Plastic {
-        let coat = v.coat[i].unwrap_or(&Coat::NONE);
-        let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear[i]);
-        Plastic { albedo, eta, facets: None, nonlinear, coat }
-    }
+/// Lane `i`'s plastic, its coat on `facets` (smooth for `None`).
+#[inline(always)]
+fn plastic_at(v: &Vertices, i: usize, facets: Option<Microfacet>) -> Plastic {
+    let coat = v.coat[i].unwrap_or(&Coat::NONE);
+    let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear[i]);
+    Plastic { albedo, eta, facets, nonlinear, coat }
 }
 
 impl LaneBsdf for SmoothPlastic {
     #[inline(always)]
-    fn frame(_: &Vertices, _: usize, ns: Vec3) -> Frame {
-        Frame::around(ns)
-    }
-
-    #[inline(always)]
     fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        Self::at(v, i).smooth_eval_pdf(wv, l)
+        plastic_at(v, i, None).smooth_eval_pdf(wv, l)
     }
 
     #[inline(always)]
     fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        Self::at(v, i).smooth_sample(wv, uc, u)
+        plastic_at(v, i, None).smooth_sample(wv, uc, u)
     }
 }
 
@@ -830,12 +808,12 @@ impl LaneBsdf for SmoothPlastic {
 fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
     match kernel {
         Kernel::Lambert => shade::<Lambertian>(v, out, unit),
-        Kernel::RoughConductor => shade::<RoughConductor<false>>(v, out, unit),
-        Kernel::RoughDielectric => shade::<RoughDielectric<false>>(v, out, unit),
-        Kernel::RoughPlastic => shade::<RoughPlastic<false>>(v, out, unit),
-        Kernel::BeckmannConductor => shade::<RoughConductor<true>>(v, out, unit),
-        Kernel::BeckmannDielectric => shade::<RoughDielectric<true>>(v, out, unit),
-        Kernel::BeckmannPlastic => shade::<RoughPlastic<true>>(v, out, unit),
+        Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, out, unit),
+        Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, out, unit),
+        Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, out, unit),
+        Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, out, unit),
+        Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, out, unit),
+        Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, out, unit),
         Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, out, unit),
