@@ -7,7 +7,7 @@
 //! `tint` (a multiplier, 1 is physical), Fresnel mode. `η = κ = 0` is an ideal mirror (`F = tint`).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, half_vector, reflect, same_side};
+use super::{BsdfSample, MicrofacetLobes, half_vector, reflect, same_side};
 use alhazen_math::{Vec2, Vec3};
 
 /// A conductor.
@@ -103,24 +103,10 @@ impl Conductor {
         self.rough_eval_pdf(f, v, l)
     }
 
-    /// [`Self::eval_pdf`] of the rough conductor of `facets` (this conductor's), computed whole
-    /// and then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
-    #[inline(always)]
-    pub(crate) fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
-        let h = (v + l).normalize_or_zero();
-        let valid = same_side(v, l) && h != Vec3::ZERO;
-        // `half_vector`'s normal, turned to the upper hemisphere.
-        let h = h * h.z.signum();
-        let d = facets.d(h);
-        let value = self.fresnel(h.dot(l)) * (d * facets.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()));
-        let pdf = facets.pdf_h_from(v, h, d) / (4.0 * h.dot(v).abs());
-        if valid { (value, pdf) } else { (Vec3::ZERO, 0.0) }
-    }
-
     /// The mirror direction, or reflection about a sampled facet.
     pub fn sample(&self, v: Vec3, _uc: f64, u: Vec2) -> Option<BsdfSample> {
         let Some(facets) = &self.facets else { return Some(self.smooth_sample(v)) };
-        let (sampled, sample) = self.rough_sample(facets, v, u);
+        let (sampled, sample) = self.rough_sample(facets, v, 0.0, u);
         sampled.then_some(sample)
     }
 
@@ -131,12 +117,28 @@ impl Conductor {
         let f = self.fresnel(v.z) / v.z.abs();
         BsdfSample { l, f, pdf: 1.0, delta: true, eta: 1.0, dispersive: false }
     }
+}
+
+impl MicrofacetLobes for Conductor {
+    /// [`Self::eval_pdf`] of the rough conductor of `facets` (this conductor's), computed whole
+    /// and then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
+    #[inline(always)]
+    fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let h = (v + l).normalize_or_zero();
+        let valid = same_side(v, l) && h != Vec3::ZERO;
+        // `half_vector`'s normal, turned to the upper hemisphere.
+        let h = h * h.z.signum();
+        let d = facets.d(h);
+        let value = self.fresnel(h.dot(l)) * (d * facets.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()));
+        let pdf = facets.pdf_h_from(v, h, d) / (4.0 * h.dot(v).abs());
+        if valid { (value, pdf) } else { (Vec3::ZERO, 0.0) }
+    }
 
     /// Reflection of `v` about a facet of `facets` (this conductor's) drawn with the numbers
-    /// `u`: whether there is one (a facet, and a positive density) and the sample. Computed
+    /// `u` (one lobe: `uc` is not needed): whether there is one (a facet, and a positive density) and the sample. Computed
     /// whole and then chosen, for the lanes as for [`Self::sample`].
     #[inline(always)]
-    pub(crate) fn rough_sample(&self, facets: &Microfacet, v: Vec3, u: Vec2) -> (bool, BsdfSample) {
+    fn rough_sample(&self, facets: &Microfacet, v: Vec3, _uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let h = facets.sample_h_from(v, u);
         let l = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
         let (f, pdf) = self.rough_eval_pdf(facets, v, l);

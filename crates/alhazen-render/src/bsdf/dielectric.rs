@@ -14,7 +14,7 @@
 //! dispersive), optional microfacets, Fresnel mode, `dispersive` (marks refracted samples).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, reflect, refract_whole};
+use super::{BsdfSample, MicrofacetLobes, reflect, refract_whole};
 use crate::optics::{fresnel_dielectric, fresnel_schlick};
 use alhazen_math::{Vec2, Vec3};
 
@@ -100,23 +100,6 @@ impl Dielectric {
         self.rough_eval_pdf(f, v, l)
     }
 
-    /// [`Self::eval_pdf`] of the rough boundary of `facets` (this one's), computed whole and
-    /// then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
-    #[inline(always)]
-    pub(crate) fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
-        let (valid, h, etap) = self.half_whole(v, l);
-        let fr = self.fresnel(v.dot(h));
-        let d = facets.d(h);
-        let (dg, pdf_h) = (d * facets.g(v, l, h), facets.pdf_h_from(v, h, d));
-        let reflected = (Vec3::splat(dg * fr / (4.0 * (l.z * v.z).abs())), pdf_h / (4.0 * v.dot(h).abs()) * fr);
-        let denom = (l.dot(h) + v.dot(h) / etap).powi(2) * (l.z * v.z).abs();
-        let value = dg * (1.0 - fr) * (l.dot(h) * v.dot(h)).abs() / denom / (etap * etap);
-        let jacobian = l.dot(h).abs() / (l.dot(h) + v.dot(h) / etap).powi(2);
-        let refracted = (Vec3::splat(value), pdf_h * jacobian * (1.0 - fr));
-        let (value, pdf) = if etap == 1.0 { reflected } else { refracted };
-        if valid { (value, pdf) } else { (Vec3::ZERO, 0.0) }
-    }
-
     /// Reflects with probability `F`, else refracts (about the normal or a sampled facet).
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         if let Some(facets) = &self.facets {
@@ -153,13 +136,32 @@ impl Dielectric {
         };
         (front && side_ok, sample)
     }
+}
+
+impl MicrofacetLobes for Dielectric {
+    /// [`Self::eval_pdf`] of the rough boundary of `facets` (this one's), computed whole and
+    /// then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
+    #[inline(always)]
+    fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (valid, h, etap) = self.half_whole(v, l);
+        let fr = self.fresnel(v.dot(h));
+        let d = facets.d(h);
+        let (dg, pdf_h) = (d * facets.g(v, l, h), facets.pdf_h_from(v, h, d));
+        let reflected = (Vec3::splat(dg * fr / (4.0 * (l.z * v.z).abs())), pdf_h / (4.0 * v.dot(h).abs()) * fr);
+        let denom = (l.dot(h) + v.dot(h) / etap).powi(2) * (l.z * v.z).abs();
+        let value = dg * (1.0 - fr) * (l.dot(h) * v.dot(h)).abs() / denom / (etap * etap);
+        let jacobian = l.dot(h).abs() / (l.dot(h) + v.dot(h) / etap).powi(2);
+        let refracted = (Vec3::splat(value), pdf_h * jacobian * (1.0 - fr));
+        let (value, pdf) = if etap == 1.0 { reflected } else { refracted };
+        if valid { (value, pdf) } else { (Vec3::ZERO, 0.0) }
+    }
 
     /// Reflection (with probability `F`, when `uc < F`) or refraction of `v` about a facet of
     /// `facets` (this boundary's) drawn with the numbers `u`: whether there is one (a facet
     /// seen from the front, a direction on the right side, a positive density) and the sample.
     /// Computed whole and then chosen, for the lanes as for [`Self::sample`].
     #[inline(always)]
-    pub(crate) fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let h = facets.sample_h_from(v, u);
         let (found, h) = (h.is_some(), h.unwrap_or(Vec3::Z));
         // A facet seen from behind: `pdf` gives such `l` no density. (NaNs pass every test

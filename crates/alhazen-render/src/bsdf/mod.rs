@@ -223,6 +223,17 @@ pub(crate) fn cosine_pdf(v: Vec3, l: Vec3) -> f64 {
     if same_side(v, l) { l.z.abs() / PI } else { 0.0 }
 }
 
+/// The lobes of a BSDF of microfacets (a rough conductor, dielectric or plastic) on given
+/// facets, computed whole and then chosen: the per-path tracer evaluates its BSDF through them,
+/// and the path tracer's lanes with the facets' kind a constant the compiler folds.
+pub(crate) trait MicrofacetLobes {
+    /// `eval_pdf` on `facets`.
+    fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64);
+    /// `sample` on `facets` with the numbers `uc` (a lobe, where there are several) and `u`:
+    /// whether there is a sample, and the sample.
+    fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
+}
+
 /// Mirror of `v` about `n` (both local).
 #[inline]
 pub(crate) fn reflect(v: Vec3, n: Vec3) -> Vec3 {

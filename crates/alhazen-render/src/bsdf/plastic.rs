@@ -21,7 +21,9 @@
 //! than Mitsuba's (its `plastic` uses a fit within 0.1 % of the integral; BENCHMARKS.md).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, cosine_hemisphere, cosine_pdf, lobe_probability, reflect, refract, same_side};
+use super::{
+    BsdfSample, MicrofacetLobes, cosine_hemisphere, cosine_pdf, lobe_probability, reflect, refract, same_side,
+};
 use crate::optics::fresnel_dielectric;
 use alhazen_math::{Vec2, Vec3};
 use std::cell::RefCell;
@@ -38,12 +40,6 @@ const NODES: usize = 48;
 pub struct Coat {
     transmittance: [f64; TABLE],
     inner_reflectance: f64,
-}
-
-impl Coat {
-    /// A coat of no transmittance, where a coat is needed before one is known (the path
-    /// tracer's lanes without plastic).
-    pub(crate) const NONE: Coat = Coat { transmittance: [0.0; TABLE], inner_reflectance: 0.0 };
 }
 
 /// Plastic at one surface point.
@@ -146,16 +142,6 @@ impl Plastic {
         if same_side(v, l) { value } else { (Vec3::ZERO, 0.0) }
     }
 
-    /// [`Self::eval_pdf`] of the rough coat of `facets` (this plastic's), computed whole and
-    /// then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
-    #[inline(always)]
-    pub(crate) fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
-        let (coat, coat_pdf) = self.coat_lobe(facets, v, l);
-        let p = self.p_coat(v);
-        let value = (self.base(v, l) + Vec3::splat(coat), p * coat_pdf + (1.0 - p) * cosine_pdf(v, l));
-        if same_side(v, l) { value } else { (Vec3::ZERO, 0.0) }
-    }
-
     /// The coat or the base by `uc`, then a direction from it.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         if let Some(facets) = &self.facets {
@@ -183,22 +169,34 @@ impl Plastic {
         }
     }
 
+    /// True for a smooth coat (a mirror lobe).
+    pub fn has_mirror(&self) -> bool {
+        self.facets.is_none()
+    }
+}
+
+impl MicrofacetLobes for Plastic {
+    /// [`Self::eval_pdf`] of the rough coat of `facets` (this plastic's), computed whole and
+    /// then chosen, for the path tracer's lanes as much as for [`Self::eval_pdf`].
+    #[inline(always)]
+    fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (coat, coat_pdf) = self.coat_lobe(facets, v, l);
+        let p = self.p_coat(v);
+        let value = (self.base(v, l) + Vec3::splat(coat), p * coat_pdf + (1.0 - p) * cosine_pdf(v, l));
+        if same_side(v, l) { value } else { (Vec3::ZERO, 0.0) }
+    }
+
     /// [`Self::sample`] with the rough coat of `facets` (this plastic's): whether there is a
     /// sample (a facet where the coat is chosen, a positive density) and the sample. Computed
     /// whole and then chosen, for the lanes as for [`Self::sample`].
     #[inline(always)]
-    pub(crate) fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let coat = uc < self.p_coat(v);
         let h = facets.sample_h_from(v, u);
         let mirrored = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
         let l = if coat { mirrored } else { cosine_hemisphere(u, v) };
         let (f, pdf) = self.rough_eval_pdf(facets, v, l);
         ((!coat || h.is_some()) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
-    }
-
-    /// True for a smooth coat (a mirror lobe).
-    pub fn has_mirror(&self) -> bool {
-        self.facets.is_none()
     }
 }
 
@@ -220,6 +218,10 @@ thread_local! {
 }
 
 impl Coat {
+    /// A coat of no transmittance, where a coat is needed before one is known (the path
+    /// tracer's lanes without plastic).
+    pub(crate) const NONE: Coat = Coat { transmittance: [0.0; TABLE], inner_reflectance: 0.0 };
+
     /// The tables of a coat of index `eta` and roughness `facets`, computed once per process.
     pub fn of(eta: f64, facets: Option<&Microfacet>) -> &'static Coat {
         let k = key(eta, facets);

@@ -32,8 +32,8 @@
 
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic};
 use crate::bsdf::{
-    Bsdf, BsdfSample, Coat, ColorMode, Conductor, Dielectric, Frame, Microfacet, Plastic, cosine_hemisphere,
-    cosine_pdf, same_side,
+    Bsdf, BsdfSample, Coat, ColorMode, Conductor, Dielectric, Frame, Microfacet, MicrofacetLobes, Plastic,
+    cosine_hemisphere, cosine_pdf, same_side,
 };
 use crate::lights::{Emitter, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
@@ -647,17 +647,14 @@ impl LaneBsdf for Lambertian {
 }
 
 /// A BSDF of microfacets a rough kernel ([`Rough`]) evaluates: built for lane `i` with the
-/// lane's facets, then evaluated and sampled through its own functions
-/// (`Conductor::rough_eval_pdf`, `Dielectric::rough_sample`, …).
-trait RoughBsdf {
+/// lane's facets, then evaluated and sampled through its own [`MicrofacetLobes`].
+trait RoughBsdf: MicrofacetLobes {
     /// The BSDF transmits ([`LaneBsdf::TRANSMITS`]).
     const TRANSMITS: bool = false;
     /// The BSDF may be anisotropic: a tangent frame where the lane has a tangent.
     const TANGENT: bool = true;
     /// Lane `i`'s BSDF on `facets`, its Fresnel mode a constant the compiler folds.
     fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self;
-    fn eval_pdf(&self, facets: &Microfacet, wv: Vec3, l: Vec3) -> (Vec3, f64);
-    fn sample(&self, facets: &Microfacet, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
 }
 
 impl RoughBsdf for Conductor {
@@ -665,16 +662,6 @@ impl RoughBsdf for Conductor {
     fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         Conductor { facets: Some(facets), eta, k, tint, schlick: false }
-    }
-
-    #[inline(always)]
-    fn eval_pdf(&self, facets: &Microfacet, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        self.rough_eval_pdf(facets, wv, l)
-    }
-
-    #[inline(always)]
-    fn sample(&self, facets: &Microfacet, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
-        self.rough_sample(facets, wv, u)
     }
 }
 
@@ -685,16 +672,6 @@ impl RoughBsdf for Dielectric {
     fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
         Dielectric { facets: Some(facets), eta: v.ior[i], schlick: false, dispersive: false }
     }
-
-    #[inline(always)]
-    fn eval_pdf(&self, facets: &Microfacet, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        self.rough_eval_pdf(facets, wv, l)
-    }
-
-    #[inline(always)]
-    fn sample(&self, facets: &Microfacet, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        self.rough_sample(facets, wv, uc, u)
-    }
 }
 
 impl RoughBsdf for Plastic {
@@ -704,16 +681,6 @@ impl RoughBsdf for Plastic {
     #[inline(always)]
     fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
         plastic_at(v, i, Some(facets))
-    }
-
-    #[inline(always)]
-    fn eval_pdf(&self, facets: &Microfacet, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        self.rough_eval_pdf(facets, wv, l)
-    }
-
-    #[inline(always)]
-    fn sample(&self, facets: &Microfacet, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        self.rough_sample(facets, wv, uc, u)
     }
 }
 
@@ -747,13 +714,13 @@ impl<B: RoughBsdf, const BECKMANN: bool> LaneBsdf for Rough<B, BECKMANN> {
     #[inline(always)]
     fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let (bsdf, facets) = Self::at(v, i);
-        bsdf.eval_pdf(&facets, wv, l)
+        bsdf.rough_eval_pdf(&facets, wv, l)
     }
 
     #[inline(always)]
     fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let (bsdf, facets) = Self::at(v, i);
-        bsdf.sample(&facets, wv, uc, u)
+        bsdf.rough_sample(&facets, wv, uc, u)
     }
 }
 
