@@ -111,6 +111,29 @@ fn slice_start(j: usize, n: usize) -> f64 {
     j as f64 * (1.0 / n as f64)
 }
 
+/// The slice of `n` holding `u`: `u·n` rounded down, mended where that rounds across a slice's
+/// edge. The mending is rare and out of line: inlined, the compiler vectorised its loops into a
+/// long preamble every search ran through.
+#[inline(always)]
+pub(crate) fn slice_of(u: f64, n: usize) -> usize {
+    let j = ((u * n as f64) as usize).min(n - 1);
+    let below = j > 0 && u < slice_start(j, n);
+    let above = j + 1 < n && u >= slice_start(j + 1, n);
+    if below || above { mend_slice(u, j, n) } else { j }
+}
+
+#[cold]
+#[inline(never)]
+fn mend_slice(u: f64, mut j: usize, n: usize) -> usize {
+    while j > 0 && u < slice_start(j, n) {
+        j -= 1;
+    }
+    while j + 1 < n && u >= slice_start(j + 1, n) {
+        j += 1;
+    }
+    j
+}
+
 /// The guide table of a non-decreasing CDF of `n + 1` entries read by `entry`: for each slice
 /// start `j` in `0..=n`, how many entries are at most it.
 pub(crate) fn guide_table(n: usize, entry: impl Fn(usize) -> f64) -> impl Iterator<Item = usize> {
@@ -137,14 +160,7 @@ pub(crate) fn search_cdf(
 ) -> usize {
     let (mut lo, mut hi) = (0, n + 1);
     if let Some(guide) = guide {
-        // The slice holding u, mended where u·n rounds across a slice's edge.
-        let mut j = ((u * n as f64) as usize).min(n - 1);
-        while j > 0 && u < slice_start(j, n) {
-            j -= 1;
-        }
-        while j + 1 < n && u >= slice_start(j + 1, n) {
-            j += 1;
-        }
+        let j = slice_of(u, n);
         lo = if j == 0 { 0 } else { guide(j) };
         hi = if j + 1 < n { guide(j + 1) } else { n + 1 };
     }

@@ -14,7 +14,7 @@
 //! CDF apart from the radiance was no faster). Densities come from the same single-precision
 //! CDF as the sampling, so samples and lookups agree exactly.
 
-use crate::distribution::{Distribution1D, guide_table, search_cdf};
+use crate::distribution::{Distribution1D, guide_table, search_cdf, slice_of};
 use alhazen_math::{Vec2, Vec3, color::luminance};
 use alhazen_scene::ImageData;
 use std::f64::consts::PI;
@@ -139,6 +139,11 @@ impl EnvMap {
         (((x as f64 + du.clamp(0.0, 1.0)) / w as f64).min(1.0 - 1e-16), x)
     }
 
+    /// The guide slice `u` falls in.
+    fn slice(&self, u: f64) -> usize {
+        slice_of(u, self.width)
+    }
+
     fn to_uv(&self, dir: Vec3) -> Vec2 {
         alhazen_scene::texture::equirect_uv(dir, self.rotation)
     }
@@ -157,7 +162,36 @@ impl EnvMap {
 
     /// A direction with density ∝ power, its radiance and solid-angle density.
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, Vec3, f64)> {
+        self.sample_in(self.sample_row(u), u)
+    }
+
+    /// The first step of [`Self::sample`]: the row `u` falls in, its `v` and index, and the
+    /// row's guide entries for `u.x` asked of memory ([`prefetch`]), so that paths sampling
+    /// side by side wait for their rows together rather than one after another.
+    pub fn sample_row(&self, u: Vec2) -> (f64, usize) {
         let (v, y) = self.rows.sample_point(u.y);
+        if !self.guides.is_empty() {
+            prefetch(&self.guides[y * (self.width + 1) + self.slice(u.x)]);
+        }
+        (v, y)
+    }
+
+    /// The second step: the texels the search of row `y` for `u.x` will read, asked of memory
+    /// (their slice's guide entries read, which [`Self::sample_row`] asked for).
+    pub fn touch_texels(&self, (_, y): (f64, usize), u: Vec2) {
+        let (w, row) = (self.width, &self.texels[y * self.width..(y + 1) * self.width]);
+        let (lo, hi) = if self.guides.is_empty() {
+            (0, w)
+        } else {
+            let (j, guides) = (self.slice(u.x), &self.guides[y * (w + 1)..]);
+            (guides[j] as usize, guides[j + 1] as usize)
+        };
+        prefetch(&row[lo.saturating_sub(1).min(w - 1)]);
+        prefetch(&row[hi.min(w) - 1]);
+    }
+
+    /// [`Self::sample`] in row `row` ([`Self::sample_row`]`(u)`).
+    pub fn sample_in(&self, (v, y): (f64, usize), u: Vec2) -> Option<(Vec3, Vec3, f64)> {
         let (u, x) = self.sample_in_row(y, u.x);
         let (dir, sin) = self.to_dir(Vec2::new(u, v));
         // The texel sampled (not looked up again from the direction: the same texel but for
@@ -180,10 +214,38 @@ impl EnvMap {
         (self.radiance_of(texel), self.solid_angle_density(texel, polar_sine(dir)))
     }
 
+    /// [`Self::radiance_and_pdf`] of many directions (`None` where a lane has none): every
+    /// texel is asked of memory before any is read, so that the lanes' cache misses overlap.
+    pub fn radiance_and_pdf_lanes<const N: usize>(&self, dirs: &[Option<Vec3>; N]) -> [(Vec3, f64); N] {
+        let texels = dirs.map(|dir| {
+            let texel = self.texel_at(self.to_uv(dir?));
+            prefetch(&self.texels[texel.1 * self.width + texel.0]);
+            Some(texel)
+        });
+        std::array::from_fn(|i| match (texels[i], dirs[i]) {
+            (Some(texel), Some(dir)) => (self.radiance_of(texel), self.solid_angle_density(texel, polar_sine(dir))),
+            _ => (Vec3::ZERO, 0.0),
+        })
+    }
+
     /// The density of a direction in `texel` whose polar angle has sine `sin`.
     fn solid_angle_density(&self, texel: (usize, usize), sin: f64) -> f64 {
         if sin <= 0.0 { 0.0 } else { self.density_uv(texel) / (2.0 * PI * PI * sin) }
     }
+}
+
+/// Asks the processor to start loading the cache line holding `x` (a hint: never faults, never
+/// changes a result).
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(crate) fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: prefetching never faults; SSE is part of x86-64.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch((x as *const T).cast(), std::arch::x86_64::_MM_HINT_T0);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }
 
 /// The sine of unit direction `dir`'s angle from +y, without trigonometry.

@@ -97,6 +97,13 @@ pub enum PathLight {
     Background(Background),
 }
 
+/// An environment map's sample ([`EnvMap::sample`]) as a light sample.
+#[inline]
+fn env_sample(sample: Option<(Vec3, Vec3, f64)>) -> Option<LightSample> {
+    let (dir, radiance, pdf) = sample?;
+    Some(LightSample { dir, dist: f64::INFINITY, radiance, pdf, delta: false })
+}
+
 /// A point on a light seen from a shading point.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample {
@@ -120,6 +127,8 @@ pub struct Lights {
     by_object: Vec<Option<u32>>,
     /// The light that rays leaving the scene see.
     sky: Option<u32>,
+    /// Some light is an environment map.
+    has_environment: bool,
 }
 
 /// The world-space geometry of an emitting object, when it can be sampled.
@@ -218,7 +227,8 @@ impl Lights {
                 lights.push(PathLight::Area { emitter, radiance });
             }
         }
-        Self { lights, by_object, sky }
+        let has_environment = lights.iter().any(|l| matches!(l, PathLight::Environment(_)));
+        Self { lights, by_object, sky, has_environment }
     }
 
     /// Number of lights.
@@ -262,6 +272,22 @@ impl Lights {
             }
             Some(PathLight::Background(b)) => (b.radiance(dir), self.choice_pdf() / (4.0 * PI)),
             _ => (Vec3::ZERO, 0.0),
+        }
+    }
+
+    /// The sky is an environment map.
+    pub fn sky_is_environment(&self) -> bool {
+        matches!(self.sky.map(|i| &self.lights[i as usize]), Some(PathLight::Environment(_)))
+    }
+
+    /// [`Self::sky`] of many directions (`None` where a lane has none, whose result is zero),
+    /// an environment map's texels asked of memory for all lanes before any is read.
+    pub fn sky_lanes<const N: usize>(&self, dirs: &[Option<Vec3>; N]) -> [(Vec3, f64); N] {
+        match self.sky.map(|i| &self.lights[i as usize]) {
+            Some(PathLight::Environment(m)) => {
+                m.radiance_and_pdf_lanes(dirs).map(|(radiance, pdf)| (radiance, pdf * self.choice_pdf()))
+            }
+            _ => dirs.map(|d| d.map_or((Vec3::ZERO, 0.0), |d| self.sky(d))),
         }
     }
 
@@ -339,6 +365,54 @@ impl Lights {
         Some(s)
     }
 
+    /// Some light is an environment map: its samples and lookups wait for memory (its tables
+    /// outgrow the caches), so paths side by side do better to take them together
+    /// ([`Self::sample_lanes`], [`Self::sky_lanes`]).
+    pub fn has_environment(&self) -> bool {
+        self.has_environment
+    }
+
+    /// [`Self::sample`] for paths side by side, each lane's `(p, u_choice, u)` or `None`,
+    /// handing lane `i`'s sample to `found(i, sample)`: the same samples, but the rows and
+    /// texels of environment maps are asked of memory for every lane before any lane reads
+    /// them, so that the lanes' cache misses overlap.
+    #[inline]
+    pub fn sample_lanes<const N: usize>(
+        &self,
+        asks: &[Option<(Vec3, f64, Vec2)>; N],
+        mut found: impl FnMut(usize, Option<LightSample>),
+    ) {
+        let map = |i: usize| match (asks[i], self.has_environment) {
+            (Some((_, choice, u)), true) => match &self.lights[self.choose(choice)] {
+                PathLight::Environment(m) => Some((m.as_ref(), u)),
+                _ => None,
+            },
+            _ => None,
+        };
+        let mut rows = [None; N];
+        if self.has_environment {
+            for (i, row) in rows.iter_mut().enumerate() {
+                *row = map(i).map(|(m, u)| m.sample_row(u));
+            }
+            for (i, row) in rows.iter().enumerate() {
+                if let (Some((m, u)), Some(row)) = (map(i), row) {
+                    m.touch_texels(*row, u);
+                }
+            }
+        }
+        for (i, ask) in asks.iter().enumerate() {
+            let Some((p, choice, u)) = *ask else { continue };
+            let sample = match (rows[i], map(i)) {
+                (Some(row), Some((m, _))) => env_sample(m.sample_in(row, u)).map(|mut s| {
+                    s.pdf *= self.choice_pdf();
+                    s
+                }),
+                _ => self.sample(p, choice, u),
+            };
+            found(i, sample);
+        }
+    }
+
     /// A point of light `light` seen from `p`, chosen by `u`; its density leaves out the
     /// choice of the light.
     pub fn sample_light(&self, light: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
@@ -367,10 +441,7 @@ impl Lights {
                 pdf: 1.0,
                 delta: true,
             }),
-            PathLight::Environment(m) => {
-                let (dir, radiance, pdf) = m.sample(u)?;
-                Some(LightSample { dir, dist: f64::INFINITY, radiance, pdf, delta: false })
-            }
+            PathLight::Environment(m) => env_sample(m.sample(u)),
             PathLight::Background(b) => {
                 let dir = uniform_sphere(u);
                 let radiance = b.radiance(dir);

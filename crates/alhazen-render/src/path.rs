@@ -338,7 +338,12 @@ impl<'a> PathTracer<'a> {
     /// `radiance`, it pushed `Lights::sample` out (cornell-rough 7 % slower).
     #[inline(never)]
     fn escaped(&self, ray: &Ray, prev: &Previous, beta: Vec3, mode: ColorMode) -> Option<Vec3> {
-        let (le, pdf) = self.lights.sky(ray.dir);
+        self.escaped_from(self.lights.sky(ray.dir), prev, beta, mode)
+    }
+
+    /// [`Self::escaped`] with the sky's radiance and density along the ray looked up
+    /// ([`Lights::sky`]).
+    fn escaped_from(&self, (le, pdf): (Vec3, f64), prev: &Previous, beta: Vec3, mode: ColorMode) -> Option<Vec3> {
         if le == Vec3::ZERO {
             return None;
         }

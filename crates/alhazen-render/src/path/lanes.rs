@@ -5,11 +5,11 @@
 //!
 //! One bounce is a round of stages over the eight lanes: the rays' nearest hits in one call
 //! ([`crate::World::intersect_rays`]: in a world of one leaf, each flat against the eight rays
-//! at once, in AVX-512 or AVX2, then each ray's spheres and other objects; elsewhere ray by ray,
-//! inside the per-path stage); per path, the vertex; the shadow rays in one call
-//! ([`crate::World::unoccluded_rays`]), after which each path gathers its light and steps on. A
-//! lane whose path ends starts the next sample of the pixels it was given, so lanes stay busy
-//! until their samples run out.
+//! at once, in AVX-512 or AVX2, then each ray's spheres and other objects; elsewhere ray by
+//! ray); the sky seen by the rays that leave the scene ([`Lights::sky_lanes`]); per path, the
+//! vertex; the shadow rays in one call ([`crate::World::unoccluded_rays`]), after which each
+//! path gathers its light and steps on. A lane whose path ends starts the next sample of the
+//! pixels it was given, so lanes stay busy until their samples run out.
 //!
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
@@ -17,12 +17,14 @@
 //! surfaces, on conductors, glass and plastic (smooth, or rough of Trowbridge–Reitz or
 //! Beckmann facets) — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
 //! instead: their random numbers, emission, material and bent normal per lane
-//! ([`PathTracer::kernel_vertex`]), then light points on parallelogram lights
-//! ([`sample_lights`]) and the shading frame, next-event weights, bump shadowing, sampled
-//! continuation and Russian roulette ([`shade`]) for all lanes at once, loops without branches
-//! the compiler turns into AVX-512 or AVX2 code. The kernels evaluate
-//! and sample the BSDFs through the per-path tracer's own functions ([`LaneBsdf`]), written to
-//! compute whole and then choose, so the two tracers share one implementation of each.
+//! ([`PathTracer::kernel_vertex`]), then light points (on parallelogram lights in lanes,
+//! [`sample_lights`]; on other lights for all lanes at once, [`Lights::sample_lanes`], an
+//! environment map's memory asked for every lane before any lane waits for it) and the shading
+//! frame, next-event weights, bump shadowing, sampled continuation and Russian roulette
+//! ([`shade`]) for all lanes at once, loops without branches the compiler turns into AVX-512 or
+//! AVX2 code. The kernels evaluate and sample the BSDFs through the per-path tracer's own
+//! functions ([`LaneBsdf`]), written to compute whole and then choose, so the two tracers share
+//! one implementation of each.
 //!
 //! Every lane performs exactly the floating-point operations of [`PathTracer::radiance`], in
 //! the same order (no fused multiply–adds, no reassociation), draws the same numbers from its
@@ -35,7 +37,7 @@ use crate::bsdf::{
     Bsdf, BsdfSample, Coat, ColorMode, Conductor, Dielectric, Frame, Microfacet, MicrofacetLobes, Plastic,
     cosine_hemisphere, cosine_pdf, same_side,
 };
-use crate::lights::{Emitter, Lights};
+use crate::lights::{Emitter, LightSample, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
 use crate::shape::ray_epsilon;
 use crate::shape::{RayPacket, VectorUnit};
@@ -140,6 +142,9 @@ struct LightLanes {
     normal: Lanes3,
     pdf_area: Lanes,
     u: [Lanes; 2],
+    /// When some light is an environment map: what each lane asks of [`Lights::sample_lanes`]
+    /// (its point and numbers), `None` where it asks nothing.
+    asks: [Option<(Vec3, f64, Vec2)>; LANES],
 }
 
 /// What [`shade`] returns, lane by lane.
@@ -354,14 +359,38 @@ impl PathTracer<'_> {
             }
             if together {
                 self.world.intersect_rays(&rays, lanes.each_ref().map(|p| p.is_some()), &mut hits);
+            } else {
+                for (lane, hit) in lanes.iter().zip(&mut hits).filter_map(|(l, h)| Some((l.as_ref()?, h))) {
+                    *hit = self.world.intersect(&lane.path.ray, f64::INFINITY);
+                }
             }
+            // Rays that leave the scene see an environment map, looked up for all lanes together
+            // (other skies in `vertex`).
+            let escaping: [Option<Vec3>; LANES] = std::array::from_fn(|i| match &lanes[i] {
+                Some(lane)
+                    if hits[i].is_none()
+                        && lane.path.depth <= self.scene.render.max_depth
+                        && self.lights.sky_is_environment() =>
+                {
+                    Some(lane.path.ray.dir)
+                }
+                _ => None,
+            });
+            let skies = escaping.iter().any(Option::is_some).then(|| self.lights.sky_lanes(&escaping));
             let mut kernels = [Kernel::Idle; LANES];
             let mut tested = [false; LANES];
+            lights.asks = [None; LANES];
             for (i, (slot, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
                 let Some(lane) = slot else { continue };
-                // Traced here when not together: a local hit costs no copy into `hits`.
-                let alone = if together { None } else { self.world.intersect(&lane.path.ray, f64::INFINITY) };
-                let hit = if together { hit.as_ref() } else { alone.as_ref() };
+                if let (Some(_), Some(skies)) = (escaping[i], &skies) {
+                    // As `vertex` ends a path whose ray leaves the scene.
+                    kernels[i] = Kernel::General;
+                    general[i] = Vertex { beta: lane.path.beta, ..Vertex::default() };
+                    let path = &mut lane.path;
+                    path.l += self.escaped_from(skies[i], &path.prev, path.beta, lane.mode).unwrap_or(Vec3::ZERO);
+                    continue;
+                }
+                let hit = hit.as_ref();
                 kernels[i] = self.kernel_vertex(lane, hit, (&mut vertices, &mut lights), i);
                 if kernels[i] != Kernel::General {
                     continue;
@@ -375,6 +404,8 @@ impl PathTracer<'_> {
             if kernels.iter().any(|k| k.is_material()) {
                 if self.lane_lights.is_some() {
                     sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
+                } else if self.lights.has_environment() {
+                    self.lights.sample_lanes(&lights.asks, |i, sample| set_light(&mut vertices, i, sample));
                 }
                 for (kernel, out) in MATERIAL_KERNELS.into_iter().zip(&mut shaded) {
                     if kernels.contains(&kernel) {
@@ -519,18 +550,25 @@ impl PathTracer<'_> {
                 set(&mut v.light_radiance, i, k.radiance);
                 (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
             }
+            None if self.lights.has_environment() => lights.asks[i] = Some((h.p, choice, u_light)),
             None => {
                 let light = self.lights.sample(h.p, choice, u_light);
-                let light = light.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
-                v.light[i] = light.is_some();
-                if let Some(ls) = light {
-                    set(&mut v.light_dir, i, ls.dir);
-                    set(&mut v.light_radiance, i, ls.radiance);
-                    (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
-                }
+                set_light(v, i, light);
             }
         }
         kernel
+    }
+}
+
+/// Lane `i`'s light sample, where it exists and has radiance and density.
+#[inline(always)]
+fn set_light(v: &mut Vertices, i: usize, sample: Option<LightSample>) {
+    let light = sample.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
+    v.light[i] = light.is_some();
+    if let Some(ls) = light {
+        set(&mut v.light_dir, i, ls.dir);
+        set(&mut v.light_radiance, i, ls.radiance);
+        (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
     }
 }
 
@@ -1076,6 +1114,25 @@ material = "glow"
         // kernel, its conductors, plastics and glass theirs.
         let mut unconnected = mixed.clone();
         unconnected.render.mirror_connections = false;
+        // The same under an environment map (a bright spot on a gradient), sampled and looked
+        // up for all lanes at once.
+        let mut environment = unconnected.clone();
+        let (w, h) = (64, 32);
+        let texels = (0..w * h).map(|i| {
+            let (x, y) = ((i % w) as f32, (i / w) as f32);
+            if (x - 40.0).abs() < 2.0 && (y - 9.0).abs() < 2.0 {
+                [60.0, 50.0, 40.0]
+            } else {
+                [0.2 + x / 90.0, 0.3, y / 40.0]
+            }
+        });
+        environment.images.push(std::sync::Arc::new(alhazen_scene::ImageData::new(
+            w as u32,
+            h as u32,
+            texels.collect(),
+        )));
+        let image = environment.images.len() - 1;
+        environment.lights.push(alhazen_scene::Light::Environment { image, scale: 1.0, rotation: 0.3 });
         // Glass whose index and its inverse do not square to exactly 1 (1.52² · (1/1.52)²):
         // Lambert vertices after it see a path's `eta_scale` off 1 in the last bit.
         let mut glass = small("cornell-rough", (16, 16, 9));
@@ -1091,6 +1148,7 @@ material = "glow"
             ("prism", small("prism", (16, 12, 5))),
             ("mixed", mixed),
             ("mixed, no specular connections", unconnected),
+            ("mixed, under an environment map", environment),
             ("two lights", two_lights),
         ];
         for (name, base) in scenes {
