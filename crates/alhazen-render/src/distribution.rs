@@ -164,10 +164,17 @@ pub(crate) fn search_cdf(
         lo = if j == 0 { 0 } else { guide(j) };
         hi = if j + 1 < n { guide(j + 1) } else { n + 1 };
     }
-    // The first entry in lo..hi above u (or hi).
-    while lo < hi {
-        let mid = lo + (hi - lo) / 2;
-        if entry(mid) <= u { lo = mid + 1 } else { hi = mid }
+    // The first entry in lo..hi above u (or hi), in [lo, lo + len]: the range halved by a
+    // count of steps that depends on its length alone, each step a conditional move rather
+    // than a branch on the entries (which the processor cannot predict).
+    let mut len = hi - lo;
+    while len > 1 {
+        let half = len / 2;
+        lo = if entry(lo + half - 1) <= u { lo + half } else { lo };
+        len -= half;
+    }
+    if len == 1 && entry(lo) <= u {
+        lo += 1;
     }
     lo.saturating_sub(1).min(n - 1)
 }
