@@ -15,6 +15,7 @@
 //! CDF as the sampling, so samples and lookups agree exactly.
 
 use crate::distribution::{Distribution1D, guide_table, search_cdf, slice_of};
+use crate::shape::VectorUnit;
 use alhazen_math::{Vec2, Vec3, color::luminance};
 use alhazen_scene::ImageData;
 use std::f64::consts::PI;
@@ -111,6 +112,7 @@ impl EnvMap {
     }
 
     /// The texel `(x, y)` holding `uv`.
+    #[inline(always)]
     fn texel_at(&self, uv: Vec2) -> (usize, usize) {
         let x = ((uv.x * self.width as f64) as usize).min(self.width - 1);
         let y = ((uv.y * self.height as f64) as usize).min(self.height - 1);
@@ -144,6 +146,7 @@ impl EnvMap {
         slice_of(u, self.width)
     }
 
+    #[inline(always)]
     fn to_uv(&self, dir: Vec3) -> Vec2 {
         alhazen_scene::texture::equirect_uv(dir, self.rotation)
     }
@@ -216,16 +219,64 @@ impl EnvMap {
 
     /// [`Self::radiance_and_pdf`] of many directions (`None` where a lane has none): every
     /// texel is asked of memory before any is read, so that the lanes' cache misses overlap.
-    pub fn radiance_and_pdf_lanes<const N: usize>(&self, dirs: &[Option<Vec3>; N]) -> [(Vec3, f64); N] {
-        let texels = dirs.map(|dir| {
-            let texel = self.texel_at(self.to_uv(dir?));
-            prefetch(&self.texels[texel.1 * self.width + texel.0]);
-            Some(texel)
-        });
-        std::array::from_fn(|i| match (texels[i], dirs[i]) {
-            (Some(texel), Some(dir)) => (self.radiance_of(texel), self.solid_angle_density(texel, polar_sine(dir))),
-            _ => (Vec3::ZERO, 0.0),
+    pub fn radiance_and_pdf_lanes<const N: usize>(
+        &self,
+        dirs: &[Option<Vec3>; N],
+        unit: VectorUnit,
+    ) -> [(Vec3, f64); N] {
+        // Every lane's texel first, in a loop of arithmetic alone (vectorised), then every
+        // lane's record asked of memory, then read.
+        let texels = self.texels_in_lanes(&dirs.map(|d| d.unwrap_or(Vec3::Y)), unit);
+        for (&(x, y), dir) in texels.iter().zip(dirs) {
+            if dir.is_some() {
+                prefetch(&self.texels[y * self.width + x]);
+            }
+        }
+        std::array::from_fn(|i| match dirs[i] {
+            Some(dir) => (self.radiance_of(texels[i]), self.solid_angle_density(texels[i], polar_sine(dir))),
+            None => (Vec3::ZERO, 0.0),
         })
+    }
+
+    /// The texels of many directions, in AVX-512 or AVX2 where `unit` has them.
+    #[allow(unsafe_code)]
+    fn texels_in_lanes<const N: usize>(&self, dirs: &[Vec3; N], unit: VectorUnit) -> [(usize, usize); N] {
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
+            return unsafe { self.texels_avx512(dirs) };
+        }
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx2() {
+            // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
+            return unsafe { self.texels_avx2(dirs) };
+        }
+        let _ = unit;
+        self.texels_of(dirs)
+    }
+
+    /// [`Self::texels_in_lanes`]'s loop, inlined into each vector unit's function.
+    #[inline(always)]
+    fn texels_of<const N: usize>(&self, dirs: &[Vec3; N]) -> [(usize, usize); N] {
+        let mut texels = [(0, 0); N];
+        for (texel, &dir) in texels.iter_mut().zip(dirs) {
+            *texel = self.texel_at(self.to_uv(dir));
+        }
+        texels
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+    #[allow(unsafe_code)]
+    unsafe fn texels_avx512<const N: usize>(&self, dirs: &[Vec3; N]) -> [(usize, usize); N] {
+        self.texels_of(dirs)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    unsafe fn texels_avx2<const N: usize>(&self, dirs: &[Vec3; N]) -> [(usize, usize); N] {
+        self.texels_of(dirs)
     }
 
     /// The density of a direction in `texel` whose polar angle has sine `sin`.

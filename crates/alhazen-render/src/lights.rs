@@ -6,6 +6,7 @@
 
 use crate::distribution::Distribution1D;
 use crate::envmap::EnvMap;
+use crate::shape::VectorUnit;
 use alhazen_math::{Vec2, Vec3, orthonormal_basis};
 use alhazen_scene::{Background, Light, Scene, Shape};
 use std::f64::consts::PI;
@@ -282,10 +283,10 @@ impl Lights {
 
     /// [`Self::sky`] of many directions (`None` where a lane has none, whose result is zero),
     /// an environment map's texels asked of memory for all lanes before any is read.
-    pub fn sky_lanes<const N: usize>(&self, dirs: &[Option<Vec3>; N]) -> [(Vec3, f64); N] {
+    pub fn sky_lanes<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [(Vec3, f64); N] {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => {
-                m.radiance_and_pdf_lanes(dirs).map(|(radiance, pdf)| (radiance, pdf * self.choice_pdf()))
+                m.radiance_and_pdf_lanes(dirs, unit).map(|(radiance, pdf)| (radiance, pdf * self.choice_pdf()))
             }
             _ => dirs.map(|d| d.map_or((Vec3::ZERO, 0.0), |d| self.sky(d))),
         }

@@ -1,7 +1,7 @@
 //! Evaluation of surface colour textures: solid, checker, image (bilinear, repeating).
 
 use crate::{ImageData, Texture};
-use alhazen_math::{Vec2, Vec3};
+use alhazen_math::{Vec2, Vec3, elementary};
 
 /// The colour of `tex` at texture coordinates `uv`.
 pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Vec3 {
@@ -16,13 +16,15 @@ pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Ve
     }
 }
 
-/// Equirectangular coordinates of direction `dir` (unit): `u` the azimuth from `−z` towards
+/// Equirectangular coordinates of direction `dir` (unit), by our own `atan2` and `acos`
+/// (calls the compiler can inline and vectorise): `u` the azimuth from `−z` towards
 /// `+x` plus `rotation`, over 2π; `v` the angle from straight up (`+y`), over π.
+#[inline(always)]
 pub fn equirect_uv(dir: Vec3, rotation: f64) -> Vec2 {
     use std::f64::consts::PI;
-    let phi = dir.x.atan2(-dir.z) + rotation;
+    let phi = elementary::atan2(dir.x, -dir.z) + rotation;
     let u = wrap_unit(phi / (2.0 * PI));
-    let v = dir.y.clamp(-1.0, 1.0).acos() / PI;
+    let v = elementary::acos(dir.y.clamp(-1.0, 1.0)) / PI;
     Vec2::new(u.min(1.0 - 1e-16), v.min(1.0 - 1e-16))
 }
 
@@ -42,7 +44,7 @@ pub fn equirect_texel_at(img: &ImageData, uv: Vec2) -> Vec3 {
 /// `x.rem_euclid(1.0)`, bit for bit, without the call to `fmod` it makes where `x` lies in
 /// `(−1, 2)` — where texture coordinates and azimuths almost always do. There the remainder is
 /// `x`, `x + 1` (the one rounding `rem_euclid` makes too) or `x − 1` (exact).
-#[inline]
+#[inline(always)]
 fn wrap_unit(x: f64) -> f64 {
     if (0.0..1.0).contains(&x) {
         x
@@ -51,7 +53,11 @@ fn wrap_unit(x: f64) -> f64 {
     } else if (1.0..2.0).contains(&x) {
         x - 1.0
     } else {
-        x.rem_euclid(1.0)
+        // `x − ⌊x⌋` is `rem_euclid`'s value (exact but for the one rounding of `x % 1 + 1`
+        // below zero, which this makes too; zero keeps `x`'s sign) without its call to `fmod`,
+        // so loops vectorise.
+        let r = x - x.floor();
+        if r == 0.0 { r.copysign(x) } else { r }
     }
 }
 

@@ -376,7 +376,7 @@ impl PathTracer<'_> {
                 }
                 _ => None,
             });
-            let skies = escaping.iter().any(Option::is_some).then(|| self.lights.sky_lanes(&escaping));
+            let skies = escaping.iter().any(Option::is_some).then(|| self.lights.sky_lanes(&escaping, unit));
             let mut kernels = [Kernel::Idle; LANES];
             let mut tested = [false; LANES];
             lights.asks = [None; LANES];
