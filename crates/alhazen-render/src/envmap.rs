@@ -213,29 +213,25 @@ impl EnvMap {
 
     /// [`Self::radiance`] and [`Self::pdf`] of `dir`, mapped to the image once.
     pub fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f64) {
-        let texel = self.texel_at(self.to_uv(dir));
-        (self.radiance_of(texel), self.solid_angle_density(texel, polar_sine(dir)))
+        self.radiance_and_pdf_at(dir, self.texel_at(self.to_uv(dir)))
     }
 
-    /// [`Self::radiance_and_pdf`] of many directions (`None` where a lane has none): every
-    /// texel is asked of memory before any is read, so that the lanes' cache misses overlap.
-    pub fn radiance_and_pdf_lanes<const N: usize>(
-        &self,
-        dirs: &[Option<Vec3>; N],
-        unit: VectorUnit,
-    ) -> [(Vec3, f64); N] {
-        // Every lane's texel first, in a loop of arithmetic alone (vectorised), then every
-        // lane's record asked of memory, then read.
+    /// The first half of [`Self::radiance_and_pdf`] for many directions (`None` where a lane
+    /// has none): every lane's texel, found in one loop of arithmetic (vectorised) and asked of
+    /// memory. [`Self::radiance_and_pdf_at`] reads them later, when they have arrived.
+    pub fn texels_ahead<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [(usize, usize); N] {
         let texels = self.texels_in_lanes(&dirs.map(|d| d.unwrap_or(Vec3::Y)), unit);
         for (&(x, y), dir) in texels.iter().zip(dirs) {
             if dir.is_some() {
                 prefetch(&self.texels[y * self.width + x]);
             }
         }
-        std::array::from_fn(|i| match dirs[i] {
-            Some(dir) => (self.radiance_of(texels[i]), self.solid_angle_density(texels[i], polar_sine(dir))),
-            None => (Vec3::ZERO, 0.0),
-        })
+        texels
+    }
+
+    /// [`Self::radiance_and_pdf`] of `dir` in its texel, `texel` ([`Self::texels_ahead`]).
+    pub fn radiance_and_pdf_at(&self, dir: Vec3, texel: (usize, usize)) -> (Vec3, f64) {
+        (self.radiance_of(texel), self.solid_angle_density(texel, polar_sine(dir)))
     }
 
     /// The texels of many directions, in AVX-512 or AVX2 where `unit` has them.

@@ -105,6 +105,16 @@ fn env_sample(sample: Option<(Vec3, Vec3, f64)>) -> Option<LightSample> {
     Some(LightSample { dir, dist: f64::INFINITY, radiance, pdf, delta: false })
 }
 
+/// A light sample asked for ahead ([`Lights::ask`]): where from, its numbers, and an
+/// environment map's row.
+#[derive(Clone, Copy, Debug)]
+pub struct LightAsk {
+    p: Vec3,
+    u_choice: f64,
+    u: Vec2,
+    row: Option<(f64, usize)>,
+}
+
 /// A point on a light seen from a shading point.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample {
@@ -281,14 +291,24 @@ impl Lights {
         matches!(self.sky.map(|i| &self.lights[i as usize]), Some(PathLight::Environment(_)))
     }
 
-    /// [`Self::sky`] of many directions (`None` where a lane has none, whose result is zero),
-    /// an environment map's texels asked of memory for all lanes before any is read.
-    pub fn sky_lanes<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [(Vec3, f64); N] {
+    /// The first half of [`Self::sky`] for many directions (`None` where a lane has none): an
+    /// environment map's texels found for all lanes at once and asked of memory;
+    /// [`Self::sky_at`] reads them, as late as the caller can wait.
+    pub fn sky_ahead<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [(usize, usize); N] {
+        match self.sky.map(|i| &self.lights[i as usize]) {
+            Some(PathLight::Environment(m)) => m.texels_ahead(dirs, unit),
+            _ => [(0, 0); N],
+        }
+    }
+
+    /// [`Self::sky`] of `dir`, whose texel [`Self::sky_ahead`] found.
+    pub fn sky_at(&self, dir: Vec3, texel: (usize, usize)) -> (Vec3, f64) {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => {
-                m.radiance_and_pdf_lanes(dirs, unit).map(|(radiance, pdf)| (radiance, pdf * self.choice_pdf()))
+                let (radiance, pdf) = m.radiance_and_pdf_at(dir, texel);
+                (radiance, pdf * self.choice_pdf())
             }
-            _ => dirs.map(|d| d.map_or((Vec3::ZERO, 0.0), |d| self.sky(d))),
+            _ => self.sky(dir),
         }
     }
 
@@ -368,47 +388,53 @@ impl Lights {
 
     /// Some light is an environment map: its samples and lookups wait for memory (its tables
     /// outgrow the caches), so paths side by side do better to take them together
-    /// ([`Self::sample_lanes`], [`Self::sky_lanes`]).
+    /// ([`Self::sample_lanes`], [`Self::sky_ahead`]).
     pub fn has_environment(&self) -> bool {
         self.has_environment
     }
 
-    /// [`Self::sample`] for paths side by side, each lane's `(p, u_choice, u)` or `None`,
-    /// handing lane `i`'s sample to `found(i, sample)`: the same samples, but the rows and
-    /// texels of environment maps are asked of memory for every lane before any lane reads
-    /// them, so that the lanes' cache misses overlap.
+    /// The first half of [`Self::sample`]`(p, u_choice, u)` for a path among others
+    /// ([`Self::sample_lanes`] finishes it): an environment map's row found and its guide
+    /// asked of memory, while the other paths are busy.
+    #[inline]
+    pub fn ask(&self, p: Vec3, u_choice: f64, u: Vec2) -> LightAsk {
+        let row = match self.lights.is_empty() {
+            false => match &self.lights[self.choose(u_choice)] {
+                PathLight::Environment(m) => Some(m.sample_row(u)),
+                _ => None,
+            },
+            true => None,
+        };
+        LightAsk { p, u_choice, u, row }
+    }
+
+    /// [`Self::sample`] for paths side by side, each lane's [`LightAsk`] or `None`, handing
+    /// lane `i`'s sample to `found(i, sample)`: the same samples, but an environment map's
+    /// texels are asked of memory for every lane before any lane reads them, so that the
+    /// lanes' cache misses overlap.
     #[inline]
     pub fn sample_lanes<const N: usize>(
         &self,
-        asks: &[Option<(Vec3, f64, Vec2)>; N],
+        asks: &[Option<LightAsk>; N],
         mut found: impl FnMut(usize, Option<LightSample>),
     ) {
-        let map = |i: usize| match (asks[i], self.has_environment) {
-            (Some((_, choice, u)), true) => match &self.lights[self.choose(choice)] {
-                PathLight::Environment(m) => Some((m.as_ref(), u)),
-                _ => None,
-            },
+        let map = |ask: &LightAsk| match (&self.lights[self.choose(ask.u_choice)], ask.row) {
+            (PathLight::Environment(m), Some(row)) => Some((m.as_ref(), row)),
             _ => None,
         };
-        let mut rows = [None; N];
-        if self.has_environment {
-            for (i, row) in rows.iter_mut().enumerate() {
-                *row = map(i).map(|(m, u)| m.sample_row(u));
-            }
-            for (i, row) in rows.iter().enumerate() {
-                if let (Some((m, u)), Some(row)) = (map(i), row) {
-                    m.touch_texels(*row, u);
-                }
+        for ask in asks.iter().flatten() {
+            if let Some((m, row)) = map(ask) {
+                m.touch_texels(row, ask.u);
             }
         }
         for (i, ask) in asks.iter().enumerate() {
-            let Some((p, choice, u)) = *ask else { continue };
-            let sample = match (rows[i], map(i)) {
-                (Some(row), Some((m, _))) => env_sample(m.sample_in(row, u)).map(|mut s| {
+            let Some(ask) = ask else { continue };
+            let sample = match map(ask) {
+                Some((m, row)) => env_sample(m.sample_in(row, ask.u)).map(|mut s| {
                     s.pdf *= self.choice_pdf();
                     s
                 }),
-                _ => self.sample(p, choice, u),
+                None => self.sample(ask.p, ask.u_choice, ask.u),
             };
             found(i, sample);
         }

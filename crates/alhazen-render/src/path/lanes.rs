@@ -6,7 +6,7 @@
 //! One bounce is a round of stages over the eight lanes: the rays' nearest hits in one call
 //! ([`crate::World::intersect_rays`]: in a world of one leaf, each flat against the eight rays
 //! at once, in AVX-512 or AVX2, then each ray's spheres and other objects; elsewhere ray by
-//! ray); the sky seen by the rays that leave the scene ([`Lights::sky_lanes`]); per path, the
+//! ray); the sky seen by the rays that leave the scene ([`Lights::sky_ahead`]); per path, the
 //! vertex; the shadow rays in one call ([`crate::World::unoccluded_rays`]), after which each
 //! path gathers its light and steps on. A lane whose path ends starts the next sample of the
 //! pixels it was given, so lanes stay busy until their samples run out.
@@ -37,7 +37,7 @@ use crate::bsdf::{
     Bsdf, BsdfSample, Coat, ColorMode, Conductor, Dielectric, Frame, Microfacet, MicrofacetLobes, Plastic,
     cosine_hemisphere, cosine_pdf, same_side,
 };
-use crate::lights::{Emitter, LightSample, Lights};
+use crate::lights::{Emitter, LightAsk, LightSample, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
 use crate::shape::ray_epsilon;
 use crate::shape::{RayPacket, VectorUnit};
@@ -143,8 +143,8 @@ struct LightLanes {
     pdf_area: Lanes,
     u: [Lanes; 2],
     /// When some light is an environment map: what each lane asks of [`Lights::sample_lanes`]
-    /// (its point and numbers), `None` where it asks nothing.
-    asks: [Option<(Vec3, f64, Vec2)>; LANES],
+    /// ([`Lights::ask`]), `None` where it asks nothing.
+    asks: [Option<LightAsk>; LANES],
 }
 
 /// What [`shade`] returns, lane by lane.
@@ -376,18 +376,17 @@ impl PathTracer<'_> {
                 }
                 _ => None,
             });
-            let skies = escaping.iter().any(Option::is_some).then(|| self.lights.sky_lanes(&escaping, unit));
+            // Their texels are asked of memory now and read when the paths finish the bounce.
+            let sky_texels = escaping.iter().any(Option::is_some).then(|| self.lights.sky_ahead(&escaping, unit));
             let mut kernels = [Kernel::Idle; LANES];
             let mut tested = [false; LANES];
             lights.asks = [None; LANES];
             for (i, (slot, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
                 let Some(lane) = slot else { continue };
-                if let (Some(_), Some(skies)) = (escaping[i], &skies) {
-                    // As `vertex` ends a path whose ray leaves the scene.
+                if escaping[i].is_some() {
+                    // As `vertex` ends a path whose ray leaves the scene (its sky added below).
                     kernels[i] = Kernel::General;
                     general[i] = Vertex { beta: lane.path.beta, ..Vertex::default() };
-                    let path = &mut lane.path;
-                    path.l += self.escaped_from(skies[i], &path.prev, path.beta, lane.mode).unwrap_or(Vec3::ZERO);
                     continue;
                 }
                 let hit = hit.as_ref();
@@ -423,6 +422,10 @@ impl PathTracer<'_> {
             let clear = self.world.unoccluded_rays(&shadows, &dist, tested);
             for (i, slot) in lanes.iter_mut().enumerate() {
                 let Some(lane) = slot.as_mut() else { continue };
+                if let (Some(dir), Some(texels)) = (escaping[i], &sky_texels) {
+                    let (path, sky) = (&mut lane.path, self.lights.sky_at(dir, texels[i]));
+                    path.l += self.escaped_from(sky, &path.prev, path.beta, lane.mode).unwrap_or(Vec3::ZERO);
+                }
                 let goes_on = match kernels[i] {
                     Kernel::General | Kernel::Idle => {
                         lane.path.gather(&general[i], !tested[i] || clear[i]);
@@ -550,7 +553,7 @@ impl PathTracer<'_> {
                 set(&mut v.light_radiance, i, k.radiance);
                 (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
             }
-            None if self.lights.has_environment() => lights.asks[i] = Some((h.p, choice, u_light)),
+            None if self.lights.has_environment() => lights.asks[i] = Some(self.lights.ask(h.p, choice, u_light)),
             None => {
                 let light = self.lights.sample(h.p, choice, u_light);
                 set_light(v, i, light);
