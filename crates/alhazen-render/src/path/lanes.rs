@@ -357,9 +357,13 @@ impl PathTracer<'_> {
             if lanes.iter().all(Option::is_none) {
                 return;
             }
+            // Under an environment map every lane's hit is needed before the vertices (for the
+            // sky lookups below); otherwise rays not traced together are traced in the
+            // per-path stage, where a local hit costs no copy into `hits`.
+            let sky_map = self.lights.sky_is_environment();
             if together {
                 self.world.intersect_rays(&rays, lanes.each_ref().map(|p| p.is_some()), &mut hits);
-            } else {
+            } else if sky_map {
                 for (lane, hit) in lanes.iter().zip(&mut hits).filter_map(|(l, h)| Some((l.as_ref()?, h))) {
                     *hit = self.world.intersect(&lane.path.ray, f64::INFINITY);
                 }
@@ -367,11 +371,7 @@ impl PathTracer<'_> {
             // Rays that leave the scene see an environment map, looked up for all lanes together
             // (other skies in `vertex`).
             let escaping: [Option<Vec3>; LANES] = std::array::from_fn(|i| match &lanes[i] {
-                Some(lane)
-                    if hits[i].is_none()
-                        && lane.path.depth <= self.scene.render.max_depth
-                        && self.lights.sky_is_environment() =>
-                {
+                Some(lane) if sky_map && hits[i].is_none() && lane.path.depth <= self.scene.render.max_depth => {
                     Some(lane.path.ray.dir)
                 }
                 _ => None,
@@ -389,7 +389,9 @@ impl PathTracer<'_> {
                     general[i] = Vertex { beta: lane.path.beta, ..Vertex::default() };
                     continue;
                 }
-                let hit = hit.as_ref();
+                let traced = together || sky_map;
+                let alone = if traced { None } else { self.world.intersect(&lane.path.ray, f64::INFINITY) };
+                let hit = if traced { hit.as_ref() } else { alone.as_ref() };
                 kernels[i] = self.kernel_vertex(lane, hit, (&mut vertices, &mut lights), i);
                 if kernels[i] != Kernel::General {
                     continue;
