@@ -12,7 +12,10 @@
 //! precision, and each row has a 16-bit guide table: a sample reads the row's guide and a
 //! record or two, a lookup a record and its neighbour (2.25 MB in all where it was 3.5; the
 //! CDF apart from the radiance was no faster). Densities come from the same single-precision
-//! CDF as the sampling, so samples and lookups agree exactly.
+//! CDF as the sampling, so samples and lookups agree exactly. Paths traced side by side take
+//! their samples and lookups in steps ([`EnvMap::sample_row`], [`EnvMap::touch_texels`],
+//! [`EnvMap::sample_in`]; [`EnvMap::texels_ahead`], [`EnvMap::radiance_and_pdf_at`]), each
+//! asking memory for what the next will read, so that the paths' cache misses overlap.
 
 use crate::distribution::{Distribution1D, guide_table, search_cdf, slice_of};
 use crate::shape::VectorUnit;

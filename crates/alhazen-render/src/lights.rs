@@ -398,12 +398,10 @@ impl Lights {
     /// asked of memory, while the other paths are busy.
     #[inline]
     pub fn ask(&self, p: Vec3, u_choice: f64, u: Vec2) -> LightAsk {
-        let row = match self.lights.is_empty() {
-            false => match &self.lights[self.choose(u_choice)] {
-                PathLight::Environment(m) => Some(m.sample_row(u)),
-                _ => None,
-            },
-            true => None,
+        let chosen = (!self.lights.is_empty()).then(|| &self.lights[self.choose(u_choice)]);
+        let row = match chosen {
+            Some(PathLight::Environment(m)) => Some(m.sample_row(u)),
+            _ => None,
         };
         LightAsk { p, u_choice, u, row }
     }
