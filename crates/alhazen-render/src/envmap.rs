@@ -18,6 +18,7 @@
 //! asking memory for what the next will read, so that the paths' cache misses overlap.
 
 use crate::distribution::{Distribution1D, guide_table, search_cdf, slice_of};
+use crate::prefetch::prefetch;
 use crate::shape::VectorUnit;
 use alhazen_math::{Vec2, Vec3, color::luminance};
 use alhazen_scene::ImageData;
@@ -282,20 +283,6 @@ impl EnvMap {
     fn solid_angle_density(&self, texel: (usize, usize), sin: f64) -> f64 {
         if sin <= 0.0 { 0.0 } else { self.density_uv(texel) / (2.0 * PI * PI * sin) }
     }
-}
-
-/// Asks the processor to start loading the cache line holding `x` (a hint: never faults, never
-/// changes a result).
-#[inline(always)]
-#[allow(unsafe_code)]
-pub(crate) fn prefetch<T>(x: &T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: prefetching never faults; SSE is part of x86-64.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch((x as *const T).cast(), std::arch::x86_64::_MM_HINT_T0);
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
 }
 
 /// The sine of unit direction `dir`'s angle from +y, without trigonometry.

@@ -41,6 +41,7 @@ pub mod lights;
 pub mod optics;
 pub mod output;
 pub mod path;
+mod prefetch;
 pub mod sampler;
 pub mod shape;
 pub mod spectrum;

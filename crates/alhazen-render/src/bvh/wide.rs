@@ -261,18 +261,9 @@ impl Slab {
 
     /// Asks the processor to start loading node `w` (its two cache lines).
     #[inline(always)]
-    #[allow(unsafe_code)]
     pub fn prefetch(w: &Wide) {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: prefetching never faults; SSE is part of x86-64.
-        unsafe {
-            use std::arch::x86_64::*;
-            let p: *const i8 = (w as *const Wide).cast();
-            _mm_prefetch(p, _MM_HINT_T0);
-            _mm_prefetch(p.add(64), _MM_HINT_T0);
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = w;
+        const { assert!(std::mem::size_of::<Wide>() == 128) };
+        crate::prefetch::prefetch_all(w);
     }
 
     /// `w`'s child `k`.

@@ -338,22 +338,11 @@ pub struct PackedFlats<L> {
 impl<L: Copy + Default> PackedFlats<L> {
     /// Asks the processor to start loading packet `k` and what its lanes stand for.
     #[inline(always)]
-    #[allow(unsafe_code)]
     pub fn prefetch(&self, k: usize) {
-        #[cfg(target_arch = "x86_64")]
         if let (Some(p), Some(l)) = (self.packets.get(k), self.lanes.get(k)) {
-            // SAFETY: prefetching never faults; SSE is part of x86-64.
-            unsafe {
-                use std::arch::x86_64::*;
-                let p: *const i8 = (p as *const FlatPacket).cast();
-                for line in (0..std::mem::size_of::<FlatPacket>()).step_by(64) {
-                    _mm_prefetch(p.add(line), _MM_HINT_T0);
-                }
-                _mm_prefetch((l as *const [L; LANES]).cast(), _MM_HINT_T0);
-            }
+            crate::prefetch::prefetch_all(p);
+            crate::prefetch::prefetch(l);
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = k;
     }
 
     /// What the flats of packets `range` stand for, in order (the lanes in use).
