@@ -2,7 +2,7 @@
 //! bounded ones and a plain list of unbounded ones (planes). Small meshes, rectangles and
 //! untextured boxes are flattened into world-space triangles and parallelograms, which the
 //! BVH's leaves test eight at a time in single precision ([`FlatPacket`]); a leaf's untransformed spheres
-//! are [`SpherePacket`]s; other objects are tested one by one. Eight rays
+//! are [`SpherePacket`]s; other objects are tested one by one, behind a test of their world box. Eight rays
 //! can be traced in one call ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path
 //! tracer's lanes); when the world is one leaf, each flat and each packed sphere is tested
 //! against the eight at once, then each ray's other objects.
@@ -17,6 +17,35 @@ use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
 use alhazen_scene as scene;
 use std::sync::Arc;
+
+/// `b` grown on every side by a millionth of its largest coordinate's magnitude: beyond any
+/// rounding in an object's own ray tests, so a ray that misses it misses what it bounds.
+fn padded(b: Bounds3) -> Bounds3 {
+    let pad = Vec3::splat(b.min.abs().max(b.max.abs()).max_element() * 1e-6);
+    Bounds3 { min: b.min - pad, max: b.max + pad }
+}
+
+/// The eight rays' reciprocal directions, axis by axis (one vector division per axis).
+#[inline(always)]
+fn inverse_dirs(rays: &RayPacket) -> [[f64; LANES]; 3] {
+    rays.dir.map(|d| d.map(|x| 1.0 / x))
+}
+
+/// Whether the segment `(0, t_max)` of `ray` (reciprocal direction `inv_dir`) may meet box
+/// `b`: the slab test, where a NaN (`0·∞`: an origin on the face of a slab the ray runs
+/// along) rejects nothing.
+#[inline(always)]
+fn may_meet_box(b: &Bounds3, ray: &Ray, inv_dir: [f64; 3], t_max: f64) -> bool {
+    let (mut near, mut far) = (0.0f64, t_max);
+    for axis in 0..3 {
+        let t0 = (b.min[axis] - ray.origin[axis]) * inv_dir[axis];
+        let t1 = (b.max[axis] - ray.origin[axis]) * inv_dir[axis];
+        let (entry, exit) = if inv_dir[axis] < 0.0 { (t1, t0) } else { (t0, t1) };
+        near = if entry > near { entry } else { near };
+        far = if exit < far { exit } else { far };
+    }
+    near <= far
+}
 
 /// An object ready to be intersected.
 #[derive(Clone, Debug)]
@@ -73,6 +102,9 @@ pub struct World {
     /// Lane by lane, whose sphere packet `k`'s spheres are.
     sphere_objects: Vec<[u32; SPHERE_LANES]>,
     leaf_objects: Vec<u32>,
+    /// Beside `leaf_objects`: each object's world box, padded by far more than the rounding of
+    /// its own tests, so a ray that misses the box misses the object.
+    leaf_boxes: Vec<Bounds3>,
     unbounded: Vec<u32>,
     /// The packets' kernel for this processor.
     vectors: VectorUnit,
@@ -334,7 +366,10 @@ impl World {
             let mut spheres: Vec<(u32, Sphere)> = vec![];
             for &k in leaf {
                 match primitives[k as usize] {
-                    Primitive::Object(i) => self.leaf_objects.push(i),
+                    Primitive::Object(i) => {
+                        self.leaf_objects.push(i);
+                        self.leaf_boxes.push(padded(self.objects[i as usize].placed.bounds()));
+                    }
                     Primitive::Flat { object, lane, flat } => flats.push((Lane { object, flat: lane }, flat)),
                     Primitive::Sphere { object, sphere } => spheres.push((object, sphere)),
                 }
@@ -413,7 +448,7 @@ impl World {
         // Most leaves hold no sphere packet: skip the kernel's call.
         let sphere =
             if spheres.is_empty() { None } else { SpherePacket::nearest_of(spheres, ray, t_max, self.vectors) };
-        self.nearest_solid_after(leaf, ray, t_max, sphere)
+        self.nearest_solid_after(leaf, ray, t_max, sphere, None)
     }
 
     /// The nearest sphere hit of each of eight rays in `leaf` ([`SpherePacket::nearest_of_rays`]).
@@ -441,6 +476,7 @@ impl World {
         ray: &Ray,
         mut t_max: f64,
         sphere: Option<(usize, usize, f64)>,
+        inv_dir: Option<[f64; 3]>,
     ) -> Option<(Candidate, u32)> {
         let mut best = None;
         if let Some((k, lane, t)) = sphere {
@@ -448,7 +484,11 @@ impl World {
             best = Some((Candidate { t, aux: 0, bary: [0.0; 2] }, object));
             t_max = t;
         }
-        for &i in &self.leaf_objects[leaf.objects.clone()] {
+        let boxes = &self.leaf_boxes[leaf.objects.clone()];
+        for (&i, b) in self.leaf_objects[leaf.objects.clone()].iter().zip(boxes) {
+            if inv_dir.is_some_and(|inv| !may_meet_box(b, ray, inv, t_max)) {
+                continue;
+            }
             if let Some(c) = self.objects[i as usize].placed.hit(ray, t_max) {
                 best = Some((c, i));
                 t_max = c.t;
@@ -462,14 +502,18 @@ impl World {
     fn solid_blocks(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> bool {
         !leaf.spheres.is_empty()
             && SpherePacket::nearest_of(&self.spheres[leaf.spheres.clone()], ray, t_max, self.vectors).is_some()
-            || self.objects_block(leaf, ray, t_max)
+            || self.objects_block(leaf, ray, t_max, None)
     }
 
     /// True when one of `leaf`'s other objects (not flats, not packed spheres) lies on `ray`
     /// before `t_max`.
     #[inline]
-    fn objects_block(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> bool {
-        self.leaf_objects[leaf.objects.clone()].iter().any(|&i| self.objects[i as usize].placed.blocks(ray, t_max))
+    fn objects_block(&self, leaf: &Leaf, ray: &Ray, t_max: f64, inv_dir: Option<[f64; 3]>) -> bool {
+        let boxes = &self.leaf_boxes[leaf.objects.clone()];
+        self.leaf_objects[leaf.objects.clone()].iter().zip(boxes).any(|(&i, b)| {
+            inv_dir.is_none_or(|inv| may_meet_box(b, ray, inv, t_max))
+                && self.objects[i as usize].placed.blocks(ray, t_max)
+        })
     }
 
     /// The nearest hit in `(0, t_max)` without its surface: the distance, the triangle and its
@@ -515,9 +559,11 @@ impl World {
         let leaf = &self.leaves[0];
         let t_max = flat.map(|f| f.map_or(f64::INFINITY, |(_, h)| h.t));
         let spheres = self.spheres_of_rays(leaf, rays, &t_max, live);
+        let inv = inverse_dirs(rays);
         for (r, slot) in out.iter_mut().enumerate() {
             let ray = rays.ray(r);
-            let solid = if live[r] { self.nearest_solid_after(leaf, &ray, t_max[r], spheres[r]) } else { None };
+            let inv = Some(inv.map(|a| a[r]));
+            let solid = if live[r] { self.nearest_solid_after(leaf, &ray, t_max[r], spheres[r], inv) } else { None };
             *slot = match (solid, flat[r]) {
                 (Some((c, i)), _) => Some(self.surface_of(&ray, c, i)),
                 (None, Some((k, h))) => Some(self.flat_hit(&ray, k, h)),
@@ -552,8 +598,12 @@ impl World {
             let leaf = &self.leaves[0];
             let open = std::array::from_fn(|r| live[r] && !blocked[r]);
             let spheres = if self.flats_only { [None; LANES] } else { self.spheres_of_rays(leaf, rays, dist, open) };
+            let inv = inverse_dirs(rays);
             return std::array::from_fn(|r| {
-                open[r] && (self.flats_only || spheres[r].is_none() && !self.objects_block(leaf, &rays.ray(r), dist[r]))
+                let inv = Some(inv.map(|a| a[r]));
+                open[r]
+                    && (self.flats_only
+                        || spheres[r].is_none() && !self.objects_block(leaf, &rays.ray(r), dist[r], inv))
             });
         }
         std::array::from_fn(|r| {
@@ -668,7 +718,11 @@ mod tests {
         let packet = format!("{rectangle}{}{}{}", sphere(-1.5), sphere(0.0), sphere(1.5));
         let cylinder = "[[object]]\nshape = \"cylinder\"\nradius = 0.3\nbase = [0, -1, 0]\ntop = [0, 0.8, 0]\n";
         let singles = format!("{rectangle}{}{}{cylinder}", sphere(-1.5), sphere(1.5));
-        for (text, packets) in [(packet, 1), (singles, 1)] {
+        // A mesh too big to flatten, placed by a transform: tested alone, behind its world box.
+        let mesh = "[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 3\nsmooth = true\n\
+                    transform = [{ scale = 0.5 }, { rotate_y = 30 }, { translate = [0.4, -0.2, 1.0] }]\n";
+        let meshes = format!("{rectangle}{}{}{mesh}", sphere(-1.5), sphere(1.5));
+        for (text, packets) in [(packet, 1), (singles, 1), (meshes, 1)] {
             let world = World::build(&scene::parse_scene("leaf.toml".as_ref(), &text).unwrap());
             assert!(world.one_leaf && !world.flats_only, "one leaf of flats and solids");
             assert_eq!(world.spheres.len(), packets);
@@ -695,6 +749,44 @@ mod tests {
                 }
             }
             assert!(n > 100, "{n} rays meet solids");
+        }
+    }
+
+    proptest::proptest! {
+        /// The box test culls no ray whose segment reaches a point of the box (on its faces
+        /// too), whatever the ray's length, direction (some along the axes) or distance.
+        #[test]
+        fn the_box_cull_keeps_every_ray_that_meets_the_box(
+            lo in proptest::array::uniform3(-1e3..1e3f64),
+            size in proptest::array::uniform3(0.0..1e2f64),
+            scale in -8i32..8,
+            u in proptest::array::uniform3(proptest::prop_oneof![0.0..1.0f64, proptest::strategy::Just(0.0), proptest::strategy::Just(1.0)]),
+            from in proptest::array::uniform3(-1e4..1e4f64),
+            zero in 0usize..5,
+            length in 0.0..10.0f64,
+        ) {
+            let s = 10f64.powi(scale);
+            let lo = Vec3::from_array(lo) * s;
+            let b = padded(Bounds3 { min: lo, max: lo + Vec3::from_array(size) * s });
+            let target = lo + Vec3::from_array(size) * s * Vec3::from_array(u);
+            let origin = Vec3::from_array(from) * s;
+            let mut dir = (target - origin) * length.max(1e-3);
+            if zero < 3 {
+                dir[zero] = 0.0;
+            }
+            proptest::prop_assume!(dir.length() > 0.0);
+            let ray = Ray::new(origin, dir);
+            // The parameter of the point nearest `target` on the line, and a bit beyond.
+            let t = ((target - origin).dot(dir) / dir.length_squared()).max(0.0);
+            let inv = (1.0 / dir).to_array();
+            let on_ray = (ray.at(t) - target).length() <= 1e-9 * (lo.length() + size.iter().sum::<f64>() * s + 1.0);
+            if on_ray {
+                proptest::prop_assert!(may_meet_box(&b, &ray, inv, t * (1.0 + 1e-12) + f64::MIN_POSITIVE), "{b:?} {ray:?} {t}");
+                proptest::prop_assert!(may_meet_box(&b, &ray, inv, f64::INFINITY));
+            }
+            // A ray pointing away from a box it starts outside never meets it.
+            let away = Ray::new(b.max + Vec3::ONE, Vec3::ONE);
+            proptest::prop_assert!(!may_meet_box(&b, &away, [1.0; 3], f64::INFINITY));
         }
     }
 
