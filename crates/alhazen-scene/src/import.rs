@@ -199,6 +199,7 @@ struct PlyReader<'a> {
 }
 
 impl PlyReader<'_> {
+    #[inline(always)]
     fn read(&mut self, ty: PlyType) -> Result<f64, String> {
         if self.format == PlyFormat::Ascii {
             return self.read_ascii();
@@ -248,8 +249,17 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
             return Err("the vertex element lacks x, y or z".into());
         }
         let mut vals = vec![0.0; el.props.len()];
+        // Buffers reused by every item (a million faces would otherwise make two million
+        // small allocations); the vectors grow at most to one item per byte of the body.
+        let (mut list, mut corners) = (Vec::new(), Vec::new());
+        let at_most = el.count.min(body.len());
+        if el.name == "vertex" {
+            mesh.positions.reserve(at_most);
+        } else if el.name == "face" {
+            mesh.triangles.reserve(at_most);
+        }
         for _ in 0..el.count {
-            let mut list = Vec::new();
+            list.clear();
             for (i, p) in el.props.iter().enumerate() {
                 match p.list {
                     None => vals[i] = rd.read(p.ty)?,
@@ -258,9 +268,12 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
                         if !(0.0..=1e6).contains(&n) {
                             return Err(format!("list length {n} out of range"));
                         }
-                        let items: Vec<f64> = (0..n as usize).map(|_| rd.read(p.ty)).collect::<Result<_, _>>()?;
-                        if Some(i) == face_list {
-                            list = items;
+                        let keep = Some(i) == face_list;
+                        for _ in 0..n as usize {
+                            let x = rd.read(p.ty)?;
+                            if keep {
+                                list.push(x);
+                            }
                         }
                     }
                 }
@@ -278,18 +291,15 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
                 if list.len() < 3 {
                     return Err("a face has fewer than 3 vertices".into());
                 }
-                let v: Vec<u32> = list
-                    .iter()
-                    .map(|x| {
-                        if *x >= 0.0 && *x < u32::MAX as f64 {
-                            Ok(*x as u32)
-                        } else {
-                            Err(format!("bad vertex index {x}"))
-                        }
-                    })
-                    .collect::<Result<_, _>>()?;
-                for k in 1..v.len() - 1 {
-                    mesh.triangles.push([v[0], v[k], v[k + 1]]);
+                corners.clear();
+                for x in &list {
+                    if !(*x >= 0.0 && *x < u32::MAX as f64) {
+                        return Err(format!("bad vertex index {x}"));
+                    }
+                    corners.push(*x as u32);
+                }
+                for k in 1..corners.len() - 1 {
+                    mesh.triangles.push([corners[0], corners[k], corners[k + 1]]);
                 }
             }
         }
