@@ -72,9 +72,10 @@ impl Default for Bvh {
     }
 }
 
+/// A primitive while building: 64 bytes (its centroid is computed from its bounds when
+/// needed), so a million of them move through the caches as few lines as possible.
 struct Item {
     bounds: Bounds3,
-    centroid: Vec3,
     index: u32,
     /// Tested [`PACK`] at a time.
     packed: bool,
@@ -142,13 +143,7 @@ impl Bvh {
     ) -> Self {
         use rayon::prelude::*;
         let mut items: Vec<Item> = Vec::new();
-        let item = |(i, b): (usize, &Bounds3)| Item {
-            bounds: *b,
-            centroid: b.centroid(),
-            index: i as u32,
-            packed: packed(i),
-            code: 0,
-        };
+        let item = |(i, b): (usize, &Bounds3)| Item { bounds: *b, index: i as u32, packed: packed(i), code: 0 };
         bounds.par_iter().enumerate().map(item).collect_into_vec(&mut items);
         if method == BuildMethod::Morton {
             morton_order(&mut items);
@@ -166,7 +161,8 @@ impl Bvh {
                 BuildMethod::Sah => Split::Sah { traversal: if packets { 1.0 } else { 0.125 } },
                 BuildMethod::Morton => Split::Morton,
             };
-            bvh.build_node(&mut items, 0, split, parallel_from);
+            let all = Summary::of(&items);
+            bvh.build_node(&mut items, all, 0, split, parallel_from);
         }
         bvh.root = bvh.nodes.first().map_or(Bounds3::EMPTY, |n| n.bounds);
         (bvh.wide, bvh.start) = wide::collapse(&bvh.nodes);
@@ -178,15 +174,25 @@ impl Bvh {
         bvh
     }
 
-    fn build_node(&mut self, items: &mut [Item], depth: usize, how: Split, parallel_from: usize) -> usize {
-        let node = Summary::of(items);
+    /// Builds the subtree over `items`, whose [`Summary`] is `node`.
+    fn build_node(
+        &mut self,
+        items: &mut [Item],
+        node: Summary,
+        depth: usize,
+        how: Split,
+        parallel_from: usize,
+    ) -> usize {
         let me = self.nodes.len();
         self.nodes.push(Node { bounds: node.bounds, offset: 0, count: 0, axis: 0 });
         let small = items.len() == 1 || node.tests.cost() <= MAX_LEAF as f64;
         let split = match how {
             _ if small || depth >= MAX_DEPTH => None,
             Split::Sah { traversal } => sah_split(items, &node, traversal),
-            Split::Morton => Some(morton_split(items)),
+            Split::Morton => {
+                let (axis, mid) = morton_split(items);
+                Some((axis, mid, None))
+            }
         };
         match split {
             None => {
@@ -194,23 +200,26 @@ impl Bvh {
                 self.nodes[me].count = items.len() as u32;
                 self.order.extend(items.iter().map(|it| it.index));
             }
-            Some((axis, mid)) => {
+            Some((axis, mid, halves)) => {
                 let parallel = items.len() >= parallel_from;
                 let (left, right) = items.split_at_mut(mid);
+                // The halves' summaries come with the split when it is the bins' (the same
+                // unions of the same boxes, in another order: the same bits).
+                let [sl, sr] = halves.unwrap_or_else(|| [Summary::of(left), Summary::of(right)]);
+                let next = depth + 1;
                 let second = if parallel {
                     let (mut a, mut b) = (Bvh::default(), Bvh::default());
-                    let next = depth + 1;
                     rayon::join(
-                        || a.build_node(left, next, how, parallel_from),
-                        || b.build_node(right, next, how, parallel_from),
+                        || a.build_node(left, sl, next, how, parallel_from),
+                        || b.build_node(right, sr, next, how, parallel_from),
                     );
                     self.append(a);
                     let second = self.nodes.len();
                     self.append(b);
                     second
                 } else {
-                    self.build_node(left, depth + 1, how, parallel_from);
-                    self.build_node(right, depth + 1, how, parallel_from)
+                    self.build_node(left, sl, next, how, parallel_from);
+                    self.build_node(right, sr, next, how, parallel_from)
                 };
                 self.nodes[me].offset = second as u32;
                 self.nodes[me].axis = axis as u8;
@@ -385,6 +394,7 @@ impl Bvh {
 /// The best binned SAH split `(axis, position in items)`, or `None` when a leaf is cheaper.
 /// What one pass over a node's items finds: their bounds, their centroids' bounds and the
 /// tests a leaf of them would cost.
+#[derive(Clone, Copy)]
 struct Summary {
     bounds: Bounds3,
     centroids: Bounds3,
@@ -392,17 +402,33 @@ struct Summary {
 }
 
 impl Summary {
+    const EMPTY: Self =
+        Self { bounds: Bounds3::EMPTY, centroids: Bounds3::EMPTY, tests: Tests { packed: 0, single: 0 } };
+
     fn of(items: &[Item]) -> Self {
-        let empty = Self { bounds: Bounds3::EMPTY, centroids: Bounds3::EMPTY, tests: Tests::default() };
-        items.iter().fold(empty, |s, it| Self {
-            bounds: s.bounds.union(it.bounds),
-            centroids: s.centroids.grow(it.centroid),
-            tests: s.tests.add(it),
-        })
+        items.iter().fold(Self::EMPTY, Self::add)
+    }
+
+    fn add(self, it: &Item) -> Self {
+        Self {
+            bounds: self.bounds.union(it.bounds),
+            centroids: self.centroids.grow(it.bounds.centroid()),
+            tests: self.tests.add(it),
+        }
+    }
+
+    fn merge(self, o: &Self) -> Self {
+        Self {
+            bounds: self.bounds.union(o.bounds),
+            centroids: self.centroids.union(o.centroids),
+            tests: self.tests.merge(o.tests),
+        }
     }
 }
 
-fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usize, usize)> {
+/// The binned SAH split of `items` (partitioned in place): its axis, the first item of the
+/// second half and, when the halves are the bins', their summaries.
+fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usize, usize, Option<[Summary; 2]>)> {
     let (cb, bounds) = (&node.centroids, &node.bounds);
     let extent = cb.extent();
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
@@ -415,29 +441,32 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
     if extent[axis] <= 0.0 || !extent[axis].is_finite() {
         // All centroids coincide: split in the middle to keep leaves small.
         if items.len() > 255 {
-            return Some((axis, items.len() / 2));
+            return Some((axis, items.len() / 2, None));
         }
         return None;
     }
     let per_unit = BINS as f64 / extent[axis];
     let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) * per_unit) as usize).min(BINS - 1);
-    let mut bins = [(Bounds3::EMPTY, Tests::default()); BINS];
-    for it in items.iter() {
-        let b = &mut bins[bin_of(it.centroid)];
-        *b = (b.0.union(it.bounds), b.1.add(it));
+    // Four sets of bins, item by item in turn, merged after: neighbouring items fall in the
+    // same bin, and one set would make each update wait for the last one's store.
+    let mut sets = [[Summary::EMPTY; BINS]; 4];
+    for (k, it) in items.iter().enumerate() {
+        let b = &mut sets[k % 4][bin_of(it.bounds.centroid())];
+        *b = b.add(it);
     }
+    let bins: [Summary; BINS] = std::array::from_fn(|i| sets.iter().fold(Summary::EMPTY, |s, set| s.merge(&set[i])));
     // Sweep from the right to get suffix areas, then from the left.
     let mut right_area = [0.0; BINS];
-    let mut acc = (Bounds3::EMPTY, Tests::default());
+    let mut acc = Summary::EMPTY;
     for i in (1..BINS).rev() {
-        acc = (acc.0.union(bins[i].0), acc.1.merge(bins[i].1));
-        right_area[i] = acc.0.surface_area() * acc.1.cost();
+        acc = acc.merge(&bins[i]);
+        right_area[i] = acc.bounds.surface_area() * acc.tests.cost();
     }
     let (mut best, mut best_cost) = (0, f64::INFINITY);
-    let mut left = (Bounds3::EMPTY, Tests::default());
+    let mut left = Summary::EMPTY;
     for i in 0..BINS - 1 {
-        left = (left.0.union(bins[i].0), left.1.merge(bins[i].1));
-        let cost = left.0.surface_area() * left.1.cost() + right_area[i + 1];
+        left = left.merge(&bins[i]);
+        let cost = left.bounds.surface_area() * left.tests.cost() + right_area[i + 1];
         if cost < best_cost {
             best_cost = cost;
             best = i;
@@ -448,11 +477,12 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
     if split_cost >= leaf_cost && items.len() <= 255 {
         return None;
     }
-    let mid = partition(items, |it| bin_of(it.centroid) <= best);
+    let mid = partition(items, |it| bin_of(it.bounds.centroid()) <= best);
     if mid == 0 || mid == items.len() {
-        return Some((axis, items.len() / 2));
+        return Some((axis, items.len() / 2, None));
     }
-    Some((axis, mid))
+    let halves = [&bins[..=best], &bins[best + 1..]].map(|b| b.iter().fold(Summary::EMPTY, |s, b| s.merge(b)));
+    Some((axis, mid, Some(halves)))
 }
 
 /// A node's split rule.
@@ -470,12 +500,13 @@ const MORTON_BITS: u32 = 21;
 /// Gives every item the Morton code of its centroid within the centroids' bounds and sorts them
 /// by it (ties by index: the order is a function of the input).
 fn morton_order(items: &mut [Item]) {
-    let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.grow(it.centroid));
+    let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.grow(it.bounds.centroid()));
     let extent = cb.extent();
     let scale = ((1u64 << MORTON_BITS) - 1) as f64;
     let quantise = |x: f64, lo: f64, e: f64| if e > 0.0 { ((x - lo) / e * scale).clamp(0.0, scale) as u64 } else { 0 };
     for it in items.iter_mut() {
-        let q: [u64; 3] = std::array::from_fn(|a| quantise(it.centroid[a], cb.min[a], extent[a]));
+        let c = it.bounds.centroid();
+        let q: [u64; 3] = std::array::from_fn(|a| quantise(c[a], cb.min[a], extent[a]));
         it.code = (0..MORTON_BITS).fold(0, |code, bit| {
             code | ((q[0] >> bit) & 1) << (3 * bit + 2)
                 | ((q[1] >> bit) & 1) << (3 * bit + 1)
