@@ -195,7 +195,9 @@ fn parallelogram(indices: &[[u32; 3]], corners: &[[Vec3; 3]]) -> Option<Emitter>
     Some(Emitter::Parallelogram { origin, e1, e2, normal: n / n.length(), area: n.length() })
 }
 
-fn uniform_sphere(u: Vec2) -> Vec3 {
+/// The direction `u` picks uniformly on the unit sphere (a sky's light sample).
+#[inline(always)]
+pub(crate) fn uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
     let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
@@ -263,10 +265,14 @@ impl Lights {
         ((u_choice * self.lights.len() as f64) as usize).min(self.lights.len() - 1)
     }
 
-    /// Every light, when all are parallelograms (one or more): `(emitter, radiance)`.
-    pub fn parallelograms(&self) -> Option<Vec<(Emitter, Vec3)>> {
+    /// Every light, when each is a parallelogram or a sky of one colour (one or more):
+    /// `(emitter, radiance)`, the emitter `None` for the sky.
+    pub fn parallelograms_and_sky(&self) -> Option<Vec<(Option<Emitter>, Vec3)>> {
         let all = self.lights.iter().map(|l| match l {
-            PathLight::Area { emitter: e @ Emitter::Parallelogram { .. }, radiance } => Some((e.clone(), *radiance)),
+            PathLight::Area { emitter: e @ Emitter::Parallelogram { .. }, radiance } => {
+                Some((Some(e.clone()), *radiance))
+            }
+            PathLight::Background(Background::Solid(c)) => Some((None, *c)),
             _ => None,
         });
         all.collect::<Option<Vec<_>>>().filter(|v| !v.is_empty())

@@ -559,10 +559,10 @@ impl World {
         let leaf = &self.leaves[0];
         let t_max = flat.map(|f| f.map_or(f64::INFINITY, |(_, h)| h.t));
         let spheres = self.spheres_of_rays(leaf, rays, &t_max, live);
-        let inv = inverse_dirs(rays);
+        let inv = (!leaf.objects.is_empty()).then(|| inverse_dirs(rays));
         for (r, slot) in out.iter_mut().enumerate() {
             let ray = rays.ray(r);
-            let inv = Some(inv.map(|a| a[r]));
+            let inv = inv.map(|inv| inv.map(|a| a[r]));
             let solid = if live[r] { self.nearest_solid_after(leaf, &ray, t_max[r], spheres[r], inv) } else { None };
             *slot = match (solid, flat[r]) {
                 (Some((c, i)), _) => Some(self.surface_of(&ray, c, i)),
@@ -598,9 +598,9 @@ impl World {
             let leaf = &self.leaves[0];
             let open = std::array::from_fn(|r| live[r] && !blocked[r]);
             let spheres = if self.flats_only { [None; LANES] } else { self.spheres_of_rays(leaf, rays, dist, open) };
-            let inv = inverse_dirs(rays);
+            let inv = (!leaf.objects.is_empty()).then(|| inverse_dirs(rays));
             return std::array::from_fn(|r| {
-                let inv = Some(inv.map(|a| a[r]));
+                let inv = inv.map(|inv| inv.map(|a| a[r]));
                 open[r]
                     && (self.flats_only
                         || spheres[r].is_none() && !self.objects_block(leaf, &rays.ray(r), dist[r], inv))

@@ -110,7 +110,8 @@ struct Vertices {
     u_roulette: Lanes,
 }
 
-/// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`).
+/// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`), or a sky
+/// of one colour (`sky`: sampled uniformly over the sphere, as `Lights::sample` does).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct LaneLight {
     corner: Vec3,
@@ -120,14 +121,25 @@ pub(super) struct LaneLight {
     /// `1 / area`.
     pdf_area: f64,
     radiance: Vec3,
+    sky: bool,
 }
 
-/// The lights in lane form when every one is a parallelogram (the lanes then sample them too).
+/// The lights in lane form when every one is a parallelogram or a sky of one colour (the lanes
+/// then sample them too).
 pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
-    let lights = lights.parallelograms()?.into_iter().map(|(e, radiance)| match e {
-        Emitter::Parallelogram { origin, e1, e2, normal, area } => {
-            Some(LaneLight { corner: origin, e1, e2, normal, pdf_area: 1.0 / area, radiance })
+    let lights = lights.parallelograms_and_sky()?.into_iter().map(|(e, radiance)| match e {
+        Some(Emitter::Parallelogram { origin, e1, e2, normal, area }) => {
+            Some(LaneLight { corner: origin, e1, e2, normal, pdf_area: 1.0 / area, radiance, sky: false })
         }
+        None => Some(LaneLight {
+            corner: Vec3::ZERO,
+            e1: Vec3::ZERO,
+            e2: Vec3::ZERO,
+            normal: Vec3::ZERO,
+            pdf_area: 0.0,
+            radiance,
+            sky: true,
+        }),
         _ => None,
     });
     lights.collect()
@@ -142,6 +154,9 @@ struct LightLanes {
     normal: Lanes3,
     pdf_area: Lanes,
     u: [Lanes; 2],
+    /// The lane samples the sky of one colour; `any_sky`: some light is that sky.
+    sky: [bool; LANES],
+    any_sky: bool,
     /// When some light is an environment map: what each lane asks of [`Lights::sample_lanes`]
     /// ([`Lights::ask`]), `None` where it asks nothing.
     asks: [Option<LightAsk>; LANES],
@@ -337,6 +352,7 @@ impl PathTracer<'_> {
         let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
         let mut general: [Vertex; LANES] = Default::default();
         let (mut vertices, mut lights) = (Vertices::default(), LightLanes::default());
+        lights.any_sky = self.lane_lights.as_ref().is_some_and(|all| all.iter().any(|k| k.sky));
         let mut shaded: [Shaded; MATERIAL_KERNELS.len()] = Default::default();
         let (mut shadows, mut dist) = (RayPacket::default(), [0.0; LANES]);
         let unit = self.world.vector_unit();
@@ -551,6 +567,7 @@ impl PathTracer<'_> {
                 set(&mut lights.e2, i, k.e2);
                 set(&mut lights.normal, i, k.normal);
                 lights.pdf_area[i] = k.pdf_area;
+                lights.sky[i] = k.sky;
                 (lights.u[0][i], lights.u[1][i]) = (u_light.x, u_light.y);
                 set(&mut v.light_radiance, i, k.radiance);
                 (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
@@ -601,40 +618,52 @@ fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> boo
     s.alive[i]
 }
 
-/// Every lane's point on its parallelogram light, as `Lights::sample` computes it.
+/// Every lane's point on its parallelogram light or direction to the sky, as `Lights::sample`
+/// computes it.
 #[allow(unsafe_code)]
 fn sample_lights(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
+    if k.any_sky {
+        sample_lights_in::<true>(k, v, choice_pdf, unit)
+    } else {
+        sample_lights_in::<false>(k, v, choice_pdf, unit)
+    }
+}
+
+#[allow(unsafe_code)]
+fn sample_lights_in<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { sample_lights_avx512(k, v, choice_pdf) };
+        return unsafe { sample_lights_avx512::<SKY>(k, v, choice_pdf) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { sample_lights_avx2(k, v, choice_pdf) };
+        return unsafe { sample_lights_avx2::<SKY>(k, v, choice_pdf) };
     }
     let _ = unit;
-    (0..LANES).for_each(|i| sample_light(k, v, choice_pdf, i));
+    (0..LANES).for_each(|i| sample_light::<SKY>(k, v, choice_pdf, i));
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn sample_lights_avx512(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
-    (0..LANES).for_each(|i| sample_light(k, v, choice_pdf, i));
+unsafe fn sample_lights_avx512<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
+    (0..LANES).for_each(|i| sample_light::<SKY>(k, v, choice_pdf, i));
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn sample_lights_avx2(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
-    (0..LANES).for_each(|i| sample_light(k, v, choice_pdf, i));
+unsafe fn sample_lights_avx2<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
+    (0..LANES).for_each(|i| sample_light::<SKY>(k, v, choice_pdf, i));
 }
 
-/// Lane `i`'s point on its parallelogram, as `lights::sample_area` computes it.
+/// Lane `i`'s point on its parallelogram, as `lights::sample_area` computes it, or (`SKY`:
+/// some light is the sky, and this lane's is) its direction uniform over the sphere, as
+/// `Lights::sample` draws it. Both are computed and one kept, so the lanes do not branch.
 #[inline(always)]
-fn sample_light(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
+fn sample_light<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
     let q = get(&k.corner, i) + get(&k.e1, i) * k.u[0][i] + get(&k.e2, i) * k.u[1][i];
     let to = q - get(&v.p, i);
     let d2 = to.length_squared();
@@ -642,9 +671,17 @@ fn sample_light(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
     let dir = to / dist;
     let cos = -get(&k.normal, i).dot(dir);
     let pdf = k.pdf_area[i] * d2 / cos * choice_pdf;
-    v.light[i] &= dist != 0.0 && not_at_most_zero(cos) && not_at_most_zero(pdf);
-    set(&mut v.light_dir, i, dir);
-    (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
+    let area_ok = dist != 0.0 && not_at_most_zero(cos) && not_at_most_zero(pdf);
+    if SKY && k.sky[i] {
+        let sky_pdf = 1.0 / (4.0 * std::f64::consts::PI) * choice_pdf;
+        v.light[i] &= not_at_most_zero(sky_pdf);
+        set(&mut v.light_dir, i, crate::lights::uniform_sphere(Vec2::new(k.u[0][i], k.u[1][i])));
+        (v.light_dist[i], v.light_pdf[i]) = (f64::INFINITY, sky_pdf);
+    } else {
+        v.light[i] &= area_ok;
+        set(&mut v.light_dir, i, dir);
+        (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
+    }
 }
 
 /// A BSDF a material kernel evaluates and samples in lane `i` of [`Vertices`], through the
@@ -1146,7 +1183,15 @@ material = "glow"
                 *ior = alhazen_scene::bsdf::Ior::Constant(1.52);
             }
         }
+        // A sky of one colour beside parallelogram lights: the lanes sample it too.
+        let sky = alhazen_scene::Background::Solid(Vec3::new(0.3, 0.4, 0.5));
+        let mut two_lights_and_sky = two_lights.clone();
+        two_lights_and_sky.background = sky;
+        let mut rough_under_sky = small("cornell-rough", (16, 16, 7));
+        rough_under_sky.background = sky;
         let scenes = [
+            ("two lights and a sky", two_lights_and_sky),
+            ("cornell-rough and a sky", rough_under_sky),
             ("cornell-box", small("cornell-box", (20, 20, 11))),
             ("cornell-rough, glass of index 1.52", glass),
             ("cornell-rough", small("cornell-rough", (16, 16, 7))),
