@@ -5,12 +5,13 @@
 //! Parameters: `albedo`, `kd`, `ks` (`k_d + k_s ≤ 1`), the microfacet distribution, roughness and
 //! shadowing, the coating's index `ior`, the Fresnel mode.
 
-use super::half_vector;
 use super::layered::{DiffuseSpecular, SpecularLobe};
 use super::microfacet::Microfacet;
 use super::reflect;
+use super::{BsdfSample, MicrofacetLobes, cosine_hemisphere, cosine_pdf, same_side};
 use crate::optics::{fresnel_dielectric, fresnel_schlick};
 use alhazen_math::{Vec2, Vec3};
+use std::f64::consts::FRAC_1_PI;
 
 /// The microfacet lobe `D G F / (4⟨l,n⟩⟨v,n⟩)` of a dielectric coating.
 #[derive(Clone, Copy, Debug)]
@@ -26,23 +27,63 @@ pub struct CookTorranceLobe {
 /// Cook–Torrance.
 pub type CookTorrance = DiffuseSpecular<CookTorranceLobe>;
 
-impl SpecularLobe for CookTorranceLobe {
-    fn value(&self, v: Vec3, l: Vec3) -> f64 {
-        let Some(h) = half_vector(v, l) else { return 0.0 };
+impl CookTorranceLobe {
+    /// [`SpecularLobe::value`] and [`SpecularLobe::pdf`] at once (`D` computed once), computed
+    /// whole and then chosen — no early return where `v` and `l` are opposite — so that the
+    /// path tracer's lanes evaluate it for eight directions at once.
+    #[inline(always)]
+    fn value_pdf(&self, v: Vec3, l: Vec3) -> (f64, f64) {
+        let h = (v + l).normalize_or_zero();
+        let met = h != Vec3::ZERO;
+        let h = h * h.z.signum();
         let c = h.dot(l);
         let f = if self.schlick { fresnel_schlick(c, self.ior) } else { fresnel_dielectric(c, self.ior) };
-        self.facets.d(h) * self.facets.g(v, l, h) * f / (4.0 * l.z.abs() * v.z.abs())
+        let d = self.facets.d(h);
+        let value = d * self.facets.g(v, l, h) * f / (4.0 * l.z.abs() * v.z.abs());
+        let pdf = self.facets.pdf_h_from(v, h, d) / (4.0 * h.dot(v).abs());
+        if met { (value, pdf) } else { (0.0, 0.0) }
+    }
+}
+
+impl SpecularLobe for CookTorranceLobe {
+    fn value(&self, v: Vec3, l: Vec3) -> f64 {
+        self.value_pdf(v, l).0
     }
 
     /// The facet's density over `4⟨h,v⟩`.
     fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        let Some(h) = half_vector(v, l) else { return 0.0 };
-        self.facets.pdf_h_from(v, h, self.facets.d(h)) / (4.0 * h.dot(v).abs())
+        self.value_pdf(v, l).1
     }
 
     /// `v` reflected about a sampled facet normal.
     fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
         let h = self.facets.sample_h_from(v, u)?;
         Some(reflect(v, h * v.z.signum()))
+    }
+}
+
+impl MicrofacetLobes for CookTorrance {
+    /// `(eval, pdf)` of [`DiffuseSpecular`] on this lobe, computed whole and then chosen: the
+    /// per-path tracer's ([`super::Bsdf::eval_pdf`]) and the lanes'. `facets` are the lobe's
+    /// own (the lanes build it with them).
+    #[inline(always)]
+    fn rough_eval_pdf(&self, _: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (value, lobe_pdf) = self.lobe.value_pdf(v, l);
+        let pd = self.p_diffuse();
+        let f = self.diffuse * FRAC_1_PI + Vec3::splat(self.ks * value);
+        let pdf = pd * cosine_pdf(v, l) + (1.0 - pd) * lobe_pdf;
+        if same_side(v, l) { (f, pdf) } else { (Vec3::ZERO, 0.0) }
+    }
+
+    /// [`DiffuseSpecular::sample`] on this lobe, computed whole and then chosen: whether there
+    /// is a sample (a facet where the lobe is chosen, a positive density) and the sample.
+    #[inline(always)]
+    fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let diffuse = uc < self.p_diffuse();
+        let h = self.lobe.facets.sample_h_from(v, u);
+        let mirrored = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
+        let l = if diffuse { cosine_hemisphere(u, v) } else { mirrored };
+        let (f, pdf) = self.rough_eval_pdf(facets, v, l);
+        ((diffuse || h.is_some()) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 }

@@ -29,7 +29,7 @@ pub struct DiffuseSpecular<S> {
 }
 
 impl<S: SpecularLobe> DiffuseSpecular<S> {
-    fn p_diffuse(&self) -> f64 {
+    pub(super) fn p_diffuse(&self) -> f64 {
         lobe_probability(luminance(self.diffuse), self.ks)
     }
 

@@ -109,12 +109,18 @@ impl Bsdf {
             Bsdf::Conductor(c) => c.eval_pdf(v, l),
             Bsdf::Dielectric(d) => d.eval_pdf(v, l),
             Bsdf::Plastic(p) => p.eval_pdf(v, l),
+            Bsdf::CookTorrance(c) => c.rough_eval_pdf(&c.lobe.facets, v, l),
             _ => (self.eval(v, l), self.pdf(v, l)),
         }
     }
 
     /// Chooses `l` from `v`; `uc` picks a lobe, `u` places the direction.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
+        if let Bsdf::CookTorrance(c) = self {
+            // The lanes' form (the same sample, computed whole and then chosen).
+            let (sampled, s) = c.rough_sample(&c.lobe.facets, v, uc, u);
+            return sampled.then_some(s);
+        }
         dispatch!(self, b => b.sample(v, uc, u))
     }
 

@@ -34,8 +34,8 @@
 
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic};
 use crate::bsdf::{
-    Bsdf, BsdfSample, Coat, ColorMode, Conductor, Dielectric, Frame, Microfacet, MicrofacetLobes, Plastic,
-    cosine_hemisphere, cosine_pdf, same_side,
+    Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe, Dielectric, Frame, Microfacet,
+    MicrofacetLobes, Plastic, cosine_hemisphere, cosine_pdf, same_side,
 };
 use crate::lights::{Emitter, LightAsk, LightSample, Lights};
 use crate::sampler::{PixelSeeds, SampleStream};
@@ -77,8 +77,10 @@ struct Vertices {
     ns: Lanes3,
     n0: Lanes3,
     bumped: [bool; LANES],
-    /// A Lambert surface's or a plastic's albedo.
+    /// A Lambert surface's or a plastic's albedo; a Cook–Torrance surface's diffuse colour
+    /// (times `k_d`) and its `k_s`.
     albedo: Lanes3,
+    ks: Lanes,
     /// A rough dielectric's relative index `η_inside/η_outside`, or a plastic coat's.
     ior: Lanes,
     /// A plastic's coat and colouring of its inner reflection.
@@ -231,11 +233,16 @@ pub(crate) enum Kernel {
     BeckmannConductor,
     BeckmannDielectric,
     BeckmannPlastic,
+    /// The course's Cook–Torrance model (Lambert plus a dielectric microfacet lobe, exact
+    /// Fresnel term) on isotropic Trowbridge–Reitz or Beckmann facets with Smith's shadowing:
+    /// what a glTF material's dielectric base becomes.
+    CookTorrance,
+    BeckmannCookTorrance,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 10] = [
+const MATERIAL_KERNELS: [Kernel; 12] = [
     Kernel::Lambert,
     Kernel::RoughConductor,
     Kernel::RoughDielectric,
@@ -246,6 +253,8 @@ const MATERIAL_KERNELS: [Kernel; 10] = [
     Kernel::BeckmannConductor,
     Kernel::BeckmannDielectric,
     Kernel::BeckmannPlastic,
+    Kernel::CookTorrance,
+    Kernel::BeckmannCookTorrance,
 ];
 
 impl Kernel {
@@ -269,6 +278,8 @@ impl Kernel {
                 | Kernel::SmoothPlastic
                 | Kernel::BeckmannDielectric
                 | Kernel::BeckmannPlastic
+                | Kernel::CookTorrance
+                | Kernel::BeckmannCookTorrance
         )
     }
 
@@ -311,6 +322,11 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             Some(true) => Kernel::BeckmannPlastic,
             None => Kernel::General,
         },
+        Bsdf::CookTorrance(c) => match cook_torrance_facets(c) {
+            Some(false) => Kernel::CookTorrance,
+            Some(true) => Kernel::BeckmannCookTorrance,
+            None => Kernel::General,
+        },
         _ => Kernel::General,
     }
 }
@@ -330,6 +346,11 @@ fn dielectric_facets(d: &Dielectric) -> Option<bool> {
 /// [`conductor_facets`] for plastic: a coat of isotropic facets.
 fn plastic_facets(p: &Plastic) -> Option<bool> {
     p.facets.filter(|f| f.alpha_u == f.alpha_v)?.smith_kind()
+}
+
+/// [`conductor_facets`] for Cook–Torrance: isotropic facets, the exact Fresnel term.
+fn cook_torrance_facets(c: &CookTorrance) -> Option<bool> {
+    Some(c.lobe.facets).filter(|f| !c.lobe.schlick && f.alpha_u == f.alpha_v)?.smith_kind()
 }
 
 impl PathTracer<'_> {
@@ -516,6 +537,11 @@ impl PathTracer<'_> {
                 if let Some(facets) = &d.facets {
                     set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
                 }
+            }
+            Bsdf::CookTorrance(c) => {
+                set(&mut v.albedo, i, c.diffuse);
+                (v.ks[i], v.ior[i]) = (c.ks, c.lobe.ior);
+                set_facets(v, i, &c.lobe.facets, None);
             }
             Bsdf::Plastic(p) => {
                 set(&mut v.albedo, i, p.albedo);
@@ -754,6 +780,17 @@ impl RoughBsdf for Dielectric {
     }
 }
 
+impl RoughBsdf for CookTorrance {
+    /// Isotropic facets only ([`cook_torrance_facets`]).
+    const TANGENT: bool = false;
+
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
+        let lobe = CookTorranceLobe { facets, ior: v.ior[i], schlick: false };
+        CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe }
+    }
+}
+
 impl RoughBsdf for Plastic {
     /// A plastic's coat takes one roughness.
     const TANGENT: bool = false;
@@ -861,6 +898,8 @@ fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, unit: VectorUnit) 
         Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, out, unit),
         Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, out, unit),
         Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, out, unit),
+        Kernel::CookTorrance => shade::<Rough<CookTorrance, false>>(v, out, unit),
+        Kernel::BeckmannCookTorrance => shade::<Rough<CookTorrance, true>>(v, out, unit),
         Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, out, unit),
@@ -1086,6 +1125,11 @@ shape = "box"
 min = [0.5, 0, -1]
 max = [1.5, 1.2, 0]
 material = { bsdf = { type = "cook-torrance", roughness = 0.1, distribution = "beckmann", color = [0.2, 0.7, 0.3], kd = 0.7, ks = 0.3 } }
+[[object]]
+shape = "sphere"
+center = [-1.3, 0.3, 2.9]
+radius = 0.3
+material = { bsdf = { type = "cook-torrance", roughness = 0.2, distribution = "ggx", color = { checker = { even = [0.8, 0.3, 0.1], odd = [0.1, 0.2, 0.7], size = 0.1 } }, kd = 0.96, ks = 1.0 } }
 [[object]]
 shape = "box"
 min = [-2.5, 0, -2]
