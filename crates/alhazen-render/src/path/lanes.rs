@@ -439,16 +439,19 @@ impl PathTracer<'_> {
                     shadows.set(i, &ray);
                 }
             }
-            if kernels.iter().any(|k| k.is_material()) {
+            // Which material kernels the lanes take, one bit each (by their `shaded` slot).
+            let present = kernels.iter().filter(|k| k.is_material()).fold(0u32, |m, k| m | 1 << k.shaded());
+            if present != 0 {
                 if self.lane_lights.is_some() {
                     sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
                 } else if self.lights.has_environment() {
                     self.lights.sample_lanes(&lights.asks, |i, sample| set_light(&mut vertices, i, sample));
                 }
-                for (kernel, out) in MATERIAL_KERNELS.into_iter().zip(&mut shaded) {
-                    if kernels.contains(&kernel) {
-                        shade_with(kernel, &vertices, out, unit);
-                    }
+                let mut left = present;
+                while left != 0 {
+                    let slot = left.trailing_zeros() as usize;
+                    left &= left - 1;
+                    shade_with(MATERIAL_KERNELS[slot], &vertices, &mut shaded[slot], unit);
                 }
                 for (i, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
                     let s = &shaded[kernel.shaded()];
