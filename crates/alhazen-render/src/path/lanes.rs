@@ -649,7 +649,6 @@ fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> boo
 
 /// Every lane's point on its parallelogram light or direction to the sky, as `Lights::sample`
 /// computes it.
-#[allow(unsafe_code)]
 fn sample_lights(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
     if k.any_sky {
         sample_lights_in::<true>(k, v, choice_pdf, unit)
