@@ -32,19 +32,10 @@ fn inverse_dirs(rays: &RayPacket) -> [[f64; LANES]; 3] {
 }
 
 /// Whether the segment `(0, t_max)` of `ray` (reciprocal direction `inv_dir`) may meet box
-/// `b`: the slab test, where a NaN (`0·∞`: an origin on the face of a slab the ray runs
-/// along) rejects nothing.
+/// `b`: [`Bounds3::hit_interval`]'s slab test, the world's cull before an object's own.
 #[inline(always)]
 fn may_meet_box(b: &Bounds3, ray: &Ray, inv_dir: [f64; 3], t_max: f64) -> bool {
-    let (mut near, mut far) = (0.0f64, t_max);
-    for axis in 0..3 {
-        let t0 = (b.min[axis] - ray.origin[axis]) * inv_dir[axis];
-        let t1 = (b.max[axis] - ray.origin[axis]) * inv_dir[axis];
-        let (entry, exit) = if inv_dir[axis] < 0.0 { (t1, t0) } else { (t0, t1) };
-        near = if entry > near { entry } else { near };
-        far = if exit < far { exit } else { far };
-    }
-    near <= far
+    b.hit_interval(ray, Vec3::from_array(inv_dir), t_max).is_some()
 }
 
 /// An object ready to be intersected.

