@@ -5,12 +5,16 @@
 # Prints, per scene, the median ratio NEW/OLD over the rounds, its range, and whether the two
 # images are the same bytes.
 #
-#   bench/ab_pairs.sh ROUNDS OLD NEW SCENE.xml...     (SPP=16 for quicker rounds; default 64)
+#   bench/ab_pairs.sh ROUNDS OLD NEW SCENE.xml...     (SPP=16 for quicker rounds; default 64;
+#                                                    SAMPLER=sobol as the suite renders)
 #
 # Needs two cores, `perf` and `taskset`. Session 25 of BENCHMARKS.md used it: 12-20 rounds at
 # 16 spp resolve ~3 % where alternated sequential runs (±15 % drift) could not.
 set -euo pipefail
 spp=${SPP:-64}
+# SAMPLER=sobol (or independent) overrides the scene file's sampler, as bench/mitsuba/suite.py does.
+sampler=()
+[ -n "${SAMPLER:-}" ] && sampler=(--sampler "$SAMPLER")
 rounds=$1 old=$2 new=$3
 shift 3
 tmp=$(mktemp -d)
@@ -20,9 +24,9 @@ for scene in "$@"; do
     for r in $(seq "$rounds"); do
         if [ $((r % 2)) = 0 ]; then a=0 b=1; else a=1 b=0; fi
         taskset -c $a perf stat -x, -o "$tmp/old.txt" -e task-clock "$old" render "$scene" -o "$tmp/old.exr" \
-            --spp "$spp" --threads 1 --quiet >/dev/null 2>&1 &
+            --spp "$spp" --threads 1 --quiet "${sampler[@]}" >/dev/null 2>&1 &
         taskset -c $b perf stat -x, -o "$tmp/new.txt" -e task-clock "$new" render "$scene" -o "$tmp/new.exr" \
-            --spp "$spp" --threads 1 --quiet >/dev/null 2>&1 &
+            --spp "$spp" --threads 1 --quiet "${sampler[@]}" >/dev/null 2>&1 &
         wait
         o=$(grep task-clock "$tmp/old.txt" | cut -d, -f1)
         n=$(grep task-clock "$tmp/new.txt" | cut -d, -f1)

@@ -6,12 +6,16 @@
 # 3 %). They are a proxy, not a time: Valgrind has no AVX-512, so the binaries take their AVX2
 # kernels, and its cache is not this processor's.
 #
-#   bench/count_pairs.sh OLD NEW SCENE.xml...     (SPP=4 by default: ~10 s a run)
+#   bench/count_pairs.sh OLD NEW SCENE.xml...     (SPP=4 by default: ~10 s a run; SAMPLER=sobol
+#                                                  as the suite renders)
 #
 # Prints, per scene, NEW/OLD for instructions (Ir), first-level data misses (D1mr + D1mw)
 # and last-level misses (DLmr + DLmw), and whether the two images are the same bytes.
 set -euo pipefail
 spp=${SPP:-4}
+# SAMPLER=sobol (or independent) overrides the scene file's sampler, as bench/mitsuba/suite.py does.
+sampler=()
+[ -n "${SAMPLER:-}" ] && sampler=(--sampler "$SAMPLER")
 old=$1 new=$2
 shift 2
 command -v valgrind >/dev/null || { echo "needs valgrind (apt-get install valgrind)" >&2; exit 2; }
@@ -19,7 +23,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 count() { # binary scene side
     valgrind --tool=cachegrind --cache-sim=yes --cachegrind-out-file="$tmp/$3.cg" \
-        "$1" render "$2" -o "$tmp/$3.exr" --spp "$spp" --threads 1 --quiet >/dev/null 2>&1
+        "$1" render "$2" -o "$tmp/$3.exr" --spp "$spp" --threads 1 --quiet "${sampler[@]}" >/dev/null 2>&1
     # The summary line: Ir I1mr ILmr Dr D1mr DLmr Dw D1mw DLmw.
     grep '^summary:' "$tmp/$3.cg" | awk '{print $2, $6 + $9, $7 + $10}'
 }

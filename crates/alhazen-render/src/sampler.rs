@@ -74,49 +74,76 @@ pub enum Sequence {
     Sobol,
 }
 
-/// What every sample of one pixel shares: the hashes of `(seed, pixel)` and of each Sobol
-/// dimension pair, computed once for all the pixel's [`SampleStream`]s.
+/// What every sample of one pixel shares: the hash of `(seed, pixel)` and the scrambling seeds
+/// of each Sobol dimension pair, computed once for all the pixel's [`SampleStream`]s.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelSeeds {
     sequence: Sequence,
-    /// `mix(pixel seed ⊕ d)` for each Sobol pair `d`.
-    dimensions: [u64; SOBOL_PAIRS as usize],
+    /// Per Sobol pair (lanes past [`SOBOL_PAIRS`] unused): the seeds that shuffle the index and
+    /// scramble the pair's first and second coordinate, from `mix(pixel seed ⊕ d)`.
+    scrambles: Scrambles,
     rng: u64,
+    /// Whether the processor runs the AVX2 loop of [`sobol_points`].
+    avx2: bool,
+}
+
+/// Lanes of the vector loop that computes a sample's Sobol pairs all at once.
+const SOBOL_LANES: usize = 8;
+const _: () = assert!(SOBOL_PAIRS as usize <= SOBOL_LANES);
+
+/// The three 32-bit scrambling seeds of each Sobol dimension pair, one array per seed.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Scrambles {
+    shuffle: [u32; SOBOL_LANES],
+    first: [u32; SOBOL_LANES],
+    second: [u32; SOBOL_LANES],
 }
 
 impl PixelSeeds {
     /// The seeds of pixel `(x, y)`.
     pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32) -> Self {
         let pixel_seed = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d) ^ ((x as u64) << 32 | y as u64));
-        let dimensions = std::array::from_fn(|d| mix(pixel_seed ^ d as u64));
-        Self { sequence, dimensions, rng: rng_pixel_hash(seed, x, y) }
+        let mut scrambles = Scrambles::default();
+        for d in 0..SOBOL_PAIRS as usize {
+            let h = mix(pixel_seed ^ d as u64);
+            scrambles.shuffle[d] = h as u32;
+            scrambles.first[d] = (h >> 32) as u32;
+            scrambles.second[d] = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
+        }
+        Self { sequence, scrambles, rng: rng_pixel_hash(seed, x, y), avx2: has_avx2() }
     }
 
     /// The stream of sample `index` of this pixel.
     #[inline]
     pub fn stream(&self, index: u32) -> SampleStream {
         let rng = Rng(mix(self.rng ^ index as u64));
-        let mut s = SampleStream {
-            sequence: self.sequence,
-            dimensions: self.dimensions,
-            index_reversed: index.reverse_bits(),
-            dimension: 0,
-            rng,
-            ahead: Vec2::ZERO,
+        let sobol = match self.sequence {
+            Sequence::Sobol => sobol_points(&self.scrambles, index.reverse_bits(), self.avx2),
+            Sequence::Independent => [[0; SOBOL_LANES]; 2],
         };
+        let mut s = SampleStream { sequence: self.sequence, sobol, dimension: 0, rng, ahead: Vec2::ZERO };
         s.ahead = s.pair();
         s
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+fn has_avx2() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn has_avx2() -> bool {
+    false
 }
 
 /// The numbers of one sample of one pixel, dimension after dimension.
 #[derive(Clone, Debug)]
 pub struct SampleStream {
     sequence: Sequence,
-    /// The pixel's hash of each Sobol pair ([`PixelSeeds`]).
-    dimensions: [u64; SOBOL_PAIRS as usize],
-    /// The sample index with its bits reversed (the form Owen scrambling works on).
-    index_reversed: u32,
+    /// The sample's Sobol pairs, computed together when the stream starts: first coordinates
+    /// then second ones, as 32-bit fractions.
+    sobol: [[u32; SOBOL_LANES]; 2],
     dimension: u32,
     rng: Rng,
     /// The pair of dimension `dimension`, computed one call ahead.
@@ -205,27 +232,47 @@ impl SampleStream {
     fn pair(&mut self) -> Vec2 {
         match self.sequence {
             Sequence::Sobol if self.dimension < SOBOL_PAIRS => {
-                let (x, y) = sobol_pair(self.dimensions[self.dimension as usize], self.index_reversed);
-                Vec2::new(x, y)
+                let d = self.dimension as usize;
+                Vec2::new(to_unit(self.sobol[0][d]), to_unit(self.sobol[1][d]))
             }
             _ => Vec2::new(self.rng.uniform(), self.rng.uniform()),
         }
     }
 }
 
-/// The Owen-scrambled Sobol pair of the dimension whose pixel hash is `h`, for the sample whose
-/// index reversed is `index_reversed`.
+/// Every Owen-scrambled Sobol pair of the sample whose index reversed is `index_reversed`,
+/// one dimension pair per lane of one vector loop (AVX2 where `avx2`; the same integers either
+/// way): first coordinates, then second ones.
+#[inline]
+fn sobol_points(scrambles: &Scrambles, index_reversed: u32, avx2: bool) -> [[u32; SOBOL_LANES]; 2] {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: `avx2` is only true where the processor has AVX2 (`has_avx2`).
+        #[allow(unsafe_code)]
+        return unsafe { sobol_points_avx2(scrambles, index_reversed) };
+    }
+    let _ = avx2;
+    sobol_points_in(scrambles, index_reversed)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+#[target_feature(enable = "avx2")]
+unsafe fn sobol_points_avx2(scrambles: &Scrambles, index_reversed: u32) -> [[u32; SOBOL_LANES]; 2] {
+    sobol_points_in(scrambles, index_reversed)
+}
+
 #[inline(always)]
-fn sobol_pair(h: u64, index_reversed: u32) -> (f64, f64) {
-    // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal done once).
-    let shuffled = scramble_reversed(index_reversed, h as u32).reverse_bits();
-    // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
-    let a = scramble_reversed(shuffled, (h >> 32) as u32);
-    let sb = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
-    let b = scramble_reversed(sobol1_reversed(shuffled), sb);
-    // Both reversed by one 64-bit reversal, which also swaps the halves.
-    let ab = ((b as u64) << 32 | a as u64).reverse_bits();
-    (to_unit((ab >> 32) as u32), to_unit(ab as u32))
+fn sobol_points_in(scrambles: &Scrambles, index_reversed: u32) -> [[u32; SOBOL_LANES]; 2] {
+    let mut out = [[0; SOBOL_LANES]; 2];
+    for d in 0..SOBOL_LANES {
+        // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal done once).
+        let shuffled = scramble_reversed(index_reversed, scrambles.shuffle[d]).reverse_bits();
+        // Dimension 0 is the van der Corput sequence, whose reversed bits are the index.
+        out[0][d] = scramble_reversed(shuffled, scrambles.first[d]).reverse_bits();
+        out[1][d] = scramble_reversed(sobol1_reversed(shuffled), scrambles.second[d]).reverse_bits();
+    }
+    out
 }
 
 /// The position in `[0, 1)²` of sample `i` of `n` in a pixel: jittered on a `k × k` grid when
@@ -300,6 +347,35 @@ mod tests {
         }
         let chi2: f64 = bins.iter().map(|&b| (b as f64 - 10_000.0).powi(2) / 10_000.0).sum();
         assert!(chi2 < 27.9, "χ² = {chi2}");
+    }
+
+    /// One Sobol pair by the definition: the index Owen-scrambled, its van der Corput and
+    /// second-Sobol-dimension points, each Owen-scrambled (each reversal written out).
+    fn sobol_pair_by_definition(index: u32, shuffle: u32, first: u32, second: u32) -> (u32, u32) {
+        let shuffled = owen_scramble(index, shuffle);
+        let sobol1 = sobol1_reversed(shuffled).reverse_bits();
+        (owen_scramble(shuffled.reverse_bits(), first), owen_scramble(sobol1, second))
+    }
+
+    proptest::proptest! {
+        /// The vector loop gives every lane the pair the definition gives, on every kernel.
+        #[test]
+        fn sobol_points_are_the_definition_on_every_kernel(
+            index in proptest::prelude::any::<u32>(),
+            seeds in proptest::collection::vec(proptest::prelude::any::<u32>(), 3 * SOBOL_LANES),
+        ) {
+            let scrambles = Scrambles {
+                shuffle: std::array::from_fn(|d| seeds[d]),
+                first: std::array::from_fn(|d| seeds[SOBOL_LANES + d]),
+                second: std::array::from_fn(|d| seeds[2 * SOBOL_LANES + d]),
+            };
+            let portable = sobol_points(&scrambles, index.reverse_bits(), false);
+            proptest::prop_assert_eq!(portable, sobol_points(&scrambles, index.reverse_bits(), has_avx2()));
+            for d in 0..SOBOL_LANES {
+                let pair = sobol_pair_by_definition(index, seeds[d], seeds[SOBOL_LANES + d], seeds[2 * SOBOL_LANES + d]);
+                proptest::prop_assert_eq!((portable[0][d], portable[1][d]), pair, "lane {}", d);
+            }
+        }
     }
 
     #[test]
