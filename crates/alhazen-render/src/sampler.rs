@@ -9,16 +9,17 @@
 //! `(seed, pixel, dimension)`, so strata stay intact at power-of-two sample counts. Only the
 //! first [`SOBOL_PAIRS`] pairs are Sobol points; later ones are independent numbers (as
 //! Mitsuba 0.5's low-discrepancy sampler does past its `dimension`): deep in a path the
-//! stratification no longer shows in the image, and the hashing costs ~100 instructions a pair.
+//! stratification no longer shows in the image. A sample's Sobol pairs are hashed together,
+//! one pair per lane of one vector loop, when its stream starts.
 
 use alhazen_math::Vec2;
 
-/// Dimension pairs drawn from the Sobol sequence: the pixel position and, in the common case of
-/// one light and one-lobe BSDFs, the light and BSDF samples of a path's first two vertices. On
-/// the Cornell box, its rough variant and the prism (6–8 seeds at 32 spp, against 1024-spp
-/// renders) the error is the same as with Sobol points in every pair, and renders are 4–7 %
-/// faster (BENCHMARKS.md).
-pub const SOBOL_PAIRS: u32 = 5;
+/// Dimension pairs drawn from the Sobol sequence: the pixel position and the first vertices'
+/// light, lobe and BSDF samples. All are computed in one vector loop of eight lanes when a
+/// sample starts, so eight cost what five did; past five, only the environment-map scene of the
+/// suite gained (mean relative error −6 % at 32 spp, six seeds; the others within ±0.5 %), and
+/// sixteen gained nothing more (BENCHMARKS.md, session 27).
+pub const SOBOL_PAIRS: u32 = 8;
 
 /// A small, fast generator (SplitMix64 sequence), adequate for jitter and stratification.
 #[derive(Clone, Debug)]
