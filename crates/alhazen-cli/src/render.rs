@@ -310,19 +310,25 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         true => Some(pool.install(|| crate::radiosity::solve(&scene, &a.radiosity, a.image.quiet))?),
         false => None,
     };
-    let world_and_map = match photon {
-        true => Some(pool.install(|| {
-            let world = alhazen_render::World::build_by(&scene, unit, bvh_method(a.bvh));
-            crate::photon::build(&scene, &world, &a.photon, a.image.quiet).map(|map| (world, map))
-        })?),
-        false => None,
+    // The world the tracers trace, built apart so that the summary tells its time.
+    let (world, map);
+    let mut world_time = None;
+    let source = match &solution {
+        Some(s) => Source::Radiosity(s),
+        None => {
+            let building = Instant::now();
+            world = pool.install(|| alhazen_render::World::build_by(&scene, unit, bvh_method(a.bvh)));
+            world_time = Some(building.elapsed());
+            match photon {
+                true => {
+                    map = pool.install(|| crate::photon::build(&scene, &world, &a.photon, a.image.quiet))?;
+                    Source::Photons(&world, &map)
+                }
+                false => Source::Scene(&world),
+            }
+        }
     };
-    let source = match (&solution, &world_and_map) {
-        (Some(s), _) => Source::Radiosity(s),
-        (None, Some((world, map))) => Source::Photons(world, map),
-        (None, None) => Source::Scene,
-    };
-    let (part, stopped) = pool.install(|| render_plan(&scene, unit, &plan, resumed, a, &source));
+    let (part, stopped) = pool.install(|| render_plan(&scene, &plan, resumed, a, &source));
     let elapsed = start.elapsed();
     let total = plan.band.len();
     if stopped {
@@ -349,7 +355,7 @@ pub(crate) fn run(a: &RenderArgs) -> Result<(), Failure> {
         let _ = std::fs::remove_file(c); // its work is in the output now
     }
     if !a.image.quiet {
-        summary(&scene, a, &plan, elapsed, pool.current_num_threads(), &source);
+        summary(&scene, a, &plan, (elapsed, world_time), pool.current_num_threads(), &source);
     }
     Ok(())
 }
@@ -400,14 +406,7 @@ fn save_checkpoint(path: &Path, part: &Part) -> Result<(), Failure> {
 
 /// Renders the plan's tiles that `resumed` lacks; returns them all, and whether an interrupt
 /// stopped the render.
-fn render_plan(
-    scene: &Scene,
-    unit: VectorUnit,
-    plan: &Plan,
-    resumed: Part,
-    a: &RenderArgs,
-    source: &Source,
-) -> (Part, bool) {
+fn render_plan(scene: &Scene, plan: &Plan, resumed: Part, a: &RenderArgs, source: &Source) -> (Part, bool) {
     let done: Vec<bool> = {
         let mut d = vec![false; plan.band.end];
         resumed.tiles.iter().for_each(|(_, t)| d[t.index] = true);
@@ -431,7 +430,7 @@ fn render_plan(
         clamped: 0,
     });
     let every = Duration::from_secs_f64(a.checkpoint_every);
-    render_tiles(scene, unit, a.bvh, source, &job, &|t| {
+    render_tiles(scene, source, &job, &|t| {
         let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
         s.unusable += t.unusable_samples;
         s.clamped += t.clamped_pixels;
@@ -467,8 +466,8 @@ fn render_plan(
 
 /// What the image is made from besides the scene.
 enum Source<'a> {
-    /// The scene's integrator.
-    Scene,
+    /// The scene's integrator over its world.
+    Scene(&'a alhazen_render::World),
     /// A radiosity solution.
     Radiosity(&'a alhazen_radiosity::Solution),
     /// The world and its caustic photon map (the path tracer takes caustics from it).
@@ -483,14 +482,7 @@ fn bvh_method(bvh: BvhArg) -> alhazen_render::bvh::BuildMethod {
 }
 
 /// The job's tiles by the scene's integrator, from a radiosity solution, or with a photon map.
-fn render_tiles(
-    scene: &Scene,
-    unit: VectorUnit,
-    bvh: BvhArg,
-    source: &Source,
-    job: &Job,
-    done: &(dyn Fn(TileResult) + Sync),
-) {
+fn render_tiles(scene: &Scene, source: &Source, job: &Job, done: &(dyn Fn(TileResult) + Sync)) {
     let (w, h) = alhazen_render::film_size(scene);
     match source {
         Source::Radiosity(s) => {
@@ -502,7 +494,7 @@ fn render_tiles(
             let tracer = alhazen_render::path::PathTracer::new(scene, world, &camera).with_caustics(*map);
             alhazen_render::film::render_tiles(w, h, &tracer, job, &STOP, done)
         }
-        Source::Scene => alhazen_render::render_tiles_by(scene, unit, bvh_method(bvh), job, &STOP, done),
+        Source::Scene(world) => alhazen_render::render_tiles_in(scene, world, job, &STOP, done),
     }
 }
 
@@ -537,7 +529,16 @@ impl Progress {
     }
 }
 
-fn summary(scene: &Scene, a: &RenderArgs, plan: &Plan, elapsed: Duration, threads: usize, source: &Source) {
+/// The summary line on stderr: what was rendered, in how long (`elapsed` in all, the part of it
+/// that built the world when one was built), on how many threads, to which file.
+fn summary(
+    scene: &Scene,
+    a: &RenderArgs,
+    plan: &Plan,
+    (elapsed, world_time): (Duration, Option<Duration>),
+    threads: usize,
+    source: &Source,
+) {
     let r = &scene.render;
     let integrator = match (r.integrator, source) {
         (_, Source::Photons(_, map)) => format!(
@@ -560,9 +561,9 @@ fn summary(scene: &Scene, a: &RenderArgs, plan: &Plan, elapsed: Duration, thread
                 100.0 * st.unshot
             )
         }
-        (alhazen_scene::IntegratorKind::Whitted, Source::Scene) => "Whitted ray tracing".to_string(),
+        (alhazen_scene::IntegratorKind::Whitted, Source::Scene(_)) => "Whitted ray tracing".to_string(),
         // Photon and radiosity renders have their own source.
-        (_, Source::Scene) => format!("path tracing, {:?} sampler", r.sampler).to_lowercase(),
+        (_, Source::Scene(_)) => format!("path tracing, {:?} sampler", r.sampler).to_lowercase(),
     };
     let what = match (a.tile, a.pass) {
         (None, None) => String::new(),
@@ -575,8 +576,9 @@ fn summary(scene: &Scene, a: &RenderArgs, plan: &Plan, elapsed: Duration, thread
             plan.samples.end
         ),
     };
+    let building = world_time.map_or(String::new(), |t| format!(", {:.3} s of it building the world", t.as_secs_f64()));
     eprintln!(
-        "rendered {} ({}×{}, {} spp, depth {}, {integrator}{what}) in {:.3} s on {threads} threads → {}",
+        "rendered {} ({}×{}, {} spp, depth {}, {integrator}{what}) in {:.3} s on {threads} threads{building} → {}",
         a.image.scene.display(),
         plan.width,
         plan.height,

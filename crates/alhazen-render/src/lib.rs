@@ -116,8 +116,20 @@ pub fn render_tiles_by(
     stop: &std::sync::atomic::AtomicBool,
     done: &(dyn Fn(film::TileResult) + Sync),
 ) {
+    render_tiles_in(scene, &World::build_by(scene, unit, method), job, stop, done)
+}
+
+/// [`render_tiles_by`] over `world`, built beforehand from `scene` by [`World::build_by`]
+/// (so that a caller can tell the build's time from the render's).
+pub fn render_tiles_in(
+    scene: &Scene,
+    world: &World,
+    job: &film::Job,
+    stop: &std::sync::atomic::AtomicBool,
+    done: &(dyn Fn(film::TileResult) + Sync),
+) {
     let (w, h) = film_size(scene);
-    with_estimator(scene, unit, method, &|estimator| film::render_tiles(w, h, estimator, job, stop, done))
+    with_estimator_in(scene, world, &|estimator| film::render_tiles(w, h, estimator, job, stop, done))
 }
 
 /// Calls `work` with the scene's integrator over its world.
@@ -127,18 +139,22 @@ fn with_estimator<T>(
     method: bvh::BuildMethod,
     work: &dyn Fn(&dyn film::PixelEstimator) -> T,
 ) -> T {
-    let world = World::build_by(scene, unit, method);
+    with_estimator_in(scene, &World::build_by(scene, unit, method), work)
+}
+
+/// Calls `work` with the scene's integrator over `world`, the scene's.
+fn with_estimator_in<T>(scene: &Scene, world: &World, work: &dyn Fn(&dyn film::PixelEstimator) -> T) -> T {
     let s = &scene.render;
     let camera = Camera::new(&scene.camera, s.width, s.height);
     match s.integrator {
         IntegratorKind::Whitted => {
-            work(&WhittedEstimator { whitted: Whitted::new(scene, &world), camera: &camera, spp: s.spp, seed: s.seed })
+            work(&WhittedEstimator { whitted: Whitted::new(scene, world), camera: &camera, spp: s.spp, seed: s.seed })
         }
         // Photon mapping and radiosity live in crates above this one (`alhazen render` runs
         // them); here the path tracer renders what the photon map converges to and radiosity
         // approximates.
         IntegratorKind::Path | IntegratorKind::Photon | IntegratorKind::Radiosity => {
-            work(&PathTracer::new(scene, &world, &camera))
+            work(&PathTracer::new(scene, world, &camera))
         }
     }
 }
