@@ -307,6 +307,30 @@ impl Bvh {
             } else {
                 let node = &self.wide[at.offset as usize];
                 let (hits, near) = slab.test(node, limit);
+                if hits != 0 && hits & (hits - 1) == 0 {
+                    // One child met: descended into at once.
+                    let k = hits.trailing_zeros() as usize;
+                    at = Slab::child(node, k, near[k]);
+                    continue;
+                }
+                if hits.count_ones() == 2 {
+                    // Two: the nearer descended into (the first in slot order on a tie), the
+                    // other waits; both asked of memory.
+                    let (a, b) = (hits.trailing_zeros() as usize, (hits & (hits - 1)).trailing_zeros() as usize);
+                    let (first, second) = if near[b] < near[a] { (b, a) } else { (a, b) };
+                    let later = Slab::child(node, second, near[second]);
+                    stack[sp].write(later);
+                    sp += 1;
+                    at = Slab::child(node, first, near[first]);
+                    for child in [at, later] {
+                        if child.is_leaf() {
+                            prefetch(child.labels());
+                        } else {
+                            Slab::prefetch(&self.wide[child.offset as usize]);
+                        }
+                    }
+                    continue;
+                }
                 if hits != 0 {
                     // The children met, nearest first (ties in slot order); the rest wait.
                     let mut met = [(0.0f32, 0usize); WIDTH];
