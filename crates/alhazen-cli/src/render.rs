@@ -578,13 +578,14 @@ fn summary(
     };
     let building = world_time.map_or(String::new(), |t| format!(", {:.3} s of it building the world", t.as_secs_f64()));
     eprintln!(
-        "rendered {} ({}×{}, {} spp, depth {}, {integrator}{what}) in {:.3} s on {threads} threads{building} → {}",
+        "rendered {} ({}×{}, {} spp, depth {}, {integrator}{what}) in {:.3} s on {threads} thread{}{building} → {}",
         a.image.scene.display(),
         plan.width,
         plan.height,
         r.spp,
         r.max_depth,
         elapsed.as_secs_f64(),
+        if threads == 1 { "" } else { "s" },
         a.image.output.display()
     );
 }

@@ -51,6 +51,25 @@ fn integrator_and_sampler_can_be_chosen_on_the_command_line() {
     assert!(!exists);
 }
 
+/// The summary line tells the render's time and the part of it that built the world, in the
+/// form the suite's script reads (bench/mitsuba/suite.py).
+#[test]
+fn summary_tells_the_time_that_built_the_world() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path(), OK);
+    let out = dir.path().join("out.png");
+    let o = alhazen(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--threads", "1"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let line = err.lines().find(|l| l.starts_with("rendered ")).unwrap_or_else(|| panic!("no summary: {err}"));
+    let seconds = |before: &str| -> f64 {
+        let at = line.find(before).unwrap_or_else(|| panic!("no {before:?} in {line}"));
+        line[..at].rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    let (total, building) = (seconds(" s on 1 thread,"), seconds(" s of it building the world"));
+    assert!(building >= 0.0 && building <= total, "{line}");
+}
+
 /// `--kernel portable` runs on every processor and renders the bits the default kernel does
 /// (the path tracer, whose Lambertian scenes the wider kernels trace in lanes).
 #[test]
