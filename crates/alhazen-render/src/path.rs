@@ -449,7 +449,7 @@ impl PixelEstimator for PathTracer<'_> {
         if self.in_lanes {
             self.pixels_in_lanes(&[(x, y)], first, out);
         } else {
-            let seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
+            let seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y, self.world.vector_unit());
             out.iter_mut().enumerate().for_each(|(i, c)| *c = self.sample_of(seeds.stream(first + i as u32), x, y));
         }
     }
@@ -463,7 +463,11 @@ impl PixelEstimator for PathTracer<'_> {
     }
 
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
-        self.sample_of(SampleStream::new(self.sequence, self.scene.render.seed, x, y, index), x, y)
+        self.sample_of(
+            SampleStream::new(self.sequence, self.scene.render.seed, x, y, index, self.world.vector_unit()),
+            x,
+            y,
+        )
     }
 }
 

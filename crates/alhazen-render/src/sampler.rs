@@ -12,6 +12,7 @@
 //! stratification no longer shows in the image. A sample's Sobol pairs are hashed together,
 //! one pair per lane of one vector loop, when its stream starts.
 
+use crate::shape::VectorUnit;
 use alhazen_math::Vec2;
 
 /// Dimension pairs drawn from the Sobol sequence: the pixel position and the first vertices'
@@ -84,8 +85,8 @@ pub struct PixelSeeds {
     /// scramble the pair's first and second coordinate, from `mix(pixel seed ⊕ d)`.
     scrambles: Scrambles,
     rng: u64,
-    /// Whether the processor runs the AVX2 loop of [`sobol_points`].
-    avx2: bool,
+    /// The vector unit that runs [`sobol_points`]'s loop (the render's kernel).
+    unit: VectorUnit,
 }
 
 /// Lanes of the vector loop that computes a sample's Sobol pairs all at once.
@@ -101,8 +102,9 @@ struct Scrambles {
 }
 
 impl PixelSeeds {
-    /// The seeds of pixel `(x, y)`.
-    pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32) -> Self {
+    /// The seeds of pixel `(x, y)`; its streams hash their Sobol pairs on `unit` (the same
+    /// numbers on every unit).
+    pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, unit: VectorUnit) -> Self {
         let pixel_seed = mix(mix(seed ^ 0x5851_f42d_4c95_7f2d) ^ ((x as u64) << 32 | y as u64));
         let mut scrambles = Scrambles::default();
         for d in 0..SOBOL_PAIRS as usize {
@@ -111,7 +113,7 @@ impl PixelSeeds {
             scrambles.first[d] = (h >> 32) as u32;
             scrambles.second[d] = (h.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 32) as u32;
         }
-        Self { sequence, scrambles, rng: rng_pixel_hash(seed, x, y), avx2: has_avx2() }
+        Self { sequence, scrambles, rng: rng_pixel_hash(seed, x, y), unit }
     }
 
     /// The stream of sample `index` of this pixel.
@@ -119,23 +121,13 @@ impl PixelSeeds {
     pub fn stream(&self, index: u32) -> SampleStream {
         let rng = Rng(mix(self.rng ^ index as u64));
         let sobol = match self.sequence {
-            Sequence::Sobol => sobol_points(&self.scrambles, index.reverse_bits(), self.avx2),
+            Sequence::Sobol => sobol_points(&self.scrambles, index.reverse_bits(), self.unit),
             Sequence::Independent => [[0; SOBOL_LANES]; 2],
         };
         let mut s = SampleStream { sequence: self.sequence, sobol, dimension: 0, rng, ahead: Vec2::ZERO };
         s.ahead = s.pair();
         s
     }
-}
-
-#[cfg(target_arch = "x86_64")]
-fn has_avx2() -> bool {
-    std::arch::is_x86_feature_detected!("avx2")
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-fn has_avx2() -> bool {
-    false
 }
 
 /// The numbers of one sample of one pixel, dimension after dimension.
@@ -205,8 +197,8 @@ fn to_unit(x: u32) -> f64 {
 impl SampleStream {
     /// The stream of sample `index` of pixel `(x, y)` (for many samples of one pixel,
     /// [`PixelSeeds::stream`] hashes the pixel once).
-    pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, index: u32) -> Self {
-        PixelSeeds::new(sequence, seed, x, y).stream(index)
+    pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, index: u32, unit: VectorUnit) -> Self {
+        PixelSeeds::new(sequence, seed, x, y, unit).stream(index)
     }
 
     /// The next pair of numbers in `[0, 1)²`.
@@ -242,17 +234,18 @@ impl SampleStream {
 }
 
 /// Every Owen-scrambled Sobol pair of the sample whose index reversed is `index_reversed`,
-/// one dimension pair per lane of one vector loop (AVX2 where `avx2`; the same integers either
-/// way): first coordinates, then second ones.
+/// one dimension pair per lane of one vector loop (in AVX2 registers where `unit` has them; the
+/// same integers on every unit): first coordinates, then second ones.
 #[inline]
-fn sobol_points(scrambles: &Scrambles, index_reversed: u32, avx2: bool) -> [[u32; SOBOL_LANES]; 2] {
+fn sobol_points(scrambles: &Scrambles, index_reversed: u32, unit: VectorUnit) -> [[u32; SOBOL_LANES]; 2] {
     #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        // SAFETY: `avx2` is only true where the processor has AVX2 (`has_avx2`).
+    if unit.is_simd() {
+        // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes AVX2) only where the
+        // processor has it.
         #[allow(unsafe_code)]
         return unsafe { sobol_points_avx2(scrambles, index_reversed) };
     }
-    let _ = avx2;
+    let _ = unit;
     sobol_points_in(scrambles, index_reversed)
 }
 
@@ -370,8 +363,10 @@ mod tests {
                 first: std::array::from_fn(|d| seeds[SOBOL_LANES + d]),
                 second: std::array::from_fn(|d| seeds[2 * SOBOL_LANES + d]),
             };
-            let portable = sobol_points(&scrambles, index.reverse_bits(), false);
-            proptest::prop_assert_eq!(portable, sobol_points(&scrambles, index.reverse_bits(), has_avx2()));
+            let portable = sobol_points(&scrambles, index.reverse_bits(), VectorUnit::PORTABLE);
+            for unit in VectorUnit::available() {
+                proptest::prop_assert_eq!(portable, sobol_points(&scrambles, index.reverse_bits(), unit), "{:?}", unit);
+            }
             for d in 0..SOBOL_LANES {
                 let pair = sobol_pair_by_definition(index, seeds[d], seeds[SOBOL_LANES + d], seeds[2 * SOBOL_LANES + d]);
                 proptest::prop_assert_eq!((portable[0][d], portable[1][d]), pair, "lane {}", d);
@@ -407,7 +402,7 @@ mod tests {
         for dim in 0..SOBOL_PAIRS {
             let pts: Vec<_> = (0..64)
                 .map(|i| {
-                    let mut s = SampleStream::new(Sequence::Sobol, 9, 5, 7, i);
+                    let mut s = SampleStream::new(Sequence::Sobol, 9, 5, 7, i, VectorUnit::PORTABLE);
                     for _ in 0..dim {
                         s.next_2d();
                     }
@@ -427,7 +422,10 @@ mod tests {
     #[test]
     fn next_1d_is_the_first_of_the_pair_and_advances_alike() {
         for sequence in [Sequence::Sobol, Sequence::Independent] {
-            let (mut one, mut two) = (SampleStream::new(sequence, 2, 3, 4, 5), SampleStream::new(sequence, 2, 3, 4, 5));
+            let (mut one, mut two) = (
+                SampleStream::new(sequence, 2, 3, 4, 5, VectorUnit::PORTABLE),
+                SampleStream::new(sequence, 2, 3, 4, 5, VectorUnit::PORTABLE),
+            );
             for _ in 0..6 {
                 assert_eq!(one.next_1d(), two.next_2d().x, "{sequence:?}");
             }
@@ -437,15 +435,15 @@ mod tests {
 
     #[test]
     fn sobol_differs_between_pixels_and_is_uniform() {
-        let a = SampleStream::new(Sequence::Sobol, 1, 0, 0, 3).next_2d();
-        let b = SampleStream::new(Sequence::Sobol, 1, 1, 0, 3).next_2d();
+        let a = SampleStream::new(Sequence::Sobol, 1, 0, 0, 3, VectorUnit::PORTABLE).next_2d();
+        let b = SampleStream::new(Sequence::Sobol, 1, 1, 0, 3, VectorUnit::PORTABLE).next_2d();
         assert_ne!(a, b);
         // The first pair, and one past the Sobol pairs (independent numbers there).
         for skip in [0, SOBOL_PAIRS + 2] {
             let mut bins = [0u32; 10];
             for px in 0..200 {
                 for i in 0..50 {
-                    let mut s = SampleStream::new(Sequence::Sobol, 4, px, 1, i);
+                    let mut s = SampleStream::new(Sequence::Sobol, 4, px, 1, i, VectorUnit::PORTABLE);
                     for _ in 0..skip {
                         s.next_2d();
                     }

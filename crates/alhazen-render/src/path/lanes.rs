@@ -368,7 +368,8 @@ impl PathTracer<'_> {
         let mut lanes: [Option<LanePath>; LANES] = Default::default();
         let spp = out.len() / pixels.len().max(1);
         let mut next = 0..out.len();
-        let mut seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, 0, 0);
+        let unit = self.world.vector_unit();
+        let mut seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, 0, 0, unit);
         let mut rays = RayPacket::default();
         let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
         let mut general: [Vertex; LANES] = Default::default();
@@ -376,7 +377,6 @@ impl PathTracer<'_> {
         lights.any_sky = self.lane_lights.as_ref().is_some_and(|all| all.iter().any(|k| k.sky));
         let mut shaded: [Shaded; MATERIAL_KERNELS.len()] = Default::default();
         let (mut shadows, mut dist) = (RayPacket::default(), [0.0; LANES]);
-        let unit = self.world.vector_unit();
         let together = self.world.traces_rays_together();
         loop {
             // Idle lanes start the pixels' next samples; all lanes' rays are traced together.
@@ -384,7 +384,7 @@ impl PathTracer<'_> {
                 *slot = next.next().map(|job| {
                     let ((x, y), index) = (pixels[job / spp], first + (job % spp) as u32);
                     if job % spp == 0 {
-                        seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y);
+                        seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y, unit);
                     }
                     let lane = self.start(job, seeds.stream(index), (x, y));
                     rays.set(i, &lane.path.ray);
