@@ -81,6 +81,8 @@ struct Item {
     packed: bool,
     /// Morton code of the centroid (Morton builds only).
     code: u64,
+    /// The bin of its centroid in the last binning of its node (SAH builds only).
+    bin: u8,
 }
 
 /// How a [`Bvh`] chooses its splits.
@@ -143,7 +145,7 @@ impl Bvh {
     ) -> Self {
         use rayon::prelude::*;
         let mut items: Vec<Item> = Vec::new();
-        let item = |(i, b): (usize, &Bounds3)| Item { bounds: *b, index: i as u32, packed: packed(i), code: 0 };
+        let item = |(i, b): (usize, &Bounds3)| Item { bounds: *b, index: i as u32, packed: packed(i), code: 0, bin: 0 };
         bounds.par_iter().enumerate().map(item).collect_into_vec(&mut items);
         if method == BuildMethod::Morton {
             morton_order(&mut items);
@@ -434,9 +436,15 @@ impl Summary {
     }
 
     fn add(self, it: &Item) -> Self {
+        self.add_centred(it, it.bounds.centroid())
+    }
+
+    /// [`Self::add`] for an item whose centroid is `centroid`.
+    #[inline(always)]
+    fn add_centred(self, it: &Item, centroid: Vec3) -> Self {
         Self {
             bounds: self.bounds.union(it.bounds),
-            centroids: self.centroids.grow(it.bounds.centroid()),
+            centroids: self.centroids.grow(centroid),
             tests: self.tests.add(it),
         }
     }
@@ -469,16 +477,11 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
         }
         return None;
     }
-    let per_unit = BINS as f64 / extent[axis];
-    let bin_of = |c: Vec3| (((c[axis] - cb.min[axis]) * per_unit) as usize).min(BINS - 1);
-    // Four sets of bins, item by item in turn, merged after: neighbouring items fall in the
-    // same bin, and one set would make each update wait for the last one's store.
-    let mut sets = [[Summary::EMPTY; BINS]; 4];
-    for (k, it) in items.iter().enumerate() {
-        let b = &mut sets[k % 4][bin_of(it.bounds.centroid())];
-        *b = b.add(it);
-    }
-    let bins: [Summary; BINS] = std::array::from_fn(|i| sets.iter().fold(Summary::EMPTY, |s, set| s.merge(&set[i])));
+    let bins = match axis {
+        0 => bin_items::<0>(items, cb),
+        1 => bin_items::<1>(items, cb),
+        _ => bin_items::<2>(items, cb),
+    };
     // Sweep from the right to get suffix areas, then from the left.
     let mut right_area = [0.0; BINS];
     let mut acc = Summary::EMPTY;
@@ -501,12 +504,31 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
     if split_cost >= leaf_cost && items.len() <= 255 {
         return None;
     }
-    let mid = partition(items, |it| bin_of(it.bounds.centroid()) <= best);
+    let mid = partition(items, |it| usize::from(it.bin) <= best);
     if mid == 0 || mid == items.len() {
         return Some((axis, items.len() / 2, None));
     }
     let halves = [&bins[..=best], &bins[best + 1..]].map(|b| b.iter().fold(Summary::EMPTY, |s, b| s.merge(b)));
     Some((axis, mid, Some(halves)))
+}
+
+/// The items' centroids put in [`BINS`] equal slices of the centroids' bounds `cb` along axis
+/// `AXIS` (each item keeping its bin), and each bin's summary.
+fn bin_items<const AXIS: usize>(items: &mut [Item], cb: &Bounds3) -> [Summary; BINS] {
+    let (lo, per_unit) = (cb.min[AXIS], BINS as f64 / cb.extent()[AXIS]);
+    // Four sets of bins, item by item in turn, merged after: neighbouring items fall in the
+    // same bin, and one set would make each update wait for the last one's store.
+    let mut sets = [[Summary::EMPTY; BINS]; 4];
+    for (k, it) in items.iter_mut().enumerate() {
+        let c = it.bounds.centroid();
+        // At or above 0 (c ≥ lo); `as i32` saturates, as the wider conversion to `usize` would,
+        // in fewer instructions.
+        let bin = (((c[AXIS] - lo) * per_unit) as i32).clamp(0, BINS as i32 - 1) as usize;
+        it.bin = bin as u8;
+        let b = &mut sets[k % 4][bin];
+        *b = b.add_centred(it, c);
+    }
+    std::array::from_fn(|i| sets.iter().fold(Summary::EMPTY, |s, set| s.merge(&set[i])))
 }
 
 /// A node's split rule.
@@ -552,15 +574,23 @@ fn morton_split(items: &[Item]) -> (usize, usize) {
     (2 - (bit % 3) as usize, mid)
 }
 
+/// Moves the items for which `pred` holds before the others (Hoare's two-ended scan: each
+/// misplaced pair swapped once); returns how many there are.
 fn partition(items: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
-    let mut i = 0;
-    for j in 0..items.len() {
-        if pred(&items[j]) {
-            items.swap(i, j);
+    let (mut i, mut j) = (0, items.len());
+    loop {
+        while i < j && pred(&items[i]) {
             i += 1;
         }
+        while i < j && !pred(&items[j - 1]) {
+            j -= 1;
+        }
+        if i == j {
+            return i;
+        }
+        items.swap(i, j - 1);
+        (i, j) = (i + 1, j - 1);
     }
-    i
 }
 
 #[cfg(test)]
