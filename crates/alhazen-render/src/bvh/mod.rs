@@ -150,11 +150,7 @@ impl Bvh {
         if method == BuildMethod::Morton {
             morton_order(&mut items);
         }
-        let mut bvh = Bvh {
-            nodes: Vec::with_capacity(2 * bounds.len()),
-            order: Vec::with_capacity(bounds.len()),
-            ..Bvh::default()
-        };
+        let mut bvh = Bvh::reserved(bounds.len());
         if !items.is_empty() {
             // A node's slab test costs about what a packet's test does, an eighth of a
             // triangle's (pbrt's ratio).
@@ -210,12 +206,14 @@ impl Bvh {
                 let [sl, sr] = halves.unwrap_or_else(|| [Summary::of(left), Summary::of(right)]);
                 let next = depth + 1;
                 let second = if parallel {
-                    let (mut a, mut b) = (Bvh::default(), Bvh::default());
+                    // The first half goes on in this tree, where the sequential build puts it;
+                    // the second is built apart (its vectors reserved whole: no copies as
+                    // they grow) and appended, one copy of it.
+                    let mut b = Bvh::reserved(right.len());
                     rayon::join(
-                        || a.build_node(left, sl, next, how, parallel_from),
+                        || self.build_node(left, sl, next, how, parallel_from),
                         || b.build_node(right, sr, next, how, parallel_from),
                     );
-                    self.append(a);
                     let second = self.nodes.len();
                     self.append(b);
                     second
@@ -228,6 +226,12 @@ impl Bvh {
             }
         }
         me
+    }
+
+    /// An empty tree with room for one over `items` primitives (at most `2·items − 1` nodes;
+    /// pages reserved and never written cost no memory).
+    fn reserved(items: usize) -> Self {
+        Bvh { nodes: Vec::with_capacity(2 * items), order: Vec::with_capacity(items), ..Bvh::default() }
     }
 
     /// Appends a subtree built on its own (its indices counted from 0) after this one's nodes and
