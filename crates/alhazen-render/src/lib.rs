@@ -38,6 +38,7 @@ pub mod distribution;
 pub mod envmap;
 pub mod film;
 pub mod lights;
+pub mod memory;
 pub mod optics;
 pub mod output;
 pub mod path;
