@@ -166,14 +166,6 @@ impl PlyType {
             _ => return None,
         })
     }
-    fn size(self) -> usize {
-        match self {
-            Self::I8 | Self::U8 => 1,
-            Self::I16 | Self::U16 => 2,
-            Self::I32 | Self::U32 | Self::F32 => 4,
-            Self::F64 => 8,
-        }
-    }
 }
 
 #[derive(Debug)]
@@ -205,24 +197,34 @@ impl PlyReader<'_> {
         if self.format == PlyFormat::Ascii {
             return self.read_ascii();
         }
-        let n = ty.size();
-        let b = self.bytes.get(self.pos..self.pos + n).ok_or("unexpected end of binary data")?;
-        self.pos += n;
-        let mut a = [0u8; 8];
-        a[..n].copy_from_slice(b);
-        if self.format == PlyFormat::BinaryBe {
-            a[..n].reverse();
-        }
+        let be = self.format == PlyFormat::BinaryBe;
+        // Each type reads a fixed number of bytes: a copy of a run-time length would be a call
+        // to `memcpy` per value.
         Ok(match ty {
-            PlyType::I8 => a[0] as i8 as f64,
-            PlyType::U8 => a[0] as f64,
-            PlyType::I16 => i16::from_le_bytes([a[0], a[1]]) as f64,
-            PlyType::U16 => u16::from_le_bytes([a[0], a[1]]) as f64,
-            PlyType::I32 => i32::from_le_bytes([a[0], a[1], a[2], a[3]]) as f64,
-            PlyType::U32 => u32::from_le_bytes([a[0], a[1], a[2], a[3]]) as f64,
-            PlyType::F32 => f32::from_le_bytes([a[0], a[1], a[2], a[3]]) as f64,
-            PlyType::F64 => f64::from_le_bytes(a),
+            PlyType::I8 => self.take::<1>(be)?[0] as i8 as f64,
+            PlyType::U8 => self.take::<1>(be)?[0] as f64,
+            PlyType::I16 => i16::from_le_bytes(self.take(be)?) as f64,
+            PlyType::U16 => u16::from_le_bytes(self.take(be)?) as f64,
+            PlyType::I32 => i32::from_le_bytes(self.take(be)?) as f64,
+            PlyType::U32 => u32::from_le_bytes(self.take(be)?) as f64,
+            PlyType::F32 => f32::from_le_bytes(self.take(be)?) as f64,
+            PlyType::F64 => f64::from_le_bytes(self.take(be)?),
         })
+    }
+
+    /// The next `N` bytes, in little-endian order (reversed when the file is big-endian).
+    #[inline(always)]
+    fn take<const N: usize>(&mut self, big_endian: bool) -> Result<[u8; N], String> {
+        let mut b: [u8; N] = self
+            .bytes
+            .get(self.pos..self.pos + N)
+            .and_then(|b| b.try_into().ok())
+            .ok_or("unexpected end of binary data")?;
+        self.pos += N;
+        if big_endian {
+            b.reverse();
+        }
+        Ok(b)
     }
 
     fn read_ascii(&mut self) -> Result<f64, String> {
@@ -250,17 +252,18 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
             return Err("the vertex element lacks x, y or z".into());
         }
         let mut vals = vec![0.0; el.props.len()];
-        // Buffers reused by every item (a million faces would otherwise make two million
+        let (vertex, face) = (el.name == "vertex", el.name == "face");
+        // One buffer reused by every face (a million faces would otherwise make a million
         // small allocations); the vectors grow at most to one item per byte of the body.
-        let (mut list, mut corners) = (Vec::new(), Vec::new());
+        let mut corners: Vec<u32> = Vec::new();
         let at_most = el.count.min(body.len());
-        if el.name == "vertex" {
+        if vertex {
             mesh.positions.reserve(at_most);
-        } else if el.name == "face" {
+        } else if face {
             mesh.triangles.reserve(at_most);
         }
         for _ in 0..el.count {
-            list.clear();
+            corners.clear();
             for (i, p) in el.props.iter().enumerate() {
                 match p.list {
                     None => vals[i] = rd.read(p.ty)?,
@@ -269,17 +272,23 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
                         if !(0.0..=1e6).contains(&n) {
                             return Err(format!("list length {n} out of range"));
                         }
-                        let keep = Some(i) == face_list;
+                        let keep = face && Some(i) == face_list;
                         for _ in 0..n as usize {
                             let x = rd.read(p.ty)?;
                             if keep {
-                                list.push(x);
+                                if !(x >= 0.0 && x < u32::MAX as f64) {
+                                    return Err(format!("bad vertex index {x}"));
+                                }
+                                corners.push(x as u32);
                             }
+                        }
+                        if keep && corners.len() < 3 {
+                            return Err("a face has fewer than 3 vertices".into());
                         }
                     }
                 }
             }
-            if el.name == "vertex" {
+            if vertex {
                 let g = |o: Option<usize>| o.map(|i| vals[i]);
                 mesh.positions.push(Vec3::new(vals[xyz[0].unwrap()], vals[xyz[1].unwrap()], vals[xyz[2].unwrap()]));
                 if let [Some(x), Some(y), Some(z)] = nrm.map(g) {
@@ -288,16 +297,9 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
                 if let [Some(u), Some(v)] = uv.map(g) {
                     mesh.uvs.push(Vec2::new(u, v));
                 }
-            } else if el.name == "face" {
-                if list.len() < 3 {
+            } else if face {
+                if face_list.is_none() {
                     return Err("a face has fewer than 3 vertices".into());
-                }
-                corners.clear();
-                for x in &list {
-                    if !(*x >= 0.0 && *x < u32::MAX as f64) {
-                        return Err(format!("bad vertex index {x}"));
-                    }
-                    corners.push(*x as u32);
                 }
                 for k in 1..corners.len() - 1 {
                     mesh.triangles.push([corners[0], corners[k], corners[k + 1]]);

@@ -88,26 +88,31 @@ impl FlatLane {
     }
 }
 
-/// The flat of triangle `t` of `mesh` and its bounds: with `pair`, the parallelogram of `t`
-/// and `t + 1` (`None` when they do not form one); else the triangle (`None` without area).
-fn flat_at(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<(Flat, Bounds3)> {
-    let corners = mesh.corners(t);
-    if !pair {
-        return Flat::triangle(corners).map(|f| (f, Bounds3::from_points(corners)));
-    }
-    if t + 1 >= mesh.triangle_count() {
-        return None;
-    }
-    let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
-    let [o, e1, e2] = parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])?;
-    Flat::new(o, e1, e2, true).map(|f| (f, Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])))
+/// The corner and edges of the flat of triangle `t` of `mesh` and its bounds: with `pair`, of
+/// the parallelogram of `t` and `t + 1` (`None` when they do not form one); else of the
+/// triangle. `None` without area (the test of [`Flat::new`], without computing the flat).
+fn flat_span(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<([Vec3; 3], Bounds3)> {
+    let corners @ [a, b, c] = mesh.corners(t);
+    let (span, bounds) = if !pair {
+        ([a, b - a, c - a], Bounds3::from_points(corners))
+    } else {
+        if t + 1 >= mesh.triangle_count() {
+            return None;
+        }
+        let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
+        let [o, e1, e2] = parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])?;
+        ([o, e1, e2], Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2]))
+    };
+    let n2 = span[1].cross(span[2]).length_squared();
+    (n2 > 0.0 && n2.is_finite()).then_some((span, bounds))
 }
 
 impl FlatLane {
     /// The flat this lane stands for in `mesh` (computed again: the same numbers as when the
     /// lane was made by [`flat_primitives`]).
     pub fn flat(self, mesh: &TriangleMesh) -> Flat {
-        flat_at(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh").0
+        let [o, e1, e2] = flat_span(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh").0;
+        Flat::new(o, e1, e2, self.parallelogram).expect("a flat with area")
     }
 }
 
@@ -123,13 +128,13 @@ pub fn flat_primitives(mesh: &TriangleMesh) -> (Vec<FlatLane>, Vec<Bounds3>) {
     let mut t = 0;
     while t < mesh.triangle_count() {
         let lane = FlatLane { triangle: t as u32, parallelogram: true };
-        if let Some((_, b)) = flat_at(mesh, t, true) {
+        if let Some((_, b)) = flat_span(mesh, t, true) {
             lanes.push(lane);
             bounds.push(b);
             t += 2;
             continue;
         }
-        if let Some((_, b)) = flat_at(mesh, t, false) {
+        if let Some((_, b)) = flat_span(mesh, t, false) {
             lanes.push(FlatLane { parallelogram: false, ..lane });
             bounds.push(b);
         }
