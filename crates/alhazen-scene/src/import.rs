@@ -487,6 +487,52 @@ mod tests {
         }
     }
 
+    /// Every binary type in both byte orders reads back the value written: the vertex's
+    /// coordinates in each type, the face's list count and indices in each integer type.
+    #[test]
+    fn binary_ply_reads_every_type_in_both_orders() {
+        type Encode = fn(f64, bool) -> Vec<u8>;
+        fn bytes<const N: usize>(le: [u8; N], big: bool) -> Vec<u8> {
+            let mut b = le.to_vec();
+            if big {
+                b.reverse();
+            }
+            b
+        }
+        // Name, encoding, integer, signed.
+        let types: [(&str, Encode, bool, bool); 8] = [
+            ("char", |x, big| bytes((x as i8).to_le_bytes(), big), true, true),
+            ("uchar", |x, big| bytes((x as u8).to_le_bytes(), big), true, false),
+            ("short", |x, big| bytes((x as i16).to_le_bytes(), big), true, true),
+            ("ushort", |x, big| bytes((x as u16).to_le_bytes(), big), true, false),
+            ("int", |x, big| bytes((x as i32).to_le_bytes(), big), true, true),
+            ("uint", |x, big| bytes((x as u32).to_le_bytes(), big), true, false),
+            ("float", |x, big| bytes((x as f32).to_le_bytes(), big), false, true),
+            ("double", |x, big| bytes(x.to_le_bytes(), big), false, true),
+        ];
+        for big in [false, true] {
+            let order = if big { "binary_big_endian" } else { "binary_little_endian" };
+            for (name, encode, integer, signed) in types {
+                // A negative coordinate where the type has a sign.
+                let corners = [[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.0, 2.0, if signed { -1.0 } else { 1.0 }]];
+                let list = if integer { name } else { "uchar" };
+                let mut b = format!(
+                    "ply\nformat {order} 1.0\nelement vertex 3\nproperty {name} x\nproperty {name} y\n\
+                     property {name} z\nelement face 1\nproperty list {list} {list} vertex_indices\nend_header\n"
+                )
+                .into_bytes();
+                let index = if integer { encode } else { types[1].1 };
+                corners.iter().flatten().for_each(|&x| b.extend(encode(x, big)));
+                [3.0, 2.0, 0.0, 1.0].iter().for_each(|&i| b.extend(index(i, big)));
+                let m = parse_ply(&b).unwrap_or_else(|e| panic!("{order} {name}: {e}"));
+                assert_eq!(m.positions, corners.map(Vec3::from_array).to_vec(), "{order} {name}");
+                assert_eq!(m.triangles, vec![[2, 0, 1]], "{order} {name}");
+                // One byte short: an error, not a panic.
+                assert!(parse_ply(&b[..b.len() - 1]).is_err(), "{order} {name}");
+            }
+        }
+    }
+
     #[test]
     fn the_teapot_data_set_tessellates() {
         let text =

@@ -601,6 +601,27 @@ fn partition(items: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
 mod tests {
     use super::*;
 
+    proptest::proptest! {
+        /// The two-ended partition moves the items that satisfy the predicate before the
+        /// others, loses none and duplicates none, and says how many there are.
+        #[test]
+        fn partition_splits_by_the_predicate(bins in proptest::collection::vec(0u8..12, 0..200), best in 0u8..12) {
+            let mut items: Vec<Item> = bins
+                .iter()
+                .enumerate()
+                .map(|(i, &bin)| Item { bounds: Bounds3::EMPTY, index: i as u32, packed: false, code: 0, bin })
+                .collect();
+            let mid = partition(&mut items, |it| it.bin <= best);
+            proptest::prop_assert_eq!(mid, bins.iter().filter(|&&b| b <= best).count());
+            proptest::prop_assert!(items[..mid].iter().all(|it| it.bin <= best));
+            proptest::prop_assert!(items[mid..].iter().all(|it| it.bin > best));
+            let mut seen: Vec<u32> = items.iter().map(|it| it.index).collect();
+            seen.sort_unstable();
+            proptest::prop_assert!(seen.iter().copied().eq(0..bins.len() as u32));
+            proptest::prop_assert!(items.iter().all(|it| bins[it.index as usize] == it.bin));
+        }
+    }
+
     /// Building subtrees on several threads lays out the very tree one thread builds.
     #[test]
     fn parallel_build_is_the_sequential_tree() {
