@@ -4,7 +4,7 @@
 //! kernel: at 4 KiB a page, ~78,000 page faults, a fifth of the build's time on our test
 //! machine (`BENCHMARKS.md`, session 28). Asking the kernel to back large blocks with 2 MiB
 //! pages (`madvise(MADV_HUGEPAGE)`, as Embree does for its BVH memory and glibc's
-//! `glibc.malloc.hugetlb=1` tunable does for every block it maps) leaves ~21,000. The advice is
+//! `glibc.malloc.hugetlb=1` tunable does for every block it maps) leaves 14,000–16,000. The advice is
 //! a hint: no byte of any result depends on it, and where the kernel has no huge pages to give
 //! (or transparent huge pages are off, or this is not Linux) the allocator is the system's.
 //!
