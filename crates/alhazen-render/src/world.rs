@@ -271,8 +271,12 @@ impl World {
     /// [`Self::build_with`], the meshes' own hierarchies built by `method` (the same hits by
     /// either; Morton order builds faster, the surface area heuristic traces faster).
     pub fn build_by(scene: &scene::Scene, unit: VectorUnit, method: crate::bvh::BuildMethod) -> Self {
-        let meshes: Vec<Arc<MeshAccel>> =
-            scene.meshes.iter().map(|m| Arc::new(MeshAccel::with_build(m.clone(), unit, method))).collect();
+        // Each mesh's tree on whichever thread is free (a scene of many meshes, each too small
+        // for its own build to split across threads, keeps every thread busy); the same trees.
+        let meshes: Vec<Arc<MeshAccel>> = {
+            use rayon::prelude::*;
+            scene.meshes.par_iter().map(|m| Arc::new(MeshAccel::with_build(m.clone(), unit, method))).collect()
+        };
         let objects: Vec<WorldObject> = scene
             .objects
             .iter()
