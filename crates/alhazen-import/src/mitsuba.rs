@@ -43,12 +43,18 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
         black_material: None,
         camera_seen: false,
         version_major: 3,
+        files: vec![],
+        pending: vec![],
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.scene.render.width = 768;
     imp.scene.render.height = 576;
     imp.scene.render.max_depth = 1000;
-    imp.file(path, 0)?;
+    let walked = imp.file(path, 0);
+    // The mesh files met before any error of the walk are loaded (an error in one of them came
+    // first in the document, so it is the one reported).
+    imp.load_meshes()?;
+    walked?;
     imp.finish()
 }
 
@@ -79,12 +85,30 @@ struct Importer {
     black_material: Option<MaterialId>,
     camera_seen: bool,
     version_major: u32,
+    /// Every file read so far (the scene and its includes) and its text, for the locations of
+    /// errors found after its walk.
+    files: Vec<(PathBuf, Arc<str>)>,
+    /// Mesh files met, loaded together once the walk is done ([`Importer::load_meshes`]).
+    pending: Vec<PendingMesh>,
+}
+
+/// A mesh file whose place in the scene (`scene.meshes[index]`, empty until loaded) is known
+/// and whose triangles are not yet read.
+struct PendingMesh {
+    index: usize,
+    path: PathBuf,
+    flip: bool,
+    /// Where its shape is: `files[file]`, bytes `span`.
+    file: usize,
+    span: std::ops::Range<usize>,
 }
 
 /// One file being read.
 struct Ctx<'a> {
     path: &'a Path,
     text: &'a str,
+    /// Its index in [`Importer::files`].
+    file: usize,
 }
 
 /// A plugin element with the names of the properties read so far.
@@ -119,13 +143,15 @@ impl Importer {
 
     /// Reads one file (the scene or an `include`d one) into the scene.
     fn file(&mut self, path: &Path, depth: usize) -> R<()> {
-        let text = common::read_text(path)?;
+        let text: Arc<str> = common::read_text(path)?.into();
+        let file = self.files.len();
+        self.files.push((path.to_path_buf(), text.clone()));
         let doc = roxmltree::Document::parse(&text).map_err(|e| {
             let p = e.pos();
             let at = text.lines().take(p.row as usize - 1).map(|l| l.len() + 1).sum::<usize>() + p.col as usize - 1;
             located(path, &text, at..at + 1, format!("XML syntax error: {e}"))
         })?;
-        let ctx = Ctx { path, text: &text };
+        let ctx = Ctx { path, text: &text, file };
         let root = doc.root_element();
         if root.tag_name().name() != "scene" {
             return Err(ctx.err(root, format!("expected a <scene> element, found <{}>", root.tag_name().name())));
@@ -1156,22 +1182,39 @@ impl Importer {
         m.bump.is_some() || m.bsdf.as_ref().is_some_and(|b| b.is_textured() || b.is_anisotropic())
     }
 
-    /// A mesh file, loaded once per file (and orientation).
+    /// A mesh file's place in the scene, once per file (and orientation); its triangles are
+    /// read with the other files' by [`Self::load_meshes`].
     fn mesh(&mut self, ctx: &Ctx, node: Node, path: &Path, flip: bool) -> R<usize> {
         if let Some(&i) = self.meshes.get(&(path.to_path_buf(), flip)) {
             return Ok(i);
         }
-        let mut loaded = alhazen_scene::import::load_mesh(path).map_err(|e| ctx.err(node, e))?;
-        // Mitsuba ignores OBJ material libraries: the shape's BSDF applies to every face.
-        loaded.mesh.material_slots.clear();
-        loaded.mesh.material_names.clear();
-        if flip {
-            flip_mesh(&mut loaded.mesh);
+        self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
+        let index = self.scene.meshes.len() - 1;
+        self.meshes.insert((path.to_path_buf(), flip), index);
+        self.pending.push(PendingMesh { index, path: path.to_path_buf(), flip, file: ctx.file, span: node.range() });
+        Ok(index)
+    }
+
+    /// Reads the mesh files met, on all threads (a scene of many meshes loads in a fraction of
+    /// the time); the first that cannot be read, in the order they were met, is the error.
+    fn load_meshes(&mut self) -> R<()> {
+        use rayon::prelude::*;
+        let pending = std::mem::take(&mut self.pending);
+        let loaded: Vec<_> = pending.par_iter().map(|m| alhazen_scene::import::load_mesh(&m.path)).collect();
+        for (m, loaded) in pending.into_iter().zip(loaded) {
+            let mut loaded = loaded.map_err(|e| {
+                let (path, text) = &self.files[m.file];
+                located(path, text, m.span.clone(), e)
+            })?;
+            // Mitsuba ignores OBJ material libraries: the shape's BSDF applies to every face.
+            loaded.mesh.material_slots.clear();
+            loaded.mesh.material_names.clear();
+            if m.flip {
+                flip_mesh(&mut loaded.mesh);
+            }
+            self.scene.meshes[m.index] = Arc::new(loaded.mesh);
         }
-        self.scene.meshes.push(Arc::new(loaded.mesh));
-        let i = self.scene.meshes.len() - 1;
-        self.meshes.insert((path.to_path_buf(), flip), i);
-        Ok(i)
+        Ok(())
     }
 
     // ---- emitters --------------------------------------------------------------------------

@@ -289,6 +289,46 @@ fn malformed_files_are_located_errors() {
     }
 }
 
+/// Mesh files are read together after the walk, yet each lands where its shape is, a file
+/// shared by two shapes is read once, and an unreadable one is the error, at its shape, even
+/// when a later element is wrong too.
+#[test]
+fn mesh_files_load_together_in_document_order() {
+    let ply = |n: usize| {
+        let mut t = format!(
+            "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+             element face {n}\nproperty list uchar int vertex_indices\nend_header\n",
+            n + 2
+        );
+        (0..n + 2).for_each(|i| t += &format!("{i} {} 0\n", i % 2));
+        (0..n).for_each(|i| t += &format!("3 {i} {} {}\n", i + 1, i + 2));
+        t
+    };
+    let shape = |file: &str| format!("<shape type=\"ply\"><string name=\"filename\" value=\"{file}\"/></shape>");
+    let body = [shape("three.ply"), shape("one.ply"), shape("three.ply"), shape("two.ply")].join("\n");
+    let (one, two, three) = (ply(1), ply(2), ply(3));
+    let s =
+        import(&[("a.xml", &scene(&body)), ("one.ply", &one), ("two.ply", &two), ("three.ply", &three)]).unwrap().scene;
+    let counts: Vec<usize> = s
+        .objects
+        .iter()
+        .map(|o| match o.shape {
+            Shape::Mesh { mesh, .. } => s.meshes[mesh].triangles.len(),
+            _ => panic!("not a mesh"),
+        })
+        .collect();
+    assert_eq!(counts, [3, 1, 3, 2]);
+    assert_eq!(s.meshes.len(), 3, "three.ply read once");
+    let later = "<shape type=\"sphere\"><float name=\"radius\" value=\"abc\"/></shape>";
+    let body = format!("{}\n{}\n{later}", shape("one.ply"), shape("missing.ply"));
+    let err = import(&[("a.xml", &scene(&body)), ("one.ply", &one)]).unwrap_err();
+    assert!(err.contains("a.xml:3:1") && err.contains("cannot load mesh"), "{err}");
+    // Without the missing file, the later element's error.
+    let body = format!("{}\n{later}", shape("one.ply"));
+    let err = import(&[("a.xml", &scene(&body)), ("one.ply", &one)]).unwrap_err();
+    assert!(err.contains("a.xml:3:") && err.contains("not a finite number"), "{err}");
+}
+
 /// Issue 19's independent check of specular connections: the cup caustic of
 /// `scenes/mitsuba/cup-caustic.xml` (a small spherical lamp, an open mirror cylinder) as alhazen
 /// renders it — the lamp joined to the table through the cylinder by the exact mirror solver —
