@@ -36,7 +36,11 @@ type R<T> = Result<T, SceneError>;
 /// Reads a pbrt-v4 scene.
 pub fn load(path: &Path) -> Result<Imported, SceneError> {
     let mut imp = Importer::new();
-    imp.file(path, 0)?;
+    let walked = imp.file(path, 0);
+    // The mesh files met before any error of the walk are loaded (an error in one of them came
+    // first, so it is the one reported).
+    imp.load_meshes()?;
+    walked?;
     imp.finish()
 }
 
@@ -180,6 +184,21 @@ struct Importer {
     camera: Option<(Mat4, CameraKind)>,
     /// The screen's aspect once `Film` is read.
     environment: Option<(Arc<ImageData>, Mat4, f64)>,
+    /// Every file read so far and its text, for the locations of errors found after its walk.
+    files: Vec<(PathBuf, Arc<str>)>,
+    /// Mesh files met, loaded together once the walk is done ([`Importer::load_meshes`]).
+    pending: Vec<PendingMesh>,
+}
+
+/// A mesh file whose place in the scene (`scene.meshes[index]`, empty until loaded) is known
+/// and whose triangles are not yet read.
+struct PendingMesh {
+    index: usize,
+    path: PathBuf,
+    reverse: bool,
+    /// Where its shape is: `files[file]`, bytes `span`.
+    file: usize,
+    span: Range<usize>,
 }
 
 #[derive(Clone, Copy)]
@@ -192,6 +211,8 @@ enum CameraKind {
 struct Ctx<'a> {
     path: &'a Path,
     text: &'a str,
+    /// Its index in [`Importer::files`].
+    file: usize,
 }
 
 impl Ctx<'_> {
@@ -225,6 +246,8 @@ impl Importer {
             default_material: None,
             camera: None,
             environment: None,
+            files: vec![],
+            pending: vec![],
         }
     }
 
@@ -234,8 +257,10 @@ impl Importer {
     }
 
     fn file(&mut self, path: &Path, depth: usize) -> R<()> {
-        let text = common::read_text(path)?;
-        let ctx = Ctx { path, text: &text };
+        let text: Arc<str> = common::read_text(path)?.into();
+        let file = self.files.len();
+        self.files.push((path.to_path_buf(), text.clone()));
+        let ctx = Ctx { path, text: &text, file };
         let tokens = tokenize(path, &text)?;
         let mut i = 0;
         while i < tokens.len() {
@@ -1349,18 +1374,36 @@ impl Importer {
         Ok(mesh)
     }
 
+    /// A mesh file's place in the scene, once per file (and orientation); its triangles are
+    /// read with the other files' by [`Self::load_meshes`].
     fn ply(&mut self, ctx: &Ctx, at: &Range<usize>, path: &Path, reverse: bool) -> R<usize> {
         if let Some(&i) = self.meshes.get(&(path.to_path_buf(), reverse)) {
             return Ok(i);
         }
-        let mut loaded = alhazen_scene::import::load_mesh(path).map_err(|e| ctx.err(at.clone(), e))?;
-        if reverse {
-            flip_mesh(&mut loaded.mesh);
+        self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
+        let index = self.scene.meshes.len() - 1;
+        self.meshes.insert((path.to_path_buf(), reverse), index);
+        self.pending.push(PendingMesh { index, path: path.to_path_buf(), reverse, file: ctx.file, span: at.clone() });
+        Ok(index)
+    }
+
+    /// Reads the mesh files met, on all threads; the first that cannot be read, in the order
+    /// they were met, is the error.
+    fn load_meshes(&mut self) -> R<()> {
+        use rayon::prelude::*;
+        let pending = std::mem::take(&mut self.pending);
+        let loaded: Vec<_> = pending.par_iter().map(|m| alhazen_scene::import::load_mesh(&m.path)).collect();
+        for (m, loaded) in pending.into_iter().zip(loaded) {
+            let mut loaded = loaded.map_err(|e| {
+                let (path, text) = &self.files[m.file];
+                located(path, text, m.span.clone(), e)
+            })?;
+            if m.reverse {
+                flip_mesh(&mut loaded.mesh);
+            }
+            self.scene.meshes[m.index] = Arc::new(loaded.mesh);
         }
-        self.scene.meshes.push(Arc::new(loaded.mesh));
-        let i = self.scene.meshes.len() - 1;
-        self.meshes.insert((path.to_path_buf(), reverse), i);
-        Ok(i)
+        Ok(())
     }
 
     // ---- the camera, and mirroring -------------------------------------------------------

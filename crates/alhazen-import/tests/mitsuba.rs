@@ -294,19 +294,9 @@ fn malformed_files_are_located_errors() {
 /// when a later element is wrong too.
 #[test]
 fn mesh_files_load_together_in_document_order() {
-    let ply = |n: usize| {
-        let mut t = format!(
-            "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
-             element face {n}\nproperty list uchar int vertex_indices\nend_header\n",
-            n + 2
-        );
-        (0..n + 2).for_each(|i| t += &format!("{i} {} 0\n", i % 2));
-        (0..n).for_each(|i| t += &format!("3 {i} {} {}\n", i + 1, i + 2));
-        t
-    };
     let shape = |file: &str| format!("<shape type=\"ply\"><string name=\"filename\" value=\"{file}\"/></shape>");
     let body = [shape("three.ply"), shape("one.ply"), shape("three.ply"), shape("two.ply")].join("\n");
-    let (one, two, three) = (ply(1), ply(2), ply(3));
+    let (one, two, three) = (strip_ply(1), strip_ply(2), strip_ply(3));
     let s =
         import(&[("a.xml", &scene(&body)), ("one.ply", &one), ("two.ply", &two), ("three.ply", &three)]).unwrap().scene;
     let counts: Vec<usize> = s

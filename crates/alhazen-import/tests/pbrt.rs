@@ -141,6 +141,35 @@ Shape "sphere""#,
     assert_eq!(s.materials[s.objects[1].material as usize].emission, Vec3::ZERO);
 }
 
+/// Mesh files are read together after the walk, yet each lands where its shape is, a file
+/// shared by two shapes is read once, and an unreadable one is the error, at its shape, even
+/// when a later directive is wrong too.
+#[test]
+fn mesh_files_load_together_in_order() {
+    let shape = |file: &str| format!("Shape \"plymesh\" \"string filename\" \"{file}\"");
+    let body = ["WorldBegin".into(), shape("three.ply"), shape("one.ply"), shape("three.ply"), shape("two.ply")];
+    let (one, two, three) = (strip_ply(1), strip_ply(2), strip_ply(3));
+    let files = [("a.pbrt", body.join("\n")), ("one.ply", one.clone()), ("two.ply", two), ("three.ply", three)];
+    let s = import(&files.each_ref().map(|(n, t)| (*n, t.as_str()))).unwrap().scene;
+    let counts: Vec<usize> = s
+        .objects
+        .iter()
+        .map(|o| match o.shape {
+            Shape::Mesh { mesh, .. } => s.meshes[mesh].triangles.len(),
+            _ => panic!("not a mesh"),
+        })
+        .collect();
+    assert_eq!(counts, [3, 1, 3, 2]);
+    assert_eq!(s.meshes.len(), 3, "three.ply read once");
+    let later = "NamedMaterial \"glod\"";
+    let text = format!("WorldBegin\n{}\n{}\n{later}", shape("one.ply"), shape("missing.ply"));
+    let err = import(&[("a.pbrt", &text), ("one.ply", &one)]).unwrap_err();
+    assert!(err.contains("a.pbrt:3:") && err.contains("cannot load mesh"), "{err}");
+    let text = format!("WorldBegin\n{}\n{later}", shape("one.ply"));
+    let err = import(&[("a.pbrt", &text), ("one.ply", &one)]).unwrap_err();
+    assert!(err.contains("a.pbrt:3:") && err.contains("no material named"), "{err}");
+}
+
 #[test]
 fn malformed_files_are_located_errors() {
     let cases: &[(&str, &str)] = &[

@@ -17,3 +17,16 @@ pub fn import(files: &[(&str, &str)]) -> Result<Imported, String> {
     }
     alhazen_import::load(&dir.path().join(files[0].0)).map_err(|e| e.to_string())
 }
+
+/// An ASCII PLY file of a strip of `n` triangles.
+#[allow(dead_code)]
+pub fn strip_ply(n: usize) -> String {
+    let mut t = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {n}\nproperty list uchar int vertex_indices\nend_header\n",
+        n + 2
+    );
+    (0..n + 2).for_each(|i| t += &format!("{i} {} 0\n", i % 2));
+    (0..n).for_each(|i| t += &format!("3 {i} {} {}\n", i + 1, i + 2));
+    t
+}
