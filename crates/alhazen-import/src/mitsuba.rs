@@ -16,7 +16,7 @@
 //! alhazen's right-handed camera seen through `lookat`, so scenes map without mirroring.
 
 use crate::Imported;
-use crate::common::{self, Warnings, located};
+use crate::common::{self, PendingMeshes, Warnings, flip_mesh, located};
 use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
 use alhazen_scene::{
@@ -43,8 +43,7 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
         black_material: None,
         camera_seen: false,
         version_major: 3,
-        files: vec![],
-        pending: vec![],
+        pending: PendingMeshes::default(),
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.scene.render.width = 768;
@@ -53,7 +52,11 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
     let walked = imp.file(path, 0);
     // The mesh files met before any error of the walk are loaded (an error in one of them came
     // first in the document, so it is the one reported).
-    imp.load_meshes()?;
+    // Mitsuba ignores OBJ material libraries: the shape's BSDF applies to every face.
+    imp.pending.load(&mut imp.scene.meshes, |m| {
+        m.material_slots.clear();
+        m.material_names.clear();
+    })?;
     walked?;
     imp.finish()
 }
@@ -85,29 +88,15 @@ struct Importer {
     black_material: Option<MaterialId>,
     camera_seen: bool,
     version_major: u32,
-    /// Every file read so far (the scene and its includes) and its text, for the locations of
-    /// errors found after its walk.
-    files: Vec<(PathBuf, Arc<str>)>,
-    /// Mesh files met, loaded together once the walk is done ([`Importer::load_meshes`]).
-    pending: Vec<PendingMesh>,
-}
-
-/// A mesh file whose place in the scene (`scene.meshes[index]`, empty until loaded) is known
-/// and whose triangles are not yet read.
-struct PendingMesh {
-    index: usize,
-    path: PathBuf,
-    flip: bool,
-    /// Where its shape is: `files[file]`, bytes `span`.
-    file: usize,
-    span: std::ops::Range<usize>,
+    /// Mesh files met, loaded together once the walk is done.
+    pending: PendingMeshes,
 }
 
 /// One file being read.
 struct Ctx<'a> {
     path: &'a Path,
     text: &'a str,
-    /// Its index in [`Importer::files`].
+    /// Its number in [`Importer::pending`].
     file: usize,
 }
 
@@ -144,8 +133,7 @@ impl Importer {
     /// Reads one file (the scene or an `include`d one) into the scene.
     fn file(&mut self, path: &Path, depth: usize) -> R<()> {
         let text: Arc<str> = common::read_text(path)?.into();
-        let file = self.files.len();
-        self.files.push((path.to_path_buf(), text.clone()));
+        let file = self.pending.file(path, text.clone());
         let doc = roxmltree::Document::parse(&text).map_err(|e| {
             let p = e.pos();
             let at = text.lines().take(p.row as usize - 1).map(|l| l.len() + 1).sum::<usize>() + p.col as usize - 1;
@@ -1183,7 +1171,7 @@ impl Importer {
     }
 
     /// A mesh file's place in the scene, once per file (and orientation); its triangles are
-    /// read with the other files' by [`Self::load_meshes`].
+    /// read with the other files' once the walk is done.
     fn mesh(&mut self, ctx: &Ctx, node: Node, path: &Path, flip: bool) -> R<usize> {
         if let Some(&i) = self.meshes.get(&(path.to_path_buf(), flip)) {
             return Ok(i);
@@ -1191,30 +1179,8 @@ impl Importer {
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert((path.to_path_buf(), flip), index);
-        self.pending.push(PendingMesh { index, path: path.to_path_buf(), flip, file: ctx.file, span: node.range() });
+        self.pending.push(index, path, flip, ctx.file, node.range());
         Ok(index)
-    }
-
-    /// Reads the mesh files met, on all threads (a scene of many meshes loads in a fraction of
-    /// the time); the first that cannot be read, in the order they were met, is the error.
-    fn load_meshes(&mut self) -> R<()> {
-        use rayon::prelude::*;
-        let pending = std::mem::take(&mut self.pending);
-        let loaded: Vec<_> = pending.par_iter().map(|m| alhazen_scene::import::load_mesh(&m.path)).collect();
-        for (m, loaded) in pending.into_iter().zip(loaded) {
-            let mut loaded = loaded.map_err(|e| {
-                let (path, text) = &self.files[m.file];
-                located(path, text, m.span.clone(), e)
-            })?;
-            // Mitsuba ignores OBJ material libraries: the shape's BSDF applies to every face.
-            loaded.mesh.material_slots.clear();
-            loaded.mesh.material_names.clear();
-            if m.flip {
-                flip_mesh(&mut loaded.mesh);
-            }
-            self.scene.meshes[m.index] = Arc::new(loaded.mesh);
-        }
-        Ok(())
     }
 
     // ---- emitters --------------------------------------------------------------------------
@@ -1313,14 +1279,4 @@ fn upside_down(img: alhazen_scene::ImageData) -> alhazen_scene::ImageData {
     let w = img.width as usize;
     let rows: Vec<&[[f32; 3]]> = img.pixels().chunks_exact(w.max(1)).rev().collect();
     alhazen_scene::ImageData::new(img.width, img.height, rows.concat())
-}
-
-/// Turns a mesh inside out: reversed winding and normals.
-pub(crate) fn flip_mesh(mesh: &mut alhazen_geom::TriangleMesh) {
-    for t in &mut mesh.triangles {
-        t.swap(1, 2);
-    }
-    for n in &mut mesh.normals {
-        *n = -*n;
-    }
 }

@@ -18,8 +18,7 @@
 //! write) are taken as they are.
 
 use crate::Imported;
-use crate::common::{self, Warnings, located};
-use crate::mitsuba::flip_mesh;
+use crate::common::{self, PendingMeshes, Warnings, flip_mesh, located};
 use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Ior};
 use alhazen_scene::{
@@ -39,7 +38,7 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
     let walked = imp.file(path, 0);
     // The mesh files met before any error of the walk are loaded (an error in one of them came
     // first, so it is the one reported).
-    imp.load_meshes()?;
+    imp.pending.load(&mut imp.scene.meshes, |_| {})?;
     walked?;
     imp.finish()
 }
@@ -184,21 +183,8 @@ struct Importer {
     camera: Option<(Mat4, CameraKind)>,
     /// The screen's aspect once `Film` is read.
     environment: Option<(Arc<ImageData>, Mat4, f64)>,
-    /// Every file read so far and its text, for the locations of errors found after its walk.
-    files: Vec<(PathBuf, Arc<str>)>,
-    /// Mesh files met, loaded together once the walk is done ([`Importer::load_meshes`]).
-    pending: Vec<PendingMesh>,
-}
-
-/// A mesh file whose place in the scene (`scene.meshes[index]`, empty until loaded) is known
-/// and whose triangles are not yet read.
-struct PendingMesh {
-    index: usize,
-    path: PathBuf,
-    reverse: bool,
-    /// Where its shape is: `files[file]`, bytes `span`.
-    file: usize,
-    span: Range<usize>,
+    /// Mesh files met, loaded together once the walk is done.
+    pending: PendingMeshes,
 }
 
 #[derive(Clone, Copy)]
@@ -211,7 +197,7 @@ enum CameraKind {
 struct Ctx<'a> {
     path: &'a Path,
     text: &'a str,
-    /// Its index in [`Importer::files`].
+    /// Its number in [`Importer::pending`].
     file: usize,
 }
 
@@ -246,8 +232,7 @@ impl Importer {
             default_material: None,
             camera: None,
             environment: None,
-            files: vec![],
-            pending: vec![],
+            pending: PendingMeshes::default(),
         }
     }
 
@@ -258,8 +243,7 @@ impl Importer {
 
     fn file(&mut self, path: &Path, depth: usize) -> R<()> {
         let text: Arc<str> = common::read_text(path)?.into();
-        let file = self.files.len();
-        self.files.push((path.to_path_buf(), text.clone()));
+        let file = self.pending.file(path, text.clone());
         let ctx = Ctx { path, text: &text, file };
         let tokens = tokenize(path, &text)?;
         let mut i = 0;
@@ -1375,7 +1359,7 @@ impl Importer {
     }
 
     /// A mesh file's place in the scene, once per file (and orientation); its triangles are
-    /// read with the other files' by [`Self::load_meshes`].
+    /// read with the other files' once the walk is done.
     fn ply(&mut self, ctx: &Ctx, at: &Range<usize>, path: &Path, reverse: bool) -> R<usize> {
         if let Some(&i) = self.meshes.get(&(path.to_path_buf(), reverse)) {
             return Ok(i);
@@ -1383,27 +1367,8 @@ impl Importer {
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert((path.to_path_buf(), reverse), index);
-        self.pending.push(PendingMesh { index, path: path.to_path_buf(), reverse, file: ctx.file, span: at.clone() });
+        self.pending.push(index, path, reverse, ctx.file, at.clone());
         Ok(index)
-    }
-
-    /// Reads the mesh files met, on all threads; the first that cannot be read, in the order
-    /// they were met, is the error.
-    fn load_meshes(&mut self) -> R<()> {
-        use rayon::prelude::*;
-        let pending = std::mem::take(&mut self.pending);
-        let loaded: Vec<_> = pending.par_iter().map(|m| alhazen_scene::import::load_mesh(&m.path)).collect();
-        for (m, loaded) in pending.into_iter().zip(loaded) {
-            let mut loaded = loaded.map_err(|e| {
-                let (path, text) = &self.files[m.file];
-                located(path, text, m.span.clone(), e)
-            })?;
-            if m.reverse {
-                flip_mesh(&mut loaded.mesh);
-            }
-            self.scene.meshes[m.index] = Arc::new(loaded.mesh);
-        }
-        Ok(())
     }
 
     // ---- the camera, and mirroring -------------------------------------------------------

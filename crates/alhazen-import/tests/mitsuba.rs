@@ -299,15 +299,7 @@ fn mesh_files_load_together_in_document_order() {
     let (one, two, three) = (strip_ply(1), strip_ply(2), strip_ply(3));
     let s =
         import(&[("a.xml", &scene(&body)), ("one.ply", &one), ("two.ply", &two), ("three.ply", &three)]).unwrap().scene;
-    let counts: Vec<usize> = s
-        .objects
-        .iter()
-        .map(|o| match o.shape {
-            Shape::Mesh { mesh, .. } => s.meshes[mesh].triangles.len(),
-            _ => panic!("not a mesh"),
-        })
-        .collect();
-    assert_eq!(counts, [3, 1, 3, 2]);
+    assert_eq!(mesh_triangle_counts(&s), [3, 1, 3, 2]);
     assert_eq!(s.meshes.len(), 3, "three.ply read once");
     let later = "<shape type=\"sphere\"><float name=\"radius\" value=\"abc\"/></shape>";
     let body = format!("{}\n{}\n{later}", shape("one.ply"), shape("missing.ply"));

@@ -151,15 +151,7 @@ fn mesh_files_load_together_in_order() {
     let (one, two, three) = (strip_ply(1), strip_ply(2), strip_ply(3));
     let files = [("a.pbrt", body.join("\n")), ("one.ply", one.clone()), ("two.ply", two), ("three.ply", three)];
     let s = import(&files.each_ref().map(|(n, t)| (*n, t.as_str()))).unwrap().scene;
-    let counts: Vec<usize> = s
-        .objects
-        .iter()
-        .map(|o| match o.shape {
-            Shape::Mesh { mesh, .. } => s.meshes[mesh].triangles.len(),
-            _ => panic!("not a mesh"),
-        })
-        .collect();
-    assert_eq!(counts, [3, 1, 3, 2]);
+    assert_eq!(mesh_triangle_counts(&s), [3, 1, 3, 2]);
     assert_eq!(s.meshes.len(), 3, "three.ply read once");
     let later = "NamedMaterial \"glod\"";
     let text = format!("WorldBegin\n{}\n{}\n{later}", shape("one.ply"), shape("missing.ply"));

@@ -30,3 +30,13 @@ pub fn strip_ply(n: usize) -> String {
     (0..n).for_each(|i| t += &format!("3 {i} {} {}\n", i + 1, i + 2));
     t
 }
+
+/// Each object's mesh's triangle count (every object a mesh).
+#[allow(dead_code)]
+pub fn mesh_triangle_counts(s: &alhazen_scene::Scene) -> Vec<usize> {
+    let count = |o: &alhazen_scene::Object| match o.shape {
+        alhazen_scene::Shape::Mesh { mesh, .. } => s.meshes[mesh].triangles.len(),
+        _ => panic!("not a mesh"),
+    };
+    s.objects.iter().map(count).collect()
+}
