@@ -247,7 +247,8 @@ pub(crate) fn flip_mesh(mesh: &mut alhazen_geom::TriangleMesh) {
 /// of many meshes loads in a fraction of the time.
 #[derive(Default)]
 pub(crate) struct PendingMeshes {
-    /// Every scene file walked and its text, for the locations of errors found afterwards.
+    /// The scene files that hold mesh files' shapes, and their texts, for the locations of
+    /// errors found after the walk.
     files: Vec<(PathBuf, Arc<str>)>,
     meshes: Vec<PendingMesh>,
 }
@@ -262,15 +263,14 @@ struct PendingMesh {
 }
 
 impl PendingMeshes {
-    /// Keeps scene file `path`'s text; returns its number, for [`Self::push`].
-    pub fn file(&mut self, path: &Path, text: Arc<str>) -> usize {
-        self.files.push((path.to_path_buf(), text));
-        self.files.len() - 1
-    }
-
     /// Mesh file `path` (turned inside out when `flip`) for `scene.meshes[index]`, its shape at
-    /// bytes `span` of scene file `file`.
-    pub fn push(&mut self, index: usize, path: &Path, flip: bool, file: usize, span: Range<usize>) {
+    /// bytes `span` of scene file `at` (its path and text, kept only for files that have mesh
+    /// files: a scene's large files of inline geometry are not held to the end).
+    pub fn push(&mut self, index: usize, path: &Path, flip: bool, at: (&Path, &Arc<str>), span: Range<usize>) {
+        if !self.files.last().is_some_and(|(_, text)| Arc::ptr_eq(text, at.1)) {
+            self.files.push((at.0.to_path_buf(), at.1.clone()));
+        }
+        let file = self.files.len() - 1;
         self.meshes.push(PendingMesh { index, path: path.to_path_buf(), flip, file, span });
     }
 

@@ -96,8 +96,8 @@ struct Importer {
 struct Ctx<'a> {
     path: &'a Path,
     text: &'a str,
-    /// Its number in [`Importer::pending`].
-    file: usize,
+    /// Its text, shared: kept for the locations of mesh files' errors found after the walk.
+    shared: &'a Arc<str>,
 }
 
 /// A plugin element with the names of the properties read so far.
@@ -133,13 +133,12 @@ impl Importer {
     /// Reads one file (the scene or an `include`d one) into the scene.
     fn file(&mut self, path: &Path, depth: usize) -> R<()> {
         let text: Arc<str> = common::read_text(path)?.into();
-        let file = self.pending.file(path, text.clone());
         let doc = roxmltree::Document::parse(&text).map_err(|e| {
             let p = e.pos();
             let at = text.lines().take(p.row as usize - 1).map(|l| l.len() + 1).sum::<usize>() + p.col as usize - 1;
             located(path, &text, at..at + 1, format!("XML syntax error: {e}"))
         })?;
-        let ctx = Ctx { path, text: &text, file };
+        let ctx = Ctx { path, text: &text, shared: &text };
         let root = doc.root_element();
         if root.tag_name().name() != "scene" {
             return Err(ctx.err(root, format!("expected a <scene> element, found <{}>", root.tag_name().name())));
@@ -1179,7 +1178,7 @@ impl Importer {
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert((path.to_path_buf(), flip), index);
-        self.pending.push(index, path, flip, ctx.file, node.range());
+        self.pending.push(index, path, flip, (ctx.path, ctx.shared), node.range());
         Ok(index)
     }
 

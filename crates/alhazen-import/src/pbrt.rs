@@ -197,8 +197,8 @@ enum CameraKind {
 struct Ctx<'a> {
     path: &'a Path,
     text: &'a str,
-    /// Its number in [`Importer::pending`].
-    file: usize,
+    /// Its text, shared: kept for the locations of mesh files' errors found after the walk.
+    shared: &'a Arc<str>,
 }
 
 impl Ctx<'_> {
@@ -243,8 +243,7 @@ impl Importer {
 
     fn file(&mut self, path: &Path, depth: usize) -> R<()> {
         let text: Arc<str> = common::read_text(path)?.into();
-        let file = self.pending.file(path, text.clone());
-        let ctx = Ctx { path, text: &text, file };
+        let ctx = Ctx { path, text: &text, shared: &text };
         let tokens = tokenize(path, &text)?;
         let mut i = 0;
         while i < tokens.len() {
@@ -1367,7 +1366,7 @@ impl Importer {
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert((path.to_path_buf(), reverse), index);
-        self.pending.push(index, path, reverse, ctx.file, at.clone());
+        self.pending.push(index, path, reverse, (ctx.path, ctx.shared), at.clone());
         Ok(index)
     }
 

@@ -305,6 +305,10 @@ fn mesh_files_load_together_in_document_order() {
     let body = format!("{}\n{}\n{later}", shape("one.ply"), shape("missing.ply"));
     let err = import(&[("a.xml", &scene(&body)), ("one.ply", &one)]).unwrap_err();
     assert!(err.contains("a.xml:3:1") && err.contains("cannot load mesh"), "{err}");
+    // A missing file met in an included file is located there.
+    let main = scene(&format!("{}\n<include filename=\"b.xml\"/>\n{}", shape("one.ply"), shape("one.ply")));
+    let err = import(&[("a.xml", &main), ("b.xml", &scene(&shape("missing.ply"))), ("one.ply", &one)]).unwrap_err();
+    assert!(err.contains("b.xml:2:1") && err.contains("cannot load mesh"), "{err}");
     // Without the missing file, the later element's error.
     let body = format!("{}\n{later}", shape("one.ply"));
     let err = import(&[("a.xml", &scene(&body)), ("one.ply", &one)]).unwrap_err();
