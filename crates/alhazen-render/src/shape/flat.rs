@@ -88,30 +88,40 @@ impl FlatLane {
     }
 }
 
-/// The corner and edges of the flat of triangle `t` of `mesh` and its bounds: with `pair`, of
-/// the parallelogram of `t` and `t + 1` (`None` when they do not form one); else of the
-/// triangle. `None` without area (the test of [`Flat::new`], without computing the flat).
-fn flat_span(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<([Vec3; 3], Bounds3)> {
+/// The corner and edges of the flat of triangle `t` of `mesh`: with `pair`, of the
+/// parallelogram of `t` and `t + 1` (`None` when they do not form one); else of the triangle.
+fn flat_edges(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<[Vec3; 3]> {
     let corners @ [a, b, c] = mesh.corners(t);
-    let (span, bounds) = if !pair {
-        ([a, b - a, c - a], Bounds3::from_points(corners))
-    } else {
-        if t + 1 >= mesh.triangle_count() {
-            return None;
-        }
-        let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
-        let [o, e1, e2] = parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])?;
-        ([o, e1, e2], Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2]))
-    };
-    let n2 = span[1].cross(span[2]).length_squared();
-    (n2 > 0.0 && n2.is_finite()).then_some((span, bounds))
+    if !pair {
+        return Some([a, b - a, c - a]);
+    }
+    if t + 1 >= mesh.triangle_count() {
+        return None;
+    }
+    let (first, second) = (mesh.triangles[t], mesh.triangles[t + 1]);
+    parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])
+}
+
+/// [`flat_edges`] and the flat's bounds, when the edges span an area (the test of
+/// [`Flat::new`], without computing the flat).
+fn flat_span(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<([Vec3; 3], Bounds3)> {
+    let span @ [o, e1, e2] = flat_edges(mesh, t, pair)?;
+    let n2 = e1.cross(e2).length_squared();
+    (n2 > 0.0 && n2.is_finite()).then(|| {
+        let bounds = if pair {
+            Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])
+        } else {
+            Bounds3::from_points(mesh.corners(t))
+        };
+        (span, bounds)
+    })
 }
 
 impl FlatLane {
     /// The flat this lane stands for in `mesh` (computed again: the same numbers as when the
     /// lane was made by [`flat_primitives`]).
     pub fn flat(self, mesh: &TriangleMesh) -> Flat {
-        let [o, e1, e2] = flat_span(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh").0;
+        let [o, e1, e2] = flat_edges(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh");
         Flat::new(o, e1, e2, self.parallelogram).expect("a flat with area")
     }
 }
