@@ -142,7 +142,13 @@ pub(super) struct Slab {
     inv: [f32; 3],
     pad: [f32; 3],
     neg: [bool; 3],
+    /// Per axis, the row of a node's six rows of planes (`min` then `max`, axis by axis) the
+    /// ray enters by, and the one it leaves by: chosen once per ray, not per node.
+    entry_row: [usize; 3],
+    exit_row: [usize; 3],
     parallel: [bool; 3],
+    /// Whether some axis is `parallel`: nodes test the origin between slabs only then.
+    any_parallel: bool,
 }
 
 impl Slab {
@@ -151,8 +157,16 @@ impl Slab {
     #[inline]
     pub fn new(ray: &Ray, reach: [f64; 3]) -> Self {
         let inv = 1.0 / ray.dir;
-        let mut s =
-            Slab { origin: [0.0; 3], inv: [0.0; 3], pad: [f32::INFINITY; 3], neg: [false; 3], parallel: [false; 3] };
+        let mut s = Slab {
+            origin: [0.0; 3],
+            inv: [0.0; 3],
+            pad: [f32::INFINITY; 3],
+            neg: [false; 3],
+            entry_row: [0; 3],
+            exit_row: [0; 3],
+            parallel: [false; 3],
+            any_parallel: false,
+        };
         for axis in 0..3 {
             let (o, a) = (ray.origin[axis], inv[axis].abs());
             let o32 = o as f32;
@@ -168,10 +182,13 @@ impl Slab {
             s.inv[axis] = if usable { inv[axis] as f32 } else { 0.0 };
             s.pad[axis] = if usable { err as f32 } else { f32::INFINITY };
             s.neg[axis] = inv[axis] < 0.0;
+            let back = 3 * usize::from(s.neg[axis]);
+            (s.entry_row[axis], s.exit_row[axis]) = (axis + back, axis + 3 - back);
             // A ray parallel to the slabs meets a box only if its origin lies between them,
             // which rounding to `f32` keeps (rounding is monotonic).
             s.parallel[axis] = ray.dir[axis] == 0.0;
         }
+        s.any_parallel = s.parallel.contains(&true);
         s
     }
 
@@ -227,26 +244,28 @@ impl Slab {
     fn test_sse(&self, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
         use std::arch::x86_64::*;
         // SAFETY: SSE and SSE2 are part of x86-64; the loads read whole `[f32; 4]` and
-        // `[u32; 4]` arrays of a 64-byte aligned node.
+        // `[u32; 4]` arrays of a 64-byte aligned node; `Wide` is `repr(C)`, so its `min` and
+        // `max` are six consecutive rows, and the rows chosen are below six.
+        const { assert!(std::mem::offset_of!(Wide, max) == std::mem::size_of::<[[f32; WIDTH]; 3]>()) };
         unsafe {
+            let rows = (&raw const w.min).cast::<[f32; WIDTH]>();
+            let row = |r: usize| _mm_load_ps(rows.add(r).cast());
             let mut near = _mm_setzero_ps();
             let mut far = _mm_set1_ps(t_max);
             let mut beside =
                 _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_load_si128(w.count.as_ptr().cast()), _mm_set1_epi32(-1)));
-            for axis in 0..3 {
-                let (entry, exit) =
-                    if self.neg[axis] { (&w.max[axis], &w.min[axis]) } else { (&w.min[axis], &w.max[axis]) };
-                let (o, inv, pad) =
-                    (_mm_set1_ps(self.origin[axis]), _mm_set1_ps(self.inv[axis]), _mm_set1_ps(self.pad[axis]));
-                if self.parallel[axis] {
-                    let inside = _mm_and_ps(
-                        _mm_cmple_ps(_mm_load_ps(w.min[axis].as_ptr()), o),
-                        _mm_cmple_ps(o, _mm_load_ps(w.max[axis].as_ptr())),
-                    );
+            if self.any_parallel {
+                for axis in (0..3).filter(|&a| self.parallel[a]) {
+                    let o = _mm_set1_ps(self.origin[axis]);
+                    let inside = _mm_and_ps(_mm_cmple_ps(row(axis), o), _mm_cmple_ps(o, row(axis + 3)));
                     beside = _mm_or_ps(beside, _mm_andnot_ps(inside, _mm_castsi128_ps(_mm_set1_epi32(-1))));
                 }
-                let t0 = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(entry.as_ptr()), o), inv), pad);
-                let t1 = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(exit.as_ptr()), o), inv), pad);
+            }
+            for axis in 0..3 {
+                let (o, inv, pad) =
+                    (_mm_set1_ps(self.origin[axis]), _mm_set1_ps(self.inv[axis]), _mm_set1_ps(self.pad[axis]));
+                let t0 = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(row(self.entry_row[axis]), o), inv), pad);
+                let t1 = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(row(self.exit_row[axis]), o), inv), pad);
                 // MAXPS/MINPS return their second operand when either is NaN: the accumulator.
                 near = _mm_max_ps(t0, near);
                 far = _mm_min_ps(t1, far);
