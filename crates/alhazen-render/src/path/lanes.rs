@@ -1,15 +1,18 @@
-//! The path tracer in lanes: eight paths traced side by side, whatever their materials, lights
-//! and colours, so that their rays are tested together and their vertices shaded by material
+//! The path tracer in lanes: paths traced side by side, whatever their materials, lights and
+//! colours, so that their rays are tested together and their vertices shaded by material
 //! kernels (a small wavefront: Laine, Karras and Aila 2013, "Megakernels Considered Harmful",
-//! split a path tracer into stages over many paths).
+//! split a path tracer into stages over many paths, and queue each material's vertices apart).
 //!
-//! One bounce is a round of stages over the eight lanes: the rays' nearest hits in one call
+//! A thread keeps [`POOL`] paths in flight, in [`GROUPS`] groups of eight lanes. One bounce is
+//! a round of stages over them all: each group's rays' nearest hits in one call
 //! ([`crate::World::intersect_rays`]: in a world of one leaf, each flat against the eight rays
 //! at once, in AVX-512 or AVX2, then each ray's spheres and other objects; elsewhere ray by
 //! ray); the sky seen by the rays that leave the scene ([`Lights::sky_ahead`]); per path, the
-//! vertex; the shadow rays in one call ([`crate::World::unoccluded_rays`]), after which each
-//! path gathers its light and steps on. A lane whose path ends starts the next sample of the
-//! pixels it was given, so lanes stay busy until their samples run out.
+//! vertex, written into a batch of eight of its material kernel ([`Batches`]); each batch's
+//! light samples and shading; each group's shadow rays in one call
+//! ([`crate::World::unoccluded_rays`]), after which each path gathers its light and steps on. A
+//! lane whose path ends starts the next sample of the pixels it was given, so lanes stay busy
+//! until their samples run out; then the paths left move to the first groups.
 //!
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
@@ -182,6 +185,69 @@ struct Shaded {
     pdf: Lanes,
     beta: Lanes3,
     eta_scale: Lanes,
+}
+
+/// Paths in flight per thread: `GROUPS` packets of [`LANES`] rays, each traced together. Their
+/// vertices are shaded in batches of [`LANES`] by material kernel ([`Batches`]), so that a
+/// kernel's loop runs on vertices of its own material (a small wavefront's queues, sorted by
+/// material), not on every lane of a bounce whatever its material.
+const GROUPS: usize = 4;
+const POOL: usize = GROUPS * LANES;
+
+/// Up to [`LANES`] vertices of one material kernel in a bounce (slots `..len`; the rest hold
+/// stale values the kernel computes and no path reads), their light samples and shading.
+#[derive(Clone, Debug)]
+struct Batch {
+    kernel: Kernel,
+    len: usize,
+    vertices: Vertices,
+    lights: LightLanes,
+    shaded: Shaded,
+}
+
+/// A bounce's batches (`all[..used]`); each kernel's newest one (`open`) takes its next vertex.
+struct Batches {
+    all: Vec<Batch>,
+    used: usize,
+    open: [Option<usize>; MATERIAL_KERNELS.len()],
+    /// Whether some light is a sky of one colour (see [`LightLanes::any_sky`]).
+    any_sky: bool,
+}
+
+impl Batches {
+    fn new(any_sky: bool) -> Self {
+        Batches { all: Vec::new(), used: 0, open: [None; MATERIAL_KERNELS.len()], any_sky }
+    }
+
+    /// Empties every batch for the next bounce (their storage kept).
+    fn clear(&mut self) {
+        self.used = 0;
+        self.open = [None; MATERIAL_KERNELS.len()];
+    }
+
+    /// A free slot for a vertex of material kernel `kernel`: its batch and slot.
+    fn slot(&mut self, kernel: Kernel) -> (usize, usize) {
+        let k = kernel.shaded();
+        if let Some(b) = self.open[k].filter(|&b| self.all[b].len < LANES) {
+            self.all[b].len += 1;
+            return (b, self.all[b].len - 1);
+        }
+        if self.used == self.all.len() {
+            let lights = LightLanes { any_sky: self.any_sky, ..LightLanes::default() };
+            let (vertices, shaded) = (Vertices::default(), Shaded::default());
+            self.all.push(Batch { kernel, len: 0, vertices, lights, shaded });
+        }
+        let b = self.used;
+        self.used += 1;
+        self.open[k] = Some(b);
+        let batch = &mut self.all[b];
+        (batch.kernel, batch.len) = (kernel, 1);
+        // What a slot is not sure to overwrite: a stale bent normal would only cost the bump
+        // kernel's work, a stale ask a light sample.
+        batch.vertices.bumped = [false; LANES];
+        batch.lights.asks = [None; LANES];
+        (b, 0)
+    }
 }
 
 /// One sample's path in a lane.
@@ -365,118 +431,140 @@ impl PathTracer<'_> {
     /// Samples `first..` of `pixels`, traced in lanes: `out` holds each pixel's samples in
     /// turn, sample `first + i` of pixel `p` at `out[p × n + i]` (`n` samples per pixel).
     pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
-        let mut lanes: [Option<LanePath>; LANES] = Default::default();
+        let mut lanes: [Option<LanePath>; POOL] = std::array::from_fn(|_| None);
         let spp = out.len() / pixels.len().max(1);
         let mut next = 0..out.len();
         let unit = self.world.vector_unit();
         let mut seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, 0, 0, unit);
-        let mut rays = RayPacket::default();
-        let mut hits: [Option<WorldHit>; LANES] = [None; LANES];
-        let mut general: [Vertex; LANES] = Default::default();
-        let (mut vertices, mut lights) = (Vertices::default(), LightLanes::default());
-        lights.any_sky = self.lane_lights.as_ref().is_some_and(|all| all.iter().any(|k| k.sky));
-        let mut shaded: [Shaded; MATERIAL_KERNELS.len()] = Default::default();
-        let (mut shadows, mut dist) = (RayPacket::default(), [0.0; LANES]);
+        let mut rays = [RayPacket::default(); GROUPS];
+        let mut hits: [[Option<WorldHit>; LANES]; GROUPS] = [[None; LANES]; GROUPS];
+        let mut general: [Vertex; POOL] = std::array::from_fn(|_| Vertex::default());
+        let any_sky = self.lane_lights.as_ref().is_some_and(|all| all.iter().any(|k| k.sky));
+        let mut batches = Batches::new(any_sky);
+        let mut kernels = [Kernel::Idle; POOL];
+        let mut at = [(0, 0); POOL];
+        let (mut shadows, mut dist) = ([RayPacket::default(); GROUPS], [[0.0; LANES]; GROUPS]);
         let together = self.world.traces_rays_together();
         loop {
-            // Idle lanes start the pixels' next samples; all lanes' rays are traced together.
-            for (i, slot) in lanes.iter_mut().enumerate().filter(|(_, p)| p.is_none()) {
+            // Idle lanes start the pixels' next samples; each group's rays are traced together.
+            for (p, slot) in lanes.iter_mut().enumerate().filter(|(_, p)| p.is_none()) {
                 *slot = next.next().map(|job| {
                     let ((x, y), index) = (pixels[job / spp], first + (job % spp) as u32);
                     if job % spp == 0 {
                         seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y, unit);
                     }
                     let lane = self.start(job, seeds.stream(index), (x, y));
-                    rays.set(i, &lane.path.ray);
+                    rays[p / LANES].set(p % LANES, &lane.path.ray);
                     lane
                 });
             }
-            if lanes.iter().all(Option::is_none) {
-                return;
+            if next.is_empty() {
+                // No samples left to start: the paths still going move to the first groups, so
+                // that the last bounces trace as few packets as there are paths to fill.
+                if !gather_paths(&mut lanes, &mut rays) {
+                    return;
+                }
             }
+            let live: [[bool; LANES]; GROUPS] =
+                std::array::from_fn(|g| std::array::from_fn(|i| lanes[g * LANES + i].is_some()));
             // Under an environment map every lane's hit is needed before the vertices (for the
             // sky lookups below); otherwise rays not traced together are traced in the
             // per-path stage, where a local hit costs no copy into `hits`.
             let sky_map = self.lights.sky_is_environment();
             if together {
-                self.world.intersect_rays(&rays, lanes.each_ref().map(|p| p.is_some()), &mut hits);
+                for g in (0..GROUPS).filter(|&g| live[g].contains(&true)) {
+                    self.world.intersect_rays(&rays[g], live[g], &mut hits[g]);
+                }
             } else if sky_map {
-                for (lane, hit) in lanes.iter().zip(&mut hits).filter_map(|(l, h)| Some((l.as_ref()?, h))) {
-                    *hit = self.world.intersect(&lane.path.ray, f64::INFINITY);
+                for (p, lane) in lanes.iter().enumerate().filter_map(|(p, l)| Some((p, l.as_ref()?))) {
+                    hits[p / LANES][p % LANES] = self.world.intersect(&lane.path.ray, f64::INFINITY);
                 }
             }
             // Rays that leave the scene see an environment map, looked up for all lanes together
             // (other skies in `vertex`).
-            let escaping: [Option<Vec3>; LANES] = std::array::from_fn(|i| match &lanes[i] {
-                Some(lane) if sky_map && hits[i].is_none() && lane.path.depth <= self.scene.render.max_depth => {
-                    Some(lane.path.ray.dir)
-                }
-                _ => None,
-            });
+            let escaping: [Option<Vec3>; POOL] = if sky_map {
+                std::array::from_fn(|p| match &lanes[p] {
+                    Some(lane)
+                        if hits[p / LANES][p % LANES].is_none() && lane.path.depth <= self.scene.render.max_depth =>
+                    {
+                        Some(lane.path.ray.dir)
+                    }
+                    _ => None,
+                })
+            } else {
+                [None; POOL]
+            };
             // Their texels are asked of memory now and read when the paths finish the bounce.
             let sky_texels = escaping.iter().any(Option::is_some).then(|| self.lights.sky_ahead(&escaping, unit));
-            let mut kernels = [Kernel::Idle; LANES];
-            let mut tested = [false; LANES];
-            lights.asks = [None; LANES];
-            for (i, (slot, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
+            batches.clear();
+            let mut tested = [[false; LANES]; GROUPS];
+            for (p, slot) in lanes.iter_mut().enumerate() {
+                let (g, i) = (p / LANES, p % LANES);
+                kernels[p] = Kernel::Idle;
                 let Some(lane) = slot else { continue };
-                if escaping[i].is_some() {
+                if escaping[p].is_some() {
                     // As `vertex` ends a path whose ray leaves the scene (its sky added below).
-                    kernels[i] = Kernel::General;
-                    general[i] = Vertex { beta: lane.path.beta, ..Vertex::default() };
+                    kernels[p] = Kernel::General;
+                    general[p] = Vertex { beta: lane.path.beta, ..Vertex::default() };
                     continue;
                 }
                 let traced = together || sky_map;
                 let alone = if traced { None } else { self.world.intersect(&lane.path.ray, f64::INFINITY) };
-                let hit = if traced { hit.as_ref() } else { alone.as_ref() };
-                kernels[i] = self.kernel_vertex(lane, hit, (&mut vertices, &mut lights), i);
-                if kernels[i] != Kernel::General {
+                let hit = if traced { hits[g][i].as_ref() } else { alone.as_ref() };
+                if let Some((b, s)) = self.kernel_vertex(lane, hit, &mut batches) {
+                    (kernels[p], at[p]) = (batches.all[b].kernel, (b, s));
                     continue;
                 }
-                self.vertex(&mut lane.path, hit, lane.mode, &mut lane.stream, &mut general[i]);
-                if let Some((ray, d)) = general[i].shadow {
-                    (tested[i], dist[i]) = (true, d);
-                    shadows.set(i, &ray);
+                kernels[p] = Kernel::General;
+                self.vertex(&mut lane.path, hit, lane.mode, &mut lane.stream, &mut general[p]);
+                if let Some((ray, d)) = general[p].shadow {
+                    (tested[g][i], dist[g][i]) = (true, d);
+                    shadows[g].set(i, &ray);
                 }
             }
-            // Which material kernels the lanes take, one bit each (by their `shaded` slot).
-            let present = kernels.iter().filter(|k| k.is_material()).fold(0u32, |m, k| m | 1 << k.shaded());
-            if present != 0 {
+            // Each material kernel's batches: their lights sampled, their vertices shaded.
+            for b in &mut batches.all[..batches.used] {
                 if self.lane_lights.is_some() {
-                    sample_lights(&lights, &mut vertices, self.lights.choice_pdf(), unit);
+                    sample_lights(&b.lights, &mut b.vertices, self.lights.choice_pdf(), unit);
                 } else if self.lights.has_environment() {
-                    self.lights.sample_lanes(&lights.asks, |i, sample| set_light(&mut vertices, i, sample));
+                    let v = &mut b.vertices;
+                    self.lights.sample_lanes(&b.lights.asks, |i, sample| set_light(v, i, sample));
                 }
-                let mut left = present;
-                while left != 0 {
-                    let slot = left.trailing_zeros() as usize;
-                    left &= left - 1;
-                    shade_with(MATERIAL_KERNELS[slot], &vertices, &mut shaded[slot], unit);
-                }
-                for (i, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
-                    let s = &shaded[kernel.shaded()];
-                    if s.shadow[i] {
-                        (tested[i], dist[i]) = (true, s.shadow_dist[i]);
-                        shadows.set(i, &Ray::new(get(&s.shadow_origin, i), get(&vertices.light_dir, i)));
-                    }
+                shade_with(b.kernel, &b.vertices, &mut b.shaded, unit);
+            }
+            for (p, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
+                let ((g, i), (b, s)) = ((p / LANES, p % LANES), at[p]);
+                let (sh, v) = (&batches.all[b].shaded, &batches.all[b].vertices);
+                debug_assert_eq!(*kernel, batches.all[b].kernel);
+                if sh.shadow[s] {
+                    (tested[g][i], dist[g][i]) = (true, sh.shadow_dist[s]);
+                    shadows[g].set(i, &Ray::new(get(&sh.shadow_origin, s), get(&v.light_dir, s)));
                 }
             }
-            let clear = self.world.unoccluded_rays(&shadows, &dist, tested);
-            for (i, slot) in lanes.iter_mut().enumerate() {
+            let clear: [[bool; LANES]; GROUPS] = std::array::from_fn(|g| {
+                if tested[g].contains(&true) {
+                    self.world.unoccluded_rays(&shadows[g], &dist[g], tested[g])
+                } else {
+                    [false; LANES]
+                }
+            });
+            for (p, slot) in lanes.iter_mut().enumerate() {
                 let Some(lane) = slot.as_mut() else { continue };
-                if let (Some(dir), Some(texels)) = (escaping[i], &sky_texels) {
-                    let (path, sky) = (&mut lane.path, self.lights.sky_at(dir, texels[i]));
+                let (g, i) = (p / LANES, p % LANES);
+                if let (Some(dir), Some(texels)) = (escaping[p], &sky_texels) {
+                    let (path, sky) = (&mut lane.path, self.lights.sky_at(dir, texels[p]));
                     path.l += self.escaped_from(sky, &path.prev, path.beta, lane.mode).unwrap_or(Vec3::ZERO);
                 }
-                let goes_on = match kernels[i] {
+                let open = !tested[g][i] || clear[g][i];
+                let goes_on = match kernels[p] {
                     Kernel::General | Kernel::Idle => {
-                        lane.path.gather(&general[i], !tested[i] || clear[i]);
-                        general[i].goes_on
+                        lane.path.gather(&general[p], open);
+                        general[p].goes_on
                     }
-                    k => finish_kernel(&mut lane.path, &shaded[k.shaded()], !tested[i] || clear[i], i),
+                    _ => finish_kernel(&mut lane.path, &batches.all[at[p].0].shaded, open, at[p].1),
                 };
                 if goes_on {
-                    rays.set(i, &lane.path.ray);
+                    rays[g].set(i, &lane.path.ray);
                 } else {
                     out[lane.job] = lane.value();
                     *slot = None;
@@ -496,21 +584,21 @@ impl PathTracer<'_> {
     }
 
     /// The per-path half of a material kernel's vertex, as in [`Self::vertex`]: emission, the
-    /// vertex, its material and its random numbers and light sample, written to lane `i`; the
-    /// kernel. [`Kernel::General`] (nothing done) when the vertex is no material kernel's: the
-    /// ray missed, the path ends here, or the material takes the general kernel.
+    /// vertex, its material and its random numbers and light sample, written to a slot of its
+    /// kernel's batch: the batch and the slot. `None` (nothing done) when the vertex is no
+    /// material kernel's: the ray missed, the path ends here, or the material takes the general
+    /// kernel.
     fn kernel_vertex(
         &self,
         lane: &mut LanePath,
         hit: Option<&WorldHit>,
-        (v, lights): (&mut Vertices, &mut LightLanes),
-        i: usize,
-    ) -> Kernel {
+        batches: &mut Batches,
+    ) -> Option<(usize, usize)> {
         let path = &mut lane.path;
-        let Some(wh) = hit else { return Kernel::General };
+        let wh = hit?;
         let material = self.material_kernels[wh.material as usize];
         if !material.is_material() || path.depth >= self.scene.render.max_depth {
-            return Kernel::General;
+            return None;
         }
         let m = &self.scene.materials[wh.material as usize];
         let at_hit;
@@ -523,8 +611,10 @@ impl PathTracer<'_> {
             }
         };
         if kernel != material {
-            return Kernel::General;
+            return None;
         }
+        let (b, i) = batches.slot(kernel);
+        let Batch { vertices: v, lights, .. } = &mut batches.all[b];
         match bsdf {
             Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
             Bsdf::Conductor(c) => {
@@ -553,7 +643,11 @@ impl PathTracer<'_> {
                     set_facets(v, i, facets, None);
                 }
             }
-            _ => return Kernel::General,
+            _ => {
+                // No kernel's (`kernel_of` gives none to other BSDFs): the slot given back.
+                batches.all[b].len -= 1;
+                return None;
+            }
         }
         let h = HitPoint::from(wh);
         path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, None, ColorMode::Rgb);
@@ -607,7 +701,7 @@ impl PathTracer<'_> {
                 set_light(v, i, light);
             }
         }
-        kernel
+        Some((b, i))
     }
 }
 
@@ -628,6 +722,25 @@ fn set_facets(v: &mut Vertices, i: usize, facets: &Microfacet, tangent: Option<V
     (v.alpha[0][i], v.alpha[1][i]) = (facets.alpha_u, facets.alpha_v);
     v.tangent_given[i] = tangent.is_some();
     set(&mut v.tangent, i, tangent.unwrap_or(Vec3::X));
+}
+
+/// Moves the paths of the pool to its first slots, each with its ray, keeping their order;
+/// false when there is none. (Where a path is traced changes none of its numbers.)
+fn gather_paths(lanes: &mut [Option<LanePath>; POOL], rays: &mut [RayPacket; GROUPS]) -> bool {
+    let mut to = 0;
+    for from in 0..POOL {
+        if lanes[from].is_none() {
+            continue;
+        }
+        if from != to {
+            lanes[to] = lanes[from].take();
+            if let Some(lane) = &lanes[to] {
+                rays[to / LANES].set(to % LANES, &lane.path.ray);
+            }
+        }
+        to += 1;
+    }
+    to > 0
 }
 
 /// The per-path half of a material kernel's vertex after [`shade`] and the shadow ray (`clear`
@@ -1266,12 +1379,38 @@ material = "glow"
         }
     }
 
-    /// Each material kernel writes a [`Shaded`] of its own.
+    /// Each material kernel has a slot of its own among the batches' open ones.
     #[test]
-    fn material_kernels_write_their_own_results() {
+    fn material_kernels_have_their_own_slots() {
         for (i, k) in MATERIAL_KERNELS.into_iter().enumerate() {
             assert!(k.is_material());
             assert_eq!(k.shaded(), i, "{k:?}");
+        }
+    }
+
+    proptest::proptest! {
+        /// A bounce's vertices, of kernels in any order, each get a slot of their own in a batch
+        /// of their kernel, and the batches are as few as the kernels' counts allow; a cleared
+        /// set of batches starts afresh with its storage kept.
+        #[test]
+        fn batches_hold_each_kernel_apart(kinds in proptest::collection::vec(0..MATERIAL_KERNELS.len(), 0..POOL)) {
+            let mut batches = Batches::new(false);
+            for round in 0..2 {
+                batches.clear();
+                let mut taken = std::collections::HashSet::new();
+                for &k in &kinds {
+                    let (b, s) = batches.slot(MATERIAL_KERNELS[k]);
+                    proptest::prop_assert!(b < batches.used && s < batches.all[b].len && s < LANES);
+                    proptest::prop_assert_eq!(batches.all[b].kernel, MATERIAL_KERNELS[k]);
+                    proptest::prop_assert!(taken.insert((b, s)), "slot {:?} given twice", (b, s));
+                }
+                let fewest: usize = (0..MATERIAL_KERNELS.len())
+                    .map(|k| kinds.iter().filter(|&&x| x == k).count().div_ceil(LANES))
+                    .sum();
+                proptest::prop_assert_eq!(batches.used, fewest, "round {}", round);
+                let filled: usize = batches.all[..batches.used].iter().map(|b| b.len).sum();
+                proptest::prop_assert_eq!(filled, kinds.len());
+            }
         }
     }
 
