@@ -99,6 +99,29 @@ fn mistakes_are_located_and_explained() {
     assert!(late.contains("must come before the first [table] header"), "{late}");
 }
 
+/// A scene's mesh files are read together before the walk; what cannot be read is still
+/// reported where the walk meets it, the first in document order, and the files read are the
+/// meshes a walk reading each in turn would give.
+#[test]
+fn mesh_files_read_together_report_errors_in_document_order() {
+    let meshes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/meshes");
+    let (ico, prism) = (meshes.join("icosahedron.obj"), meshes.join("prism.obj"));
+    let object = |file: &Path| format!("[[object]]\nshape = \"mesh\"\nfile = {:?}\n", file.display().to_string());
+    let dir = tempfile::tempdir().unwrap();
+    let (first, second) = (dir.path().join("first-missing.ply"), dir.path().join("second-missing.obj"));
+    let text = [object(&ico), object(&second), object(&prism), object(&first)].concat();
+    let e = parse_scene(&dir.path().join("s.toml"), &text).unwrap_err().to_string();
+    assert!(e.contains("s.toml:6:8") && e.contains("second-missing.obj"), "{e}");
+    assert!(!e.contains("first-missing"), "{e}");
+    // Read together (two files) or alone (one), the same meshes.
+    let together = parse_scene(&dir.path().join("s.toml"), &[object(&ico), object(&prism)].concat()).unwrap();
+    for (i, alone) in [&ico, &prism].into_iter().enumerate() {
+        let alone = parse_scene(&dir.path().join("s.toml"), &object(alone)).unwrap();
+        assert_eq!(together.meshes[i].positions, alone.meshes[0].positions);
+        assert_eq!(together.meshes[i].triangles, alone.meshes[0].triangles);
+    }
+}
+
 #[test]
 fn invalid_utf8_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
