@@ -91,9 +91,58 @@ impl SpherePacket {
             let hits = unsafe { avx512::nearest_rays(packets, rays, t_max) };
             return std::array::from_fn(|r| hits[r].filter(|_| live[r]));
         }
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx2() {
+            // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
+            let hits = unsafe { nearest_rays_avx2(packets, rays, t_max) };
+            return std::array::from_fn(|r| hits[r].filter(|_| live[r]));
+        }
         let _ = unit;
         std::array::from_fn(|r| if live[r] { Self::nearest_portable(packets, &rays.ray(r), t_max[r]) } else { None })
     }
+}
+
+/// [`SpherePacket::nearest_of_rays`] in loops over the eight rays without branches, which the
+/// compiler turns into AVX2 code: each sphere in turn against all rays, [`Sphere::hit`]'s
+/// operations in its order (its early return a mask), strictly nearer replacing.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn nearest_rays_avx2(packets: &[SpherePacket], rays: &RayPacket, t_max: &[f64; SPHERE_LANES]) -> RaysSphereHits {
+    const R: usize = SPHERE_LANES;
+    let (o, d) = (&rays.origin, &rays.dir);
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let a: [f64; R] = std::array::from_fn(|r| dot([d[0][r], d[1][r], d[2][r]], [d[0][r], d[1][r], d[2][r]]));
+    let inv_a = a.map(|a| 1.0 / a);
+    let (mut best, mut which, mut hit) = (*t_max, [0u64; R], [false; R]);
+    for (k, p) in packets.iter().enumerate() {
+        for lane in 0..p.used {
+            let (center, radius) = ([p.center[0][lane], p.center[1][lane], p.center[2][lane]], p.radius[lane]);
+            let id = (k * SPHERE_LANES + lane) as u64;
+            for r in 0..R {
+                let dir = [d[0][r], d[1][r], d[2][r]];
+                let f = [o[0][r] - center[0], o[1][r] - center[1], o[2][r] - center[2]];
+                let beta = -dot(f, dir);
+                let s = beta * inv_a[r];
+                let perp = [f[0] + dir[0] * s, f[1] + dir[1] * s, f[2] + dir[2] * s];
+                let r2 = radius * radius;
+                let disc = a[r] * (r2 - dot(perp, perp));
+                let real = !(disc < 0.0 || disc.is_nan() || a[r] == 0.0);
+                let c = dot(f, f) - r2;
+                let q = beta + disc.sqrt().copysign(beta);
+                let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q * inv_a[r]) };
+                let (lo, hi) = (t0.min(t1), t0.max(t1));
+                let t = if lo > 0.0 { lo } else { hi };
+                let closer = real && t > 0.0 && t < best[r];
+                best[r] = if closer { t } else { best[r] };
+                which[r] = if closer { id } else { which[r] };
+                hit[r] |= closer;
+            }
+        }
+    }
+    std::array::from_fn(|r| {
+        let id = which[r] as usize;
+        hit[r].then(|| (id / SPHERE_LANES, id % SPHERE_LANES, best[r]))
+    })
 }
 
 #[cfg(target_arch = "x86_64")]
