@@ -171,15 +171,16 @@ impl FlatPacket {
     /// The packet of `flats` (at most [`LANES`]); lane `i` is `flats[i]`.
     pub fn new(flats: &[Flat]) -> Self {
         assert!(flats.len() <= LANES, "a packet holds at most {LANES} flats");
+        Self::of(flats.iter().copied())
+    }
+
+    /// The packet of the first [`LANES`] of `flats`, lane by lane.
+    fn of(flats: impl Iterator<Item = Flat>) -> Self {
         // An unused lane is all zero: its t is 0/0, which fails every comparison.
-        let mut p = Self {
-            axes: [[[0.0; LANES]; 3]; 3],
-            offsets: [[0.0; LANES]; 3],
-            triangle: [0.0; LANES],
-            used: flats.len(),
-        };
-        for (lane, f) in flats.iter().enumerate() {
-            let planes = FlatPlanes::of(f);
+        let mut p = Self { axes: [[[0.0; LANES]; 3]; 3], offsets: [[0.0; LANES]; 3], triangle: [0.0; LANES], used: 0 };
+        for (lane, f) in flats.take(LANES).enumerate() {
+            p.used = lane + 1;
+            let planes = FlatPlanes::of(&f);
             for a in 0..3 {
                 for c in 0..3 {
                     p.axes[a][c][lane] = planes.axes[a][c];
@@ -318,12 +319,14 @@ impl FlatPacket {
 /// One packet of up to [`LANES`] flats and what each stands for.
 fn pack<L: Copy + Default>(flats: impl Iterator<Item = (L, Flat)>) -> (FlatPacket, [L; LANES]) {
     let mut lanes = [L::default(); LANES];
-    let mut packet = Vec::with_capacity(LANES);
-    for ((lane, f), slot) in flats.zip(&mut lanes) {
+    // Straight into the packet, no vector between (a million-triangle mesh makes a hundred
+    // thousand packets).
+    let flats = flats.zip(&mut lanes).map(|((lane, f), slot)| {
         *slot = lane;
-        packet.push(f);
-    }
-    (FlatPacket::new(&packet), lanes)
+        f
+    });
+    let packet = FlatPacket::of(flats);
+    (packet, lanes)
 }
 
 /// Packets of flats with what each lane stands for (`L`), filled leaf by leaf.
