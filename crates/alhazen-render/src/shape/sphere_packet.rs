@@ -58,6 +58,11 @@ impl SpherePacket {
             // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
             return unsafe { avx512::nearest(packets, ray, t_max) };
         }
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx2() {
+            // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
+            return unsafe { nearest_avx2(packets, ray, t_max) };
+        }
         let _ = unit;
         Self::nearest_portable(packets, ray, t_max)
     }
@@ -102,6 +107,50 @@ impl SpherePacket {
     }
 }
 
+/// [`Sphere::hit`]'s distance of `ray` to `center`, `radius` (`a = d·d`, its reciprocal given):
+/// NaN where it misses, in `Sphere::roots`' operations and order, its early return a select.
+#[inline(always)]
+fn sphere_t(center: [f64; 3], radius: f64, origin: [f64; 3], dir: [f64; 3], a: f64, inv_a: f64) -> f64 {
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let f = [origin[0] - center[0], origin[1] - center[1], origin[2] - center[2]];
+    let beta = -dot(f, dir);
+    let s = beta * inv_a;
+    let perp = [f[0] + dir[0] * s, f[1] + dir[1] * s, f[2] + dir[2] * s];
+    let r2 = radius * radius;
+    let disc = a * (r2 - dot(perp, perp));
+    let real = !(disc < 0.0 || disc.is_nan() || a == 0.0);
+    let c = dot(f, f) - r2;
+    let q = beta + disc.sqrt().copysign(beta);
+    let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q * inv_a) };
+    let (lo, hi) = (t0.min(t1), t0.max(t1));
+    let t = if lo > 0.0 { lo } else { hi };
+    if real { t } else { f64::NAN }
+}
+
+/// [`SpherePacket::nearest_of`] with each packet's lanes tested in a loop without branches
+/// (AVX2 code), then the nearest taken: the lane of least `t` below the limit, the first on a
+/// tie, as testing them in turn against a shrinking limit finds.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn nearest_avx2(packets: &[SpherePacket], ray: &Ray, t_max: f64) -> Option<(usize, usize, f64)> {
+    let (origin, dir) = (ray.origin.to_array(), ray.dir.to_array());
+    let a = ray.dir.length_squared();
+    let inv_a = 1.0 / a;
+    let (mut best, mut limit) = (None, t_max);
+    for (k, p) in packets.iter().enumerate() {
+        let t: [f64; SPHERE_LANES] = std::array::from_fn(|l| {
+            let center = [p.center[0][l], p.center[1][l], p.center[2][l]];
+            sphere_t(center, p.radius[l], origin, dir, a, inv_a)
+        });
+        for (lane, &t) in t.iter().enumerate().take(p.used) {
+            if t > 0.0 && t < limit {
+                (limit, best) = (t, Some((k, lane, t)));
+            }
+        }
+    }
+    best
+}
+
 /// [`SpherePacket::nearest_of_rays`] in loops over the eight rays without branches, which the
 /// compiler turns into AVX2 code: each sphere in turn against all rays, [`Sphere::hit`]'s
 /// operations in its order (its early return a mask), strictly nearer replacing.
@@ -119,20 +168,9 @@ fn nearest_rays_avx2(packets: &[SpherePacket], rays: &RayPacket, t_max: &[f64; S
             let (center, radius) = ([p.center[0][lane], p.center[1][lane], p.center[2][lane]], p.radius[lane]);
             let id = (k * SPHERE_LANES + lane) as u64;
             for r in 0..R {
-                let dir = [d[0][r], d[1][r], d[2][r]];
-                let f = [o[0][r] - center[0], o[1][r] - center[1], o[2][r] - center[2]];
-                let beta = -dot(f, dir);
-                let s = beta * inv_a[r];
-                let perp = [f[0] + dir[0] * s, f[1] + dir[1] * s, f[2] + dir[2] * s];
-                let r2 = radius * radius;
-                let disc = a[r] * (r2 - dot(perp, perp));
-                let real = !(disc < 0.0 || disc.is_nan() || a[r] == 0.0);
-                let c = dot(f, f) - r2;
-                let q = beta + disc.sqrt().copysign(beta);
-                let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q * inv_a[r]) };
-                let (lo, hi) = (t0.min(t1), t0.max(t1));
-                let t = if lo > 0.0 { lo } else { hi };
-                let closer = real && t > 0.0 && t < best[r];
+                let (origin, dir) = ([o[0][r], o[1][r], o[2][r]], [d[0][r], d[1][r], d[2][r]]);
+                let t = sphere_t(center, radius, origin, dir, a[r], inv_a[r]);
+                let closer = t > 0.0 && t < best[r];
                 best[r] = if closer { t } else { best[r] };
                 which[r] = if closer { id } else { which[r] };
                 hit[r] |= closer;
