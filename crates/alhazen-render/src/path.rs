@@ -22,7 +22,7 @@
 //! are then off (the estimate holds their paths too), and so are the lanes' material kernels.
 //!
 //! Where the world tests eight rays at once faster than one by one (`World::traces_rays_together`),
-//! eight samples are traced side by side (`lanes`), each with the same arithmetic ([`PathTracer::vertex`]),
+//! samples are traced side by side in groups of eight (`lanes`), each with the same arithmetic ([`PathTracer::vertex`]),
 //! so the same samples, whatever the materials.
 
 use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_at};
@@ -53,7 +53,7 @@ pub struct PathTracer<'a> {
     sequence: Sequence,
     /// Each material's BSDF in RGB when it does not vary over the surface (no texture).
     uniform_bsdfs: Vec<Option<Bsdf>>,
-    /// Samples are traced eight at a time in lanes (module `lanes`): the same samples.
+    /// Samples are traced side by side in lanes (module `lanes`): the same samples.
     in_lanes: bool,
     /// The lights, when every one is a parallelogram, for the lanes' material kernels to sample.
     lane_lights: Option<Vec<lanes::LaneLight>>,
