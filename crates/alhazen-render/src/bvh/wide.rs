@@ -38,6 +38,14 @@ pub(super) struct Wide {
     count: [u32; WIDTH],
 }
 
+impl Wide {
+    /// Row `r` of the six rows of planes: `min` along axis `r`, or `max` along axis `r − 3`.
+    #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+    fn row(&self, r: usize) -> &[f32; WIDTH] {
+        if r < 3 { &self.min[r] } else { &self.max[r - 3] }
+    }
+}
+
 /// A child to visit: a leaf's labels `offset..offset + count` or, for `count == 0`, node
 /// `offset`; `near` is a lower bound of where the ray enters its box.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -141,7 +149,6 @@ pub(super) struct Slab {
     origin: [f32; 3],
     inv: [f32; 3],
     pad: [f32; 3],
-    neg: [bool; 3],
     /// Per axis, the row of a node's six rows of planes (`min` then `max`, axis by axis) the
     /// ray enters by, and the one it leaves by: chosen once per ray, not per node.
     entry_row: [usize; 3],
@@ -161,7 +168,6 @@ impl Slab {
             origin: [0.0; 3],
             inv: [0.0; 3],
             pad: [f32::INFINITY; 3],
-            neg: [false; 3],
             entry_row: [0; 3],
             exit_row: [0; 3],
             parallel: [false; 3],
@@ -181,8 +187,7 @@ impl Slab {
             s.origin[axis] = o32;
             s.inv[axis] = if usable { inv[axis] as f32 } else { 0.0 };
             s.pad[axis] = if usable { err as f32 } else { f32::INFINITY };
-            s.neg[axis] = inv[axis] < 0.0;
-            let back = 3 * usize::from(s.neg[axis]);
+            let back = 3 * usize::from(inv[axis] < 0.0);
             (s.entry_row[axis], s.exit_row[axis]) = (axis + back, axis + 3 - back);
             // A ray parallel to the slabs meets a box only if its origin lies between them,
             // which rounding to `f32` keeps (rounding is monotonic).
@@ -213,8 +218,7 @@ impl Slab {
         let mut far = [t_max; WIDTH];
         let mut beside = [false; WIDTH];
         for axis in 0..3 {
-            let (entry, exit) =
-                if self.neg[axis] { (&w.max[axis], &w.min[axis]) } else { (&w.min[axis], &w.max[axis]) };
+            let (entry, exit) = (w.row(self.entry_row[axis]), w.row(self.exit_row[axis]));
             let (o, inv, pad) = (self.origin[axis], self.inv[axis], self.pad[axis]);
             if self.parallel[axis] {
                 for k in 0..WIDTH {

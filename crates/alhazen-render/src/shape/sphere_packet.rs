@@ -107,11 +107,16 @@ impl SpherePacket {
     }
 }
 
+/// `a·b` summed as glam's `dot` (and `Sphere::roots`): `(x·x + y·y) + z·z`.
+#[inline(always)]
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 /// [`Sphere::hit`]'s distance of `ray` to `center`, `radius` (`a = d·d`, its reciprocal given):
 /// NaN where it misses, in `Sphere::roots`' operations and order, its early return a select.
 #[inline(always)]
 fn sphere_t(center: [f64; 3], radius: f64, origin: [f64; 3], dir: [f64; 3], a: f64, inv_a: f64) -> f64 {
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let f = [origin[0] - center[0], origin[1] - center[1], origin[2] - center[2]];
     let beta = -dot(f, dir);
     let s = beta * inv_a;
@@ -159,7 +164,6 @@ fn nearest_avx2(packets: &[SpherePacket], ray: &Ray, t_max: f64) -> Option<(usiz
 fn nearest_rays_avx2(packets: &[SpherePacket], rays: &RayPacket, t_max: &[f64; SPHERE_LANES]) -> RaysSphereHits {
     const R: usize = SPHERE_LANES;
     let (o, d) = (&rays.origin, &rays.dir);
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let a: [f64; R] = std::array::from_fn(|r| dot([d[0][r], d[1][r], d[2][r]], [d[0][r], d[1][r], d[2][r]]));
     let inv_a = a.map(|a| 1.0 / a);
     let (mut best, mut which, mut hit) = (*t_max, [0u64; R], [false; R]);
