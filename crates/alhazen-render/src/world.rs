@@ -294,11 +294,10 @@ impl World {
         for (i, o) in objects.iter().enumerate() {
             let object = i as u32;
             if let Some(mesh) = flattenable(&o.placed) {
-                let (lanes, bounds) = flat_primitives(mesh);
-                for (lane, bounds) in lanes.into_iter().zip(bounds) {
+                for lane in flat_primitives(mesh) {
                     let flat = lane.flat(mesh);
                     primitives.push(Primitive::Flat { object, lane, flat });
-                    prim_bounds.push(bounds);
+                    prim_bounds.push(lane.bounds(mesh));
                 }
                 continue;
             }

@@ -72,17 +72,37 @@ impl Default for Bvh {
     }
 }
 
-/// A primitive while building: 64 bytes (its centroid is computed from its bounds when
-/// needed), so a million of them move through the caches as few lines as possible.
+/// A primitive while building: 32 bytes, its bounds rounded outwards to `f32` (as traversal's
+/// nodes hold them: the nodes' boxes are the same) and its centroid computed from them when
+/// needed, so a million of them are 32 MB of fresh memory and move through the caches as few
+/// lines as possible.
+#[derive(Clone, Copy)]
 struct Item {
-    bounds: Bounds3,
+    min: [f32; 3],
+    max: [f32; 3],
     index: u32,
     /// Tested [`PACK`] at a time.
     packed: bool,
-    /// Morton code of the centroid (Morton builds only).
-    code: u64,
     /// The bin of its centroid in the last binning of its node (SAH builds only).
     bin: u8,
+}
+
+impl Item {
+    fn new(index: usize, b: Bounds3, packed: bool) -> Self {
+        Item {
+            min: std::array::from_fn(|a| wide::down(b.min[a])),
+            max: std::array::from_fn(|a| wide::up(b.max[a])),
+            index: index as u32,
+            packed,
+            bin: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn bounds(&self) -> Bounds3 {
+        let v = |c: [f32; 3]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+        Bounds3 { min: v(self.min), max: v(self.max) }
+    }
 }
 
 /// How a [`Bvh`] chooses its splits.
@@ -123,46 +143,56 @@ impl Bvh {
         Self::build_packed(bounds, |_| false)
     }
 
+    /// [`Self::build_packed_by`] over `count` primitives whose bounds `bounds(i)` gives: no
+    /// vector of them is made (a million-triangle mesh's would be 48 MB of fresh memory).
+    pub fn build_with(
+        count: usize,
+        bounds: impl Fn(usize) -> Bounds3 + Sync,
+        packed: impl Fn(usize) -> bool + Sync,
+        method: BuildMethod,
+    ) -> Self {
+        Self::build_split_from(count, bounds, packed, PARALLEL_ITEMS, method)
+    }
+
     /// [`Self::build`] for primitives some of which (`packed(i)`) are tested [`PACK`] at a time
     /// in a leaf: the surface area heuristic charges a leaf one test per started group of
     /// them plus one per other primitive, so leaves of such primitives grow large.
     pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync) -> Self {
-        Self::build_split_from(bounds, packed, PARALLEL_ITEMS, BuildMethod::Sah)
+        Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, BuildMethod::Sah)
     }
 
     /// [`Self::build_packed`] by `method`.
     pub fn build_packed_by(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync, method: BuildMethod) -> Self {
-        Self::build_split_from(bounds, packed, PARALLEL_ITEMS, method)
+        Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, method)
     }
 
     /// [`Self::build_packed`] building subtrees of at least `parallel_from` primitives in
     /// parallel.
     fn build_split_from(
-        bounds: &[Bounds3],
+        count: usize,
+        bounds: impl Fn(usize) -> Bounds3 + Sync,
         packed: impl Fn(usize) -> bool + Sync,
         parallel_from: usize,
         method: BuildMethod,
     ) -> Self {
-        use rayon::prelude::*;
-        let mut items: Vec<Item> = Vec::new();
-        let item = |(i, b): (usize, &Bounds3)| Item { bounds: *b, index: i as u32, packed: packed(i), code: 0, bin: 0 };
-        bounds.par_iter().enumerate().map(item).collect_into_vec(&mut items);
-        if method == BuildMethod::Morton {
-            morton_order(&mut items);
-        }
-        let mut bvh = Bvh::reserved(bounds.len());
+        let (mut items, root) = items_of(count, bounds, packed);
+        let codes = match method {
+            BuildMethod::Morton => morton_order(&mut items),
+            BuildMethod::Sah => vec![],
+        };
+        let mut bvh = Bvh::reserved(count);
         if !items.is_empty() {
             // A node's slab test costs about what a packet's test does, an eighth of a
             // triangle's (pbrt's ratio).
             let packets = items.iter().any(|it| it.packed);
             let split = match method {
                 BuildMethod::Sah => Split::Sah { traversal: if packets { 1.0 } else { 0.125 } },
-                BuildMethod::Morton => Split::Morton,
+                BuildMethod::Morton => Split::Morton { codes: &codes },
             };
             let all = Summary::of(&items);
             bvh.build_node(&mut items, all, 0, split, parallel_from);
         }
-        bvh.root = bvh.nodes.first().map_or(Bounds3::EMPTY, |n| n.bounds);
+        bvh.root = root;
         (bvh.wide, bvh.start) = wide::collapse(&bvh.nodes);
         bvh.reach = std::array::from_fn(|a| {
             let (lo, hi) = (wide::down(bvh.root.min[a]) as f64, wide::up(bvh.root.max[a]) as f64);
@@ -187,8 +217,8 @@ impl Bvh {
         let split = match how {
             _ if small || depth >= MAX_DEPTH => None,
             Split::Sah { traversal } => sah_split(items, &node, traversal),
-            Split::Morton => {
-                let (axis, mid) = morton_split(items);
+            Split::Morton { codes } => {
+                let (axis, mid) = morton_split(codes);
                 Some((axis, mid, None))
             }
         };
@@ -204,6 +234,7 @@ impl Bvh {
                 // The halves' summaries come with the split when it is the bins' (the same
                 // unions of the same boxes, in another order: the same bits).
                 let [sl, sr] = halves.unwrap_or_else(|| [Summary::of(left), Summary::of(right)]);
+                let (hl, hr) = how.split_at(mid);
                 let next = depth + 1;
                 let second = if parallel {
                     // The first half goes on in this tree, where the sequential build puts it;
@@ -211,15 +242,15 @@ impl Bvh {
                     // they grow) and appended, one copy of it.
                     let mut b = Bvh::reserved(right.len());
                     rayon::join(
-                        || self.build_node(left, sl, next, how, parallel_from),
-                        || b.build_node(right, sr, next, how, parallel_from),
+                        || self.build_node(left, sl, next, hl, parallel_from),
+                        || b.build_node(right, sr, next, hr, parallel_from),
                     );
                     let second = self.nodes.len();
                     self.append(b);
                     second
                 } else {
-                    self.build_node(left, sl, next, how, parallel_from);
-                    self.build_node(right, sr, next, how, parallel_from)
+                    self.build_node(left, sl, next, hl, parallel_from);
+                    self.build_node(right, sr, next, hr, parallel_from)
                 };
                 self.nodes[me].offset = second as u32;
                 self.nodes[me].axis = axis as u8;
@@ -440,17 +471,14 @@ impl Summary {
     }
 
     fn add(self, it: &Item) -> Self {
-        self.add_centred(it, it.bounds.centroid())
+        let b = it.bounds();
+        self.add_centred(it, b, b.centroid())
     }
 
-    /// [`Self::add`] for an item whose centroid is `centroid`.
+    /// [`Self::add`] for an item whose bounds are `b` and centroid is `centroid`.
     #[inline(always)]
-    fn add_centred(self, it: &Item, centroid: Vec3) -> Self {
-        Self {
-            bounds: self.bounds.union(it.bounds),
-            centroids: self.centroids.grow(centroid),
-            tests: self.tests.add(it),
-        }
+    fn add_centred(self, it: &Item, b: Bounds3, centroid: Vec3) -> Self {
+        Self { bounds: self.bounds.union(b), centroids: self.centroids.grow(centroid), tests: self.tests.add(it) }
     }
 
     fn merge(self, o: &Self) -> Self {
@@ -524,57 +552,110 @@ fn bin_items<const AXIS: usize>(items: &mut [Item], cb: &Bounds3) -> [Summary; B
     // same bin, and one set would make each update wait for the last one's store.
     let mut sets = [[Summary::EMPTY; BINS]; 4];
     for (k, it) in items.iter_mut().enumerate() {
-        let c = it.bounds.centroid();
+        let b = it.bounds();
+        let c = b.centroid();
         // At or above 0 (c ≥ lo); `as i32` saturates, as the wider conversion to `usize` would,
         // in fewer instructions.
         let bin = (((c[AXIS] - lo) * per_unit) as i32).clamp(0, BINS as i32 - 1) as usize;
         it.bin = bin as u8;
-        let b = &mut sets[k % 4][bin];
-        *b = b.add_centred(it, c);
+        let set = &mut sets[k % 4][bin];
+        *set = set.add_centred(it, b, c);
     }
     std::array::from_fn(|i| sets.iter().fold(Summary::EMPTY, |s, set| s.merge(&set[i])))
 }
 
 /// A node's split rule.
 #[derive(Clone, Copy)]
-enum Split {
+enum Split<'a> {
     /// The surface area heuristic, a node's test costing `traversal` primitive tests.
     Sah { traversal: f64 },
-    /// Morton order (the items sorted by code).
-    Morton,
+    /// Morton order: the items sorted by their Morton `codes` (one per item of the node).
+    Morton { codes: &'a [u64] },
+}
+
+impl<'a> Split<'a> {
+    /// The rules of the two halves when a node's items split at `mid`.
+    fn split_at(self, mid: usize) -> (Self, Self) {
+        match self {
+            Split::Sah { .. } => (self, self),
+            Split::Morton { codes } => {
+                let (left, right) = codes.split_at(mid);
+                (Split::Morton { codes: left }, Split::Morton { codes: right })
+            }
+        }
+    }
+}
+
+/// Width of the chunks in which [`items_of`] makes the items on all threads.
+const ITEM_CHUNK: usize = 4096;
+
+/// The items of primitives `0..count` and the exact union of their `bounds`, made in one pass
+/// on all threads (the union is of minima and maxima: the same bits in any order).
+fn items_of(
+    count: usize,
+    bounds: impl Fn(usize) -> Bounds3 + Sync,
+    packed: impl Fn(usize) -> bool + Sync,
+) -> (Vec<Item>, Bounds3) {
+    use rayon::prelude::*;
+    let mut items: Vec<Item> = Vec::with_capacity(count);
+    let root = items.spare_capacity_mut()[..count]
+        .par_chunks_mut(ITEM_CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut root = Bounds3::EMPTY;
+            for (k, slot) in chunk.iter_mut().enumerate() {
+                let i = c * ITEM_CHUNK + k;
+                let b = bounds(i);
+                root = root.union(b);
+                slot.write(Item::new(i, b, packed(i)));
+            }
+            root
+        })
+        .reduce(|| Bounds3::EMPTY, Bounds3::union);
+    // SAFETY: the chunks cover the first `count` slots, and each slot was written above.
+    #[allow(unsafe_code)]
+    unsafe {
+        items.set_len(count)
+    };
+    (items, root)
 }
 
 /// Bits of a Morton code per axis.
 const MORTON_BITS: u32 = 21;
 
-/// Gives every item the Morton code of its centroid within the centroids' bounds and sorts them
-/// by it (ties by index: the order is a function of the input).
-fn morton_order(items: &mut [Item]) {
-    let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.grow(it.bounds.centroid()));
+/// Sorts the items by the Morton code of their centroids within the centroids' bounds (ties by
+/// index: the order is a function of the input); returns the codes in that order.
+fn morton_order(items: &mut Vec<Item>) -> Vec<u64> {
+    let cb = items.iter().fold(Bounds3::EMPTY, |b, it| b.grow(it.bounds().centroid()));
     let extent = cb.extent();
     let scale = ((1u64 << MORTON_BITS) - 1) as f64;
     let quantise = |x: f64, lo: f64, e: f64| if e > 0.0 { ((x - lo) / e * scale).clamp(0.0, scale) as u64 } else { 0 };
-    for it in items.iter_mut() {
-        let c = it.bounds.centroid();
+    let code = |it: &Item| {
+        let c = it.bounds().centroid();
         let q: [u64; 3] = std::array::from_fn(|a| quantise(c[a], cb.min[a], extent[a]));
-        it.code = (0..MORTON_BITS).fold(0, |code, bit| {
+        (0..MORTON_BITS).fold(0, |code, bit| {
             code | ((q[0] >> bit) & 1) << (3 * bit + 2)
                 | ((q[1] >> bit) & 1) << (3 * bit + 1)
                 | ((q[2] >> bit) & 1) << (3 * bit)
-        });
-    }
-    items.sort_unstable_by_key(|it| (it.code, it.index));
+        })
+    };
+    let mut keyed: Vec<(u64, Item)> = items.drain(..).map(|it| (code(&it), it)).collect();
+    keyed.sort_unstable_by_key(|(code, it)| (*code, it.index));
+    let codes = keyed.iter().map(|(code, _)| *code).collect();
+    items.extend(keyed.into_iter().map(|(_, it)| it));
+    codes
 }
 
-/// The split of Morton-sorted items where their codes first differ (the highest bit on which
-/// the first and last disagree), in the middle when all codes are equal; the axis is that bit's.
-fn morton_split(items: &[Item]) -> (usize, usize) {
-    let (first, last) = (items[0].code, items[items.len() - 1].code);
+/// The split of Morton-sorted items, given by their `codes`, where the codes first differ (the
+/// highest bit on which the first and last disagree), in the middle when all codes are equal;
+/// the axis is that bit's.
+fn morton_split(codes: &[u64]) -> (usize, usize) {
+    let (first, last) = (codes[0], codes[codes.len() - 1]);
     if first == last {
-        return (0, items.len() / 2);
+        return (0, codes.len() / 2);
     }
     let bit = 63 - (first ^ last).leading_zeros();
-    let mid = items.partition_point(|it| it.code & (1 << bit) == 0);
+    let mid = codes.partition_point(|code| code & (1 << bit) == 0);
     (2 - (bit % 3) as usize, mid)
 }
 
@@ -609,7 +690,7 @@ mod tests {
             let mut items: Vec<Item> = bins
                 .iter()
                 .enumerate()
-                .map(|(i, &bin)| Item { bounds: Bounds3::EMPTY, index: i as u32, packed: false, code: 0, bin })
+                .map(|(i, &bin)| Item { bin, ..Item::new(i, Bounds3::EMPTY, false) })
                 .collect();
             let mid = partition(&mut items, |it| it.bin <= best);
             proptest::prop_assert_eq!(mid, bins.iter().filter(|&&b| b <= best).count());
@@ -640,8 +721,8 @@ mod tests {
             })
             .collect();
         for method in [BuildMethod::Sah, BuildMethod::Morton] {
-            let sequential = Bvh::build_split_from(&bounds, |i| i % 3 == 0, usize::MAX, method);
-            let parallel = Bvh::build_split_from(&bounds, |i| i % 3 == 0, 256, method);
+            let sequential = Bvh::build_split_from(bounds.len(), |i| bounds[i], |i| i % 3 == 0, usize::MAX, method);
+            let parallel = Bvh::build_split_from(bounds.len(), |i| bounds[i], |i| i % 3 == 0, 256, method);
             assert_eq!(sequential.order, parallel.order);
             assert_eq!(sequential.wide, parallel.wide);
             assert!(sequential.wide.len() > 300);

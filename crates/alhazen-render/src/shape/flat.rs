@@ -124,33 +124,35 @@ impl FlatLane {
         let [o, e1, e2] = flat_edges(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh");
         Flat::new(o, e1, e2, self.parallelogram).expect("a flat with area")
     }
+
+    /// The bounds of the flat this lane stands for in `mesh`.
+    pub fn bounds(self, mesh: &TriangleMesh) -> Bounds3 {
+        flat_span(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh").1
+    }
 }
 
 /// The triangles of `mesh` as flats (their lanes: [`FlatLane::flat`] gives each flat again
-/// where it is needed, so a million-triangle mesh does not hold a hundred megabytes of them
-/// while it packs them) and their bounds: consecutive pairs that form a parallelogram become
-/// one; triangles without area are dropped.
-pub fn flat_primitives(mesh: &TriangleMesh) -> (Vec<FlatLane>, Vec<Bounds3>) {
-    // At most one flat per triangle: reserved once, so the vectors are not copied as they grow
+/// where it is needed, and [`FlatLane::bounds`] its bounds, so a million-triangle mesh does not
+/// hold a hundred megabytes of them while it packs them): consecutive pairs that form a
+/// parallelogram become one; triangles without area are dropped.
+pub fn flat_primitives(mesh: &TriangleMesh) -> Vec<FlatLane> {
+    // At most one flat per triangle: reserved once, so the vector is not copied as it grows
     // (pages reserved and never written cost no memory).
     let mut lanes = Vec::with_capacity(mesh.triangle_count());
-    let mut bounds = Vec::with_capacity(mesh.triangle_count());
     let mut t = 0;
     while t < mesh.triangle_count() {
         let lane = FlatLane { triangle: t as u32, parallelogram: true };
-        if let Some((_, b)) = flat_span(mesh, t, true) {
+        if flat_span(mesh, t, true).is_some() {
             lanes.push(lane);
-            bounds.push(b);
             t += 2;
             continue;
         }
-        if let Some((_, b)) = flat_span(mesh, t, false) {
+        if flat_span(mesh, t, false).is_some() {
             lanes.push(FlatLane { parallelogram: false, ..lane });
-            bounds.push(b);
         }
         t += 1;
     }
-    (lanes, bounds)
+    lanes
 }
 
 #[cfg(test)]

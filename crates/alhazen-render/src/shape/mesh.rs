@@ -20,10 +20,8 @@ pub struct MeshAccel {
     /// Each leaf's flats, tested in packets.
     packets: PackedFlats<FlatLane>,
     vectors: VectorUnit,
-    /// Unit geometric normal per triangle (zero for triangles without area).
-    face_normals: Vec<Vec3>,
     /// Per triangle: its vertex normals all equal its face normal (smooth shading would only
-    /// interpolate it back).
+    /// interpolate it back); empty when the mesh has no vertex normals (every triangle flat).
     flat: Vec<bool>,
 }
 
@@ -41,9 +39,8 @@ impl MeshAccel {
 
     /// [`Self::with_unit`] with the hierarchy built by `method`.
     pub fn with_build(mesh: Arc<TriangleMesh>, vectors: VectorUnit, method: crate::bvh::BuildMethod) -> Self {
-        let (prims, bounds) = flat_primitives(&mesh);
-        let mut bvh = Bvh::build_packed_by(&bounds, |_| true, method);
-        drop(bounds);
+        let prims = flat_primitives(&mesh);
+        let mut bvh = Bvh::build_with(prims.len(), |k| prims[k].bounds(&mesh), |_| true, method);
         // Each leaf is relabelled with the packets it will have, then all are packed at once.
         let (mut leaves, mut packed) = (vec![], 0);
         bvh.relabel_leaf_ranges(|leaf| {
@@ -57,20 +54,24 @@ impl MeshAccel {
             (lane, lane.flat(&mesh))
         });
         drop((prims, leaves));
-        let (mut face_normals, mut flat) = (Vec::new(), Vec::new());
-        (0..mesh.triangle_count())
-            .into_par_iter()
-            .map(|i| {
-                let [a, b, c] = mesh.corners(i);
-                (b - a).cross(c - a).normalize_or_zero()
-            })
-            .collect_into_vec(&mut face_normals);
-        let shades_flat = |(t, n): (&[u32; 3], &Vec3)| {
-            mesh.normals.is_empty() || t.iter().all(|&i| (mesh.normals[i as usize] - *n).length() < 1e-12)
-        };
-        mesh.triangles.par_iter().zip(&face_normals).map(shades_flat).collect_into_vec(&mut flat);
-        Self { mesh, bvh, packets, vectors, face_normals, flat }
+        let mut flat = Vec::new();
+        if !mesh.normals.is_empty() {
+            let shades_flat = |(i, t): (usize, &[u32; 3])| {
+                let n = face_normal(mesh.corners(i));
+                t.iter().all(|&v| (mesh.normals[v as usize] - n).length() < 1e-12)
+            };
+            mesh.triangles.par_iter().enumerate().map(shades_flat).collect_into_vec(&mut flat);
+        }
+        Self { mesh, bvh, packets, vectors, flat }
     }
+}
+
+/// The unit geometric normal of the triangle with these corners (zero when it has no area):
+/// computed where it is needed from the corners the hit reads anyway, rather than stored (24
+/// bytes a triangle, a cache miss a hit).
+#[inline]
+fn face_normal([a, b, c]: [Vec3; 3]) -> Vec3 {
+    (b - a).cross(c - a).normalize_or_zero()
 }
 
 /// An instance of a mesh.
@@ -117,7 +118,7 @@ impl MeshShape {
     /// True when triangle `tri` is shaded with its face normal (no vertex normals to blend).
     #[inline]
     pub fn shades_flat(&self, tri: usize) -> bool {
-        !self.smooth || self.accel.flat[tri]
+        !self.smooth || self.accel.flat.get(tri).is_none_or(|&f| f)
     }
 
     /// Triangle `tri`'s geometric and shading normals and material slot at barycentric
@@ -125,7 +126,7 @@ impl MeshShape {
     #[inline]
     pub fn normals_and_slot(&self, tri: usize, b1: f64, b2: f64) -> (Vec3, Vec3, u32) {
         let m = &self.accel.mesh;
-        let n = self.accel.face_normals[tri];
+        let n = face_normal(m.corners(tri));
         let ns = if !self.shades_flat(tri) {
             let idx = m.triangles[tri].map(|i| i as usize);
             let b0 = 1.0 - b1 - b2;
