@@ -29,7 +29,9 @@ const PARALLEL_ITEMS: usize = 1 << 14;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
-    bounds: Bounds3,
+    /// Its box: a union of [`Item`]s' boxes, so `f32` holds it exactly (36-byte nodes).
+    min: [f32; 3],
+    max: [f32; 3],
     /// Leaf: first primitive index; interior: index of the second child.
     offset: u32,
     /// Number of primitives in a leaf, 0 for an interior node.
@@ -56,6 +58,13 @@ pub struct Bvh {
     relabeled: bool,
     /// Primitive indices in leaf order.
     order: Vec<u32>,
+}
+
+impl Node {
+    fn bounds(&self) -> Bounds3 {
+        let v = |c: [f32; 3]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+        Bounds3 { min: v(self.min), max: v(self.max) }
+    }
 }
 
 impl Default for Bvh {
@@ -212,7 +221,8 @@ impl Bvh {
         parallel_from: usize,
     ) -> usize {
         let me = self.nodes.len();
-        self.nodes.push(Node { bounds: node.bounds, offset: 0, count: 0, axis: 0 });
+        let (min, max) = (node.bounds.min.to_array(), node.bounds.max.to_array());
+        self.nodes.push(Node { min: min.map(|x| x as f32), max: max.map(|x| x as f32), offset: 0, count: 0, axis: 0 });
         let small = items.len() == 1 || node.tests.cost() <= MAX_LEAF as f64;
         let split = match how {
             _ if small || depth >= MAX_DEPTH => None,

@@ -97,7 +97,7 @@ fn wide_node(nodes: &[Node], at: usize, out: &mut Vec<Wide>) -> u32 {
     while len < WIDTH {
         let open = (0..len)
             .filter(|&k| nodes[kids[k]].count == 0)
-            .max_by(|&a, &b| nodes[kids[a]].bounds.surface_area().total_cmp(&nodes[kids[b]].bounds.surface_area()));
+            .max_by(|&a, &b| nodes[kids[a]].bounds().surface_area().total_cmp(&nodes[kids[b]].bounds().surface_area()));
         let Some(k) = open else { break };
         let n = kids[k];
         // Its two children take its place, the later ones moving up one slot.
@@ -118,8 +118,9 @@ fn wide_node(nodes: &[Node], at: usize, out: &mut Vec<Wide>) -> u32 {
         let (offset, count) = if n.count > 0 { (n.offset, n.count) } else { (wide_node(nodes, k, out), 0) };
         let w = &mut out[me];
         for axis in 0..3 {
-            w.min[axis][slot] = down(n.bounds.min[axis]);
-            w.max[axis][slot] = up(n.bounds.max[axis]);
+            // The node's box is already in `f32`.
+            w.min[axis][slot] = n.min[axis];
+            w.max[axis][slot] = n.max[axis];
         }
         (w.offset[slot], w.count[slot]) = (offset, count);
     }
