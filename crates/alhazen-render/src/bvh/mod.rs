@@ -7,6 +7,7 @@
 //! of walls, boxes and balls becomes one leaf of packets rather than a tree of overlapping boxes.
 
 use alhazen_math::{Bounds3, Ray, Vec3};
+use rayon::prelude::*;
 use wide::{Entry, Slab, WIDTH, Wide};
 
 mod wide;
@@ -32,19 +33,31 @@ struct Node {
     /// Its box: a union of [`Item`]s' boxes, so `f32` holds it exactly (36-byte nodes).
     min: [f32; 3],
     max: [f32; 3],
-    /// Leaf: first primitive index; interior: index of the second child.
+    /// Leaf: its first item's position in [`Bvh::leaf_order`]; interior: where its second
+    /// child is — an index into its [`Tree`]'s nodes, or, when `remote`, into its subtrees.
     offset: u32,
     /// Number of primitives in a leaf, 0 for an interior node.
     count: u32,
-    /// Split axis of an interior node (to visit the nearer child first).
-    axis: u8,
+    /// The second child was built on its own ([`Tree::subtrees`]).
+    remote: bool,
 }
+
+/// The binary tree while it is built: its nodes depth first, a node's first child after it.
+/// The second half of a node split on another thread stays in its own tree, one of
+/// `subtrees`: no node is copied (on a VM that backs fresh memory slowly, the copies were a
+/// sixth of a million-triangle build).
+#[derive(Default)]
+struct Tree {
+    nodes: Vec<Node>,
+    subtrees: Vec<Tree>,
+}
+
+/// A node: the tree that holds it and its index there.
+type NodeRef<'a> = (&'a Tree, usize);
 
 /// A BVH over primitives given by their bounds; it stores indices, not primitives.
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    /// The nodes while building (emptied when the tree is done).
-    nodes: Vec<Node>,
     /// The nodes for traversal, four-wide, depth first.
     wide: Vec<Wide>,
     /// Where traversal starts: the first wide node, or the one leaf; `None` when empty.
@@ -60,6 +73,80 @@ pub struct Bvh {
     order: Vec<u32>,
 }
 
+impl Tree {
+    /// An empty tree with room for one over `items` primitives (at most `2·items − 1` nodes;
+    /// pages reserved and never written cost no memory).
+    fn reserved(items: usize) -> Self {
+        Tree { nodes: Vec::with_capacity(2 * items), subtrees: vec![] }
+    }
+
+    /// How many nodes it holds, its subtrees' included.
+    fn len(&self) -> usize {
+        self.nodes.len() + self.subtrees.iter().map(Tree::len).sum::<usize>()
+    }
+
+    /// The node `at`.
+    fn node(&self, at: usize) -> &Node {
+        &self.nodes[at]
+    }
+
+    /// The children of interior node `at`.
+    fn children(&self, at: usize) -> [NodeRef<'_>; 2] {
+        let n = &self.nodes[at];
+        let second = if n.remote { (&self.subtrees[n.offset as usize], 0) } else { (self, n.offset as usize) };
+        [(self, at + 1), second]
+    }
+
+    /// Builds the subtree over `items`, whose [`Summary`] is `node` and whose first item is
+    /// the `first`th of all; returns its index.
+    fn build(
+        &mut self,
+        items: &mut [Item],
+        first: usize,
+        node: Summary,
+        depth: usize,
+        how: Split,
+        parallel_from: usize,
+    ) -> usize {
+        let me = self.nodes.len();
+        let (min, max) = (node.bounds.min.to_array(), node.bounds.max.to_array());
+        let (min, max) = (min.map(|x| x as f32), max.map(|x| x as f32));
+        self.nodes.push(Node { min, max, offset: first as u32, count: items.len() as u32, remote: false });
+        let small = items.len() == 1 || node.tests.cost() <= MAX_LEAF as f64;
+        let split = match how {
+            _ if small || depth >= MAX_DEPTH => None,
+            Split::Sah { traversal } => sah_split(items, &node, traversal),
+            Split::Morton { codes } => Some((morton_split(codes), None)),
+        };
+        // A leaf as pushed, unless split.
+        let Some((mid, halves)) = split else { return me };
+        let parallel = items.len() >= parallel_from;
+        let (left, right) = items.split_at_mut(mid);
+        // The halves' summaries come with the split when it is the bins' (the same unions of
+        // the same boxes, in another order: the same bits).
+        let [sl, sr] = halves.unwrap_or_else(|| [Summary::of(left), Summary::of(right)]);
+        let (hl, hr) = how.split_at(mid);
+        let (next, second_first) = (depth + 1, first + mid);
+        let second = if parallel {
+            // The first half goes on in this tree, where the sequential build puts it; the
+            // second is built apart (its nodes reserved whole: no copies as they grow) and
+            // kept as a subtree.
+            let mut b = Tree::reserved(right.len());
+            rayon::join(
+                || self.build(left, first, sl, next, hl, parallel_from),
+                || b.build(right, second_first, sr, next, hr, parallel_from),
+            );
+            self.subtrees.push(b);
+            self.subtrees.len() - 1
+        } else {
+            self.build(left, first, sl, next, hl, parallel_from);
+            self.build(right, second_first, sr, next, hr, parallel_from)
+        };
+        self.nodes[me] = Node { offset: second as u32, count: 0, remote: parallel, ..self.nodes[me] };
+        me
+    }
+}
+
 impl Node {
     fn bounds(&self) -> Bounds3 {
         let v = |c: [f32; 3]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
@@ -70,7 +157,6 @@ impl Node {
 impl Default for Bvh {
     fn default() -> Self {
         Bvh {
-            nodes: vec![],
             wide: vec![],
             start: None,
             root: Bounds3::EMPTY,
@@ -189,7 +275,7 @@ impl Bvh {
             BuildMethod::Morton => morton_order(&mut items),
             BuildMethod::Sah => vec![],
         };
-        let mut bvh = Bvh::reserved(count);
+        let mut tree = Tree::reserved(count);
         if !items.is_empty() {
             // A node's slab test costs about what a packet's test does, an eighth of a
             // triangle's (pbrt's ratio).
@@ -199,91 +285,18 @@ impl Bvh {
                 BuildMethod::Morton => Split::Morton { codes: &codes },
             };
             let all = Summary::of(&items);
-            bvh.build_node(&mut items, all, 0, split, parallel_from);
+            tree.build(&mut items, 0, all, 0, split, parallel_from);
         }
-        bvh.root = root;
-        (bvh.wide, bvh.start) = wide::collapse(&bvh.nodes);
+        let mut bvh = Bvh { root, ..Bvh::default() };
+        // Every item lies in one leaf, the leaves in item order: the items' indices are the
+        // leaf order.
+        items.par_iter().map(|it| it.index).collect_into_vec(&mut bvh.order);
+        (bvh.wide, bvh.start) = wide::collapse(&tree);
         bvh.reach = std::array::from_fn(|a| {
             let (lo, hi) = (wide::down(bvh.root.min[a]) as f64, wide::up(bvh.root.max[a]) as f64);
-            if bvh.nodes.is_empty() { 0.0 } else { lo.abs().max(hi.abs()) }
+            if items.is_empty() { 0.0 } else { lo.abs().max(hi.abs()) }
         });
-        bvh.nodes = vec![];
         bvh
-    }
-
-    /// Builds the subtree over `items`, whose [`Summary`] is `node`.
-    fn build_node(
-        &mut self,
-        items: &mut [Item],
-        node: Summary,
-        depth: usize,
-        how: Split,
-        parallel_from: usize,
-    ) -> usize {
-        let me = self.nodes.len();
-        let (min, max) = (node.bounds.min.to_array(), node.bounds.max.to_array());
-        self.nodes.push(Node { min: min.map(|x| x as f32), max: max.map(|x| x as f32), offset: 0, count: 0, axis: 0 });
-        let small = items.len() == 1 || node.tests.cost() <= MAX_LEAF as f64;
-        let split = match how {
-            _ if small || depth >= MAX_DEPTH => None,
-            Split::Sah { traversal } => sah_split(items, &node, traversal),
-            Split::Morton { codes } => {
-                let (axis, mid) = morton_split(codes);
-                Some((axis, mid, None))
-            }
-        };
-        match split {
-            None => {
-                self.nodes[me].offset = self.order.len() as u32;
-                self.nodes[me].count = items.len() as u32;
-                self.order.extend(items.iter().map(|it| it.index));
-            }
-            Some((axis, mid, halves)) => {
-                let parallel = items.len() >= parallel_from;
-                let (left, right) = items.split_at_mut(mid);
-                // The halves' summaries come with the split when it is the bins' (the same
-                // unions of the same boxes, in another order: the same bits).
-                let [sl, sr] = halves.unwrap_or_else(|| [Summary::of(left), Summary::of(right)]);
-                let (hl, hr) = how.split_at(mid);
-                let next = depth + 1;
-                let second = if parallel {
-                    // The first half goes on in this tree, where the sequential build puts it;
-                    // the second is built apart (its vectors reserved whole: no copies as
-                    // they grow) and appended, one copy of it.
-                    let mut b = Bvh::reserved(right.len());
-                    rayon::join(
-                        || self.build_node(left, sl, next, hl, parallel_from),
-                        || b.build_node(right, sr, next, hr, parallel_from),
-                    );
-                    let second = self.nodes.len();
-                    self.append(b);
-                    second
-                } else {
-                    self.build_node(left, sl, next, hl, parallel_from);
-                    self.build_node(right, sr, next, hr, parallel_from)
-                };
-                self.nodes[me].offset = second as u32;
-                self.nodes[me].axis = axis as u8;
-            }
-        }
-        me
-    }
-
-    /// An empty tree with room for one over `items` primitives (at most `2·items − 1` nodes;
-    /// pages reserved and never written cost no memory).
-    fn reserved(items: usize) -> Self {
-        Bvh { nodes: Vec::with_capacity(2 * items), order: Vec::with_capacity(items), ..Bvh::default() }
-    }
-
-    /// Appends a subtree built on its own (its indices counted from 0) after this one's nodes and
-    /// primitives, as the depth-first build would have laid it out.
-    fn append(&mut self, sub: Bvh) {
-        let (node_base, order_base) = (self.nodes.len() as u32, self.order.len() as u32);
-        self.nodes.extend(sub.nodes.into_iter().map(|mut n| {
-            n.offset += if n.count > 0 { order_base } else { node_base };
-            n
-        }));
-        self.order.extend(sub.order);
     }
 
     /// Visits candidate primitives front to back. `visit(index, t_max)` returns a closer hit
@@ -500,9 +513,9 @@ impl Summary {
     }
 }
 
-/// The binned SAH split of `items` (partitioned in place): its axis, the first item of the
-/// second half and, when the halves are the bins', their summaries.
-fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usize, usize, Option<[Summary; 2]>)> {
+/// The binned SAH split of `items` (partitioned in place): the first item of the second half
+/// and, when the halves are the bins', their summaries.
+fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usize, Option<[Summary; 2]>)> {
     let (cb, bounds) = (&node.centroids, &node.bounds);
     let extent = cb.extent();
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
@@ -515,7 +528,7 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
     if extent[axis] <= 0.0 || !extent[axis].is_finite() {
         // All centroids coincide: split in the middle to keep leaves small.
         if items.len() > 255 {
-            return Some((axis, items.len() / 2, None));
+            return Some((items.len() / 2, None));
         }
         return None;
     }
@@ -548,10 +561,10 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
     }
     let mid = partition(items, |it| usize::from(it.bin) <= best);
     if mid == 0 || mid == items.len() {
-        return Some((axis, items.len() / 2, None));
+        return Some((items.len() / 2, None));
     }
     let halves = [&bins[..=best], &bins[best + 1..]].map(|b| b.iter().fold(Summary::EMPTY, |s, b| s.merge(b)));
-    Some((axis, mid, Some(halves)))
+    Some((mid, Some(halves)))
 }
 
 /// The items' centroids put in [`BINS`] equal slices of the centroids' bounds `cb` along axis
@@ -606,7 +619,6 @@ fn items_of(
     bounds: impl Fn(usize) -> Bounds3 + Sync,
     packed: impl Fn(usize) -> bool + Sync,
 ) -> (Vec<Item>, Bounds3) {
-    use rayon::prelude::*;
     let mut items: Vec<Item> = Vec::with_capacity(count);
     let root = items.spare_capacity_mut()[..count]
         .par_chunks_mut(ITEM_CHUNK)
@@ -657,16 +669,14 @@ fn morton_order(items: &mut Vec<Item>) -> Vec<u64> {
 }
 
 /// The split of Morton-sorted items, given by their `codes`, where the codes first differ (the
-/// highest bit on which the first and last disagree), in the middle when all codes are equal;
-/// the axis is that bit's.
-fn morton_split(codes: &[u64]) -> (usize, usize) {
+/// highest bit on which the first and last disagree), in the middle when all codes are equal.
+fn morton_split(codes: &[u64]) -> usize {
     let (first, last) = (codes[0], codes[codes.len() - 1]);
     if first == last {
-        return (0, codes.len() / 2);
+        return codes.len() / 2;
     }
     let bit = 63 - (first ^ last).leading_zeros();
-    let mid = codes.partition_point(|code| code & (1 << bit) == 0);
-    (2 - (bit % 3) as usize, mid)
+    codes.partition_point(|code| code & (1 << bit) == 0)
 }
 
 /// Moves the items for which `pred` holds before the others (Hoare's two-ended scan: each

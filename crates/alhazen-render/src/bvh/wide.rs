@@ -13,7 +13,7 @@
 //! gives the same bits on every processor and the visiting order, which decides between equally
 //! near hits, is the same everywhere.
 
-use super::Node;
+use super::{Node, NodeRef, Tree};
 use alhazen_math::Ray;
 
 /// Children per node.
@@ -77,32 +77,39 @@ pub(super) fn up(x: f64) -> f32 {
     if (f as f64) < x { f.next_up() } else { f }
 }
 
-/// The nodes of a binary tree (laid out depth first, a node's first child after it) as four-wide
-/// nodes, and the entry of its root: a leaf when the whole tree is one.
-pub(super) fn collapse(nodes: &[Node]) -> (Vec<Wide>, Option<Entry>) {
-    let Some(root) = nodes.first() else { return (vec![], None) };
+/// The nodes of a binary tree as four-wide nodes, depth first, and the entry of its root: a
+/// leaf when the whole tree is one.
+pub(super) fn collapse(tree: &Tree) -> (Vec<Wide>, Option<Entry>) {
+    if tree.len() == 0 {
+        return (vec![], None);
+    }
+    let root = tree.node(0);
     if root.count > 0 {
         return (vec![], Some(Entry { offset: root.offset, count: root.count, near: 0.0 }));
     }
-    let mut wide = Vec::with_capacity(nodes.len() / 2);
-    let first = wide_node(nodes, 0, &mut wide);
+    let mut wide = Vec::with_capacity(tree.len() / 2);
+    let first = wide_node((tree, 0), &mut wide);
     (wide, Some(Entry { offset: first, count: 0, near: 0.0 }))
 }
 
 /// Adds the four-wide node of binary interior node `at` and those below it; returns its index.
 /// Its children are `at`'s two, the interior one of largest area replaced by its own two until
 /// there are four or only leaves.
-fn wide_node(nodes: &[Node], at: usize, out: &mut Vec<Wide>) -> u32 {
-    let (mut kids, mut len) = ([at + 1, nodes[at].offset as usize, 0, 0], 2);
+fn wide_node<'a>((tree, at): NodeRef<'a>, out: &mut Vec<Wide>) -> u32 {
+    fn node<'a>((t, i): NodeRef<'a>) -> &'a Node {
+        t.node(i)
+    }
+    let [first, second] = tree.children(at);
+    let (mut kids, mut len) = ([first, second, first, first], 2);
     while len < WIDTH {
         let open = (0..len)
-            .filter(|&k| nodes[kids[k]].count == 0)
-            .max_by(|&a, &b| nodes[kids[a]].bounds().surface_area().total_cmp(&nodes[kids[b]].bounds().surface_area()));
+            .filter(|&k| node(kids[k]).count == 0)
+            .max_by(|&a, &b| node(kids[a]).bounds().surface_area().total_cmp(&node(kids[b]).bounds().surface_area()));
         let Some(k) = open else { break };
-        let n = kids[k];
+        let (t, n) = kids[k];
         // Its two children take its place, the later ones moving up one slot.
         kids.copy_within(k + 1..len, k + 2);
-        (kids[k], kids[k + 1]) = (n + 1, nodes[n].offset as usize);
+        [kids[k], kids[k + 1]] = t.children(n);
         len += 1;
     }
     let kids = &kids[..len];
@@ -113,12 +120,12 @@ fn wide_node(nodes: &[Node], at: usize, out: &mut Vec<Wide>) -> u32 {
         offset: [0; WIDTH],
         count: [EMPTY; WIDTH],
     });
-    for (slot, &k) in kids.iter().enumerate() {
-        let n = &nodes[k];
-        let (offset, count) = if n.count > 0 { (n.offset, n.count) } else { (wide_node(nodes, k, out), 0) };
+    for (slot, &kid) in kids.iter().enumerate() {
+        let n = node(kid);
+        let (offset, count) = if n.count > 0 { (n.offset, n.count) } else { (wide_node(kid, out), 0) };
         let w = &mut out[me];
+        // The node's box is already in `f32`.
         for axis in 0..3 {
-            // The node's box is already in `f32`.
             w.min[axis][slot] = n.min[axis];
             w.max[axis][slot] = n.max[axis];
         }
