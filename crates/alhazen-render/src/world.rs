@@ -207,16 +207,26 @@ fn uses_uv(o: &scene::Object, s: &scene::Scene) -> bool {
 /// transform; larger ones are shared between instances.
 const BAKE_TRIANGLES: usize = 256;
 
-/// A small mesh with `tf` applied to its positions and normals.
+/// `mesh` with `tf` applied to its positions and normals (on all threads: the mesh may be
+/// large, see [`placed_once`]).
 fn baked(mesh: &TriangleMesh, tf: &alhazen_math::Transform) -> TriangleMesh {
-    let mut m = mesh.clone();
-    m.positions.iter_mut().for_each(|p| *p = tf.point(*p));
-    m.normals.iter_mut().for_each(|n| *n = tf.normal(*n).normalize_or_zero());
+    use rayon::prelude::*;
+    let (mut positions, mut normals) = (Vec::new(), Vec::new());
+    mesh.positions.par_iter().map(|p| tf.point(*p)).collect_into_vec(&mut positions);
+    mesh.normals.par_iter().map(|n| tf.normal(*n).normalize_or_zero()).collect_into_vec(&mut normals);
+    let mut triangles = mesh.triangles.clone();
     // A mirroring transform reverses the winding; keep the outside outside.
     if tf.is_mirroring() {
-        m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+        triangles.par_iter_mut().for_each(|t| t.swap(1, 2));
     }
-    m
+    TriangleMesh {
+        positions,
+        normals,
+        triangles,
+        uvs: mesh.uvs.clone(),
+        material_slots: mesh.material_slots.clone(),
+        material_names: mesh.material_names.clone(),
+    }
 }
 
 /// The world-space mesh of a small mesh object without a transform, whose triangles go
@@ -233,7 +243,60 @@ fn turned_sphere(shape: &scene::Shape, t: &alhazen_math::Transform) -> Option<Sp
     Sphere::placed(*center, *radius, t)
 }
 
-fn place(o: &scene::Object, meshes: &[Arc<MeshAccel>], scene: &scene::Scene, unit: VectorUnit) -> Placed {
+/// Per mesh of `scene`, the transform of the one object that places it, when no other object
+/// (nor a CSG operand) uses it, the transform is not the identity and the mesh is too large to
+/// be baked per object: such a mesh is built in world space, as Mitsuba and pbrt do with every
+/// mesh, so its rays and hits need no transform. Meshes placed several times stay shared
+/// (instancing), in their own space.
+fn placed_once(scene: &scene::Scene) -> Vec<Option<alhazen_math::Transform>> {
+    let mut uses = vec![0usize; scene.meshes.len()];
+    let mut placer = vec![None; scene.meshes.len()];
+    fn operands(s: &scene::Shape, uses: &mut [usize]) {
+        if let scene::Shape::Csg { a, b, .. } = s {
+            for o in [a, b] {
+                match &o.shape {
+                    // Never baked: counted as shared.
+                    scene::Shape::Mesh { mesh, .. } => uses[*mesh] += 2,
+                    other => operands(other, uses),
+                }
+            }
+        }
+    }
+    for o in &scene.objects {
+        match &o.shape {
+            scene::Shape::Mesh { mesh, .. } => {
+                uses[*mesh] += 1;
+                placer[*mesh] = Some(o.transform);
+            }
+            other => operands(other, &mut uses),
+        }
+    }
+    let large = |m: &TriangleMesh| m.triangle_count() > BAKE_TRIANGLES;
+    placer
+        .into_iter()
+        .zip(uses)
+        .zip(&scene.meshes)
+        // A mirror reverses the baked triangles' winding, and with it the barycentric
+        // parametrisation that stands in for missing texture coordinates.
+        .map(|((tf, n), m)| {
+            tf.filter(|tf| n == 1 && !tf.is_identity() && large(m) && (!tf.is_mirroring() || !m.uvs.is_empty()))
+        })
+        .collect()
+}
+
+fn place(
+    o: &scene::Object,
+    meshes: &[Arc<MeshAccel>],
+    world_space: &[Option<alhazen_math::Transform>],
+    scene: &scene::Scene,
+    unit: VectorUnit,
+) -> Placed {
+    if let scene::Shape::Mesh { mesh, .. } = &o.shape
+        && world_space[*mesh].is_some()
+    {
+        // Its mesh was built with this object's transform applied.
+        return Placed::new(build_shape(&o.shape, meshes), alhazen_math::Transform::IDENTITY);
+    }
     let small = match &o.shape {
         scene::Shape::Mesh { mesh, smooth } if !o.transform.is_identity() => {
             let m = &scene.meshes[*mesh];
@@ -273,15 +336,20 @@ impl World {
     pub fn build_by(scene: &scene::Scene, unit: VectorUnit, method: crate::bvh::BuildMethod) -> Self {
         // Each mesh's tree on whichever thread is free (a scene of many meshes, each too small
         // for its own build to split across threads, keeps every thread busy); the same trees.
+        let world_space = placed_once(scene);
         let meshes: Vec<Arc<MeshAccel>> = {
             use rayon::prelude::*;
-            scene.meshes.par_iter().map(|m| Arc::new(MeshAccel::with_build(m.clone(), unit, method))).collect()
+            let accel = |(m, tf): (&Arc<TriangleMesh>, &Option<alhazen_math::Transform>)| {
+                let m = tf.as_ref().map_or_else(|| m.clone(), |tf| Arc::new(baked(m, tf)));
+                Arc::new(MeshAccel::with_build(m, unit, method))
+            };
+            scene.meshes.par_iter().zip(&world_space).map(accel).collect()
         };
         let objects: Vec<WorldObject> = scene
             .objects
             .iter()
             .map(|o| WorldObject {
-                placed: Placed { uv: uses_uv(o, scene), ..place(o, &meshes, scene, unit) },
+                placed: Placed { uv: uses_uv(o, scene), ..place(o, &meshes, &world_space, scene, unit) },
                 material: o.material,
                 slot_materials: o.mesh_materials.clone(),
                 tangents: std::iter::once(&o.material).chain(&o.mesh_materials).any(|&m| {
@@ -678,6 +746,50 @@ pub fn shading_normal(hit: &SurfaceHit, m: &scene::Material, images: &[Arc<scene
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A large mesh placed by one object is built in world space (no transform left on the
+    /// object); placed by two, it is shared and each ray transformed. Either way the same
+    /// surfaces, to the flats' single precision (barycentrics to 10⁻⁴ of a small triangle). A mirror without texture coordinates is not
+    /// baked (the winding, and with it the barycentric parametrisation, would turn).
+    #[test]
+    fn a_mesh_placed_once_is_built_in_world_space() {
+        let scene_with = |scale: &str| {
+            let text = format!(
+                "[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 3\nsmooth = true\n\
+                 transform = [{{ scale = {scale} }}, {{ rotate_y = 30 }}, {{ translate = [0.4, -0.2, 1.0] }}]\n"
+            );
+            scene::parse_scene("once.toml".as_ref(), &text).unwrap()
+        };
+        assert!(World::build(&scene_with("[0.5, -0.8, 0.6]")).objects[0].placed.to_world.is_some(), "a mirror");
+        let once = scene_with("0.7");
+        let mut twice = once.clone();
+        let far = scene::Object {
+            transform: alhazen_math::Transform::translate(Vec3::new(100.0, 0.0, 0.0)) * once.objects[0].transform,
+            ..once.objects[0].clone()
+        };
+        twice.objects.push(far);
+        let (baked, shared) = (World::build(&once), World::build(&twice));
+        assert!(once.meshes[0].triangle_count() > BAKE_TRIANGLES);
+        assert!(baked.objects[0].placed.to_world.is_none(), "built in world space");
+        assert!(shared.objects[0].placed.to_world.is_some(), "shared, placed by its transform");
+        let mut hits = 0;
+        for k in 0..400 {
+            let a = k as f64 * 0.37;
+            let origin = Vec3::new(3.0 * a.cos(), 1.5 * (1.3 * a).sin(), 1.0 + 3.0 * a.sin());
+            let target = Vec3::new(0.4 + 0.5 * (2.1 * a).sin(), -0.2 + 0.6 * a.cos(), 1.0 + 0.4 * (0.7 * a).cos());
+            let ray = Ray::new(origin, (target - origin).normalize());
+            let (b, s) = (baked.intersect(&ray, f64::INFINITY), shared.intersect(&ray, f64::INFINITY));
+            assert_eq!(b.is_some(), s.is_some(), "ray {k}");
+            let (Some(b), Some(s)) = (b, s) else { continue };
+            hits += 1;
+            let close = |x: Vec3, y: Vec3, tol: f64| (x - y).length() < tol;
+            let (b, s) = (b.hit, s.hit);
+            assert!((b.t - s.t).abs() < 1e-5 && close(b.p, s.p, 1e-5), "ray {k}: {b:?} vs {s:?}");
+            assert!(close(b.n, s.n, 1e-9) && close(b.ns, s.ns, 1e-5), "ray {k}: normals {b:?} vs {s:?}");
+            assert!((b.uv - s.uv).length() < 1e-4, "ray {k}: uv {b:?} vs {s:?}");
+        }
+        assert!(hits > 200, "{hits} hits");
+    }
 
     /// Anisotropic microfacets turn with the surface's `∂p/∂u` (a sphere's is the azimuth about
     /// +y), not with an arbitrary frame; isotropic ones need no tangent.

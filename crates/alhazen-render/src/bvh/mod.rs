@@ -156,14 +156,7 @@ impl Node {
 
 impl Default for Bvh {
     fn default() -> Self {
-        Bvh {
-            wide: vec![],
-            start: None,
-            root: Bounds3::EMPTY,
-            reach: [0.0; 3],
-            relabeled: false,
-            order: vec![],
-        }
+        Bvh { wide: vec![], start: None, root: Bounds3::EMPTY, reach: [0.0; 3], relabeled: false, order: vec![] }
     }
 }
 
