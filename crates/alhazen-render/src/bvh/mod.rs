@@ -109,8 +109,7 @@ impl Tree {
         parallel_from: usize,
     ) -> usize {
         let me = self.nodes.len();
-        let (min, max) = (node.bounds.min.to_array(), node.bounds.max.to_array());
-        let (min, max) = (min.map(|x| x as f32), max.map(|x| x as f32));
+        let (min, max) = ([node.lo[0], node.lo[1], node.lo[2]], [node.hi[0], node.hi[1], node.hi[2]]);
         self.nodes.push(Node { min, max, offset: first as u32, count: items.len() as u32, remote: false });
         let small = items.len() == 1 || node.tests.cost() <= MAX_LEAF as f64;
         let split = match how {
@@ -190,6 +189,12 @@ impl Item {
     fn bounds(&self) -> Bounds3 {
         let v = |c: [f32; 3]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
         Bounds3 { min: v(self.min), max: v(self.max) }
+    }
+    /// Its box as [`Lanes4`].
+    #[inline(always)]
+    fn lanes(&self) -> (Lanes4, Lanes4) {
+        let (l, h) = (self.min, self.max);
+        ([l[0], l[1], l[2], l[2]], [h[0], h[1], h[2], h[2]])
     }
 }
 
@@ -469,51 +474,93 @@ impl Bvh {
 }
 
 /// The best binned SAH split `(axis, position in items)`, or `None` when a leaf is cheaper.
-/// What one pass over a node's items finds: their bounds, their centroids' bounds and the
-/// tests a leaf of them would cost.
+/// Four `f32` lanes: x, y, z and a copy of z, so that a box's corners and an item's centroid
+/// are one register each and the binning's minima, maxima and sums are one instruction.
+type Lanes4 = [f32; 4];
+
+#[inline(always)]
+fn min4(a: Lanes4, b: Lanes4) -> Lanes4 {
+    // `b < a ? b : a` keeps the accumulator `a` when `b` is NaN (MINPS's rule).
+    std::array::from_fn(|k| if b[k] < a[k] { b[k] } else { a[k] })
+}
+
+#[inline(always)]
+fn max4(a: Lanes4, b: Lanes4) -> Lanes4 {
+    std::array::from_fn(|k| if b[k] > a[k] { b[k] } else { a[k] })
+}
+
+/// What one pass over a node's items finds: their bounds, the bounds of their centroids
+/// (doubled: `min + max` in `f32`, the binning's coordinate) and the tests a leaf of them would
+/// cost. All in `f32`: the items' boxes are, so their unions are exact.
 #[derive(Clone, Copy)]
 struct Summary {
-    bounds: Bounds3,
-    centroids: Bounds3,
+    lo: Lanes4,
+    hi: Lanes4,
+    centroid_lo: Lanes4,
+    centroid_hi: Lanes4,
     tests: Tests,
 }
 
 impl Summary {
-    const EMPTY: Self =
-        Self { bounds: Bounds3::EMPTY, centroids: Bounds3::EMPTY, tests: Tests { packed: 0, single: 0 } };
+    const EMPTY: Self = Self {
+        lo: [f32::INFINITY; 4],
+        hi: [f32::NEG_INFINITY; 4],
+        centroid_lo: [f32::INFINITY; 4],
+        centroid_hi: [f32::NEG_INFINITY; 4],
+        tests: Tests { packed: 0, single: 0 },
+    };
 
     fn of(items: &[Item]) -> Self {
         items.iter().fold(Self::EMPTY, Self::add)
     }
 
     fn add(self, it: &Item) -> Self {
-        let b = it.bounds();
-        self.add_centred(it, b, b.centroid())
+        let (lo, hi) = it.lanes();
+        self.add_lanes(it, lo, hi, doubled_centroid(lo, hi))
     }
 
-    /// [`Self::add`] for an item whose bounds are `b` and centroid is `centroid`.
+    /// [`Self::add`] for an item whose box is `lo`, `hi` and doubled centroid `centroid`.
     #[inline(always)]
-    fn add_centred(self, it: &Item, b: Bounds3, centroid: Vec3) -> Self {
-        Self { bounds: self.bounds.union(b), centroids: self.centroids.grow(centroid), tests: self.tests.add(it) }
+    fn add_lanes(self, it: &Item, lo: Lanes4, hi: Lanes4, centroid: Lanes4) -> Self {
+        Self {
+            lo: min4(self.lo, lo),
+            hi: max4(self.hi, hi),
+            centroid_lo: min4(self.centroid_lo, centroid),
+            centroid_hi: max4(self.centroid_hi, centroid),
+            tests: self.tests.add(it),
+        }
     }
 
     fn merge(self, o: &Self) -> Self {
         Self {
-            bounds: self.bounds.union(o.bounds),
-            centroids: self.centroids.union(o.centroids),
+            lo: min4(self.lo, o.lo),
+            hi: max4(self.hi, o.hi),
+            centroid_lo: min4(self.centroid_lo, o.centroid_lo),
+            centroid_hi: max4(self.centroid_hi, o.centroid_hi),
             tests: self.tests.merge(o.tests),
         }
     }
+
+    /// The items' bounds.
+    fn bounds(&self) -> Bounds3 {
+        let v = |c: Lanes4| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+        Bounds3 { min: v(self.lo), max: v(self.hi) }
+    }
+}
+
+/// Twice an item's centroid, `lo + hi`, rounded to `f32`.
+#[inline(always)]
+fn doubled_centroid(lo: Lanes4, hi: Lanes4) -> Lanes4 {
+    std::array::from_fn(|k| lo[k] + hi[k])
 }
 
 /// The binned SAH split of `items` (partitioned in place): the first item of the second half
 /// and, when the halves are the bins', their summaries.
 fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usize, Option<[Summary; 2]>)> {
-    let (cb, bounds) = (&node.centroids, &node.bounds);
-    let extent = cb.extent();
-    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+    let extent: [f32; 3] = std::array::from_fn(|a| node.centroid_hi[a] - node.centroid_lo[a]);
+    let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
         0
-    } else if extent.y >= extent.z {
+    } else if extent[1] >= extent[2] {
         1
     } else {
         2
@@ -525,30 +572,32 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
         }
         return None;
     }
+    let (lo, per_unit) = (node.centroid_lo[axis], BINS as f32 / extent[axis]);
     let bins = match axis {
-        0 => bin_items::<0>(items, cb),
-        1 => bin_items::<1>(items, cb),
-        _ => bin_items::<2>(items, cb),
+        0 => bin_items::<0>(items, lo, per_unit),
+        1 => bin_items::<1>(items, lo, per_unit),
+        _ => bin_items::<2>(items, lo, per_unit),
     };
     // Sweep from the right to get suffix areas, then from the left.
     let mut right_area = [0.0; BINS];
     let mut acc = Summary::EMPTY;
     for i in (1..BINS).rev() {
         acc = acc.merge(&bins[i]);
-        right_area[i] = acc.bounds.surface_area() * acc.tests.cost();
+        right_area[i] = acc.bounds().surface_area() * acc.tests.cost();
     }
     let (mut best, mut best_cost) = (0, f64::INFINITY);
     let mut left = Summary::EMPTY;
     for i in 0..BINS - 1 {
         left = left.merge(&bins[i]);
-        let cost = left.bounds.surface_area() * left.tests.cost() + right_area[i + 1];
+        let cost = left.bounds().surface_area() * left.tests.cost() + right_area[i + 1];
         if cost < best_cost {
             best_cost = cost;
             best = i;
         }
     }
-    let leaf_cost = node.tests.cost() * bounds.surface_area();
-    let split_cost = traversal * bounds.surface_area() + best_cost;
+    let area = node.bounds().surface_area();
+    let leaf_cost = node.tests.cost() * area;
+    let split_cost = traversal * area + best_cost;
     if split_cost >= leaf_cost && items.len() <= 255 {
         return None;
     }
@@ -560,22 +609,20 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
     Some((mid, Some(halves)))
 }
 
-/// The items' centroids put in [`BINS`] equal slices of the centroids' bounds `cb` along axis
-/// `AXIS` (each item keeping its bin), and each bin's summary.
-fn bin_items<const AXIS: usize>(items: &mut [Item], cb: &Bounds3) -> [Summary; BINS] {
-    let (lo, per_unit) = (cb.min[AXIS], BINS as f64 / cb.extent()[AXIS]);
+/// The items' doubled centroids put in [`BINS`] equal slices, from `lo` at `per_unit` slices a
+/// unit along axis `AXIS` (each item keeping its bin), and each bin's summary.
+fn bin_items<const AXIS: usize>(items: &mut [Item], lo: f32, per_unit: f32) -> [Summary; BINS] {
     // Four sets of bins, item by item in turn, merged after: neighbouring items fall in the
     // same bin, and one set would make each update wait for the last one's store.
     let mut sets = [[Summary::EMPTY; BINS]; 4];
     for (k, it) in items.iter_mut().enumerate() {
-        let b = it.bounds();
-        let c = b.centroid();
-        // At or above 0 (c ≥ lo); `as i32` saturates, as the wider conversion to `usize` would,
-        // in fewer instructions.
+        let (l, h) = it.lanes();
+        let c = doubled_centroid(l, h);
+        // At or above 0 (c ≥ lo); `as i32` saturates (and takes NaN to 0).
         let bin = (((c[AXIS] - lo) * per_unit) as i32).clamp(0, BINS as i32 - 1) as usize;
         it.bin = bin as u8;
         let set = &mut sets[k % 4][bin];
-        *set = set.add_centred(it, b, c);
+        *set = set.add_lanes(it, l, h, c);
     }
     std::array::from_fn(|i| sets.iter().fold(Summary::EMPTY, |s, set| s.merge(&set[i])))
 }
