@@ -102,18 +102,22 @@ fn flat_edges(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<[Vec3; 3]> {
     parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])
 }
 
-/// [`flat_edges`] and the flat's bounds, when the edges span an area (the test of
-/// [`Flat::new`], without computing the flat).
-fn flat_span(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<([Vec3; 3], Bounds3)> {
-    let span @ [o, e1, e2] = flat_edges(mesh, t, pair)?;
+/// [`flat_edges`], when the edges span an area (the test of [`Flat::new`], without computing
+/// the flat).
+fn flat_spanned(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<[Vec3; 3]> {
+    let span @ [_, e1, e2] = flat_edges(mesh, t, pair)?;
     let n2 = e1.cross(e2).length_squared();
-    (n2 > 0.0 && n2.is_finite()).then(|| {
-        let bounds = if pair {
+    (n2 > 0.0 && n2.is_finite()).then_some(span)
+}
+
+/// The bounds of the flat [`flat_spanned`] finds.
+fn flat_bounds(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<Bounds3> {
+    flat_spanned(mesh, t, pair).map(|[o, e1, e2]| {
+        if pair {
             Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])
         } else {
             Bounds3::from_points(mesh.corners(t))
-        };
-        (span, bounds)
+        }
     })
 }
 
@@ -127,7 +131,7 @@ impl FlatLane {
 
     /// The bounds of the flat this lane stands for in `mesh`.
     pub fn bounds(self, mesh: &TriangleMesh) -> Bounds3 {
-        flat_span(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh").1
+        flat_bounds(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh")
     }
 }
 
@@ -142,12 +146,12 @@ pub fn flat_primitives(mesh: &TriangleMesh) -> Vec<FlatLane> {
     let mut t = 0;
     while t < mesh.triangle_count() {
         let lane = FlatLane { triangle: t as u32, parallelogram: true };
-        if flat_span(mesh, t, true).is_some() {
+        if flat_spanned(mesh, t, true).is_some() {
             lanes.push(lane);
             t += 2;
             continue;
         }
-        if flat_span(mesh, t, false).is_some() {
+        if flat_spanned(mesh, t, false).is_some() {
             lanes.push(FlatLane { parallelogram: false, ..lane });
         }
         t += 1;
