@@ -190,6 +190,7 @@ impl Item {
         let v = |c: [f32; 3]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
         Bounds3 { min: v(self.min), max: v(self.max) }
     }
+
     /// Its box as [`Lanes4`].
     #[inline(always)]
     fn lanes(&self) -> (Lanes4, Lanes4) {
@@ -236,8 +237,9 @@ impl Bvh {
         Self::build_packed(bounds, |_| false)
     }
 
-    /// [`Self::build_packed_by`] over `count` primitives whose bounds `bounds(i)` gives: no
-    /// vector of them is made (a million-triangle mesh's would be 48 MB of fresh memory).
+    /// [`Self::build_packed`] by `method`, over `count` primitives whose bounds `bounds(i)`
+    /// gives: no vector of them is made (a million-triangle mesh's would be 48 MB of fresh
+    /// memory).
     pub fn build_with(
         count: usize,
         bounds: impl Fn(usize) -> Bounds3 + Sync,
@@ -252,11 +254,6 @@ impl Bvh {
     /// them plus one per other primitive, so leaves of such primitives grow large.
     pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync) -> Self {
         Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, BuildMethod::Sah)
-    }
-
-    /// [`Self::build_packed`] by `method`.
-    pub fn build_packed_by(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync, method: BuildMethod) -> Self {
-        Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, method)
     }
 
     /// [`Self::build_packed`] building subtrees of at least `parallel_from` primitives in
@@ -473,7 +470,6 @@ impl Bvh {
     }
 }
 
-/// The best binned SAH split `(axis, position in items)`, or `None` when a leaf is cheaper.
 /// Four `f32` lanes: x, y, z and a copy of z, so that a box's corners and an item's centroid
 /// are one register each and the binning's minima, maxima and sums are one instruction.
 type Lanes4 = [f32; 4];
