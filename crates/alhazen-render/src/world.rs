@@ -749,8 +749,9 @@ mod tests {
 
     /// A large mesh placed by one object is built in world space (no transform left on the
     /// object); placed by two, it is shared and each ray transformed. Either way the same
-    /// surfaces, to the flats' single precision (barycentrics to 10⁻⁴ of a small triangle). A mirror without texture coordinates is not
-    /// baked (the winding, and with it the barycentric parametrisation, would turn).
+    /// surfaces, to the flats' single precision (barycentrics to 10⁻⁴ of a small triangle),
+    /// mirrored or not. A mirror is baked only when the mesh has texture coordinates (the
+    /// winding turns, and with it the barycentric parametrisation that stands in for them).
     #[test]
     fn a_mesh_placed_once_is_built_in_world_space() {
         let scene_with = |scale: &str| {
@@ -761,34 +762,42 @@ mod tests {
             scene::parse_scene("once.toml".as_ref(), &text).unwrap()
         };
         assert!(World::build(&scene_with("[0.5, -0.8, 0.6]")).objects[0].placed.to_world.is_some(), "a mirror");
-        let once = scene_with("0.7");
-        let mut twice = once.clone();
-        let far = scene::Object {
-            transform: alhazen_math::Transform::translate(Vec3::new(100.0, 0.0, 0.0)) * once.objects[0].transform,
-            ..once.objects[0].clone()
-        };
-        twice.objects.push(far);
-        let (baked, shared) = (World::build(&once), World::build(&twice));
-        assert!(once.meshes[0].triangle_count() > BAKE_TRIANGLES);
-        assert!(baked.objects[0].placed.to_world.is_none(), "built in world space");
-        assert!(shared.objects[0].placed.to_world.is_some(), "shared, placed by its transform");
-        let mut hits = 0;
-        for k in 0..400 {
-            let a = k as f64 * 0.37;
-            let origin = Vec3::new(3.0 * a.cos(), 1.5 * (1.3 * a).sin(), 1.0 + 3.0 * a.sin());
-            let target = Vec3::new(0.4 + 0.5 * (2.1 * a).sin(), -0.2 + 0.6 * a.cos(), 1.0 + 0.4 * (0.7 * a).cos());
-            let ray = Ray::new(origin, (target - origin).normalize());
-            let (b, s) = (baked.intersect(&ray, f64::INFINITY), shared.intersect(&ray, f64::INFINITY));
-            assert_eq!(b.is_some(), s.is_some(), "ray {k}");
-            let (Some(b), Some(s)) = (b, s) else { continue };
-            hits += 1;
-            let close = |x: Vec3, y: Vec3, tol: f64| (x - y).length() < tol;
-            let (b, s) = (b.hit, s.hit);
-            assert!((b.t - s.t).abs() < 1e-5 && close(b.p, s.p, 1e-5), "ray {k}: {b:?} vs {s:?}");
-            assert!(close(b.n, s.n, 1e-9) && close(b.ns, s.ns, 1e-5), "ray {k}: normals {b:?} vs {s:?}");
-            assert!((b.uv - s.uv).length() < 1e-4, "ray {k}: uv {b:?} vs {s:?}");
+        // A turn and uniform scale; a mirror, baked once the mesh has texture coordinates.
+        for (scale, uvs) in [("0.7", false), ("[0.7, -0.7, 0.7]", true)] {
+            let mut once = scene_with(scale);
+            if uvs {
+                let mut m = (*once.meshes[0]).clone();
+                m.uvs = m.positions.iter().map(|p| alhazen_math::Vec2::new(p.x + 0.3 * p.z, p.y - 0.2 * p.z)).collect();
+                once.meshes[0] = std::sync::Arc::new(m);
+            }
+            let mut twice = once.clone();
+            let far = scene::Object {
+                transform: alhazen_math::Transform::translate(Vec3::new(100.0, 0.0, 0.0)) * once.objects[0].transform,
+                ..once.objects[0].clone()
+            };
+            twice.objects.push(far);
+            let (baked, shared) = (World::build(&once), World::build(&twice));
+            assert!(once.meshes[0].triangle_count() > BAKE_TRIANGLES);
+            assert!(baked.objects[0].placed.to_world.is_none(), "{scale}: built in world space");
+            assert!(shared.objects[0].placed.to_world.is_some(), "{scale}: shared, placed by its transform");
+            let mut hits = 0;
+            for k in 0..400 {
+                let a = k as f64 * 0.37;
+                let origin = Vec3::new(3.0 * a.cos(), 1.5 * (1.3 * a).sin(), 1.0 + 3.0 * a.sin());
+                let target = Vec3::new(0.4 + 0.5 * (2.1 * a).sin(), -0.2 + 0.6 * a.cos(), 1.0 + 0.4 * (0.7 * a).cos());
+                let ray = Ray::new(origin, (target - origin).normalize());
+                let (b, s) = (baked.intersect(&ray, f64::INFINITY), shared.intersect(&ray, f64::INFINITY));
+                assert_eq!(b.is_some(), s.is_some(), "{scale}, ray {k}");
+                let (Some(b), Some(s)) = (b, s) else { continue };
+                hits += 1;
+                let close = |x: Vec3, y: Vec3, tol: f64| (x - y).length() < tol;
+                let (b, s) = (b.hit, s.hit);
+                assert!((b.t - s.t).abs() < 1e-5 && close(b.p, s.p, 1e-5), "{scale}, ray {k}: {b:?} vs {s:?}");
+                assert!(close(b.n, s.n, 1e-9) && close(b.ns, s.ns, 1e-5), "{scale}, ray {k}: normals {b:?} vs {s:?}");
+                assert!((b.uv - s.uv).length() < 1e-4, "{scale}, ray {k}: uv {b:?} vs {s:?}");
+            }
+            assert!(hits > 200, "{scale}: {hits} hits");
         }
-        assert!(hits > 200, "{hits} hits");
     }
 
     /// Anisotropic microfacets turn with the surface's `∂p/∂u` (a sphere's is the azimuth about
