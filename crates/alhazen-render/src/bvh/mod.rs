@@ -148,8 +148,7 @@ impl Tree {
 
 impl Node {
     fn bounds(&self) -> Bounds3 {
-        let v = |c: [f32; 3]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-        Bounds3 { min: v(self.min), max: v(self.max) }
+        f32_box(&self.min, &self.max)
     }
 }
 
@@ -187,8 +186,7 @@ impl Item {
 
     #[inline(always)]
     fn bounds(&self) -> Bounds3 {
-        let v = |c: [f32; 3]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-        Bounds3 { min: v(self.min), max: v(self.max) }
+        f32_box(&self.min, &self.max)
     }
 
     /// Its box as [`Lanes4`].
@@ -197,6 +195,13 @@ impl Item {
         let (l, h) = (self.min, self.max);
         ([l[0], l[1], l[2], l[2]], [h[0], h[1], h[2], h[2]])
     }
+}
+
+/// The box with corners `min`, `max` (their first three coordinates), in `f64`.
+#[inline(always)]
+fn f32_box(min: &[f32], max: &[f32]) -> Bounds3 {
+    let v = |c: &[f32]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+    Bounds3 { min: v(min), max: v(max) }
 }
 
 /// How a [`Bvh`] chooses its splits.
@@ -539,8 +544,7 @@ impl Summary {
 
     /// The items' bounds.
     fn bounds(&self) -> Bounds3 {
-        let v = |c: Lanes4| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-        Bounds3 { min: v(self.lo), max: v(self.hi) }
+        f32_box(&self.lo, &self.hi)
     }
 }
 

@@ -110,17 +110,6 @@ fn flat_spanned(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<[Vec3; 3]> 
     (n2 > 0.0 && n2.is_finite()).then_some(span)
 }
 
-/// The bounds of the flat [`flat_spanned`] finds.
-fn flat_bounds(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<Bounds3> {
-    flat_spanned(mesh, t, pair).map(|[o, e1, e2]| {
-        if pair {
-            Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])
-        } else {
-            Bounds3::from_points(mesh.corners(t))
-        }
-    })
-}
-
 impl FlatLane {
     /// The flat this lane stands for in `mesh` (computed again: the same numbers as when the
     /// lane was made by [`flat_primitives`]).
@@ -131,7 +120,13 @@ impl FlatLane {
 
     /// The bounds of the flat this lane stands for in `mesh`.
     pub fn bounds(self, mesh: &TriangleMesh) -> Bounds3 {
-        flat_bounds(mesh, self.triangle as usize, self.parallelogram).expect("a lane of this mesh")
+        let t = self.triangle as usize;
+        let [o, e1, e2] = flat_edges(mesh, t, self.parallelogram).expect("a lane of this mesh");
+        if self.parallelogram {
+            Bounds3::from_points([o, o + e1, o + e2, o + e1 + e2])
+        } else {
+            Bounds3::from_points(mesh.corners(t))
+        }
     }
 }
 
