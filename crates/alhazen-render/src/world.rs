@@ -31,12 +31,16 @@ fn inverse_dirs(rays: &RayPacket) -> [[f64; LANES]; 3] {
     rays.dir.map(|d| d.map(|x| 1.0 / x))
 }
 
-/// Whether the segment `(0, t_max)` of `ray` (reciprocal direction `inv_dir`) may meet box
+/// Whether the segment `(0, t_max)` of `ray` (reciprocal direction lane `r` of `inv`) may meet box
 /// `b`: [`Bounds3::hit_interval`]'s slab test, the world's cull before an object's own.
 #[inline(always)]
-fn may_meet_box(b: &Bounds3, ray: &Ray, inv_dir: [f64; 3], t_max: f64) -> bool {
-    b.hit_interval(ray, Vec3::from_array(inv_dir), t_max).is_some()
+fn may_meet_box(b: &Bounds3, ray: &Ray, (inv, r): LaneInverse, t_max: f64) -> bool {
+    b.hit_interval(ray, Vec3::new(inv[0][r], inv[1][r], inv[2][r]), t_max).is_some()
 }
+
+/// Lane `r` of rays' reciprocal directions ([`inverse_dirs`]), read where it is used: copied
+/// out into an array of its own, its three stores stalled the wider load that read them back.
+type LaneInverse<'a> = (&'a [[f64; LANES]; 3], usize);
 
 /// An object ready to be intersected.
 #[derive(Clone, Debug)]
@@ -538,7 +542,7 @@ impl World {
         ray: &Ray,
         mut t_max: f64,
         sphere: Option<(usize, usize, f64)>,
-        inv_dir: Option<[f64; 3]>,
+        inv_dir: Option<LaneInverse>,
     ) -> Option<(Candidate, u32)> {
         let mut best = None;
         if let Some((k, lane, t)) = sphere {
@@ -570,7 +574,7 @@ impl World {
     /// True when one of `leaf`'s other objects (not flats, not packed spheres) lies on `ray`
     /// before `t_max`.
     #[inline]
-    fn objects_block(&self, leaf: &Leaf, ray: &Ray, t_max: f64, inv_dir: Option<[f64; 3]>) -> bool {
+    fn objects_block(&self, leaf: &Leaf, ray: &Ray, t_max: f64, inv_dir: Option<LaneInverse>) -> bool {
         let boxes = &self.leaf_boxes[leaf.objects.clone()];
         self.leaf_objects[leaf.objects.clone()].iter().zip(boxes).any(|(&i, b)| {
             inv_dir.is_none_or(|inv| may_meet_box(b, ray, inv, t_max))
@@ -614,6 +618,9 @@ impl World {
     /// then each ray's spheres and other objects, as [`Self::nearest`] tests them.
     #[inline(never)]
     fn intersect_rays_in_leaf(&self, rays: &RayPacket, live: [bool; LANES], out: &mut [Option<WorldHit>; LANES]) {
+        // Each ray is copied out of the packet first: the loads that read such a copy stall
+        // when its stores have not yet been written to the cache.
+        let each: [Ray; LANES] = std::array::from_fn(|r| rays.ray(r));
         let mut flat = [None; LANES];
         FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
             flat[r] = Some((k, h));
@@ -623,12 +630,12 @@ impl World {
         let spheres = self.spheres_of_rays(leaf, rays, &t_max, live);
         let inv = (!leaf.objects.is_empty()).then(|| inverse_dirs(rays));
         for (r, slot) in out.iter_mut().enumerate() {
-            let ray = rays.ray(r);
-            let inv = inv.map(|inv| inv.map(|a| a[r]));
-            let solid = if live[r] { self.nearest_solid_after(leaf, &ray, t_max[r], spheres[r], inv) } else { None };
+            let ray = &each[r];
+            let inv = inv.as_ref().map(|inv| (inv, r));
+            let solid = if live[r] { self.nearest_solid_after(leaf, ray, t_max[r], spheres[r], inv) } else { None };
             *slot = match (solid, flat[r]) {
-                (Some((c, i)), _) => Some(self.surface_of(&ray, c, i)),
-                (None, Some((k, h))) => Some(self.flat_hit(&ray, k, h)),
+                (Some((c, i)), _) => Some(self.surface_of(ray, c, i)),
+                (None, Some((k, h))) => Some(self.flat_hit(ray, k, h)),
                 (None, None) => None,
             };
         }
@@ -662,7 +669,7 @@ impl World {
             let spheres = if self.flats_only { [None; LANES] } else { self.spheres_of_rays(leaf, rays, dist, open) };
             let inv = (!leaf.objects.is_empty()).then(|| inverse_dirs(rays));
             return std::array::from_fn(|r| {
-                let inv = inv.map(|inv| inv.map(|a| a[r]));
+                let inv = inv.as_ref().map(|inv| (inv, r));
                 open[r]
                     && (self.flats_only
                         || spheres[r].is_none() && !self.objects_block(leaf, &rays.ray(r), dist[r], inv))
@@ -893,7 +900,10 @@ mod tests {
             let ray = Ray::new(origin, dir);
             // The parameter of the point nearest `target` on the line, and a bit beyond.
             let t = ((target - origin).dot(dir) / dir.length_squared()).max(0.0);
-            let inv = (1.0 / dir).to_array();
+            // The reciprocal in lane 3 of a packet's.
+            let mut lanes = [[f64::NAN; LANES]; 3];
+            (0..3).for_each(|a| lanes[a][3] = 1.0 / dir[a]);
+            let inv = (&lanes, 3);
             let on_ray = (ray.at(t) - target).length() <= 1e-9 * (lo.length() + size.iter().sum::<f64>() * s + 1.0);
             if on_ray {
                 proptest::prop_assert!(may_meet_box(&b, &ray, inv, t * (1.0 + 1e-12) + f64::MIN_POSITIVE), "{b:?} {ray:?} {t}");
@@ -901,7 +911,7 @@ mod tests {
             }
             // A ray pointing away from a box it starts outside never meets it.
             let away = Ray::new(b.max + Vec3::ONE, Vec3::ONE);
-            proptest::prop_assert!(!may_meet_box(&b, &away, [1.0; 3], f64::INFINITY));
+            proptest::prop_assert!(!may_meet_box(&b, &away, (&[[1.0; LANES]; 3], 0), f64::INFINITY));
         }
     }
 
