@@ -119,18 +119,27 @@ impl PixelSeeds {
     /// The stream of sample `index` of this pixel.
     #[inline]
     pub fn stream(&self, index: u32) -> SampleStream {
-        let rng = Rng(mix(self.rng ^ index as u64));
-        let sobol = match self.sequence {
-            Sequence::Sobol => sobol_points(&self.scrambles, index.reverse_bits(), self.unit),
-            Sequence::Independent => [[0; SOBOL_LANES]; 2],
-        };
-        let mut s = SampleStream { sequence: self.sequence, sobol, dimension: 0, rng, ahead: Vec2::ZERO };
-        s.ahead = s.pair();
+        let mut s = SampleStream::default();
+        self.restart(&mut s, index);
         s
+    }
+
+    /// Makes `s` the stream of sample `index` of this pixel, written in place (a stream is
+    /// ~100 bytes: the lanes restart theirs where they keep them rather than copy new ones in).
+    #[inline]
+    pub fn restart(&self, s: &mut SampleStream, index: u32) {
+        s.sequence = self.sequence;
+        s.rng = Rng(mix(self.rng ^ index as u64));
+        if self.sequence == Sequence::Sobol {
+            s.sobol = sobol_points(&self.scrambles, index.reverse_bits(), self.unit);
+        }
+        s.dimension = 0;
+        s.ahead = s.pair();
     }
 }
 
-/// The numbers of one sample of one pixel, dimension after dimension.
+/// The numbers of one sample of one pixel, dimension after dimension (by default, independent
+/// numbers of a zero seed: a stream to [`PixelSeeds::restart`]).
 #[derive(Clone, Debug)]
 pub struct SampleStream {
     sequence: Sequence,
@@ -192,6 +201,18 @@ fn sobol1_reversed(mut i: u32) -> u32 {
 #[inline]
 fn to_unit(x: u32) -> f64 {
     x as f64 * (1.0 / 4_294_967_296.0)
+}
+
+impl Default for SampleStream {
+    fn default() -> Self {
+        Self {
+            sequence: Sequence::Independent,
+            sobol: [[0; SOBOL_LANES]; 2],
+            dimension: 0,
+            rng: Rng(0),
+            ahead: Vec2::ZERO,
+        }
+    }
 }
 
 impl SampleStream {

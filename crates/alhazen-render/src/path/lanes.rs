@@ -250,8 +250,11 @@ impl Batches {
     }
 }
 
-/// One sample's path in a lane.
+/// One sample's path in a lane, or none: a lane's record stays in its place and is restarted
+/// there (moved in whole, its ~350 bytes cost more than the start itself).
 struct LanePath {
+    /// A path is in the lane.
+    live: bool,
     /// Where its result goes.
     job: usize,
     path: PathState,
@@ -261,6 +264,13 @@ struct LanePath {
 }
 
 impl LanePath {
+    /// An idle lane (depth 0 until its path starts).
+    fn idle() -> Self {
+        let mut path = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
+        path.depth = 0;
+        Self { live: false, job: 0, path, stream: SampleStream::default(), mode: ColorMode::Rgb }
+    }
+
     /// The sample's value: its radiance, in RGB.
     fn value(&self) -> Vec3 {
         match self.mode {
@@ -431,7 +441,7 @@ impl PathTracer<'_> {
     /// Samples `first..` of `pixels`, traced in lanes: `out` holds each pixel's samples in
     /// turn, sample `first + i` of pixel `p` at `out[p × n + i]` (`n` samples per pixel).
     pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
-        let mut lanes: [Option<LanePath>; POOL] = std::array::from_fn(|_| None);
+        let mut lanes: [LanePath; POOL] = std::array::from_fn(|_| LanePath::idle());
         let spp = out.len() / pixels.len().max(1);
         let mut next = 0..out.len();
         let unit = self.world.vector_unit();
@@ -446,17 +456,25 @@ impl PathTracer<'_> {
         let (mut shadows, mut dist) = ([RayPacket::default(); GROUPS], [[0.0; LANES]; GROUPS]);
         let together = self.world.traces_rays_together();
         loop {
-            // Idle lanes start the pixels' next samples; each group's rays are traced together.
-            for (p, slot) in lanes.iter_mut().enumerate().filter(|(_, p)| p.is_none()) {
-                *slot = next.next().map(|job| {
-                    let ((x, y), index) = (pixels[job / spp], first + (job % spp) as u32);
-                    if job % spp == 0 {
-                        seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y, unit);
-                    }
-                    let lane = self.start(job, seeds.stream(index), (x, y));
-                    rays[p / LANES].set(p % LANES, &lane.path.ray);
-                    lane
-                });
+            // Idle lanes start the pixels' next samples: their streams, then their camera rays
+            // (two short loops whose iterations the processor overlaps, where one long one would
+            // wait on each lane's hashing and square root in turn). Each group's rays are traced
+            // together.
+            let mut starting = [(0.0, 0.0); POOL];
+            for (p, lane) in lanes.iter_mut().enumerate().filter(|(_, l)| !l.live) {
+                let Some(job) = next.next() else { break };
+                let ((x, y), index) = (pixels[job / spp], first + (job % spp) as u32);
+                if job % spp == 0 {
+                    seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y, unit);
+                }
+                seeds.restart(&mut lane.stream, index);
+                (lane.live, lane.job) = (true, job);
+                let film = lane.stream.next_2d();
+                starting[p] = (x as f64 + film.x, y as f64 + film.y);
+            }
+            for (p, lane) in lanes.iter_mut().enumerate().filter(|(_, l)| l.live && l.path.depth == 0) {
+                self.start(lane, starting[p]);
+                rays[p / LANES].set(p % LANES, &lane.path.ray);
             }
             if next.is_empty() {
                 // No samples left to start: the paths still going move to the first groups, so
@@ -466,7 +484,7 @@ impl PathTracer<'_> {
                 }
             }
             let live: [[bool; LANES]; GROUPS] =
-                std::array::from_fn(|g| std::array::from_fn(|i| lanes[g * LANES + i].is_some()));
+                std::array::from_fn(|g| std::array::from_fn(|i| lanes[g * LANES + i].live));
             // Under an environment map every lane's hit is needed before the vertices (for the
             // sky lookups below); otherwise rays not traced together are traced in the
             // per-path stage, where a local hit costs no copy into `hits`.
@@ -476,20 +494,17 @@ impl PathTracer<'_> {
                     self.world.intersect_rays(&rays[g], live[g], &mut hits[g]);
                 }
             } else if sky_map {
-                for (p, lane) in lanes.iter().enumerate().filter_map(|(p, l)| Some((p, l.as_ref()?))) {
+                for (p, lane) in lanes.iter().enumerate().filter(|(_, l)| l.live) {
                     hits[p / LANES][p % LANES] = self.world.intersect(&lane.path.ray, f64::INFINITY);
                 }
             }
             // Rays that leave the scene see an environment map, looked up for all lanes together
             // (other skies in `vertex`).
             let escaping: [Option<Vec3>; POOL] = if sky_map {
-                std::array::from_fn(|p| match &lanes[p] {
-                    Some(lane)
-                        if hits[p / LANES][p % LANES].is_none() && lane.path.depth <= self.scene.render.max_depth =>
-                    {
-                        Some(lane.path.ray.dir)
-                    }
-                    _ => None,
+                std::array::from_fn(|p| {
+                    let lane = &lanes[p];
+                    let escapes = hits[p / LANES][p % LANES].is_none() && lane.path.depth <= self.scene.render.max_depth;
+                    (lane.live && escapes).then_some(lane.path.ray.dir)
                 })
             } else {
                 [None; POOL]
@@ -498,10 +513,12 @@ impl PathTracer<'_> {
             let sky_texels = escaping.iter().any(Option::is_some).then(|| self.lights.sky_ahead(&escaping, unit));
             batches.clear();
             let mut tested = [[false; LANES]; GROUPS];
-            for (p, slot) in lanes.iter_mut().enumerate() {
+            for (p, lane) in lanes.iter_mut().enumerate() {
                 let (g, i) = (p / LANES, p % LANES);
                 kernels[p] = Kernel::Idle;
-                let Some(lane) = slot else { continue };
+                if !lane.live {
+                    continue;
+                }
                 if escaping[p].is_some() {
                     // As `vertex` ends a path whose ray leaves the scene (its sky added below).
                     kernels[p] = Kernel::General;
@@ -548,8 +565,7 @@ impl PathTracer<'_> {
                     [false; LANES]
                 }
             });
-            for (p, slot) in lanes.iter_mut().enumerate() {
-                let Some(lane) = slot.as_mut() else { continue };
+            for (p, lane) in lanes.iter_mut().enumerate().filter(|(_, l)| l.live) {
                 let (g, i) = (p / LANES, p % LANES);
                 if let (Some(dir), Some(texels)) = (escaping[p], &sky_texels) {
                     let (path, sky) = (&mut lane.path, self.lights.sky_at(dir, texels[p]));
@@ -567,20 +583,21 @@ impl PathTracer<'_> {
                     rays[g].set(i, &lane.path.ray);
                 } else {
                     out[lane.job] = lane.value();
-                    *slot = None;
+                    (lane.live, lane.path.depth) = (false, 0);
                 }
             }
         }
     }
 
-    /// The path of sample `stream` of pixel `(x, y)`, whose result goes to `out[job]`, as
-    /// [`Self::sample_of`] starts it.
-    fn start(&self, job: usize, mut stream: SampleStream, (x, y): (u32, u32)) -> LanePath {
-        let film = stream.next_2d();
-        let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
-        let mode =
-            if self.spectral { ColorMode::Spectral(sample_wavelengths(stream.next_1d())) } else { ColorMode::Rgb };
-        LanePath { job, path: PathState::new(ray), stream, mode }
+    /// Starts `lane`'s path, its stream restarted and its film position drawn, as
+    /// [`Self::sample_of`] starts it: its camera ray through film position `(fx, fy)`.
+    fn start(&self, lane: &mut LanePath, (fx, fy): (f64, f64)) {
+        lane.path = PathState::new(self.camera.ray(fx, fy));
+        lane.mode = if self.spectral {
+            ColorMode::Spectral(sample_wavelengths(lane.stream.next_1d()))
+        } else {
+            ColorMode::Rgb
+        };
     }
 
     /// The per-path half of a material kernel's vertex, as in [`Self::vertex`]: emission, the
@@ -726,17 +743,16 @@ fn set_facets(v: &mut Vertices, i: usize, facets: &Microfacet, tangent: Option<V
 
 /// Moves the paths of the pool to its first slots, each with its ray, keeping their order;
 /// false when there is none. (Where a path is traced changes none of its numbers.)
-fn gather_paths(lanes: &mut [Option<LanePath>; POOL], rays: &mut [RayPacket; GROUPS]) -> bool {
+fn gather_paths(lanes: &mut [LanePath; POOL], rays: &mut [RayPacket; GROUPS]) -> bool {
     let mut to = 0;
     for from in 0..POOL {
-        if lanes[from].is_none() {
+        if !lanes[from].live {
             continue;
         }
         if from != to {
-            lanes[to] = lanes[from].take();
-            if let Some(lane) = &lanes[to] {
-                rays[to / LANES].set(to % LANES, &lane.path.ray);
-            }
+            // The idle record goes where the path was.
+            lanes.swap(to, from);
+            rays[to / LANES].set(to % LANES, &lanes[to].path.ray);
         }
         to += 1;
     }
