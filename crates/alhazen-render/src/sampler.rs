@@ -131,7 +131,7 @@ impl PixelSeeds {
         s.sequence = self.sequence;
         s.rng = Rng(mix(self.rng ^ index as u64));
         if self.sequence == Sequence::Sobol {
-            s.sobol = sobol_points(&self.scrambles, index.reverse_bits(), self.unit);
+            sobol_points(&self.scrambles, index.reverse_bits(), self.unit, &mut s.sobol);
         }
         s.dimension = 0;
         s.ahead = s.pair();
@@ -256,30 +256,30 @@ impl SampleStream {
 
 /// Every Owen-scrambled Sobol pair of the sample whose index reversed is `index_reversed`,
 /// one dimension pair per lane of one vector loop (in AVX2 registers where `unit` has them; the
-/// same integers on every unit): first coordinates, then second ones.
+/// same integers on every unit), into `out`: first coordinates, then second ones. Written in
+/// place: returned, the pairs went through a copy whose loads waited on the loop's stores.
 #[inline]
-fn sobol_points(scrambles: &Scrambles, index_reversed: u32, unit: VectorUnit) -> [[u32; SOBOL_LANES]; 2] {
+fn sobol_points(scrambles: &Scrambles, index_reversed: u32, unit: VectorUnit, out: &mut [[u32; SOBOL_LANES]; 2]) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_simd() {
         // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes AVX2) only where the
         // processor has it.
         #[allow(unsafe_code)]
-        return unsafe { sobol_points_avx2(scrambles, index_reversed) };
+        return unsafe { sobol_points_avx2(scrambles, index_reversed, out) };
     }
     let _ = unit;
-    sobol_points_in(scrambles, index_reversed)
+    sobol_points_in(scrambles, index_reversed, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 #[target_feature(enable = "avx2")]
-unsafe fn sobol_points_avx2(scrambles: &Scrambles, index_reversed: u32) -> [[u32; SOBOL_LANES]; 2] {
-    sobol_points_in(scrambles, index_reversed)
+unsafe fn sobol_points_avx2(scrambles: &Scrambles, index_reversed: u32, out: &mut [[u32; SOBOL_LANES]; 2]) {
+    sobol_points_in(scrambles, index_reversed, out)
 }
 
 #[inline(always)]
-fn sobol_points_in(scrambles: &Scrambles, index_reversed: u32) -> [[u32; SOBOL_LANES]; 2] {
-    let mut out = [[0; SOBOL_LANES]; 2];
+fn sobol_points_in(scrambles: &Scrambles, index_reversed: u32, out: &mut [[u32; SOBOL_LANES]; 2]) {
     for d in 0..SOBOL_LANES {
         // The index shuffled by Owen scrambling (`owen_scramble`, its first reversal done once).
         let shuffled = scramble_reversed(index_reversed, scrambles.shuffle[d]).reverse_bits();
@@ -287,7 +287,6 @@ fn sobol_points_in(scrambles: &Scrambles, index_reversed: u32) -> [[u32; SOBOL_L
         out[0][d] = scramble_reversed(shuffled, scrambles.first[d]).reverse_bits();
         out[1][d] = scramble_reversed(sobol1_reversed(shuffled), scrambles.second[d]).reverse_bits();
     }
-    out
 }
 
 /// The position in `[0, 1)²` of sample `i` of `n` in a pixel: jittered on a `k × k` grid when
@@ -384,9 +383,14 @@ mod tests {
                 first: std::array::from_fn(|d| seeds[SOBOL_LANES + d]),
                 second: std::array::from_fn(|d| seeds[2 * SOBOL_LANES + d]),
             };
-            let portable = sobol_points(&scrambles, index.reverse_bits(), VectorUnit::PORTABLE);
+            let points = |unit| {
+                let mut out = [[0; SOBOL_LANES]; 2];
+                sobol_points(&scrambles, index.reverse_bits(), unit, &mut out);
+                out
+            };
+            let portable = points(VectorUnit::PORTABLE);
             for unit in VectorUnit::available() {
-                proptest::prop_assert_eq!(portable, sobol_points(&scrambles, index.reverse_bits(), unit), "{:?}", unit);
+                proptest::prop_assert_eq!(portable, points(unit), "{:?}", unit);
             }
             for d in 0..SOBOL_LANES {
                 let pair = sobol_pair_by_definition(index, seeds[d], seeds[SOBOL_LANES + d], seeds[2 * SOBOL_LANES + d]);

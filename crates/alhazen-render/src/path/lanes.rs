@@ -456,11 +456,11 @@ impl PathTracer<'_> {
         let (mut shadows, mut dist) = ([RayPacket::default(); GROUPS], [[0.0; LANES]; GROUPS]);
         let together = self.world.traces_rays_together();
         loop {
-            // Idle lanes start the pixels' next samples: their streams, then their camera rays
-            // (two short loops whose iterations the processor overlaps, where one long one would
-            // wait on each lane's hashing and square root in turn). Each group's rays are traced
-            // together.
-            let mut starting = [(0.0, 0.0); POOL];
+            // Idle lanes start the pixels' next samples: their streams, then their film positions
+            // and camera rays (two short loops whose iterations the processor overlaps, where one
+            // long one would wait on each lane's hashing and square root in turn). Each group's
+            // rays are traced together.
+            let mut pixel = [(0, 0); POOL];
             for (p, lane) in lanes.iter_mut().enumerate().filter(|(_, l)| !l.live) {
                 let Some(job) = next.next() else { break };
                 let ((x, y), index) = (pixels[job / spp], first + (job % spp) as u32);
@@ -468,12 +468,10 @@ impl PathTracer<'_> {
                     seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y, unit);
                 }
                 seeds.restart(&mut lane.stream, index);
-                (lane.live, lane.job) = (true, job);
-                let film = lane.stream.next_2d();
-                starting[p] = (x as f64 + film.x, y as f64 + film.y);
+                (lane.live, lane.job, pixel[p]) = (true, job, (x, y));
             }
             for (p, lane) in lanes.iter_mut().enumerate().filter(|(_, l)| l.live && l.path.depth == 0) {
-                self.start(lane, starting[p]);
+                self.start(lane, pixel[p]);
                 rays[p / LANES].set(p % LANES, &lane.path.ray);
             }
             if next.is_empty() {
@@ -589,10 +587,11 @@ impl PathTracer<'_> {
         }
     }
 
-    /// Starts `lane`'s path, its stream restarted and its film position drawn, as
-    /// [`Self::sample_of`] starts it: its camera ray through film position `(fx, fy)`.
-    fn start(&self, lane: &mut LanePath, (fx, fy): (f64, f64)) {
-        lane.path = PathState::new(self.camera.ray(fx, fy));
+    /// Starts `lane`'s path in pixel `(x, y)`, its stream restarted, as [`Self::sample_of`]
+    /// starts it: its film position, its camera ray.
+    fn start(&self, lane: &mut LanePath, (x, y): (u32, u32)) {
+        let film = lane.stream.next_2d();
+        lane.path = PathState::new(self.camera.ray(x as f64 + film.x, y as f64 + film.y));
         lane.mode = if self.spectral {
             ColorMode::Spectral(sample_wavelengths(lane.stream.next_1d()))
         } else {
