@@ -190,8 +190,11 @@ struct Shaded {
 /// Paths in flight per thread: `GROUPS` packets of [`LANES`] rays, each traced together. Their
 /// vertices are shaded in batches of [`LANES`] by material kernel ([`Batches`]), so that a
 /// kernel's loop runs on vertices of its own material (a small wavefront's queues, sorted by
-/// material), not on every lane of a bounce whatever its material.
-const GROUPS: usize = 4;
+/// material), not on every lane of a bounce whatever its material. Sixty-four paths: more
+/// vertices of each material fill the batches, and a lane's start and its hashing overlap more
+/// of the others' work (with lanes restarted in place, 2–3.5 % faster than 32 on four of the
+/// suite's scenes; 128 gained nothing more).
+const GROUPS: usize = 8;
 const POOL: usize = GROUPS * LANES;
 
 /// Up to [`LANES`] vertices of one material kernel in a bounce (slots `..len`; the rest hold
