@@ -11,7 +11,8 @@
 //! vertex, written into a batch of eight of its material kernel ([`Batches`]); each batch's
 //! light samples and shading; each group's shadow rays in one call
 //! ([`crate::World::unoccluded_rays`]), after which each path gathers its light and steps on. A
-//! lane whose path ends starts the next sample of the pixels it was given, so lanes stay busy
+//! lane whose path ends starts the next sample of the pixels it was given, in place (its record
+//! is not moved: a path's start costs what its hashing and camera ray cost), so lanes stay busy
 //! until their samples run out; then the paths left move to the first groups.
 //!
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
