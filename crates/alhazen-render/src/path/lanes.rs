@@ -505,7 +505,8 @@ impl PathTracer<'_> {
             let escaping: [Option<Vec3>; POOL] = if sky_map {
                 std::array::from_fn(|p| {
                     let lane = &lanes[p];
-                    let escapes = hits[p / LANES][p % LANES].is_none() && lane.path.depth <= self.scene.render.max_depth;
+                    let escapes =
+                        hits[p / LANES][p % LANES].is_none() && lane.path.depth <= self.scene.render.max_depth;
                     (lane.live && escapes).then_some(lane.path.ray.dir)
                 })
             } else {
@@ -596,11 +597,8 @@ impl PathTracer<'_> {
     fn start(&self, lane: &mut LanePath, (x, y): (u32, u32)) {
         let film = lane.stream.next_2d();
         lane.path = PathState::new(self.camera.ray(x as f64 + film.x, y as f64 + film.y));
-        lane.mode = if self.spectral {
-            ColorMode::Spectral(sample_wavelengths(lane.stream.next_1d()))
-        } else {
-            ColorMode::Rgb
-        };
+        lane.mode =
+            if self.spectral { ColorMode::Spectral(sample_wavelengths(lane.stream.next_1d())) } else { ColorMode::Rgb };
     }
 
     /// The per-path half of a material kernel's vertex, as in [`Self::vertex`]: emission, the
