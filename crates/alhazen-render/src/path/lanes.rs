@@ -268,10 +268,9 @@ struct LanePath {
 }
 
 impl LanePath {
-    /// An idle lane (depth 0 until its path starts).
+    /// An idle lane.
     fn idle() -> Self {
-        let mut path = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
-        path.depth = 0;
+        let path = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
         Self { live: false, job: 0, path, stream: SampleStream::default(), mode: ColorMode::Rgb }
     }
 
@@ -464,7 +463,7 @@ impl PathTracer<'_> {
             // and camera rays (two short loops whose iterations the processor overlaps, where one
             // long one would wait on each lane's hashing and square root in turn). Each group's
             // rays are traced together.
-            let mut pixel = [(0, 0); POOL];
+            let mut starting: [Option<(u32, u32)>; POOL] = [None; POOL];
             for (p, lane) in lanes.iter_mut().enumerate().filter(|(_, l)| !l.live) {
                 let Some(job) = next.next() else { break };
                 let ((x, y), index) = (pixels[job / spp], first + (job % spp) as u32);
@@ -472,10 +471,11 @@ impl PathTracer<'_> {
                     seeds = PixelSeeds::new(self.sequence, self.scene.render.seed, x, y, unit);
                 }
                 seeds.restart(&mut lane.stream, index);
-                (lane.live, lane.job, pixel[p]) = (true, job, (x, y));
+                (lane.live, lane.job, starting[p]) = (true, job, Some((x, y)));
             }
-            for (p, lane) in lanes.iter_mut().enumerate().filter(|(_, l)| l.live && l.path.depth == 0) {
-                self.start(lane, pixel[p]);
+            for (p, lane) in lanes.iter_mut().enumerate() {
+                let Some(pixel) = starting[p] else { continue };
+                self.start(lane, pixel);
                 rays[p / LANES].set(p % LANES, &lane.path.ray);
             }
             if next.is_empty() {
@@ -586,7 +586,7 @@ impl PathTracer<'_> {
                     rays[g].set(i, &lane.path.ray);
                 } else {
                     out[lane.job] = lane.value();
-                    (lane.live, lane.path.depth) = (false, 0);
+                    lane.live = false;
                 }
             }
         }
