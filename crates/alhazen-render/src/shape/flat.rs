@@ -102,12 +102,13 @@ fn flat_edges(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<[Vec3; 3]> {
     parallelogram_of(first, second, corners, mesh.positions[second[2] as usize])
 }
 
-/// [`flat_edges`], when the edges span an area (the test of [`Flat::new`], without computing
-/// the flat).
-fn flat_spanned(mesh: &TriangleMesh, t: usize, pair: bool) -> Option<[Vec3; 3]> {
-    let span @ [_, e1, e2] = flat_edges(mesh, t, pair)?;
-    let n2 = e1.cross(e2).length_squared();
-    (n2 > 0.0 && n2.is_finite()).then_some(span)
+/// True when [`flat_edges`] span an area (the test of [`Flat::new`], without computing the
+/// flat).
+fn spans_area(mesh: &TriangleMesh, t: usize, pair: bool) -> bool {
+    flat_edges(mesh, t, pair).is_some_and(|[_, e1, e2]| {
+        let n2 = e1.cross(e2).length_squared();
+        n2 > 0.0 && n2.is_finite()
+    })
 }
 
 impl FlatLane {
@@ -141,12 +142,12 @@ pub fn flat_primitives(mesh: &TriangleMesh) -> Vec<FlatLane> {
     let mut t = 0;
     while t < mesh.triangle_count() {
         let lane = FlatLane { triangle: t as u32, parallelogram: true };
-        if flat_spanned(mesh, t, true).is_some() {
+        if spans_area(mesh, t, true) {
             lanes.push(lane);
             t += 2;
             continue;
         }
-        if flat_spanned(mesh, t, false).is_some() {
+        if spans_area(mesh, t, false) {
             lanes.push(FlatLane { parallelogram: false, ..lane });
         }
         t += 1;
