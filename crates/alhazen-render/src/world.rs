@@ -478,7 +478,32 @@ impl World {
 
     /// The nearest hit in `(0, t_max)`: the object and its candidate, no surface details.
     #[inline]
+    #[allow(unsafe_code)]
     fn nearest(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
+        #[cfg(target_arch = "x86_64")]
+        if self.vectors.is_simd() && !self.bvh.is_one_leaf() {
+            // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes it) only where the
+            // processor has it.
+            return unsafe { self.nearest_avx2(ray, t_max) };
+        }
+        // SAFETY: without AVX2.
+        unsafe { self.nearest_with::<false>(ray, t_max) }
+    }
+
+    /// [`Self::nearest`] compiled for AVX2, the tree's nodes tested in AVX2 registers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    fn nearest_avx2(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
+        // SAFETY: this function runs only where AVX2 is.
+        unsafe { self.nearest_with::<true>(ray, t_max) }
+    }
+
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn nearest_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
         let mut best: Option<(Candidate, u32)> = None;
         let mut t_best = t_max;
         for &i in &self.unbounded {
@@ -489,7 +514,7 @@ impl World {
         }
         // The nearest flat's packet and lane; made a candidate once, after the traversal.
         let mut best_flat: Option<(Lane, LaneHit)> = None;
-        self.bvh.traverse_leaves(ray, t_best, |range, t_max| {
+        let visit = |range: std::ops::Range<usize>, t_max| {
             let leaf = &self.leaves[range.start];
             let mut closer = None;
             let mut t_max = t_max;
@@ -502,7 +527,9 @@ impl World {
                 closer = Some(c.t);
             }
             closer
-        });
+        };
+        // SAFETY: the caller's contract.
+        unsafe { self.bvh.traverse_leaves_with::<AVX2>(ray, t_best, visit) };
         best_flat.map(|(lane, h)| (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)).or(best)
     }
 
@@ -713,18 +740,44 @@ impl World {
     /// True when nothing blocks the segment from `origin` along unit `dir` over `dist`; stops at
     /// the first blocker found.
     #[inline]
+    #[allow(unsafe_code)]
     pub fn unoccluded(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.vectors.is_simd() && !self.bvh.is_one_leaf() {
+            // SAFETY: as in `nearest`.
+            return unsafe { self.unoccluded_avx2(origin, dir, dist) };
+        }
+        // SAFETY: without AVX2.
+        unsafe { self.unoccluded_with::<false>(origin, dir, dist) }
+    }
+
+    /// [`Self::unoccluded`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    fn unoccluded_avx2(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
+        // SAFETY: this function runs only where AVX2 is.
+        unsafe { self.unoccluded_with::<true>(origin, dir, dist) }
+    }
+
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn unoccluded_with<const AVX2: bool>(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
         let ray = Ray::new(origin, dir);
         if self.unbounded.iter().any(|&i| self.objects[i as usize].placed.blocks(&ray, dist)) {
             return false;
         }
         let mut blocked = false;
-        self.bvh.traverse_leaves(&ray, dist, |range, t_max| {
+        let visit = |range: std::ops::Range<usize>, t_max| {
             let leaf = &self.leaves[range.start];
             blocked = FlatPacket::any_of(&self.flats.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
                 || self.solid_blocks(leaf, &ray, t_max);
             blocked.then_some(0.0)
-        });
+        };
+        // SAFETY: the caller's contract.
+        unsafe { self.bvh.traverse_leaves_with::<AVX2>(&ray, dist, visit) };
         !blocked
     }
 

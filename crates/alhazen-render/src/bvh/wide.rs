@@ -1,7 +1,8 @@
-//! The tree traversal reads: the binary SAH tree collapsed into nodes of four children whose
+//! The tree traversal reads: the binary SAH tree collapsed into nodes of eight children whose
 //! boxes are stored together in `f32`, rounded outward (Wald et al. 2008, "Getting Rid of
-//! Packets": multi-branching BVHs; Embree's BVH4). One node, two cache lines, gives a ray four
-//! boxes to test at once, so a descent takes half the dependent memory loads of the binary tree.
+//! Packets": multi-branching BVHs; Embree's BVH8). One node, four cache lines, gives a ray eight
+//! boxes to test at once — in one AVX2 register, or two SSE ones — so a descent takes a third
+//! of the dependent memory loads of the binary tree.
 //!
 //! The slab test runs in `f32` and is *conservative*: it never rejects a box the exact ray
 //! segment meets. Each child's entry distance is padded by a per-ray bound on every rounding
@@ -17,7 +18,7 @@ use super::{Node, NodeRef, Tree};
 use alhazen_math::Ray;
 
 /// Children per node.
-pub(super) const WIDTH: usize = 4;
+pub(super) const WIDTH: usize = 8;
 /// A child slot holding nothing.
 const EMPTY: u32 = u32::MAX;
 /// The unit roundoff of `f32`.
@@ -26,7 +27,7 @@ const ROUNDOFF: f64 = 1.0 / (1u64 << 24) as f64;
 /// `f32` keeps their relative error bounded without overflow or denormals.
 const STEEP: f64 = 1e18;
 
-/// Four children's boxes, axis by axis, and what each child is.
+/// [`WIDTH`] children's boxes, axis by axis, and what each child is.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub(super) struct Wide {
@@ -77,7 +78,7 @@ pub(super) fn up(x: f64) -> f32 {
     if (f as f64) < x { f.next_up() } else { f }
 }
 
-/// The nodes of a binary tree as four-wide nodes, depth first, and the entry of its root: a
+/// The nodes of a binary tree as wide nodes, depth first, and the entry of its root: a
 /// leaf when the whole tree is one.
 pub(super) fn collapse(tree: &Tree) -> (Vec<Wide>, Option<Entry>) {
     if tree.len() == 0 {
@@ -92,15 +93,16 @@ pub(super) fn collapse(tree: &Tree) -> (Vec<Wide>, Option<Entry>) {
     (wide, Some(Entry { offset: first, count: 0, near: 0.0 }))
 }
 
-/// Adds the four-wide node of binary interior node `at` and those below it; returns its index.
+/// Adds the wide node of binary interior node `at` and those below it; returns its index.
 /// Its children are `at`'s two, the interior one of largest area replaced by its own two until
-/// there are four or only leaves.
+/// there are [`WIDTH`] or only leaves.
 fn wide_node<'a>((tree, at): NodeRef<'a>, out: &mut Vec<Wide>) -> u32 {
     fn node<'a>((t, i): NodeRef<'a>) -> &'a Node {
         t.node(i)
     }
     let [first, second] = tree.children(at);
-    let (mut kids, mut len) = ([first, second, first, first], 2);
+    let (mut kids, mut len) = ([first; WIDTH], 2);
+    kids[1] = second;
     while len < WIDTH {
         let open = (0..len)
             .filter(|&k| node(kids[k]).count == 0)
@@ -206,12 +208,23 @@ impl Slab {
     }
 
     /// Which of `w`'s children the ray may meet within `[0, t_max]` (bit `k` for child `k`)
-    /// and lower bounds of where it enters each.
+    /// and lower bounds of where it enters each: with `AVX2`, all eight children in one AVX
+    /// register; otherwise in two halves of four in SSE registers (which every x86-64
+    /// processor has), or one by one on other processors. Every way gives the same bits.
+    ///
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2 (fast only where the caller is compiled for it).
     #[inline(always)]
-    pub fn test(&self, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
+    #[allow(unsafe_code)]
+    pub unsafe fn test<const AVX2: bool>(&self, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
         #[cfg(target_arch = "x86_64")]
         {
-            self.test_sse(w, t_max)
+            if AVX2 {
+                // SAFETY: the caller's contract.
+                unsafe { self.test_avx2(w, t_max) }
+            } else {
+                self.test_sse(w, t_max)
+            }
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
@@ -249,43 +262,90 @@ impl Slab {
         (hits, near)
     }
 
-    /// [`Self::test`] with SSE, which every x86-64 processor has: four children at once.
+    /// [`Self::test`] with SSE, which every x86-64 processor has: four children at a time.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     #[allow(unsafe_code)]
     fn test_sse(&self, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
         use std::arch::x86_64::*;
-        // SAFETY: SSE and SSE2 are part of x86-64; the loads read whole `[f32; 4]` and
-        // `[u32; 4]` arrays of a 64-byte aligned node; `Wide` is `repr(C)`, so its `min` and
-        // `max` are six consecutive rows, and the rows chosen are below six.
+        const HALF: usize = WIDTH / 2;
+        // SAFETY: SSE and SSE2 are part of x86-64; each load reads four of a row's eight `f32`s
+        // (or `u32`s), 16-byte aligned in a 64-byte aligned node; `Wide` is `repr(C)`, so its
+        // `min` and `max` are six consecutive rows, and the rows chosen are below six.
         const { assert!(std::mem::offset_of!(Wide, max) == std::mem::size_of::<[[f32; WIDTH]; 3]>()) };
         unsafe {
             let rows = (&raw const w.min).cast::<[f32; WIDTH]>();
-            let row = |r: usize| _mm_load_ps(rows.add(r).cast());
-            let mut near = _mm_setzero_ps();
-            let mut far = _mm_set1_ps(t_max);
-            let mut beside =
-                _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_load_si128(w.count.as_ptr().cast()), _mm_set1_epi32(-1)));
+            let (mut hits, mut out) = (0, [0.0f32; WIDTH]);
+            for half in 0..2 {
+                let row = |r: usize| _mm_load_ps(rows.add(r).cast::<f32>().add(half * HALF));
+                let mut near = _mm_setzero_ps();
+                let mut far = _mm_set1_ps(t_max);
+                let count = _mm_load_si128(w.count.as_ptr().add(half * HALF).cast());
+                let mut beside = _mm_castsi128_ps(_mm_cmpeq_epi32(count, _mm_set1_epi32(-1)));
+                if self.any_parallel {
+                    for axis in (0..3).filter(|&a| self.parallel[a]) {
+                        let o = _mm_set1_ps(self.origin[axis]);
+                        let inside = _mm_and_ps(_mm_cmple_ps(row(axis), o), _mm_cmple_ps(o, row(axis + 3)));
+                        beside = _mm_or_ps(beside, _mm_andnot_ps(inside, _mm_castsi128_ps(_mm_set1_epi32(-1))));
+                    }
+                }
+                for axis in 0..3 {
+                    let (o, inv, pad) =
+                        (_mm_set1_ps(self.origin[axis]), _mm_set1_ps(self.inv[axis]), _mm_set1_ps(self.pad[axis]));
+                    let t0 = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(row(self.entry_row[axis]), o), inv), pad);
+                    let t1 = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(row(self.exit_row[axis]), o), inv), pad);
+                    // MAXPS/MINPS return their second operand when either is NaN: the accumulator.
+                    near = _mm_max_ps(t0, near);
+                    far = _mm_min_ps(t1, far);
+                }
+                // Empty slots count as beside the ray.
+                hits |= (_mm_movemask_ps(_mm_andnot_ps(beside, _mm_cmple_ps(near, far))) as u32) << (half * HALF);
+                _mm_storeu_ps(out.as_mut_ptr().add(half * HALF), near);
+            }
+            (hits, out)
+        }
+    }
+
+    /// [`Self::test`] with AVX2: eight children at once, the same operations as [`Self::test_sse`]
+    /// on twice the lanes.
+    ///
+    /// # Safety
+    /// Only on a processor with AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn test_avx2(&self, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
+        use std::arch::x86_64::*;
+        // SAFETY: the caller's contract gives AVX2; the loads read whole 32-byte aligned rows
+        // of a 64-byte aligned node (`Wide` is `repr(C)`: `min` and `max` are six consecutive
+        // rows), and the rows chosen are below six.
+        unsafe {
+            let rows = (&raw const w.min).cast::<[f32; WIDTH]>();
+            let row = |r: usize| _mm256_load_ps(rows.add(r).cast());
+            let (le, all) = (|a, b| _mm256_cmp_ps::<_CMP_LE_OQ>(a, b), _mm256_set1_epi32(-1));
+            let mut near = _mm256_setzero_ps();
+            let mut far = _mm256_set1_ps(t_max);
+            let count = _mm256_load_si256(w.count.as_ptr().cast());
+            let mut beside = _mm256_castsi256_ps(_mm256_cmpeq_epi32(count, all));
             if self.any_parallel {
                 for axis in (0..3).filter(|&a| self.parallel[a]) {
-                    let o = _mm_set1_ps(self.origin[axis]);
-                    let inside = _mm_and_ps(_mm_cmple_ps(row(axis), o), _mm_cmple_ps(o, row(axis + 3)));
-                    beside = _mm_or_ps(beside, _mm_andnot_ps(inside, _mm_castsi128_ps(_mm_set1_epi32(-1))));
+                    let o = _mm256_set1_ps(self.origin[axis]);
+                    let inside = _mm256_and_ps(le(row(axis), o), le(o, row(axis + 3)));
+                    beside = _mm256_or_ps(beside, _mm256_andnot_ps(inside, _mm256_castsi256_ps(all)));
                 }
             }
             for axis in 0..3 {
                 let (o, inv, pad) =
-                    (_mm_set1_ps(self.origin[axis]), _mm_set1_ps(self.inv[axis]), _mm_set1_ps(self.pad[axis]));
-                let t0 = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(row(self.entry_row[axis]), o), inv), pad);
-                let t1 = _mm_add_ps(_mm_mul_ps(_mm_sub_ps(row(self.exit_row[axis]), o), inv), pad);
-                // MAXPS/MINPS return their second operand when either is NaN: the accumulator.
-                near = _mm_max_ps(t0, near);
-                far = _mm_min_ps(t1, far);
+                    (_mm256_set1_ps(self.origin[axis]), _mm256_set1_ps(self.inv[axis]), _mm256_set1_ps(self.pad[axis]));
+                let t0 = _mm256_sub_ps(_mm256_mul_ps(_mm256_sub_ps(row(self.entry_row[axis]), o), inv), pad);
+                let t1 = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(row(self.exit_row[axis]), o), inv), pad);
+                // VMAXPS/VMINPS return their second operand when either is NaN: the accumulator.
+                near = _mm256_max_ps(t0, near);
+                far = _mm256_min_ps(t1, far);
             }
-            // Empty slots count as beside the ray.
-            let hits = _mm_movemask_ps(_mm_andnot_ps(beside, _mm_cmple_ps(near, far))) as u32;
+            let hits = _mm256_movemask_ps(_mm256_andnot_ps(beside, le(near, far))) as u32;
             let mut out = [0.0f32; WIDTH];
-            _mm_storeu_ps(out.as_mut_ptr(), near);
+            _mm256_storeu_ps(out.as_mut_ptr(), near);
             (hits, out)
         }
     }
@@ -293,7 +353,7 @@ impl Slab {
     /// Asks the processor to start loading node `w` (its two cache lines).
     #[inline(always)]
     pub fn prefetch(w: &Wide) {
-        const { assert!(std::mem::size_of::<Wide>() == 128) };
+        const { assert!(std::mem::size_of::<Wide>() == 64 * WIDTH / 2) };
         crate::prefetch::prefetch_all(w);
     }
 
@@ -310,7 +370,12 @@ mod tests {
     use alhazen_math::{Bounds3, Vec3};
 
     fn one_box(b: Bounds3) -> Wide {
-        let mut w = Wide { min: [[f32::MAX; 4]; 3], max: [[-f32::MAX; 4]; 3], offset: [0; 4], count: [EMPTY; 4] };
+        let mut w = Wide {
+            min: [[f32::MAX; WIDTH]; 3],
+            max: [[-f32::MAX; WIDTH]; 3],
+            offset: [0; WIDTH],
+            count: [EMPTY; WIDTH],
+        };
         for axis in 0..3 {
             (w.min[axis][0], w.max[axis][0]) = (down(b.min[axis]), up(b.max[axis]));
         }
@@ -355,38 +420,61 @@ mod tests {
             let slab = Slab::new(&ray, reach.map(|r| up(r) as f64));
             let w = one_box(b);
             let exact = b.hit_interval(&ray, 1.0 / ray.dir, f64::INFINITY);
-            let (hits, near) = slab.test(&w, f32::INFINITY);
+            let (hits, near) = portable_or_sse(&slab, &w, f32::INFINITY);
             if let Some((t_near, _)) = exact {
                 proptest::prop_assert!(hits & 1 == 1, "rejected {b:?} for {ray:?}");
                 proptest::prop_assert!(near[0] as f64 <= t_near);
             }
             // The exact point of entry is kept with the segment ending there.
             if let Some((t_near, _)) = exact {
-                let (hits, _) = slab.test(&w, up(t_near));
+                let (hits, _) = portable_or_sse(&slab, &w, up(t_near));
                 proptest::prop_assert!(hits & 1 == 1);
             }
             proptest::prop_assert!(hits & !1 == 0, "empty slots are never met");
         }
     }
 
-    /// The SSE test gives the portable test's bits.
-    #[cfg(target_arch = "x86_64")]
-    #[test]
-    fn sse_and_portable_tests_agree() {
-        let mut w = one_box(Bounds3 { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) });
-        (w.min[0][1], w.max[0][1], w.count[1]) = (f32::NEG_INFINITY, 3.0, 2);
-        (w.min[1][2], w.max[1][2], w.count[2]) = (0.5, f32::INFINITY, 0);
-        for (o, d) in [
-            (Vec3::new(-5.0, 0.0, 0.0), Vec3::X),
-            (Vec3::new(0.3, -7.0, 2.0), Vec3::new(0.0, 1.0, -0.2)),
-            (Vec3::new(1e20, 0.5, 0.5), Vec3::new(-1.0, 1e-30, 0.0)),
-            (Vec3::new(2.0, 2.0, 2.0), Vec3::new(-1.0, -1.0, -1.0)),
-        ] {
-            let slab = Slab::new(&Ray::new(o, d), [1e20, 1e20, 1e20]);
-            for t_max in [f32::INFINITY, 1.0, 0.0] {
-                let (a, b) = (slab.test_sse(&w, t_max), slab.test_portable(&w, t_max));
-                assert_eq!(a.0, b.0);
-                assert_eq!(a.1.map(f32::to_bits), b.1.map(f32::to_bits));
+    /// [`Slab::test`] without AVX2.
+    #[allow(unsafe_code)]
+    fn portable_or_sse(slab: &Slab, w: &Wide, t_max: f32) -> (u32, [f32; WIDTH]) {
+        // SAFETY: without AVX2.
+        unsafe { slab.test::<false>(w, t_max) }
+    }
+
+    proptest::proptest! {
+        /// The SSE and AVX2 tests give the portable test's bits, children in every slot of
+        /// both halves, empty slots among them, rays along the axes and not.
+        #[cfg(target_arch = "x86_64")]
+        #[test]
+        #[allow(unsafe_code)]
+        fn sse_avx2_and_portable_tests_agree(
+            boxes in proptest::collection::vec((proptest::array::uniform3(-4.0..4.0f32), proptest::array::uniform3(0.0..3.0f32), 0u32..3), WIDTH),
+            origin in proptest::array::uniform3(-6.0..6.0f64),
+            dir in proptest::array::uniform3(-1.0..1.0f64),
+            flat_axis in 0usize..4,
+            t_max in proptest::sample::select(vec![f32::INFINITY, 5.0, 1.0, 0.0]),
+        ) {
+            let mut w = one_box(Bounds3::EMPTY);
+            for (k, (lo, size, kind)) in boxes.into_iter().enumerate() {
+                for axis in 0..3 {
+                    (w.min[axis][k], w.max[axis][k]) = (lo[axis], lo[axis] + size[axis]);
+                }
+                // Leaves, interior nodes and empty slots.
+                w.count[k] = [1, 0, EMPTY][kind as usize];
+            }
+            let mut dir = Vec3::from_array(dir);
+            if flat_axis < 3 {
+                dir[flat_axis] = 0.0;
+            }
+            proptest::prop_assume!(dir.length() > 1e-3);
+            let slab = Slab::new(&Ray::new(Vec3::from_array(origin), dir), [10.0; 3]);
+            let portable = slab.test_portable(&w, t_max);
+            let bits = |(hits, near): (u32, [f32; WIDTH])| (hits, near.map(f32::to_bits));
+            proptest::prop_assert_eq!(bits(slab.test_sse(&w, t_max)), bits(portable));
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor has AVX2.
+                let avx2 = unsafe { slab.test_avx2(&w, t_max) };
+                proptest::prop_assert_eq!(bits(avx2), bits(portable));
             }
         }
     }
@@ -396,7 +484,7 @@ mod tests {
         let b = Bounds3 { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) };
         let w = one_box(b);
         let reach = [1.0; 3];
-        let test = |o: Vec3, d: Vec3, t_max: f32| Slab::new(&Ray::new(o, d), reach).test(&w, t_max).0 & 1;
+        let test = |o: Vec3, d: Vec3, t_max: f32| portable_or_sse(&Slab::new(&Ray::new(o, d), reach), &w, t_max).0 & 1;
         assert_eq!(test(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, f32::INFINITY), 1);
         assert_eq!(test(Vec3::new(5.0, 0.0, 0.0), Vec3::X, f32::INFINITY), 0, "behind");
         assert_eq!(test(Vec3::new(-5.0, 2.0, 0.0), Vec3::X, f32::INFINITY), 0, "beside");

@@ -166,33 +166,103 @@ impl MeshShape {
     }
 
     /// The tree's leaves `ray` may meet, nearest first ([`Bvh::traverse_leaves_prefetching`]):
-    /// `visit(packets, t_max)`, each leaf's packets prefetched as soon as its box is met.
-    fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>) {
+    /// `visit(packets, t_max)`, each leaf's packets prefetched as soon as its box is met; the
+    /// nodes tested in AVX2 registers with `AVX2`.
+    ///
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn traverse<const AVX2: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
+    ) {
         let a = &*self.accel;
-        a.bvh.traverse_leaves_prefetching(ray, t_max, |packets| a.packets.prefetch(packets.start), visit);
+        let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
+        if AVX2 {
+            // SAFETY: the caller's contract.
+            unsafe { a.bvh.traverse_leaves_prefetching_avx2(ray, t_max, prefetch, visit) };
+        } else {
+            a.bvh.traverse_leaves_prefetching(ray, t_max, prefetch, visit);
+        }
     }
 
     /// Nearest hit in `(0, t_max)`; `aux` is the triangle.
+    #[allow(unsafe_code)]
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        #[cfg(target_arch = "x86_64")]
+        if self.accel.vectors.is_simd() {
+            // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes it) only where the
+            // processor has it.
+            return unsafe { self.hit_avx2(ray, t_max) };
+        }
+        // SAFETY: without AVX2.
+        unsafe { self.hit_with::<false>(ray, t_max) }
+    }
+
+    /// [`Self::hit`] compiled for AVX2, its nodes tested in AVX2 registers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    fn hit_avx2(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        // SAFETY: this function runs only where AVX2 is.
+        unsafe { self.hit_with::<true>(ray, t_max) }
+    }
+
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn hit_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let a = &*self.accel;
         let mut best = None;
-        self.traverse(ray, t_max, |packets, t_max| {
+        let visit = |packets, t_max| {
             let (lane, h) = a.packets.nearest(packets, ray, t_max, a.vectors)?;
             best = Some((lane, h));
             Some(h.t)
-        });
+        };
+        // SAFETY: the caller's contract.
+        unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
         best.map(|(lane, h)| lane.candidate(h.t, h.b1, h.b2))
     }
 
     /// True when some triangle lies on `ray` in `(0, t_max)`: [`MeshShape::hit`]`.is_some()`,
     /// stopping at the first leaf that holds one (shadow rays need no nearest hit).
+    #[allow(unsafe_code)]
     pub fn blocks(&self, ray: &Ray, t_max: f64) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.accel.vectors.is_simd() {
+            // SAFETY: as in `hit`.
+            return unsafe { self.blocks_avx2(ray, t_max) };
+        }
+        // SAFETY: without AVX2.
+        unsafe { self.blocks_with::<false>(ray, t_max) }
+    }
+
+    /// [`Self::blocks`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    fn blocks_avx2(&self, ray: &Ray, t_max: f64) -> bool {
+        // SAFETY: this function runs only where AVX2 is.
+        unsafe { self.blocks_with::<true>(ray, t_max) }
+    }
+
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn blocks_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> bool {
         let a = &*self.accel;
         let mut blocked = false;
-        self.traverse(ray, t_max, |packets, t_max| {
+        let visit = |packets: std::ops::Range<usize>, t_max| {
             blocked = FlatPacket::any_of(&a.packets.packets[packets], ray, t_max, a.vectors);
             blocked.then_some(0.0)
-        });
+        };
+        // SAFETY: the caller's contract.
+        unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
         blocked
     }
 
