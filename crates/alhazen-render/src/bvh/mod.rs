@@ -3,7 +3,7 @@
 //! interleaved bit by bit, sorted, and each node split where its first and last codes first
 //! differ — a linear BVH), flattened depth-first so that a node's first child follows it. Used twice: over the objects
 //! of a scene and over the triangles of each mesh. The world's tree charges one test per
-//! started group of four packed primitives ([`Bvh::build_packed`]: flats and spheres), so a room
+//! started group of eight packed primitives ([`Bvh::build_packed`]: flats and spheres), so a room
 //! of walls, boxes and balls becomes one leaf of packets rather than a tree of overlapping boxes.
 
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -13,12 +13,6 @@ use wide::{Entry, Slab, WIDTH, Wide};
 mod wide;
 
 const BINS: usize = 12;
-/// Leaves that cost at most this many tests are not split.
-const MAX_LEAF: usize = 4;
-/// Packed primitives the heuristic charges as one test: four, on every processor, so the tree
-/// (and with it which of two equally near hits wins) is the same everywhere. (Packets of flats
-/// hold eight in `f32`, a test costing about what four in `f64` did; charging eight is untried.)
-pub const PACK: usize = 4;
 /// Deeper subtrees become leaves, so traversal's fixed stack never overflows.
 const MAX_DEPTH: usize = 48;
 /// Traversal's stack: each wide node on the way down leaves at most `WIDTH − 1` children
@@ -107,14 +101,15 @@ impl Tree {
         depth: usize,
         how: Split,
         parallel_from: usize,
+        leaves: Leaves,
     ) -> usize {
         let me = self.nodes.len();
         let (min, max) = ([node.lo[0], node.lo[1], node.lo[2]], [node.hi[0], node.hi[1], node.hi[2]]);
         self.nodes.push(Node { min, max, offset: first as u32, count: items.len() as u32, remote: false });
-        let small = items.len() == 1 || node.tests.cost() <= MAX_LEAF as f64;
+        let small = items.len() == 1 || node.tests.cost(leaves.pack) <= leaves.max_tests as f64;
         let split = match how {
             _ if small || depth >= MAX_DEPTH => None,
-            Split::Sah { traversal } => sah_split(items, &node, traversal),
+            Split::Sah { traversal } => sah_split(items, &node, traversal, leaves.pack),
             Split::Morton { codes } => Some((morton_split(codes), None)),
         };
         // A leaf as pushed, unless split.
@@ -132,14 +127,14 @@ impl Tree {
             // kept as a subtree.
             let mut b = Tree::reserved(right.len());
             rayon::join(
-                || self.build(left, first, sl, next, hl, parallel_from),
-                || b.build(right, second_first, sr, next, hr, parallel_from),
+                || self.build(left, first, sl, next, hl, parallel_from, leaves),
+                || b.build(right, second_first, sr, next, hr, parallel_from, leaves),
             );
             self.subtrees.push(b);
             self.subtrees.len() - 1
         } else {
-            self.build(left, first, sl, next, hl, parallel_from);
-            self.build(right, second_first, sr, next, hr, parallel_from)
+            self.build(left, first, sl, next, hl, parallel_from, leaves);
+            self.build(right, second_first, sr, next, hr, parallel_from, leaves)
         };
         self.nodes[me] = Node { offset: second as u32, count: 0, remote: parallel, ..self.nodes[me] };
         me
@@ -167,7 +162,7 @@ struct Item {
     min: [f32; 3],
     max: [f32; 3],
     index: u32,
-    /// Tested [`PACK`] at a time.
+    /// Tested several at a time ([`Leaves::pack`]).
     packed: bool,
     /// The bin of its centroid in the last binning of its node (SAH builds only).
     bin: u8,
@@ -231,8 +226,8 @@ impl Tests {
     }
 
     /// Tests a ray makes in the leaf, in units of one primitive test.
-    fn cost(self) -> f64 {
-        (self.packed.div_ceil(PACK) + self.single) as f64
+    fn cost(self, pack: usize) -> f64 {
+        (self.packed.div_ceil(pack) + self.single) as f64
     }
 }
 
@@ -242,23 +237,24 @@ impl Bvh {
         Self::build_packed(bounds, |_| false)
     }
 
-    /// [`Self::build_packed`] by `method`, over `count` primitives whose bounds `bounds(i)`
-    /// gives: no vector of them is made (a million-triangle mesh's would be 48 MB of fresh
-    /// memory).
+    /// A mesh's tree ([`Leaves::MESH`]) by `method`, over `count` primitives whose bounds
+    /// `bounds(i)` gives: no vector of them is made (a million-triangle mesh's would be 48 MB
+    /// of fresh memory).
     pub fn build_with(
         count: usize,
         bounds: impl Fn(usize) -> Bounds3 + Sync,
         packed: impl Fn(usize) -> bool + Sync,
         method: BuildMethod,
     ) -> Self {
-        Self::build_split_from(count, bounds, packed, PARALLEL_ITEMS, method)
+        Self::build_split_from(count, bounds, packed, PARALLEL_ITEMS, method, Leaves::MESH)
     }
 
-    /// [`Self::build`] for primitives some of which (`packed(i)`) are tested [`PACK`] at a time
+    /// [`Self::build`] for primitives some of which (`packed(i)`) are tested eight at a time
     /// in a leaf: the surface area heuristic charges a leaf one test per started group of
-    /// them plus one per other primitive, so leaves of such primitives grow large.
+    /// them plus one per other primitive ([`Leaves::WORLD`]), so leaves of such primitives grow
+    /// large.
     pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync) -> Self {
-        Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, BuildMethod::Sah)
+        Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, BuildMethod::Sah, Leaves::WORLD)
     }
 
     /// [`Self::build_packed`] building subtrees of at least `parallel_from` primitives in
@@ -269,6 +265,7 @@ impl Bvh {
         packed: impl Fn(usize) -> bool + Sync,
         parallel_from: usize,
         method: BuildMethod,
+        leaves: Leaves,
     ) -> Self {
         let (mut items, root) = items_of(count, bounds, packed);
         let codes = match method {
@@ -285,7 +282,7 @@ impl Bvh {
                 BuildMethod::Morton => Split::Morton { codes: &codes },
             };
             let all = Summary::of(&items);
-            tree.build(&mut items, 0, all, 0, split, parallel_from);
+            tree.build(&mut items, 0, all, 0, split, parallel_from, leaves);
         }
         let mut bvh = Bvh { root, ..Bvh::default() };
         // Every item lies in one leaf, the leaves in item order: the items' indices are the
@@ -616,7 +613,7 @@ fn doubled_centroid(lo: Lanes4, hi: Lanes4) -> Lanes4 {
 
 /// The binned SAH split of `items` (partitioned in place): the first item of the second half
 /// and, when the halves are the bins', their summaries.
-fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usize, Option<[Summary; 2]>)> {
+fn sah_split(items: &mut [Item], node: &Summary, traversal: f64, pack: usize) -> Option<(usize, Option<[Summary; 2]>)> {
     let extent: [f32; 3] = std::array::from_fn(|a| node.centroid_hi[a] - node.centroid_lo[a]);
     let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
         0
@@ -643,20 +640,20 @@ fn sah_split(items: &mut [Item], node: &Summary, traversal: f64) -> Option<(usiz
     let mut acc = Summary::EMPTY;
     for i in (1..BINS).rev() {
         acc = acc.merge(&bins[i]);
-        right_area[i] = acc.bounds().surface_area() * acc.tests.cost();
+        right_area[i] = acc.bounds().surface_area() * acc.tests.cost(pack);
     }
     let (mut best, mut best_cost) = (0, f64::INFINITY);
     let mut left = Summary::EMPTY;
     for i in 0..BINS - 1 {
         left = left.merge(&bins[i]);
-        let cost = left.bounds().surface_area() * left.tests.cost() + right_area[i + 1];
+        let cost = left.bounds().surface_area() * left.tests.cost(pack) + right_area[i + 1];
         if cost < best_cost {
             best_cost = cost;
             best = i;
         }
     }
     let area = node.bounds().surface_area();
-    let leaf_cost = node.tests.cost() * area;
+    let leaf_cost = node.tests.cost(pack) * area;
     let split_cost = traversal * area + best_cost;
     if split_cost >= leaf_cost && items.len() <= 255 {
         return None;
@@ -685,6 +682,26 @@ fn bin_items<const AXIS: usize>(items: &mut [Item], lo: f32, per_unit: f32) -> [
         *set = set.add_lanes(it, l, h, c);
     }
     std::array::from_fn(|i| sets.iter().fold(Summary::EMPTY, |s, set| s.merge(&set[i])))
+}
+
+/// What the heuristic charges for a leaf: one test per started group of `pack` packed
+/// primitives, plus one per other primitive; leaves costing at most `max_tests` are not split.
+/// The same on every processor, so the tree (and with it which of two equally near hits wins)
+/// is the same everywhere.
+#[derive(Clone, Copy, Debug)]
+struct Leaves {
+    pack: usize,
+    max_tests: usize,
+}
+
+impl Leaves {
+    /// A mesh's flats, eight to a packet: charged four to a test (a leaf of up to sixteen is
+    /// not split). Charging eight, with leaves of up to eight or sixteen, measured no faster
+    /// (session 32, `BENCHMARKS.md`).
+    const MESH: Self = Self { pack: 4, max_tests: 4 };
+    /// The world's flats and spheres, eight to a packet: charged eight to a test, leaves of up
+    /// to sixteen not split (so a still life of a few dozen objects stays a leaf or two).
+    const WORLD: Self = Self { pack: 8, max_tests: 2 };
 }
 
 /// A node's split rule.
@@ -841,8 +858,10 @@ mod tests {
             })
             .collect();
         for method in [BuildMethod::Sah, BuildMethod::Morton] {
-            let sequential = Bvh::build_split_from(bounds.len(), |i| bounds[i], |i| i % 3 == 0, usize::MAX, method);
-            let parallel = Bvh::build_split_from(bounds.len(), |i| bounds[i], |i| i % 3 == 0, 256, method);
+            let sequential =
+                Bvh::build_split_from(bounds.len(), |i| bounds[i], |i| i % 3 == 0, usize::MAX, method, Leaves::WORLD);
+            let parallel =
+                Bvh::build_split_from(bounds.len(), |i| bounds[i], |i| i % 3 == 0, 256, method, Leaves::WORLD);
             assert_eq!(sequential.order, parallel.order);
             assert_eq!(sequential.wide, parallel.wide);
             assert!(sequential.wide.len() > 300);
