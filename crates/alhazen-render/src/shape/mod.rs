@@ -207,10 +207,12 @@ pub struct Placed {
 }
 
 impl Shape {
-    /// `∂p/∂u`, `∂p/∂v` at `hit` (object space), found by `c`; zero where the shape has none.
-    pub fn tangents(&self, hit: &SurfaceHit, c: Candidate) -> [Vec3; 2] {
+    /// `∂p/∂u`, `∂p/∂v` at the hit of `ray` found by `c` (object space); zero where the shape
+    /// has none. Only what they need of the surface is computed: a sphere's normal (not its
+    /// texture coordinates' inverse trigonometry), nothing of a mesh's or a plane's.
+    pub fn tangents(&self, ray: &Ray, c: Candidate) -> [Vec3; 2] {
         match self {
-            Shape::Sphere(s) => s.tangents(hit),
+            Shape::Sphere(s) => s.tangents(&s.hit_at_without_uv(ray, c.t)),
             Shape::Plane(p) => p.tangents(),
             Shape::Mesh(m) => m.tangents(c.aux as usize),
             _ => [Vec3::ZERO; 2],
@@ -222,11 +224,8 @@ impl Placed {
     /// `∂p/∂u`, `∂p/∂v` in world space at the hit of `ray` found by `c`.
     pub fn tangents(&self, ray: &Ray, c: Candidate) -> [Vec3; 2] {
         match &self.to_world {
-            None => self.shape.tangents(&self.shape.surface(ray, c), c),
-            Some(tf) => {
-                let local = tf.inverse_ray(ray);
-                self.shape.tangents(&self.shape.surface(&local, c), c).map(|d| tf.vector(d))
-            }
+            None => self.shape.tangents(ray, c),
+            Some(tf) => self.shape.tangents(&tf.inverse_ray(ray), c).map(|d| tf.vector(d)),
         }
     }
 

@@ -280,7 +280,7 @@ fn tangents_are_the_derivatives_of_the_texture_parametrisation() {
         let ray = Ray::new(origin, (target - origin).normalize());
         let c = shape.hit(&ray, f64::INFINITY).unwrap();
         let a = shape.surface(&ray, c);
-        let [dpdu, dpdv] = shape.tangents(&a, c);
+        let [dpdu, dpdv] = shape.tangents(&ray, c);
         let b = shape
             .intersect(&Ray::new(origin, (target + Vec3::new(d, 0.0, d) - origin).normalize()), f64::INFINITY)
             .unwrap();
