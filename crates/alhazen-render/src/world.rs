@@ -529,7 +529,7 @@ impl World {
             closer
         };
         // SAFETY: the caller's contract.
-        unsafe { self.bvh.traverse_leaves_with::<AVX2>(ray, t_best, visit) };
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<AVX2>(ray, t_best, |_| {}, visit) };
         best_flat.map(|(lane, h)| (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)).or(best)
     }
 
@@ -777,7 +777,7 @@ impl World {
             blocked.then_some(0.0)
         };
         // SAFETY: the caller's contract.
-        unsafe { self.bvh.traverse_leaves_with::<AVX2>(&ray, dist, visit) };
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<AVX2>(&ray, dist, |_| {}, visit) };
         !blocked
     }
 

@@ -331,23 +331,6 @@ impl Bvh {
         self.traverse_leaves_prefetching(ray, t_max, |_| {}, visit)
     }
 
-    /// [`Self::traverse_leaves`], its nodes tested in AVX2 registers with `AVX2`
-    /// ([`Self::traverse_leaves_prefetching_avx2`]).
-    ///
-    /// # Safety
-    /// `AVX2` only on a processor with AVX2.
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    pub unsafe fn traverse_leaves_with<const AVX2: bool>(
-        &self,
-        ray: &Ray,
-        t_max: f64,
-        visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
-    ) -> f64 {
-        // SAFETY: the caller's contract.
-        unsafe { self.walk::<AVX2>(ray, t_max, |_| {}, visit) }
-    }
-
     /// True when the whole tree is one leaf: traversal tests no node.
     pub fn is_one_leaf(&self) -> bool {
         self.start.is_none_or(|e| e.is_leaf())
@@ -366,35 +349,18 @@ impl Bvh {
         visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
     ) -> f64 {
         // SAFETY: without AVX2.
-        unsafe { self.walk::<false>(ray, t_max, prefetch, visit) }
+        unsafe { self.traverse_leaves_prefetching_with::<false>(ray, t_max, prefetch, visit) }
     }
 
-    /// [`Self::traverse_leaves_prefetching`] testing each node's eight children in one AVX2
-    /// register: the same leaves in the same order. Fast where the caller is compiled for AVX2
-    /// (`#[target_feature(enable = "avx2")]`), so the node test is inlined.
-    ///
-    /// # Safety
-    /// Only on a processor with AVX2.
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    pub unsafe fn traverse_leaves_prefetching_avx2(
-        &self,
-        ray: &Ray,
-        t_max: f64,
-        prefetch: impl Fn(std::ops::Range<usize>),
-        visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
-    ) -> f64 {
-        // SAFETY: the caller's contract.
-        unsafe { self.walk::<true>(ray, t_max, prefetch, visit) }
-    }
-
-    /// The traversal, its nodes tested by [`Slab::test`]`::<AVX2>`.
+    /// [`Self::traverse_leaves_prefetching`] with each node's eight children tested in one
+    /// AVX2 register when `AVX2`: the same leaves in the same order. Fast where the caller is
+    /// compiled for AVX2 (`#[target_feature(enable = "avx2")]`), so the node test is inlined.
     ///
     /// # Safety
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn walk<const AVX2: bool>(
+    pub unsafe fn traverse_leaves_prefetching_with<const AVX2: bool>(
         &self,
         ray: &Ray,
         mut t_max: f64,

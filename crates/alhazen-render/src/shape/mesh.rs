@@ -181,12 +181,8 @@ impl MeshShape {
     ) {
         let a = &*self.accel;
         let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
-        if AVX2 {
-            // SAFETY: the caller's contract.
-            unsafe { a.bvh.traverse_leaves_prefetching_avx2(ray, t_max, prefetch, visit) };
-        } else {
-            a.bvh.traverse_leaves_prefetching(ray, t_max, prefetch, visit);
-        }
+        // SAFETY: the caller's contract.
+        unsafe { a.bvh.traverse_leaves_prefetching_with::<AVX2>(ray, t_max, prefetch, visit) };
     }
 
     /// Nearest hit in `(0, t_max)`; `aux` is the triangle.
