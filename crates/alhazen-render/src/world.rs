@@ -499,6 +499,8 @@ impl World {
         unsafe { self.nearest_with::<true>(ray, t_max) }
     }
 
+    /// [`Self::nearest`] with the tree's node test of `AVX2` ([`Bvh::traverse_leaves_prefetching_with`]).
+    ///
     /// # Safety
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]
@@ -760,6 +762,8 @@ impl World {
         unsafe { self.unoccluded_with::<true>(origin, dir, dist) }
     }
 
+    /// [`Self::unoccluded`] with the tree's node test of `AVX2`.
+    ///
     /// # Safety
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]

@@ -207,6 +207,8 @@ impl MeshShape {
         unsafe { self.hit_with::<true>(ray, t_max) }
     }
 
+    /// [`Self::hit`] with the tree's node test of `AVX2`.
+    ///
     /// # Safety
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]
@@ -246,6 +248,8 @@ impl MeshShape {
         unsafe { self.blocks_with::<true>(ray, t_max) }
     }
 
+    /// [`Self::blocks`] with the tree's node test of `AVX2`.
+    ///
     /// # Safety
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]
