@@ -158,7 +158,7 @@ fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
         }
         Shape::Disk { center, normal, radius } => similarity().map(|s| Emitter::Disk {
             center: t.point(*center),
-            normal: t.normal(*normal),
+            normal: t.normal(*normal).normalize(),
             radius: radius * s,
         }),
         Shape::Mesh { mesh, .. } => {
