@@ -111,7 +111,7 @@ impl Flat {
 
 /// Up to eight flats, lane by lane; unused lanes (all zero) never report a hit.
 #[derive(Clone, Debug)]
-#[repr(C, align(32))]
+#[repr(C, align(64))]
 pub struct FlatPacket {
     /// Axis `a`'s coordinate `c` in `axes[a][c]`, lane by lane (normal, `u`, `v`).
     axes: [[[f32; LANES]; 3]; 3],
