@@ -219,8 +219,9 @@ struct Batches {
 }
 
 impl Batches {
-    fn new(any_sky: bool) -> Self {
-        Batches { all: Vec::new(), used: 0, open: [None; MATERIAL_KERNELS.len()], any_sky }
+    /// Batches in the storage `all` (a thread's, kept from its last call: see [`SPARE_BATCHES`]).
+    fn reusing(all: Vec<Batch>, any_sky: bool) -> Self {
+        Batches { all, used: 0, open: [None; MATERIAL_KERNELS.len()], any_sky }
     }
 
     /// Empties every batch for the next bounce (their storage kept).
@@ -245,13 +246,19 @@ impl Batches {
         self.used += 1;
         self.open[k] = Some(b);
         let batch = &mut self.all[b];
-        (batch.kernel, batch.len) = (kernel, 1);
+        (batch.kernel, batch.len, batch.lights.any_sky) = (kernel, 1, self.any_sky);
         // What a slot is not sure to overwrite: a stale bent normal would only cost the bump
         // kernel's work, a stale ask a light sample.
         batch.vertices.bumped = [false; LANES];
         batch.lights.asks = [None; LANES];
         (b, 0)
     }
+}
+
+thread_local! {
+    /// Each thread's batches between calls of [`PathTracer::pixels_in_lanes`]: a call that made
+    /// its own grew them anew, their 14 KB apiece cleared and copied for every row of pixels.
+    static SPARE_BATCHES: std::cell::RefCell<Vec<Batch>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// One sample's path in a lane, or none: a lane's record stays in its place and is restarted
@@ -444,6 +451,14 @@ impl PathTracer<'_> {
     /// Samples `first..` of `pixels`, traced in lanes: `out` holds each pixel's samples in
     /// turn, sample `first + i` of pixel `p` at `out[p × n + i]` (`n` samples per pixel).
     pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
+        let any_sky = self.lane_lights.as_ref().is_some_and(|all| all.iter().any(|k| k.sky));
+        let mut batches = Batches::reusing(SPARE_BATCHES.take(), any_sky);
+        self.trace_in_lanes(pixels, first, out, &mut batches);
+        SPARE_BATCHES.set(batches.all);
+    }
+
+    /// [`Self::pixels_in_lanes`] with the vertices shaded in `batches`.
+    fn trace_in_lanes(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3], batches: &mut Batches) {
         let mut lanes: [LanePath; POOL] = std::array::from_fn(|_| LanePath::idle());
         let spp = out.len() / pixels.len().max(1);
         let mut next = 0..out.len();
@@ -452,8 +467,6 @@ impl PathTracer<'_> {
         let mut rays = [RayPacket::default(); GROUPS];
         let mut hits: [[Option<WorldHit>; LANES]; GROUPS] = [[None; LANES]; GROUPS];
         let mut general: [Vertex; POOL] = std::array::from_fn(|_| Vertex::default());
-        let any_sky = self.lane_lights.as_ref().is_some_and(|all| all.iter().any(|k| k.sky));
-        let mut batches = Batches::new(any_sky);
         let mut kernels = [Kernel::Idle; POOL];
         let mut at = [(0, 0); POOL];
         let (mut shadows, mut dist) = ([RayPacket::default(); GROUPS], [[0.0; LANES]; GROUPS]);
@@ -531,7 +544,7 @@ impl PathTracer<'_> {
                 let traced = together || sky_map;
                 let alone = if traced { None } else { self.world.intersect(&lane.path.ray, f64::INFINITY) };
                 let hit = if traced { hits[g][i].as_ref() } else { alone.as_ref() };
-                if let Some((b, s)) = self.kernel_vertex(lane, hit, &mut batches) {
+                if let Some((b, s)) = self.kernel_vertex(lane, hit, batches) {
                     (kernels[p], at[p]) = (batches.all[b].kernel, (b, s));
                     continue;
                 }
@@ -1411,7 +1424,7 @@ material = "glow"
         /// set of batches starts afresh with its storage kept.
         #[test]
         fn batches_hold_each_kernel_apart(kinds in proptest::collection::vec(0..MATERIAL_KERNELS.len(), 0..POOL)) {
-            let mut batches = Batches::new(false);
+            let mut batches = Batches::reusing(vec![], false);
             for round in 0..2 {
                 batches.clear();
                 let mut taken = std::collections::HashSet::new();
