@@ -1,6 +1,6 @@
 //! The renderable world: every object of the scene placed, with a top-level BVH over the
-//! bounded ones and a plain list of unbounded ones (planes). Small meshes, rectangles and
-//! untextured boxes are flattened into world-space triangles and parallelograms, which the
+//! bounded ones (one leaf for a world of a few) and a plain list of unbounded ones (planes,
+//! which each ray meets first). Small meshes, rectangles and untextured boxes are flattened into world-space triangles and parallelograms, which the
 //! BVH's leaves test eight at a time in single precision ([`FlatPacket`]); a leaf's untransformed spheres
 //! are [`SpherePacket`]s; other objects are tested one by one, behind a test of their world box. Eight rays
 //! can be traced in one call ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path
@@ -29,6 +29,19 @@ fn padded(b: Bounds3) -> Bounds3 {
 #[inline(always)]
 fn inverse_dirs(rays: &RayPacket) -> [[f64; LANES]; 3] {
     rays.dir.map(|d| d.map(|x| 1.0 / x))
+}
+
+/// A world whose primitives cost at most this many tests (a packet of flats or spheres, or
+/// another object, one each), its packets no more than a leaf holds, is one leaf: rays traced
+/// eight at a time through it, each object behind its box, measured faster than through the
+/// SAH's tree at 12 tests or fewer (even at 16, slower at 20; with more packets, slower:
+/// `BENCHMARKS.md`, session 33).
+const ONE_LEAF_TESTS: usize = 12;
+
+/// One ray's reciprocal direction as lane 0 of [`inverse_dirs`]'s.
+fn inverse_dir(ray: &Ray) -> [[f64; LANES]; 3] {
+    let d = ray.dir.to_array();
+    std::array::from_fn(|a| std::array::from_fn(|r| if r == 0 { 1.0 / d[a] } else { 0.0 }))
 }
 
 /// Whether the segment `(0, t_max)` of `ray` (reciprocal direction lane `r` of `inv`) may meet box
@@ -103,10 +116,10 @@ pub struct World {
     unbounded: Vec<u32>,
     /// The packets' kernel for this processor.
     vectors: VectorUnit,
-    /// Everything is in one leaf and nothing is unbounded: its flats are tested against eight
-    /// rays at once, ray by lane (then each ray's spheres and other objects).
+    /// Everything bounded is in one leaf: its flats are tested against eight rays at once, ray
+    /// by lane (after each ray's unbounded objects, before its spheres and other objects).
     one_leaf: bool,
-    /// ... and the leaf holds only flats.
+    /// ... the leaf holds only flats, and nothing is unbounded.
     flats_only: bool,
     /// Beside `flats.lanes` in a one-leaf world, for flats without smooth normals: each
     /// triangle's normal and material.
@@ -388,13 +401,18 @@ impl World {
         // neither do the order of tests nor the hit chosen on a tie. Flats and untransformed
         // spheres are both tested in packets: a few spheres on a floor make one leaf, whose
         // rays the lanes trace together (the glossy suite scene 1.29 → 1.06 s).
-        let mut bvh = Bvh::build_packed(&prim_bounds, |k| {
-            matches!(primitives[k], Primitive::Flat { .. } | Primitive::Sphere { .. })
-        });
+        // A world of a few objects stays one leaf even where the SAH would split it: its rays
+        // are then traced eight at a time ([`Self::intersect_rays`]), each object behind its box.
+        let mut bvh = Bvh::build_packed_within(
+            &prim_bounds,
+            |k| matches!(primitives[k], Primitive::Flat { .. } | Primitive::Sphere { .. }),
+            ONE_LEAF_TESTS,
+        );
         let mut world = Self { objects, unbounded, vectors: unit, ..Self::default() };
         world.fill_leaves(&mut bvh, &primitives);
-        world.one_leaf = world.unbounded.is_empty() && world.leaves.len() == 1;
+        world.one_leaf = world.leaves.len() == 1;
         world.flats_only = world.one_leaf
+            && world.unbounded.is_empty()
             && matches!(world.leaves.as_slice(), [leaf] if leaf.spheres.is_empty() && leaf.objects.is_empty());
         world.bvh = bvh;
         if world.one_leaf {
@@ -506,14 +524,8 @@ impl World {
     #[inline(always)]
     #[allow(unsafe_code)]
     unsafe fn nearest_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
-        let mut best: Option<(Candidate, u32)> = None;
-        let mut t_best = t_max;
-        for &i in &self.unbounded {
-            if let Some(c) = self.objects[i as usize].placed.hit(ray, t_best) {
-                t_best = c.t;
-                best = Some((c, i));
-            }
-        }
+        let mut best = self.nearest_unbounded(ray, t_max);
+        let t_best = best.map_or(t_max, |(c, _)| c.t);
         // The nearest flat's packet and lane; made a candidate once, after the traversal.
         let mut best_flat: Option<(Lane, LaneHit)> = None;
         let visit = |range: std::ops::Range<usize>, t_max| {
@@ -535,6 +547,27 @@ impl World {
         best_flat.map(|(lane, h)| (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)).or(best)
     }
 
+    /// The nearest hit on an unbounded object (a plane) before `t_max`: the first of equally
+    /// near ones.
+    #[inline]
+    fn nearest_unbounded(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
+        let mut best = None;
+        let mut t_best = t_max;
+        for &i in &self.unbounded {
+            if let Some(c) = self.objects[i as usize].placed.hit(ray, t_best) {
+                t_best = c.t;
+                best = Some((c, i));
+            }
+        }
+        best
+    }
+
+    /// True when an unbounded object lies on `ray` before `t_max`.
+    #[inline]
+    fn unbounded_blocks(&self, ray: &Ray, t_max: f64) -> bool {
+        self.unbounded.iter().any(|&i| self.objects[i as usize].placed.blocks(ray, t_max))
+    }
+
     /// The nearest of `leaf`'s spheres and other objects before `t_max` (its flats tested
     /// already): the candidate and its object.
     #[inline]
@@ -543,7 +576,15 @@ impl World {
         // Most leaves hold no sphere packet: skip the kernel's call.
         let sphere =
             if spheres.is_empty() { None } else { SpherePacket::nearest_of(spheres, ray, t_max, self.vectors) };
-        self.nearest_solid_after(leaf, ray, t_max, sphere, None)
+        let inv = self.culls_by_box(leaf).then(|| inverse_dir(ray));
+        self.nearest_solid_after(leaf, ray, t_max, sphere, inv.as_ref().map(|inv| (inv, 0)))
+    }
+
+    /// A ray's objects in `leaf` are culled by their boxes first: the world is one leaf of
+    /// several (no tree culled them).
+    #[inline]
+    fn culls_by_box(&self, leaf: &Leaf) -> bool {
+        self.one_leaf && leaf.objects.len() > 1
     }
 
     /// The nearest sphere hit of each of eight rays in `leaf` ([`SpherePacket::nearest_of_rays`]).
@@ -597,7 +638,12 @@ impl World {
     fn solid_blocks(&self, leaf: &Leaf, ray: &Ray, t_max: f64) -> bool {
         !leaf.spheres.is_empty()
             && SpherePacket::nearest_of(&self.spheres[leaf.spheres.clone()], ray, t_max, self.vectors).is_some()
-            || self.objects_block(leaf, ray, t_max, None)
+            || self.objects_block(
+                leaf,
+                ray,
+                t_max,
+                self.culls_by_box(leaf).then(|| inverse_dir(ray)).as_ref().map(|inv| (inv, 0)),
+            )
     }
 
     /// True when one of `leaf`'s other objects (not flats, not packed spheres) lies on `ray`
@@ -654,18 +700,34 @@ impl World {
         FlatPacket::nearest_of_rays(&self.flats.packets, rays, live, self.vectors, |r, k, h| {
             flat[r] = Some((k, h));
         });
+        // The unbounded objects first, as `nearest` tests them: a flat is nearer only below
+        // their hit, compared as `FlatPacket::nearest_of` compares with its limit.
+        let unbounded: [Option<(Candidate, u32)>; LANES] =
+            std::array::from_fn(|r| if live[r] { self.nearest_unbounded(&each[r], f64::INFINITY) } else { None });
+        for (f, u) in flat.iter_mut().zip(&unbounded) {
+            if let (Some((_, h)), Some((c, _))) = (*f, u)
+                && h.t as f32 >= c.t as f32
+            {
+                *f = None;
+            }
+        }
         let leaf = &self.leaves[0];
-        let t_max = flat.map(|f| f.map_or(f64::INFINITY, |(_, h)| h.t));
+        let t_max: [f64; LANES] = std::array::from_fn(|r| match (flat[r], unbounded[r]) {
+            (Some((_, h)), _) => h.t,
+            (None, Some((c, _))) => c.t,
+            (None, None) => f64::INFINITY,
+        });
         let spheres = self.spheres_of_rays(leaf, rays, &t_max, live);
         let inv = (!leaf.objects.is_empty()).then(|| inverse_dirs(rays));
         for (r, slot) in out.iter_mut().enumerate() {
             let ray = &each[r];
             let inv = inv.as_ref().map(|inv| (inv, r));
             let solid = if live[r] { self.nearest_solid_after(leaf, ray, t_max[r], spheres[r], inv) } else { None };
-            *slot = match (solid, flat[r]) {
-                (Some((c, i)), _) => Some(self.surface_of(ray, c, i)),
-                (None, Some((k, h))) => Some(self.flat_hit(ray, k, h)),
-                (None, None) => None,
+            *slot = match (solid, flat[r], unbounded[r]) {
+                (Some((c, i)), ..) => Some(self.surface_of(ray, c, i)),
+                (None, Some((k, h)), _) => Some(self.flat_hit(ray, k, h)),
+                (None, None, Some((c, i))) => Some(self.surface_of(ray, c, i)),
+                (None, None, None) => None,
             };
         }
     }
@@ -694,7 +756,9 @@ impl World {
         if self.one_leaf {
             let blocked = FlatPacket::any_of_rays(&self.flats.packets, rays, dist, live, self.vectors);
             let leaf = &self.leaves[0];
-            let open = std::array::from_fn(|r| live[r] && !blocked[r]);
+            let open = std::array::from_fn(|r| {
+                live[r] && !blocked[r] && (self.unbounded.is_empty() || !self.unbounded_blocks(&rays.ray(r), dist[r]))
+            });
             let spheres = if self.flats_only { [None; LANES] } else { self.spheres_of_rays(leaf, rays, dist, open) };
             let inv = (!leaf.objects.is_empty()).then(|| inverse_dirs(rays));
             return std::array::from_fn(|r| {
@@ -770,7 +834,7 @@ impl World {
     #[allow(unsafe_code)]
     unsafe fn unoccluded_with<const AVX2: bool>(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
         let ray = Ray::new(origin, dir);
-        if self.unbounded.iter().any(|&i| self.objects[i as usize].placed.blocks(&ray, dist)) {
+        if self.unbounded_blocks(&ray, dist) {
             return false;
         }
         let mut blocked = false;
@@ -888,8 +952,8 @@ mod tests {
     }
 
     /// Rays into one-leaf worlds of flats and solids (a packet of three spheres; a packet of two
-    /// and a cylinder tested alone), eight at a time and one by one: the same hits and the same
-    /// shadows.
+    /// and a cylinder tested alone; a mesh; a plane and six cylinders beside them), eight at a
+    /// time and one by one: the same hits and the same shadows.
     #[test]
     fn eight_rays_meet_a_leaf_of_flats_and_solids_as_one_does() {
         let rectangle = "[[object]]\nshape = \"rectangle\"\ntransform = [{ scale = 3 }, { rotate_x = -90 }, { translate = [0, -1, 0] }]\n";
@@ -901,7 +965,19 @@ mod tests {
         let mesh = "[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 3\nsmooth = true\n\
                     transform = [{ scale = 0.5 }, { rotate_y = 30 }, { translate = [0.4, -0.2, 1.0] }]\n";
         let meshes = format!("{rectangle}{}{}{mesh}", sphere(-1.5), sphere(1.5));
-        for (text, packets) in [(packet, 1), (singles, 1), (meshes, 1)] {
+        // An unbounded plane, tested first (it crosses the rectangle and the spheres), and a
+        // few cylinders, more than a tree's leaf holds.
+        let plane = "[[object]]\nshape = \"plane\"\npoint = [0, -0.7, 0]\nnormal = [0.2, 1, 0.1]\n";
+        let cylinders: String = (0..6)
+            .map(|k| {
+                format!(
+                    "[[object]]\nshape = \"cylinder\"\nradius = 0.2\nbase = [{x}, -1, 1]\ntop = [{x}, 0.5, 1]\n",
+                    x = k as f64 - 2.5
+                )
+            })
+            .collect();
+        let planar = format!("{packet}{plane}{cylinders}");
+        for (text, packets) in [(packet, 1), (singles, 1), (meshes, 1), (planar, 1)] {
             let world = World::build(&scene::parse_scene("leaf.toml".as_ref(), &text).unwrap());
             assert!(world.one_leaf && !world.flats_only, "one leaf of flats and solids");
             assert_eq!(world.spheres.len(), packets);

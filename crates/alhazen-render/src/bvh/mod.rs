@@ -106,7 +106,12 @@ impl Tree {
         let me = self.nodes.len();
         let (min, max) = ([node.lo[0], node.lo[1], node.lo[2]], [node.hi[0], node.hi[1], node.hi[2]]);
         self.nodes.push(Node { min, max, offset: first as u32, count: items.len() as u32, remote: false });
-        let small = items.len() == 1 || node.tests.cost(leaves.pack) <= leaves.max_tests as f64;
+        let cost = node.tests.cost(leaves.pack);
+        // The whole set within `whole` tests stays one leaf if its packets would fit a leaf:
+        // its other primitives are each culled by their own box, its packets are not.
+        let whole =
+            depth == 0 && cost <= leaves.whole as f64 && node.tests.packed.div_ceil(leaves.pack) <= leaves.max_tests;
+        let small = items.len() == 1 || cost <= leaves.max_tests as f64 || whole;
         let split = match how {
             _ if small || depth >= MAX_DEPTH => None,
             Split::Sah { traversal } => sah_split(items, &node, traversal, leaves.pack),
@@ -254,7 +259,14 @@ impl Bvh {
     /// them plus one per other primitive ([`Leaves::WORLD`]), so leaves of such primitives grow
     /// large.
     pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync) -> Self {
-        Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, BuildMethod::Sah, Leaves::WORLD)
+        Self::build_packed_within(bounds, packed, 0)
+    }
+
+    /// [`Self::build_packed`], one leaf when all the primitives together cost at most `whole`
+    /// tests.
+    pub fn build_packed_within(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync, whole: usize) -> Self {
+        let leaves = Leaves { whole, ..Leaves::WORLD };
+        Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, BuildMethod::Sah, leaves)
     }
 
     /// [`Self::build_packed`] building subtrees of at least `parallel_from` primitives in
@@ -658,16 +670,19 @@ fn bin_items<const AXIS: usize>(items: &mut [Item], lo: f32, per_unit: f32) -> [
 struct Leaves {
     pack: usize,
     max_tests: usize,
+    /// A whole set costing at most this many tests, its packets at most `max_tests`, is one
+    /// leaf (the root is not split).
+    whole: usize,
 }
 
 impl Leaves {
     /// A mesh's flats, eight to a packet: charged four to a test (a leaf of up to sixteen is
     /// not split). Charging eight, with leaves of up to eight or sixteen, measured no faster
     /// (session 32, `BENCHMARKS.md`).
-    const MESH: Self = Self { pack: 4, max_tests: 4 };
+    const MESH: Self = Self { pack: 4, max_tests: 4, whole: 0 };
     /// The world's flats and spheres, eight to a packet: charged eight to a test, leaves of up
     /// to sixteen not split (so a still life of a few dozen objects stays a leaf or two).
-    const WORLD: Self = Self { pack: 8, max_tests: 2 };
+    const WORLD: Self = Self { pack: 8, max_tests: 2, whole: 0 };
 }
 
 /// A node's split rule.
@@ -803,6 +818,26 @@ mod tests {
             seen.sort_unstable();
             proptest::prop_assert!(seen.iter().copied().eq(0..bins.len() as u32));
             proptest::prop_assert!(items.iter().all(|it| bins[it.index as usize] == it.bin));
+        }
+    }
+
+    /// A set costing at most `whole` tests is one leaf where the SAH splits it; one costing
+    /// more is split as before (its tree unchanged below the root).
+    #[test]
+    fn a_set_within_whole_is_one_leaf() {
+        // Ten boxes far apart in a row, two of them packed (one test between them): 9 tests.
+        let bounds: Vec<Bounds3> = (0..10)
+            .map(|k| Bounds3 {
+                min: Vec3::new(10.0 * k as f64, 0.0, 0.0),
+                max: Vec3::new(10.0 * k as f64 + 1.0, 1.0, 1.0),
+            })
+            .collect();
+        let packed = |i: usize| i < 2;
+        assert!(!Bvh::build_packed(&bounds, packed).is_one_leaf());
+        for (whole, one) in [(8, false), (9, true), (12, true)] {
+            let bvh = Bvh::build_packed_within(&bounds, packed, whole);
+            assert_eq!(bvh.is_one_leaf(), one, "within {whole}");
+            assert_eq!(bvh.leaves().count(), if one { 1 } else { Bvh::build_packed(&bounds, packed).leaves().count() });
         }
     }
 

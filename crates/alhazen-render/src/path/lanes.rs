@@ -1445,11 +1445,14 @@ material = "glow"
     }
 
     /// The lanes trace every scene where the processor has a vector unit for their kernels;
-    /// the world tests their eight rays at once where it is one leaf (the Cornell boxes; not
-    /// the prism, whose floor is an unbounded plane).
+    /// the world tests their eight rays at once where it is one leaf (the Cornell boxes; the
+    /// prism too, whose floor, an unbounded plane, each ray meets first; not the scene graph's
+    /// tree of many objects).
     #[test]
     fn lanes_apply_with_vector_units() {
-        for (name, together) in [("cornell-box", true), ("cornell-rough", true), ("prism", false)] {
+        for (name, together) in
+            [("cornell-box", true), ("cornell-rough", true), ("prism", true), ("scene-graph", false)]
+        {
             let scene = small(name, (8, 8, 1));
             for unit in VectorUnit::available() {
                 let world = World::build_with(&scene, unit);
