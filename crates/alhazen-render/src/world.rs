@@ -1,11 +1,12 @@
-//! The renderable world: every object of the scene placed, with a top-level BVH over the
-//! bounded ones (one leaf for a world of a few) and a plain list of unbounded ones (planes,
-//! which each ray meets first). Small meshes, rectangles and untextured boxes are flattened into world-space triangles and parallelograms, which the
-//! BVH's leaves test eight at a time in single precision ([`FlatPacket`]); a leaf's untransformed spheres
-//! are [`SpherePacket`]s; other objects are tested one by one, behind a test of their world box. Eight rays
-//! can be traced in one call ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path
-//! tracer's lanes); when the world is one leaf, each flat and each packed sphere is tested
-//! against the eight at once, then each ray's other objects.
+//! The renderable world: every object of the scene placed, with a top-level BVH over the bounded
+//! ones (one leaf for a world of a few) and a plain list of unbounded ones (planes, which each ray
+//! meets first). Small meshes, rectangles and untextured boxes are flattened into world-space
+//! triangles and parallelograms, which the BVH's leaves test eight at a time in single precision
+//! ([`FlatPacket`]); a leaf's untransformed spheres are [`SpherePacket`]s; other objects are tested
+//! one by one, behind a test of their world box. Eight rays can be traced in one call
+//! ([`World::intersect_rays`], [`World::unoccluded_rays`]: the path tracer's lanes); when the world
+//! is one leaf, each flat and each packed sphere is tested against the eight at once, then each
+//! ray's other objects.
 
 use crate::bvh::Bvh;
 use crate::shape::{
