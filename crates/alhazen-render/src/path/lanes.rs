@@ -21,8 +21,8 @@
 //! surfaces, on conductors, glass and plastic (smooth, or rough of Trowbridge–Reitz or
 //! Beckmann facets) — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
 //! instead: their random numbers, emission, material and bent normal per lane
-//! ([`PathTracer::kernel_vertex`]), then light points (on parallelogram lights in lanes,
-//! [`sample_lights`]; on other lights for all lanes at once, [`Lights::sample_lanes`], an
+//! ([`PathTracer::kernel_vertex`]), then light points (on parallelogram and point lights in
+//! lanes, [`sample_lights`]; on other lights for all lanes at once, [`Lights::sample_lanes`], an
 //! environment map's memory asked for every lane before any lane waits for it) and the shading
 //! frame, next-event weights, bump shadowing, sampled continuation and Russian roulette
 //! ([`shade`]) for all lanes at once, loops without branches the compiler turns into AVX-512 or
@@ -116,8 +116,9 @@ struct Vertices {
     u_roulette: Lanes,
 }
 
-/// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`), or a sky
-/// of one colour (`sky`: sampled uniformly over the sphere, as `Lights::sample` does).
+/// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`), a point
+/// light (`point`: at `corner`, `radiance` its intensity, as `Lights::sample` takes it) or a
+/// sky of one colour (`sky`: sampled uniformly over the sphere, as `Lights::sample` does).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct LaneLight {
     corner: Vec3,
@@ -128,14 +129,16 @@ pub(super) struct LaneLight {
     pdf_area: f64,
     radiance: Vec3,
     sky: bool,
+    point: bool,
 }
 
-/// The lights in lane form when every one is a parallelogram or a sky of one colour (the lanes
-/// then sample them too).
+/// The lights in lane form when every one is a parallelogram, a point or a sky of one colour
+/// (the lanes then sample them too).
 pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
-    let lights = lights.parallelograms_and_sky()?.into_iter().map(|(e, radiance)| match e {
+    let lights = lights.parallelograms_points_and_sky()?.into_iter().map(|(e, radiance, point)| match e {
         Some(Emitter::Parallelogram { origin, e1, e2, normal, area }) => {
-            Some(LaneLight { corner: origin, e1, e2, normal, pdf_area: 1.0 / area, radiance, sky: false })
+            let pdf_area = if point { 0.0 } else { 1.0 / area };
+            Some(LaneLight { corner: origin, e1, e2, normal, pdf_area, radiance, sky: false, point })
         }
         None => Some(LaneLight {
             corner: Vec3::ZERO,
@@ -145,13 +148,15 @@ pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
             pdf_area: 0.0,
             radiance,
             sky: true,
+            point: false,
         }),
         _ => None,
     });
     lights.collect()
 }
 
-/// Where the lanes sample parallelogram lights: each lane's light and its two numbers.
+/// Where the lanes sample parallelogram and point lights: each lane's light and its two
+/// numbers.
 #[derive(Clone, Debug, Default)]
 struct LightLanes {
     corner: Lanes3,
@@ -163,6 +168,9 @@ struct LightLanes {
     /// The lane samples the sky of one colour; `any_sky`: some light is that sky.
     sky: [bool; LANES],
     any_sky: bool,
+    /// The lane samples a point light; `any_point`: some light is a point.
+    point: [bool; LANES],
+    any_point: bool,
     /// When some light is an environment map: what each lane asks of [`Lights::sample_lanes`]
     /// ([`Lights::ask`]), `None` where it asks nothing.
     asks: [Option<LightAsk>; LANES],
@@ -214,14 +222,16 @@ struct Batches {
     all: Vec<Batch>,
     used: usize,
     open: [Option<usize>; MATERIAL_KERNELS.len()],
-    /// Whether some light is a sky of one colour (see [`LightLanes::any_sky`]).
+    /// Whether some light is a sky of one colour or a point (see [`LightLanes::any_sky`],
+    /// [`LightLanes::any_point`]).
     any_sky: bool,
+    any_point: bool,
 }
 
 impl Batches {
     /// Batches in the storage `all` (a thread's, kept from its last call: see [`SPARE_BATCHES`]).
-    fn reusing(all: Vec<Batch>, any_sky: bool) -> Self {
-        Batches { all, used: 0, open: [None; MATERIAL_KERNELS.len()], any_sky }
+    fn reusing(all: Vec<Batch>, any_sky: bool, any_point: bool) -> Self {
+        Batches { all, used: 0, open: [None; MATERIAL_KERNELS.len()], any_sky, any_point }
     }
 
     /// Empties every batch for the next bounce (their storage kept).
@@ -238,7 +248,7 @@ impl Batches {
             return (b, self.all[b].len - 1);
         }
         if self.used == self.all.len() {
-            let lights = LightLanes { any_sky: self.any_sky, ..LightLanes::default() };
+            let lights = LightLanes { any_sky: self.any_sky, any_point: self.any_point, ..LightLanes::default() };
             let (vertices, shaded) = (Vertices::default(), Shaded::default());
             self.all.push(Batch { kernel, len: 0, vertices, lights, shaded });
         }
@@ -246,7 +256,8 @@ impl Batches {
         self.used += 1;
         self.open[k] = Some(b);
         let batch = &mut self.all[b];
-        (batch.kernel, batch.len, batch.lights.any_sky) = (kernel, 1, self.any_sky);
+        (batch.kernel, batch.len) = (kernel, 1);
+        (batch.lights.any_sky, batch.lights.any_point) = (self.any_sky, self.any_point);
         // What a slot is not sure to overwrite: a stale bent normal would only cost the bump
         // kernel's work, a stale ask a light sample.
         batch.vertices.bumped = [false; LANES];
@@ -451,8 +462,8 @@ impl PathTracer<'_> {
     /// Samples `first..` of `pixels`, traced in lanes: `out` holds each pixel's samples in
     /// turn, sample `first + i` of pixel `p` at `out[p × n + i]` (`n` samples per pixel).
     pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
-        let any_sky = self.lane_lights.as_ref().is_some_and(|all| all.iter().any(|k| k.sky));
-        let mut batches = Batches::reusing(SPARE_BATCHES.take(), any_sky);
+        let any = |kind: fn(&LaneLight) -> bool| self.lane_lights.as_ref().is_some_and(|all| all.iter().any(kind));
+        let mut batches = Batches::reusing(SPARE_BATCHES.take(), any(|k| k.sky), any(|k| k.point));
         self.trace_in_lanes(pixels, first, out, &mut batches);
         SPARE_BATCHES.set(batches.all);
     }
@@ -721,10 +732,10 @@ impl PathTracer<'_> {
                 set(&mut lights.e2, i, k.e2);
                 set(&mut lights.normal, i, k.normal);
                 lights.pdf_area[i] = k.pdf_area;
-                lights.sky[i] = k.sky;
+                (lights.sky[i], lights.point[i]) = (k.sky, k.point);
                 (lights.u[0][i], lights.u[1][i]) = (u_light.x, u_light.y);
                 set(&mut v.light_radiance, i, k.radiance);
-                (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, false);
+                (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, k.point);
             }
             None if self.lights.has_environment() => lights.asks[i] = Some(self.lights.ask(h.p, choice, u_light)),
             None => {
@@ -790,52 +801,62 @@ fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> boo
     s.alive[i]
 }
 
-/// Every lane's point on its parallelogram light or direction to the sky, as `Lights::sample`
-/// computes it.
+/// Every lane's point on its parallelogram light, its point light's position or its direction
+/// to the sky, as `Lights::sample` computes them.
 fn sample_lights(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
-    if k.any_sky {
-        sample_lights_in::<true>(k, v, choice_pdf, unit)
-    } else {
-        sample_lights_in::<false>(k, v, choice_pdf, unit)
+    match (k.any_sky, k.any_point) {
+        (false, false) => sample_lights_in::<false, false>(k, v, choice_pdf, unit),
+        (true, false) => sample_lights_in::<true, false>(k, v, choice_pdf, unit),
+        (false, true) => sample_lights_in::<false, true>(k, v, choice_pdf, unit),
+        (true, true) => sample_lights_in::<true, true>(k, v, choice_pdf, unit),
     }
 }
 
 #[allow(unsafe_code)]
-fn sample_lights_in<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
+fn sample_lights_in<const SKY: bool, const POINT: bool>(
+    k: &LightLanes,
+    v: &mut Vertices,
+    choice_pdf: f64,
+    unit: VectorUnit,
+) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { sample_lights_avx512::<SKY>(k, v, choice_pdf) };
+        return unsafe { sample_lights_avx512::<SKY, POINT>(k, v, choice_pdf) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { sample_lights_avx2::<SKY>(k, v, choice_pdf) };
+        return unsafe { sample_lights_avx2::<SKY, POINT>(k, v, choice_pdf) };
     }
     let _ = unit;
-    (0..LANES).for_each(|i| sample_light::<SKY>(k, v, choice_pdf, i));
+    (0..LANES).for_each(|i| sample_light::<SKY, POINT>(k, v, choice_pdf, i));
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn sample_lights_avx512<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
-    (0..LANES).for_each(|i| sample_light::<SKY>(k, v, choice_pdf, i));
+unsafe fn sample_lights_avx512<const SKY: bool, const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
+    (0..LANES).for_each(|i| sample_light::<SKY, POINT>(k, v, choice_pdf, i));
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn sample_lights_avx2<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
-    (0..LANES).for_each(|i| sample_light::<SKY>(k, v, choice_pdf, i));
+unsafe fn sample_lights_avx2<const SKY: bool, const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
+    (0..LANES).for_each(|i| sample_light::<SKY, POINT>(k, v, choice_pdf, i));
 }
 
 /// Lane `i`'s point on its parallelogram, as `lights::sample_area` computes it, or (`SKY`:
-/// some light is the sky, and this lane's is) its direction uniform over the sphere, as
-/// `Lights::sample` draws it. Both are computed and one kept, so the lanes do not branch.
+/// some light is the sky, and this lane's is) its direction uniform over the sphere, or
+/// (`POINT`: some light is a point, and this lane's is) the point with its intensity over the
+/// squared distance, as `Lights::sample` draws them. All are computed and one kept, so the
+/// lanes do not branch.
 #[inline(always)]
-fn sample_light<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
-    let q = get(&k.corner, i) + get(&k.e1, i) * k.u[0][i] + get(&k.e2, i) * k.u[1][i];
+fn sample_light<const SKY: bool, const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
+    let corner = get(&k.corner, i);
+    let on_area = corner + get(&k.e1, i) * k.u[0][i] + get(&k.e2, i) * k.u[1][i];
+    let q = if POINT && k.point[i] { corner } else { on_area };
     let to = q - get(&v.p, i);
     let d2 = to.length_squared();
     let dist = d2.sqrt();
@@ -848,6 +869,14 @@ fn sample_light<const SKY: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f
         v.light[i] &= not_at_most_zero(sky_pdf);
         set(&mut v.light_dir, i, crate::lights::uniform_sphere(Vec2::new(k.u[0][i], k.u[1][i])));
         (v.light_dist[i], v.light_pdf[i]) = (f64::INFINITY, sky_pdf);
+    } else if POINT && k.point[i] {
+        // `Lights::sample`'s point: `dist` is `to.length()`, the radiance its intensity over
+        // `dist · dist`, the density the choice's alone.
+        let (radiance, pdf) = (get(&v.light_radiance, i) / (dist * dist), 1.0 * choice_pdf);
+        v.light[i] &= dist > 0.0 && radiance != Vec3::ZERO && not_at_most_zero(pdf);
+        set(&mut v.light_dir, i, dir);
+        set(&mut v.light_radiance, i, radiance);
+        (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
     } else {
         v.light[i] &= area_ok;
         set(&mut v.light_dir, i, dir);
@@ -1378,7 +1407,16 @@ material = "glow"
         two_lights_and_sky.background = sky;
         let mut rough_under_sky = small("cornell-rough", (16, 16, 7));
         rough_under_sky.background = sky;
+        // Point lights beside a parallelogram and a sky: the lanes sample them too (one on
+        // the floor's plane, whose points there are at no distance from it).
+        let mut points = small("cornell-rough", (16, 16, 9));
+        points.background = sky;
+        for (position, intensity) in [(Vec3::new(0.3, 0.6, 0.4), 0.5), (Vec3::new(-0.5, -1.0, 0.2), 0.2)] {
+            let intensity = Vec3::splat(intensity);
+            points.lights.push(alhazen_scene::Light::Point { position, intensity, attenuation: [1.0, 0.0, 0.0] });
+        }
         let scenes = [
+            ("point lights, a parallelogram and a sky", points),
             ("two lights and a sky", two_lights_and_sky),
             ("cornell-rough and a sky", rough_under_sky),
             ("cornell-box", small("cornell-box", (20, 20, 11))),
@@ -1424,7 +1462,7 @@ material = "glow"
         /// set of batches starts afresh with its storage kept.
         #[test]
         fn batches_hold_each_kernel_apart(kinds in proptest::collection::vec(0..MATERIAL_KERNELS.len(), 0..POOL)) {
-            let mut batches = Batches::reusing(vec![], false);
+            let mut batches = Batches::reusing(vec![], false, false);
             for round in 0..2 {
                 batches.clear();
                 let mut taken = std::collections::HashSet::new();
