@@ -263,7 +263,7 @@ impl Bvh {
     }
 
     /// [`Self::build_packed`], one leaf when all the primitives together cost at most `whole`
-    /// tests.
+    /// tests and their packets fit a leaf.
     pub fn build_packed_within(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync, whole: usize) -> Self {
         let leaves = Leaves { whole, ..Leaves::WORLD };
         Self::build_split_from(bounds.len(), |i| bounds[i], packed, PARALLEL_ITEMS, BuildMethod::Sah, leaves)
@@ -839,6 +839,10 @@ mod tests {
             assert_eq!(bvh.is_one_leaf(), one, "within {whole}");
             assert_eq!(bvh.leaves().count(), if one { 1 } else { Bvh::build_packed(&bounds, packed).leaves().count() });
         }
+        // All packed, three packets (three tests, more than a leaf's two): split however few.
+        let all_packed = |_: usize| true;
+        let many: Vec<Bounds3> = (0..24).map(|k| bounds[k % 10]).collect();
+        assert!(!Bvh::build_packed_within(&many, all_packed, 12).is_one_leaf());
     }
 
     /// Building subtrees on several threads lays out the very tree one thread builds.
