@@ -265,25 +265,6 @@ impl Lights {
         ((u_choice * self.lights.len() as f64) as usize).min(self.lights.len() - 1)
     }
 
-    /// Every light, when each is a parallelogram, a point or a sky of one colour (one or more):
-    /// `(emitter, radiance)`, the emitter `None` for the sky; a point as
-    /// [`Emitter::Parallelogram`] of no edges at the point, its intensity for radiance, and
-    /// `true` beside it.
-    pub fn parallelograms_points_and_sky(&self) -> Option<Vec<(Option<Emitter>, Vec3, bool)>> {
-        let all = self.lights.iter().map(|l| match l {
-            PathLight::Area { emitter: e @ Emitter::Parallelogram { .. }, radiance } => {
-                Some((Some(e.clone()), *radiance, false))
-            }
-            PathLight::Point { position, intensity } => {
-                let (e1, e2, normal) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
-                Some((Some(Emitter::Parallelogram { origin: *position, e1, e2, normal, area: 0.0 }), *intensity, true))
-            }
-            PathLight::Background(Background::Solid(c)) => Some((None, *c, false)),
-            _ => None,
-        });
-        all.collect::<Option<Vec<_>>>().filter(|v| !v.is_empty())
-    }
-
     /// Radiance arriving from the sky along `-dir` (`dir` pointing away from the scene) and the
     /// density of sampling `dir` among the lights (an environment map's direction is mapped to
     /// its image once).

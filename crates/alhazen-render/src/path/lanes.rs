@@ -41,13 +41,14 @@ use crate::bsdf::{
     Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe, Dielectric, Frame, Microfacet,
     MicrofacetLobes, Plastic, cosine_hemisphere, cosine_pdf, same_side,
 };
-use crate::lights::{Emitter, LightAsk, LightSample, Lights};
+use crate::lights::{Emitter, LightAsk, LightSample, Lights, PathLight};
 use crate::sampler::{PixelSeeds, SampleStream};
 use crate::shape::ray_epsilon;
 use crate::shape::{RayPacket, VectorUnit};
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::world::{HitPoint, WorldHit};
 use alhazen_math::{Ray, Vec2, Vec3};
+use alhazen_scene::Background;
 use std::f64::consts::FRAC_1_PI;
 
 /// Paths traced side by side: one AVX-512 register of `f64` (two AVX2 ones).
@@ -135,24 +136,27 @@ pub(super) struct LaneLight {
 /// The lights in lane form when every one is a parallelogram, a point or a sky of one colour
 /// (the lanes then sample them too).
 pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
-    let lights = lights.parallelograms_points_and_sky()?.into_iter().map(|(e, radiance, point)| match e {
-        Some(Emitter::Parallelogram { origin, e1, e2, normal, area }) => {
-            let pdf_area = if point { 0.0 } else { 1.0 / area };
-            Some(LaneLight { corner: origin, e1, e2, normal, pdf_area, radiance, sky: false, point })
+    let none = LaneLight {
+        corner: Vec3::ZERO,
+        e1: Vec3::ZERO,
+        e2: Vec3::ZERO,
+        normal: Vec3::ZERO,
+        pdf_area: 0.0,
+        radiance: Vec3::ZERO,
+        sky: false,
+        point: false,
+    };
+    let lane = |light: &PathLight| match *light {
+        PathLight::Area { emitter: Emitter::Parallelogram { origin, e1, e2, normal, area }, radiance } => {
+            Some(LaneLight { corner: origin, e1, e2, normal, pdf_area: 1.0 / area, radiance, ..none })
         }
-        None => Some(LaneLight {
-            corner: Vec3::ZERO,
-            e1: Vec3::ZERO,
-            e2: Vec3::ZERO,
-            normal: Vec3::ZERO,
-            pdf_area: 0.0,
-            radiance,
-            sky: true,
-            point: false,
-        }),
+        PathLight::Point { position, intensity } => {
+            Some(LaneLight { corner: position, radiance: intensity, point: true, ..none })
+        }
+        PathLight::Background(Background::Solid(radiance)) => Some(LaneLight { radiance, sky: true, ..none }),
         _ => None,
-    });
-    lights.collect()
+    };
+    lights.all().iter().map(lane).collect::<Option<Vec<_>>>().filter(|all| !all.is_empty())
 }
 
 /// Where the lanes sample parallelogram and point lights: each lane's light and its two
