@@ -113,17 +113,31 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// [`Sphere::hit`]'s distance of `ray` to `center`, `radius` (`a = d·d`, its reciprocal given):
-/// NaN where it misses, in `Sphere::roots`' operations and order, its early return a select.
+/// The first half of [`sphere_t`]: `f = o − c`, `β = −f·d` and the discriminant, and whether
+/// the roots are real (the line meets the sphere).
 #[inline(always)]
-fn sphere_t(center: [f64; 3], radius: f64, origin: [f64; 3], dir: [f64; 3], a: f64, inv_a: f64) -> f64 {
+fn sphere_disc(
+    center: [f64; 3],
+    radius: f64,
+    origin: [f64; 3],
+    dir: [f64; 3],
+    a: f64,
+    inv_a: f64,
+) -> ([f64; 3], f64, f64, bool) {
     let f = [origin[0] - center[0], origin[1] - center[1], origin[2] - center[2]];
     let beta = -dot(f, dir);
     let s = beta * inv_a;
     let perp = [f[0] + dir[0] * s, f[1] + dir[1] * s, f[2] + dir[2] * s];
+    let disc = a * (radius * radius - dot(perp, perp));
+    (f, beta, disc, !(disc < 0.0 || disc.is_nan() || a == 0.0))
+}
+
+/// [`Sphere::hit`]'s distance of `ray` to `center`, `radius` (`a = d·d`, its reciprocal given):
+/// NaN where it misses, in `Sphere::roots`' operations and order, its early return a select.
+#[inline(always)]
+fn sphere_t(center: [f64; 3], radius: f64, origin: [f64; 3], dir: [f64; 3], a: f64, inv_a: f64) -> f64 {
+    let (f, beta, disc, real) = sphere_disc(center, radius, origin, dir, a, inv_a);
     let r2 = radius * radius;
-    let disc = a * (r2 - dot(perp, perp));
-    let real = !(disc < 0.0 || disc.is_nan() || a == 0.0);
     let c = dot(f, f) - r2;
     let q = beta + disc.sqrt().copysign(beta);
     let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q * inv_a) };
@@ -143,6 +157,13 @@ fn nearest_avx2(packets: &[SpherePacket], ray: &Ray, t_max: f64) -> Option<(usiz
     let inv_a = 1.0 / a;
     let (mut best, mut limit) = (None, t_max);
     for (k, p) in packets.iter().enumerate() {
+        let meets = (0..SPHERE_LANES).fold(false, |any, l| {
+            let center = [p.center[0][l], p.center[1][l], p.center[2][l]];
+            any | sphere_disc(center, p.radius[l], origin, dir, a, inv_a).3
+        });
+        if !meets {
+            continue;
+        }
         let t: [f64; SPHERE_LANES] = std::array::from_fn(|l| {
             let center = [p.center[0][l], p.center[1][l], p.center[2][l]];
             sphere_t(center, p.radius[l], origin, dir, a, inv_a)
@@ -171,6 +192,15 @@ fn nearest_rays_avx2(packets: &[SpherePacket], rays: &RayPacket, t_max: &[f64; S
         for lane in 0..p.used {
             let (center, radius) = ([p.center[0][lane], p.center[1][lane], p.center[2][lane]], p.radius[lane]);
             let id = (k * SPHERE_LANES + lane) as u64;
+            // Most spheres are missed by all eight rays: their square roots and divisions
+            // (slow on every processor, slowest where AVX2 runs in halves) are skipped.
+            let meets = (0..R).fold(false, |any, r| {
+                let (origin, dir) = ([o[0][r], o[1][r], o[2][r]], [d[0][r], d[1][r], d[2][r]]);
+                any | sphere_disc(center, radius, origin, dir, a[r], inv_a[r]).3
+            });
+            if !meets {
+                continue;
+            }
             for r in 0..R {
                 let (origin, dir) = ([o[0][r], o[1][r], o[2][r]], [d[0][r], d[1][r], d[2][r]]);
                 let t = sphere_t(center, radius, origin, dir, a[r], inv_a[r]);
