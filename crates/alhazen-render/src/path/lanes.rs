@@ -578,7 +578,7 @@ impl PathTracer<'_> {
                     let v = &mut b.vertices;
                     self.lights.sample_lanes(&b.lights.asks, |i, sample| set_light(v, i, sample));
                 }
-                shade_with(b.kernel, &b.vertices, &mut b.shaded, unit);
+                shade_with(b.kernel, &b.vertices, &mut b.shaded, b.len, unit);
             }
             for (p, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
                 let ((g, i), (b, s)) = ((p / LANES, p % LANES), at[p]);
@@ -1066,21 +1066,22 @@ impl LaneBsdf for SmoothPlastic {
     }
 }
 
-/// Every lane's vertex at once as `kernel` shades it.
-fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
+/// Every lane's vertex at once as `kernel` shades it (lanes from `len` on, unused, may be
+/// left as they were).
+fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUnit) {
     match kernel {
-        Kernel::Lambert => shade::<Lambertian>(v, out, unit),
-        Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, out, unit),
-        Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, out, unit),
-        Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, out, unit),
-        Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, out, unit),
-        Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, out, unit),
-        Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, out, unit),
-        Kernel::CookTorrance => shade::<Rough<CookTorrance, false>>(v, out, unit),
-        Kernel::BeckmannCookTorrance => shade::<Rough<CookTorrance, true>>(v, out, unit),
-        Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, unit),
-        Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, unit),
-        Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, out, unit),
+        Kernel::Lambert => shade::<Lambertian>(v, out, len, unit),
+        Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, out, len, unit),
+        Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, out, len, unit),
+        Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, out, len, unit),
+        Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, out, len, unit),
+        Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, out, len, unit),
+        Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, out, len, unit),
+        Kernel::CookTorrance => shade::<Rough<CookTorrance, false>>(v, out, len, unit),
+        Kernel::BeckmannCookTorrance => shade::<Rough<CookTorrance, true>>(v, out, len, unit),
+        Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, len, unit),
+        Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, len, unit),
+        Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, out, len, unit),
         Kernel::Idle | Kernel::General => {}
     }
 }
@@ -1088,43 +1089,58 @@ fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, unit: VectorUnit) 
 /// Every lane's vertex at once as material `M` shades it, with the per-path tracer's
 /// arithmetic; with the bump terminator's arithmetic where some lane's normal may be bent (a
 /// kernel apiece, the plain one as lean as before bump maps took it).
-fn shade<M: LaneBsdf>(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
-    if v.bumped.contains(&true) { shade_in::<M, true>(v, out, unit) } else { shade_in::<M, false>(v, out, unit) }
+fn shade<M: LaneBsdf>(v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUnit) {
+    if v.bumped.contains(&true) {
+        shade_in::<M, true>(v, out, len, unit)
+    } else {
+        shade_in::<M, false>(v, out, len, unit)
+    }
 }
 
+/// Half the lanes: a batch of at most this many vertices is shaded in half a vector loop
+/// (a quarter to a third of the suite's batches are, the last of their kernel in a bounce).
+const HALF: usize = LANES / 2;
+
 #[allow(unsafe_code)]
-fn shade_in<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, unit: VectorUnit) {
+fn shade_in<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUnit) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { shade_avx512::<M, BUMPS>(v, out) };
+        return unsafe { shade_avx512::<M, BUMPS>(v, out, len) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { shade_avx2::<M, BUMPS>(v, out) };
+        return unsafe { shade_avx2::<M, BUMPS>(v, out, len) };
     }
     let _ = unit;
-    shade_lanes::<M, BUMPS>(v, out)
+    (0..len).for_each(|i| shade_lane::<M, BUMPS>(v, out, i));
 }
 
+/// One loop over all lanes, or over the first half of them for a batch that fits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
-    shade_lanes::<M, BUMPS>(v, out)
+unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, len: usize) {
+    if len <= HALF { shade_lanes::<M, BUMPS, 0, HALF>(v, out) } else { shade_lanes::<M, BUMPS, 0, LANES>(v, out) }
 }
 
+/// A loop over each half of the lanes (an AVX2 register of `f64` each), the second only where
+/// the batch reaches it.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx2<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
-    shade_lanes::<M, BUMPS>(v, out)
+unsafe fn shade_avx2<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, len: usize) {
+    shade_lanes::<M, BUMPS, 0, HALF>(v, out);
+    if len > HALF {
+        shade_lanes::<M, BUMPS, HALF, LANES>(v, out);
+    }
 }
 
+/// Lanes `FROM..TO` in one loop without branches.
 #[inline(always)]
-fn shade_lanes<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded) {
-    for i in 0..LANES {
+fn shade_lanes<M: LaneBsdf, const BUMPS: bool, const FROM: usize, const TO: usize>(v: &Vertices, out: &mut Shaded) {
+    for i in FROM..TO {
         shade_lane::<M, BUMPS>(v, out, i);
     }
 }
