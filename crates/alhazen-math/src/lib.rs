@@ -47,7 +47,8 @@ pub fn sin_cos_turns(t: f64) -> (f64, f64) {
     // Round to nearest by the 1.5·2⁵² trick (exact for |t| < 2⁴⁹; `round` is a libm call on
     // baseline x86-64).
     const MAGIC: f64 = 6_755_399_441_055_744.0;
-    let q = (quarters + MAGIC) - MAGIC;
+    let shifted = quarters + MAGIC;
+    let q = shifted - MAGIC;
     let x = (quarters - q) * std::f64::consts::FRAC_PI_2;
     let x2 = x * x;
     // Taylor coefficients in x², evaluated by Estrin's scheme: the next ray waits on this, so
@@ -62,8 +63,10 @@ pub fn sin_cos_turns(t: f64) -> (f64, f64) {
     let (s, c) = (estrin(&SIN), estrin(&COS));
     let (sin, cos) = (x * s, c);
     // The quadrant without branches (its value is random in sampling): odd quadrants swap,
-    // and bit 1 of q (of q + 1) flips the sign of the sine (cosine).
-    let q = q as i64 as u64;
+    // and bit 1 of q (of q + 1) flips the sign of the sine (cosine). `shifted`'s mantissa
+    // counts in units of 1, so its low bits are q's (two's complement below zero): read from
+    // its bits, which vectorise, where converting q to an integer does not under AVX2.
+    let q = shifted.to_bits();
     let (sin, cos) = if q & 1 == 0 { (sin, cos) } else { (cos, sin) };
     let flip = |v: f64, bit: u64| f64::from_bits(v.to_bits() ^ ((bit & 2) << 62));
     (flip(sin, q), flip(cos, q.wrapping_add(1)))
@@ -104,6 +107,17 @@ mod tests {
             // The library's argument 2πt is itself rounded (≈ 4e-16 at a full turn).
             prop_assert!((s - s0).abs() <= 1e-15 && (c - c0).abs() <= 1e-15, "{t}: {s} {c} vs {s0} {c0}");
             prop_assert!((s * s + c * c - 1.0).abs() <= 1e-15);
+        }
+
+        /// Whole turns do not change the result, nor do negative ones: the quadrant read from
+        /// the shifted bits is right on both sides of zero and far from it.
+        #[test]
+        fn sin_cos_turns_repeats_every_turn(t in 0.0..1.0f64, turns in -100_000i32..100_000) {
+            let (s, c) = sin_cos_turns(t);
+            let (s1, c1) = sin_cos_turns(t + turns as f64);
+            // `t + turns` is rounded to the turns' magnitude: within it, the result agrees.
+            let tolerance = 1e-15 + 8.0 * f64::EPSILON * turns.unsigned_abs() as f64;
+            prop_assert!((s - s1).abs() <= tolerance && (c - c1).abs() <= tolerance, "{t} + {turns}: {s1} {c1} vs {s} {c}");
         }
     }
 
