@@ -312,6 +312,9 @@ pub(crate) enum Kernel {
     Idle,
     /// [`PathTracer::vertex`]: its result in the lane's [`Vertex`].
     General,
+    /// The path's ray left the scene: the sky it sees added as [`PathTracer::vertex`] adds
+    /// it, the path ended (half of all vertices in the suite's open scenes).
+    Escaped,
     /// Lambert: textured or not, bump-mapped or not.
     Lambert,
     /// A rough conductor of Trowbridge–Reitz facets with Smith's shadowing and the exact
@@ -366,7 +369,7 @@ impl Kernel {
 
     /// A material kernel (not idle, not the general one).
     fn is_material(self) -> bool {
-        !matches!(self, Kernel::Idle | Kernel::General)
+        !matches!(self, Kernel::Idle | Kernel::General | Kernel::Escaped)
     }
 
     /// The kernel's BSDF has lobes to choose between (it draws a number for the choice).
@@ -552,13 +555,23 @@ impl PathTracer<'_> {
                 }
                 if escaping[p].is_some() {
                     // As `vertex` ends a path whose ray leaves the scene (its sky added below).
-                    kernels[p] = Kernel::General;
-                    general[p] = Vertex { beta: lane.path.beta, ..Vertex::default() };
+                    kernels[p] = Kernel::Escaped;
                     continue;
                 }
                 let traced = together || sky_map;
                 let alone = if traced { None } else { self.world.intersect(&lane.path.ray, f64::INFINITY) };
                 let hit = if traced { hits[g][i].as_ref() } else { alone.as_ref() };
+                if hit.is_none() {
+                    // As `vertex` ends a path whose ray leaves the scene.
+                    kernels[p] = Kernel::Escaped;
+                    let path = &mut lane.path;
+                    if path.depth <= self.scene.render.max_depth
+                        && let Some(sky) = self.escaped(&path.ray, &path.prev, path.beta, lane.mode)
+                    {
+                        path.l += sky;
+                    }
+                    continue;
+                }
                 if let Some((b, s)) = self.kernel_vertex(lane, hit, batches) {
                     (kernels[p], at[p]) = (batches.all[b].kernel, (b, s));
                     continue;
@@ -608,6 +621,7 @@ impl PathTracer<'_> {
                         lane.path.gather(&general[p], open);
                         general[p].goes_on
                     }
+                    Kernel::Escaped => false,
                     _ => finish_kernel(&mut lane.path, &batches.all[at[p].0].shaded, open, at[p].1),
                 };
                 if goes_on {
@@ -1082,7 +1096,7 @@ fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, len: usize, unit: 
         Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, len, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, len, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, out, len, unit),
-        Kernel::Idle | Kernel::General => {}
+        Kernel::Idle | Kernel::General | Kernel::Escaped => {}
     }
 }
 
