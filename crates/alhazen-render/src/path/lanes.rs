@@ -7,8 +7,9 @@
 //! a round of stages over them all: each group's rays' nearest hits in one call
 //! ([`crate::World::intersect_rays`]: in a world of one leaf, each ray's planes, each flat
 //! against the eight rays at once, in AVX-512 or AVX2, then each ray's spheres and other
-//! objects; elsewhere ray by ray); the sky seen by the rays that leave the scene ([`Lights::sky_ahead`]); per path, the
-//! vertex, written into a batch of eight of its material kernel ([`Batches`]); each batch's
+//! objects; elsewhere ray by ray); the sky seen by the rays that leave the scene
+//! ([`Lights::sky_ahead`]; such a path, half of all in open scenes, ends there:
+//! [`Kernel::Escaped`]); per path, the vertex, written into a batch of eight of its material kernel ([`Batches`]); each batch's
 //! light samples and shading; each group's shadow rays in one call
 //! ([`crate::World::unoccluded_rays`]), after which each path gathers its light and steps on. A
 //! lane whose path ends starts the next sample of the pixels it was given, in place (its record
