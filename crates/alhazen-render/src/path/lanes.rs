@@ -9,8 +9,8 @@
 //! against the eight rays at once, in AVX-512 or AVX2, then each ray's spheres and other
 //! objects; elsewhere ray by ray); the sky seen by the rays that leave the scene
 //! ([`Lights::sky_ahead`]; such a path, half of all in open scenes, ends there:
-//! [`Kernel::Escaped`]); per path, the vertex, written into a batch of eight of its material kernel ([`Batches`]); each batch's
-//! light samples and shading; each group's shadow rays in one call
+//! [`Kernel::Escaped`]); per path, the vertex, written into a batch of eight of its material
+//! kernel ([`Batches`]); each batch's light samples and shading; each group's shadow rays in one call
 //! ([`crate::World::unoccluded_rays`]), after which each path gathers its light and steps on. A
 //! lane whose path ends starts the next sample of the pixels it was given, in place (its record
 //! is not moved: a path's start costs what its hashing and camera ray cost), so lanes stay busy
@@ -1113,7 +1113,7 @@ fn shade<M: LaneBsdf>(v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUn
 }
 
 /// Half the lanes: a batch of at most this many vertices is shaded in half a vector loop
-/// (a quarter to a third of the suite's batches are, the last of their kernel in a bounce).
+/// (up to a third of the suite's batches are, the last of their kernel in a bounce).
 const HALF: usize = LANES / 2;
 
 #[allow(unsafe_code)]
