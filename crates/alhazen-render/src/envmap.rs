@@ -37,6 +37,9 @@ struct Texel {
     cdf: f32,
 }
 
+/// Directions [`EnvMap::texels_ahead`] maps to texels in one vector loop.
+const AHEAD: usize = 8;
+
 /// An environment map ready for lookup and sampling.
 #[derive(Clone, Debug)]
 pub struct EnvMap {
@@ -224,9 +227,22 @@ impl EnvMap {
     /// has none): every lane's texel, found in one loop of arithmetic (vectorised) and asked of
     /// memory. [`Self::radiance_and_pdf_at`] reads them later, when they have arrived.
     pub fn texels_ahead<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [(usize, usize); N] {
-        let texels = self.texels_in_lanes(&dirs.map(|d| d.unwrap_or(Vec3::Y)), unit);
-        for (&(x, y), dir) in texels.iter().zip(dirs) {
-            if dir.is_some() {
+        // The directions given, side by side, [`AHEAD`] at a time: lanes without one (often
+        // half of them) cost no inverse trigonometry.
+        let (mut dense, mut from, mut n) = ([Vec3::Y; N], [0; N], 0);
+        for (i, dir) in dirs.iter().enumerate() {
+            if let Some(dir) = *dir {
+                (dense[n], from[n]) = (dir, i);
+                n += 1;
+            }
+        }
+        let mut texels = [(0, 0); N];
+        for start in (0..n).step_by(AHEAD) {
+            let mut some = [Vec3::Y; AHEAD];
+            let len = AHEAD.min(n - start);
+            some[..len].copy_from_slice(&dense[start..start + len]);
+            for (k, &(x, y)) in self.texels_in_lanes(&some, unit)[..len].iter().enumerate() {
+                texels[from[start + k]] = (x, y);
                 prefetch(&self.texels[y * self.width + x]);
             }
         }
