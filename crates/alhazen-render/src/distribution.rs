@@ -14,9 +14,10 @@ pub struct Distribution1D {
     func: Vec<f64>,
     cdf: Vec<f64>,
     integral: f64,
-    /// `guide[j]`: how many CDF entries are at most [`slice_start`]`(j, n)`, for `j` in `0..=n`;
+    /// `guide[j]`: how many CDF entries are at most the start of slice `j` ([`Slices`]), for `j` in `0..=n`;
     /// empty for few cells, which are searched whole.
     guide: Vec<u32>,
+    slices: Slices,
 }
 
 impl Distribution1D {
@@ -38,7 +39,7 @@ impl Distribution1D {
         } else {
             cdf.iter_mut().for_each(|c| *c /= integral);
         }
-        let mut d = Self { func, cdf, integral, guide: vec![] };
+        let mut d = Self { func, cdf, integral, guide: vec![], slices: Slices::new(n) };
         if n <= GUIDED_FROM {
             return d;
         }
@@ -63,7 +64,7 @@ impl Distribution1D {
 
     /// The cell of the last CDF entry `≤ u` ([`search_cdf`] with this distribution's table).
     fn cell(&self, u: f64) -> usize {
-        let guide = (!self.guide.is_empty()).then_some(|j: usize| self.guide[j] as usize);
+        let guide = (!self.guide.is_empty()).then_some((&self.slices, |j: usize| self.guide[j] as usize));
         search_cdf(u, self.func.len(), guide, |i| self.cdf[i])
     }
 
@@ -104,42 +105,58 @@ impl Distribution1D {
     }
 }
 
-/// The start of slice `j` of `n` equal slices of `[0, 1)` (about `j / n`, the same bits
-/// wherever computed, which is all a guide table needs).
-#[inline]
-fn slice_start(j: usize, n: usize) -> f64 {
-    j as f64 * (1.0 / n as f64)
+/// `n` equal slices of `[0, 1)`, their width computed once: a search finds its slice without
+/// a division or the long conversions of `usize` (x86-64 has signed ones only).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Slices {
+    n: usize,
+    count: f64,
+    width: f64,
 }
 
-/// The slice of `n` holding `u`: `u·n` rounded down, mended where that rounds across a slice's
-/// edge. The mending is rare and out of line: inlined, the compiler vectorised its loops into a
-/// long preamble every search ran through.
-#[inline(always)]
-pub(crate) fn slice_of(u: f64, n: usize) -> usize {
-    let j = ((u * n as f64) as usize).min(n - 1);
-    let below = j > 0 && u < slice_start(j, n);
-    let above = j + 1 < n && u >= slice_start(j + 1, n);
-    if below || above { mend_slice(u, j, n) } else { j }
-}
+impl Slices {
+    pub fn new(n: usize) -> Self {
+        Slices { n, count: n as f64, width: 1.0 / n as f64 }
+    }
 
-#[cold]
-#[inline(never)]
-fn mend_slice(u: f64, mut j: usize, n: usize) -> usize {
-    while j > 0 && u < slice_start(j, n) {
-        j -= 1;
+    /// The start of slice `j`: about `j / n`, the same bits wherever computed, which is all a
+    /// guide table needs.
+    #[inline(always)]
+    fn start(&self, j: usize) -> f64 {
+        j as i64 as f64 * self.width
     }
-    while j + 1 < n && u >= slice_start(j + 1, n) {
-        j += 1;
+
+    /// The slice holding `u`: `u·n` rounded down, mended where that rounds across a slice's
+    /// edge. The mending is rare and out of line: inlined, the compiler vectorised its loops
+    /// into a long preamble every search ran through.
+    #[inline(always)]
+    pub fn of(&self, u: f64) -> usize {
+        // Saturating as `as usize` does: NaN and below zero to 0.
+        let j = (((u * self.count) as i64).max(0) as usize).min(self.n - 1);
+        let below = j > 0 && u < self.start(j);
+        let above = j + 1 < self.n && u >= self.start(j + 1);
+        if below || above { self.mend(u, j) } else { j }
     }
-    j
+
+    #[cold]
+    #[inline(never)]
+    fn mend(&self, u: f64, mut j: usize) -> usize {
+        while j > 0 && u < self.start(j) {
+            j -= 1;
+        }
+        while j + 1 < self.n && u >= self.start(j + 1) {
+            j += 1;
+        }
+        j
+    }
 }
 
 /// The guide table of a non-decreasing CDF of `n + 1` entries read by `entry`: for each slice
 /// start `j` in `0..=n`, how many entries are at most it.
 pub(crate) fn guide_table(n: usize, entry: impl Fn(usize) -> f64) -> impl Iterator<Item = usize> {
-    let mut at = 0;
+    let (mut at, slices) = (0, Slices::new(n));
     (0..=n).map(move |j| {
-        let edge = slice_start(j, n);
+        let edge = slices.start(j);
         while at <= n && entry(at) <= edge {
             at += 1;
         }
@@ -155,12 +172,12 @@ pub(crate) fn guide_table(n: usize, entry: impl Fn(usize) -> f64) -> impl Iterat
 pub(crate) fn search_cdf(
     u: f64,
     n: usize,
-    guide: Option<impl Fn(usize) -> usize>,
+    guide: Option<(&Slices, impl Fn(usize) -> usize)>,
     entry: impl Fn(usize) -> f64,
 ) -> usize {
     let (mut lo, mut hi) = (0, n + 1);
-    if let Some(guide) = guide {
-        let j = slice_of(u, n);
+    if let Some((slices, guide)) = guide {
+        let j = slices.of(u);
         lo = if j == 0 { 0 } else { guide(j) };
         hi = if j + 1 < n { guide(j + 1) } else { n + 1 };
     }
@@ -210,11 +227,15 @@ mod tests {
         ) {
             let d = Distribution1D::new(&weights);
             let mut us = us;
-            us.extend(d.cdf.iter().copied().chain((0..=d.len()).map(|j| slice_start(j, d.len()))));
+            us.extend(d.cdf.iter().copied().chain((0..=d.len()).map(|j| d.slices.start(j))));
             us.extend([0.0, 1.0, 1.0 - 1e-16, f64::NAN, f64::INFINITY, -0.0]);
             for u in us {
                 let whole = d.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(d.len() - 1);
                 proptest::prop_assert_eq!(d.cell(u), whole, "u = {}", u);
+                // The slice as a division would give it: the last start at or below `u`.
+                let n = d.len();
+                let by_division = (0..n).rfind(|&j| j == 0 || u >= j as f64 * (1.0 / n as f64)).unwrap();
+                proptest::prop_assert_eq!(d.slices.of(u), if u >= 0.0 { by_division } else { 0 }, "u = {}", u);
             }
         }
     }

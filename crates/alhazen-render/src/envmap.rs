@@ -17,7 +17,7 @@
 //! [`EnvMap::sample_in`]; [`EnvMap::texels_ahead`], [`EnvMap::radiance_and_pdf_at`]), each
 //! asking memory for what the next will read, so that the paths' cache misses overlap.
 
-use crate::distribution::{Distribution1D, guide_table, search_cdf, slice_of};
+use crate::distribution::{Distribution1D, Slices, guide_table, search_cdf};
 use crate::prefetch::prefetch;
 use crate::shape::VectorUnit;
 use alhazen_math::{Vec2, Vec3, color::luminance};
@@ -48,6 +48,8 @@ pub struct EnvMap {
     texels: Vec<Texel>,
     /// Per row, `width + 1` guide entries ([`guide_table`]); empty for narrow maps.
     guides: Vec<u16>,
+    /// The guide entries' slices of a row.
+    slices: Slices,
     scale: f64,
     rotation: f64,
     /// The rotation in turns.
@@ -84,6 +86,7 @@ impl EnvMap {
             height,
             texels,
             guides: vec![],
+            slices: Slices::new(width),
             scale,
             rotation,
             turns: rotation / (2.0 * PI),
@@ -141,7 +144,8 @@ impl EnvMap {
     /// A point in row `y` (`u` in `[0, 1)`) by the row's CDF, and its texel's column.
     fn sample_in_row(&self, y: usize, u: f64) -> (f64, usize) {
         let w = self.width;
-        let guide = (!self.guides.is_empty()).then_some(|j: usize| self.guides[y * (w + 1) + j] as usize);
+        let guide =
+            (!self.guides.is_empty()).then_some((&self.slices, |j: usize| self.guides[y * (w + 1) + j] as usize));
         let x = search_cdf(u, w, guide, |i| self.cdf(y, i));
         let (lo, hi) = (self.cdf(y, x), self.cdf(y, x + 1));
         let du = if hi > lo { (u - lo) / (hi - lo) } else { 0.5 };
@@ -150,7 +154,7 @@ impl EnvMap {
 
     /// The guide slice `u` falls in.
     fn slice(&self, u: f64) -> usize {
-        slice_of(u, self.width)
+        self.slices.of(u)
     }
 
     #[inline(always)]
