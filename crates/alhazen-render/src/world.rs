@@ -615,11 +615,9 @@ impl World {
         sphere: Option<(usize, usize, f64)>,
         inv_dir: Option<LaneInverse>,
     ) -> Option<(Candidate, u32)> {
-        let mut best = None;
-        if let Some((k, lane, t)) = sphere {
-            let object = self.sphere_objects[leaf.spheres.start + k][lane];
-            best = Some((Candidate { t, aux: 0, bary: [0.0; 2] }, object));
-            t_max = t;
+        let mut best = self.sphere_candidate(leaf, sphere);
+        if let Some((c, _)) = best {
+            t_max = c.t;
         }
         let boxes = &self.leaf_boxes[leaf.objects.clone()];
         for (&i, b) in self.leaf_objects[leaf.objects.clone()].iter().zip(boxes) {
@@ -632,6 +630,13 @@ impl World {
             }
         }
         best
+    }
+
+    /// The candidate and object of `leaf`'s sphere hit `sphere` (its packet, lane and distance).
+    #[inline(always)]
+    fn sphere_candidate(&self, leaf: &Leaf, sphere: Option<(usize, usize, f64)>) -> Option<(Candidate, u32)> {
+        let (k, lane, t) = sphere?;
+        Some((Candidate { t, aux: 0, bary: [0.0; 2] }, self.sphere_objects[leaf.spheres.start + k][lane]))
     }
 
     /// True when one of `leaf`'s spheres or other objects lies on `ray` before `t_max`.
@@ -723,7 +728,12 @@ impl World {
         for (r, slot) in out.iter_mut().enumerate() {
             let ray = &each[r];
             let inv = inv.as_ref().map(|inv| (inv, r));
-            let solid = if live[r] { self.nearest_solid_after(leaf, ray, t_max[r], spheres[r], inv) } else { None };
+            // A leaf of flats and spheres only (most small scenes) has no other object to test.
+            let solid = match live[r] {
+                false => None,
+                true if leaf.objects.is_empty() => self.sphere_candidate(leaf, spheres[r]),
+                true => self.nearest_solid_after(leaf, ray, t_max[r], spheres[r], inv),
+            };
             *slot = match (solid, flat[r], unbounded[r]) {
                 (Some((c, i)), ..) => Some(self.surface_of(ray, c, i)),
                 (None, Some((k, h)), _) => Some(self.flat_hit(ray, k, h)),
