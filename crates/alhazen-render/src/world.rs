@@ -588,8 +588,9 @@ impl World {
         self.one_leaf && leaf.objects.len() > 1
     }
 
-    /// The nearest sphere hit of each of eight rays in `leaf` ([`SpherePacket::nearest_of_rays`]).
-    #[inline]
+    /// The nearest sphere hit of each of eight rays in `leaf` ([`SpherePacket::nearest_of_rays`]),
+    /// inlined so that the kernel writes its hits where the caller keeps them.
+    #[inline(always)]
     fn spheres_of_rays(
         &self,
         leaf: &Leaf,
