@@ -606,8 +606,9 @@ impl World {
     }
 
     /// [`Self::nearest_solid`] with the leaf's nearest sphere hit already found (`sphere`: its
-    /// packet, lane and distance).
-    #[inline]
+    /// packet, lane and distance). Inlined: out of line, its call and result cost what its box
+    /// tests cost.
+    #[inline(always)]
     fn nearest_solid_after(
         &self,
         leaf: &Leaf,
