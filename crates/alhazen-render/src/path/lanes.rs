@@ -396,8 +396,8 @@ impl Kernel {
 
 /// Per material: the kernel its vertices take, in a scene whose vertices may take material
 /// kernels (RGB, no specular connections). A material's kind of BSDF does not vary over its
-/// surface (textures vary colours and roughnesses only), so the BSDF at any point tells; the
-/// BSDF at each hit is checked again ([`kernel_of`]).
+/// surface (textures vary colours only), so the BSDF at any point tells (checked at each hit in
+/// debug builds).
 pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<Kernel> {
     let scene_allows = !tracer.spectral && tracer.mirrors.is_none();
     let images = &tracer.scene.images;
@@ -663,17 +663,17 @@ impl PathTracer<'_> {
         }
         let m = &self.scene.materials[wh.material as usize];
         let at_hit;
-        let (bsdf, kernel) = match &self.uniform_bsdfs[wh.material as usize] {
-            // The material's kernel is this BSDF's.
-            Some(bsdf) => (bsdf, material),
+        let bsdf = match &self.uniform_bsdfs[wh.material as usize] {
+            Some(bsdf) => bsdf,
             None => {
                 at_hit = crate::bsdf::bsdf_at(m, wh.hit.uv, &self.scene.images, ColorMode::Rgb);
-                (&at_hit, kernel_of(&at_hit, m))
+                // Textures vary colours only: the kind of BSDF, and so its kernel, is the same
+                // at every point of the surface (`bsdf::build` branches on none of them).
+                debug_assert_eq!(kernel_of(&at_hit, m), material);
+                &at_hit
             }
         };
-        if kernel != material {
-            return None;
-        }
+        let kernel = material;
         let (b, i) = batches.slot(kernel);
         let Batch { vertices: v, lights, .. } = &mut batches.all[b];
         match bsdf {
