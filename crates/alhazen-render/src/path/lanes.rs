@@ -566,11 +566,8 @@ impl PathTracer<'_> {
                     // As `vertex` ends a path whose ray leaves the scene.
                     kernels[p] = Kernel::Escaped;
                     let path = &mut lane.path;
-                    // `escaped`'s work inlined (out of line for `radiance`'s sake, its call
-                    // and result cost 2 % of the glossy scene here).
-                    let sky = || self.escaped_from(self.lights.sky(path.ray.dir), &path.prev, path.beta, lane.mode);
                     if path.depth <= self.scene.render.max_depth
-                        && let Some(sky) = sky()
+                        && let Some(sky) = self.escaped_inline(&path.ray, &path.prev, path.beta, lane.mode)
                     {
                         path.l += sky;
                     }
