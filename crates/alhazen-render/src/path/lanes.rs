@@ -61,6 +61,29 @@ type Lanes = [f64; LANES];
 /// One vector per lane, component by component (a [`RayPacket`]'s layout).
 type Lanes3 = [Lanes; 3];
 
+/// One flag per lane, 0 or 1, in words as wide as [`Lanes`]' numbers: the kernels' loads and
+/// stores then all step by the same stride, and their masks are as wide as their numbers, which
+/// the compiler needs to vectorise their loops for AVX2.
+#[derive(Clone, Copy, Debug, Default)]
+struct Flags([u64; LANES]);
+
+impl Flags {
+    #[inline(always)]
+    fn at(&self, i: usize) -> bool {
+        self.0[i] != 0
+    }
+
+    #[inline(always)]
+    fn put(&mut self, i: usize, on: bool) {
+        self.0[i] = u64::from(on);
+    }
+
+    /// Some lane's flag is set.
+    fn any(&self) -> bool {
+        self.0.iter().any(|&f| f != 0)
+    }
+}
+
 #[inline(always)]
 fn get(v: &Lanes3, i: usize) -> Vec3 {
     Vec3::new(v[0][i], v[1][i], v[2][i])
@@ -82,7 +105,7 @@ struct Vertices {
     ng: Lanes3,
     ns: Lanes3,
     n0: Lanes3,
-    bumped: [bool; LANES],
+    bumped: Flags,
     /// A Lambert surface's or a plastic's albedo; a Cook–Torrance surface's diffuse colour
     /// (times `k_d`) and its `k_s`.
     albedo: Lanes3,
@@ -91,7 +114,7 @@ struct Vertices {
     ior: Lanes,
     /// A plastic's coat and colouring of its inner reflection.
     coat: [Option<&'static Coat>; LANES],
-    nonlinear: [bool; LANES],
+    nonlinear: Flags,
     /// A rough conductor's index `η + iκ` and tint; the roughnesses `m_u, m_v` of a rough
     /// conductor or dielectric, and its tangent where it is anisotropic (`tangent_given`).
     eta: Lanes3,
@@ -99,22 +122,22 @@ struct Vertices {
     tint: Lanes3,
     alpha: [Lanes; 2],
     tangent: Lanes3,
-    tangent_given: [bool; LANES],
+    tangent_given: Flags,
     beta: Lanes3,
     /// The path's product of squared relative indices so far (for roulette).
     eta_scale: Lanes,
     /// The light sample, valid where `light` is set (it exists, has radiance and density).
-    light: [bool; LANES],
+    light: Flags,
     light_dir: Lanes3,
     light_dist: Lanes,
     light_radiance: Lanes3,
     light_pdf: Lanes,
-    light_delta: [bool; LANES],
+    light_delta: Flags,
     /// The continuation's lobe choice (where the BSDF has lobes to choose) and two numbers,
     /// and roulette's where `roulette` is set.
     u_lobe: Lanes,
     u_bsdf: [Lanes; 2],
-    roulette: [bool; LANES],
+    roulette: Flags,
     u_roulette: Lanes,
 }
 
@@ -187,13 +210,13 @@ struct Shaded {
     /// Next-event contribution (before `beta`) if the shadow ray is clear; zero when there is
     /// no light to test (`shadow` unset).
     light: Lanes3,
-    shadow: [bool; LANES],
+    shadow: Flags,
     shadow_origin: Lanes3,
     shadow_dist: Lanes,
     /// The path goes on (`alive`) from `origin` along `dir`, sampled with density `pdf` (a
     /// delta distribution's where `delta` is set), carrying `beta` and `eta_scale`.
-    alive: [bool; LANES],
-    delta: [bool; LANES],
+    alive: Flags,
+    delta: Flags,
     origin: Lanes3,
     dir: Lanes3,
     pdf: Lanes,
@@ -265,7 +288,7 @@ impl Batches {
         (batch.lights.any_sky, batch.lights.any_point) = (self.any_sky, self.any_point);
         // What a slot is not sure to overwrite: a stale bent normal would only cost the bump
         // kernel's work, a stale ask a light sample.
-        batch.vertices.bumped = [false; LANES];
+        batch.vertices.bumped = Flags::default();
         batch.lights.asks = [None; LANES];
         (b, 0)
     }
@@ -598,7 +621,7 @@ impl PathTracer<'_> {
                 let ((g, i), (b, s)) = ((p / LANES, p % LANES), at[p]);
                 let (sh, v) = (&batches.all[b].shaded, &batches.all[b].vertices);
                 debug_assert_eq!(*kernel, batches.all[b].kernel);
-                if sh.shadow[s] {
+                if sh.shadow.at(s) {
                     (tested[g][i], dist[g][i]) = (true, sh.shadow_dist[s]);
                     shadows[g].set(i, &Ray::new(get(&sh.shadow_origin, s), get(&v.light_dir, s)));
                 }
@@ -699,7 +722,8 @@ impl PathTracer<'_> {
             }
             Bsdf::Plastic(p) => {
                 set(&mut v.albedo, i, p.albedo);
-                (v.ior[i], v.coat[i], v.nonlinear[i]) = (p.eta, Some(p.coat), p.nonlinear);
+                (v.ior[i], v.coat[i]) = (p.eta, Some(p.coat));
+                v.nonlinear.put(i, p.nonlinear);
                 if let Some(facets) = &p.facets {
                     set_facets(v, i, facets, None);
                 }
@@ -712,12 +736,12 @@ impl PathTracer<'_> {
         }
         let h = HitPoint::from(wh);
         path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, None, ColorMode::Rgb);
-        v.roulette[i] = path.depth >= RR_DEPTH;
+        v.roulette.put(i, path.depth >= RR_DEPTH);
         set(&mut v.wo, i, -path.ray.dir);
         set(&mut v.p, i, h.p);
         set(&mut v.ng, i, h.n);
-        v.bumped[i] = m.bump.is_some();
-        if v.bumped[i] {
+        v.bumped.put(i, m.bump.is_some());
+        if v.bumped.at(i) {
             set(&mut v.ns, i, crate::world::shading_normal(&wh.hit, m, &self.scene.images));
             set(&mut v.n0, i, h.ns);
         } else {
@@ -739,11 +763,11 @@ impl PathTracer<'_> {
         let u_light = if kernel.is_delta() { Vec2::ZERO } else { s.next_2d() };
         let u_bsdf = s.next_2d();
         (v.u_bsdf[0][i], v.u_bsdf[1][i]) = (u_bsdf.x, u_bsdf.y);
-        if v.roulette[i] {
+        if v.roulette.at(i) {
             v.u_roulette[i] = s.next_1d();
         }
         match &self.lane_lights {
-            _ if kernel.is_delta() => v.light[i] = false,
+            _ if kernel.is_delta() => v.light.put(i, false),
             Some(all) => {
                 let k = &all[self.lights.choose(choice)];
                 set(&mut lights.corner, i, k.corner);
@@ -754,7 +778,8 @@ impl PathTracer<'_> {
                 (lights.sky[i], lights.point[i]) = (k.sky, k.point);
                 (lights.u[0][i], lights.u[1][i]) = (u_light.x, u_light.y);
                 set(&mut v.light_radiance, i, k.radiance);
-                (v.light[i], v.light_delta[i]) = (k.radiance != Vec3::ZERO, k.point);
+                v.light.put(i, k.radiance != Vec3::ZERO);
+                v.light_delta.put(i, k.point);
             }
             None if self.lights.has_environment() => lights.asks[i] = Some(self.lights.ask(h.p, choice, u_light)),
             None => {
@@ -770,18 +795,19 @@ impl PathTracer<'_> {
 #[inline(always)]
 fn set_light(v: &mut Vertices, i: usize, sample: Option<LightSample>) {
     let light = sample.filter(|ls| ls.radiance != Vec3::ZERO && not_at_most_zero(ls.pdf));
-    v.light[i] = light.is_some();
+    v.light.put(i, light.is_some());
     if let Some(ls) = light {
         set(&mut v.light_dir, i, ls.dir);
         set(&mut v.light_radiance, i, ls.radiance);
-        (v.light_dist[i], v.light_pdf[i], v.light_delta[i]) = (ls.dist, ls.pdf, ls.delta);
+        (v.light_dist[i], v.light_pdf[i]) = (ls.dist, ls.pdf);
+        v.light_delta.put(i, ls.delta);
     }
 }
 
 /// Lane `i`'s microfacets and tangent.
 fn set_facets(v: &mut Vertices, i: usize, facets: &Microfacet, tangent: Option<Vec3>) {
     (v.alpha[0][i], v.alpha[1][i]) = (facets.alpha_u, facets.alpha_v);
-    v.tangent_given[i] = tangent.is_some();
+    v.tangent_given.put(i, tangent.is_some());
     set(&mut v.tangent, i, tangent.unwrap_or(Vec3::X));
 }
 
@@ -809,15 +835,15 @@ fn gather_paths(lanes: &mut [LanePath; POOL], rays: &mut [RayPacket; GROUPS]) ->
 fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> bool {
     let light = if clear { get(&s.light, i) } else { Vec3::ZERO };
     path.l += path.beta * light;
-    if s.alive[i] {
+    if s.alive.at(i) {
         path.beta = get(&s.beta, i);
         path.eta_scale = s.eta_scale[i];
         path.prev.pdf = s.pdf[i];
-        path.prev.delta = s.delta[i];
+        path.prev.delta = s.delta.at(i);
         path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
         path.depth += 1;
     }
-    s.alive[i]
+    s.alive.at(i)
 }
 
 /// Every lane's point on its parallelogram light, its point light's position or its direction
@@ -885,19 +911,19 @@ fn sample_light<const SKY: bool, const POINT: bool>(k: &LightLanes, v: &mut Vert
     let area_ok = dist != 0.0 && not_at_most_zero(cos) && not_at_most_zero(pdf);
     if SKY && k.sky[i] {
         let sky_pdf = 1.0 / (4.0 * std::f64::consts::PI) * choice_pdf;
-        v.light[i] &= not_at_most_zero(sky_pdf);
+        v.light.put(i, v.light.at(i) && not_at_most_zero(sky_pdf));
         set(&mut v.light_dir, i, crate::lights::uniform_sphere(Vec2::new(k.u[0][i], k.u[1][i])));
         (v.light_dist[i], v.light_pdf[i]) = (f64::INFINITY, sky_pdf);
     } else if POINT && k.point[i] {
         // `Lights::sample`'s point: `dist` is `to.length()`, the radiance its intensity over
         // `dist · dist`, the density the choice's alone.
         let (radiance, pdf) = (get(&v.light_radiance, i) / (dist * dist), 1.0 * choice_pdf);
-        v.light[i] &= dist > 0.0 && radiance != Vec3::ZERO && not_at_most_zero(pdf);
+        v.light.put(i, v.light.at(i) && dist > 0.0 && radiance != Vec3::ZERO && not_at_most_zero(pdf));
         set(&mut v.light_dir, i, dir);
         set(&mut v.light_radiance, i, radiance);
         (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
     } else {
-        v.light[i] &= area_ok;
+        v.light.put(i, v.light.at(i) && area_ok);
         set(&mut v.light_dir, i, dir);
         (v.light_dist[i], v.light_pdf[i]) = (dist, pdf);
     }
@@ -1018,7 +1044,7 @@ impl<B: RoughBsdf, const BECKMANN: bool> LaneBsdf for Rough<B, BECKMANN> {
             return around;
         }
         let along = Frame::new(ns, get(&v.tangent, i));
-        if v.tangent_given[i] { along } else { around }
+        if v.tangent_given.at(i) { along } else { around }
     }
 
     #[inline(always)]
@@ -1065,7 +1091,7 @@ struct SmoothPlastic;
 #[inline(always)]
 fn plastic_at(v: &Vertices, i: usize, facets: Option<Microfacet>) -> Plastic {
     let coat = v.coat[i].unwrap_or(&Coat::NONE);
-    let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear[i]);
+    let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear.at(i));
     Plastic { albedo, eta, facets, nonlinear, coat }
 }
 
@@ -1105,11 +1131,7 @@ fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, len: usize, unit: 
 /// arithmetic; with the bump terminator's arithmetic where some lane's normal may be bent (a
 /// kernel apiece, the plain one as lean as before bump maps took it).
 fn shade<M: LaneBsdf>(v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUnit) {
-    if v.bumped.contains(&true) {
-        shade_in::<M, true>(v, out, len, unit)
-    } else {
-        shade_in::<M, false>(v, out, len, unit)
-    }
+    if v.bumped.any() { shade_in::<M, true>(v, out, len, unit) } else { shade_in::<M, false>(v, out, len, unit) }
 }
 
 /// Half the lanes: a batch of at most this many vertices is shaded in half a vector loop
@@ -1176,7 +1198,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i:
     }
     // The bump terminator's shadowing (`Terminator::shadowing`), chosen without branches.
     let (bent, terminator) = Terminator::bent(n0, ns);
-    let bent = BUMPS && v.bumped[i] && bent;
+    let bent = BUMPS && v.bumped.at(i) && bent;
     let shadowing = |dir: Vec3| if bent { terminator.factor(dir) } else { 1.0 };
     let frame = M::frame(v, i, ns);
     let wv = frame.to_local(wo);
@@ -1185,12 +1207,12 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i:
     let l = frame.to_local(dir);
     let (f, pdf_bsdf) = M::eval_pdf(v, i, wv, l);
     let f = f * l.z.abs() * shadowing(dir);
-    let shadow = v.light[i] && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0) && !M::TRANSMITS);
+    let shadow = v.light.at(i) && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0) && !M::TRANSMITS);
     let pdf_light = v.light_pdf[i];
-    let w = if v.light_delta[i] { 1.0 } else { power_heuristic(pdf_light, pdf_bsdf) };
+    let w = if v.light_delta.at(i) { 1.0 } else { power_heuristic(pdf_light, pdf_bsdf) };
     let c = if shadow { f * get(&v.light_radiance, i) * (w / pdf_light) } else { Vec3::ZERO };
     set(&mut out.light, i, c);
-    out.shadow[i] = shadow;
+    out.shadow.put(i, shadow);
     set(&mut out.shadow_origin, i, offset(p, ng, dir));
     let d = v.light_dist[i];
     out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * ray_epsilon(p) } else { f64::INFINITY };
@@ -1202,15 +1224,15 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i:
     let mut beta = get(&v.beta, i) * weight;
     let eta_scale = v.eta_scale[i] * (bs.eta * bs.eta);
     let mut alive = sampled && pdf > 0.0 && weight.is_finite() && weight != Vec3::ZERO;
-    if v.roulette[i] {
+    if v.roulette.at(i) {
         let q = (beta.max_element() * eta_scale).min(0.95);
         // `u ≥ q` ends the path (u is never NaN; a NaN q does not end it).
         alive &= v.u_roulette[i] < q || q.is_nan();
         beta /= q;
     }
-    out.alive[i] = alive;
+    out.alive.put(i, alive);
     out.pdf[i] = pdf;
-    out.delta[i] = bs.delta;
+    out.delta.put(i, bs.delta);
     out.eta_scale[i] = eta_scale;
     set(&mut out.beta, i, beta);
     set(&mut out.dir, i, dir);
