@@ -112,8 +112,7 @@ struct Vertices {
     ks: Lanes,
     /// A rough dielectric's relative index `η_inside/η_outside`, or a plastic coat's.
     ior: Lanes,
-    /// A plastic's coat and colouring of its inner reflection.
-    coat: [Option<&'static Coat>; LANES],
+    /// A plastic's colouring of its inner reflection (its coat is its batch's: [`Batch::coat`]).
     nonlinear: Flags,
     /// A rough conductor's index `η + iκ` and tint; the roughnesses `m_u, m_v` of a rough
     /// conductor or dielectric, and its tangent where it is anisotropic (`tangent_given`).
@@ -239,6 +238,10 @@ const POOL: usize = GROUPS * LANES;
 #[derive(Clone, Debug)]
 struct Batch {
     kernel: Kernel,
+    /// A plastic kernel's coat, the same for every vertex of the batch: the kernel reads its
+    /// tables through one pointer, its function's argument, which the compiler can tell from
+    /// the records it writes (through a pointer per lane it cannot, and the loop stays scalar).
+    coat: Option<&'static Coat>,
     len: usize,
     vertices: Vertices,
     lights: LightLanes,
@@ -268,29 +271,43 @@ impl Batches {
         self.open = [None; MATERIAL_KERNELS.len()];
     }
 
-    /// A free slot for a vertex of material kernel `kernel`: its batch and slot.
-    fn slot(&mut self, kernel: Kernel) -> (usize, usize) {
+    /// A free slot for a vertex of material kernel `kernel` (a plastic's of coat `coat`): its
+    /// batch and slot.
+    fn slot(&mut self, kernel: Kernel, coat: Option<&'static Coat>) -> (usize, usize) {
         let k = kernel.shaded();
-        if let Some(b) = self.open[k].filter(|&b| self.all[b].len < LANES) {
+        let takes = |b: &Batch| b.len < LANES && same_coat(b.coat, coat);
+        // The kernel's newest batch, or (plastics of several coats) an older one of this coat.
+        let open = self.open[k].filter(|&b| takes(&self.all[b])).or_else(|| {
+            (coat.is_some()).then(|| (0..self.used).find(|&b| self.all[b].kernel == kernel && takes(&self.all[b])))?
+        });
+        if let Some(b) = open {
             self.all[b].len += 1;
             return (b, self.all[b].len - 1);
         }
         if self.used == self.all.len() {
             let lights = LightLanes { any_sky: self.any_sky, any_point: self.any_point, ..LightLanes::default() };
             let (vertices, shaded) = (Vertices::default(), Shaded::default());
-            self.all.push(Batch { kernel, len: 0, vertices, lights, shaded });
+            self.all.push(Batch { kernel, coat, len: 0, vertices, lights, shaded });
         }
         let b = self.used;
         self.used += 1;
         self.open[k] = Some(b);
         let batch = &mut self.all[b];
-        (batch.kernel, batch.len) = (kernel, 1);
+        (batch.kernel, batch.coat, batch.len) = (kernel, coat, 1);
         (batch.lights.any_sky, batch.lights.any_point) = (self.any_sky, self.any_point);
         // What a slot is not sure to overwrite: a stale bent normal would only cost the bump
         // kernel's work, a stale ask a light sample.
         batch.vertices.bumped = Flags::default();
         batch.lights.asks = [None; LANES];
         (b, 0)
+    }
+}
+
+/// The same coat (or none), by address: a scene's coats are made once each.
+fn same_coat(a: Option<&'static Coat>, b: Option<&'static Coat>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => std::ptr::eq(a, b),
+        (a, b) => a.is_none() && b.is_none(),
     }
 }
 
@@ -615,7 +632,7 @@ impl PathTracer<'_> {
                     let v = &mut b.vertices;
                     self.lights.sample_lanes(&b.lights.asks, |i, sample| set_light(v, i, sample));
                 }
-                shade_with(b.kernel, &b.vertices, &mut b.shaded, b.len, unit);
+                shade_with(b.kernel, &b.vertices, b.coat.unwrap_or(&Coat::NONE), &mut b.shaded, b.len, unit);
             }
             for (p, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
                 let ((g, i), (b, s)) = ((p / LANES, p % LANES), at[p]);
@@ -697,7 +714,8 @@ impl PathTracer<'_> {
             }
         };
         let kernel = material;
-        let (b, i) = batches.slot(kernel);
+        let coat = if let Bsdf::Plastic(p) = bsdf { Some(p.coat) } else { None };
+        let (b, i) = batches.slot(kernel, coat);
         let Batch { vertices: v, lights, .. } = &mut batches.all[b];
         match bsdf {
             Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
@@ -722,7 +740,7 @@ impl PathTracer<'_> {
             }
             Bsdf::Plastic(p) => {
                 set(&mut v.albedo, i, p.albedo);
-                (v.ior[i], v.coat[i]) = (p.eta, Some(p.coat));
+                v.ior[i] = p.eta;
                 v.nonlinear.put(i, p.nonlinear);
                 if let Some(facets) = &p.facets {
                     set_facets(v, i, facets, None);
@@ -944,12 +962,12 @@ trait LaneBsdf {
     /// `ρ` and the sampling density towards `l`, seen from `wv` (local): `Bsdf::eval_pdf`;
     /// nothing for a delta distribution (the default).
     #[inline(always)]
-    fn eval_pdf(_: &Vertices, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(_: &Vertices, _: &'static Coat, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
         (Vec3::ZERO, 0.0)
     }
     /// The continuation drawn with the numbers `uc, u`, as `Bsdf::sample` draws it: whether
     /// there is one, and the sample.
-    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
+    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
 }
 
 /// Lambert's BSDF ([`crate::bsdf::Lambert`]), cosine-weighted sampling (`sample_cosine`).
@@ -957,13 +975,13 @@ struct Lambertian;
 
 impl LaneBsdf for Lambertian {
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let rho = get(&v.albedo, i) * FRAC_1_PI;
         (if same_side(wv, l) { rho } else { Vec3::ZERO }, cosine_pdf(wv, l))
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
         // `cosine_hemisphere` keeps `l` on the side of `wv`, where `ρ` is the albedo's.
         let l = cosine_hemisphere(u, wv);
         let (f, pdf) = (get(&v.albedo, i) * FRAC_1_PI, cosine_pdf(wv, l));
@@ -979,12 +997,12 @@ trait RoughBsdf: MicrofacetLobes {
     /// The BSDF may be anisotropic: a tangent frame where the lane has a tangent.
     const TANGENT: bool = true;
     /// Lane `i`'s BSDF on `facets`, its Fresnel mode a constant the compiler folds.
-    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self;
+    fn at(v: &Vertices, coat: &'static Coat, i: usize, facets: Microfacet) -> Self;
 }
 
 impl RoughBsdf for Conductor {
     #[inline(always)]
-    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
+    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         Conductor { facets: Some(facets), eta, k, tint, schlick: false }
     }
@@ -994,7 +1012,7 @@ impl RoughBsdf for Dielectric {
     const TRANSMITS: bool = true;
 
     #[inline(always)]
-    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
+    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         Dielectric { facets: Some(facets), eta: v.ior[i], schlick: false, dispersive: false }
     }
 }
@@ -1004,7 +1022,7 @@ impl RoughBsdf for CookTorrance {
     const TANGENT: bool = false;
 
     #[inline(always)]
-    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
+    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let lobe = CookTorranceLobe { facets, ior: v.ior[i], schlick: false };
         CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe }
     }
@@ -1015,8 +1033,8 @@ impl RoughBsdf for Plastic {
     const TANGENT: bool = false;
 
     #[inline(always)]
-    fn at(v: &Vertices, i: usize, facets: Microfacet) -> Self {
-        plastic_at(v, i, Some(facets))
+    fn at(v: &Vertices, coat: &'static Coat, i: usize, facets: Microfacet) -> Self {
+        plastic_at(v, coat, i, Some(facets))
     }
 }
 
@@ -1028,9 +1046,9 @@ struct Rough<B, const BECKMANN: bool>(std::marker::PhantomData<B>);
 impl<B: RoughBsdf, const BECKMANN: bool> Rough<B, BECKMANN> {
     /// Lane `i`'s BSDF and its facets.
     #[inline(always)]
-    fn at(v: &Vertices, i: usize) -> (B, Microfacet) {
+    fn at(v: &Vertices, coat: &'static Coat, i: usize) -> (B, Microfacet) {
         let facets = Microfacet::smith::<BECKMANN>(v.alpha[0][i], v.alpha[1][i]);
-        (B::at(v, i, facets), facets)
+        (B::at(v, coat, i, facets), facets)
     }
 }
 
@@ -1048,14 +1066,14 @@ impl<B: RoughBsdf, const BECKMANN: bool> LaneBsdf for Rough<B, BECKMANN> {
     }
 
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        let (bsdf, facets) = Self::at(v, i);
+    fn eval_pdf(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (bsdf, facets) = Self::at(v, coat, i);
         bsdf.rough_eval_pdf(&facets, wv, l)
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        let (bsdf, facets) = Self::at(v, i);
+    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let (bsdf, facets) = Self::at(v, coat, i);
         bsdf.rough_sample(&facets, wv, uc, u)
     }
 }
@@ -1065,7 +1083,7 @@ struct SmoothConductor;
 
 impl LaneBsdf for SmoothConductor {
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         (true, Conductor { facets: None, eta, k, tint, schlick: false }.smooth_sample(wv))
     }
@@ -1078,7 +1096,7 @@ impl LaneBsdf for SmoothDielectric {
     const TRANSMITS: bool = true;
 
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
         Dielectric { facets: None, eta: v.ior[i], schlick: false, dispersive: false }.smooth_sample(wv, uc)
     }
 }
@@ -1089,40 +1107,39 @@ struct SmoothPlastic;
 
 /// Lane `i`'s plastic, its coat on `facets` (smooth for `None`).
 #[inline(always)]
-fn plastic_at(v: &Vertices, i: usize, facets: Option<Microfacet>) -> Plastic {
-    let coat = v.coat[i].unwrap_or(&Coat::NONE);
+fn plastic_at(v: &Vertices, coat: &'static Coat, i: usize, facets: Option<Microfacet>) -> Plastic {
     let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear.at(i));
     Plastic { albedo, eta, facets, nonlinear, coat }
 }
 
 impl LaneBsdf for SmoothPlastic {
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        plastic_at(v, i, None).smooth_eval_pdf(wv, l)
+    fn eval_pdf(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        plastic_at(v, coat, i, None).smooth_eval_pdf(wv, l)
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        plastic_at(v, i, None).smooth_sample(wv, uc, u)
+    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        plastic_at(v, coat, i, None).smooth_sample(wv, uc, u)
     }
 }
 
 /// Every lane's vertex at once as `kernel` shades it (lanes from `len` on, unused, may be
 /// left as they were).
-fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUnit) {
+fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize, unit: VectorUnit) {
     match kernel {
-        Kernel::Lambert => shade::<Lambertian>(v, out, len, unit),
-        Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, out, len, unit),
-        Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, out, len, unit),
-        Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, out, len, unit),
-        Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, out, len, unit),
-        Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, out, len, unit),
-        Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, out, len, unit),
-        Kernel::CookTorrance => shade::<Rough<CookTorrance, false>>(v, out, len, unit),
-        Kernel::BeckmannCookTorrance => shade::<Rough<CookTorrance, true>>(v, out, len, unit),
-        Kernel::SmoothConductor => shade::<SmoothConductor>(v, out, len, unit),
-        Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, out, len, unit),
-        Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, out, len, unit),
+        Kernel::Lambert => shade::<Lambertian>(v, coat, out, len, unit),
+        Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, coat, out, len, unit),
+        Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, coat, out, len, unit),
+        Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, coat, out, len, unit),
+        Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, coat, out, len, unit),
+        Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, coat, out, len, unit),
+        Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, coat, out, len, unit),
+        Kernel::CookTorrance => shade::<Rough<CookTorrance, false>>(v, coat, out, len, unit),
+        Kernel::BeckmannCookTorrance => shade::<Rough<CookTorrance, true>>(v, coat, out, len, unit),
+        Kernel::SmoothConductor => shade::<SmoothConductor>(v, coat, out, len, unit),
+        Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, coat, out, len, unit),
+        Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, coat, out, len, unit),
         Kernel::Idle | Kernel::General | Kernel::Escaped => {}
     }
 }
@@ -1130,8 +1147,12 @@ fn shade_with(kernel: Kernel, v: &Vertices, out: &mut Shaded, len: usize, unit: 
 /// Every lane's vertex at once as material `M` shades it, with the per-path tracer's
 /// arithmetic; with the bump terminator's arithmetic where some lane's normal may be bent (a
 /// kernel apiece, the plain one as lean as before bump maps took it).
-fn shade<M: LaneBsdf>(v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUnit) {
-    if v.bumped.any() { shade_in::<M, true>(v, out, len, unit) } else { shade_in::<M, false>(v, out, len, unit) }
+fn shade<M: LaneBsdf>(v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize, unit: VectorUnit) {
+    if v.bumped.any() {
+        shade_in::<M, true>(v, coat, out, len, unit)
+    } else {
+        shade_in::<M, false>(v, coat, out, len, unit)
+    }
 }
 
 /// Half the lanes: a batch of at most this many vertices is shaded in half a vector loop
@@ -1139,27 +1160,42 @@ fn shade<M: LaneBsdf>(v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUn
 const HALF: usize = LANES / 2;
 
 #[allow(unsafe_code)]
-fn shade_in<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, len: usize, unit: VectorUnit) {
+fn shade_in<M: LaneBsdf, const BUMPS: bool>(
+    v: &Vertices,
+    coat: &'static Coat,
+    out: &mut Shaded,
+    len: usize,
+    unit: VectorUnit,
+) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { shade_avx512::<M, BUMPS>(v, out, len) };
+        return unsafe { shade_avx512::<M, BUMPS>(v, coat, out, len) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { shade_avx2::<M, BUMPS>(v, out, len) };
+        return unsafe { shade_avx2::<M, BUMPS>(v, coat, out, len) };
     }
     let _ = unit;
-    (0..len).for_each(|i| shade_lane::<M, BUMPS>(v, out, i));
+    (0..len).for_each(|i| shade_lane::<M, BUMPS>(v, coat, out, i));
 }
 
 /// One loop over all lanes, or over the first half of them for a batch that fits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, len: usize) {
-    if len <= HALF { shade_lanes::<M, BUMPS, 0, HALF>(v, out) } else { shade_lanes::<M, BUMPS, 0, LANES>(v, out) }
+unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(
+    v: &Vertices,
+    coat: &'static Coat,
+    out: &mut Shaded,
+    len: usize,
+) {
+    if len <= HALF {
+        shade_lanes::<M, BUMPS, 0, HALF>(v, coat, out)
+    } else {
+        shade_lanes::<M, BUMPS, 0, LANES>(v, coat, out)
+    }
 }
 
 /// A loop over each half of the lanes (an AVX2 register of `f64` each), the second only where
@@ -1167,18 +1203,22 @@ unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut S
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx2<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, len: usize) {
-    shade_lanes::<M, BUMPS, 0, HALF>(v, out);
+unsafe fn shade_avx2<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize) {
+    shade_lanes::<M, BUMPS, 0, HALF>(v, coat, out);
     if len > HALF {
-        shade_lanes::<M, BUMPS, HALF, LANES>(v, out);
+        shade_lanes::<M, BUMPS, HALF, LANES>(v, coat, out);
     }
 }
 
 /// Lanes `FROM..TO` in one loop without branches.
 #[inline(always)]
-fn shade_lanes<M: LaneBsdf, const BUMPS: bool, const FROM: usize, const TO: usize>(v: &Vertices, out: &mut Shaded) {
+fn shade_lanes<M: LaneBsdf, const BUMPS: bool, const FROM: usize, const TO: usize>(
+    v: &Vertices,
+    coat: &'static Coat,
+    out: &mut Shaded,
+) {
     for i in FROM..TO {
-        shade_lane::<M, BUMPS>(v, out, i);
+        shade_lane::<M, BUMPS>(v, coat, out, i);
     }
 }
 
@@ -1186,7 +1226,7 @@ fn shade_lanes<M: LaneBsdf, const BUMPS: bool, const FROM: usize, const TO: usiz
 /// frame, evaluation and sampling, [`offset`], [`epsilon`], [`power_heuristic`]) on one lane,
 /// inlined into the all-lane loop.
 #[inline(always)]
-fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i: usize) {
+fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat, out: &mut Shaded, i: usize) {
     let (wo, p) = (get(&v.wo, i), get(&v.p, i));
     // The shading frame (`PathTracer::shading_frame`).
     let (mut ng, mut ns, mut n0) = (get(&v.ng, i), get(&v.ns, i), get(&v.n0, i));
@@ -1205,7 +1245,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i:
     // Next event (`PathTracer::next_event`).
     let dir = get(&v.light_dir, i);
     let l = frame.to_local(dir);
-    let (f, pdf_bsdf) = M::eval_pdf(v, i, wv, l);
+    let (f, pdf_bsdf) = M::eval_pdf(v, coat, i, wv, l);
     let f = f * l.z.abs() * shadowing(dir);
     let shadow = v.light.at(i) && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0) && !M::TRANSMITS);
     let pdf_light = v.light_pdf[i];
@@ -1217,7 +1257,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, out: &mut Shaded, i:
     let d = v.light_dist[i];
     out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * ray_epsilon(p) } else { f64::INFINITY };
     // The continuation.
-    let (sampled, bs) = M::sample(v, i, wv, v.u_lobe[i], Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
+    let (sampled, bs) = M::sample(v, coat, i, wv, v.u_lobe[i], Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
     let (l, pdf) = (bs.l, bs.pdf);
     let dir = frame.to_world(l);
     let weight = bs.f * l.z.abs() / pdf * shadowing(dir);
@@ -1518,20 +1558,30 @@ material = "glow"
         /// of their kernel, and the batches are as few as the kernels' counts allow; a cleared
         /// set of batches starts afresh with its storage kept.
         #[test]
-        fn batches_hold_each_kernel_apart(kinds in proptest::collection::vec(0..MATERIAL_KERNELS.len(), 0..POOL)) {
+        fn batches_hold_each_kernel_and_coat_apart(
+            kinds in proptest::collection::vec((0..MATERIAL_KERNELS.len(), 0..2usize), 0..POOL),
+        ) {
+            // Plastics of two coats; other kernels have none.
+            let coats = [Coat::of(1.5, None), Coat::of(1.3, None)];
+            let plastic = |k: Kernel| matches!(k, Kernel::RoughPlastic | Kernel::BeckmannPlastic | Kernel::SmoothPlastic);
+            let coat_of = |(k, c): (usize, usize)| plastic(MATERIAL_KERNELS[k]).then_some(coats[c]);
+            let key = |(k, c): (usize, usize)| (k, if plastic(MATERIAL_KERNELS[k]) { c } else { 0 });
             let mut batches = Batches::reusing(vec![], false, false);
             for round in 0..2 {
                 batches.clear();
                 let mut taken = std::collections::HashSet::new();
-                for &k in &kinds {
-                    let (b, s) = batches.slot(MATERIAL_KERNELS[k]);
+                for &kind in &kinds {
+                    let (b, s) = batches.slot(MATERIAL_KERNELS[kind.0], coat_of(kind));
                     proptest::prop_assert!(b < batches.used && s < batches.all[b].len && s < LANES);
-                    proptest::prop_assert_eq!(batches.all[b].kernel, MATERIAL_KERNELS[k]);
+                    proptest::prop_assert_eq!(batches.all[b].kernel, MATERIAL_KERNELS[kind.0]);
+                    proptest::prop_assert!(same_coat(batches.all[b].coat, coat_of(kind)));
                     proptest::prop_assert!(taken.insert((b, s)), "slot {:?} given twice", (b, s));
                 }
-                let fewest: usize = (0..MATERIAL_KERNELS.len())
-                    .map(|k| kinds.iter().filter(|&&x| x == k).count().div_ceil(LANES))
-                    .sum();
+                let mut counts = std::collections::HashMap::new();
+                for &kind in &kinds {
+                    *counts.entry(key(kind)).or_insert(0usize) += 1;
+                }
+                let fewest: usize = counts.values().map(|n| n.div_ceil(LANES)).sum();
                 proptest::prop_assert_eq!(batches.used, fewest, "round {}", round);
                 let filled: usize = batches.all[..batches.used].iter().map(|b| b.len).sum();
                 proptest::prop_assert_eq!(filled, kinds.len());
