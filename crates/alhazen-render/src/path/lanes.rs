@@ -27,7 +27,8 @@
 //! environment map's memory asked for every lane before any lane waits for it) and the shading
 //! frame, next-event weights, bump shadowing, sampled continuation and Russian roulette
 //! ([`shade`]) for all lanes at once, loops without branches the compiler turns into AVX-512 or
-//! AVX2 code. The kernels evaluate and sample the BSDFs through the per-path tracer's own
+//! AVX2 code (`bench/vectorised.sh` checks; the plastic kernels vectorise for AVX-512 only, their
+//! coat tables' reads being gathers). The kernels evaluate and sample the BSDFs through the per-path tracer's own
 //! functions ([`LaneBsdf`]), written to compute whole and then choose, so the two tracers share
 //! one implementation of each.
 //!
