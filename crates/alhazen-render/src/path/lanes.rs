@@ -27,10 +27,10 @@
 //! environment map's memory asked for every lane before any lane waits for it) and the shading
 //! frame, next-event weights, bump shadowing, sampled continuation and Russian roulette
 //! ([`shade`]) for all lanes at once, loops without branches the compiler turns into AVX-512 or
-//! AVX2 code (`bench/vectorised.sh` checks; the plastic kernels vectorise for AVX-512 only, their
-//! coat tables' reads being gathers). The kernels evaluate and sample the BSDFs through the per-path tracer's own
-//! functions ([`LaneBsdf`]), written to compute whole and then choose, so the two tracers share
-//! one implementation of each.
+//! AVX2 code (`bench/vectorised.sh` checks; the plastic kernels vectorise for AVX-512 only,
+//! their coat tables' reads being gathers). The kernels evaluate and sample the BSDFs through
+//! the per-path tracer's own functions ([`LaneBsdf`]), written to compute whole and then
+//! choose, so the two tracers share one implementation of each.
 //!
 //! Every lane performs exactly the floating-point operations of [`PathTracer::radiance`], in
 //! the same order (no fused multiply–adds, no reassociation), draws the same numbers from its
@@ -279,7 +279,7 @@ impl Batches {
         let takes = |b: &Batch| b.len < LANES && same_coat(b.coat, coat);
         // The kernel's newest batch, or (plastics of several coats) an older one of this coat.
         let open = self.open[k].filter(|&b| takes(&self.all[b])).or_else(|| {
-            (coat.is_some()).then(|| (0..self.used).find(|&b| self.all[b].kernel == kernel && takes(&self.all[b])))?
+            coat.and_then(|_| (0..self.used).find(|&b| self.all[b].kernel == kernel && takes(&self.all[b])))
         });
         if let Some(b) = open {
             self.all[b].len += 1;
