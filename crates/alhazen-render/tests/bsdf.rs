@@ -340,7 +340,7 @@ fn eval_pdf_gives_eval_and_pdf_bit_for_bit() {
 #[test]
 fn white_smooth_plastic_reflects_all_it_receives() {
     // The coat's mirror F plus the base's closed-form bounces: exactly 1 in theory; the
-    // tabulated transmittance leaves a small error.
+    // transmittance's polynomial and the inner reflectance's quadrature leave a small error.
     let b = Bsdf::Plastic(Plastic::new(Vec3::ONE, 1.5, None, false));
     for theta in [0.0, 40.0, 75.0] {
         let (a, err) = albedo(&b, direction(theta, 0.2), 200_000);

@@ -27,8 +27,7 @@
 //! environment map's memory asked for every lane before any lane waits for it) and the shading
 //! frame, next-event weights, bump shadowing, sampled continuation and Russian roulette
 //! ([`shade`]) for all lanes at once, loops without branches the compiler turns into AVX-512 or
-//! AVX2 code (`bench/vectorised.sh` checks; the plastic kernels vectorise for AVX-512 only,
-//! their coat tables' reads being gathers). The kernels evaluate and sample the BSDFs through
+//! AVX2 code (`bench/vectorised.sh` checks). The kernels evaluate and sample the BSDFs through
 //! the per-path tracer's own functions ([`LaneBsdf`]), written to compute whole and then
 //! choose, so the two tracers share one implementation of each.
 //!
@@ -240,7 +239,7 @@ const POOL: usize = GROUPS * LANES;
 struct Batch {
     kernel: Kernel,
     /// A plastic kernel's coat, the same for every vertex of the batch: the kernel reads its
-    /// tables through one pointer, its function's argument, which the compiler can tell from
+    /// numbers through one pointer, its function's argument, which the compiler can tell from
     /// the records it writes (through a pointer per lane it cannot, and the loop stays scalar).
     coat: Option<&'static Coat>,
     len: usize,
