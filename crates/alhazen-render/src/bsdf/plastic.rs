@@ -233,7 +233,7 @@ impl Coat {
     pub(crate) const NONE: Coat = Coat { transmittance: [0.0; TERMS], inner_reflectance: 0.0 };
 
     /// `t(μ)` (of `|μ|`, at most 1) by Estrin's scheme, within `[0, 1]`: the terms paired,
-    /// `a_2k + a_2k+1·x`, then the pairs paired with `x²`, and so on — five rounds of
+    /// `a_{2k} + a_{2k+1}·x`, then the pairs paired with `x²`, and so on — five rounds of
     /// independent operations where Horner's rule is one chain of 23 (a lane's several
     /// evaluations wait on its latency).
     #[inline(always)]
