@@ -305,10 +305,7 @@ impl Batches {
 
 /// The same coat (or none), by address: a scene's coats are made once each.
 fn same_coat(a: Option<&'static Coat>, b: Option<&'static Coat>) -> bool {
-    match (a, b) {
-        (Some(a), Some(b)) => std::ptr::eq(a, b),
-        (a, b) => a.is_none() && b.is_none(),
-    }
+    a.map(std::ptr::from_ref) == b.map(std::ptr::from_ref)
 }
 
 thread_local! {
