@@ -9,10 +9,10 @@
 //!
 //! * `exp(x) = 2^k · e^r`, `k = round(x / ln 2)`, `r = x − k ln 2` with `ln 2` split in two
 //!   parts (the first with trailing zero bits, so `k · ln2_hi` is exact), `|r| ≤ ln 2 / 2`;
-//!   `e^r` by its Taylor polynomial of degree 13 (truncation below 5·10⁻¹⁸), `2^k` built from
+//!   `e^r` by its Taylor polynomial of degree 13 (truncation below 5·10⁻¹⁸, Estrin's scheme), `2^k` built from
 //!   its bits in two halves (results down to the subnormals).
 //! * `ln(x) = e ln 2 + ln m`, `x = m · 2^e`, `m ∈ [√½, √2)`; `ln m = 2 atanh s`,
-//!   `s = (m − 1)/(m + 1)`, `|s| ≤ 0.1716`, by its series to `s²³` (truncation below 10⁻¹⁸).
+//!   `s = (m − 1)/(m + 1)`, `|s| ≤ 0.1716`, by its series to `s²³` (truncation below 10⁻¹⁸, Estrin's scheme).
 //!
 //! * `atan2(y, x)`: `t = min/max` of `|x|, |y|` moved by the addition formula next to the
 //!   nearest of `tan(kπ/8)`, `k ∈ {0, 1, 2}` (`|s| ≤ tan(π/16)`), the series of `atan s` to
@@ -46,12 +46,14 @@ pub fn exp(x: f64) -> f64 {
     let t = xc * std::f64::consts::LOG2_E + ROUNDER;
     let k = t - ROUNDER;
     let r = (xc - k * LN2_HI) - k * LN2_LO;
-    // Horner's scheme on 1/n! (no fused multiply–adds: the same bits everywhere).
-    let mut p = 1.0 / 6_227_020_800.0;
-    for n in (1..13).rev() {
-        p = p * r + 1.0 / factorial(n);
-    }
-    let er = p * r + 1.0;
+    // e^r − 1 − r = r² Σ rⁿ/(n + 2)!, n in 0..12, by Estrin's scheme (short dependency chains;
+    // no fused multiply–adds: the same bits everywhere), added to 1 + r last.
+    let a = |n: u32| 1.0 / factorial(n + 2);
+    let (r2, r4) = (r * r, r * r * (r * r));
+    let pair = |n: u32| a(n) + a(n + 1) * r;
+    let quad = |n: u32| pair(n) + pair(n + 2) * r2;
+    let p = quad(0) + quad(4) * r4 + quad(8) * (r4 * r4);
+    let er = 1.0 + (r + r2 * p);
     // 2^k in two factors, each a normal number, so subnormal results round once at the end.
     let k = (t.to_bits() as i64).wrapping_sub(ROUNDER.to_bits() as i64);
     let half = k >> 1;
@@ -84,12 +86,14 @@ pub fn ln(x: f64) -> f64 {
     let m = f64::from_bits(bits.wrapping_sub((e as u64) << 52));
     let s = (m - 1.0) / (m + 1.0);
     let s2 = s * s;
-    // 2 atanh s = 2 (s + s³/3 + … + s²³/23), Horner on s².
-    let mut p = 1.0 / 23.0;
-    for n in (0..11).rev() {
-        p = p * s2 + 1.0 / (2 * n + 1) as f64;
-    }
-    let ln_m = 2.0 * s * p;
+    // 2 atanh s = 2s + 2s (s²/3 + s⁴/5 + … + s²²/23): the sum's s²ⁿ⁻²/(2n + 1), n in 1..=11,
+    // by Estrin's scheme on s² (short chains), the largest term added last.
+    let b = |n: i32| 1.0 / (2 * n + 1) as f64;
+    let (z2, z4) = (s2 * s2, s2 * s2 * (s2 * s2));
+    let pair = |n: i32| b(n) + b(n + 1) * s2;
+    let quad = |n: i32| pair(n) + pair(n + 2) * z2;
+    let p = quad(1) + quad(5) * z4 + (b(9) + b(10) * s2 + b(11) * z2) * (z4 * z4);
+    let ln_m = 2.0 * s + 2.0 * s * (s2 * p);
     let e = (e - shift) as f64;
     let value = e * LN2_HI + (e * LN2_LO + ln_m);
     let special = if x == f64::INFINITY { x } else { f64::NAN };
