@@ -38,9 +38,9 @@ pub fn fresnel_dielectric(cos_theta: f64, eta: f64) -> f64 {
     let c = cos_theta.abs().min(1.0);
     let g2 = eta * eta + c * c - 1.0;
     let g = g2.sqrt();
-    let a = (g - c) / (g + c);
-    let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
-    let f = (0.5 * a * a * (1.0 + b * b)).min(1.0);
+    // `½ a² (1 + b²)` with `a = (g − c)/(g + c)`, `b = n/m`, over one denominator.
+    let (n, m) = (c * (g + c) - 1.0, c * (g - c) + 1.0);
+    let f = (0.5 * (g - c) * (g - c) * (m * m + n * n) / ((g + c) * (g + c) * (m * m))).min(1.0);
     if g2 < 0.0 || g + c == 0.0 { 1.0 } else { f }
 }
 

@@ -30,8 +30,9 @@ pub struct Conductor {
 /// quantities (Born and Wolf §14.2): with `s² = 1 − c²`, `t₀ = η² − κ² − s²`,
 /// `a² + b² = √(t₀² + 4η²κ²)` and `a = √((a² + b² + t₀)/2)`,
 /// `R_⊥ = (a² + b² + c² − 2ac)/(a² + b² + c² + 2ac)` and
-/// `R_∥ = R_⊥ (c²(a² + b²) + s⁴ − 2acs²)/(c²(a² + b²) + s⁴ + 2acs²)` — two square roots and two
-/// divisions where complex arithmetic takes three complex divisions (test: the same values).
+/// `R_∥ = R_⊥ (c²(a² + b²) + s⁴ − 2acs²)/(c²(a² + b²) + s⁴ + 2acs²)` — two square roots and one
+/// division (their mean is `R_⊥ t₃/(t₃ + t₄)` for `t₃ ± t₄` the last fraction's terms) where
+/// complex arithmetic takes three complex divisions (test: the same values).
 #[cfg(test)]
 fn fresnel_conductor(cos_i: f64, eta: f64, k: f64) -> f64 {
     fresnel_conductor_channels(cos_i, [eta; 4], [k; 4])[0]
@@ -50,10 +51,9 @@ fn fresnel_conductor_channels(cos_i: f64, eta: [f64; 4], k: [f64; 4]) -> [f64; 4
         let ab2 = (t0 * t0 + 4.0 * eta[i] * eta[i] * k[i] * k[i]).sqrt();
         let a = (0.5 * (ab2 + t0)).max(0.0).sqrt();
         let (t1, t2) = (ab2 + c2, 2.0 * c * a);
-        let perp = (t1 - t2) / (t1 + t2);
         let (t3, t4) = (c2 * ab2 + s2 * s2, t2 * s2);
-        let par = perp * (t3 - t4) / (t3 + t4);
-        out[i] = ((par + perp) / 2.0).clamp(0.0, 1.0);
+        // `(R_⊥ + R_∥)/2 = R_⊥ (1 + (t₃ − t₄)/(t₃ + t₄))/2 = R_⊥ t₃/(t₃ + t₄)`: one division.
+        out[i] = ((t1 - t2) * t3 / ((t1 + t2) * (t3 + t4))).clamp(0.0, 1.0);
     }
     out
 }

@@ -60,10 +60,15 @@ impl Microfacet {
         }
     }
 
-    /// `tan²ϑ (c²/m_u² + s²/m_v²)` for the normal `h`.
+    /// `m_u² m_v² cos²ϑ + m_v² x² + m_u² y²` for the normal `h = (x, y, cos ϑ)`: the
+    /// ellipse's stretch with no division. `tan²ϑ (c²/m_u² + s²/m_v²)` is `1/(m_u² m_v² cos²ϑ)`
+    /// times its last two terms, and Trowbridge–Reitz's `cos⁴ϑ (1 + tan²ϑ(…))²` is its square
+    /// over `m_u⁴ m_v⁴`.
     #[inline(always)]
-    fn slope2(&self, h: Vec3) -> f64 {
-        (h.x / self.alpha_u).powi(2) / (h.z * h.z) + (h.y / self.alpha_v).powi(2) / (h.z * h.z)
+    fn stretch(&self, h: Vec3) -> (f64, f64) {
+        let (au2, av2) = (self.alpha_u * self.alpha_u, self.alpha_v * self.alpha_v);
+        let across = h.x * h.x * av2 + h.y * h.y * au2;
+        (au2 * av2 * (h.z * h.z), across)
     }
 
     /// A Trowbridge–Reitz (or, with `BECKMANN`, Beckmann) distribution with Smith's
@@ -91,11 +96,17 @@ impl Microfacet {
     /// the same function for eight normals at once.
     #[inline(always)]
     pub fn d(&self, h: Vec3) -> f64 {
-        let cos4 = h.z.powi(4);
-        let e = self.slope2(h);
+        // One division each (the vector unit's slowest operation, which the lanes run for
+        // every evaluation): `e = tan²ϑ(…)` over the stretch, and the whole of `D`.
+        let (along, across) = self.stretch(h);
+        let area = self.alpha_u * self.alpha_v;
         let d = match self.distribution {
-            Distribution::Beckmann => exp(-e) / (PI * self.alpha_u * self.alpha_v * cos4),
-            Distribution::TrowbridgeReitz => 1.0 / (PI * self.alpha_u * self.alpha_v * cos4 * (1.0 + e).powi(2)),
+            Distribution::Beckmann => {
+                let cos4 = h.z.powi(4);
+                exp(-(across / along)) / (PI * area * cos4)
+            }
+            // `(m_u m_v)³ / (π (m_u² m_v² cos²ϑ + m_v² x² + m_u² y²)²)`.
+            Distribution::TrowbridgeReitz => area * area * area / (PI * (along + across).powi(2)),
             Distribution::Gaussian => {
                 let theta = h.z.min(1.0).acos();
                 self.gaussian_a * (-(theta / self.alpha_u).powi(2)).exp()
@@ -192,34 +203,38 @@ impl Microfacet {
         self.d(h) * h.z.max(0.0)
     }
 
-    /// Smith's `Λ(w)` (Beckmann by Walter's rational fit, Trowbridge–Reitz exactly).
+    /// Smith's `Λ(w)` (Beckmann by Walter's rational fit, Trowbridge–Reitz exactly), of
+    /// `α² tan²ϑ = (x² m_u² + y² m_v²)/cos²ϑ` (the projected roughness `α²` has `sin²ϑ` below,
+    /// `tan²ϑ` above: they cancel).
     #[inline(always)]
     fn lambda(&self, w: Vec3) -> f64 {
         let sin2 = (1.0 - w.z * w.z).max(0.0);
-        let tan2 = sin2 / (w.z * w.z);
-        let alpha2 = (w.x * w.x * self.alpha_u * self.alpha_u + w.y * w.y * self.alpha_v * self.alpha_v) / sin2;
+        let spread = w.x * w.x * self.alpha_u * self.alpha_u + w.y * w.y * self.alpha_v * self.alpha_v;
         let lambda = match self.distribution {
             Distribution::Beckmann => {
-                let a = 1.0 / (alpha2 * tan2).sqrt();
+                // `a = 1/(α tanϑ)`.
+                let a = ((w.z * w.z) / spread).sqrt();
                 if a >= 1.6 { 0.0 } else { (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a) }
             }
-            _ => ((1.0 + alpha2 * tan2).sqrt() - 1.0) / 2.0,
+            _ => ((1.0 + spread / (w.z * w.z)).sqrt() - 1.0) / 2.0,
         };
         if sin2 == 0.0 { 0.0 } else { lambda }
     }
 
-    /// Smith's `G₁(w)` for a microfacet `h` (0 where `w` sees the facet's back).
+    /// `1 + Λ(w)`, or ∞ where `w` sees the back of the facet `h` (Smith's `G₁(w)` is its
+    /// reciprocal).
     #[inline(always)]
-    fn g1(&self, w: Vec3, h: Vec3) -> f64 {
-        let g1 = 1.0 / (1.0 + self.lambda(w));
-        if w.dot(h) * w.z <= 0.0 { 0.0 } else { g1 }
+    fn g1_denominator(&self, w: Vec3, h: Vec3) -> f64 {
+        let denominator = 1.0 + self.lambda(w);
+        if w.dot(h) * w.z <= 0.0 { f64::INFINITY } else { denominator }
     }
 
     /// `G(l, v)` for the microfacet normal `h`.
     #[inline(always)]
     pub fn g(&self, v: Vec3, l: Vec3, h: Vec3) -> f64 {
         match self.shadowing {
-            Shadowing::Smith => self.g1(v, h) * self.g1(l, h),
+            // `G₁(v) G₁(l)` in one division.
+            Shadowing::Smith => 1.0 / (self.g1_denominator(v, h) * self.g1_denominator(l, h)),
             Shadowing::CookTorrance => {
                 let (hn, vn, ln) = (h.z, v.z.abs(), l.z.abs());
                 let (vh, lh) = (v.dot(h).abs(), l.dot(h).abs());

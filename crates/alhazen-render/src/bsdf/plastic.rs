@@ -88,8 +88,9 @@ impl Plastic {
     #[inline(always)]
     fn p_coat(&self, v: Vec3) -> f64 {
         let t = self.transmittance(v.z);
-        let base = (self.albedo.x + self.albedo.y + self.albedo.z) / 3.0;
-        lobe_probability((1.0 - t) / (1.0 + base), t * base / (1.0 + base))
+        // Both shares over `1 + base`, which the ratio cancels.
+        let base = (self.albedo.x + self.albedo.y + self.albedo.z) * (1.0 / 3.0);
+        lobe_probability(1.0 - t, t * base)
     }
 
     #[inline(always)]

@@ -1257,7 +1257,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat,
     let (sampled, bs) = M::sample(v, coat, i, wv, v.u_lobe[i], Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
     let (l, pdf) = (bs.l, bs.pdf);
     let dir = frame.to_world(l);
-    let weight = bs.f * l.z.abs() / pdf * shadowing(dir);
+    let weight = bs.f * (l.z.abs() / pdf) * shadowing(dir);
     let mut beta = get(&v.beta, i) * weight;
     let eta_scale = v.eta_scale[i] * (bs.eta * bs.eta);
     let mut alive = sampled && pdf > 0.0 && weight.is_finite() && weight != Vec3::ZERO;
@@ -1265,7 +1265,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat,
         let q = (beta.max_element() * eta_scale).min(0.95);
         // `u ≥ q` ends the path (u is never NaN; a NaN q does not end it).
         alive &= v.u_roulette[i] < q || q.is_nan();
-        beta /= q;
+        beta *= 1.0 / q;
     }
     out.alive.put(i, alive);
     out.pdf[i] = pdf;
