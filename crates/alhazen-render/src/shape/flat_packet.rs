@@ -684,10 +684,20 @@ mod simd {
                 let at = _mm256_add_epi32(_mm256_set1_epi32((k * LANES) as i32), lane);
                 best.update(hits(&packet_lanes(p), &r, limit), at);
             }
+            // Most leaves a ray visits it misses, and most it hits it hits in one lane: neither
+            // needs the lanes stored and compared (a loop whose branches follow random hits).
+            let hit = _mm256_movemask_ps(best.hit) as u32;
+            if hit == 0 {
+                return None;
+            }
             let h = best.store();
-            let nearest = (0..LANES)
-                .filter(|&l| h.hit & (1 << l) != 0)
-                .min_by(|&a, &b| h.t[a].total_cmp(&h.t[b]).then(h.at[a].cmp(&h.at[b])))?;
+            let nearest = if hit & (hit - 1) == 0 {
+                hit.trailing_zeros() as usize
+            } else {
+                (0..LANES)
+                    .filter(|&l| h.hit & (1 << l) != 0)
+                    .min_by(|&a, &b| h.t[a].total_cmp(&h.t[b]).then(h.at[a].cmp(&h.at[b])))?
+            };
             let at = h.at[nearest] as usize;
             Some((at / LANES, super::LaneHit::new(at % LANES, (h.t[nearest], h.b1[nearest], h.b2[nearest]))))
         }
