@@ -127,7 +127,7 @@ impl Camera {
     }
 
     /// The ray through film position `(fx, fy)` in pixels, `y` down.
-    #[inline]
+    #[inline(always)]
     pub fn ray(&self, fx: f64, fy: f64) -> Ray {
         let (w, h) = (self.film_width as f64, self.film_height as f64);
         match &self.kind {
