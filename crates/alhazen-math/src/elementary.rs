@@ -9,10 +9,14 @@
 //!
 //! * `exp(x) = 2^k · e^r`, `k = round(x / ln 2)`, `r = x − k ln 2` with `ln 2` split in two
 //!   parts (the first with trailing zero bits, so `k · ln2_hi` is exact), `|r| ≤ ln 2 / 2`;
-//!   `e^r` by its Taylor polynomial of degree 13 (truncation below 5·10⁻¹⁸, Estrin's scheme), `2^k` built from
+//!   `e^r` by its Taylor polynomial of degree 13 (truncation below 5·10⁻¹⁸), `2^k` built from
 //!   its bits in two halves (results down to the subnormals).
 //! * `ln(x) = e ln 2 + ln m`, `x = m · 2^e`, `m ∈ [√½, √2)`; `ln m = 2 atanh s`,
-//!   `s = (m − 1)/(m + 1)`, `|s| ≤ 0.1716`, by its series to `s²³` (truncation below 10⁻¹⁸, Estrin's scheme).
+//!   `s = (m − 1)/(m + 1)`, `|s| ≤ 0.1716`, by its series to `s²³` (truncation below 10⁻¹⁸).
+//!
+//! The polynomials are evaluated by Estrin's scheme (terms paired, pairs paired with the
+//! square, …): a few short chains of operations instead of Horner's one long one, which each
+//! lane of a material kernel would wait on.
 //!
 //! * `atan2(y, x)`: `t = min/max` of `|x|, |y|` moved by the addition formula next to the
 //!   nearest of `tan(kπ/8)`, `k ∈ {0, 1, 2}` (`|s| ≤ tan(π/16)`), the series of `atan s` to
