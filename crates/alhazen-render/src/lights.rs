@@ -55,6 +55,21 @@ pub enum Emitter {
     },
 }
 
+impl Emitter {
+    /// A point at the middle of the emitter: a sphere's or disk's centre, a parallelogram's,
+    /// the mean of the triangles' corners.
+    pub fn centre(&self) -> Vec3 {
+        match self {
+            Emitter::Sphere { center, .. } | Emitter::Disk { center, .. } => *center,
+            Emitter::Parallelogram { origin, e1, e2, .. } => *origin + (*e1 + *e2) * 0.5,
+            Emitter::Triangles { triangles, .. } => {
+                let sum: Vec3 = triangles.iter().flatten().copied().sum();
+                sum / (3 * triangles.len()).max(1) as f64
+            }
+        }
+    }
+}
+
 /// One light of the path tracer.
 #[derive(Clone, Debug)]
 pub enum PathLight {

@@ -216,3 +216,77 @@ fn connected_images_do_not_depend_on_the_thread_count() {
         assert!(at(1) == at(2), "{name}");
     }
 }
+
+/// Several lamps and several mirrors: each vertex connects through one (lamp, mirror) pair drawn
+/// at random, and the emission found by sampling weighs itself with that draw's probability.
+/// The floor in view is lit only through the mirrors (both lamps face away from it); its mean
+/// is the one sampling alone converges to.
+#[test]
+fn one_drawn_lamp_and_mirror_per_vertex_is_unbiased() {
+    let scene = |connections: bool, spp: u32, seed: u32| {
+        format!(
+            r#"
+[render]
+width = 16
+height = 16
+spp = {spp}
+max_depth = 4
+seed = {seed}
+integrator = "path"
+mirror_connections = {connections}
+[camera]
+type = "orthographic"
+eye = [-2.0, 6, -0.6]
+target = [-2.0, 0, -0.6]
+up = [0, 0, 1]
+width = 1.6
+[materials.floor]
+color = 0.8
+[materials.chrome]
+color = 0
+diffuse = 0
+mirror = 0.9
+[materials.lamp]
+color = 0
+emission = 10
+[[object]]
+shape = "plane"
+normal = [0, 1, 0]
+material = "floor"
+[[object]]
+shape = "sphere"
+center = [0, 1, 0]
+radius = 1
+material = "chrome"
+[[object]]
+shape = "sphere"
+center = [-3.5, 0.5, 1.5]
+radius = 0.5
+material = "chrome"
+[[object]]
+shape = "cylinder"
+base = [-1.0, 0, -2.5]
+top = [-1.0, 1.2, -2.5]
+radius = 0.4
+material = "chrome"
+[[object]]
+shape = "disk"
+center = [-1.7, 0.5, 0.7]
+normal = [0.5, 1, 0]
+radius = 0.4
+material = "lamp"
+[[object]]
+shape = "disk"
+center = [-2.6, 0.4, 2.2]
+normal = [0, 1, 0.4]
+radius = 0.3
+material = "lamp"
+"#
+        )
+    };
+    let connected = mean(&render(&scene(true, 256, 0))).x;
+    let sampled = mean(&render(&scene(false, 16384, 2))).x;
+    let rel = (connected - sampled).abs() / sampled;
+    eprintln!("means {connected:.5} / {sampled:.5} ({:.2} %)", rel * 100.0);
+    assert!(rel < 0.03, "means {connected} with connections, {sampled} without ({:.2} %)", rel * 100.0);
+}

@@ -136,17 +136,22 @@ impl MirrorShape {
         }
     }
 
-    /// False when the whole mirror lies behind the plane through `x` with normal `n` (no light
-    /// can come from it to a surface that only reflects).
-    pub fn in_front_of(&self, x: Vec3, n: Vec3) -> bool {
-        let (center, reach) = match *self {
+    /// A sphere holding the piece — its centre and radius —, or `None` for an unbounded plane.
+    pub fn bounding_sphere(&self) -> Option<(Vec3, f64)> {
+        Some(match *self {
             MirrorShape::Sphere { center, radius } => (center, radius),
             MirrorShape::Cylinder { base, axis, height, radius, .. } => {
                 (base + axis * (0.5 * height), (radius * radius + 0.25 * height * height).sqrt())
             }
             MirrorShape::Disk { center, radius, .. } => (center, radius),
-            MirrorShape::Plane { .. } => return true,
-        };
+            MirrorShape::Plane { .. } => return None,
+        })
+    }
+
+    /// False when the whole mirror lies behind the plane through `x` with normal `n` (no light
+    /// can come from it to a surface that only reflects).
+    pub fn in_front_of(&self, x: Vec3, n: Vec3) -> bool {
+        let Some((center, reach)) = self.bounding_sphere() else { return true };
         (center - x).dot(n) > -reach
     }
 
@@ -154,13 +159,22 @@ impl MirrorShape {
     /// or a closed cylinder, or beside an open one (radially outside, between its ends: a
     /// straight leg to the inner wall would have to pass over an end, but both of its ends lie
     /// between them). A point at infinity is beside an open cylinder unless it lies along the axis.
+    ///
+    /// A point radially outside an open cylinder, a distance `d` beyond one end's plane, sees
+    /// the inner wall through that end only within `2r·d/(ρ − r)` of its rim (`ρ` its distance
+    /// from the axis: the leg must cross the end's plane inside the rim). Where that band is
+    /// thinner than 10⁻⁹ of the height — a floor the cylinder stands on, its plane rounded to
+    /// either side — it counts as beside.
     fn outside_only(&self, p: Site) -> bool {
         match (*self, p) {
             (MirrorShape::Sphere { center, radius }, Site::At(p)) => (p - center).length_squared() > radius * radius,
             (MirrorShape::Cylinder { base, axis, height, radius, closed }, Site::At(p)) => {
                 let h = (p - base).dot(axis);
-                let outside = (p - base - axis * h).length_squared() > radius * radius;
-                outside && (closed || (0.0..=height).contains(&h)) || closed && !(0.0..=height).contains(&h)
+                let rho = (p - base - axis * h).length();
+                let beyond = (-h).max(h - height).max(0.0);
+                let band = 2.0 * radius * beyond / (rho - radius);
+                let outside = rho > radius;
+                outside && (closed || band <= 1e-9 * height) || closed && !(0.0..=height).contains(&h)
             }
             (MirrorShape::Sphere { .. }, Site::Toward(_)) => true,
             (MirrorShape::Cylinder { closed, .. }, Site::Toward(_)) => closed,
