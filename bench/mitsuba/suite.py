@@ -5,6 +5,7 @@ Mitsuba XML file that both renderers read as it is (so the twins are one file).
     python3 bench/mitsuba/suite/make_data.py           # textures, sky, meshes (once)
     python3 bench/mitsuba/suite.py reference [NAME…]   # Mitsuba's converged images (committed)
     python3 bench/mitsuba/suite.py run [--runs 3] [NAME…]
+    python3 bench/mitsuba/suite.py depths [--runs 3] [NAME…]
 
 `run`, per scene, 256×256, 64 spp, max depth 8, on all cores:
 1. Equal samples: median wall time of the whole `alhazen render` process (parse, build, render,
@@ -17,6 +18,11 @@ Mitsuba XML file that both renderers read as it is (so the twins are one file).
    time; RMSE and mean relative error of both images against the committed reference
    (suite/ref/NAME.exr, Mitsuba llvm at 4096 spp), and the relative difference of the means of
    alhazen's 64-spp image and the reference (the model's agreement, not noise).
+
+`depths`, per scene: the render alone of both renderers (alhazen's reported time less its
+build, against `mi.render` in llvm) with the path depth capped at 1, 2, 3 and the scene's own:
+where the time goes — a depth of 1 is the camera rays, their hits and the emitters seen, each
+further depth one bounce with its light sample — and so which part of a sample to speed up.
 
 Needs `pip install mitsuba numpy`, `apt-get install libllvm19`.
 """
@@ -129,9 +135,39 @@ def run(name, runs, spp, tmp):
           f"{e_mi[0]:.5f} / {e_mi[1]:.4f} | {bias * 100:+.2f} % |", flush=True)
 
 
+def with_depth(path, depth):
+    """A copy of scene file `path` whose `max_depth` is `depth`, beside it (its relative file
+    names resolve as before); the caller removes it."""
+    text = open(path).read()
+    capped, n = re.subn(r'(name="max_depth" value=")[^"]*"', rf'\g<1>{depth}"', text)
+    if n != 1:
+        sys.exit(f"{path}: no single max_depth to cap")
+    out = os.path.join(os.path.dirname(path), f".depth-{depth}-{os.path.basename(path)}")
+    with open(out, "w") as f:
+        f.write(capped)
+    return out
+
+
+def depths(name, runs, spp, tmp):
+    path = SCENES[name]
+    own = int(re.search(r'name="max_depth" value="(\d+)"', open(path).read()).group(1))
+    cells = []
+    for depth in [1, 2, 3, own]:
+        capped = with_depth(path, depth)
+        try:
+            llvm = mitsuba_renderer("llvm_ad_rgb", capped, spp, f"{tmp}/llvm.exr")
+            alhazen_run(capped, spp, f"{tmp}/ours.exr")
+            pairs = [(alhazen_run(capped, spp, f"{tmp}/ours.exr")[1], llvm()) for _ in range(runs)]
+        finally:
+            os.remove(capped)
+        ours, theirs = (float(np.median(ts)) for ts in zip(*pairs))
+        cells.append(f"{ours:.3f} / {theirs:.3f} s: **{ours / theirs:.2f}**")
+    print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("mode", choices=["reference", "run"])
+    ap.add_argument("mode", choices=["reference", "run", "depths"])
     ap.add_argument("names", nargs="*")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--spp", type=int, default=64)
@@ -145,6 +181,13 @@ def main():
     if "ALHAZEN" not in os.environ:
         subprocess.run(["cargo", "build", "--release", "-q", "-p", "alhazen-cli"], cwd=ROOT, check=True)
     tmp = tempfile.mkdtemp()
+    if a.mode == "depths":
+        print(f"{os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}; render alone, alhazen / Mitsuba llvm")
+        print("| scene | depth 1 | depth 2 | depth 3 | the scene's depth |")
+        print("|---|---|---|---|---|")
+        for n in names:
+            depths(n, a.runs, a.spp, tmp)
+        return
     print(f"{os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}")
     print("| scene | alhazen | Mitsuba llvm | Mitsuba scalar | alhazen/llvm | alhazen render alone: /llvm "
           "| alhazen/scalar | alhazen at llvm's time: RMSE / mean rel. | Mitsuba llvm: RMSE / mean rel. "
