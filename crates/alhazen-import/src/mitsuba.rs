@@ -697,22 +697,44 @@ impl Importer {
         if let Some(id) = self.default_material {
             return id;
         }
-        let m = alhazen_scene::Material::from_bsdf(
+        let mut m = alhazen_scene::Material::from_bsdf(
             "mitsuba default",
             BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::splat(0.5)) },
         );
+        m.one_sided = true;
         let id = common::add_material(&mut self.scene, m);
         self.default_material = Some(id);
         id
     }
 
-    /// A `<bsdf>` element as a new material.
+    /// A `<bsdf>` element as a new material: one-sided, as Mitsuba's are, unless wrapped in
+    /// `twosided` or letting light through.
     fn bsdf_material(&mut self, ctx: &Ctx, node: Node) -> R<MaterialId> {
         let (desc, bump) = self.bsdf(ctx, node, 0)?;
         let name = self.attr(ctx, node, "id")?.unwrap_or_else(|| format!("bsdf at line {}", ctx.line(node)));
+        let one_sided = !self.is_twosided(node, 0) && reflects_only(&desc);
         let mut m = alhazen_scene::Material::from_bsdf(&name, desc);
-        m.bump = bump;
+        (m.bump, m.one_sided) = (bump, one_sided);
         Ok(common::add_material(&mut self.scene, m))
+    }
+
+    /// True when the BSDF `node` shades both sides: a `twosided`, or a wrapper of one (a bump
+    /// or normal map, a mask), or a reference to a two-sided material.
+    fn is_twosided(&self, node: Node, depth: usize) -> bool {
+        if depth > 32 {
+            return false;
+        }
+        match (node.tag_name().name(), node.attribute("type")) {
+            ("ref", _) => node.attribute("id").is_some_and(
+                |id| matches!(self.ids.get(id), Some(Named::Bsdf(m)) if !self.scene.materials[*m as usize].one_sided),
+            ),
+            (_, Some("twosided")) => true,
+            (_, Some("bumpmap" | "normalmap" | "mask")) => node
+                .children()
+                .find(|c| c.tag_name().name() == "bsdf" || c.tag_name().name() == "ref")
+                .is_some_and(|inner| self.is_twosided(inner, depth + 1)),
+            _ => false,
+        }
     }
 
     /// The nested BSDF of a wrapper (`twosided`, `bumpmap`, …).
@@ -1278,4 +1300,13 @@ fn upside_down(img: alhazen_scene::ImageData) -> alhazen_scene::ImageData {
     let w = img.width as usize;
     let rows: Vec<&[[f32; 3]]> = img.pixels().chunks_exact(w.max(1)).rev().collect();
     alhazen_scene::ImageData::new(img.width, img.height, rows.concat())
+}
+
+/// True when no part of the BSDF lets light through (glass is two-sided in Mitsuba too).
+fn reflects_only(desc: &BsdfDesc) -> bool {
+    match desc {
+        BsdfDesc::Dielectric { .. } => false,
+        BsdfDesc::Mix { a, b, .. } => reflects_only(a) && reflects_only(b),
+        _ => true,
+    }
 }

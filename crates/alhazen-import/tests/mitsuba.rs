@@ -129,6 +129,29 @@ fn parameters_includes_groups_and_instances() {
     assert_eq!(eta, alhazen_scene::bsdf::metal("gold").unwrap().0);
 }
 
+/// Mitsuba's BSDFs shade their front only unless wrapped in `twosided` (or a bump map of one,
+/// or a reference to one); glass lets light through either side.
+#[test]
+fn opaque_bsdfs_are_one_sided_unless_twosided() {
+    let s = import(&[(
+        "s.xml",
+        &scene(
+            r#"<bsdf type="twosided" id="both"><bsdf type="diffuse"/></bsdf>
+            <shape type="sphere"><bsdf type="diffuse"/></shape>
+            <shape type="sphere"><ref id="both"/></shape>
+            <shape type="sphere"><bsdf type="roughconductor"/></shape>
+            <shape type="sphere"><bsdf type="dielectric"/></shape>
+            <shape type="sphere"><bsdf type="bumpmap"><ref id="both"/>
+                <texture type="checkerboard"/></bsdf></shape>
+            <shape type="sphere"/>"#,
+        ),
+    )])
+    .unwrap()
+    .scene;
+    let one_sided: Vec<bool> = s.objects.iter().map(|o| s.materials[o.material as usize].one_sided).collect();
+    assert_eq!(one_sided, [true, false, true, false, false, true]);
+}
+
 #[test]
 fn emitters_map_to_lights() {
     let s = import(&[(

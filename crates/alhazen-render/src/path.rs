@@ -74,6 +74,13 @@ pub trait CausticEstimate: Sync {
     fn radiance(&self, p: Vec3, ng: Vec3, f: &dyn Fn(Vec3) -> Vec3) -> Vec3;
 }
 
+/// A one-sided material's back, seen along `dir`: black, the path ends there (Mitsuba's BSDFs
+/// without `twosided`; the side is the shading normal's, before any bump map).
+#[inline(always)]
+fn seen_from_behind(m: &alhazen_scene::Material, wh: &WorldHit, dir: Vec3) -> bool {
+    m.one_sided && wh.hit.ns.dot(dir) >= 0.0
+}
+
 /// Power heuristic with β = 2.
 #[inline]
 fn power_heuristic(a: f64, b: f64) -> f64 {
@@ -271,10 +278,10 @@ impl<'a> PathTracer<'a> {
         if !(path.caustic_chain && self.caustics.is_some()) {
             path.l += path.beta * self.emitted(&HitPoint::from(wh), &path.ray, &path.prev, path.visit.as_ref(), mode);
         }
-        if path.depth == max_depth {
+        let m = &self.scene.materials[wh.material as usize];
+        if path.depth == max_depth || seen_from_behind(m, wh, path.ray.dir) {
             return;
         }
-        let m = &self.scene.materials[wh.material as usize];
         let bsdf = match (&self.uniform_bsdfs[wh.material as usize], mode) {
             (Some(b), ColorMode::Rgb) => Cow::Borrowed(b),
             _ => Cow::Owned(bsdf_at(m, wh.hit.uv, &self.scene.images, mode)),

@@ -200,3 +200,48 @@ material = {{ emission = [6, 6, 6] }}
     assert!(plain.x > 0.01, "the floor is lit: {plain}");
     assert!(((plain - scaled) / plain).abs().max_element() < 0.03, "{plain} vs {scaled}");
 }
+
+/// A one-sided material is black from behind and ends the paths that reach its back; two-sided
+/// (the default), both faces are shaded alike. A disk lit and seen from below, facing down
+/// (its front) or up (its back).
+#[test]
+fn one_sided_surfaces_are_black_from_behind() {
+    let scene = |one_sided: bool, normal_y: f64| {
+        let text = format!(
+            r#"
+[render]
+width = 4
+height = 4
+spp = 16
+max_depth = 3
+integrator = "path"
+[camera]
+type = "orthographic"
+eye = [0, -2, 0]
+target = [0, 0, 0]
+up = [0, 0, 1]
+width = 0.5
+[[light]]
+type = "point"
+position = [0, -3, 0]
+intensity = 10
+[materials.card]
+color = 0.8
+one_sided = {one_sided}
+[[object]]
+shape = "disk"
+center = [0, 0, 0]
+normal = [0, {normal_y}, 0]
+radius = 1
+material = "card"
+"#
+        );
+        let scene = parse_scene("card.toml".as_ref(), &text).unwrap();
+        mean(&render(&scene, &|_, _| {})).x
+    };
+    let front = scene(true, -1.0);
+    assert!(front > 0.1, "the front is lit: {front}");
+    assert_eq!(scene(true, 1.0), 0.0, "one-sided, the back is black");
+    assert_eq!(scene(false, -1.0), front, "the front does not depend on the flag");
+    assert_eq!(scene(false, 1.0), front, "two-sided, the back is shaded as the front");
+}

@@ -485,6 +485,10 @@ pub struct Material {
     pub bsdf: Option<crate::bsdf::BsdfDesc>,
     /// Bump mapping: small displacements along the normal, seen through the perturbed normal.
     pub bump: Option<Bump>,
+    /// The path tracer shades the front side only (that of the shading normal): seen from
+    /// behind, an opaque surface is black and ends paths, as Mitsuba's BSDFs not wrapped in
+    /// `twosided` are. `false` (the default): both sides alike, the course's reading.
+    pub one_sided: bool,
 }
 
 /// A displacement `d(q(u, v))` of a surface along its normal (course, §"Shading methods":
@@ -542,6 +546,7 @@ impl Default for Material {
             emission: Vec3::ZERO,
             bsdf: None,
             bump: None,
+            one_sided: false,
         }
     }
 }

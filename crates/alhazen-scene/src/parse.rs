@@ -218,6 +218,7 @@ impl Parser<'_> {
             "bump",
             "anisotropy",
             "scratches",
+            "one_sided",
         ];
         let t = n.table(KEYS)?;
         let plain = Material::default();
@@ -256,6 +257,7 @@ impl Parser<'_> {
             emission: t.opt_rgb("emission", d.emission)?,
             bsdf,
             bump: t.get("bump").map(|b| self.bump(&b)).transpose()?,
+            one_sided: t.opt_bool("one_sided", false)?,
         })
     }
 

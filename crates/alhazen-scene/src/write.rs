@@ -337,6 +337,9 @@ impl Writer<'_> {
             let t = self.bsdf(b);
             self.line("bsdf", t);
         }
+        if m.one_sided {
+            self.line("one_sided", "true".to_string());
+        }
     }
 
     fn bsdf(&self, b: &BsdfDesc) -> String {

@@ -202,18 +202,27 @@ impl MirrorShape {
 
     /// Every light path from `source` to `x` with one reflection on this mirror, each handed to
     /// `found`. Occlusion is not tested: the caller traces both legs.
-    pub fn reflections(&self, x: Vec3, source: Source, mut found: impl FnMut(MirrorPath)) {
+    pub fn reflections(&self, x: Vec3, source: Source, found: impl FnMut(MirrorPath)) {
+        self.reflections_on(x, source, false, found);
+    }
+
+    /// [`Self::reflections`] on the front only when `front_only` (a one-sided mirror: the
+    /// outside of a sphere or cylinder, the side a disk's or plane's normal faces), whose
+    /// back reflects nothing.
+    pub fn reflections_on(&self, x: Vec3, source: Source, front_only: bool, mut found: impl FnMut(MirrorPath)) {
         let site = match source {
             Source::At(y) => Site::At(y),
             Source::Toward(d) => Site::Toward(d),
         };
         let mut visit = |m: Vec3, n: Vec3| {
-            if let Some(path) = self.contains(m).then(|| self.path(x, m, n, source)).flatten() {
+            if let Some(path) = self.contains(m).then(|| self.path(x, m, n, source)).flatten()
+                && !(front_only && path.normal.dot(self.outward_normal(m)) < 0.0)
+            {
                 found(path);
             }
         };
         // Inside reflections need both legs inside: either end beside or outside rules them out.
-        let visible_only = self.outside_only(Site::At(x)) || self.outside_only(site);
+        let visible_only = front_only || self.outside_only(Site::At(x)) || self.outside_only(site);
         let reflexes = match *self {
             MirrorShape::Sphere { center, radius } if visible_only => {
                 let sphere = alhazen_mirror::Sphere { center, radius };

@@ -695,10 +695,13 @@ impl PathTracer<'_> {
         let path = &mut lane.path;
         let wh = hit?;
         let material = self.material_kernels[wh.material as usize];
-        if !material.is_material() || path.depth >= self.scene.render.max_depth {
+        let m = &self.scene.materials[wh.material as usize];
+        if !material.is_material()
+            || path.depth >= self.scene.render.max_depth
+            || super::seen_from_behind(m, wh, path.ray.dir)
+        {
             return None;
         }
-        let m = &self.scene.materials[wh.material as usize];
         let at_hit;
         let bsdf = match &self.uniform_bsdfs[wh.material as usize] {
             Some(bsdf) => bsdf,

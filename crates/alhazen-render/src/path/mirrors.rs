@@ -33,6 +33,8 @@ pub(super) struct MirrorPiece {
     shape: MirrorShape,
     /// The shape's bounding sphere (`None`: an unbounded plane), for choosing pieces.
     bound: Option<(Vec3, f64)>,
+    /// Its material is one-sided: only its front reflects.
+    front_only: bool,
 }
 
 /// A light the connections join through the mirrors.
@@ -88,6 +90,7 @@ impl MirrorConnections {
                     object: i as u32,
                     material: o.material,
                     bound: shape.bounding_sphere(),
+                    front_only: scene.materials[o.material as usize].one_sided,
                     shape,
                 })
             })
@@ -214,7 +217,7 @@ impl PathTracer<'_> {
             return Vec3::ZERO;
         }
         let mut sum = Vec3::ZERO;
-        piece.shape.reflections(x, source, |path| {
+        piece.shape.reflections_on(x, source, piece.front_only, |path| {
             let at = (bsdf, frame, terminator);
             sum += self.connected_path(piece, (light, area_point, p_choice), at, x, ng, v, mode, &path);
         });
@@ -339,14 +342,14 @@ mod tests {
     fn connections() -> MirrorConnections {
         let sphere = |object, center: Vec3, radius| {
             let shape = MirrorShape::Sphere { center, radius };
-            MirrorPiece { object, material: 0, bound: shape.bounding_sphere(), shape }
+            MirrorPiece { object, material: 0, bound: shape.bounding_sphere(), front_only: false, shape }
         };
         let plane = MirrorShape::Plane { point: Vec3::ZERO, normal: Vec3::Y };
         let pieces = vec![
             sphere(0, Vec3::new(1.0, 1.0, 0.0), 0.5),
             sphere(1, Vec3::new(-2.0, 0.5, 1.0), 0.2),
             sphere(2, Vec3::new(0.0, 3.0, -4.0), 1.5),
-            MirrorPiece { object: 3, material: 0, bound: None, shape: plane },
+            MirrorPiece { object: 3, material: 0, bound: None, front_only: false, shape: plane },
         ];
         let lights = vec![
             ConnectedLight { light: 0, object: None, anchor: Some(Vec3::new(0.0, 5.0, 0.0)) },
