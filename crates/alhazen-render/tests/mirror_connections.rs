@@ -134,16 +134,11 @@ fn the_cup_caustic_lies_on_the_catacaustic() {
     assert!(median <= 1.0 && max <= 2.0, "distance to the catacaustic: median {median:.2} px, max {max:.2} px");
 }
 
-/// A small lamp that faces away from the floor lights it only through a mirror ball. With
-/// connections, paths that reach the lamp after the ball are weighted against them (MIS);
-/// without, only BSDF sampling finds them. Both estimate the same image (means within 3 %, the
-/// BSDF-only estimate at 64× the samples), and the connected one is much less noisy at equal
-/// samples.
-#[test]
-fn area_light_through_a_mirror_ball_is_unbiased_with_and_without_connections() {
-    let scene = |connections: bool, spp: u32, seed: u32| {
-        format!(
-            r#"
+/// A floor lit by a disk lamp facing away from it, through a mirror ball only, seen from above
+/// where the lamp's reflection falls, and `extra` objects.
+fn lamp_and_mirror_ball(connections: bool, spp: u32, seed: u32, extra: &str) -> String {
+    format!(
+        r#"
 [render]
 width = 16
 height = 16
@@ -182,9 +177,18 @@ center = [-1.7, 0.5, 0.7]
 normal = [0.5, 1, 0]
 radius = 0.4
 material = "lamp"
-"#
-        )
-    };
+{extra}"#
+    )
+}
+
+/// A small lamp that faces away from the floor lights it only through a mirror ball. With
+/// connections, paths that reach the lamp after the ball are weighted against them (MIS);
+/// without, only BSDF sampling finds them. Both estimate the same image (means within 3 %, the
+/// BSDF-only estimate at 64× the samples), and the connected one is much less noisy at equal
+/// samples.
+#[test]
+fn area_light_through_a_mirror_ball_is_unbiased_with_and_without_connections() {
+    let scene = |connections: bool, spp: u32, seed: u32| lamp_and_mirror_ball(connections, spp, seed, "");
     let noise = |connections: bool| {
         let (a, b) = (render(&scene(connections, 256, 0)), render(&scene(connections, 256, 1)));
         let n = (a.width * a.height) as f64;
@@ -223,41 +227,7 @@ fn connected_images_do_not_depend_on_the_thread_count() {
 /// is the one sampling alone converges to.
 #[test]
 fn one_drawn_lamp_and_mirror_per_vertex_is_unbiased() {
-    let scene = |connections: bool, spp: u32, seed: u32| {
-        format!(
-            r#"
-[render]
-width = 16
-height = 16
-spp = {spp}
-max_depth = 4
-seed = {seed}
-integrator = "path"
-mirror_connections = {connections}
-[camera]
-type = "orthographic"
-eye = [-2.0, 6, -0.6]
-target = [-2.0, 0, -0.6]
-up = [0, 0, 1]
-width = 1.6
-[materials.floor]
-color = 0.8
-[materials.chrome]
-color = 0
-diffuse = 0
-mirror = 0.9
-[materials.lamp]
-color = 0
-emission = 10
-[[object]]
-shape = "plane"
-normal = [0, 1, 0]
-material = "floor"
-[[object]]
-shape = "sphere"
-center = [0, 1, 0]
-radius = 1
-material = "chrome"
+    let more = r#"
 [[object]]
 shape = "sphere"
 center = [-3.5, 0.5, 1.5]
@@ -271,19 +241,12 @@ radius = 0.4
 material = "chrome"
 [[object]]
 shape = "disk"
-center = [-1.7, 0.5, 0.7]
-normal = [0.5, 1, 0]
-radius = 0.4
-material = "lamp"
-[[object]]
-shape = "disk"
 center = [-2.6, 0.4, 2.2]
 normal = [0, 1, 0.4]
 radius = 0.3
 material = "lamp"
-"#
-        )
-    };
+"#;
+    let scene = |connections: bool, spp: u32, seed: u32| lamp_and_mirror_ball(connections, spp, seed, more);
     let connected = mean(&render(&scene(true, 256, 0))).x;
     let sampled = mean(&render(&scene(false, 16384, 2))).x;
     let rel = (connected - sampled).abs() / sampled;
