@@ -140,7 +140,7 @@ impl MirrorConnections {
             .pieces
             .iter()
             .filter(|piece| piece.object != x_object)
-            .map(|piece| piece.bound.map_or(1.0, |(centre, r)| (r * r / (centre - x).length_squared()).min(1.0)))
+            .map(|piece| apparent_size(piece.bound, Some(x)))
             .sum();
         (ROULETTE_GAIN * seen).min(1.0)
     }
@@ -154,11 +154,7 @@ impl MirrorConnections {
         if piece.object == x_object || Some(piece.object) == l.object {
             return 0.0;
         }
-        let seen_from = |p: Option<Vec3>| match (piece.bound, p) {
-            (Some((centre, r)), Some(p)) => (r * r / (centre - p).length_squared()).min(1.0),
-            _ => 1.0,
-        };
-        seen_from(Some(x)) * seen_from(l.anchor)
+        apparent_size(piece.bound, Some(x)) * apparent_size(piece.bound, l.anchor)
     }
 
     /// The (light, piece) pair a vertex at `x` connects through, drawn by `u` — whether it
@@ -208,6 +204,15 @@ impl MirrorConnections {
     fn piece_at(&self, object: u32, p: Vec3) -> Option<u32> {
         let of_object = self.pieces.iter().enumerate().filter(|(_, piece)| piece.object == object);
         of_object.min_by(|(_, a), (_, b)| a.shape.distance(p).total_cmp(&b.shape.distance(p))).map(|(i, _)| i as u32)
+    }
+}
+
+/// How large a bounding sphere looks from `p`: its radius² over the squared distance, at most
+/// 1; 1 for an unbounded plane or a point at infinity.
+fn apparent_size(bound: Option<(Vec3, f64)>, p: Option<Vec3>) -> f64 {
+    match (bound, p) {
+        (Some((centre, r)), Some(p)) => (r * r / (centre - p).length_squared()).min(1.0),
+        _ => 1.0,
     }
 }
 
