@@ -296,3 +296,22 @@ material = "b"
         assert!(e.contains(expected) || e.contains("3:"), "{bad}: {e}");
     }
 }
+
+/// `one_sided`: false unless given, kept when the scene is written back, and refused with its
+/// place when it is not a boolean.
+#[test]
+fn one_sided_reads_writes_back_and_refuses_non_booleans() {
+    let text = "[materials.card]\ncolor = 0.8\none_sided = true\n[materials.plain]\ncolor = 0.5\n";
+    let s = parse_scene("card.toml".as_ref(), text).unwrap();
+    let flag = |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().one_sided;
+    assert!(flag(&s, "card") && !flag(&s, "plain"));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&path).unwrap();
+    assert!(flag(&again, "card") && !flag(&again, "plain"));
+    for bad in ["1", "\"yes\"", "nan", "[true]"] {
+        let e = err(&format!("[materials.card]\none_sided = {bad}\n"));
+        assert!(e.contains("one_sided") && e.contains(":2:"), "{bad}: {e}");
+    }
+}
