@@ -302,8 +302,8 @@ impl<'a> PathTracer<'a> {
             let (light, shadow) = self.next_event(&bsdf, &frame, terminator, wh.hit.p, ng, v, mode, choices.x, s);
             (out.light, out.shadow) = (Some(light), shadow);
             if let Some(c) = self.mirrors.as_ref().filter(|_| path.depth + 2 <= max_depth) {
-                out.mirrored =
-                    Some(self.mirror_connections(c, &bsdf, &frame, terminator, wh.hit.p, ng, v, wh.object, mode, s));
+                let shading = || mirrors::VertexShading { frame, ng, terminator, v };
+                out.mirrored = Some(self.mirror_connections(c, &bsdf, shading, wh.hit.p, wh.object, mode, s));
             }
             if let Some(c) = self.caustics {
                 // RGB only: photon mapping refuses dispersive scenes.

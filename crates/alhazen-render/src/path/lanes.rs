@@ -17,12 +17,11 @@
 //! until their samples run out; then the paths left move to the first groups.
 //!
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
-//! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light, colour mode
-//! and specular connection. In RGB scenes without specular connections, vertices on Lambert
-//! surfaces, on conductors, glass and plastic (smooth, or rough of Trowbridge–Reitz or
+//! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light and colour
+//! mode. In RGB scenes, vertices on Lambert surfaces, on conductors, glass and plastic (smooth, or rough of Trowbridge–Reitz or
 //! Beckmann facets) — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
-//! instead: their random numbers, emission, material and bent normal per lane
-//! ([`PathTracer::kernel_vertex`]), then light points (on parallelogram and point lights in
+//! instead: their random numbers, emission, material, bent normal and specular connections
+//! through the scene's mirrors per lane ([`PathTracer::kernel_vertex`]), then light points (on parallelogram and point lights in
 //! lanes, [`sample_lights`]; on other lights for all lanes at once, [`Lights::sample_lanes`], an
 //! environment map's memory asked for every lane before any lane waits for it) and the shading
 //! frame, next-event weights, bump shadowing, sampled continuation and Russian roulette
@@ -325,13 +324,18 @@ struct LanePath {
     stream: SampleStream,
     /// RGB, or the wavelengths of a spectral sample.
     mode: ColorMode,
+    /// A material kernel's vertex: the light its specular connections brought, and the
+    /// mirror visit its continuation records if it samples a delta lobe.
+    mirrored: Option<Vec3>,
+    visit: Option<super::mirrors::MirrorVisit>,
 }
 
 impl LanePath {
     /// An idle lane.
     fn idle() -> Self {
         let path = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
-        Self { live: false, job: 0, path, stream: SampleStream::default(), mode: ColorMode::Rgb }
+        let stream = SampleStream::default();
+        Self { live: false, job: 0, path, stream, mode: ColorMode::Rgb, mirrored: None, visit: None }
     }
 
     /// The sample's value: its radiance, in RGB.
@@ -429,14 +433,19 @@ impl Kernel {
     fn is_delta(self) -> bool {
         matches!(self, Kernel::SmoothConductor | Kernel::SmoothDielectric)
     }
+
+    /// The kernel's BSDF has a delta lobe (a path may leave its vertices specularly).
+    fn samples_delta(self) -> bool {
+        self.is_delta() || self == Kernel::SmoothPlastic
+    }
 }
 
 /// Per material: the kernel its vertices take, in a scene whose vertices may take material
-/// kernels (RGB, no specular connections). A material's kind of BSDF does not vary over its
+/// kernels (RGB). A material's kind of BSDF does not vary over its
 /// surface (textures vary colours only), so the BSDF at any point tells (checked at each hit in
 /// debug builds).
 pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<Kernel> {
-    let scene_allows = !tracer.spectral && tracer.mirrors.is_none();
+    let scene_allows = !tracer.spectral;
     let images = &tracer.scene.images;
     let kernel = |m| kernel_of(&crate::bsdf::bsdf_at(m, Vec2::ZERO, images, ColorMode::Rgb), m);
     tracer.scene.materials.iter().map(|m| if scene_allows { kernel(m) } else { Kernel::General }).collect()
@@ -660,7 +669,7 @@ impl PathTracer<'_> {
                         general[p].goes_on
                     }
                     Kernel::Escaped => false,
-                    _ => finish_kernel(&mut lane.path, &batches.all[at[p].0].shaded, open, at[p].1),
+                    _ => finish_kernel(lane, &batches.all[at[p].0].shaded, open, at[p].1),
                 };
                 if goes_on {
                     rays[g].set(i, &lane.path.ray);
@@ -753,7 +762,15 @@ impl PathTracer<'_> {
             }
         }
         let h = HitPoint::from(wh);
-        path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, None, ColorMode::Rgb);
+        path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, path.visit.as_ref(), ColorMode::Rgb);
+        // As `vertex` records a mirror's visit, from the previous vertex as it was.
+        lane.visit = match &self.mirrors {
+            Some(c) if !path.prev.delta && kernel.samples_delta() => {
+                c.visit(path.prev.p, path.prev_object, path.prev.pdf, &h)
+            }
+            _ => None,
+        };
+        path.prev_object = wh.object;
         v.roulette.put(i, path.depth >= RR_DEPTH);
         set(&mut v.wo, i, -path.ray.dir);
         set(&mut v.p, i, h.p);
@@ -773,12 +790,14 @@ impl PathTracer<'_> {
         // is known whether the path survives the continuation; a path that does not never draws
         // again, so the stream stays the per-path tracer's.
         let s = &mut lane.stream;
+        let path = &lane.path;
         // One pair picks the light and the lobe, drawn only when there is a choice; a delta
         // BSDF samples no light and draws no number for it.
         let chooses = self.lights.len() > 1 || kernel.chooses_lobe();
         let (choice, u_lobe) = if chooses { s.next_2d().into() } else { (0.0, 0.0) };
         v.u_lobe[i] = u_lobe;
         let u_light = if kernel.is_delta() { Vec2::ZERO } else { s.next_2d() };
+        lane.mirrored = self.kernel_mirror_connections(kernel, path, wh, bsdf, s);
         let u_bsdf = s.next_2d();
         (v.u_bsdf[0][i], v.u_bsdf[1][i]) = (u_bsdf.x, u_bsdf.y);
         if v.roulette.at(i) {
@@ -806,6 +825,34 @@ impl PathTracer<'_> {
             }
         }
         Some((b, i))
+    }
+}
+
+impl PathTracer<'_> {
+    /// The light a kernel's vertex gathers through the scene's mirrors, drawn from `s` where
+    /// [`Self::vertex`] draws it (after the light point, before the continuation); `None`
+    /// where `vertex` connects nothing (no mirrors, a delta BSDF, too deep). The vertex's
+    /// frame, which the kernels compute in lanes, is computed here only for a vertex the
+    /// roulette lets connect.
+    fn kernel_mirror_connections(
+        &self,
+        kernel: Kernel,
+        path: &PathState,
+        wh: &WorldHit,
+        bsdf: &Bsdf,
+        s: &mut SampleStream,
+    ) -> Option<Vec3> {
+        let c = self.mirrors.as_ref()?;
+        if kernel.is_delta() || path.depth + 2 > self.scene.render.max_depth {
+            return None;
+        }
+        let shading = || {
+            let m = &self.scene.materials[wh.material as usize];
+            let wo = -path.ray.dir;
+            let (frame, ng, terminator) = self.shading_frame(wh, bsdf, wo, crate::bsdf::tangent_at(m, wh.hit.dpduv[0]));
+            super::mirrors::VertexShading { frame, ng, terminator, v: frame.to_local(wo) }
+        };
+        Some(self.mirror_connections(c, bsdf, shading, wh.hit.p, wh.object, ColorMode::Rgb, s))
     }
 }
 
@@ -848,11 +895,16 @@ fn gather_paths(lanes: &mut [LanePath; POOL], rays: &mut [RayPacket; GROUPS]) ->
 }
 
 /// The per-path half of a material kernel's vertex after [`shade`] and the shadow ray (`clear`
-/// when it was not traced or met nothing): the light gathered, then the step to the next
-/// vertex. True when the path goes on.
-fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> bool {
+/// when it was not traced or met nothing): the light gathered, then the light through mirrors,
+/// then the step to the next vertex (the mirror visit kept if the lobe taken was a delta one).
+/// True when the path goes on.
+fn finish_kernel(lane: &mut LanePath, s: &Shaded, clear: bool, i: usize) -> bool {
+    let path = &mut lane.path;
     let light = if clear { get(&s.light, i) } else { Vec3::ZERO };
     path.l += path.beta * light;
+    if let Some(mirrored) = lane.mirrored {
+        path.l += path.beta * mirrored;
+    }
     if s.alive.at(i) {
         path.beta = get(&s.beta, i);
         path.eta_scale = s.eta_scale[i];
@@ -860,6 +912,7 @@ fn finish_kernel(path: &mut PathState, s: &Shaded, clear: bool, i: usize) -> boo
         path.prev.delta = s.delta.at(i);
         path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
         path.depth += 1;
+        path.visit = if path.prev.delta { lane.visit } else { None };
     }
     s.alive.at(i)
 }

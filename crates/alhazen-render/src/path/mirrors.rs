@@ -44,14 +44,15 @@ pub(super) struct MirrorPiece {
 }
 
 /// A light the connections join through the mirrors.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct ConnectedLight {
     /// Its index among the scene's lights, and its emitting object.
     light: usize,
     object: Option<u32>,
-    /// Where it is, for choosing pieces: a point light's position, an area light's centre;
-    /// `None` for a light at infinity.
-    anchor: Option<Vec3>,
+    /// How large each piece looks from the light ([`apparent_size`] from a point light's
+    /// position, an area light's centre; 1 from a light at infinity), for choosing pieces;
+    /// zero for the light's own object, which no connection goes through.
+    seen_from_light: Vec<f64>,
 }
 
 /// What the connections need from the scene: its mirrors and the lights to join through them.
@@ -62,6 +63,15 @@ pub(super) struct MirrorConnections {
     lights: Vec<ConnectedLight>,
     /// Some light is an area light: each vertex draws a point on them.
     any_area: bool,
+}
+
+/// A vertex's shading frame, its geometric normal on the viewer's side, its bump shadowing
+/// and the direction to the viewer in the frame.
+pub(super) struct VertexShading {
+    pub(super) frame: Frame,
+    pub(super) ng: Vec3,
+    pub(super) terminator: Option<Terminator>,
+    pub(super) v: Vec3,
 }
 
 /// A path that left a non-specular vertex `x` by sampling its BSDF and reflected on a mirror:
@@ -102,7 +112,7 @@ impl MirrorConnections {
             })
             .collect();
         let objects = lights.objects();
-        let connected: Vec<ConnectedLight> = lights
+        let connected: Vec<_> = lights
             .all()
             .iter()
             .enumerate()
@@ -113,11 +123,25 @@ impl MirrorConnections {
                     PathLight::Directional { .. } => None,
                     _ => return None,
                 };
-                Some(ConnectedLight { light: i, object: objects[i], anchor })
+                Some((i, objects[i], anchor))
             })
             .collect();
-        let any_area = connected.iter().any(|l| l.object.is_some());
-        (!pieces.is_empty() && !connected.is_empty()).then_some(Self { pieces, lights: connected, any_area })
+        (!pieces.is_empty() && !connected.is_empty()).then(|| Self::new(pieces, &connected))
+    }
+
+    /// The connections through `pieces` of the lights `(index, emitting object, anchor)`.
+    fn new(pieces: Vec<MirrorPiece>, lights: &[(usize, Option<u32>, Option<Vec3>)]) -> Self {
+        let lights: Vec<ConnectedLight> = lights
+            .iter()
+            .map(|&(light, object, anchor)| {
+                let seen = |p: &MirrorPiece| {
+                    if Some(p.object) == object { 0.0 } else { apparent_size(p.bound, anchor) }
+                };
+                ConnectedLight { light, object, seen_from_light: pieces.iter().map(seen).collect() }
+            })
+            .collect();
+        let any_area = lights.iter().any(|l| l.object.is_some());
+        Self { pieces, lights, any_area }
     }
 
     /// The visit to record when the path sampled a delta lobe at `hit` after sampling a
@@ -131,18 +155,32 @@ impl MirrorConnections {
         Some(MirrorVisit { x, x_object, pdf_x, piece, m: hit.p })
     }
 
-    /// The probability that a vertex at `x` (on `x_object`) connects at all: `K · Σ s_k(x)`
-    /// over the pieces (how large each looks, as in [`Self::piece_weight`]), at most 1 — a
-    /// Russian roulette on what mirrors far away and small can bring, decided before any
-    /// solve. Near a mirror (a sphere within `√K` radii) a vertex always connects.
+    /// How large piece `k` looks from `x` (on `x_object`): zero from its own object.
+    fn seen_from(&self, k: usize, x: Vec3, x_object: u32) -> f64 {
+        let piece = &self.pieces[k];
+        if piece.object == x_object { 0.0 } else { apparent_size(piece.bound, Some(x)) }
+    }
+
+    /// The probability `q` that a vertex at `x` (on `x_object`) connects at all,
+    /// `min(1, K · Σ s_k(x))` over the pieces (how large each looks) — a Russian roulette on
+    /// what mirrors far away and small can bring, decided before any solve; near a mirror (a
+    /// sphere within `√K` radii) a vertex always connects — and the sum of the pieces' weights
+    /// in the draw for light `l` ([`Self::piece_weight`]). One pass, one division per piece.
+    fn draw_totals(&self, l: &ConnectedLight, x: Vec3, x_object: u32) -> (f64, f64) {
+        let (mut seen, mut total) = (0.0, 0.0);
+        for k in 0..self.pieces.len() {
+            let s = self.seen_from(k, x, x_object);
+            seen += s;
+            total += s * l.seen_from_light[k];
+        }
+        ((ROULETTE_GAIN * seen).min(1.0), total)
+    }
+
+    /// The probability that a vertex at `x` (on `x_object`) connects at all
+    /// ([`Self::draw_totals`]).
+    #[cfg(test)]
     fn connect_probability(&self, x: Vec3, x_object: u32) -> f64 {
-        let seen: f64 = self
-            .pieces
-            .iter()
-            .filter(|piece| piece.object != x_object)
-            .map(|piece| apparent_size(piece.bound, Some(x)))
-            .sum();
-        (ROULETTE_GAIN * seen).min(1.0)
+        self.draw_totals(&self.lights[0], x, x_object).0
     }
 
     /// The weight of piece `k` in the draw for light `l` at `x` (an object on `x_object`):
@@ -150,31 +188,25 @@ impl MirrorConnections {
     /// over the squared distance, at most 1; an unbounded plane 1); zero for the object `x`
     /// lies on and for the light's own object, which no connection goes through.
     fn piece_weight(&self, l: &ConnectedLight, k: usize, x: Vec3, x_object: u32) -> f64 {
-        let piece = &self.pieces[k];
-        if piece.object == x_object || Some(piece.object) == l.object {
-            return 0.0;
-        }
-        apparent_size(piece.bound, Some(x)) * apparent_size(piece.bound, l.anchor)
+        self.seen_from(k, x, x_object) * l.seen_from_light[k]
     }
 
     /// The (light, piece) pair a vertex at `x` connects through, drawn by `u` — whether it
-    /// connects at all by [`Self::connect_probability`] `q` (`u.y < q`), then the light
-    /// uniformly and the piece by [`Self::piece_weight`] (`u.y / q`, uniform again) — with the
-    /// probability of the draw; `None` when it does not connect.
+    /// connects at all by [`Self::draw_totals`]' `q` (`u.y < q`), then the light uniformly and
+    /// the piece by [`Self::piece_weight`] (`u.y / q`, uniform again) — with the probability
+    /// of the draw; `None` when it does not connect.
     fn choose(&self, x: Vec3, x_object: u32, u: Vec2) -> Option<(usize, usize, f64)> {
-        let q = self.connect_probability(x, x_object);
-        if u.y >= q {
-            return None;
-        }
         let slot = ((u.x * self.lights.len() as f64) as usize).min(self.lights.len() - 1);
         let l = &self.lights[slot];
-        let weight = |k| self.piece_weight(l, k, x, x_object);
-        let total = self.total_weight(l, x, x_object)?;
+        let (q, total) = self.draw_totals(l, x, x_object);
+        if u.y >= q || total <= 0.0 {
+            return None;
+        }
         // The first piece whose running sum passes `(u.y / q) · total` (the last one weighed,
         // should rounding keep the sum below it).
         let (target, mut below, mut chosen) = (u.y / q * total, 0.0, None);
         for k in 0..self.pieces.len() {
-            let w = weight(k);
+            let w = self.piece_weight(l, k, x, x_object);
             if w > 0.0 {
                 (below, chosen) = (below + w, Some((k, w)));
                 if target < below {
@@ -189,15 +221,11 @@ impl MirrorConnections {
     /// The probability that [`Self::choose`] draws light `slot` and piece `k` at `x`.
     fn choice_probability(&self, slot: usize, k: usize, x: Vec3, x_object: u32) -> f64 {
         let l = &self.lights[slot];
-        let Some(total) = self.total_weight(l, x, x_object) else { return 0.0 };
-        let q = self.connect_probability(x, x_object);
+        let (q, total) = self.draw_totals(l, x, x_object);
+        if total <= 0.0 {
+            return 0.0;
+        }
         q * (self.piece_weight(l, k, x, x_object) / total / self.lights.len() as f64)
-    }
-
-    /// The sum of the pieces' weights for light `l` at `x`; `None` when nothing is drawn.
-    fn total_weight(&self, l: &ConnectedLight, x: Vec3, x_object: u32) -> Option<f64> {
-        let total: f64 = (0..self.pieces.len()).map(|k| self.piece_weight(l, k, x, x_object)).sum();
-        (total > 0.0).then_some(total)
     }
 
     /// The piece of mirror object `object` that `p` lies on.
@@ -220,17 +248,16 @@ impl PathTracer<'_> {
     /// Light reaching `x` through one mirror reflection: `Σ f·cos·F·L` over the reflections
     /// of one (light, mirror) pair drawn at random ([`MirrorConnections::choose`]), divided by
     /// the probability of the draw, with the generalised geometry term; MIS-weighted for area
-    /// lights.
+    /// lights. `shading` gives the vertex's frame, geometric normal, bump shadowing and
+    /// direction to the viewer in the frame ([`PathTracer::shading_frame`]): asked only when
+    /// the vertex connects.
     #[inline(never)]
     pub(super) fn mirror_connections(
         &self,
         c: &MirrorConnections,
         bsdf: &Bsdf,
-        frame: &Frame,
-        terminator: Option<Terminator>,
+        shading: impl FnOnce() -> VertexShading,
         x: Vec3,
-        ng: Vec3,
-        v: Vec3,
         x_object: u32,
         mode: ColorMode,
         s: &mut SampleStream,
@@ -240,12 +267,13 @@ impl PathTracer<'_> {
         let Some((slot, k, p_choice)) = c.choose(x, x_object, u_choice) else { return Vec3::ZERO };
         let (light, piece) = (c.lights[slot].light, &c.pieces[k]);
         let Some((source, area_point)) = self.connection_source(light, u) else { return Vec3::ZERO };
+        let VertexShading { frame, ng, terminator, v } = shading();
         if !bsdf.transmits() && !piece.shape.in_front_of(x, ng) {
             return Vec3::ZERO;
         }
         let mut sum = Vec3::ZERO;
         piece.shape.reflections_on(x, source, piece.front_only, |path| {
-            let at = (bsdf, frame, terminator);
+            let at = (bsdf, &frame, terminator);
             sum += self.connected_path(piece, (light, area_point, p_choice), at, x, ng, v, mode, &path);
         });
         sum
@@ -378,12 +406,12 @@ mod tests {
             sphere(2, Vec3::new(0.0, 3.0, -4.0), 1.5),
             MirrorPiece { object: 3, material: 0, bound: None, front_only: false, shape: plane },
         ];
-        let lights = vec![
-            ConnectedLight { light: 0, object: None, anchor: Some(Vec3::new(0.0, 5.0, 0.0)) },
-            ConnectedLight { light: 1, object: Some(2), anchor: Some(Vec3::new(0.0, 3.0, -4.0)) },
-        ];
-        MirrorConnections { pieces, lights, any_area: true }
+        MirrorConnections::new(pieces, &LIGHTS)
     }
+
+    /// A light at a point, and one on the largest sphere.
+    const LIGHTS: [(usize, Option<u32>, Option<Vec3>); 2] =
+        [(0, None, Some(Vec3::new(0.0, 5.0, 0.0))), (1, Some(2), Some(Vec3::new(0.0, 3.0, -4.0)))];
 
     /// The draw's frequencies over a fine grid of `u` are the probabilities it reports, and
     /// those [`MirrorConnections::choice_probability`] gives the emission's MIS weight, which
@@ -391,7 +419,7 @@ mod tests {
     /// connects (its own object, the light's).
     #[test]
     fn the_drawn_pair_has_the_probability_the_weights_use() {
-        let without_plane = MirrorConnections { pieces: connections().pieces[..3].to_vec(), ..connections() };
+        let without_plane = MirrorConnections::new(connections().pieces[..3].to_vec(), &LIGHTS);
         let points = [(Vec3::new(0.3, 0.0, 0.2), 3), (Vec3::new(1.0, 1.5, 0.0), 0), (Vec3::new(-5.0, 2.0, 7.0), 9)];
         for (c, (x, x_object)) in
             [connections(), without_plane].into_iter().flat_map(|c| points.map(|p| (c.clone(), p)))
