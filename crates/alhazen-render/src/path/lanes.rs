@@ -18,11 +18,13 @@
 //!
 //! A vertex is shaded by its material's kernel. The general kernel is the per-path tracer's
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light and colour
-//! mode. In RGB scenes, vertices on Lambert surfaces, on conductors, glass and plastic (smooth, or rough of Trowbridge–Reitz or
-//! Beckmann facets) — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
+//! mode. In RGB scenes, vertices on Lambert surfaces, on conductors (exact or Schlick's
+//! Fresnel term), glass and plastic (smooth, or rough of Trowbridge–Reitz or Beckmann facets)
+//! and Cook–Torrance — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
 //! instead: their random numbers, emission, material, bent normal and specular connections
-//! through the scene's mirrors per lane ([`PathTracer::kernel_vertex`]), then light points (on parallelogram and point lights in
-//! lanes, [`sample_lights`]; on other lights for all lanes at once, [`Lights::sample_lanes`], an
+//! through the scene's mirrors per lane ([`PathTracer::kernel_vertex`]), then light points
+//! (on parallelogram and point lights in lanes, [`sample_lights`]; on other lights for all
+//! lanes at once, [`Lights::sample_lanes`], an
 //! environment map's memory asked for every lane before any lane waits for it) and the shading
 //! frame, next-event weights, bump shadowing, sampled continuation and Russian roulette
 //! ([`shade`]) for all lanes at once, loops without branches the compiler turns into AVX-512 or
@@ -384,11 +386,16 @@ pub(crate) enum Kernel {
     /// what a glTF material's dielectric base becomes.
     CookTorrance,
     BeckmannCookTorrance,
+    /// [`Kernel::RoughConductor`], [`Kernel::BeckmannConductor`] and
+    /// [`Kernel::SmoothConductor`] with Schlick's Fresnel term: a glTF metal's.
+    RoughSchlickConductor,
+    BeckmannSchlickConductor,
+    SmoothSchlickConductor,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 12] = [
+const MATERIAL_KERNELS: [Kernel; 15] = [
     Kernel::Lambert,
     Kernel::RoughConductor,
     Kernel::RoughDielectric,
@@ -401,6 +408,9 @@ const MATERIAL_KERNELS: [Kernel; 12] = [
     Kernel::BeckmannPlastic,
     Kernel::CookTorrance,
     Kernel::BeckmannCookTorrance,
+    Kernel::RoughSchlickConductor,
+    Kernel::BeckmannSchlickConductor,
+    Kernel::SmoothSchlickConductor,
 ];
 
 impl Kernel {
@@ -431,7 +441,7 @@ impl Kernel {
 
     /// The kernel's BSDF is a delta distribution: its vertices sample no light.
     fn is_delta(self) -> bool {
-        matches!(self, Kernel::SmoothConductor | Kernel::SmoothDielectric)
+        matches!(self, Kernel::SmoothConductor | Kernel::SmoothSchlickConductor | Kernel::SmoothDielectric)
     }
 
     /// The kernel's BSDF has a delta lobe (a path may leave its vertices specularly).
@@ -455,11 +465,14 @@ pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<Kernel> {
 fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
     match bsdf {
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
-        Bsdf::Conductor(c) if c.facets.is_none() && !c.schlick => Kernel::SmoothConductor,
-        Bsdf::Conductor(c) => match conductor_facets(c) {
-            Some(false) => Kernel::RoughConductor,
-            Some(true) => Kernel::BeckmannConductor,
-            None => Kernel::General,
+        Bsdf::Conductor(c) => match (c.facets.map(|_| conductor_facets(c)), c.schlick) {
+            (None, false) => Kernel::SmoothConductor,
+            (None, true) => Kernel::SmoothSchlickConductor,
+            (Some(Some(false)), false) => Kernel::RoughConductor,
+            (Some(Some(true)), false) => Kernel::BeckmannConductor,
+            (Some(Some(false)), true) => Kernel::RoughSchlickConductor,
+            (Some(Some(true)), true) => Kernel::BeckmannSchlickConductor,
+            (Some(None), _) => Kernel::General,
         },
         Bsdf::Dielectric(d) if d.facets.is_none() && !d.schlick && !d.dispersive => Kernel::SmoothDielectric,
         Bsdf::Dielectric(d) => match dielectric_facets(d) {
@@ -483,10 +496,10 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
 }
 
 /// For a conductor a rough kernel evaluates — Trowbridge–Reitz or Beckmann facets with Smith's
-/// shadowing (the lanes' [`Microfacet::smith`]), the exact Fresnel term — whether its facets
-/// are Beckmann's.
+/// shadowing (the lanes' [`Microfacet::smith`]), the exact or Schlick's Fresnel term — whether
+/// its facets are Beckmann's.
 fn conductor_facets(c: &Conductor) -> Option<bool> {
-    c.facets.filter(|_| !c.schlick)?.smith_kind()
+    c.facets?.smith_kind()
 }
 
 /// [`conductor_facets`] for a dielectric of one index for every colour.
@@ -1061,6 +1074,29 @@ impl RoughBsdf for Conductor {
     }
 }
 
+/// A conductor with Schlick's Fresnel term (a constant the compiler folds, as the exact one's).
+struct SchlickConductor(Conductor);
+
+impl MicrofacetLobes for SchlickConductor {
+    #[inline(always)]
+    fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        self.0.rough_eval_pdf(facets, v, l)
+    }
+
+    #[inline(always)]
+    fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        self.0.rough_sample(facets, v, uc, u)
+    }
+}
+
+impl RoughBsdf for SchlickConductor {
+    #[inline(always)]
+    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
+        let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
+        SchlickConductor(Conductor { facets: Some(facets), eta, k, tint, schlick: true })
+    }
+}
+
 impl RoughBsdf for Dielectric {
     const TRANSMITS: bool = true;
 
@@ -1131,14 +1167,15 @@ impl<B: RoughBsdf, const BECKMANN: bool> LaneBsdf for Rough<B, BECKMANN> {
     }
 }
 
-/// Smooth conductors: [`Conductor::smooth_sample`]; nothing to evaluate (a delta distribution).
-struct SmoothConductor;
+/// Smooth conductors: [`Conductor::smooth_sample`], with Schlick's Fresnel term where
+/// `SCHLICK`; nothing to evaluate (a delta distribution).
+struct SmoothConductor<const SCHLICK: bool>;
 
-impl LaneBsdf for SmoothConductor {
+impl<const SCHLICK: bool> LaneBsdf for SmoothConductor<SCHLICK> {
     #[inline(always)]
     fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        (true, Conductor { facets: None, eta, k, tint, schlick: false }.smooth_sample(wv))
+        (true, Conductor { facets: None, eta, k, tint, schlick: SCHLICK }.smooth_sample(wv))
     }
 }
 
@@ -1190,7 +1227,10 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
         Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, coat, out, len, unit),
         Kernel::CookTorrance => shade::<Rough<CookTorrance, false>>(v, coat, out, len, unit),
         Kernel::BeckmannCookTorrance => shade::<Rough<CookTorrance, true>>(v, coat, out, len, unit),
-        Kernel::SmoothConductor => shade::<SmoothConductor>(v, coat, out, len, unit),
+        Kernel::SmoothConductor => shade::<SmoothConductor<false>>(v, coat, out, len, unit),
+        Kernel::RoughSchlickConductor => shade::<Rough<SchlickConductor, false>>(v, coat, out, len, unit),
+        Kernel::BeckmannSchlickConductor => shade::<Rough<SchlickConductor, true>>(v, coat, out, len, unit),
+        Kernel::SmoothSchlickConductor => shade::<SmoothConductor<true>>(v, coat, out, len, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, coat, out, len, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, coat, out, len, unit),
         Kernel::Idle | Kernel::General | Kernel::Escaped => {}
@@ -1349,7 +1389,8 @@ mod tests {
     /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
     /// and bump-mapped, one of Beckmann facets) and a smooth one, rough plastics (one textured,
     /// one of Beckmann facets) and a smooth one, Beckmann glass, a mirror
-    /// (with specular connections), spheres, boxes and a plane, an emitting box (triangles)
+    /// (with specular connections), Schlick conductors (a glTF metal's; rough and smooth),
+    /// spheres, boxes and a plane, an emitting box (triangles)
     /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
 background = { zenith = [0.3, 0.4, 0.9], horizon = [0.8, 0.8, 0.7], ground = [0.2, 0.15, 0.1] }
@@ -1469,6 +1510,21 @@ shape = "sphere"
 center = [2, 0.4, 1]
 radius = 0.4
 material = "glow"
+[[object]]
+shape = "sphere"
+center = [-0.2, 0.2, 3.2]
+radius = 0.2
+material = { bsdf = { type = "conductor", roughness = 0.25, distribution = "ggx", eta = [1.8, 1.2, 0.6], k = [0, 0, 0], fresnel = "schlick" } }
+[[object]]
+shape = "box"
+min = [-3.2, 0, 0.4]
+max = [-2.6, 0.9, 1.0]
+material = { bsdf = { type = "conductor", eta = [2.1, 1.5, 0.9], k = [0, 0, 0], fresnel = "schlick" } }
+[[object]]
+shape = "sphere"
+center = [2.8, 0.3, 0.2]
+radius = 0.3
+material = { bsdf = { type = "conductor", roughness = 0.3, distribution = "beckmann", eta = [0.3, 0.5, 1.2], k = [3, 2.5, 2], fresnel = "schlick" } }
 "#;
 
     /// Every sample of every pixel, `(in lanes, per path)`, in full precision, with `unit`'s
@@ -1594,6 +1650,19 @@ material = "glow"
                     }
                 }
             }
+        }
+    }
+
+    /// The mixed scene's materials take every material kernel, so that
+    /// `lanes_match_the_per_path_tracer` checks each of them.
+    #[test]
+    fn the_mixed_scene_takes_every_kernel() {
+        let scene = alhazen_scene::parse_scene("mixed.toml".as_ref(), MIXED).unwrap();
+        let world = World::build(&scene);
+        let camera = Camera::new(&scene.camera, 8, 8);
+        let kernels = material_kernels(&PathTracer::new(&scene, &world, &camera));
+        for k in MATERIAL_KERNELS {
+            assert!(kernels.contains(&k), "{k:?}");
         }
     }
 
