@@ -17,15 +17,28 @@ pub struct Mix {
     pub weight: f64,
 }
 
+/// `w·ρ_a + (1 − w)·ρ_b`: [`Mix::eval`] from its components' values (the path tracer's lanes
+/// blend a mirror and Lambert through it too).
+#[inline(always)]
+pub(crate) fn blend(w: f64, a: Vec3, b: Vec3) -> Vec3 {
+    a * w + b * (1.0 - w)
+}
+
+/// `w·p_a + (1 − w)·p_b`: [`Mix::pdf`] from its components' densities.
+#[inline(always)]
+pub(crate) fn blend_density(w: f64, a: f64, b: f64) -> f64 {
+    a * w + b * (1.0 - w)
+}
+
 impl Mix {
     /// Weighted sum.
     pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
-        self.a.eval(v, l) * self.weight + self.b.eval(v, l) * (1.0 - self.weight)
+        blend(self.weight, self.a.eval(v, l), self.b.eval(v, l))
     }
 
     /// Weighted sum of the densities.
     pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        self.a.pdf(v, l) * self.weight + self.b.pdf(v, l) * (1.0 - self.weight)
+        blend_density(self.weight, self.a.pdf(v, l), self.b.pdf(v, l))
     }
 
     /// Picks a component by `uc` (rescaled for the component's own use). A delta sample keeps its

@@ -391,11 +391,14 @@ pub(crate) enum Kernel {
     RoughSchlickConductor,
     BeckmannSchlickConductor,
     SmoothSchlickConductor,
+    /// Lambert plus an ideal mirror ([`crate::bsdf::Mix`] of a smooth conductor, exact
+    /// Fresnel term, and Lambert): the course's Whitted material as the path tracer reads it.
+    LambertMirror,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 15] = [
+const MATERIAL_KERNELS: [Kernel; 16] = [
     Kernel::Lambert,
     Kernel::RoughConductor,
     Kernel::RoughDielectric,
@@ -411,6 +414,7 @@ const MATERIAL_KERNELS: [Kernel; 15] = [
     Kernel::RoughSchlickConductor,
     Kernel::BeckmannSchlickConductor,
     Kernel::SmoothSchlickConductor,
+    Kernel::LambertMirror,
 ];
 
 impl Kernel {
@@ -436,6 +440,7 @@ impl Kernel {
                 | Kernel::BeckmannPlastic
                 | Kernel::CookTorrance
                 | Kernel::BeckmannCookTorrance
+                | Kernel::LambertMirror
         )
     }
 
@@ -446,7 +451,7 @@ impl Kernel {
 
     /// The kernel's BSDF has a delta lobe (a path may leave its vertices specularly).
     fn samples_delta(self) -> bool {
-        self.is_delta() || self == Kernel::SmoothPlastic
+        self.is_delta() || matches!(self, Kernel::SmoothPlastic | Kernel::LambertMirror)
     }
 }
 
@@ -491,6 +496,7 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             Some(true) => Kernel::BeckmannCookTorrance,
             None => Kernel::General,
         },
+        Bsdf::Mix(mix) if lambert_mirror(mix).is_some() && !crate::bsdf::is_anisotropic(m) => Kernel::LambertMirror,
         _ => Kernel::General,
     }
 }
@@ -500,6 +506,15 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
 /// its facets are Beckmann's.
 fn conductor_facets(c: &Conductor) -> Option<bool> {
     c.facets?.smith_kind()
+}
+
+/// A mix's mirror, Lambert and the mirror's weight, where it is an ideal mirror (a smooth
+/// conductor, exact Fresnel term) mixed with Lambert.
+fn lambert_mirror(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &crate::bsdf::Lambert, f64)> {
+    match (&mix.a, &mix.b) {
+        (Bsdf::Conductor(c), Bsdf::Lambert(l)) if c.facets.is_none() && !c.schlick => Some((c, l, mix.weight)),
+        _ => None,
+    }
 }
 
 /// [`conductor_facets`] for a dielectric of one index for every colour.
@@ -759,6 +774,13 @@ impl PathTracer<'_> {
                 set(&mut v.albedo, i, c.diffuse);
                 (v.ks[i], v.ior[i]) = (c.ks, c.lobe.ior);
                 set_facets(v, i, &c.lobe.facets, None);
+            }
+            Bsdf::Mix(mix) if let Some((c, lambert, weight)) = lambert_mirror(mix) => {
+                set(&mut v.albedo, i, lambert.albedo);
+                set(&mut v.eta, i, c.eta);
+                set(&mut v.k, i, c.k);
+                set(&mut v.tint, i, c.tint);
+                v.ks[i] = weight;
             }
             Bsdf::Plastic(p) => {
                 set(&mut v.albedo, i, p.albedo);
@@ -1214,6 +1236,44 @@ impl LaneBsdf for SmoothPlastic {
     }
 }
 
+/// Lambert plus an ideal mirror of weight `w` (the lane's `ks`): [`crate::bsdf::Mix`]'s
+/// arithmetic on its two components, its sample computed for both and then chosen.
+struct LambertMirror;
+
+impl LambertMirror {
+    /// Lane `i`'s mirror, Lambert and the mirror's weight.
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> (Conductor, crate::bsdf::Lambert, f64) {
+        let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
+        let mirror = Conductor { facets: None, eta, k, tint, schlick: false };
+        (mirror, crate::bsdf::Lambert { albedo: get(&v.albedo, i) }, v.ks[i])
+    }
+}
+
+impl LaneBsdf for LambertMirror {
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (mirror, lambert, w) = Self::at(v, i);
+        let f = crate::bsdf::blend(w, mirror.eval(wv, l), lambert.eval(wv, l));
+        (f, crate::bsdf::blend_density(w, mirror.pdf(wv, l), lambert.pdf(wv, l)))
+    }
+
+    /// `Mix::sample`: the mirror with probability `w` (its delta sample's value and density
+    /// times `w`), else Lambert's cosine-weighted direction valued as the whole mix.
+    #[inline(always)]
+    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let (mirror, _, w) = Self::at(v, i);
+        let mut reflected = mirror.smooth_sample(wv);
+        (reflected.f, reflected.pdf) = (reflected.f * w, reflected.pdf * w);
+        let l = cosine_hemisphere(u, wv);
+        let (f, pdf) = Self::eval_pdf(v, coat, i, wv, l);
+        let diffuse = BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false };
+        // `sample_cosine`'s condition, then the mix's.
+        let first = uc < w;
+        (first || cosine_pdf(wv, l) > 0.0 && pdf > 0.0, if first { reflected } else { diffuse })
+    }
+}
+
 /// Every lane's vertex at once as `kernel` shades it (lanes from `len` on, unused, may be
 /// left as they were).
 fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize, unit: VectorUnit) {
@@ -1231,6 +1291,7 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
         Kernel::RoughSchlickConductor => shade::<Rough<SchlickConductor, false>>(v, coat, out, len, unit),
         Kernel::BeckmannSchlickConductor => shade::<Rough<SchlickConductor, true>>(v, coat, out, len, unit),
         Kernel::SmoothSchlickConductor => shade::<SmoothConductor<true>>(v, coat, out, len, unit),
+        Kernel::LambertMirror => shade::<LambertMirror>(v, coat, out, len, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, coat, out, len, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, coat, out, len, unit),
         Kernel::Idle | Kernel::General | Kernel::Escaped => {}
@@ -1389,7 +1450,8 @@ mod tests {
     /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
     /// and bump-mapped, one of Beckmann facets) and a smooth one, rough plastics (one textured,
     /// one of Beckmann facets) and a smooth one, Beckmann glass, a mirror
-    /// (with specular connections), Schlick conductors (a glTF metal's; rough and smooth),
+    /// (with specular connections) and a Lambert surface with a mirror's gloss (the course's
+    /// Whitted material), Schlick conductors (a glTF metal's; rough and smooth),
     /// spheres, boxes and a plane, an emitting box (triangles)
     /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
@@ -1525,6 +1587,11 @@ shape = "sphere"
 center = [2.8, 0.3, 0.2]
 radius = 0.3
 material = { bsdf = { type = "conductor", roughness = 0.3, distribution = "beckmann", eta = [0.3, 0.5, 1.2], k = [3, 2.5, 2], fresnel = "schlick" } }
+[[object]]
+shape = "box"
+min = [2.6, 0, -0.6]
+max = [3.4, 0.7, 0.0]
+material = { color = [0.6, 0.3, 0.2], mirror = [0.5, 0.4, 0.3] }
 "#;
 
     /// Every sample of every pixel, `(in lanes, per path)`, in full precision, with `unit`'s
