@@ -167,9 +167,18 @@ impl MirrorConnections {
     /// sphere within `√K` radii) a vertex always connects — and the sum of the pieces' weights
     /// in the draw for light `l` ([`Self::piece_weight`]). One pass, one division per piece.
     fn draw_totals(&self, l: &ConnectedLight, x: Vec3, x_object: u32) -> (f64, f64) {
+        self.draw_totals_keeping(l, x, x_object, &mut [])
+    }
+
+    /// [`Self::draw_totals`], keeping the first pieces' sizes seen from `x` in `sizes`.
+    #[inline(always)]
+    fn draw_totals_keeping(&self, l: &ConnectedLight, x: Vec3, x_object: u32, sizes: &mut [f64]) -> (f64, f64) {
         let (mut seen, mut total) = (0.0, 0.0);
         for k in 0..self.pieces.len() {
             let s = self.seen_from(k, x, x_object);
+            if let Some(kept) = sizes.get_mut(k) {
+                *kept = s;
+            }
             seen += s;
             total += s * l.seen_from_light[k];
         }
@@ -198,7 +207,10 @@ impl MirrorConnections {
     fn choose(&self, x: Vec3, x_object: u32, u: Vec2) -> Option<(usize, usize, f64)> {
         let slot = ((u.x * self.lights.len() as f64) as usize).min(self.lights.len() - 1);
         let l = &self.lights[slot];
-        let (q, total) = self.draw_totals(l, x, x_object);
+        // The pieces' sizes from `x` (up to `KEPT` of them), kept for the draw's running sum.
+        const KEPT: usize = 32;
+        let mut sizes = [0.0; KEPT];
+        let (q, total) = self.draw_totals_keeping(l, x, x_object, &mut sizes);
         if u.y >= q || total <= 0.0 {
             return None;
         }
@@ -206,7 +218,8 @@ impl MirrorConnections {
         // should rounding keep the sum below it).
         let (target, mut below, mut chosen) = (u.y / q * total, 0.0, None);
         for k in 0..self.pieces.len() {
-            let w = self.piece_weight(l, k, x, x_object);
+            // `piece_weight`, its first factor kept.
+            let w = sizes.get(k).map_or_else(|| self.piece_weight(l, k, x, x_object), |s| s * l.seen_from_light[k]);
             if w > 0.0 {
                 (below, chosen) = (below + w, Some((k, w)));
                 if target < below {
