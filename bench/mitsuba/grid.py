@@ -1,10 +1,16 @@
 #!/usr/bin/env python3
-"""A scene nobody tuned for: 49 objects on a floor — spheres, boxes and open cylinders (Mitsuba's
+"""Scenes nobody tuned for. `grid` (the default): 49 objects on a floor — spheres, boxes and open cylinders (Mitsuba's
 `cylinder`) of six materials, among them smooth gold/silver conductors (mirrors, so specular
 connections), rough conductors, plastics, glass — under a 4×4 area lamp and a constant sky,
 320×240, max depth 8. Written from a fixed seed, so every run renders the same file.
 
-    python3 bench/mitsuba/grid.py [--spp 64] [--runs 3]
+    python3 bench/mitsuba/grid.py [--scene grid|chrome-ball|gltf-metals] [--spp 64] [--runs 3]
+
+Two more are the suite's glossy scene changed as a user's would be: `chrome-ball` adds a small
+smooth silver ball (a mirror: specular connections), `gltf-metals` writes its two rough metals
+as Mitsuba's `principled` with metallic 1 (what a glTF metal becomes: alhazen reads it as the
+glTF metallic-roughness model, a conductor with Schlick's Fresnel term; Mitsuba's principled
+differs, so only the times compare).
 
 Prints the whole `alhazen render` process's wall time (with and without specular connections)
 and `mi.render`'s in Mitsuba `llvm_ad_rgb` (after a warm-up render), medians of the runs, and the
@@ -68,6 +74,24 @@ def scene():
 '''
 
 
+def glossy_variant(name):
+    """The suite's glossy scene as the variant `name` changes it."""
+    with open(os.path.join(ROOT, "bench/mitsuba/suite/glossy.xml")) as f:
+        text = f.read()
+    if name == "chrome-ball":
+        ball = ('<shape type="sphere"><point name="center" x="1.8" y="0.25" z="1.5"/>'
+                '<float name="radius" value="0.25"/>'
+                '<bsdf type="conductor"><string name="material" value="Ag"/></bsdf></shape>\n</scene>')
+        return text.replace("</scene>", ball)
+    for base, roughness in [("0.95, 0.64, 0.54", 0.3), ("0.91, 0.92, 0.92", 0.05)]:
+        start = text.index('<bsdf type="roughconductor">')
+        end = text.index("</bsdf>", start) + len("</bsdf>")
+        metal = (f'<bsdf type="principled"><rgb name="base_color" value="{base}"/>'
+                 f'<float name="metallic" value="1"/><float name="roughness" value="{roughness}"/></bsdf>')
+        text = text[:start] + metal + text[end:]
+    return text
+
+
 def mean(path):
     mi.set_variant("scalar_rgb")
     return float(np.array(mi.Bitmap(path))[..., :3].mean())
@@ -77,11 +101,12 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--scene", choices=["grid", "chrome-ball", "gltf-metals"], default="grid")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp()
-    path = os.path.join(tmp, "grid.xml")
+    path = os.path.join(tmp, a.scene + ".xml")
     with open(path, "w") as f:
-        f.write(scene())
+        f.write(scene() if a.scene == "grid" else glossy_variant(a.scene))
     mi.set_variant("llvm_ad_rgb")
     import drjit as dr
     loaded = mi.load_file(path)
@@ -111,7 +136,7 @@ def main():
         rows["alhazen --no-mirror-connections"].append(t)
         rows["Mitsuba llvm"].append(mitsuba())
     means = [mean(with_out), mean(without_out), mean(os.path.join(tmp, "mitsuba.exr"))]
-    print(f"{os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}")
+    print(f"{a.scene}: {os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}")
     for (name, ts), m in zip(rows.items(), means):
         print(f"| {name} | {np.median(ts):.3f} s | mean {m:.5f} |")
 
