@@ -111,6 +111,7 @@ impl Bsdf {
             Bsdf::Dielectric(d) => d.eval_pdf(v, l),
             Bsdf::Plastic(p) => p.eval_pdf(v, l),
             Bsdf::CookTorrance(c) => c.rough_eval_pdf(&c.lobe.facets, v, l),
+            Bsdf::Mix(m) => m.eval_pdf(v, l),
             _ => (self.eval(v, l), self.pdf(v, l)),
         }
     }

@@ -20,7 +20,9 @@
 //! own [`PathTracer::vertex`], lane by lane: every BSDF, texture, bump map, light and colour
 //! mode. In RGB scenes, vertices on Lambert surfaces, on conductors (exact or Schlick's
 //! Fresnel term), glass and plastic (smooth, or rough of Trowbridge–Reitz or Beckmann facets)
-//! and Cook–Torrance — textured, bump-mapped or plain — take a material kernel ([`Kernel`])
+//! and Cook–Torrance, and two mixes (Lambert plus an ideal mirror; the glTF metallic–roughness
+//! model of a partly metallic surface) — textured, bump-mapped or plain — take a material
+//! kernel ([`Kernel`])
 //! instead: their random numbers, emission, material, bent normal and specular connections
 //! through the scene's mirrors per lane ([`PathTracer::kernel_vertex`]), then light points
 //! (on parallelogram and point lights in lanes, [`sample_lights`]; on other lights for all
@@ -111,6 +113,8 @@ struct Vertices {
     /// (times `k_d`) and its `k_s`.
     albedo: Lanes3,
     ks: Lanes,
+    /// A mix's weight of its first component ([`crate::bsdf::Mix`]).
+    mix_weight: Lanes,
     /// A rough dielectric's relative index `η_inside/η_outside`, or a plastic coat's.
     ior: Lanes,
     /// A plastic's colouring of its inner reflection (its coat is its batch's: [`Batch::coat`]).
@@ -394,11 +398,15 @@ pub(crate) enum Kernel {
     /// Lambert plus an ideal mirror ([`crate::bsdf::Mix`] of a smooth conductor, exact
     /// Fresnel term, and Lambert): the course's Whitted material as the path tracer reads it.
     LambertMirror,
+    /// The glTF metallic–roughness model where it is partly metallic (a metallic factor, or a
+    /// metallic texture's mean, between 0 and 1): a [`crate::bsdf::Mix`] of a rough conductor
+    /// with Schlick's term and Cook–Torrance, both on isotropic Trowbridge–Reitz facets.
+    MetallicRoughness,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 16] = [
+const MATERIAL_KERNELS: [Kernel; 17] = [
     Kernel::Lambert,
     Kernel::RoughConductor,
     Kernel::RoughDielectric,
@@ -415,6 +423,7 @@ const MATERIAL_KERNELS: [Kernel; 16] = [
     Kernel::BeckmannSchlickConductor,
     Kernel::SmoothSchlickConductor,
     Kernel::LambertMirror,
+    Kernel::MetallicRoughness,
 ];
 
 impl Kernel {
@@ -441,6 +450,7 @@ impl Kernel {
                 | Kernel::CookTorrance
                 | Kernel::BeckmannCookTorrance
                 | Kernel::LambertMirror
+                | Kernel::MetallicRoughness
         )
     }
 
@@ -497,6 +507,9 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             None => Kernel::General,
         },
         Bsdf::Mix(mix) if lambert_mirror(mix).is_some() && !crate::bsdf::is_anisotropic(m) => Kernel::LambertMirror,
+        Bsdf::Mix(mix) if metallic_roughness(mix).is_some() && !crate::bsdf::is_anisotropic(m) => {
+            Kernel::MetallicRoughness
+        }
         _ => Kernel::General,
     }
 }
@@ -513,6 +526,23 @@ fn conductor_facets(c: &Conductor) -> Option<bool> {
 fn lambert_mirror(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &crate::bsdf::Lambert, f64)> {
     match (&mix.a, &mix.b) {
         (Bsdf::Conductor(c), Bsdf::Lambert(l)) if c.facets.is_none() && !c.schlick => Some((c, l, mix.weight)),
+        _ => None,
+    }
+}
+
+/// A mix's metal, its Cook–Torrance base and the metal's weight, where it is the glTF
+/// metallic–roughness model's mix: a rough conductor with Schlick's term and Cook–Torrance (exact
+/// term), both on isotropic Trowbridge–Reitz facets.
+fn metallic_roughness(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &CookTorrance, f64)> {
+    match (&mix.a, &mix.b) {
+        (Bsdf::Conductor(c), Bsdf::CookTorrance(base))
+            if c.schlick
+                && conductor_facets(c) == Some(false)
+                && c.facets.is_some_and(|f| f.alpha_u == f.alpha_v)
+                && cook_torrance_facets(base) == Some(false) =>
+        {
+            Some((c, base, mix.weight))
+        }
         _ => None,
     }
 }
@@ -780,7 +810,17 @@ impl PathTracer<'_> {
                 set(&mut v.eta, i, c.eta);
                 set(&mut v.k, i, c.k);
                 set(&mut v.tint, i, c.tint);
-                v.ks[i] = weight;
+                v.mix_weight[i] = weight;
+            }
+            Bsdf::Mix(mix) if let Some((metal, base, weight)) = metallic_roughness(mix) => {
+                set(&mut v.eta, i, metal.eta);
+                set(&mut v.k, i, metal.k);
+                set(&mut v.tint, i, metal.tint);
+                let metal_alpha = metal.facets.map_or(0.0, |f| f.alpha_u);
+                (v.alpha[0][i], v.alpha[1][i]) = (metal_alpha, base.lobe.facets.alpha_u);
+                set(&mut v.albedo, i, base.diffuse);
+                (v.ks[i], v.ior[i]) = (base.ks, base.lobe.ior);
+                v.mix_weight[i] = weight;
             }
             Bsdf::Plastic(p) => {
                 set(&mut v.albedo, i, p.albedo);
@@ -1236,7 +1276,7 @@ impl LaneBsdf for SmoothPlastic {
     }
 }
 
-/// Lambert plus an ideal mirror of weight `w` (the lane's `ks`): [`crate::bsdf::Mix`]'s
+/// Lambert plus an ideal mirror of weight `w` (the lane's `mix_weight`): [`crate::bsdf::Mix`]'s
 /// arithmetic on its two components, its sample computed for both and then chosen.
 struct LambertMirror;
 
@@ -1246,7 +1286,7 @@ impl LambertMirror {
     fn at(v: &Vertices, i: usize) -> (Conductor, crate::bsdf::Lambert, f64) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         let mirror = Conductor { facets: None, eta, k, tint, schlick: false };
-        (mirror, crate::bsdf::Lambert { albedo: get(&v.albedo, i) }, v.ks[i])
+        (mirror, crate::bsdf::Lambert { albedo: get(&v.albedo, i) }, v.mix_weight[i])
     }
 }
 
@@ -1274,6 +1314,50 @@ impl LaneBsdf for LambertMirror {
     }
 }
 
+/// The glTF metallic–roughness mix (lane `i`'s `mix_weight` the metal's share): a rough
+/// conductor with Schlick's term on the lane's `alpha[0]` and Cook–Torrance on its `alpha[1]`,
+/// both isotropic Trowbridge–Reitz facets; [`crate::bsdf::Mix`]'s arithmetic, its sample
+/// drawn from both components and then chosen.
+struct MetallicRoughness;
+
+impl MetallicRoughness {
+    /// Lane `i`'s metal and its facets, its Cook–Torrance base and its facets, and the metal's
+    /// weight.
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> ((Conductor, Microfacet), (CookTorrance, Microfacet), f64) {
+        let metal_facets = Microfacet::smith::<false>(v.alpha[0][i], v.alpha[0][i]);
+        let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
+        let metal = Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true };
+        let base_facets = Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]);
+        let lobe = CookTorranceLobe { facets: base_facets, ior: v.ior[i], schlick: false };
+        let base = CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe };
+        ((metal, metal_facets), (base, base_facets), v.mix_weight[i])
+    }
+}
+
+impl LaneBsdf for MetallicRoughness {
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let ((metal, metal_facets), (base, base_facets), w) = Self::at(v, i);
+        let (fa, pa) = metal.rough_eval_pdf(&metal_facets, wv, l);
+        let (fb, pb) = base.rough_eval_pdf(&base_facets, wv, l);
+        (crate::bsdf::blend(w, fa, fb), crate::bsdf::blend_density(w, pa, pb))
+    }
+
+    /// `Mix::sample`: the metal with probability `w`, else the base (each drawn as
+    /// `Bsdf::sample` draws it: the metal's without its lobe number), valued as the whole mix.
+    #[inline(always)]
+    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let ((metal, metal_facets), (base, base_facets), w) = Self::at(v, i);
+        let (first, uc) = crate::bsdf::Mix::component_choice(w, uc);
+        let (metal_ok, metal_sample) = metal.rough_sample(&metal_facets, wv, 0.0, u);
+        let (base_ok, base_sample) = base.rough_sample(&base_facets, wv, uc, u);
+        let (sampled, l) = if first { (metal_ok, metal_sample.l) } else { (base_ok, base_sample.l) };
+        let (f, pdf) = Self::eval_pdf(v, coat, i, wv, l);
+        (sampled && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+}
+
 /// Every lane's vertex at once as `kernel` shades it (lanes from `len` on, unused, may be
 /// left as they were).
 fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize, unit: VectorUnit) {
@@ -1292,6 +1376,7 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
         Kernel::BeckmannSchlickConductor => shade::<Rough<SchlickConductor, true>>(v, coat, out, len, unit),
         Kernel::SmoothSchlickConductor => shade::<SmoothConductor<true>>(v, coat, out, len, unit),
         Kernel::LambertMirror => shade::<LambertMirror>(v, coat, out, len, unit),
+        Kernel::MetallicRoughness => shade::<MetallicRoughness>(v, coat, out, len, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, coat, out, len, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, coat, out, len, unit),
         Kernel::Idle | Kernel::General | Kernel::Escaped => {}
@@ -1451,7 +1536,7 @@ mod tests {
     /// and bump-mapped, one of Beckmann facets) and a smooth one, rough plastics (one textured,
     /// one of Beckmann facets) and a smooth one, Beckmann glass, a mirror
     /// (with specular connections) and a Lambert surface with a mirror's gloss (the course's
-    /// Whitted material), Schlick conductors (a glTF metal's; rough and smooth),
+    /// Whitted material), a glTF metallic–roughness mix, Schlick conductors (a glTF metal's; rough and smooth),
     /// spheres, boxes and a plane, an emitting box (triangles)
     /// and sphere, point and spot lights, a gradient sky.
     const MIXED: &str = r#"
@@ -1592,6 +1677,11 @@ shape = "box"
 min = [2.6, 0, -0.6]
 max = [3.4, 0.7, 0.0]
 material = { color = [0.6, 0.3, 0.2], mirror = [0.5, 0.4, 0.3] }
+[[object]]
+shape = "sphere"
+center = [0.9, 1.5, -1.2]
+radius = 0.35
+material = { bsdf = { type = "mix", weight = 0.6, a = { type = "conductor", roughness = 0.2, distribution = "ggx", eta = [2.0, 1.6, 1.2], k = [0, 0, 0], fresnel = "schlick" }, b = { type = "cook-torrance", roughness = 0.3, distribution = "ggx", color = [0.3, 0.5, 0.2], kd = 0.96, ks = 1.0, ior = 1.5 } } }
 "#;
 
     /// Every sample of every pixel, `(in lanes, per path)`, in full precision, with `unit`'s
