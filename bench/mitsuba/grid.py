@@ -4,13 +4,14 @@
 connections), rough conductors, plastics, glass — under a 4×4 area lamp and a constant sky,
 320×240, max depth 8. Written from a fixed seed, so every run renders the same file.
 
-    python3 bench/mitsuba/grid.py [--scene grid|chrome-ball|gltf-metals] [--spp 64] [--runs 3]
+    python3 bench/mitsuba/grid.py [--scene grid|chrome-ball|gltf-metals|gltf-half-metals] [--spp 64] [--runs 3]
 
 Two more are the suite's glossy scene changed as a user's would be: `chrome-ball` adds a small
 smooth silver ball (a mirror: specular connections), `gltf-metals` writes its two rough metals
 as Mitsuba's `principled` with metallic 1 (what a glTF metal becomes: alhazen reads it as the
 glTF metallic-roughness model, a conductor with Schlick's Fresnel term; Mitsuba's principled
-differs, so only the times compare).
+differs, so only the times compare); `gltf-half-metals` the same with metallic 0.5 (a
+partly metallic glTF material: a mix of that conductor and Cook–Torrance).
 
 Prints the whole `alhazen render` process's wall time (with and without specular connections)
 and `mi.render`'s in Mitsuba `llvm_ad_rgb` (after a warm-up render), medians of the runs, and the
@@ -86,8 +87,9 @@ def glossy_variant(name):
     for base, roughness in [("0.95, 0.64, 0.54", 0.3), ("0.91, 0.92, 0.92", 0.05)]:
         start = text.index('<bsdf type="roughconductor">')
         end = text.index("</bsdf>", start) + len("</bsdf>")
+        metallic = 0.5 if name == "gltf-half-metals" else 1
         metal = (f'<bsdf type="principled"><rgb name="base_color" value="{base}"/>'
-                 f'<float name="metallic" value="1"/><float name="roughness" value="{roughness}"/></bsdf>')
+                 f'<float name="metallic" value="{metallic}"/><float name="roughness" value="{roughness}"/></bsdf>')
         text = text[:start] + metal + text[end:]
     return text
 
@@ -101,7 +103,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--runs", type=int, default=3)
-    ap.add_argument("--scene", choices=["grid", "chrome-ball", "gltf-metals"], default="grid")
+    ap.add_argument("--scene", choices=["grid", "chrome-ball", "gltf-metals", "gltf-half-metals"], default="grid")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp()
     path = os.path.join(tmp, a.scene + ".xml")
