@@ -26,6 +26,13 @@ fn padded(b: Bounds3) -> Bounds3 {
     Bounds3 { min: b.min - pad, max: b.max + pad }
 }
 
+/// What a ray's traversal found nearest: lane `h.lane` of flat packet `k`, or another
+/// object's candidate (a sphere's, a plane's, a nested mesh's…).
+enum Nearest {
+    Flat(usize, LaneHit),
+    Other(Candidate, u32),
+}
+
 /// The eight rays' reciprocal directions, axis by axis (one vector division per axis).
 #[inline(always)]
 fn inverse_dirs(rays: &RayPacket) -> [[f64; LANES]; 3] {
@@ -38,6 +45,11 @@ fn inverse_dirs(rays: &RayPacket) -> [[f64; LANES]; 3] {
 /// SAH's tree at 12 tests or fewer (even at 16, slower at 20; with more packets, slower:
 /// `BENCHMARKS.md`, session 33).
 const ONE_LEAF_TESTS: usize = 12;
+
+/// The most flat packets whose hits' shading is kept ([`FlatShading`], ~1.7 KB a packet, so
+/// at most ~14 MB): a world of more (over 65 K triangles in small meshes) finds its hits'
+/// normals as a mesh does, rather than hold another 200 bytes a triangle.
+const FLAT_SHADING_PACKETS: usize = 1 << 13;
 
 /// One ray's reciprocal direction as lane 0 of [`inverse_dirs`]'s.
 fn inverse_dir(ray: &Ray) -> [[f64; LANES]; 3] {
@@ -122,8 +134,8 @@ pub struct World {
     one_leaf: bool,
     /// ... the leaf holds only flats, and nothing is unbounded.
     flats_only: bool,
-    /// Beside `flats.lanes` in a one-leaf world, for flats without smooth normals: each
-    /// triangle's normal and material.
+    /// Beside `flats.lanes` (where they are at most [`FLAT_SHADING_PACKETS`]), for flats
+    /// without smooth normals: each triangle's normal and material (empty: none kept).
     flat_shading: Vec<[Option<FlatShading>; LANES]>,
 }
 
@@ -416,7 +428,7 @@ impl World {
             && world.unbounded.is_empty()
             && matches!(world.leaves.as_slice(), [leaf] if leaf.spheres.is_empty() && leaf.objects.is_empty());
         world.bvh = bvh;
-        if world.one_leaf {
+        if world.flats.lanes.len() <= FLAT_SHADING_PACKETS {
             world.flat_shading = world.flats.lanes.iter().map(|lanes| lanes.map(|l| world.flat_shading(l))).collect();
         }
         world
@@ -497,8 +509,20 @@ impl World {
 
     /// The nearest hit in `(0, t_max)`: the object and its candidate, no surface details.
     #[inline]
-    #[allow(unsafe_code)]
     fn nearest(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
+        self.nearest_found(ray, t_max).map(|found| match found {
+            Nearest::Flat(k, h) => {
+                let lane = self.flats.lanes[k][h.lane];
+                (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)
+            }
+            Nearest::Other(c, i) => (c, i),
+        })
+    }
+
+    /// The nearest hit in `(0, t_max)` as the traversal found it.
+    #[inline]
+    #[allow(unsafe_code)]
+    fn nearest_found(&self, ray: &Ray, t_max: f64) -> Option<Nearest> {
         #[cfg(target_arch = "x86_64")]
         if self.vectors.is_simd() && !self.bvh.is_one_leaf() {
             // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes it) only where the
@@ -513,7 +537,7 @@ impl World {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[allow(unsafe_code)]
-    fn nearest_avx2(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
+    fn nearest_avx2(&self, ray: &Ray, t_max: f64) -> Option<Nearest> {
         // SAFETY: this function runs only where AVX2 is.
         unsafe { self.nearest_with::<true>(ray, t_max) }
     }
@@ -524,17 +548,17 @@ impl World {
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn nearest_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
+    unsafe fn nearest_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> Option<Nearest> {
         let mut best = self.nearest_unbounded(ray, t_max);
         let t_best = best.map_or(t_max, |(c, _)| c.t);
         // The nearest flat's packet and lane; made a candidate once, after the traversal.
-        let mut best_flat: Option<(Lane, LaneHit)> = None;
+        let mut best_flat: Option<(usize, LaneHit)> = None;
         let visit = |range: std::ops::Range<usize>, t_max| {
             let leaf = &self.leaves[range.start];
             let mut closer = None;
             let mut t_max = t_max;
-            if let Some((lane, h)) = self.flats.nearest(leaf.packets.clone(), ray, t_max, self.vectors) {
-                best_flat = Some((lane, h));
+            if let Some((k, h)) = self.flats.nearest_packet(leaf.packets.clone(), ray, t_max, self.vectors) {
+                best_flat = Some((k, h));
                 (t_max, closer) = (h.t, Some(h.t));
             }
             if let Some((c, i)) = self.nearest_solid(leaf, ray, t_max) {
@@ -545,7 +569,7 @@ impl World {
         };
         // SAFETY: the caller's contract.
         unsafe { self.bvh.traverse_leaves_prefetching_with::<AVX2>(ray, t_best, |_| {}, visit) };
-        best_flat.map(|(lane, h)| (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)).or(best)
+        best_flat.map(|(k, h)| Nearest::Flat(k, h)).or(best.map(|(c, i)| Nearest::Other(c, i)))
     }
 
     /// The nearest hit on an unbounded object (a plane) before `t_max`: the first of equally
@@ -677,8 +701,10 @@ impl World {
     /// The nearest hit in `(0, t_max)` with its surface and material.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<WorldHit> {
-        let (c, i) = self.nearest(ray, t_max)?;
-        Some(self.surface_of(ray, c, i))
+        Some(match self.nearest_found(ray, t_max)? {
+            Nearest::Flat(k, h) => self.flat_hit(ray, k, h),
+            Nearest::Other(c, i) => self.surface_of(ray, c, i),
+        })
     }
 
     /// [`Self::intersect`] for eight rays without a limit, into `out` (`None` where not
@@ -754,7 +780,7 @@ impl World {
     fn flat_hit(&self, ray: &Ray, k: usize, h: LaneHit) -> WorldHit {
         let lane = self.flats.lanes[k][h.lane];
         let c = lane.flat.candidate(h.t, h.b1, h.b2);
-        if let Some(s) = &self.flat_shading[k][h.lane] {
+        if let Some(s) = self.flat_shading.get(k).and_then(|lanes| lanes[h.lane].as_ref()) {
             // The triangle of the pair the candidate picked.
             let second = (c.aux - lane.flat.triangle) as usize;
             let (n, material) = (s.normal[second], s.material[second]);
@@ -1107,5 +1133,47 @@ max = [2.5, 1, 1]
             }
         }
         assert!(n > 50 && uv == n, "{n} hits with smooth normals, {uv} with texture coordinates");
+    }
+
+    /// A flat's hit from its kept shading ([`FlatShading`]) is the mesh's own (its candidate's
+    /// surface, [`World::surface_of`]), in a world of one leaf and in a tree of many.
+    #[test]
+    fn kept_flat_shading_is_the_meshes_own() {
+        let mut text = String::new();
+        for (i, j) in (0..6).flat_map(|i| (0..6).map(move |j| (i, j))) {
+            let (x, z) = (i as f64 * 1.5 - 4.0, j as f64 * 1.5 - 4.0);
+            text += &format!(
+                "[[object]]\nshape = \"box\"\nmin = [{x}, 0, {z}]\nmax = [{}, {}, {}]\n",
+                x + 1.0,
+                0.5 + 0.1 * i as f64,
+                z + 0.8
+            );
+        }
+        let many = World::build(&scene::parse_scene("many.toml".as_ref(), &text).unwrap());
+        let one = World::build(
+            &scene::parse_scene(
+                "one.toml".as_ref(),
+                "[[object]]\nshape = \"box\"\nmin = [-1, 0, -1]\nmax = [1, 1, 1]\n",
+            )
+            .unwrap(),
+        );
+        assert!(!many.one_leaf && one.one_leaf);
+        for world in [many, one] {
+            assert!(world.flat_shading.iter().flatten().all(Option::is_some), "every box shades flat");
+            let mut met = 0;
+            for k in 0..2000 {
+                let a = k as f64 * 0.61;
+                let origin = Vec3::new(7.0 * a.cos(), 3.0 + 2.0 * (1.7 * a).sin(), 7.0 * a.sin());
+                let ray = Ray::new(
+                    origin,
+                    (Vec3::new(2.0 * (2.3 * a).sin(), 0.2, 2.0 * (1.1 * a).cos()) - origin).normalize(),
+                );
+                let kept = world.intersect(&ray, f64::INFINITY);
+                let own = world.nearest_hit(&ray, f64::INFINITY).map(|(c, i)| world.surface_of(&ray, c, i));
+                assert_eq!(kept.map(HitPoint::from), own.map(HitPoint::from), "ray {k}");
+                met += usize::from(kept.is_some());
+            }
+            assert!(met > 500, "{met} hits");
+        }
     }
 }

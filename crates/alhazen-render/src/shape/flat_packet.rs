@@ -395,9 +395,22 @@ impl<L: Copy + Default> PackedFlats<L> {
         t_max: f64,
         unit: VectorUnit,
     ) -> Option<(L, LaneHit)> {
+        let (k, h) = self.nearest_packet(range, ray, t_max, unit)?;
+        Some((self.lanes[k][h.lane], h))
+    }
+
+    /// [`Self::nearest`] naming the packet (its index among all) rather than its lane's label.
+    #[inline]
+    pub fn nearest_packet(
+        &self,
+        range: std::ops::Range<usize>,
+        ray: &Ray,
+        t_max: f64,
+        unit: VectorUnit,
+    ) -> Option<(usize, LaneHit)> {
         let first = range.start;
         let (k, h) = FlatPacket::nearest_of(&self.packets[range], ray, t_max, unit)?;
-        Some((self.lanes[first + k][h.lane], h))
+        Some((first + k, h))
     }
 }
 
