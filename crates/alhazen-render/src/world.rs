@@ -145,6 +145,9 @@ pub struct World {
 struct FlatShading {
     normal: [Vec3; 2],
     material: [u32; 2],
+    /// Each triangle's material slot, as the mesh reports it (the radiosity solution's mesh
+    /// numbers its triangles by it).
+    slot: [u32; 2],
     /// Each triangle's corners (the hit point is interpolated on them, as the mesh does).
     corners: [[Vec3; 3]; 2],
 }
@@ -448,10 +451,10 @@ impl World {
         }
         let [a, b] = triangles.map(|t| {
             let (n, _, slot) = mesh.normals_and_slot(t, 0.0, 0.0);
-            (n, o.slot_materials.get(slot as usize).copied().unwrap_or(o.material))
+            (n, o.slot_materials.get(slot as usize).copied().unwrap_or(o.material), slot)
         });
         let corners = triangles.map(|t| mesh.accel.mesh.corners(t));
-        Some(FlatShading { normal: [a.0, b.0], material: [a.1, b.1], corners })
+        Some(FlatShading { normal: [a.0, b.0], material: [a.1, b.1], slot: [a.2, b.2], corners })
     }
 
     /// Sorts each leaf's primitives into packets of flats, packets of spheres and a list of
@@ -785,7 +788,7 @@ impl World {
             let second = (c.aux - lane.flat.triangle) as usize;
             let (n, material) = (s.normal[second], s.material[second]);
             let p = on_triangle(s.corners[second], c.bary[0], c.bary[1]);
-            let hit = SurfaceHit::flat(h.t, p, n, alhazen_math::Vec2::ZERO);
+            let hit = SurfaceHit { slot: s.slot[second], ..SurfaceHit::flat(h.t, p, n, alhazen_math::Vec2::ZERO) };
             return WorldHit { hit, material, object: lane.object };
         }
         self.surface_of(ray, c, lane.object)
@@ -1170,7 +1173,8 @@ max = [2.5, 1, 1]
                 );
                 let kept = world.intersect(&ray, f64::INFINITY);
                 let own = world.nearest_hit(&ray, f64::INFINITY).map(|(c, i)| world.surface_of(&ray, c, i));
-                assert_eq!(kept.map(HitPoint::from), own.map(HitPoint::from), "ray {k}");
+                let seen = |h: Option<WorldHit>| h.map(|h| (HitPoint::from(h), h.hit.slot));
+                assert_eq!(seen(kept), seen(own), "ray {k}");
                 met += usize::from(kept.is_some());
             }
             assert!(met > 500, "{met} hits");
