@@ -514,12 +514,16 @@ impl World {
     #[inline]
     fn nearest(&self, ray: &Ray, t_max: f64) -> Option<(Candidate, u32)> {
         self.nearest_found(ray, t_max).map(|found| match found {
-            Nearest::Flat(k, h) => {
-                let lane = self.flats.lanes[k][h.lane];
-                (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)
-            }
+            Nearest::Flat(k, h) => self.flat_candidate(k, h),
             Nearest::Other(c, i) => (c, i),
         })
+    }
+
+    /// The candidate and object of lane `h.lane` of flat packet `k`'s hit `h`.
+    #[inline(always)]
+    fn flat_candidate(&self, k: usize, h: LaneHit) -> (Candidate, u32) {
+        let lane = self.flats.lanes[k][h.lane];
+        (lane.flat.candidate(h.t, h.b1, h.b2), lane.object)
     }
 
     /// The nearest hit in `(0, t_max)` as the traversal found it.
@@ -781,17 +785,16 @@ impl World {
     /// surface's interpolation: their hits carry zero texture coordinates.
     #[inline(always)]
     fn flat_hit(&self, ray: &Ray, k: usize, h: LaneHit) -> WorldHit {
-        let lane = self.flats.lanes[k][h.lane];
-        let c = lane.flat.candidate(h.t, h.b1, h.b2);
+        let (c, object) = self.flat_candidate(k, h);
         if let Some(s) = self.flat_shading.get(k).and_then(|lanes| lanes[h.lane].as_ref()) {
             // The triangle of the pair the candidate picked.
-            let second = (c.aux - lane.flat.triangle) as usize;
+            let second = (c.aux - self.flats.lanes[k][h.lane].flat.triangle) as usize;
             let (n, material) = (s.normal[second], s.material[second]);
             let p = on_triangle(s.corners[second], c.bary[0], c.bary[1]);
             let hit = SurfaceHit { slot: s.slot[second], ..SurfaceHit::flat(h.t, p, n, alhazen_math::Vec2::ZERO) };
-            return WorldHit { hit, material, object: lane.object };
+            return WorldHit { hit, material, object };
         }
-        self.surface_of(ray, c, lane.object)
+        self.surface_of(ray, c, object)
     }
 
     /// [`Self::unoccluded`] for eight segments, `rays[r]` over `dist[r]` (false where not `live`).

@@ -22,8 +22,7 @@
 //! Fresnel term), glass and plastic (smooth, or rough of Trowbridge–Reitz or Beckmann facets)
 //! and Cook–Torrance, and two mixes (Lambert plus an ideal mirror; the glTF metallic–roughness
 //! model of a partly metallic surface) — textured, bump-mapped or plain — take a material
-//! kernel ([`Kernel`])
-//! instead: their random numbers, emission, material, bent normal and specular connections
+//! kernel ([`Kernel`]) instead: their random numbers, emission, material, bent normal and specular connections
 //! through the scene's mirrors per lane ([`PathTracer::kernel_vertex`]), then light points
 //! (on parallelogram and point lights in lanes, [`sample_lights`]; on other lights for all
 //! lanes at once, [`Lights::sample_lanes`], an
