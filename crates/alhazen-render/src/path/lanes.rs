@@ -329,8 +329,14 @@ struct LanePath {
     stream: SampleStream,
     /// RGB, or the wavelengths of a spectral sample.
     mode: ColorMode,
-    /// A material kernel's vertex: the light its specular connections brought, and the
-    /// mirror visit its continuation records if it samples a delta lobe.
+}
+
+/// What a material kernel's vertex gathers through mirrors, from [`PathTracer::kernel_vertex`]
+/// to [`finish_kernel`] within one bounce: the light its specular connections brought, and the
+/// mirror visit its continuation records if it samples a delta lobe. Kept beside the pool, not
+/// in its records: few scenes have mirrors, and every pass over the pool reads the records.
+#[derive(Clone, Copy, Default)]
+struct KernelMirrors {
     mirrored: Option<Vec3>,
     visit: Option<super::mirrors::MirrorVisit>,
 }
@@ -340,7 +346,7 @@ impl LanePath {
     fn idle() -> Self {
         let path = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
         let stream = SampleStream::default();
-        Self { live: false, job: 0, path, stream, mode: ColorMode::Rgb, mirrored: None, visit: None }
+        Self { live: false, job: 0, path, stream, mode: ColorMode::Rgb }
     }
 
     /// The sample's value: its radiance, in RGB.
@@ -590,6 +596,7 @@ impl PathTracer<'_> {
         let mut hits: [[Option<WorldHit>; LANES]; GROUPS] = [[None; LANES]; GROUPS];
         let mut general: [Vertex; POOL] = std::array::from_fn(|_| Vertex::default());
         let mut kernels = [Kernel::Idle; POOL];
+        let mut mirrors = [KernelMirrors::default(); POOL];
         let mut at = [(0, 0); POOL];
         let (mut shadows, mut dist) = ([RayPacket::default(); GROUPS], [[0.0; LANES]; GROUPS]);
         let together = self.world.traces_rays_together();
@@ -676,7 +683,7 @@ impl PathTracer<'_> {
                     }
                     continue;
                 }
-                if let Some((b, s)) = self.kernel_vertex(lane, hit, batches) {
+                if let Some((b, s)) = self.kernel_vertex(lane, hit, batches, &mut mirrors[p]) {
                     (kernels[p], at[p]) = (batches.all[b].kernel, (b, s));
                     continue;
                 }
@@ -726,7 +733,7 @@ impl PathTracer<'_> {
                         general[p].goes_on
                     }
                     Kernel::Escaped => false,
-                    _ => finish_kernel(lane, &batches.all[at[p].0].shaded, open, at[p].1),
+                    _ => finish_kernel(lane, &mirrors[p], &batches.all[at[p].0].shaded, open, at[p].1),
                 };
                 if goes_on {
                     rays[g].set(i, &lane.path.ray);
@@ -757,6 +764,7 @@ impl PathTracer<'_> {
         lane: &mut LanePath,
         hit: Option<&WorldHit>,
         batches: &mut Batches,
+        mirrors: &mut KernelMirrors,
     ) -> Option<(usize, usize)> {
         let path = &mut lane.path;
         let wh = hit?;
@@ -838,7 +846,7 @@ impl PathTracer<'_> {
         let h = HitPoint::from(wh);
         path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, path.visit.as_ref(), ColorMode::Rgb);
         // As `vertex` records a mirror's visit, from the previous vertex as it was.
-        lane.visit = match &self.mirrors {
+        mirrors.visit = match &self.mirrors {
             Some(c) if !path.prev.delta && kernel.samples_delta() => {
                 c.visit(path.prev.p, path.prev_object, path.prev.pdf, &h)
             }
@@ -871,7 +879,7 @@ impl PathTracer<'_> {
         let (choice, u_lobe) = if chooses { s.next_2d().into() } else { (0.0, 0.0) };
         v.u_lobe[i] = u_lobe;
         let u_light = if kernel.is_delta() { Vec2::ZERO } else { s.next_2d() };
-        lane.mirrored = self.kernel_mirror_connections(kernel, path, wh, bsdf, s);
+        mirrors.mirrored = self.kernel_mirror_connections(kernel, path, wh, bsdf, s);
         let u_bsdf = s.next_2d();
         (v.u_bsdf[0][i], v.u_bsdf[1][i]) = (u_bsdf.x, u_bsdf.y);
         if v.roulette.at(i) {
@@ -972,11 +980,11 @@ fn gather_paths(lanes: &mut [LanePath; POOL], rays: &mut [RayPacket; GROUPS]) ->
 /// when it was not traced or met nothing): the light gathered, then the light through mirrors,
 /// then the step to the next vertex (the mirror visit kept if the lobe taken was a delta one).
 /// True when the path goes on.
-fn finish_kernel(lane: &mut LanePath, s: &Shaded, clear: bool, i: usize) -> bool {
+fn finish_kernel(lane: &mut LanePath, mirrors: &KernelMirrors, s: &Shaded, clear: bool, i: usize) -> bool {
     let path = &mut lane.path;
     let light = if clear { get(&s.light, i) } else { Vec3::ZERO };
     path.l += path.beta * light;
-    if let Some(mirrored) = lane.mirrored {
+    if let Some(mirrored) = mirrors.mirrored {
         path.l += path.beta * mirrored;
     }
     if s.alive.at(i) {
@@ -986,7 +994,7 @@ fn finish_kernel(lane: &mut LanePath, s: &Shaded, clear: bool, i: usize) -> bool
         path.prev.delta = s.delta.at(i);
         path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
         path.depth += 1;
-        path.visit = if path.prev.delta { lane.visit } else { None };
+        path.visit = if path.prev.delta { mirrors.visit } else { None };
     }
     s.alive.at(i)
 }
