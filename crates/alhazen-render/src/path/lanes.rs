@@ -845,13 +845,14 @@ impl PathTracer<'_> {
         }
         let h = HitPoint::from(wh);
         path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, path.visit.as_ref(), ColorMode::Rgb);
-        // As `vertex` records a mirror's visit, from the previous vertex as it was.
-        mirrors.visit = match &self.mirrors {
-            Some(c) if !path.prev.delta && kernel.samples_delta() => {
-                c.visit(path.prev.p, path.prev_object, path.prev.pdf, &h)
-            }
-            _ => None,
-        };
+        // As `vertex` records a mirror's visit, from the previous vertex as it was. (Without
+        // mirrors the visit stays `None`, unwritten: a whole record's copy each vertex.)
+        if let Some(c) = &self.mirrors {
+            mirrors.visit = match !path.prev.delta && kernel.samples_delta() {
+                true => c.visit(path.prev.p, path.prev_object, path.prev.pdf, &h),
+                false => None,
+            };
+        }
         path.prev_object = wh.object;
         v.roulette.put(i, path.depth >= RR_DEPTH);
         set(&mut v.wo, i, -path.ray.dir);
@@ -994,7 +995,9 @@ fn finish_kernel(lane: &mut LanePath, mirrors: &KernelMirrors, s: &Shaded, clear
         path.prev.delta = s.delta.at(i);
         path.ray = Ray::new(get(&s.origin, i), get(&s.dir, i));
         path.depth += 1;
-        path.visit = if path.prev.delta { mirrors.visit } else { None };
+        if mirrors.visit.is_some() || path.visit.is_some() {
+            path.visit = if path.prev.delta { mirrors.visit } else { None };
+        }
     }
     s.alive.at(i)
 }
