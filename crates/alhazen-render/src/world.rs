@@ -744,13 +744,18 @@ impl World {
         });
         // The unbounded objects first, as `nearest` tests them: a flat is nearer only below
         // their hit, compared as `FlatPacket::nearest_of` compares with its limit.
-        let unbounded: [Option<(Candidate, u32)>; LANES] =
-            std::array::from_fn(|r| if live[r] { self.nearest_unbounded(&each[r], f64::INFINITY) } else { None });
-        for (f, u) in flat.iter_mut().zip(&unbounded) {
-            if let (Some((_, h)), Some((c, _))) = (*f, u)
-                && h.t as f32 >= c.t as f32
-            {
-                *f = None;
+        let mut unbounded: [Option<(Candidate, u32)>; LANES] = [None; LANES];
+        // (Most worlds have none: their lanes' `None`s are not built and copied in.)
+        if !self.unbounded.is_empty() {
+            for (r, u) in unbounded.iter_mut().enumerate().filter(|&(r, _)| live[r]) {
+                *u = self.nearest_unbounded(&each[r], f64::INFINITY);
+            }
+            for (f, u) in flat.iter_mut().zip(&unbounded) {
+                if let (Some((_, h)), Some((c, _))) = (*f, u)
+                    && h.t as f32 >= c.t as f32
+                {
+                    *f = None;
+                }
             }
         }
         let leaf = &self.leaves[0];
