@@ -848,10 +848,8 @@ impl PathTracer<'_> {
         // As `vertex` records a mirror's visit, from the previous vertex as it was. (Without
         // mirrors the visit stays `None`, unwritten: a whole record's copy each vertex.)
         if let Some(c) = &self.mirrors {
-            mirrors.visit = match !path.prev.delta && kernel.samples_delta() {
-                true => c.visit(path.prev.p, path.prev_object, path.prev.pdf, &h),
-                false => None,
-            };
+            let reflected = !path.prev.delta && kernel.samples_delta();
+            mirrors.visit = if reflected { c.visit(path.prev.p, path.prev_object, path.prev.pdf, &h) } else { None };
         }
         path.prev_object = wh.object;
         v.roulette.put(i, path.depth >= RR_DEPTH);
