@@ -1029,7 +1029,7 @@ impl Importer {
                 // Mitsuba reads texture coordinate v = 0 at the image's top row, alhazen at its
                 // bottom (as OpenGL and glTF's flipped convention do): turned upside down, the
                 // image shows each coordinate the texel Mitsuba shows it.
-                let img = upside_down(img.map_err(|e| ctx.err(node, e))?);
+                let img = img.map_err(|e| ctx.err(node, e))?.rows_reversed();
                 if let Some(w) = self.string(ctx, &p, "wrap_mode")?.filter(|w| w != "repeat") {
                     self.warn(ctx, node, format!("wrap_mode \"{w}\": alhazen's image textures repeat"));
                 }
@@ -1293,13 +1293,6 @@ impl Importer {
         }
         angle
     }
-}
-
-/// The image with its rows in reverse order.
-fn upside_down(img: alhazen_scene::ImageData) -> alhazen_scene::ImageData {
-    let w = img.width as usize;
-    let rows: Vec<&[[f32; 3]]> = img.pixels().chunks_exact(w.max(1)).rev().collect();
-    alhazen_scene::ImageData::new(img.width, img.height, rows.concat())
 }
 
 /// True when no part of the BSDF lets light through (glass is two-sided in Mitsuba too).

@@ -723,6 +723,14 @@ impl ImageData {
         &self.pixels
     }
 
+    /// The image upside down (its rows in reverse order), its codes kept: no pixel is looked
+    /// at again, where [`Self::new`] on the reversed pixels would find their codes anew.
+    pub fn rows_reversed(self) -> Self {
+        let w = (self.width as usize).max(1);
+        let codes = self.codes.map(|c| PixelCodes { codes: rows_reversed(&c.codes, w), table: c.table });
+        Self { width: self.width, height: self.height, pixels: rows_reversed(&self.pixels, w), codes }
+    }
+
     /// The pixels, given up (to build another image from them).
     pub fn into_pixels(self) -> Vec<[f32; 3]> {
         self.pixels
@@ -741,6 +749,11 @@ impl ImageData {
             None => self.pixels[i],
         }
     }
+}
+
+/// The rows of `width` items of `items` in reverse order.
+fn rows_reversed<T: Copy>(items: &[T], width: usize) -> Vec<T> {
+    items.chunks_exact(width).rev().flatten().copied().collect()
 }
 
 impl PixelCodes {

@@ -119,6 +119,33 @@ mod tests {
             }
         }
 
+        /// An image turned upside down keeps its codes and reads, texel by texel, as the image
+        /// of its reversed rows made afresh.
+        #[test]
+        fn rows_reversed_is_the_image_of_the_reversed_rows(
+            codes in proptest::collection::vec(proptest::prelude::any::<[u8; 3]>(), 1..60),
+            width in 1u32..7,
+            coded in proptest::prelude::any::<bool>(),
+        ) {
+            let rows = codes.len() / width as usize;
+            proptest::prop_assume!(rows > 0);
+            let codes = &codes[..rows * width as usize];
+            let table: [f32; 256] = std::array::from_fn(|k| k as f32 * 0.25 - 3.0);
+            let img = if coded {
+                ImageData::from_codes(width, rows as u32, table, codes.to_vec())
+            } else {
+                ImageData::new(width, rows as u32, codes.iter().map(|c| c.map(|k| table[k as usize] + 0.5)).collect())
+            };
+            let reversed: Vec<[f32; 3]> = img.pixels().chunks_exact(width as usize).rev().flatten().copied().collect();
+            let fresh = ImageData::new(width, rows as u32, reversed);
+            let turned = img.clone().rows_reversed();
+            proptest::prop_assert_eq!(&turned, &fresh);
+            proptest::prop_assert_eq!(turned.has_codes(), img.has_codes());
+            for i in 0..codes.len() {
+                proptest::prop_assert_eq!(turned.texel(i).map(f32::to_bits), fresh.texel(i).map(f32::to_bits));
+            }
+        }
+
         /// `wrap_unit` is `rem_euclid(1.0)` to the bit, near the unit interval and far from it.
         #[test]
         fn wrap_unit_is_rem_euclid(x in -3.0..3.0f64, far in -1e300..1e300f64, tiny in -1e-300..1e-300f64) {
