@@ -79,6 +79,11 @@ impl Axis {
         (radial.dot(self.e2).atan2(radial.dot(self.e1)) + PI) / TAU
     }
 
+    /// Texture coordinates on the side: the angle around the axis, the height along it.
+    fn side_uv(&self, sp: &Split, radial: Vec3, t: f64) -> Vec2 {
+        Vec2::new(self.angle_u(radial), (sp.od + t * sp.dd) / self.height)
+    }
+
     /// Ray parameter of the cap disk at axial position `s` and radius `r`, if hit.
     fn cap_t(&self, sp: &Split, s: f64, r: f64) -> Option<f64> {
         if sp.dd == 0.0 {
@@ -161,6 +166,12 @@ impl Cylinder {
 
     /// The surface at a hit found by [`Cylinder::hit`].
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        self.surface_with(ray, c, true)
+    }
+
+    /// [`Self::surface`], its side's texture coordinates left at zero unless `uv` (their angle
+    /// costs an inverse tangent).
+    pub fn surface_with(&self, ray: &Ray, c: Candidate, uv: bool) -> SurfaceHit {
         let ax = &self.axis;
         match c.aux {
             BOTTOM => ax.cap_surface(ray, c.t, self.radius, -1.0),
@@ -168,7 +179,7 @@ impl Cylinder {
             _ => {
                 let sp = ax.split(ray);
                 let radial = (sp.op + sp.dp * c.t) / self.radius;
-                let uv = Vec2::new(ax.angle_u(radial), (sp.od + c.t * sp.dd) / ax.height);
+                let uv = if uv { ax.side_uv(&sp, radial, c.t) } else { Vec2::ZERO };
                 SurfaceHit::flat(c.t, ray.at(c.t), radial.normalize(), uv)
             }
         }
@@ -236,6 +247,11 @@ impl Cone {
 
     /// The surface at a hit found by [`Cone::hit`].
     pub fn surface(&self, ray: &Ray, c: Candidate) -> SurfaceHit {
+        self.surface_with(ray, c, true)
+    }
+
+    /// [`Self::surface`], its side's texture coordinates left at zero unless `uv`.
+    pub fn surface_with(&self, ray: &Ray, c: Candidate, uv: bool) -> SurfaceHit {
         let ax = &self.axis;
         if c.aux == BOTTOM {
             return ax.cap_surface(ray, c.t, self.radius, -1.0);
@@ -243,7 +259,7 @@ impl Cone {
         let sp = ax.split(ray);
         let radial = (sp.op + sp.dp * c.t).try_normalize().unwrap_or(ax.e1);
         let n = (radial * ax.height + ax.dir * self.radius).normalize();
-        let uv = Vec2::new(ax.angle_u(radial), (sp.od + c.t * sp.dd) / ax.height);
+        let uv = if uv { ax.side_uv(&sp, radial, c.t) } else { Vec2::ZERO };
         SurfaceHit::flat(c.t, ray.at(c.t), n, uv)
     }
 

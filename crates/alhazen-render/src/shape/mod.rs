@@ -130,14 +130,15 @@ impl Shape {
         self.surface_with(ray, c, true)
     }
 
-    /// [`Shape::surface`], leaving a sphere's texture coordinates at zero unless `uv`.
+    /// [`Shape::surface`], leaving a sphere's, a cylinder's or a cone's texture coordinates at
+    /// zero unless `uv` (their angles cost inverse trigonometric functions).
     #[inline]
     pub fn surface_with(&self, ray: &Ray, c: Candidate, uv: bool) -> SurfaceHit {
         match self {
             Shape::Sphere(s) if !uv => s.hit_at_without_uv(ray, c.t),
             Shape::Sphere(s) => s.hit_at(ray, c.t),
-            Shape::Cylinder(s) => s.surface(ray, c),
-            Shape::Cone(s) => s.surface(ray, c),
+            Shape::Cylinder(s) => s.surface_with(ray, c, uv),
+            Shape::Cone(s) => s.surface_with(ray, c, uv),
             Shape::Disk(s) => s.surface(ray, c),
             Shape::Plane(s) => s.surface(ray, c),
             Shape::Box(s) => s.surface(ray, c),
