@@ -564,7 +564,14 @@ impl World {
             let leaf = &self.leaves[range.start];
             let mut closer = None;
             let mut t_max = t_max;
-            if let Some((k, h)) = self.flats.nearest_packet(leaf.packets.clone(), ray, t_max, self.vectors) {
+            // Leaves of spheres and other objects only skip the flat kernel's call, as leaves
+            // without spheres skip the sphere kernel's.
+            let flats = if leaf.packets.is_empty() {
+                None
+            } else {
+                self.flats.nearest_packet(leaf.packets.clone(), ray, t_max, self.vectors)
+            };
+            if let Some((k, h)) = flats {
                 best_flat = Some((k, h));
                 (t_max, closer) = (h.t, Some(h.t));
             }
@@ -891,7 +898,8 @@ impl World {
         let mut blocked = false;
         let visit = |range: std::ops::Range<usize>, t_max| {
             let leaf = &self.leaves[range.start];
-            blocked = FlatPacket::any_of(&self.flats.packets[leaf.packets.clone()], &ray, t_max, self.vectors)
+            let flats = &self.flats.packets[leaf.packets.clone()];
+            blocked = !flats.is_empty() && FlatPacket::any_of(flats, &ray, t_max, self.vectors)
                 || self.solid_blocks(leaf, &ray, t_max);
             blocked.then_some(0.0)
         };
