@@ -186,7 +186,7 @@ fn bilinear(img: &alhazen_scene::ImageData, uv: Vec2) -> [f32; 3] {
     let (x0, y0) = (x.floor() as usize, y.floor() as usize);
     let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
     let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
-    let p = |x: usize, y: usize| img.pixels()[y * w + x];
+    let p = |x: usize, y: usize| img.texel(y * w + x);
     let mut c = [0.0f32; 3];
     for k in 0..3 {
         let top = p(x0, y0)[k] * (1.0 - fx) + p(x1, y0)[k] * fx;

@@ -201,8 +201,8 @@ pub(crate) fn texture_mean(t: &Texture, scene: &Scene) -> Rgb {
 
 /// The mean of an image's pixels.
 pub(crate) fn image_mean(img: &alhazen_scene::ImageData) -> Rgb {
-    let sum = img.pixels().iter().fold(Vec3::ZERO, |s, p| s + Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-    sum / img.pixels().len().max(1) as f64
+    let sum = img.texels().fold(Vec3::ZERO, |s, p| s + Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+    sum / img.texel_count().max(1) as f64
 }
 
 /// A point light's `cos^e` falloff that best stands for a smooth fall-off from full intensity

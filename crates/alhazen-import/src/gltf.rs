@@ -509,12 +509,7 @@ fn scaled(img: &ImageData, factor: Vec3) -> ImageData {
     if factor == Vec3::ONE {
         return img.clone();
     }
-    let f = factor.to_array().map(|x| x as f32);
-    ImageData::new(
-        img.width,
-        img.height,
-        img.pixels().iter().map(|p| [p[0] * f[0], p[1] * f[1], p[2] * f[2]]).collect(),
-    )
+    img.channels_scaled(factor.to_array().map(|x| x as f32))
 }
 
 /// Decoded glTF image data as linear RGB.
@@ -533,8 +528,19 @@ fn decode(data: &gltf::image::Data, srgb: bool) -> Option<ImageData> {
         R32G32B32A32FLOAT => (4, 4),
     };
     let n = data.width as usize * data.height as usize;
-    if data.pixels.len() != n * channels * bytes {
+    if data.pixels.len() != n * channels * bytes || data.width == 0 || data.height == 0 {
         return None;
+    }
+    // Channel `i` of a pixel: grey images repeat their first.
+    let channel = |i: usize| if channels < 3 { 0 } else { i };
+    if bytes == 1 {
+        // Eight bits a channel: the 256 values decoded once, the pixels kept as their codes.
+        let table = std::array::from_fn(|k| {
+            let v = k as f32 / 255.0;
+            if srgb { alhazen_math::color::srgb_to_linear(v as f64) as f32 } else { v }
+        });
+        let codes = data.pixels.chunks_exact(channels).map(|p| std::array::from_fn(|i| p[channel(i)])).collect();
+        return Some(ImageData::from_codes(data.width, data.height, table, codes));
     }
     let value = |k: usize| -> f32 {
         let b = &data.pixels[k * bytes..(k + 1) * bytes];
@@ -545,11 +551,6 @@ fn decode(data: &gltf::image::Data, srgb: bool) -> Option<ImageData> {
         };
         if srgb && bytes < 4 { alhazen_math::color::srgb_to_linear(v as f64) as f32 } else { v }
     };
-    let pixels = (0..n)
-        .map(|p| {
-            let c = |i: usize| value(p * channels + i.min(channels.min(3) - 1));
-            if channels < 3 { [c(0), c(0), c(0)] } else { [c(0), c(1), c(2)] }
-        })
-        .collect();
-    (data.width > 0 && data.height > 0).then_some(ImageData::new(data.width, data.height, pixels))
+    let pixels = (0..n).map(|p| std::array::from_fn(|i| value(p * channels + channel(i)))).collect();
+    Some(ImageData::new(data.width, data.height, pixels))
 }

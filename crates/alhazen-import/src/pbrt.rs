@@ -1443,7 +1443,7 @@ impl Importer {
                 let local = (light_from_world * d).normalize_or_zero();
                 let st = equal_area_sphere_to_square(local);
                 let (i, j) = (((st.x * n as f64) as usize).min(n - 1), ((st.y * n as f64) as usize).min(n - 1));
-                pixels.push(img.pixels()[j * n + i]);
+                pixels.push(img.texel(j * n + i));
             }
         }
         self.scene.images.push(Arc::new(ImageData::new(w as u32, h as u32, pixels)));

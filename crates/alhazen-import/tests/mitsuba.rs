@@ -78,7 +78,7 @@ fn agrees_with_mitsuba(name: &str, spp: u32, mean_tolerance: f64) {
             .unwrap();
     let ours: Vec<Vec3> =
         (0..img.height).flat_map(|y| (0..img.width).map(move |x| (x, y))).map(|(x, y)| img.get(x, y)).collect();
-    let refs: Vec<Vec3> = reference.pixels().iter().map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)).collect();
+    let refs: Vec<Vec3> = reference.texels().map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)).collect();
     let (a, b) = (ours.iter().sum::<Vec3>(), refs.iter().sum::<Vec3>());
     let rel = ((a - b) / b).abs().max_element();
     eprintln!("image means {a} vs {b}: {rel:.4}");
@@ -361,7 +361,7 @@ fn cup_caustic_agrees_with_mitsuba_particle_tracer() {
     let (w, h) = (img.width as usize, img.height as usize);
     assert_eq!((reference.width as usize, reference.height as usize), (w, h));
     let ours = |x: usize, y: usize| img.get(x as u32, y as u32).x;
-    let theirs = |x: usize, y: usize| reference.pixels()[y * w + x][0] as f64;
+    let theirs = |x: usize, y: usize| reference.texel(y * w + x)[0] as f64;
     // The table inside the cup: 24° across 96 pixels from 6 above; radius < 0.95 (the wall is
     // between the floor circle and the rim in the image).
     let half = 6.0 * (12f64).to_radians().tan();

@@ -64,7 +64,9 @@ impl EnvMap {
         let (width, height) = (image.width as usize, image.height as usize);
         let mut texels = Vec::with_capacity(width * height);
         let mut row_power = Vec::with_capacity(height);
-        for (y, row) in image.pixels().chunks_exact(width).enumerate() {
+        for y in 0..height {
+            // One row at a time: an image kept as codes is never expanded whole.
+            let row: Vec<[f32; 3]> = (0..width).map(|x| image.texel(y * width + x)).collect();
             let sin = (PI * (y as f64 + 0.5) / height as f64).sin();
             let power = |p: &[f32; 3]| {
                 let w = luminance(Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)) * sin;

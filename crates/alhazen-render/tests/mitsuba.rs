@@ -15,7 +15,7 @@ fn reference(name: &str) -> Vec<Vec3> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mitsuba").join(name);
     let img = alhazen_scene::import::load_hdr_image(&path).expect("reference EXR");
     assert_eq!((img.width, img.height), (256, 256));
-    img.pixels().iter().map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)).collect()
+    img.texels().map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)).collect()
 }
 
 fn render(scene: &str, spp: u32) -> Image {

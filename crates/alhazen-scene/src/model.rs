@@ -663,34 +663,38 @@ pub struct Object {
 }
 
 /// A decoded image in linear RGB, rows top to bottom. Made by [`ImageData::new`] (or
-/// [`ImageData::from_codes`]), which also keeps the pixels as one-byte codes when they take at
-/// most 256 values; the pixels are read-only, so the codes stay theirs. Two images are equal when
-/// their sizes and pixels are (the codes are derived from the pixels).
+/// [`ImageData::from_codes`]), which keeps the pixels as one-byte codes when each channel takes
+/// at most 256 values (every 8-bit image does), as `f32`s otherwise; the pixels are read-only.
+/// Two images are equal when their sizes and pixels are (however they are kept).
 #[derive(Clone)]
 pub struct ImageData {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// `width × height` linear RGB values.
-    pixels: Vec<[f32; 3]>,
-    /// The pixels as codes into a table of their values, for texture lookups.
-    codes: Option<PixelCodes>,
+    texels: Texels,
 }
 
-/// An image's pixels as one byte per channel into a table of at most 256 values: what every
-/// 8-bit image decodes to. A lookup reads 3 bytes instead of 12, so a 512² texture is 0.75 MB
-/// instead of 3 — a texture's cost in a render is its cache footprint — and decodes to the
-/// very values of `pixels`.
+/// How an image keeps its pixels: a texture's cost in a render is its cache footprint, and an
+/// image's cost in loading the memory it fills, so an image that codes keeps only its codes
+/// (3 bytes a pixel instead of 12: a 2048² texture 12 MB instead of 48).
+#[derive(Clone)]
+enum Texels {
+    Floats(Vec<[f32; 3]>),
+    Codes(PixelCodes),
+}
+
+/// An image's pixels as one byte per channel into a table of at most 256 values per channel:
+/// what every 8-bit image decodes to, and what scaling its channels keeps.
 #[derive(Clone)]
 struct PixelCodes {
-    table: Box<[f32; 256]>,
+    tables: Box<[[f32; 256]; 3]>,
     codes: Vec<[u8; 3]>,
 }
 
 impl PartialEq for ImageData {
     fn eq(&self, other: &Self) -> bool {
-        (self.width, self.height) == (other.width, other.height) && self.pixels == other.pixels
+        (self.width, self.height) == (other.width, other.height) && self.texels().eq(other.texels())
     }
 }
 
@@ -699,7 +703,7 @@ impl std::fmt::Debug for ImageData {
         f.debug_struct("ImageData")
             .field("width", &self.width)
             .field("height", &self.height)
-            .field("pixels", &self.pixels)
+            .field("pixels", &self.texels().collect::<Vec<_>>())
             .field("has_codes", &self.has_codes())
             .finish()
     }
@@ -708,45 +712,69 @@ impl std::fmt::Debug for ImageData {
 impl ImageData {
     /// The image of `pixels` (`width × height`, rows top to bottom).
     pub fn new(width: u32, height: u32, pixels: Vec<[f32; 3]>) -> Self {
-        let codes = PixelCodes::of(&pixels);
-        Self { width, height, pixels, codes }
+        let texels = PixelCodes::of(&pixels).map_or(Texels::Floats(pixels), Texels::Codes);
+        Self { width, height, texels }
     }
 
     /// The image whose pixel channels are `table[code]`: an 8-bit image and its decoding.
     pub fn from_codes(width: u32, height: u32, table: [f32; 256], codes: Vec<[u8; 3]>) -> Self {
-        let pixels = codes.iter().map(|c| c.map(|k| table[k as usize])).collect();
-        Self { width, height, pixels, codes: Some(PixelCodes { table: Box::new(table), codes }) }
+        Self { width, height, texels: Texels::Codes(PixelCodes { tables: Box::new([table; 3]), codes }) }
+    }
+
+    /// The number of pixels.
+    pub fn texel_count(&self) -> usize {
+        match &self.texels {
+            Texels::Floats(p) => p.len(),
+            Texels::Codes(c) => c.codes.len(),
+        }
     }
 
     /// The `width × height` linear RGB values, row by row.
-    pub fn pixels(&self) -> &[[f32; 3]] {
-        &self.pixels
+    pub fn texels(&self) -> impl Iterator<Item = [f32; 3]> + '_ {
+        (0..self.texel_count()).map(|i| self.texel(i))
     }
 
     /// The image upside down (its rows in reverse order), its codes kept: no pixel is looked
     /// at again, where [`Self::new`] on the reversed pixels would find their codes anew.
     pub fn rows_reversed(self) -> Self {
         let w = (self.width as usize).max(1);
-        let codes = self.codes.map(|c| PixelCodes { codes: rows_reversed(&c.codes, w), table: c.table });
-        Self { width: self.width, height: self.height, pixels: rows_reversed(&self.pixels, w), codes }
+        let texels = match self.texels {
+            Texels::Floats(p) => Texels::Floats(rows_reversed(&p, w)),
+            Texels::Codes(c) => Texels::Codes(PixelCodes { codes: rows_reversed(&c.codes, w), tables: c.tables }),
+        };
+        Self { width: self.width, height: self.height, texels }
     }
 
-    /// The pixels, given up (to build another image from them).
-    pub fn into_pixels(self) -> Vec<[f32; 3]> {
-        self.pixels
+    /// The image with each pixel's channels multiplied by `factor`'s (`p[c] · factor[c]` in
+    /// `f32`): an image that codes keeps its codes and scales its tables.
+    pub fn channels_scaled(&self, factor: [f32; 3]) -> Self {
+        let (width, height) = (self.width, self.height);
+        match &self.texels {
+            Texels::Floats(p) => {
+                Self::new(width, height, p.iter().map(|p| std::array::from_fn(|c| p[c] * factor[c])).collect())
+            }
+            Texels::Codes(c) => {
+                let tables = Box::new(std::array::from_fn(|k| c.tables[k].map(|v| v * factor[k])));
+                Self { width, height, texels: Texels::Codes(PixelCodes { tables, codes: c.codes.clone() }) }
+            }
+        }
     }
 
-    /// True when lookups read the pixels as one-byte codes (at most 256 distinct values).
+    /// True when lookups read the pixels as one-byte codes (at most 256 distinct values a
+    /// channel).
     pub fn has_codes(&self) -> bool {
-        self.codes.is_some()
+        matches!(self.texels, Texels::Codes(_))
     }
 
-    /// Pixel `i` (row by row), as texture lookups read it: the same values as `pixels[i]`.
+    /// Pixel `i` (row by row), as texture lookups read it.
     #[inline]
     pub fn texel(&self, i: usize) -> [f32; 3] {
-        match &self.codes {
-            Some(c) => c.codes[i].map(|k| c.table[k as usize]),
-            None => self.pixels[i],
+        match &self.texels {
+            Texels::Codes(c) => {
+                let k = c.codes[i];
+                [c.tables[0][k[0] as usize], c.tables[1][k[1] as usize], c.tables[2][k[2] as usize]]
+            }
+            Texels::Floats(p) => p[i],
         }
     }
 }
@@ -757,26 +785,27 @@ fn rows_reversed<T: Copy>(items: &[T], width: usize) -> Vec<T> {
 }
 
 impl PixelCodes {
-    /// The codes of `pixels` when their channels take at most 256 distinct values (found by a
-    /// small open-addressed table of the values' bits; an image of more gives up early).
+    /// The codes of `pixels` when each channel takes at most 256 distinct values (found by a
+    /// small open-addressed table of the values' bits per channel; an image of more gives up
+    /// early).
     fn of(pixels: &[[f32; 3]]) -> Option<Self> {
         const SLOTS: usize = 1024;
-        let mut slots = [(0u32, u16::MAX); SLOTS];
-        let mut table = [0.0f32; 256];
-        let mut used = 0usize;
-        let mut code = |v: f32| -> Option<u8> {
+        let mut slots = [[(0u32, u16::MAX); SLOTS]; 3];
+        let mut tables = Box::new([[0.0f32; 256]; 3]);
+        let mut used = [0usize; 3];
+        let mut code = |c: usize, v: f32| -> Option<u8> {
             let bits = v.to_bits();
             let mut at = (bits.wrapping_mul(0x9E37_79B1) >> 22) as usize;
             loop {
-                let (b, k) = slots[at];
+                let (b, k) = slots[c][at];
                 if k == u16::MAX {
-                    if used == 256 {
+                    if used[c] == 256 {
                         return None;
                     }
-                    slots[at] = (bits, used as u16);
-                    table[used] = v;
-                    used += 1;
-                    return Some((used - 1) as u8);
+                    slots[c][at] = (bits, used[c] as u16);
+                    tables[c][used[c]] = v;
+                    used[c] += 1;
+                    return Some((used[c] - 1) as u8);
                 }
                 if b == bits {
                     return Some(k as u8);
@@ -784,7 +813,10 @@ impl PixelCodes {
                 at = (at + 1) % SLOTS;
             }
         };
-        let codes = pixels.iter().map(|p| Some([code(p[0])?, code(p[1])?, code(p[2])?])).collect::<Option<Vec<_>>>()?;
-        Some(Self { table: Box::new(table), codes })
+        let codes = pixels
+            .iter()
+            .map(|p| Some([code(0, p[0])?, code(1, p[1])?, code(2, p[2])?]))
+            .collect::<Option<Vec<_>>>()?;
+        Some(Self { tables, codes })
     }
 }

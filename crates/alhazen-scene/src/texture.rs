@@ -102,21 +102,27 @@ mod tests {
 
     proptest::proptest! {
         /// Lookups read the pixels' own bits whether the image keeps codes (at most 256
-        /// distinct channel values, in any order, NaN and −0 included) or not (more).
+        /// distinct values in each channel, in any order, NaN and −0 included) or not (more),
+        /// and so do its scaled channels.
         #[test]
         fn texels_are_the_pixels(
-            values in proptest::collection::vec(proptest::prelude::any::<f32>(), 1..300),
-            picks in proptest::collection::vec(proptest::prelude::any::<proptest::sample::Index>(), 3..600),
+            values in proptest::collection::vec(proptest::prelude::any::<f32>(), 1..600),
+            picks in proptest::collection::vec(proptest::prelude::any::<proptest::sample::Index>(), 3..1800),
+            factor in proptest::array::uniform3(-4.0..4.0f32),
         ) {
             let n = picks.len() / 3;
             let pixels: Vec<[f32; 3]> =
                 (0..n).map(|i| std::array::from_fn(|c| values[picks[3 * i + c].index(values.len())])).collect();
-            let distinct = pixels.iter().flatten().map(|v| v.to_bits()).collect::<std::collections::HashSet<_>>().len();
+            let distinct = |c: usize| pixels.iter().map(|p| p[c].to_bits()).collect::<std::collections::HashSet<_>>().len();
             let img = ImageData::new(n as u32, 1, pixels.clone());
-            proptest::prop_assert_eq!(img.has_codes(), distinct <= 256);
+            proptest::prop_assert_eq!(img.has_codes(), (0..3).all(|c| distinct(c) <= 256));
+            let scaled = img.channels_scaled(factor);
             for (i, p) in pixels.iter().enumerate() {
                 proptest::prop_assert_eq!(img.texel(i).map(f32::to_bits), p.map(f32::to_bits));
+                let want: [f32; 3] = std::array::from_fn(|c| p[c] * factor[c]);
+                proptest::prop_assert_eq!(scaled.texel(i).map(f32::to_bits), want.map(f32::to_bits));
             }
+            proptest::prop_assert_eq!(img.texels().count(), n);
         }
 
         /// An image turned upside down keeps its codes and reads, texel by texel, as the image
@@ -136,7 +142,8 @@ mod tests {
             } else {
                 ImageData::new(width, rows as u32, codes.iter().map(|c| c.map(|k| table[k as usize] + 0.5)).collect())
             };
-            let reversed: Vec<[f32; 3]> = img.pixels().chunks_exact(width as usize).rev().flatten().copied().collect();
+            let pixels: Vec<[f32; 3]> = img.texels().collect();
+            let reversed: Vec<[f32; 3]> = pixels.chunks_exact(width as usize).rev().flatten().copied().collect();
             let fresh = ImageData::new(width, rows as u32, reversed);
             let turned = img.clone().rows_reversed();
             proptest::prop_assert_eq!(&turned, &fresh);
@@ -178,7 +185,7 @@ mod tests {
             let (x0, y0) = (x.floor(), y.floor());
             let (fx, fy) = (x - x0, y - y0);
             let px = |i: i64, j: i64| {
-                let p = img.pixels()[(j.rem_euclid(h) * w + i.rem_euclid(w)) as usize];
+                let p = img.texel((j.rem_euclid(h) * w + i.rem_euclid(w)) as usize);
                 Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
             };
             let (i, j) = (x0 as i64, y0 as i64);

@@ -552,7 +552,7 @@ pub fn ply_bytes(m: &alhazen_geom::TriangleMesh) -> Vec<u8> {
 }
 
 fn write_exr(img: &ImageData, path: &Path) -> Result<(), WriteError> {
-    let flat: Vec<f32> = img.pixels().iter().flatten().copied().collect();
+    let flat: Vec<f32> = img.texels().flatten().collect();
     let buf = image::Rgb32FImage::from_raw(img.width, img.height, flat)
         .ok_or_else(|| WriteError::Unsupported(format!("image {}: size and pixels disagree", path.display())))?;
     buf.save_with_format(path, image::ImageFormat::OpenExr)

@@ -45,7 +45,7 @@ fn image_texture_is_loaded_and_linearised() {
     let file = dir.path().join("s.toml");
     std::fs::write(&file, "[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = { color = { image = { file = \"t.png\", scale = 2 } } }\n").unwrap();
     let s = load_scene(&file).unwrap();
-    let px = s.images[0].pixels()[0];
+    let px = s.images[0].texel(0);
     assert_eq!(px[0], 1.0);
     assert!((px[1] - 0.2158605).abs() < 1e-6, "sRGB 128 is linear 0.216");
     let missing =
