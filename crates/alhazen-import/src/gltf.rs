@@ -21,6 +21,7 @@ use alhazen_scene::{
     PerspectiveOpening, Scene, SceneError, Shape, Texture,
 };
 use gltf::mesh::Mode;
+use rayon::prelude::*;
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
@@ -72,6 +73,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
         materials: HashMap::new(),
         meshes: HashMap::new(),
         images: HashMap::new(),
+        decoded: HashMap::new(),
         camera: None,
         bounds: Bounds3::EMPTY,
     };
@@ -79,6 +81,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
     imp.extensions(&document)?;
     let scene = document.default_scene().or_else(|| document.scenes().next());
     let Some(scene) = scene else { return Err(error(path, bytes, "the file has no scene")) };
+    imp.decode_ahead(&document, &scene);
     for node in scene.nodes() {
         imp.node(&node, Mat4::IDENTITY, 0)?;
     }
@@ -111,6 +114,9 @@ struct Importer<'a> {
     materials: HashMap<Option<usize>, MaterialId>,
     meshes: HashMap<(usize, usize), Option<usize>>,
     images: HashMap<(usize, bool), Arc<ImageData>>,
+    /// Images decoded ahead of the walk, on all threads, or why they could not be
+    /// ([`Importer::decode_ahead`]): taken by [`Importer::image`] when the walk asks.
+    decoded: HashMap<(usize, bool), Result<ImageData, String>>,
     camera: Option<CameraDesc>,
     bounds: Bounds3,
 }
@@ -405,17 +411,50 @@ impl Importer<'_> {
     /// A texture's image in linear RGB (decoded from sRGB when `srgb`).
     fn image(&mut self, texture: &gltf::Texture, srgb: bool) -> R<Arc<ImageData>> {
         let source = texture.source();
-        if let Some(img) = self.images.get(&(source.index(), srgb)) {
+        let key = (source.index(), srgb);
+        if let Some(img) = self.images.get(&key) {
             return Ok(img.clone());
         }
-        let data = gltf::image::Data::from_source(source.source(), Some(self.base), &self.buffers)
-            .map_err(|e| self.err(format!("image {}: {e}", source.index())))?;
-        let img = Arc::new(
-            decode(&data, srgb)
-                .ok_or_else(|| self.err(format!("image {}: unsupported pixel format", source.index())))?,
-        );
-        self.images.insert((source.index(), srgb), img.clone());
+        let decoded = match self.decoded.remove(&key) {
+            Some(ahead) => ahead,
+            None => decode_image(&source, srgb, self.base, &self.buffers),
+        };
+        let img = Arc::new(decoded.map_err(|e| self.err(e))?);
+        self.images.insert(key, img.clone());
         Ok(img)
+    }
+
+    /// Decodes every image the materials of `scene`'s meshes will ask for, all at once on all
+    /// threads (a Blender export's textures are its load time); each error is kept, and
+    /// reported only where the walk asks for the image, as if it were decoded there.
+    fn decode_ahead(&mut self, document: &gltf::Document, scene: &gltf::Scene) {
+        let mut wanted = std::collections::BTreeSet::new();
+        let mut seen = std::collections::HashSet::new();
+        let mut todo: Vec<(gltf::Node, usize)> = scene.nodes().map(|n| (n, 0)).collect();
+        while let Some((node, depth)) = todo.pop() {
+            if depth > 256 || !seen.insert(node.index()) {
+                continue;
+            }
+            for material in node.mesh().iter().flat_map(|m| m.primitives()).map(|p| p.material()) {
+                let pbr = material.pbr_metallic_roughness();
+                let srgb =
+                    [pbr.base_color_texture().map(|t| t.texture()), material.emissive_texture().map(|t| t.texture())];
+                let linear = [
+                    pbr.metallic_roughness_texture().map(|t| t.texture()),
+                    material.normal_texture().map(|t| t.texture()),
+                ];
+                wanted.extend(srgb.iter().flatten().map(|t| (t.source().index(), true)));
+                wanted.extend(linear.iter().flatten().map(|t| (t.source().index(), false)));
+            }
+            todo.extend(node.children().map(|c| (c, depth + 1)));
+        }
+        let images: Vec<gltf::Image> = document.images().collect();
+        let (base, buffers) = (self.base, &self.buffers);
+        let decoded: Vec<_> = wanted
+            .into_par_iter()
+            .filter_map(|(i, srgb)| Some(((i, srgb), decode_image(images.get(i)?, srgb, base, buffers))))
+            .collect();
+        self.decoded = decoded.into_iter().collect();
     }
 
     // ---- camera and lights ---------------------------------------------------------------------
@@ -510,6 +549,19 @@ fn scaled(img: &ImageData, factor: Vec3) -> ImageData {
         return img.clone();
     }
     img.channels_scaled(factor.to_array().map(|x| x as f32))
+}
+
+/// Image `source` read (from its file, data URI or buffer view) and decoded to linear RGB, or
+/// why it could not be.
+fn decode_image(
+    source: &gltf::Image,
+    srgb: bool,
+    base: &Path,
+    buffers: &[gltf::buffer::Data],
+) -> Result<ImageData, String> {
+    let data = gltf::image::Data::from_source(source.source(), Some(base), buffers)
+        .map_err(|e| format!("image {}: {e}", source.index()))?;
+    decode(&data, srgb).ok_or_else(|| format!("image {}: unsupported pixel format", source.index()))
 }
 
 /// Decoded glTF image data as linear RGB.

@@ -289,3 +289,24 @@ fn blender_gltf_agrees_with_cycles() {
         assert!(off < 0.05, "{name}: alhazen {a} against Cycles {b}");
     }
 }
+
+/// The scene's images are decoded ahead of the walk, all at once, yet an image that cannot be
+/// read is an error only where a material of the scene uses it, and named there.
+#[test]
+fn an_unreadable_image_is_an_error_only_where_the_scene_uses_it() {
+    let doc = embedded();
+    let data_uri = format!("data:image/png;base64,{}", base64(&png()));
+    assert!(doc.contains(&data_uri));
+    let used = doc.replace(&data_uri, "missing.png");
+    let err = write_and_import(&[("a.gltf", used.into_bytes())]).expect_err("the base colour's image is missing");
+    assert!(err.contains("image 0"), "{err}");
+    // A second material, on no mesh, whose texture's file is missing.
+    let unused = doc
+        .replace(
+            "}],\n  \"textures\": [{ \"source\": 0 }],",
+            "}, { \"name\": \"unused\", \"pbrMetallicRoughness\": { \"baseColorTexture\": { \"index\": 1 } } }],\n  \"textures\": [{ \"source\": 0 }, { \"source\": 1 }],",
+        )
+        .replace(" }],\n  \"buffers\"", " }, { \"uri\": \"missing.png\" }],\n  \"buffers\"");
+    assert!(unused.contains("\"unused\"") && unused.contains("\"uri\": \"missing.png\""));
+    check_scene(&write_and_import(&[("a.gltf", unused.into_bytes())]).expect("the missing image is used by no mesh"));
+}
