@@ -1,5 +1,5 @@
 //! What the importers share: reading files with a size limit, located errors and warnings, mesh
-//! files read together on all threads (`PendingMeshes`), and
+//! files read together on all threads (`PendingFiles`: meshes and images), and
 //! the mapping of the common material models (metallic–roughness, named IORs) to alhazen's
 //! BSDFs (course, §"Physically based models").
 
@@ -242,60 +242,111 @@ pub(crate) fn flip_mesh(mesh: &mut alhazen_geom::TriangleMesh) {
     }
 }
 
-/// Mesh files met while scene files are walked, each with its place in `scene.meshes` (empty
-/// until loaded), read together on all threads when the walk is done ([`Self::load`]): a scene
-/// of many meshes loads in a fraction of the time.
+/// Mesh and image files met while scene files are walked, each with its place in
+/// `scene.meshes` or `scene.images` (a placeholder until loaded), read together on all threads
+/// when the walk is done ([`Self::load`]): a scene of many meshes or textures loads in a
+/// fraction of the time.
 #[derive(Default)]
-pub(crate) struct PendingMeshes {
-    /// The scene files that hold mesh files' shapes, and their texts, for the locations of
-    /// errors found after the walk.
+pub(crate) struct PendingFiles {
+    /// The scene files that name such files, and their texts, for the locations of errors
+    /// found after the walk.
     files: Vec<(PathBuf, Arc<str>)>,
-    meshes: Vec<PendingMesh>,
+    reads: Vec<PendingRead>,
 }
 
-struct PendingMesh {
-    index: usize,
+struct PendingRead {
     path: PathBuf,
-    flip: bool,
-    /// Where its shape is: `files[file]`, bytes `span`.
+    what: Read,
+    /// Where the scene names it: `files[file]`, bytes `span`.
     file: usize,
     span: Range<usize>,
 }
 
-impl PendingMeshes {
+/// What a pending file becomes.
+#[derive(Clone, Copy)]
+enum Read {
+    /// `scene.meshes[index]`, turned inside out when `flip`.
+    Mesh { index: usize, flip: bool },
+    /// `scene.images[index]`: linear values (or sRGB decoded), upside down when `rows_reversed`.
+    Image { index: usize, linear: bool, rows_reversed: bool },
+}
+
+/// A pending file as read, with where it goes.
+enum Loaded {
+    Mesh { index: usize, flip: bool, mesh: Result<alhazen_scene::import::LoadedMesh, String> },
+    Image { index: usize, rows_reversed: bool, image: Result<alhazen_scene::ImageData, String> },
+}
+
+impl PendingFiles {
     /// Mesh file `path` (turned inside out when `flip`) for `scene.meshes[index]`, its shape at
-    /// bytes `span` of scene file `at` (its path and text, kept only for files that have mesh
-    /// files: a scene's large files of inline geometry are not held to the end).
-    pub fn push(&mut self, index: usize, path: &Path, flip: bool, at: (&Path, &Arc<str>), span: Range<usize>) {
+    /// bytes `span` of scene file `at` (its path and text, kept only for files that name mesh
+    /// or image files: a scene's large files of inline geometry are not held to the end).
+    pub fn push_mesh(&mut self, index: usize, path: &Path, flip: bool, at: (&Path, &Arc<str>), span: Range<usize>) {
+        self.push(path, Read::Mesh { index, flip }, at, span);
+    }
+
+    /// Image file `path` for `scene.images[index]`, read as linear values (else decoded from
+    /// sRGB), turned upside down when `rows_reversed`; named at bytes `span` of scene file `at`.
+    pub fn push_image(
+        &mut self,
+        index: usize,
+        path: &Path,
+        (linear, rows_reversed): (bool, bool),
+        at: (&Path, &Arc<str>),
+        span: Range<usize>,
+    ) {
+        self.push(path, Read::Image { index, linear, rows_reversed }, at, span);
+    }
+
+    fn push(&mut self, path: &Path, what: Read, at: (&Path, &Arc<str>), span: Range<usize>) {
         if !self.files.last().is_some_and(|(_, text)| Arc::ptr_eq(text, at.1)) {
             self.files.push((at.0.to_path_buf(), at.1.clone()));
         }
         let file = self.files.len() - 1;
-        self.meshes.push(PendingMesh { index, path: path.to_path_buf(), flip, file, span });
+        self.reads.push(PendingRead { path: path.to_path_buf(), what, file, span });
     }
 
-    /// Reads the files pushed, on all threads, into `meshes`, each given to `adjust` first; the
-    /// first that cannot be read, in the order they were pushed, is the error, at its shape.
+    /// Reads the files pushed, on all threads, into `scene`, each mesh given to `adjust` first;
+    /// the first that cannot be read, in the order they were pushed, is the error, where the
+    /// scene names it.
     pub fn load(
         &mut self,
-        meshes: &mut [Arc<alhazen_geom::TriangleMesh>],
+        scene: &mut Scene,
         adjust: impl Fn(&mut alhazen_geom::TriangleMesh),
     ) -> Result<(), SceneError> {
         use rayon::prelude::*;
-        let pending = std::mem::take(&mut self.meshes);
-        let loaded: Vec<_> = pending.par_iter().map(|m| alhazen_scene::import::load_mesh(&m.path)).collect();
-        for (m, loaded) in pending.into_iter().zip(loaded) {
-            let mut mesh = loaded
-                .map_err(|e| {
-                    let (path, text) = &self.files[m.file];
-                    located(path, text, m.span.clone(), e)
-                })?
-                .mesh;
-            adjust(&mut mesh);
-            if m.flip {
-                flip_mesh(&mut mesh);
+        let pending = std::mem::take(&mut self.reads);
+        let read = |r: &PendingRead| match r.what {
+            Read::Mesh { index, flip } => Loaded::Mesh { index, flip, mesh: alhazen_scene::import::load_mesh(&r.path) },
+            Read::Image { index, linear, rows_reversed } => {
+                let image = if linear {
+                    alhazen_scene::import::load_hdr_image(&r.path)
+                } else {
+                    alhazen_scene::import::load_image(&r.path)
+                };
+                Loaded::Image { index, rows_reversed, image }
             }
-            meshes[m.index] = Arc::new(mesh);
+        };
+        let loaded: Vec<_> = pending.par_iter().map(read).collect();
+        for (r, loaded) in pending.into_iter().zip(loaded) {
+            let at = |e: String| {
+                let (path, text) = &self.files[r.file];
+                located(path, text, r.span.clone(), e)
+            };
+            match loaded {
+                Loaded::Mesh { index, flip, mesh } => {
+                    let mut mesh = mesh.map_err(at)?.mesh;
+                    adjust(&mut mesh);
+                    if flip {
+                        flip_mesh(&mut mesh);
+                    }
+                    scene.meshes[index] = Arc::new(mesh);
+                }
+                Loaded::Image { index, rows_reversed, image } => {
+                    let image = image.map_err(at)?;
+                    scene.images[index] = Arc::new(if rows_reversed { image.rows_reversed() } else { image });
+                }
+            }
         }
         Ok(())
     }

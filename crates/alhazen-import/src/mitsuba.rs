@@ -16,7 +16,7 @@
 //! alhazen's right-handed camera seen through `lookat`, so scenes map without mirroring.
 
 use crate::Imported;
-use crate::common::{self, PendingMeshes, Warnings, flip_mesh, located};
+use crate::common::{self, PendingFiles, Warnings, flip_mesh, located};
 use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
 use alhazen_scene::{
@@ -43,17 +43,17 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
         black_material: None,
         camera_seen: false,
         version_major: 3,
-        pending: PendingMeshes::default(),
+        pending: PendingFiles::default(),
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.scene.render.width = 768;
     imp.scene.render.height = 576;
     imp.scene.render.max_depth = 1000;
     let walked = imp.file(path, 0);
-    // The mesh files met before any error of the walk are loaded (an error in one of them came
-    // first in the document, so it is the one reported).
+    // The mesh and image files met before any error of the walk are loaded (an error in one of
+    // them came first in the document, so it is the one reported).
     // Mitsuba ignores OBJ material libraries: the shape's BSDF applies to every face.
-    imp.pending.load(&mut imp.scene.meshes, |m| {
+    imp.pending.load(&mut imp.scene, |m| {
         m.material_slots.clear();
         m.material_names.clear();
     })?;
@@ -89,7 +89,7 @@ struct Importer {
     camera_seen: bool,
     version_major: u32,
     /// Mesh files met, loaded together once the walk is done.
-    pending: PendingMeshes,
+    pending: PendingFiles,
 }
 
 /// One file being read.
@@ -1021,21 +1021,17 @@ impl Importer {
                     path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
                     Some("exr" | "hdr" | "pfm")
                 );
-                let img = if hdr || raw {
-                    alhazen_scene::import::load_hdr_image(&path)
-                } else {
-                    alhazen_scene::import::load_image(&path)
-                };
-                // Mitsuba reads texture coordinate v = 0 at the image's top row, alhazen at its
-                // bottom (as OpenGL and glTF's flipped convention do): turned upside down, the
-                // image shows each coordinate the texel Mitsuba shows it.
-                let img = img.map_err(|e| ctx.err(node, e))?.rows_reversed();
+                // Read with the other files once the walk is done. Mitsuba reads texture
+                // coordinate v = 0 at the image's top row, alhazen at its bottom (as OpenGL and
+                // glTF's flipped convention do): turned upside down, the image shows each
+                // coordinate the texel Mitsuba shows it.
+                let index = self.placeholder_image();
+                self.pending.push_image(index, &path, (hdr || raw, true), (ctx.path, ctx.shared), node.range());
                 if let Some(w) = self.string(ctx, &p, "wrap_mode")?.filter(|w| w != "repeat") {
                     self.warn(ctx, node, format!("wrap_mode \"{w}\": alhazen's image textures repeat"));
                 }
                 self.string(ctx, &p, "filter_type")?;
-                self.scene.images.push(Arc::new(img));
-                Texture::Image { image: self.scene.images.len() - 1, scale }
+                Texture::Image { image: index, scale }
             }
             "checkerboard" => {
                 let even = self.constant_color(ctx, &p, "color0", Vec3::splat(0.4))?;
@@ -1191,6 +1187,12 @@ impl Importer {
         m.bump.is_some() || m.bsdf.as_ref().is_some_and(|b| b.is_textured() || b.is_anisotropic())
     }
 
+    /// An image's place in the scene, filled when the files are read after the walk.
+    fn placeholder_image(&mut self) -> usize {
+        self.scene.images.push(Arc::new(alhazen_scene::ImageData::new(1, 1, vec![[0.0; 3]])));
+        self.scene.images.len() - 1
+    }
+
     /// A mesh file's place in the scene, once per file (and orientation); its triangles are
     /// read with the other files' once the walk is done.
     fn mesh(&mut self, ctx: &Ctx, node: Node, path: &Path, flip: bool) -> R<usize> {
@@ -1200,7 +1202,7 @@ impl Importer {
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert((path.to_path_buf(), flip), index);
-        self.pending.push(index, path, flip, (ctx.path, ctx.shared), node.range());
+        self.pending.push_mesh(index, path, flip, (ctx.path, ctx.shared), node.range());
         Ok(index)
     }
 

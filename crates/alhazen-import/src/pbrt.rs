@@ -18,7 +18,7 @@
 //! write) are taken as they are.
 
 use crate::Imported;
-use crate::common::{self, PendingMeshes, Warnings, flip_mesh, located};
+use crate::common::{self, PendingFiles, Warnings, flip_mesh, located};
 use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Ior};
 use alhazen_scene::{
@@ -38,7 +38,7 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
     let walked = imp.file(path, 0);
     // The mesh files met before any error of the walk are loaded (an error in one of them came
     // first, so it is the one reported).
-    imp.pending.load(&mut imp.scene.meshes, |_| {})?;
+    imp.pending.load(&mut imp.scene, |_| {})?;
     walked?;
     imp.finish()
 }
@@ -184,7 +184,7 @@ struct Importer {
     /// The screen's aspect once `Film` is read.
     environment: Option<(Arc<ImageData>, Mat4, f64)>,
     /// Mesh files met, loaded together once the walk is done.
-    pending: PendingMeshes,
+    pending: PendingFiles,
 }
 
 #[derive(Clone, Copy)]
@@ -232,7 +232,7 @@ impl Importer {
             default_material: None,
             camera: None,
             environment: None,
-            pending: PendingMeshes::default(),
+            pending: PendingFiles::default(),
         }
     }
 
@@ -1044,12 +1044,10 @@ impl Importer {
                 if let Some(e) = encoding.as_deref().filter(|e| !matches!(*e, "sRGB" | "linear")) {
                     self.warn(ctx, at, format!("encoding \"{e}\" is read as sRGB"));
                 }
-                let img = if linear {
-                    alhazen_scene::import::load_hdr_image(&path)
-                } else {
-                    alhazen_scene::import::load_image(&path)
-                };
-                let img = img.map_err(|e| ctx.err(at.clone(), e))?;
+                // Read with the other files once the walk is done.
+                self.scene.images.push(Arc::new(ImageData::new(1, 1, vec![[0.0; 3]])));
+                let index = self.scene.images.len() - 1;
+                self.pending.push_image(index, &path, (linear, false), (ctx.path, ctx.shared), at.clone());
                 let (us, vs) = (self.float(ctx, p, "uscale", 1.0)?, self.float(ctx, p, "vscale", 1.0)?);
                 if self.float(ctx, p, "udelta", 0.0)? != 0.0 || self.float(ctx, p, "vdelta", 0.0)? != 0.0 {
                     self.warn(ctx, at, "udelta/vdelta offsets are not supported; ignored");
@@ -1061,8 +1059,7 @@ impl Importer {
                 if self.boolean(ctx, p, "invert", false)? {
                     self.warn(ctx, at, "invert is not supported; ignored");
                 }
-                self.scene.images.push(Arc::new(img));
-                Texture::Image { image: self.scene.images.len() - 1, scale: Vec2::new(us, vs) }
+                Texture::Image { image: index, scale: Vec2::new(us, vs) }
             }
             "checkerboard" => {
                 let (us, vs) = (self.float(ctx, p, "uscale", 1.0)?, self.float(ctx, p, "vscale", 1.0)?);
@@ -1366,7 +1363,7 @@ impl Importer {
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert((path.to_path_buf(), reverse), index);
-        self.pending.push(index, path, reverse, (ctx.path, ctx.shared), at.clone());
+        self.pending.push_mesh(index, path, reverse, (ctx.path, ctx.shared), at.clone());
         Ok(index)
     }
 

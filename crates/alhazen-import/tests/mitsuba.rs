@@ -411,3 +411,30 @@ fn cup_caustic_agrees_with_mitsuba_particle_tracer() {
     }
     eprintln!("worst 8×8 block {:.2} %; line through the cusp (bin, ours, Mitsuba): {line:.4?}", worst * 100.0);
 }
+
+/// Bitmap files are read with the mesh files once the walk is done, all together; an
+/// unreadable one is still the error, at its texture, even when a later element is wrong too.
+#[test]
+fn bitmap_files_load_together_and_an_unreadable_one_is_located() {
+    let bitmap = |file: &str| {
+        format!(
+            "<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture name=\"reflectance\" type=\"bitmap\">\
+             <string name=\"filename\" value=\"{file}\"/></texture></bsdf></shape>"
+        )
+    };
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 0])).save(dir.path().join("red.png")).unwrap();
+    image::RgbImage::from_pixel(1, 1, image::Rgb([0, 0, 255])).save(dir.path().join("blue.png")).unwrap();
+    let load = |body: &str| {
+        std::fs::write(dir.path().join("t.xml"), scene(body)).unwrap();
+        alhazen_import::load(&dir.path().join("t.xml")).map_err(|e| e.to_string())
+    };
+    let s = load(&[bitmap("red.png"), bitmap("blue.png"), bitmap("red.png")].join("\n")).unwrap().scene;
+    let sizes: Vec<_> = s.images.iter().map(|i| (i.width, i.texel(0))).collect();
+    assert_eq!(sizes, [(2, [1.0, 0.0, 0.0]), (1, [0.0, 0.0, 1.0]), (2, [1.0, 0.0, 0.0])]);
+    let later = "<shape type=\"sphere\"><float name=\"radius\" value=\"big\"/></shape>";
+    let err = load(&[bitmap("red.png"), bitmap("missing.png"), later.into()].join("\n")).unwrap_err();
+    assert!(err.contains("t.xml:3:") && err.contains("cannot load image"), "{err}");
+    let err = load(&[bitmap("red.png"), later.into()].join("\n")).unwrap_err();
+    assert!(err.contains("t.xml:3:") && !err.contains("cannot load image"), "{err}");
+}

@@ -203,3 +203,25 @@ fn unsupported_parameters_are_warned_about_where_they_are() {
     assert!(said.iter().any(|w| w.contains("w.pbrt:4: light \"goniometric\" is not supported")), "{said:?}");
     assert!(said.iter().any(|w| w.contains("no Camera")), "{said:?}");
 }
+
+/// Image maps are read with the mesh files once the walk is done; an unreadable one is the
+/// error, at its texture, even when a later directive is wrong too.
+#[test]
+fn image_maps_load_after_the_walk_and_an_unreadable_one_is_located() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 1, image::Rgb([0, 255, 0])).save(dir.path().join("green.png")).unwrap();
+    let texture = |file: &str| format!("Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"{file}\"");
+    let load = |text: &str| {
+        std::fs::write(dir.path().join("a.pbrt"), text).unwrap();
+        alhazen_import::load(&dir.path().join("a.pbrt")).map_err(|e| e.to_string())
+    };
+    let body = format!(
+        "WorldBegin\n{}\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"",
+        texture("green.png")
+    );
+    let s = load(&body).unwrap().scene;
+    assert_eq!(s.images.len(), 1);
+    assert_eq!((s.images[0].width, s.images[0].texel(1)), (2, [0.0, 1.0, 0.0]));
+    let err = load(&format!("WorldBegin\n{}\nNamedMaterial \"glod\"", texture("missing.png"))).unwrap_err();
+    assert!(err.contains("a.pbrt:2:") && err.contains("cannot load image"), "{err}");
+}
