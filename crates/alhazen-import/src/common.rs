@@ -285,17 +285,21 @@ impl PendingFiles {
         self.push(path, Read::Mesh { index, flip }, at, span);
     }
 
-    /// Image file `path` for `scene.images[index]`, read as linear values (else decoded from
-    /// sRGB), turned upside down when `rows_reversed`; named at bytes `span` of scene file `at`.
+    /// Image file `path`, read as linear values (else decoded from sRGB), turned upside down
+    /// when `rows_reversed`; named at bytes `span` of scene file `at`. Its place in `images` (a
+    /// placeholder until [`Self::load`]) is returned.
     pub fn push_image(
         &mut self,
-        index: usize,
+        images: &mut Vec<Arc<alhazen_scene::ImageData>>,
         path: &Path,
         (linear, rows_reversed): (bool, bool),
         at: (&Path, &Arc<str>),
         span: Range<usize>,
-    ) {
+    ) -> usize {
+        images.push(Arc::new(alhazen_scene::ImageData::new(1, 1, vec![[0.0; 3]])));
+        let index = images.len() - 1;
         self.push(path, Read::Image { index, linear, rows_reversed }, at, span);
+        index
     }
 
     fn push(&mut self, path: &Path, what: Read, at: (&Path, &Arc<str>), span: Range<usize>) {

@@ -312,9 +312,9 @@ impl Importer<'_> {
             Some(info) => {
                 let scale = self.texture_scale(&info, &name);
                 let img = self.image(&info.texture(), true)?;
-                let img = scaled(&img, factor);
+                let img = scaled(img, factor);
                 let mean = common::image_mean(&img);
-                self.scene.images.push(Arc::new(img));
+                self.scene.images.push(img);
                 (Texture::Image { image: self.scene.images.len() - 1, scale }, mean)
             }
             None => (Texture::Solid(factor), factor),
@@ -544,11 +544,12 @@ fn framing(bounds: Bounds3, aspect: f64) -> Option<CameraDesc> {
 }
 
 /// An image multiplied by `factor` (the base-colour factor glTF applies to its texture).
-fn scaled(img: &ImageData, factor: Vec3) -> ImageData {
+fn scaled(img: Arc<ImageData>, factor: Vec3) -> Arc<ImageData> {
     if factor == Vec3::ONE {
-        return img.clone();
+        // The decoded image itself, not a copy of its pixels.
+        return img;
     }
-    img.channels_scaled(factor.to_array().map(|x| x as f32))
+    Arc::new(img.channels_scaled(factor.to_array().map(|x| x as f32)))
 }
 
 /// Image `source` read (from its file, data URI or buffer view) and decoded to linear RGB, or

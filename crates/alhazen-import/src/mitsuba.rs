@@ -1025,8 +1025,8 @@ impl Importer {
                 // coordinate v = 0 at the image's top row, alhazen at its bottom (as OpenGL and
                 // glTF's flipped convention do): turned upside down, the image shows each
                 // coordinate the texel Mitsuba shows it.
-                let index = self.placeholder_image();
-                self.pending.push_image(index, &path, (hdr || raw, true), (ctx.path, ctx.shared), node.range());
+                let (images, at) = (&mut self.scene.images, (ctx.path, ctx.shared));
+                let index = self.pending.push_image(images, &path, (hdr || raw, true), at, node.range());
                 if let Some(w) = self.string(ctx, &p, "wrap_mode")?.filter(|w| w != "repeat") {
                     self.warn(ctx, node, format!("wrap_mode \"{w}\": alhazen's image textures repeat"));
                 }
@@ -1185,12 +1185,6 @@ impl Importer {
     fn parametrised(&self, m: u32) -> bool {
         let m = &self.scene.materials[m as usize];
         m.bump.is_some() || m.bsdf.as_ref().is_some_and(|b| b.is_textured() || b.is_anisotropic())
-    }
-
-    /// An image's place in the scene, filled when the files are read after the walk.
-    fn placeholder_image(&mut self) -> usize {
-        self.scene.images.push(Arc::new(alhazen_scene::ImageData::new(1, 1, vec![[0.0; 3]])));
-        self.scene.images.len() - 1
     }
 
     /// A mesh file's place in the scene, once per file (and orientation); its triangles are

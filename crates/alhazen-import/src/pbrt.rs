@@ -1045,9 +1045,8 @@ impl Importer {
                     self.warn(ctx, at, format!("encoding \"{e}\" is read as sRGB"));
                 }
                 // Read with the other files once the walk is done.
-                self.scene.images.push(Arc::new(ImageData::new(1, 1, vec![[0.0; 3]])));
-                let index = self.scene.images.len() - 1;
-                self.pending.push_image(index, &path, (linear, false), (ctx.path, ctx.shared), at.clone());
+                let (images, file) = (&mut self.scene.images, (ctx.path, ctx.shared));
+                let index = self.pending.push_image(images, &path, (linear, false), file, at.clone());
                 let (us, vs) = (self.float(ctx, p, "uscale", 1.0)?, self.float(ctx, p, "vscale", 1.0)?);
                 if self.float(ctx, p, "udelta", 0.0)? != 0.0 || self.float(ctx, p, "vdelta", 0.0)? != 0.0 {
                     self.warn(ctx, at, "udelta/vdelta offsets are not supported; ignored");
