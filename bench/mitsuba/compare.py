@@ -43,6 +43,7 @@ def errors(img, ref):
 def alhazen_run(spp, out):
     """Wall time of one whole `alhazen render` process."""
     exe = os.path.join(ROOT, "target/release/alhazen")
+    suite.settle()
     t0 = time.perf_counter()
     subprocess.run([exe, "render", os.path.join(ROOT, "scenes/cornell-box.toml"), "-o", out,
                     "--spp", str(spp), "--quiet"], check=True)

@@ -24,6 +24,9 @@ os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM-1
 import numpy as np
 import mitsuba as mi
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import suite  # noqa: E402  (its `settle`: alhazen timed once Mitsuba is idle)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 EXE = os.environ.get("ALHAZEN", os.path.join(ROOT, "target/release/alhazen"))
 MATERIALS = [
@@ -126,6 +129,7 @@ def main():
 
     def ours(*extra):
         out = os.path.join(tmp, "ours" + "".join(extra) + ".exr")
+        suite.settle()
         t0 = time.perf_counter()
         subprocess.run([EXE, "render", path, "-o", out, "--spp", str(a.spp), "--quiet", *extra], check=True)
         return time.perf_counter() - t0, out
