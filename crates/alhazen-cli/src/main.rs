@@ -19,11 +19,6 @@ mod raster;
 mod render;
 mod view;
 
-/// Large blocks (a million-triangle mesh's BVH build, big textures) on huge pages: fewer page
-/// faults, the same results (`alhazen_render::memory`).
-#[global_allocator]
-static ALLOCATOR: alhazen_render::memory::LargePageAlloc = alhazen_render::memory::LargePageAlloc;
-
 #[derive(Parser)]
 #[command(name = "alhazen", version, about = "Mirrors, glass and line art: one scene, exact reflections.")]
 struct Cli {

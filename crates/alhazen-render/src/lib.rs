@@ -38,7 +38,6 @@ pub mod distribution;
 pub mod envmap;
 pub mod film;
 pub mod lights;
-pub mod memory;
 pub mod optics;
 pub mod output;
 pub mod path;
