@@ -766,6 +766,19 @@ impl ImageData {
         matches!(self.texels, Texels::Codes(_))
     }
 
+    /// Pixels `at` (row by row), as [`Self::texel`] reads each: a bilinear lookup's four,
+    /// the kind of storage matched once.
+    #[inline]
+    pub fn texels_at<const N: usize>(&self, at: [usize; N]) -> [[f32; 3]; N] {
+        match &self.texels {
+            Texels::Codes(c) => at.map(|i| {
+                let k = c.codes[i];
+                [c.tables[0][k[0] as usize], c.tables[1][k[1] as usize], c.tables[2][k[2] as usize]]
+            }),
+            Texels::Floats(p) => at.map(|i| p[i]),
+        }
+    }
+
     /// Pixel `i` (row by row), as texture lookups read it.
     #[inline]
     pub fn texel(&self, i: usize) -> [f32; 3] {

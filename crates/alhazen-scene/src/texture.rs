@@ -86,13 +86,13 @@ fn bilinear(img: &ImageData, uv: Vec2) -> Vec3 {
             k
         }
     };
-    let px = |i: i64, j: i64| {
-        let p = img.texel((wrap(j, h) * w + wrap(i, w)) as usize);
-        Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
-    };
     let (i, j) = (x0 as i64, y0 as i64);
-    let top = px(i, j) * (1.0 - fx) + px(i + 1, j) * fx;
-    let bottom = px(i, j + 1) * (1.0 - fx) + px(i + 1, j + 1) * fx;
+    let (left, right) = (wrap(i, w), wrap(i + 1, w));
+    let (upper, lower) = (wrap(j, h) * w, wrap(j + 1, h) * w);
+    let [a, b, c, d] = img.texels_at([upper + left, upper + right, lower + left, lower + right].map(|k| k as usize));
+    let v = |p: [f32; 3]| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+    let top = v(a) * (1.0 - fx) + v(b) * fx;
+    let bottom = v(c) * (1.0 - fx) + v(d) * fx;
     top * (1.0 - fy) + bottom * fy
 }
 
