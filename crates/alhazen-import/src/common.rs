@@ -6,7 +6,8 @@
 use crate::Warning;
 use alhazen_math::Transform;
 use alhazen_math::Vec3;
-use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
+use alhazen_scene::bsdf::{BsdfDesc, Ior};
+pub(crate) use alhazen_scene::bsdf::{eta_from_f0, ggx};
 use alhazen_scene::{Diagnostic, FresnelMode, Material, MaterialId, Rgb, Scene, SceneError, Shape, Texture};
 use std::collections::HashSet;
 use std::ops::Range;
@@ -91,23 +92,6 @@ pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb) -> Ma
     m.name = format!("{} (emitting)", m.name);
     m.emission = emission;
     add_material(scene, m)
-}
-
-/// Trowbridge–Reitz (GGX) microfacets with Smith shadowing, roughness `α` (clamped away from 0,
-/// where the distribution degenerates).
-pub(crate) fn ggx(alpha_u: f64, alpha_v: f64) -> Microfacets {
-    Microfacets {
-        distribution: Distribution::TrowbridgeReitz,
-        alpha_u: alpha_u.max(1e-3),
-        alpha_v: alpha_v.max(1e-3),
-        shadowing: Shadowing::Smith,
-    }
-}
-
-/// The real index `η` (with `κ = 0`) whose normal-incidence reflectance is `f0`.
-pub(crate) fn eta_from_f0(f0: Rgb) -> Rgb {
-    let r = f0.clamp(Vec3::ZERO, Vec3::splat(0.999)).powf(0.5);
-    (Vec3::ONE + r) / (Vec3::ONE - r)
 }
 
 /// The glTF 2.0 metallic–roughness model (also Mitsuba's `principled` and pbrt's

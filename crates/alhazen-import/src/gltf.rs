@@ -7,8 +7,9 @@
 //! top — indices; strips and fans unrolled), instanced by every node that uses it. Materials map
 //! through the metallic–roughness model (`common::metal_rough`): the base-colour texture and
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
-//! `KHR_materials_emissive_strength`; textured metallic–roughness and emission by their means, with
-//! a warning. `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the
+//! `KHR_materials_emissive_strength`; a metallic–roughness texture is read per point
+//! (`BsdfDesc::MetallicRoughness`, the model at each point), by its mean under transmission;
+//! an emission texture by its mean, with a warning. `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the
 //! 683 lm/W that Blender's exporter uses. The first camera met is the camera; without one the
 //! scene's bounds are framed from `+z`.
 
@@ -319,12 +320,6 @@ impl Importer<'_> {
             }
             None => (Texture::Solid(factor), factor),
         };
-        let (mut metallic, mut roughness) = (pbr.metallic_factor() as f64, pbr.roughness_factor() as f64);
-        if let Some(info) = pbr.metallic_roughness_texture() {
-            let mean = common::image_mean(&*self.image(&info.texture(), false)?);
-            (roughness, metallic) = (roughness * mean.y, metallic * mean.z);
-            self.warn(format!("{name}: the metallic-roughness texture is replaced by its mean (metallic {metallic:.3}, roughness {roughness:.3})"));
-        }
         let mut emission = rgb(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0) as f64;
         if let Some(info) = material.emissive_texture() {
             emission *= common::image_mean(&*self.image(&info.texture(), true)?);
@@ -341,6 +336,24 @@ impl Importer<'_> {
             t.transmission_factor() as f64
         });
         let ior = material.ior().unwrap_or(1.5) as f64;
+        let (mut metallic, mut roughness) = (pbr.metallic_factor() as f64, pbr.roughness_factor() as f64);
+        // The metallic-roughness texture is read per point (roughness in green, metalness in
+        // blue), except under transmission, whose glass the model mixes in by one weight.
+        let mut map = None;
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            let image = self.image(&info.texture(), false)?;
+            if transmission > 0.0 {
+                let mean = common::image_mean(&image);
+                (roughness, metallic) = (roughness * mean.y, metallic * mean.z);
+                self.warn(format!(
+                    "{name}: with transmission, the metallic-roughness texture is replaced by its mean (metallic {metallic:.3}, roughness {roughness:.3})"
+                ));
+            } else {
+                let scale = self.texture_scale(&info, &name);
+                self.scene.images.push(image);
+                map = Some((self.scene.images.len() - 1, scale));
+            }
+        }
         let bump = match material.normal_texture() {
             Some(nt) => {
                 if nt.tex_coord() != 0 {
@@ -368,14 +381,11 @@ impl Importer<'_> {
                 self.warn(format!("{name}: {ext} is not supported; ignored"));
             }
         }
-        let bsdf = common::metal_rough(
-            base,
-            base_mean,
-            metallic.clamp(0.0, 1.0),
-            roughness.clamp(0.0, 1.0),
-            ior,
-            transmission.clamp(0.0, 1.0),
-        );
+        let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
+        let bsdf = match map {
+            Some(_) => alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior },
+            None => common::metal_rough(base, base_mean, metallic, roughness, ior, transmission.clamp(0.0, 1.0)),
+        };
         let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
         m.emission = emission;
         m.bump = bump;

@@ -72,7 +72,7 @@ fn every_shipped_and_imported_scene_survives_the_round_trip_bit_for_bit() {
 }
 
 #[test]
-fn textures_bumps_environments_csg_and_spots_survive_the_round_trip() {
+fn textures_bumps_environments_csg_spots_and_metallic_roughness_maps_survive_the_round_trip() {
     let dir = tempfile::tempdir().unwrap();
     let png = image::RgbImage::from_fn(4, 2, |x, y| image::Rgb([(x * 60) as u8, (y * 200) as u8, 90]));
     png.save(dir.path().join("tex.png")).unwrap();
@@ -105,6 +105,13 @@ bump = { height = 0.7, normal_map = { file = "tex.png", scale = 2 } }
 bsdf = { type = "oren-nayar", color = { checker = { even = 0.9, odd = 0.2, size = 0.25 } }, sigma = 17 }
 [materials.glass]
 bsdf = { type = "dielectric", glass = "bk7", roughness = [0.1, 0.2], distribution = "beckmann" }
+[materials.worn]
+bsdf = { type = "metallic-roughness", color = { image = { file = "tex.png" } }, metallic = 0.8, roughness = 0.6, ior = 1.45, map = { file = "tex.png", scale = [2, 1] } }
+[[object]]
+shape = "sphere"
+center = [0, 1.6, 0]
+radius = 0.5
+material = "worn"
 [[object]]
 shape = "sphere"
 radius = 1
@@ -134,10 +141,12 @@ material = "glass"
     assert_eq!(a.images, b.images, "images are written as float EXR and read back exactly");
     assert_eq!(a.lights, b.lights);
     assert_eq!(a.background, b.background);
-    assert_eq!(a.objects[1].shape, b.objects[1].shape, "the CSG operands");
+    assert_eq!(a.objects[2].shape, b.objects[2].shape, "the CSG operands");
     let bumps = |s: &Scene| s.materials.iter().map(|m| m.bump.clone()).collect::<Vec<_>>();
     assert_eq!(bumps(&a).len(), bumps(&b).len());
-    assert!(a.objects[0].transform.point(Vec3::X) == b.objects[0].transform.point(Vec3::X));
+    assert!(a.objects[1].transform.point(Vec3::X) == b.objects[1].transform.point(Vec3::X));
+    let bsdfs = |s: &Scene| s.materials.iter().map(|m| m.bsdf.clone()).collect::<Vec<_>>();
+    assert_eq!(bsdfs(&a), bsdfs(&b), "images are numbered alike, so the maps' descriptions are equal");
     assert!(bits(a) == bits(b));
 }
 

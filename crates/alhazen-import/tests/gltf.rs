@@ -310,3 +310,77 @@ fn an_unreadable_image_is_an_error_only_where_the_scene_uses_it() {
     assert!(unused.contains("\"unused\"") && unused.contains("\"uri\": \"missing.png\""));
     check_scene(&write_and_import(&[("a.gltf", unused.into_bytes())]).expect("the missing image is used by no mesh"));
 }
+
+/// A metallic–roughness texture is read per point (roughness in its green channel, metalness
+/// in its blue, times the factors), linearly and without a warning; under transmission, whose
+/// glass the model mixes in by one weight, it is replaced by its mean, with a warning.
+#[test]
+fn a_metallic_roughness_texture_is_read_per_point() {
+    let doc = embedded().replace(
+        "\"metallicFactor\": 0, \"roughnessFactor\": 0.5 }",
+        "\"metallicFactor\": 0.8, \"roughnessFactor\": 0.5, \"metallicRoughnessTexture\": { \"index\": 0 } }",
+    );
+    assert!(doc.contains("metallicRoughnessTexture"));
+    let s = write_and_import(&[("a.gltf", doc.clone().into_bytes())]).unwrap();
+    let m = &s.scene.materials[s.scene.objects[0].material as usize];
+    let Some(BsdfDesc::MetallicRoughness { metallic, roughness, map: Some((image, scale)), base, .. }) = &m.bsdf else {
+        panic!("not a metallic-roughness map: {:?}", m.bsdf)
+    };
+    assert_eq!((*metallic, *roughness, *scale), (0.8f32 as f64, 0.5, Vec2::ONE), "glTF's f32 factors");
+    assert!(matches!(base, Texture::Image { .. }));
+    // The PNG's red and blue texels, not decoded as sRGB and not scaled by the base colour.
+    assert_eq!(s.scene.images[*image].texels().collect::<Vec<_>>(), vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
+    assert!(s.warnings.iter().all(|w| !w.to_string().contains("metallic-roughness")), "{:?}", s.warnings);
+    let glassy = doc.replace(
+        "\"name\": \"tex\",",
+        "\"name\": \"tex\", \"extensions\": { \"KHR_materials_transmission\": { \"transmissionFactor\": 0.5 } },",
+    );
+    assert!(glassy.contains("transmissionFactor"));
+    let s = write_and_import(&[("a.gltf", glassy.into_bytes())]).unwrap();
+    let m = &s.scene.materials[s.scene.objects[0].material as usize];
+    assert!(!matches!(m.bsdf, Some(BsdfDesc::MetallicRoughness { .. })), "{:?}", m.bsdf);
+    assert!(s.warnings.iter().any(|w| w.to_string().contains("replaced by its mean")), "{:?}", s.warnings);
+}
+
+/// A metallic–roughness map of ones renders the same bits as its factors alone: read per
+/// point, the material is the importer's constant one wherever the map leaves the factors as
+/// they are (a metal of 0.6 over a rough coating; a plain base colour).
+#[test]
+fn a_map_of_ones_renders_as_the_factors_alone() {
+    let white = {
+        let img = image::RgbImage::from_pixel(2, 2, image::Rgb([255, 255, 255]));
+        let mut out = std::io::Cursor::new(vec![]);
+        img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+        format!("data:image/png;base64,{}", base64(&out.into_inner()))
+    };
+    // The point light moved off the quad's plane, in front of it.
+    let plain = embedded()
+        .replace(
+            "\"baseColorTexture\": { \"index\": 0 }, \"metallicFactor\": 0, \"roughnessFactor\": 0.5",
+            "\"metallicFactor\": 0.6, \"roughnessFactor\": 0.5",
+        )
+        .replace("\"translation\": [0, 3, 0]", "\"translation\": [2, 1, 2]");
+    let mapped = plain
+        .replace("\"roughnessFactor\": 0.5", "\"roughnessFactor\": 0.5, \"metallicRoughnessTexture\": { \"index\": 1 }")
+        .replace("\"textures\": [{ \"source\": 0 }]", "\"textures\": [{ \"source\": 0 }, { \"source\": 1 }]")
+        .replace(" }],\n  \"buffers\"", &format!(" }}, {{ \"uri\": \"{white}\" }}],\n  \"buffers\""));
+    assert!(plain.contains("\"metallicFactor\": 0.6") && plain.contains("[2, 1, 2]") && mapped.contains(&white));
+    let render = |doc: &str| {
+        let mut s = write_and_import(&[("a.gltf", doc.as_bytes().to_vec())]).unwrap().scene;
+        (s.render.width, s.render.height, s.render.spp, s.render.integrator) =
+            (24, 12, 4, alhazen_scene::IntegratorKind::Path);
+        let material = &s.materials[s.objects[0].material as usize];
+        let mapped = matches!(material.bsdf, Some(BsdfDesc::MetallicRoughness { map: Some(_), .. }));
+        let img = alhazen_render::render(&s, &|_, _| {});
+        let bits: Vec<u64> = (0..img.height)
+            .flat_map(|y| (0..img.width).map(move |x| (x, y)))
+            .flat_map(|(x, y)| img.get(x, y).to_array())
+            .map(f64::to_bits)
+            .collect();
+        (mapped, bits)
+    };
+    let ((plain_mapped, plain), (mapped_mapped, mapped)) = (render(&plain), render(&mapped));
+    assert!(!plain_mapped && mapped_mapped);
+    assert!(plain.iter().any(|&b| f64::from_bits(b) > 0.0), "lit");
+    assert!(plain == mapped, "a map of ones changes the image");
+}

@@ -6,7 +6,7 @@
 
 use crate::model::{FresnelMode, Rgb, Texture};
 
-use alhazen_math::Vec3;
+use alhazen_math::{Vec2, Vec3};
 
 /// The microfacet normal distribution `D`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -183,6 +183,23 @@ pub enum BsdfDesc {
         /// Exact or Schlick.
         fresnel: FresnelMode,
     },
+    /// glTF 2.0's metallic–roughness material with its values read per point
+    /// ([`BsdfDesc::metallic_roughness_at`]): the base colour, and metallic and roughness as
+    /// their factors times the map's blue and green channels (read linearly), where there is
+    /// a map.
+    MetallicRoughness {
+        /// Base colour.
+        base: Texture,
+        /// Metalness factor.
+        metallic: f64,
+        /// Perceptual roughness factor (`α = roughness²`).
+        roughness: f64,
+        /// The metallic–roughness map: an image ([`crate::Scene::images`]) and its repeats per
+        /// texture unit in u and v.
+        map: Option<(usize, Vec2)>,
+        /// The coating's index of refraction.
+        ior: f64,
+    },
     /// `weight · a + (1 − weight) · b`.
     Mix {
         /// First BSDF.
@@ -249,9 +266,59 @@ impl crate::model::Material {
                 self.specular = Vec3::ONE;
                 self.shininess = 200.0;
             }
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, ior, .. } => {
+                // As the importers' material of these factors is followed: its metal where there
+                // is metal, else its coating, of colour `base`.
+                let (metal, coating) = metallic_roughness_lobes(Vec3::ONE, *roughness, *ior);
+                if *metallic > 0.0 {
+                    self.follow(&metal);
+                } else {
+                    self.follow(&coating);
+                    self.color = base.clone();
+                }
+            }
             BsdfDesc::Mix { a, .. } => self.follow(a),
         }
     }
+}
+
+/// The metal and the coating of [`BsdfDesc::metallic_roughness_at`].
+fn metallic_roughness_lobes(base: Rgb, roughness: f64, ior: f64) -> (BsdfDesc, BsdfDesc) {
+    let alpha = (roughness * roughness).clamp(0.0, 1.0);
+    let metal = BsdfDesc::Conductor {
+        facets: Some(ggx(alpha, alpha)),
+        eta: eta_from_f0(base),
+        k: Vec3::ZERO,
+        tint: Vec3::ONE,
+        fresnel: FresnelMode::Schlick,
+    };
+    let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+    let coating = BsdfDesc::CookTorrance {
+        albedo: Texture::Solid(base),
+        kd: 1.0 - f0,
+        ks: 1.0,
+        facets: ggx(alpha.max(0.01), alpha.max(0.01)),
+        ior,
+        fresnel: FresnelMode::Exact,
+    };
+    (metal, coating)
+}
+
+/// GGX microfacets with Smith shadowing, `α` clamped away from 0 (where the distribution
+/// degenerates) as imported materials have it.
+pub fn ggx(alpha_u: f64, alpha_v: f64) -> Microfacets {
+    Microfacets {
+        distribution: Distribution::TrowbridgeReitz,
+        alpha_u: alpha_u.max(1e-3),
+        alpha_v: alpha_v.max(1e-3),
+        shadowing: Shadowing::Smith,
+    }
+}
+
+/// The real index `η` (with `κ = 0`) whose normal-incidence reflectance is `f0`.
+pub fn eta_from_f0(f0: Rgb) -> Rgb {
+    let r = f0.clamp(Vec3::ZERO, Vec3::splat(0.999)).powf(0.5);
+    (Vec3::ONE + r) / (Vec3::ONE - r)
 }
 
 impl BsdfDesc {
@@ -265,8 +332,20 @@ impl BsdfDesc {
             | BsdfDesc::CookTorrance { albedo, .. }
             | BsdfDesc::Plastic { albedo, .. } => t(albedo),
             BsdfDesc::Mix { a, b, .. } => a.is_textured() || b.is_textured(),
+            BsdfDesc::MetallicRoughness { base, map, .. } => t(base) || map.is_some(),
             BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } => false,
         }
+    }
+
+    /// glTF 2.0's metallic–roughness model at a point of base colour `base`: a metal whose
+    /// normal-incidence reflectance is `base` (Schlick's term) mixed by `metallic` with
+    /// Cook–Torrance over Lambert (a coating of index `ior`), both on GGX facets of `α =
+    /// roughness²`. Every point has the same lobes — a mix even where `metallic` is 0 or 1,
+    /// facets of `α ≥ 10⁻³` even where `roughness` is 0 (the coating's `α ≥ 0.01`, as the
+    /// importers' constant materials) — so a surface's kind of BSDF never changes.
+    pub fn metallic_roughness_at(base: Rgb, metallic: f64, roughness: f64, ior: f64) -> BsdfDesc {
+        let (metal, coating) = metallic_roughness_lobes(base, roughness, ior);
+        BsdfDesc::Mix { a: Box::new(metal), b: Box::new(coating), weight: metallic.clamp(0.0, 1.0) }
     }
 
     /// True when some lobe turns with the surface's tangent: Blinn–Phong's scratches, or

@@ -263,7 +263,7 @@ impl Parser<'_> {
 
     /// `{ file = "x.png", scale = s or [u, v] }`: a repeated image (its index and scale); PNG and
     /// JPEG are sRGB unless `linear` (normal maps), EXR and HDR always linear.
-    fn image_texture(&mut self, i: &Node, linear: bool) -> R<(usize, Vec2)> {
+    pub(crate) fn image_texture(&mut self, i: &Node, linear: bool) -> R<(usize, Vec2)> {
         let i = i.table(&["file", "scale"])?;
         let file = i.req("file")?;
         let path = self.dir.join(file.str()?);

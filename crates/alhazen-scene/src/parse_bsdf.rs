@@ -29,6 +29,7 @@ impl Parser<'_> {
             "conductor",
             "dielectric",
             "mix",
+            "metallic-roughness",
         ])?;
         let keys: Vec<&str> = match kind {
             "lambert" => vec!["color"],
@@ -39,6 +40,7 @@ impl Parser<'_> {
             "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
+            "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior"],
             _ => vec!["a", "b", "weight"],
         };
         t.check_keys(&[&["type"][..], &keys].concat())?;
@@ -112,6 +114,14 @@ impl Parser<'_> {
                 }
             }
             "dielectric" => BsdfDesc::Dielectric { facets: microfacets(&t)?, ior: ior(&t)?, fresnel: fresnel(&t)? },
+            "metallic-roughness" => BsdfDesc::MetallicRoughness {
+                base: albedo,
+                metallic: t.get("metallic").map_or(Ok(0.0), |n| n.in_range(0.0, 1.0))?,
+                roughness: t.get("roughness").map_or(Ok(0.5), |n| n.in_range(0.0, 1.0))?,
+                // Read linearly, as glTF's metallic-roughness textures are.
+                map: t.get("map").map(|m| self.image_texture(&m, true)).transpose()?,
+                ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
+            },
             _ => BsdfDesc::Mix {
                 a: Box::new(self.bsdf(&t.req("a")?, &albedo)?),
                 b: Box::new(self.bsdf(&t.req("b")?, &albedo)?),

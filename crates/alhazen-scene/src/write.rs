@@ -424,6 +424,14 @@ impl Writer<'_> {
             BsdfDesc::Mix { a, b, weight } => {
                 format!("{{ type = \"mix\", a = {}, b = {}, weight = {} }}", self.bsdf(a), self.bsdf(b), num(*weight))
             }
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior } => format!(
+                "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{} }}",
+                self.texture(base),
+                num(*metallic),
+                num(*roughness),
+                num(*ior),
+                map.map_or(String::new(), |(image, scale)| format!(", map = {}", self.image(image, scale)))
+            ),
         }
     }
 

@@ -196,6 +196,43 @@ material = "lamp"
     assert_eq!(s.meshes[mesh].triangle_count(), 2);
 }
 
+/// glTF's metallic–roughness material: its defaults, its factors and map, and the same after
+/// writing the scene back out.
+#[test]
+fn metallic_roughness_reads_and_writes_back() {
+    use alhazen_scene::bsdf::BsdfDesc;
+    let dir = tempfile::tempdir().unwrap();
+    let png = image::RgbImage::from_fn(2, 2, |x, y| image::Rgb([0, (x * 200) as u8, (y * 255) as u8]));
+    png.save(dir.path().join("mr.png")).unwrap();
+    let text = r#"
+[materials.plain]
+bsdf = { type = "metallic-roughness" }
+[materials.worn]
+bsdf = { type = "metallic-roughness", color = [0.9, 0.6, 0.2], metallic = 1, roughness = 0.7, ior = 1.4, map = { file = "mr.png", scale = 2 } }
+"#;
+    let path = dir.path().join("mr.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let mat = |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().bsdf.clone();
+    let Some(BsdfDesc::MetallicRoughness { metallic, roughness, ior, map: None, .. }) = mat(&s, "plain") else {
+        panic!()
+    };
+    assert_eq!((metallic, roughness, ior), (0.0, 0.5, 1.5));
+    let Some(BsdfDesc::MetallicRoughness { metallic, roughness, map: Some((image, scale)), .. }) = mat(&s, "worn")
+    else {
+        panic!()
+    };
+    assert_eq!((metallic, roughness, scale), (1.0, 0.7, alhazen_math::Vec2::splat(2.0)));
+    // Read linearly: 200/255, not its sRGB decoding.
+    assert_eq!(s.images[image].texel(1), [0.0, 200.0 / 255.0, 0.0]);
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&again_path).unwrap();
+    for name in ["plain", "worn"] {
+        assert_eq!(mat(&s, name), mat(&again, name));
+    }
+}
+
 /// Plastic: smooth by default (Mitsuba's polypropylene coat), rough with a roughness, and the
 /// same after writing the scene back out.
 #[test]
@@ -238,6 +275,10 @@ fn physically_based_mistakes_are_explained() {
     assert!(m(r#"{ type = "plastic", ior = 1e300 }"#).contains("ior"));
     assert!(m(r#"{ type = "plastic", nonlinear = 1 }"#).contains("nonlinear"));
     assert!(m(r#"{ type = "dielectric", glass = "bk8" }"#).contains("did you mean \"bk7\"?"));
+    assert!(m(r#"{ type = "metallic-roughness", metallic = 1.5 }"#).contains("s.toml:2:"));
+    assert!(m(r#"{ type = "metallic-roughness", roughness = -0.1 }"#).contains("roughness"));
+    assert!(m(r#"{ type = "metallic-roughness", map = { file = "none.png" } }"#).contains("none.png"));
+    assert!(m(r#"{ type = "metallic-roughness", metalic = 0.5 }"#).contains("did you mean `metallic`?"));
     assert!(m(r#"{ type = "dielectric", cauchy = [1.5, -1] }"#).contains("index of refraction at 360 nm"));
     assert!(m(r#"{ type = "conductor", metal = "gold", eta = [1, 1, 1] }"#).contains("either `metal` or `eta`"));
     assert!(m(r#"{ type = "lambert", roughness = 0.1 }"#).contains("unknown key `roughness`"));

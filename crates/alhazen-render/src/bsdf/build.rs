@@ -36,9 +36,10 @@ impl ColorMode {
 
 /// The BSDF of `m` at texture coordinates `uv`.
 pub fn bsdf_at(m: &Material, uv: Vec2, images: &[Arc<ImageData>], mode: ColorMode) -> Bsdf {
-    let tex = |t: &alhazen_scene::Texture| mode.color(texture::eval(t, uv, images));
+    let rgb = |t: &alhazen_scene::Texture| texture::eval(t, uv, images);
+    let tex = |t: &alhazen_scene::Texture| mode.color(rgb(t));
     match &m.bsdf {
-        Some(desc) => from_desc(desc, &tex, mode),
+        Some(desc) => from_desc(desc, &Lookups { tex: &tex, rgb: &rgb }, mode),
         None => whitted_equivalent(m, &tex, mode),
     }
 }
@@ -69,7 +70,14 @@ fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec
     Bsdf::Mix(Box::new(Mix { a: mirror, b: lambert, weight: w }))
 }
 
-fn from_desc(desc: &BsdfDesc, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mode: ColorMode) -> Bsdf {
+/// A point's texture lookups: colours in the path's channels, and as stored (linear RGB).
+struct Lookups<'a> {
+    tex: &'a dyn Fn(&alhazen_scene::Texture) -> Vec3,
+    rgb: &'a dyn Fn(&alhazen_scene::Texture) -> Vec3,
+}
+
+fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
+    let tex = lookups.tex;
     match desc {
         BsdfDesc::Lambert { albedo } => Bsdf::Lambert(Lambert { albedo: tex(albedo) }),
         BsdfDesc::OrenNayar { albedo, sigma, interreflection } => {
@@ -109,7 +117,15 @@ fn from_desc(desc: &BsdfDesc, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec3, mod
             dispersive: ior.is_dispersive() && matches!(mode, ColorMode::Spectral(_)),
         }),
         BsdfDesc::Mix { a, b, weight } => {
-            Bsdf::Mix(Box::new(Mix { a: from_desc(a, tex, mode), b: from_desc(b, tex, mode), weight: *weight }))
+            Bsdf::Mix(Box::new(Mix { a: from_desc(a, lookups, mode), b: from_desc(b, lookups, mode), weight: *weight }))
+        }
+        BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior } => {
+            // glTF's map: roughness in its green channel, metalness in its blue.
+            let texel =
+                map.map_or(Vec3::ONE, |(image, scale)| (lookups.rgb)(&alhazen_scene::Texture::Image { image, scale }));
+            let at =
+                BsdfDesc::metallic_roughness_at((lookups.rgb)(base), metallic * texel.z, roughness * texel.y, *ior);
+            from_desc(&at, lookups, mode)
         }
     }
 }

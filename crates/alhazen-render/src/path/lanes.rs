@@ -1690,7 +1690,27 @@ shape = "sphere"
 center = [0.9, 1.5, -1.2]
 radius = 0.35
 material = { bsdf = { type = "mix", weight = 0.6, a = { type = "conductor", roughness = 0.2, distribution = "ggx", eta = [2.0, 1.6, 1.2], k = [0, 0, 0], fresnel = "schlick" }, b = { type = "cook-torrance", roughness = 0.3, distribution = "ggx", color = [0.3, 0.5, 0.2], kd = 0.96, ks = 1.0, ior = 1.5 } } }
+[[object]]
+name = "metallic-roughness"
+shape = "sphere"
+center = [-1.9, 2.1, -2.0]
+radius = 0.4
+material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0.8, color = { checker = { even = [0.9, 0.6, 0.2], odd = [0.3, 0.3, 0.35], size = 0.15 } } } }
 "#;
+
+    /// [`MIXED`] with its metallic–roughness sphere given a map (4 × 4 texels: roughness from
+    /// 0 to 1 along u in green, metalness 0, ½, 1 and 1 from the top row down in blue).
+    fn mixed_scene() -> alhazen_scene::Scene {
+        let mut scene = alhazen_scene::parse_scene("mixed.toml".as_ref(), MIXED).unwrap();
+        let texels = (0..16).map(|i| [0.0, (i % 4) as f32 / 3.0, [0.0, 0.5, 1.0, 1.0][i / 4]]).collect();
+        scene.images.push(std::sync::Arc::new(alhazen_scene::ImageData::new(4, 4, texels)));
+        let image = scene.images.len() - 1;
+        let material = scene.objects.iter().find(|o| o.name.as_deref() == Some("metallic-roughness")).unwrap().material;
+        let bsdf = scene.materials[material as usize].bsdf.as_mut();
+        let Some(alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { map, .. }) = bsdf else { panic!("{bsdf:?}") };
+        *map = Some((image, alhazen_math::Vec2::ONE));
+        scene
+    }
 
     /// Every sample of every pixel, `(in lanes, per path)`, in full precision, with `unit`'s
     /// kernels.
@@ -1734,7 +1754,7 @@ material = { bsdf = { type = "mix", weight = 0.6, a = { type = "conductor", roug
     #[test]
     fn lanes_match_the_per_path_tracer() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-        let mixed = alhazen_scene::parse_scene("mixed.toml".as_ref(), MIXED).unwrap();
+        let mixed = mixed_scene();
         // Two parallelogram lights: the vertices choose one.
         let text = std::fs::read_to_string(root.join("cornell-box.toml")).unwrap()
             + "[[object]]\nshape = \"rectangle\"\nmaterial = \"light\"\n\
@@ -1829,6 +1849,31 @@ material = { bsdf = { type = "mix", weight = 0.6, a = { type = "conductor", roug
         for k in MATERIAL_KERNELS {
             assert!(kernels.contains(&k), "{k:?}");
         }
+    }
+
+    /// A metallic–roughness map varies the BSDF from point to point — its metal's weight and
+    /// both lobes' roughness — and every point, the map's zeros and ones included, takes the
+    /// metallic–roughness kernel.
+    #[test]
+    fn a_metallic_roughness_map_varies_the_bsdf_and_keeps_its_kernel() {
+        let scene = mixed_scene();
+        let object = scene.objects.iter().find(|o| o.name.as_deref() == Some("metallic-roughness")).unwrap();
+        let m = &scene.materials[object.material as usize];
+        let (mut weights, mut alphas) = (std::collections::BTreeSet::new(), std::collections::BTreeSet::new());
+        // The texels' centres (read exactly), and points between them.
+        for i in 0..64 {
+            let uv = Vec2::new((i % 8 + 1) as f64 / 8.0, (i / 8 + 1) as f64 / 8.0);
+            let bsdf = crate::bsdf::bsdf_at(m, uv, &scene.images, ColorMode::Rgb);
+            assert_eq!(kernel_of(&bsdf, m), Kernel::MetallicRoughness, "{uv}");
+            let Bsdf::Mix(mix) = &bsdf else { panic!("{bsdf:?}") };
+            let Bsdf::Conductor(Conductor { facets: Some(f), .. }) = &mix.a else { panic!("{bsdf:?}") };
+            weights.insert(mix.weight.to_bits());
+            alphas.insert(f.alpha_u.to_bits());
+        }
+        // Metalness in blue (0, ½ and 1 times the factor 0.9), not green (thirds).
+        let metals = [0.0, 0.45, 0.9].map(|w: f64| weights.contains(&w.to_bits()));
+        assert!(metals.iter().all(|&m| m), "{weights:?}");
+        assert!(weights.len() >= 4 && alphas.len() >= 6 && alphas.contains(&1e-3f64.to_bits()), "{alphas:?}");
     }
 
     /// Each material kernel has a slot of its own among the batches' open ones.
