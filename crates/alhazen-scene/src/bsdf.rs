@@ -337,15 +337,15 @@ impl BsdfDesc {
         }
     }
 
-    /// glTF 2.0's metallic–roughness model at a point of base colour `base`: a metal whose
-    /// normal-incidence reflectance is `base` (Schlick's term) mixed by `metallic` with
-    /// Cook–Torrance over Lambert (a coating of index `ior`), both on GGX facets of `α =
-    /// roughness²`. Every point has the same lobes — a mix even where `metallic` is 0 or 1,
-    /// facets of `α ≥ 10⁻³` even where `roughness` is 0 (the coating's `α ≥ 0.01`, as the
+    /// glTF 2.0's metallic–roughness model at a point of base colour `base`, as the parts of a
+    /// mix: a metal whose normal-incidence reflectance is `base` (Schlick's term), its weight
+    /// `metallic`, and Cook–Torrance over Lambert (a coating of index `ior`), both on GGX facets
+    /// of `α = roughness²`. Every point has the same lobes — a mix even where `metallic` is 0
+    /// or 1, facets of `α ≥ 10⁻³` even where `roughness` is 0 (the coating's `α ≥ 0.01`, as the
     /// importers' constant materials) — so a surface's kind of BSDF never changes.
-    pub fn metallic_roughness_at(base: Rgb, metallic: f64, roughness: f64, ior: f64) -> BsdfDesc {
+    pub fn metallic_roughness_at(base: Rgb, metallic: f64, roughness: f64, ior: f64) -> (BsdfDesc, BsdfDesc, f64) {
         let (metal, coating) = metallic_roughness_lobes(base, roughness, ior);
-        BsdfDesc::Mix { a: Box::new(metal), b: Box::new(coating), weight: metallic.clamp(0.0, 1.0) }
+        (metal, coating, metallic.clamp(0.0, 1.0))
     }
 
     /// True when some lobe turns with the surface's tangent: Blinn–Phong's scratches, or

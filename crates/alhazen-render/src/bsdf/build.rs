@@ -123,9 +123,10 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel =
                 map.map_or(Vec3::ONE, |(image, scale)| (lookups.rgb)(&alhazen_scene::Texture::Image { image, scale }));
-            let at =
+            let (metal, coating, weight) =
                 BsdfDesc::metallic_roughness_at((lookups.rgb)(base), metallic * texel.z, roughness * texel.y, *ior);
-            from_desc(&at, lookups, mode)
+            let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
+            Bsdf::Mix(Box::new(Mix { a, b, weight }))
         }
     }
 }
