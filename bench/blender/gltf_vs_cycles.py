@@ -2,11 +2,19 @@
 """Blender's side of the glTF validation (issue 20): build a scene with Blender's Python module,
 export it as glTF 2.0 with Blender's own exporter, and render it with Cycles as the reference.
 
-    python3 bench/blender/gltf_vs_cycles.py OUT_DIR [--spp 4096] [--size 160x120]
+    python3 bench/blender/gltf_vs_cycles.py OUT_DIR [--spp 4096] [--size 160x120] [--maps]
 
 writes OUT_DIR/materials.glb (what a Blender user would hand alhazen) and
 OUT_DIR/materials-cycles.exr (Cycles, CPU, 2 threads, box pixel filter of one pixel, no
 denoiser, no adaptive sampling, light paths up to 8 bounces, no caustic filtering).
+`--maps` (session 43) gives the sphere a metallic–roughness map instead of its constant
+metal — one image, non-colour, its green channel to Roughness and blue to Metallic through a
+Separate Color node, which Blender's exporter writes as `metallicRoughnessTexture`: metal on
+the upper half of the texture, dielectric below, in eight stripes along u alternately rougher
+(0.4) and smoother (0.1) — and names the files materials-maps.glb and
+materials-maps-cycles.exr. (Rougher maps part the two renderers by Cycles' multiple-scattering
+GGX: a uniform roughness of 0.7 renders the metal 31 % brighter in red there, with or without a
+map, where single-scattering microfacets — ours, Mitsuba's — lose that light.)
 Needs `pip install bpy`. The committed copies live in crates/alhazen-import/tests/data/blender/
 and the test `blender_gltf_agrees_with_cycles` compares alhazen's image of the .glb with the EXR.
 """
@@ -25,7 +33,35 @@ def material(name, color, metallic, roughness):
     return m
 
 
-def build():
+def mapped_material(name, color, path):
+    """`color` with Roughness and Metallic read from a 64×64 map written to `path`."""
+    n = 64
+    img = bpy.data.images.new("metallic-roughness", n, n, alpha=False)
+    pixels = []
+    for y in range(n):  # Blender's rows run bottom to top, as texture v does
+        for x in range(n):
+            pixels += [0.0, 0.4 if (x // 8) % 2 == 0 else 0.1, 1.0 if y >= n // 2 else 0.0, 1.0]
+    img.pixels = pixels
+    img.filepath_raw = path
+    img.file_format = "PNG"
+    img.save()
+    img.colorspace_settings.name = "Non-Color"
+    m = material(name, color, 0.0, 0.5)
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    tex.interpolation = "Linear"
+    split = nodes.new("ShaderNodeSeparateColor")
+    links.new(tex.outputs["Color"], split.inputs["Color"])
+    p = nodes["Principled BSDF"]
+    links.new(split.outputs["Green"], p.inputs["Roughness"])
+    links.new(split.outputs["Blue"], p.inputs["Metallic"])
+    p.inputs["Roughness"].default_value = 1.0
+    p.inputs["Metallic"].default_value = 1.0
+    return m
+
+
+def build(maps_path=None):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     bpy.ops.mesh.primitive_plane_add(size=12, location=(0, 0, 0))
@@ -34,7 +70,11 @@ def build():
     bpy.context.object.data.materials.append(material("red", (0.7, 0.08, 0.06), 0.0, 0.6))
     bpy.ops.mesh.primitive_uv_sphere_add(segments=96, ring_count=48, radius=1, location=(1.3, -0.2, 1))
     bpy.ops.object.shade_smooth()
-    bpy.context.object.data.materials.append(material("gold", (1.0, 0.77, 0.34), 1.0, 0.35))
+    gold = (1.0, 0.77, 0.34)
+    if maps_path:
+        bpy.context.object.data.materials.append(mapped_material("gold", gold, maps_path))
+    else:
+        bpy.context.object.data.materials.append(material("gold", gold, 1.0, 0.35))
     bpy.ops.object.light_add(type="POINT", location=(1.5, -3.5, 5.0))
     light = bpy.context.object.data
     light.energy = 1500.0
@@ -90,14 +130,16 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=4096)
     ap.add_argument("--size", default="160x120")
+    ap.add_argument("--maps", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    scene = build()
+    stem = "materials-maps" if a.maps else "materials"
+    scene = build(os.path.join(os.path.abspath(a.out), "metallic-roughness.png") if a.maps else None)
     size = tuple(int(x) for x in a.size.split("x"))
     scene.render.resolution_x, scene.render.resolution_y = size
-    glb = os.path.join(a.out, "materials.glb")
+    glb = os.path.join(a.out, f"{stem}.glb")
     bpy.ops.export_scene.gltf(filepath=glb, export_format="GLB", export_lights=True, export_cameras=True, export_yup=True)
-    seconds = render(scene, os.path.join(os.path.abspath(a.out), "materials-cycles.exr"), a.spp, size)
+    seconds = render(scene, os.path.join(os.path.abspath(a.out), f"{stem}-cycles.exr"), a.spp, size)
     print(f"Cycles: {a.spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
 
 

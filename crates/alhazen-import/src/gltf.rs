@@ -7,9 +7,9 @@
 //! top — indices; strips and fans unrolled), instanced by every node that uses it. Materials map
 //! through the metallic–roughness model (`common::metal_rough`): the base-colour texture and
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
-//! `KHR_materials_emissive_strength`; a metallic–roughness texture is read per point
-//! (`BsdfDesc::MetallicRoughness`, the model at each point), by its mean under transmission;
-//! an emission texture by its mean, with a warning. `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the
+//! `KHR_materials_emissive_strength`; a metallic–roughness texture, and a textured metal's
+//! colour, are read per point (`BsdfDesc::MetallicRoughness`, the model at each point), by
+//! their means under transmission; an emission texture by its mean, with a warning. `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the
 //! 683 lm/W that Blender's exporter uses. The first camera met is the camera; without one the
 //! scene's bounds are framed from `+z`.
 
@@ -382,9 +382,13 @@ impl Importer<'_> {
             }
         }
         let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
-        let bsdf = match map {
-            Some(_) => alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior },
-            None => common::metal_rough(base, base_mean, metallic, roughness, ior, transmission.clamp(0.0, 1.0)),
+        // Per point where the map or a textured metal's colour varies (glTF's metal takes each
+        // texel's base colour), else the constant mix (and its glass under transmission).
+        let textured_metal = metallic > 0.0 && transmission <= 0.0 && !matches!(base, Texture::Solid(_));
+        let bsdf = if map.is_some() || textured_metal {
+            alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior }
+        } else {
+            common::metal_rough(base, base_mean, metallic, roughness, ior, transmission.clamp(0.0, 1.0))
         };
         let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
         m.emission = emission;
