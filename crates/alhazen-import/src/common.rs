@@ -106,24 +106,18 @@ pub(crate) fn metal_rough(
     ior: f64,
     transmission: f64,
 ) -> BsdfDesc {
+    // The model at a point of colour `base_mean`, its coating given the texture itself, its
+    // metal smooth where the roughness is below the facets' least `α` (a material with a
+    // single value need not keep the same lobes everywhere).
+    let (mut metal, mut plastic, _) = BsdfDesc::metallic_roughness_at(base_mean, metallic, roughness, ior);
     let alpha = (roughness * roughness).clamp(0.0, 1.0);
     let facets = (alpha > 1e-3).then(|| ggx(alpha, alpha));
-    let metal = BsdfDesc::Conductor {
-        facets,
-        eta: eta_from_f0(base_mean),
-        k: Vec3::ZERO,
-        tint: Vec3::ONE,
-        fresnel: FresnelMode::Schlick,
-    };
-    let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
-    let plastic = BsdfDesc::CookTorrance {
-        albedo: base,
-        kd: 1.0 - f0,
-        ks: 1.0,
-        facets: ggx(alpha.max(0.01), alpha.max(0.01)),
-        ior,
-        fresnel: FresnelMode::Exact,
-    };
+    if let BsdfDesc::Conductor { facets: f, .. } = &mut metal {
+        *f = facets;
+    }
+    if let BsdfDesc::CookTorrance { albedo, .. } = &mut plastic {
+        *albedo = base;
+    }
     let opaque = mix(metal, plastic, metallic);
     let glass = BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact };
     mix(glass, opaque, transmission * (1.0 - metallic))
