@@ -13,7 +13,8 @@ Mitsuba XML file that both renderers read as it is (so the twins are one file).
    and its BVHs —, the part that `mi.render` times; its default Sobol sampler,
    `ALHAZEN_SAMPLER=independent` for the files' own) against `mi.render` in Mitsuba
    `llvm_ad_rgb` (after one warm-up render, so the JIT is excluded; alhazen and llvm runs
-   alternate so the VM's drift hits both) and `scalar_rgb`.
+   alternate so the VM's drift hits both, each alhazen run started once Mitsuba's process has
+   gone idle, `settle`) and `scalar_rgb`.
 2. Equal time: alhazen renders with the most samples whose run (median of 3) fits in llvm's
    time; RMSE and mean relative error of both images against the committed reference
    (suite/ref/NAME.exr, Mitsuba llvm at 4096 spp), and the relative difference of the means of
