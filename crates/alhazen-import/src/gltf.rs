@@ -9,8 +9,9 @@
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
 //! `KHR_materials_emissive_strength`; a metallic–roughness texture, and a textured metal's
 //! colour, are read per point (`BsdfDesc::MetallicRoughness`, the model at each point), by
-//! their means under transmission; an emission texture by its mean, with a warning. `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the
-//! 683 lm/W that Blender's exporter uses. The first camera met is the camera; without one the
+//! their means under transmission; an emission texture by its mean, with a warning.
+//! `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the 683 lm/W
+//! that Blender's exporter uses. The first camera met is the camera; without one the
 //! scene's bounds are framed from `+z`.
 
 use crate::Imported;

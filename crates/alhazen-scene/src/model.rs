@@ -782,13 +782,7 @@ impl ImageData {
     /// Pixel `i` (row by row), as texture lookups read it.
     #[inline]
     pub fn texel(&self, i: usize) -> [f32; 3] {
-        match &self.texels {
-            Texels::Codes(c) => {
-                let k = c.codes[i];
-                [c.tables[0][k[0] as usize], c.tables[1][k[1] as usize], c.tables[2][k[2] as usize]]
-            }
-            Texels::Floats(p) => p[i],
-        }
+        self.texels_at([i])[0]
     }
 }
 

@@ -272,8 +272,7 @@ impl Parser<'_> {
                 path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
                 Some("exr" | "hdr" | "pfm")
             );
-        let data = if linear { import::load_hdr_image(&path) } else { import::load_image(&path) };
-        let data = data.map_err(|e| file.err(e))?;
+        // The scale is checked before the image is read.
         let scale = match i.get("scale") {
             Some(s) if s.is_table() => return Err(s.err("`scale`: expected a number or [u, v]")),
             Some(s) => match s.v {
@@ -282,6 +281,8 @@ impl Parser<'_> {
             },
             None => Vec2::ONE,
         };
+        let data = if linear { import::load_hdr_image(&path) } else { import::load_image(&path) };
+        let data = data.map_err(|e| file.err(e))?;
         self.scene.images.push(Arc::new(data));
         Ok((self.scene.images.len() - 1, scale))
     }

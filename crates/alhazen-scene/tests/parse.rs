@@ -277,6 +277,11 @@ fn physically_based_mistakes_are_explained() {
     assert!(m(r#"{ type = "dielectric", glass = "bk8" }"#).contains("did you mean \"bk7\"?"));
     assert!(m(r#"{ type = "metallic-roughness", metallic = 1.5 }"#).contains("s.toml:2:"));
     assert!(m(r#"{ type = "metallic-roughness", roughness = -0.1 }"#).contains("roughness"));
+    assert!(m(r#"{ type = "metallic-roughness", metallic = nan }"#).contains("expected a finite number"));
+    assert!(m(r#"{ type = "metallic-roughness", roughness = 1e300 }"#).contains("roughness"));
+    assert!(m(r#"{ type = "metallic-roughness", ior = 0.5 }"#).contains("must lie in [1, 10]"));
+    assert!(m(r#"{ type = "metallic-roughness", map = 3 }"#).contains("`map`: expected a table"));
+    assert!(m(r#"{ type = "metallic-roughness", map = { file = "mr.png", scale = 0 } }"#).contains("positive"));
     assert!(m(r#"{ type = "metallic-roughness", map = { file = "none.png" } }"#).contains("none.png"));
     assert!(m(r#"{ type = "metallic-roughness", metalic = 0.5 }"#).contains("did you mean `metallic`?"));
     assert!(m(r#"{ type = "dielectric", cauchy = [1.5, -1] }"#).contains("index of refraction at 360 nm"));

@@ -1705,11 +1705,17 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         let texels = (0..16).map(|i| [0.0, (i % 4) as f32 / 3.0, [0.0, 0.5, 1.0, 1.0][i / 4]]).collect();
         scene.images.push(std::sync::Arc::new(alhazen_scene::ImageData::new(4, 4, texels)));
         let image = scene.images.len() - 1;
-        let material = scene.objects.iter().find(|o| o.name.as_deref() == Some("metallic-roughness")).unwrap().material;
-        let bsdf = scene.materials[material as usize].bsdf.as_mut();
+        let material = mapped_material(&scene);
+        let bsdf = scene.materials[material].bsdf.as_mut();
         let Some(alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { map, .. }) = bsdf else { panic!("{bsdf:?}") };
         *map = Some((image, alhazen_math::Vec2::ONE));
         scene
+    }
+
+    /// The material of [`MIXED`]'s metallic–roughness sphere.
+    fn mapped_material(scene: &alhazen_scene::Scene) -> usize {
+        let object = scene.objects.iter().find(|o| o.name.as_deref() == Some("metallic-roughness")).unwrap();
+        object.material as usize
     }
 
     /// Every sample of every pixel, `(in lanes, per path)`, in full precision, with `unit`'s
@@ -1857,8 +1863,7 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
     #[test]
     fn a_metallic_roughness_map_varies_the_bsdf_and_keeps_its_kernel() {
         let scene = mixed_scene();
-        let object = scene.objects.iter().find(|o| o.name.as_deref() == Some("metallic-roughness")).unwrap();
-        let m = &scene.materials[object.material as usize];
+        let m = &scene.materials[mapped_material(&scene)];
         let (mut weights, mut alphas) = (std::collections::BTreeSet::new(), std::collections::BTreeSet::new());
         // The texels' centres (read exactly), and points between them.
         for i in 0..64 {
