@@ -288,6 +288,37 @@ impl PendingFiles {
         self.reads.push(PendingRead { path: path.to_path_buf(), what, file, span });
     }
 
+    /// Reads image `index` into `scene` now, if it is still pending (a texture replaced by its
+    /// mean needs its pixels before the walk ends); an error is located where the scene names
+    /// the file.
+    pub fn load_image_now(&mut self, scene: &mut Scene, index: usize) -> Result<(), SceneError> {
+        let Some(at) = self.reads.iter().position(|r| matches!(r.what, Read::Image { index: i, .. } if i == index))
+        else {
+            return Ok(());
+        };
+        let r = self.reads.remove(at);
+        let Read::Image { linear, rows_reversed, .. } = r.what else { unreachable!("found as an image") };
+        let image = if linear {
+            alhazen_scene::import::load_hdr_image(&r.path)
+        } else {
+            alhazen_scene::import::load_image(&r.path)
+        };
+        let image = image.map_err(|e| {
+            let (path, text) = &self.files[r.file];
+            located(path, text, r.span.clone(), e)
+        })?;
+        scene.images[index] = Arc::new(if rows_reversed { image.rows_reversed() } else { image });
+        Ok(())
+    }
+
+    /// The mean colour of `t` ([`texture_mean`]), its image read first if it is pending.
+    pub fn texture_mean(&mut self, t: &Texture, scene: &mut Scene) -> Result<Rgb, SceneError> {
+        if let Texture::Image { image, .. } = t {
+            self.load_image_now(scene, *image)?;
+        }
+        Ok(texture_mean(t, scene))
+    }
+
     /// Reads the files pushed, on all threads, into `scene`, each mesh given to `adjust` first;
     /// the first that cannot be read, in the order they were pushed, is the error, where the
     /// scene names it.

@@ -834,7 +834,7 @@ impl Importer {
             }
             "principled" => {
                 let base = self.color(ctx, &p, "base_color", Vec3::splat(0.8))?;
-                let mean = common::texture_mean(&base, &self.scene);
+                let mean = self.pending.texture_mean(&base, &mut self.scene)?;
                 let metallic = self.float(ctx, &p, "metallic", 0.0)?;
                 let roughness = self.float(ctx, &p, "roughness", 0.5)?;
                 let ior = self.float(ctx, &p, "eta", 1.5)?;
@@ -850,7 +850,7 @@ impl Importer {
                 if !matches!(w, Texture::Solid(_)) {
                     self.warn(ctx, node, "a textured blend weight is replaced by its mean");
                 }
-                let w = common::texture_mean(&w, &self.scene).x;
+                let w = self.pending.texture_mean(&w, &mut self.scene)?.x;
                 let kids: Vec<Node> = node
                     .children()
                     .filter(|c| matches!(c.tag_name().name(), "bsdf" | "ref") && c.attribute("name") != Some("weight"))
@@ -936,7 +936,7 @@ impl Importer {
             let n = self.prop(p, name).expect("read above");
             self.warn(ctx, n, format!("a textured `{name}` is replaced by its mean colour"));
         }
-        Ok(common::texture_mean(&t, &self.scene))
+        self.pending.texture_mean(&t, &mut self.scene)
     }
 
     fn named_metal(&mut self, ctx: &Ctx, node: Node, name: &str) -> (Vec3, Vec3) {

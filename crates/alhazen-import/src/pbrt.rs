@@ -772,7 +772,7 @@ impl Importer {
             let span = p.list.iter().find(|q| q.name == name).map_or(0..0, |q| q.span.clone());
             self.warn(ctx, &span, format!("a textured \"{name}\" is replaced by its mean colour"));
         }
-        Ok(common::texture_mean(&t, &self.scene))
+        self.pending.texture_mean(&t, &mut self.scene)
     }
 
     fn color_of(&mut self, ctx: &Ctx, q: &Param) -> R<Vec3> {

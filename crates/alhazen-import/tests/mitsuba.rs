@@ -438,3 +438,31 @@ fn bitmap_files_load_together_and_an_unreadable_one_is_located() {
     let err = load(&[bitmap("red.png"), later.into()].join("\n")).unwrap_err();
     assert!(err.contains("t.xml:3:") && !err.contains("cannot load image"), "{err}");
 }
+
+/// A texture the model holds constant is replaced by the mean of its image's pixels, read
+/// before the walk ends (not the placeholder that waits for the file, which is black); a
+/// missing file is still located at its texture.
+#[test]
+fn a_texture_replaced_by_its_mean_is_read_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = image::RgbImage::from_fn(2, 1, |x, _| image::Rgb(if x == 0 { [255, 0, 0] } else { [255, 255, 0] }));
+    png.save(dir.path().join("rg.png")).unwrap();
+    let metal = |file: &str| {
+        scene(&format!(
+            "<shape type=\"sphere\"><bsdf type=\"conductor\"><string name=\"material\" value=\"none\"/>\
+             <texture name=\"specular_reflectance\" type=\"bitmap\"><string name=\"filename\" value=\"{file}\"/>\
+             </texture></bsdf></shape>"
+        ))
+    };
+    let load = |text: String| {
+        std::fs::write(dir.path().join("t.xml"), text).unwrap();
+        alhazen_import::load(&dir.path().join("t.xml")).map_err(|e| e.to_string())
+    };
+    let s = load(metal("rg.png")).unwrap().scene;
+    match s.materials[s.objects[0].material as usize].bsdf.as_ref().unwrap() {
+        BsdfDesc::Conductor { tint, .. } => assert_eq!(*tint, Vec3::new(1.0, 0.5, 0.0)),
+        other => panic!("not a conductor: {other:?}"),
+    }
+    let err = load(metal("missing.png")).unwrap_err();
+    assert!(err.contains("t.xml:2:") && err.contains("cannot load image"), "{err}");
+}
