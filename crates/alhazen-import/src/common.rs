@@ -86,11 +86,12 @@ pub(crate) fn add_material(scene: &mut Scene, m: Material) -> MaterialId {
     (scene.materials.len() - 1) as MaterialId
 }
 
-/// `base` with `emission` added (a new material; `base` is shared by other objects).
-pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb) -> MaterialId {
+/// `base` with `emission` added, its `texture` where it varies (a new material; `base` is
+/// shared by other objects).
+pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb, texture: Option<Texture>) -> MaterialId {
     let mut m = scene.materials[base as usize].clone();
     m.name = format!("{} (emitting)", m.name);
-    m.emission = emission;
+    (m.emission, m.emission_texture) = (emission, texture);
     add_material(scene, m)
 }
 
@@ -170,17 +171,12 @@ pub(crate) fn named_ior(name: &str) -> Option<f64> {
 
 /// The mean colour of a texture (for parameters the model holds as constants).
 pub(crate) fn texture_mean(t: &Texture, scene: &Scene) -> Rgb {
-    match t {
-        Texture::Solid(c) => *c,
-        Texture::Checker { even, odd, .. } => (*even + *odd) * 0.5,
-        Texture::Image { image, .. } => image_mean(&scene.images[*image]),
-    }
+    alhazen_scene::texture::mean(t, &scene.images)
 }
 
 /// The mean of an image's pixels.
 pub(crate) fn image_mean(img: &alhazen_scene::ImageData) -> Rgb {
-    let sum = img.texels().fold(Vec3::ZERO, |s, p| s + Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-    sum / img.texel_count().max(1) as f64
+    alhazen_scene::texture::image_mean(img)
 }
 
 /// A point light's `cos^e` falloff that best stands for a smooth fall-off from full intensity

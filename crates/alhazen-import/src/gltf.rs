@@ -9,7 +9,8 @@
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
 //! `KHR_materials_emissive_strength`; a metallic–roughness texture, and a textured metal's
 //! colour, are read per point (`BsdfDesc::MetallicRoughness`, the model at each point), by
-//! their means under transmission; an emission texture by its mean, with a warning.
+//! their means under transmission; so is an emission texture (its factor and strength
+//! multiplied in).
 //! `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the 683 lm/W
 //! that Blender's exporter uses. The first camera met is the camera; without one the
 //! scene's bounds are framed from `+z`.
@@ -321,10 +322,17 @@ impl Importer<'_> {
             }
             None => (Texture::Solid(factor), factor),
         };
+        // The emissive texture is read per point, its factor and strength multiplied in.
         let mut emission = rgb(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0) as f64;
-        if let Some(info) = material.emissive_texture() {
-            emission *= common::image_mean(&*self.image(&info.texture(), true)?);
-            self.warn(format!("{name}: the emissive texture is replaced by its mean colour"));
+        let mut emission_texture = None;
+        if let Some(info) = material.emissive_texture()
+            && emission != Vec3::ZERO
+        {
+            let scale = self.texture_scale(&info, &name);
+            let img = scaled(self.image(&info.texture(), true)?, emission);
+            emission = common::image_mean(&img);
+            self.scene.images.push(img);
+            emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale });
         }
         let transmission = material.transmission().map_or(0.0, |t| {
             if t.transmission_texture().is_some() {
@@ -392,7 +400,7 @@ impl Importer<'_> {
             common::metal_rough(base, base_mean, metallic, roughness, ior, transmission.clamp(0.0, 1.0))
         };
         let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
-        m.emission = emission;
+        (m.emission, m.emission_texture) = (emission, emission_texture);
         m.bump = bump;
         let id = common::add_material(&mut self.scene, m);
         self.materials.insert(material.index(), id);

@@ -1148,7 +1148,13 @@ impl Importer {
                     if e.kind != "area" {
                         return Err(ctx.err(c, format!("a shape can only hold an `area` emitter, not `{}`", e.kind)));
                     }
-                    let radiance = self.constant_color(ctx, &e, "radiance", Vec3::ONE)?;
+                    // A textured radiance is read per point on meshes; other shapes shine its mean.
+                    let textured = self.color(ctx, &e, "radiance", Vec3::ONE)?;
+                    let radiance = if matches!(textured, Texture::Solid(_)) || !matches!(shape, Shape::Mesh { .. }) {
+                        (self.constant_color(ctx, &e, "radiance", Vec3::ONE)?, None)
+                    } else {
+                        (self.pending.texture_mean(&textured, &mut self.scene)?, Some(textured))
+                    };
                     self.unused(ctx, &e, "emitter");
                     emission = Some(radiance);
                 }
@@ -1157,13 +1163,13 @@ impl Importer {
         }
         // Mitsuba gives a shape without a BSDF a diffuse one of reflectance 0.5, and an emitting
         // shape one of reflectance 0: a bare light does not reflect.
-        let mut material = match (material, emission) {
+        let mut material = match (material, &emission) {
             (Some(m), _) => m,
             (None, None) => self.default_material(),
             (None, Some(_)) => self.black_material(),
         };
-        if let Some(e) = emission {
-            material = common::emissive(&mut self.scene, material, e);
+        if let Some((e, texture)) = emission {
+            material = common::emissive(&mut self.scene, material, e, texture);
         }
         self.unused(ctx, &p, "shape");
         let name = self.attr(ctx, node, "id")?;

@@ -1286,7 +1286,7 @@ impl Importer {
         self.unused(ctx, p, &format!("shape \"{kind}\""));
         let mut material = self.current_material();
         if let Some(area) = self.state.area.clone() {
-            material = common::emissive(&mut self.scene, material, area.radiance);
+            material = common::emissive(&mut self.scene, material, area.radiance, None);
         }
         let (shape, transform) = common::placed_sphere(shape, transform);
         self.emit(Object { name: None, shape, transform, material, mesh_materials: vec![] });

@@ -414,3 +414,41 @@ fn a_map_of_ones_renders_as_the_factors_alone() {
     assert!(plain.iter().any(|&b| f64::from_bits(b) > 0.0), "lit");
     assert!(plain == mapped, "a map of ones changes the image");
 }
+
+/// An emissive texture is read per point, its factor and strength multiplied in: seen
+/// straight on, the quad glows red on its left and blue on its right (the PNG's two texels),
+/// and the material's constant emission is their mean.
+#[test]
+fn an_emissive_texture_is_read_per_point() {
+    let extra = r#", "emissiveFactor": [1, 0.5, 1], "emissiveTexture": { "index": 0 },
+                     "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4 } }"#;
+    let json =
+        document(&format!(r#", "uri": "data:application/octet-stream;base64,{}""#, base64(&quad_buffer())), extra)
+            .replace(
+                r#""extensionsUsed": ["KHR_lights_punctual"]"#,
+                r#""extensionsUsed": ["KHR_materials_emissive_strength"]"#,
+            );
+    let s = write_and_import(&[("e.gltf", json.into_bytes())]).unwrap();
+    assert!(s.warnings.iter().all(|w| !w.to_string().contains("emissive")), "{:?}", s.warnings);
+    let mut sc = s.scene;
+    let m = &sc.materials[sc.objects[0].material as usize];
+    assert_eq!(m.emission, Vec3::new(2.0, 0.0, 2.0));
+    let Some(Texture::Image { image, scale }) = m.emission_texture else { panic!("{:?}", m.emission_texture) };
+    assert_eq!(
+        (sc.images[image].texels().collect::<Vec<_>>(), scale),
+        (vec![[4.0, 0.0, 0.0], [0.0, 0.0, 4.0]], Vec2::ONE)
+    );
+    sc.lights.clear();
+    sc.materials[sc.objects[0].material as usize].bsdf = Some(BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::ZERO) });
+    (sc.render.width, sc.render.height, sc.render.spp, sc.render.max_depth) = (16, 8, 16, 1);
+    sc.camera = CameraDesc::Perspective {
+        look: alhazen_scene::LookAt { eye: Vec3::new(2.0, 1.0, 3.0), target: Vec3::new(2.0, 1.0, 0.0), up: Vec3::Y },
+        opening: PerspectiveOpening::Fov { angle: 0.3, horizontal: false },
+    };
+    let img = alhazen_render::render(&sc, &|_, _| {});
+    // Pixels 3 and 12 see u ≈ 0.25 and 0.75, the two texels' centres (bilinear: a little of
+    // the other mixed in).
+    let (left, right) = (img.get(3, 4), img.get(12, 4));
+    assert!(left.x > 3.6 && left.z < 0.4 && left.y == 0.0, "{left}");
+    assert!(right.z > 3.6 && right.x < 0.4 && right.y == 0.0, "{right}");
+}

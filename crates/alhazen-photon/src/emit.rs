@@ -105,9 +105,9 @@ impl<'a> Emitter<'a> {
                 }
                 Emission { origin: *position, dir, power: *intensity * c.powf(*falloff) / pdf }
             }
-            PathLight::Area { radiance, .. } => {
-                let (origin, n, pdf_area) =
-                    self.lights.point_by_area(light, Vec2::new(rng.uniform(), rng.uniform()))?;
+            PathLight::Area { .. } => {
+                let point = self.lights.point_by_area(light, Vec2::new(rng.uniform(), rng.uniform()))?;
+                let (origin, n, pdf_area, radiance) = (point.p, point.n, point.pdf_area, point.radiance);
                 let (dir, pdf) = self.direction(origin, rng)?;
                 let cos = n.dot(dir);
                 if cos <= 0.0 {
@@ -116,7 +116,7 @@ impl<'a> Emitter<'a> {
                 Emission {
                     origin: origin + n * 1e-9 * (1.0 + origin.abs().max_element()),
                     dir,
-                    power: *radiance * cos / (pdf_area * pdf),
+                    power: radiance * cos / (pdf_area * pdf),
                 }
             }
             PathLight::Directional { direction, irradiance } => {

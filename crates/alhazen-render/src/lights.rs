@@ -8,8 +8,9 @@ use crate::distribution::Distribution1D;
 use crate::envmap::EnvMap;
 use crate::shape::VectorUnit;
 use alhazen_math::{Vec2, Vec3, orthonormal_basis};
-use alhazen_scene::{Background, Light, Scene, Shape};
+use alhazen_scene::{Background, ImageData, Light, Scene, Shape, Texture};
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// Geometry of an area light, in world space.
 #[derive(Clone, Debug)]
@@ -104,13 +105,60 @@ pub enum PathLight {
     Area {
         /// Geometry.
         emitter: Emitter,
-        /// Radiance from the front side.
+        /// Radiance from the front side (with a `texture`, its mean).
         radiance: Vec3,
+        /// The radiance point by point, where it varies (on triangles only).
+        texture: Option<Box<AreaTexture>>,
     },
     /// An environment map.
     Environment(Box<EnvMap>),
     /// A solid or gradient background.
     Background(Background),
+}
+
+/// An area light's radiance point by point: its texture, the scene's images, and each
+/// triangle's texture coordinates (in the order of [`Emitter::Triangles`]' corners).
+#[derive(Clone, Debug)]
+pub struct AreaTexture {
+    texture: Texture,
+    images: Vec<Arc<ImageData>>,
+    uvs: Vec<[Vec2; 3]>,
+}
+
+impl AreaTexture {
+    /// The radiance at barycentric weights `b` of triangle `i`.
+    #[inline]
+    fn radiance(&self, (i, b): (usize, [f64; 3])) -> Vec3 {
+        let [a, c, d] = self.uvs[i];
+        alhazen_scene::texture::eval(&self.texture, a * b[0] + c * b[1] + d * b[2], &self.images)
+    }
+}
+
+/// The radiance a scene object's material emits at texture coordinates `uv`, as the lights
+/// see it: a textured emission is read per point on meshes, other shapes shine its mean.
+#[inline]
+pub fn emission_at(scene: &Scene, material: u32, object: u32, uv: Vec2) -> Vec3 {
+    let m = &scene.materials[material as usize];
+    match &m.emission_texture {
+        Some(t) if matches!(scene.objects[object as usize].shape, Shape::Mesh { .. }) => {
+            alhazen_scene::texture::eval(t, uv, &scene.images)
+        }
+        _ => m.emission,
+    }
+}
+
+/// A point drawn on an area light by area: where, its emitting side's unit normal, the area
+/// density, and the radiance it sends.
+#[derive(Clone, Copy, Debug)]
+pub struct AreaPoint {
+    /// The point.
+    pub p: Vec3,
+    /// Unit normal of the emitting side.
+    pub n: Vec3,
+    /// Density per unit area.
+    pub pdf_area: f64,
+    /// Radiance emitted there.
+    pub radiance: Vec3,
 }
 
 /// An environment map's sample ([`EnvMap::sample`]) as a light sample.
@@ -157,16 +205,34 @@ pub struct Lights {
     has_environment: bool,
 }
 
+/// The world-space triangles of an emitting mesh object whose radiance is `texture`, with
+/// their texture coordinates (never a parallelogram: its two triangles' coordinates may differ).
+fn textured_emitter_of(scene: &Scene, o: &alhazen_scene::Object, texture: &Texture) -> Option<(Emitter, AreaTexture)> {
+    let Shape::Mesh { mesh, .. } = &o.shape else { return None };
+    let m = &scene.meshes[*mesh];
+    let mirroring = o.transform.is_mirroring();
+    let indices: Vec<[u32; 3]> = m.triangles.iter().map(|&tri| outside_first(tri, mirroring)).collect();
+    let uv = |i: u32| m.uvs.get(i as usize).copied().unwrap_or(Vec2::ZERO);
+    let uvs = indices.iter().map(|tri| tri.map(uv)).collect();
+    let tris: Vec<[Vec3; 3]> =
+        indices.iter().map(|tri| tri.map(|i| o.transform.point(m.positions[i as usize]))).collect();
+    let emitter = triangles_emitter(tris)?;
+    Some((emitter, AreaTexture { texture: texture.clone(), images: scene.images.clone(), uvs }))
+}
+
+/// Triangles chosen by area, when they have any.
+fn triangles_emitter(tris: Vec<[Vec3; 3]>) -> Option<Emitter> {
+    let areas: Vec<f64> = tris.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
+    let area: f64 = areas.iter().sum();
+    (area > 0.0).then(|| Emitter::Triangles { triangles: tris, by_area: Distribution1D::new(&areas), area })
+}
+
 /// The world-space geometry of an emitting object, when it can be sampled.
 fn emitter_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<Emitter> {
     let t = &o.transform;
     let similarity = || t.similarity_scale();
     let mirroring = t.is_mirroring();
-    let triangles = |tris: Vec<[Vec3; 3]>| {
-        let areas: Vec<f64> = tris.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
-        let area: f64 = areas.iter().sum();
-        (area > 0.0).then(|| Emitter::Triangles { triangles: tris, by_area: Distribution1D::new(&areas), area })
-    };
+    let triangles = triangles_emitter;
     match &o.shape {
         Shape::Sphere { center, radius } => {
             similarity().map(|s| Emitter::Sphere { center: t.point(*center), radius: radius * s })
@@ -246,13 +312,19 @@ impl Lights {
         }
         let mut by_object = vec![None; scene.objects.len()];
         for (i, o) in scene.objects.iter().enumerate() {
-            let radiance = scene.materials[o.material as usize].emission;
+            let m = &scene.materials[o.material as usize];
+            let radiance = m.emission;
             if radiance == Vec3::ZERO {
                 continue;
             }
-            if let Some(emitter) = emitter_of(scene, o) {
+            let textured = m.emission_texture.as_ref().and_then(|t| textured_emitter_of(scene, o, t));
+            let light = match textured {
+                Some((emitter, t)) => Some(PathLight::Area { emitter, radiance, texture: Some(Box::new(t)) }),
+                None => emitter_of(scene, o).map(|emitter| PathLight::Area { emitter, radiance, texture: None }),
+            };
+            if let Some(light) = light {
                 by_object[i] = Some(lights.len() as u32);
-                lights.push(PathLight::Area { emitter, radiance });
+                lights.push(light);
             }
         }
         let has_environment = lights.iter().any(|l| matches!(l, PathLight::Environment(_)));
@@ -367,9 +439,13 @@ impl Lights {
 
     /// A point of area light `light` chosen uniformly by area (not including the light choice):
     /// the point, its emitting normal and the area density; `None` for other lights.
-    pub fn point_by_area(&self, light: usize, u: Vec2) -> Option<(Vec3, Vec3, f64)> {
+    pub fn point_by_area(&self, light: usize, u: Vec2) -> Option<AreaPoint> {
         match &self.lights[light] {
-            PathLight::Area { emitter, .. } => Some(point_by_area(emitter, u)),
+            PathLight::Area { emitter, radiance, texture } => {
+                let (p, n, pdf_area, at) = point_by_area(emitter, u);
+                let radiance = texture.as_ref().map_or(*radiance, |t| t.radiance(at));
+                Some(AreaPoint { p, n, pdf_area, radiance })
+            }
             _ => None,
         }
     }
@@ -483,7 +559,7 @@ impl Lights {
                 let radiance = b.radiance(dir);
                 Some(LightSample { dir, dist: f64::INFINITY, radiance, pdf: 1.0 / (4.0 * PI), delta: false })
             }
-            PathLight::Area { emitter, radiance } => sample_area(emitter, *radiance, p, u),
+            PathLight::Area { emitter, radiance, texture } => sample_area(emitter, *radiance, texture.as_deref(), p, u),
         }
     }
 }
@@ -500,15 +576,20 @@ fn cone(p: Vec3, center: Vec3, radius: f64) -> Option<(Vec3, f64)> {
     Some((to / d2.sqrt(), sin2 / (1.0 + cos)))
 }
 
+/// Which triangle of an emitter a point lies on, and its barycentric weights there.
+type OnTriangle = (usize, [f64; 3]);
+
 /// A point on an emitter chosen uniformly by area: the point, its unit normal (the emitting
-/// side) and the area density. Always inlined: the connections call it too, and sampling a
-/// light for next-event estimation must not pay a call for it.
+/// side), the area density, and the triangle it lies on (triangles only; else the first,
+/// unused). Always inlined: the connections call it too, and sampling a light for next-event
+/// estimation must not pay a call for it.
 #[inline(always)]
-fn point_by_area(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f64) {
+fn point_by_area(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f64, OnTriangle) {
+    let nowhere = (0, [1.0, 0.0, 0.0]);
     match emitter {
         Emitter::Sphere { center, radius } => {
             let n = uniform_sphere(u);
-            (*center + n * *radius, n, 1.0 / (4.0 * PI * radius * radius))
+            (*center + n * *radius, n, 1.0 / (4.0 * PI * radius * radius), nowhere)
         }
         Emitter::Triangles { triangles, by_area, area } => {
             let (x, _, i) = by_area.sample_continuous(u.x);
@@ -516,24 +597,31 @@ fn point_by_area(emitter: &Emitter, u: Vec2) -> (Vec3, Vec3, f64) {
             let [a, b, c] = triangles[i];
             let su = ux.clamp(0.0, 1.0).sqrt();
             let (b0, b1) = (1.0 - su, u.y * su);
-            let q = a * b0 + b * b1 + c * (1.0 - b0 - b1);
-            (q, (b - a).cross(c - a).normalize_or_zero(), 1.0 / area)
+            let b2 = 1.0 - b0 - b1;
+            let q = a * b0 + b * b1 + c * b2;
+            (q, (b - a).cross(c - a).normalize_or_zero(), 1.0 / area, (i, [b0, b1, b2]))
         }
         Emitter::Parallelogram { origin, e1, e2, normal, area } => {
-            (*origin + *e1 * u.x + *e2 * u.y, *normal, 1.0 / area)
+            (*origin + *e1 * u.x + *e2 * u.y, *normal, 1.0 / area, nowhere)
         }
         Emitter::Disk { center, normal, radius } => {
             let (s, t) = orthonormal_basis(*normal);
             let r = radius * u.x.sqrt();
             let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
-            (*center + (s * cos + t * sin) * r, *normal, 1.0 / (PI * radius * radius))
+            (*center + (s * cos + t * sin) * r, *normal, 1.0 / (PI * radius * radius), nowhere)
         }
     }
 }
 
 /// A point on an area light: the direction, distance, radiance (0 from its back) and density.
 #[inline(always)]
-fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<LightSample> {
+fn sample_area(
+    emitter: &Emitter,
+    radiance: Vec3,
+    texture: Option<&AreaTexture>,
+    p: Vec3,
+    u: Vec2,
+) -> Option<LightSample> {
     if let Emitter::Sphere { center, radius } = emitter
         && let Some((axis, one_minus_cos)) = cone(p, *center, *radius)
     {
@@ -549,7 +637,7 @@ fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<Li
         let pdf = 1.0 / (2.0 * PI * one_minus_cos);
         return Some(LightSample { dir, dist, radiance, pdf, delta: false });
     }
-    let (q, n, pdf_area) = point_by_area(emitter, u);
+    let (q, n, pdf_area, at) = point_by_area(emitter, u);
     let to = q - p;
     let d2 = to.length_squared();
     let dist = d2.sqrt();
@@ -561,5 +649,6 @@ fn sample_area(emitter: &Emitter, radiance: Vec3, p: Vec3, u: Vec2) -> Option<Li
     if cos <= 0.0 {
         return None; // the back of a one-sided emitter
     }
+    let radiance = texture.map_or(radiance, |t| t.radiance(at));
     Some(LightSample { dir, dist, radiance, pdf: pdf_area * d2 / cos, delta: false })
 }

@@ -247,7 +247,7 @@ impl<'a> Whitted<'a> {
             color += self.through_mirrors(&at, wh.object);
         }
         if front {
-            color += ch.c(m.emission);
+            color += ch.c(crate::lights::emission_at(self.scene, wh.material, wh.object, h.uv));
         }
         if depth < self.max_depth {
             let dispersion = self.dispersion[wh.material as usize].as_ref();
@@ -297,8 +297,8 @@ impl<'a> Whitted<'a> {
                 if s.pdf.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                     continue;
                 }
-                let reach = s.dist * (1.0 - 1e-7) - 4.0 * ray_epsilon(p + s.dir * s.dist);
-                let through = self.transmittance(at.origin(), s.dir, reach, at.ch);
+                let (from, toward, reach) = crate::path::shadow_segment(p, at.ng, s.dir, s.dist, p + s.dir * s.dist);
+                let through = self.transmittance(from, toward, reach, at.ch);
                 if through == Vec3::ZERO {
                     continue;
                 }
@@ -343,13 +343,13 @@ impl<'a> Whitted<'a> {
     /// What passes both legs of a mirror path: `p → m` short of the mirror, `m → light`.
     fn legs_transmittance(&self, p: Vec3, ng: Vec3, path: &MirrorPath, ch: Channels) -> Vec3 {
         let m = path.point;
-        let to_mirror = path.dist_to_mirror * (1.0 - 1e-7) - 4.0 * ray_epsilon(m);
-        let first = self.transmittance(p + ng * ray_epsilon(p), path.to_mirror, to_mirror, ch);
+        let (from, toward, reach) = crate::path::shadow_segment(p, ng, path.to_mirror, path.dist_to_mirror, m);
+        let first = self.transmittance(from, toward, reach, ch);
         if first == Vec3::ZERO {
             return first;
         }
-        let to_light = path.dist_to_source * (1.0 - 1e-7) - 4.0 * ray_epsilon(m);
-        first * self.transmittance(m + path.normal * ray_epsilon(m), path.to_source, to_light, ch)
+        let (from, toward, reach) = crate::path::shadow_segment(m, path.normal, path.to_source, path.dist_to_source, m);
+        first * self.transmittance(from, toward, reach, ch)
     }
 
     /// How much light passes from `origin` along `l` over `dist`: 0 at an opaque surface; at a

@@ -226,12 +226,13 @@ fn build_shape(s: &scene::Shape, meshes: &[Arc<MeshAccel>]) -> Shape {
 }
 
 /// True when some material of the object looks at texture coordinates (a texture, a bump map,
-/// a textured BSDF).
+/// a textured emission or BSDF).
 fn uses_uv(o: &scene::Object, s: &scene::Scene) -> bool {
     std::iter::once(&o.material).chain(&o.mesh_materials).any(|&m| {
         let m = &s.materials[m as usize];
         !matches!(m.color, scene::Texture::Solid(_))
             || m.bump.is_some()
+            || m.emission_texture.is_some()
             || m.bsdf.as_ref().is_some_and(|b| b.is_textured())
     })
 }

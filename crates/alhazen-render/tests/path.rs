@@ -245,3 +245,45 @@ material = "card"
     assert_eq!(scene(false, -1.0), front, "the front does not depend on the flag");
     assert_eq!(scene(false, 1.0), front, "two-sided, the back is shaded as the front");
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+    /// A point that sees an area light's front, however grazing (down to a cosine of 0.02 at
+    /// the light), finds every light point it samples unshadowed by the light itself: its shadow
+    /// segment is aimed from its moved origin at the point (aimed along the sampled direction,
+    /// it cut the light's plane short of the point: a floor beside a tilted lamp went dark).
+    #[test]
+    fn shadow_segments_reach_their_light_at_grazing_angles(
+        tilt in -80.0..80.0f64, turn in 0.0..360.0f64, (sx, sy) in (0.2..3.0f64, 0.2..3.0f64),
+        along in -6.0..6.0f64, across in -6.0..6.0f64, cos_light in 0.02..0.3f64, far in 0.5..8.0f64,
+        (nx, ny, nz) in (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64), u in (0.0..1.0f64, 0.0..1.0f64),
+    ) {
+        let text = format!(
+            r#"
+[materials.lamp]
+emission = [1, 1, 1]
+[[object]]
+shape = "rectangle"
+material = "lamp"
+transform = [{{ scale = [{sx}, {sy}, 1] }}, {{ rotate_x = {tilt} }}, {{ rotate_y = {turn} }}, {{ translate = [0.3, 1.2, -0.7] }}]
+"#
+        );
+        let scene = parse_scene("lamp.toml".as_ref(), &text).unwrap();
+        let (world, lights) = (alhazen_render::world::World::build(&scene), alhazen_render::lights::Lights::build(&scene));
+        let o = &scene.objects[0].transform;
+        let (centre, normal) = (o.point(Vec3::ZERO), o.normal(Vec3::Z).normalize());
+        let (s, t) = alhazen_math::orthonormal_basis(normal);
+        // A point seen from the light's centre at `cos_light` off its plane, `far` away.
+        let side = (s * along + t * across).normalize_or(s);
+        let sin = (1.0 - cos_light * cos_light).sqrt();
+        let p = centre + (side * sin + normal * cos_light) * (far + sx.max(sy));
+        let ls = lights.sample(p, 0.5, alhazen_math::Vec2::new(u.0, u.1));
+        proptest::prop_assume!(ls.is_some());
+        let ls = ls.unwrap();
+        // A receiving surface whose normal faces the light point.
+        let ng = Vec3::new(nx, ny, nz).normalize_or(ls.dir);
+        let ng = if ng.dot(ls.dir) < 0.0 { -ng } else { ng };
+        let (origin, dir, dist) = alhazen_render::path::shadow_segment(p, ng, ls.dir, ls.dist, p);
+        proptest::prop_assert!(world.unoccluded(origin, dir, dist), "p {p}, dir {}, cos at the light {}", ls.dir, -normal.dot(ls.dir));
+    }
+}

@@ -479,7 +479,13 @@ pub struct Material {
     /// Fresnel treatment of transparent surfaces.
     pub fresnel: FresnelMode,
     /// Radiance emitted from the front side: a non-zero value makes the object an area light.
+    /// With an [`Self::emission_texture`], its mean over the texture (what the preview, the
+    /// radiosity solver and the choice of photons' lights use).
     pub emission: Rgb,
+    /// Radiance emitted point by point, where it varies (an image or a checker, already scaled
+    /// by its strength); `None`: `emission` everywhere. The path and Whitted tracers read it per
+    /// point on meshes; other shapes shine `emission`.
+    pub emission_texture: Option<Texture>,
     /// The scattering function for the path tracer; `None` derives one from the Whitted
     /// coefficients (see [`crate::bsdf`]).
     pub bsdf: Option<crate::bsdf::BsdfDesc>,
@@ -544,6 +550,7 @@ impl Default for Material {
             absorption: Vec3::ZERO,
             fresnel: FresnelMode::Exact,
             emission: Vec3::ZERO,
+            emission_texture: None,
             bsdf: None,
             bump: None,
             one_sided: false,

@@ -227,6 +227,10 @@ impl Parser<'_> {
         // The Whitted and preview coefficients not given follow the BSDF.
         let d = bsdf.clone().map_or(plain, |b| Material::from_bsdf(name, b));
         let color = given.unwrap_or_else(|| d.color.clone());
+        let (emission, emission_texture) = match t.get("emission") {
+            Some(e) => self.emission(&e)?,
+            None => (d.emission, None),
+        };
         Ok(Material {
             name: name.to_string(),
             color,
@@ -254,7 +258,8 @@ impl Parser<'_> {
             },
             anisotropy: t.get("anisotropy").map_or(Ok(d.anisotropy), |n| n.in_range(1e-3, 1.0))?,
             scratches: t.get("scratches").map_or(Ok(d.scratches), |n| n.unit_vec3())?,
-            emission: t.opt_rgb("emission", d.emission)?,
+            emission,
+            emission_texture,
             bsdf,
             bump: t.get("bump").map(|b| self.bump(&b)).transpose()?,
             one_sided: t.opt_bool("one_sided", false)?,
@@ -331,6 +336,45 @@ impl Parser<'_> {
             return Ok(Texture::Image { image, scale });
         }
         Err(n.err("`color`: expected a colour, { hsv = [h, s, v] }, { hsl = [h, s, l] }, { checker = {...} } or { image = {...} }"))
+    }
+
+    /// `emission = [r, g, b]`, or a texture whose colours are multiplied by `strength` (a
+    /// number or a colour, 1 by default): `{ image = {...}, strength = s }` or
+    /// `{ checker = {...}, strength = s }`. The mean radiance, and the texture where it varies.
+    fn emission(&mut self, n: &Node) -> R<(Vec3, Option<Texture>)> {
+        let t = match n.is_table() {
+            true => n.table(&["hsv", "hsl", "checker", "image", "strength"])?,
+            false => return Ok((n.rgb()?, None)),
+        };
+        if t.get("hsv").is_some() || t.get("hsl").is_some() {
+            return Ok((n.rgb()?, None));
+        }
+        // Numbers are within ±1e100, so products of two stay finite.
+        let strength = t.opt_rgb("strength", Vec3::ONE)?;
+        let texture = match (t.get("checker"), t.get("image")) {
+            (Some(c), None) => {
+                let c = c.table(&["even", "odd", "size"])?;
+                Texture::Checker {
+                    even: c.opt_rgb("even", Vec3::splat(0.9))? * strength,
+                    odd: c.opt_rgb("odd", Vec3::splat(0.1))? * strength,
+                    size: c.get("size").map_or(Ok(1.0), |n| n.positive())?,
+                }
+            }
+            (None, Some(i)) => {
+                let (image, scale) = self.image_texture(&i, false)?;
+                if strength != Vec3::ONE {
+                    let factor = strength.as_vec3().to_array();
+                    self.scene.images[image] = Arc::new(self.scene.images[image].channels_scaled(factor));
+                }
+                Texture::Image { image, scale }
+            }
+            _ => {
+                return Err(n.err(
+                    "`emission`: expected a colour, { image = {...}, strength = s } or { checker = {...}, strength = s }",
+                ));
+            }
+        };
+        Ok((crate::texture::mean(&texture, &self.scene.images), Some(texture)))
     }
 
     fn material_ref(&mut self, n: &Node, object_name: &str) -> R<MaterialId> {

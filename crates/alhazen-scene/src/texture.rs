@@ -16,6 +16,22 @@ pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Ve
     }
 }
 
+/// The mean colour of `tex` over its texture space: an image's pixels' mean, a checker's two
+/// colours' mean.
+pub fn mean(tex: &Texture, images: &[std::sync::Arc<ImageData>]) -> Vec3 {
+    match tex {
+        Texture::Solid(c) => *c,
+        Texture::Checker { even, odd, .. } => (*even + *odd) * 0.5,
+        Texture::Image { image, .. } => image_mean(&images[*image]),
+    }
+}
+
+/// The mean of an image's pixels.
+pub fn image_mean(img: &ImageData) -> Vec3 {
+    let sum = img.texels().fold(Vec3::ZERO, |s, p| s + Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+    sum / img.texel_count().max(1) as f64
+}
+
 /// Equirectangular coordinates of direction `dir` (unit), by our own `atan2` and `acos`
 /// (calls the compiler can inline and vectorise): `u` the azimuth from `−z` towards
 /// `+x` plus `rotation`, over 2π; `v` the angle from straight up (`+y`), over π.

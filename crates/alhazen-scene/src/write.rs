@@ -324,7 +324,13 @@ impl Writer<'_> {
         self.line("ior", num(m.ior));
         self.line("absorption", vec3(m.absorption));
         self.line("fresnel", string(fresnel(m.fresnel)));
-        self.line("emission", vec3(m.emission));
+        match &m.emission_texture {
+            Some(t) => {
+                let t = self.texture(t);
+                self.line("emission", t);
+            }
+            None => self.line("emission", vec3(m.emission)),
+        }
         if let Some(b) = &m.bump {
             let pattern = match &b.pattern {
                 BumpPattern::Waves { size } => format!("waves = {}", num(*size)),

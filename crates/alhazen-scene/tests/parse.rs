@@ -361,3 +361,55 @@ fn one_sided_reads_writes_back_and_refuses_non_booleans() {
         assert!(e.contains("one_sided") && e.contains(":2:"), "{bad}: {e}");
     }
 }
+
+/// An emission may be a texture times a strength: the image scaled once when read (sRGB
+/// decoded), its mean the constant emission; a checker's colours scaled; the same after the
+/// scene is written back out; mistakes explained.
+#[test]
+fn textured_emission_reads_and_writes_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = image::RgbImage::from_fn(2, 1, |x, _| image::Rgb(if x == 0 { [255, 0, 0] } else { [0, 0, 255] }));
+    png.save(dir.path().join("screen.png")).unwrap();
+    let text = r#"
+[materials.screen]
+emission = { image = { file = "screen.png", scale = [2, 1] }, strength = 4 }
+[materials.tiles]
+emission = { checker = { even = [1, 1, 1], odd = [0, 0, 0], size = 0.5 }, strength = [1, 2, 3] }
+[materials.plain]
+emission = { hsv = [0, 0, 0.5] }
+"#;
+    let path = dir.path().join("e.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let mat = |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().clone();
+    let screen = mat(&s, "screen");
+    assert_eq!(screen.emission, Vec3::new(2.0, 0.0, 2.0));
+    let Some(Texture::Image { image, scale }) = screen.emission_texture else {
+        panic!("{:?}", screen.emission_texture)
+    };
+    assert_eq!(scale, alhazen_math::Vec2::new(2.0, 1.0));
+    assert_eq!(s.images[image].texels().collect::<Vec<_>>(), vec![[4.0, 0.0, 0.0], [0.0, 0.0, 4.0]]);
+    let tiles = mat(&s, "tiles");
+    assert_eq!(tiles.emission, Vec3::new(0.5, 1.0, 1.5));
+    assert_eq!(
+        tiles.emission_texture,
+        Some(Texture::Checker { even: Vec3::new(1.0, 2.0, 3.0), odd: Vec3::ZERO, size: 0.5 })
+    );
+    assert_eq!((mat(&s, "plain").emission, mat(&s, "plain").emission_texture), (Vec3::splat(0.5), None));
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&again_path).unwrap();
+    for name in ["screen", "tiles", "plain"] {
+        let (a, b) = (mat(&s, name), mat(&again, name));
+        assert_eq!((a.emission, a.emission_texture.is_some()), (b.emission, b.emission_texture.is_some()), "{name}");
+    }
+    let Some(Texture::Image { image, .. }) = mat(&again, "screen").emission_texture else { panic!() };
+    assert_eq!(again.images[image].texels().collect::<Vec<_>>(), vec![[4.0, 0.0, 0.0], [0.0, 0.0, 4.0]]);
+    let m = |emission: &str| err(&format!("[materials.m]\nemission = {emission}\n"));
+    assert!(m("{ strength = 2 }").contains("expected a colour, { image"), "{}", m("{ strength = 2 }"));
+    assert!(m(r#"{ checker = {}, strength = -1 }"#).contains("≥ 0"));
+    assert!(m(r#"{ checker = {}, strenght = 2 }"#).contains("strenght"));
+    assert!(m(r#"{ checker = {}, strength = 2, image = { file = "x.png" } }"#).contains("expected a colour"));
+    assert!(m(r#"{ checker = {}, strength = 1e300 }"#).contains("beyond ±1e100"));
+    assert!(m(r#"{ image = { file = "none.png" } }"#).contains("none.png"));
+}

@@ -39,14 +39,13 @@
 //! bit-identical to the per-path tracer's on every processor (test
 //! `lanes_match_the_per_path_tracer`).
 
-use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic};
+use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic, shadow_segment};
 use crate::bsdf::{
     Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe, Dielectric, Frame, Microfacet,
     MicrofacetLobes, Plastic, cosine_hemisphere, cosine_pdf, same_side,
 };
 use crate::lights::{Emitter, LightAsk, LightSample, Lights, PathLight};
 use crate::sampler::{PixelSeeds, SampleStream};
-use crate::shape::ray_epsilon;
 use crate::shape::{RayPacket, VectorUnit};
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::world::{HitPoint, WorldHit};
@@ -174,9 +173,11 @@ pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
         point: false,
     };
     let lane = |light: &PathLight| match *light {
-        PathLight::Area { emitter: Emitter::Parallelogram { origin, e1, e2, normal, area }, radiance } => {
-            Some(LaneLight { corner: origin, e1, e2, normal, pdf_area: 1.0 / area, radiance, ..none })
-        }
+        PathLight::Area {
+            emitter: Emitter::Parallelogram { origin, e1, e2, normal, area },
+            radiance,
+            texture: None,
+        } => Some(LaneLight { corner: origin, e1, e2, normal, pdf_area: 1.0 / area, radiance, ..none }),
         PathLight::Point { position, intensity } => {
             Some(LaneLight { corner: position, radiance: intensity, point: true, ..none })
         }
@@ -215,6 +216,7 @@ struct Shaded {
     light: Lanes3,
     shadow: Flags,
     shadow_origin: Lanes3,
+    shadow_dir: Lanes3,
     shadow_dist: Lanes,
     /// The path goes on (`alive`) from `origin` along `dir`, sampled with density `pdf` (a
     /// delta distribution's where `delta` is set), carrying `beta` and `eta_scale`.
@@ -706,11 +708,11 @@ impl PathTracer<'_> {
             }
             for (p, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
                 let ((g, i), (b, s)) = ((p / LANES, p % LANES), at[p]);
-                let (sh, v) = (&batches.all[b].shaded, &batches.all[b].vertices);
+                let sh = &batches.all[b].shaded;
                 debug_assert_eq!(*kernel, batches.all[b].kernel);
                 if sh.shadow.at(s) {
                     (tested[g][i], dist[g][i]) = (true, sh.shadow_dist[s]);
-                    shadows[g].set(i, &Ray::new(get(&sh.shadow_origin, s), get(&v.light_dir, s)));
+                    shadows[g].set(i, &Ray::new(get(&sh.shadow_origin, s), get(&sh.shadow_dir, s)));
                 }
             }
             let clear: [[bool; LANES]; GROUPS] = std::array::from_fn(|g| {
@@ -844,7 +846,7 @@ impl PathTracer<'_> {
             }
         }
         let h = HitPoint::from(wh);
-        path.l += path.beta * self.emitted(&h, &path.ray, &path.prev, path.visit.as_ref(), ColorMode::Rgb);
+        path.l += path.beta * self.emitted(&h, wh.hit.uv, &path.ray, &path.prev, path.visit.as_ref(), ColorMode::Rgb);
         // As `vertex` records a mirror's visit, from the previous vertex as it was. (Without
         // mirrors the visit stays `None`, unwritten: a whole record's copy each vertex.)
         if let Some(c) = &self.mirrors {
@@ -1500,9 +1502,10 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat,
     let c = if shadow { f * get(&v.light_radiance, i) * (w / pdf_light) } else { Vec3::ZERO };
     set(&mut out.light, i, c);
     out.shadow.put(i, shadow);
-    set(&mut out.shadow_origin, i, offset(p, ng, dir));
-    let d = v.light_dist[i];
-    out.shadow_dist[i] = if d.is_finite() { d * (1.0 - 1e-7) - 4.0 * ray_epsilon(p) } else { f64::INFINITY };
+    let (origin, toward, dist) = shadow_segment(p, ng, dir, v.light_dist[i], p);
+    set(&mut out.shadow_origin, i, origin);
+    set(&mut out.shadow_dir, i, toward);
+    out.shadow_dist[i] = dist;
     // The continuation.
     let (sampled, bs) = M::sample(v, coat, i, wv, v.u_lobe[i], Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
     let (l, pdf) = (bs.l, bs.pdf);

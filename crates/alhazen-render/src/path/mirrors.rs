@@ -15,12 +15,11 @@
 //! mirror; both strategies are weighted by the power heuristic, the connection's density
 //! expressed as a solid angle at `x`: `p_A / (G cos θ_y)`.
 
-use super::{PathTracer, Terminator, offset, power_heuristic};
+use super::{PathTracer, Terminator, power_heuristic, shadow_segment};
 use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at};
 use crate::connect::{MirrorPath, MirrorShape, Source};
-use crate::lights::{Lights, PathLight};
+use crate::lights::{AreaPoint, Lights, PathLight};
 use crate::sampler::SampleStream;
-use crate::shape::ray_epsilon;
 use crate::world::HitPoint;
 use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::Scene;
@@ -336,13 +335,13 @@ impl PathTracer<'_> {
 
     /// The light as the mirror solver sees it; for an area light a point drawn by area with its
     /// normal and density.
-    fn connection_source(&self, light: usize, u: Vec2) -> Option<(Source, Option<(Vec3, f64)>)> {
+    fn connection_source(&self, light: usize, u: Vec2) -> Option<(Source, Option<AreaPoint>)> {
         Some(match &self.lights.all()[light] {
             PathLight::Point { position, .. } | PathLight::Spot { position, .. } => (Source::At(*position), None),
             PathLight::Directional { direction, .. } => (Source::Toward(-*direction), None),
             PathLight::Area { .. } => {
-                let (y, n, pdf) = self.lights.point_by_area(light, u)?;
-                (Source::At(y), Some((n, pdf)))
+                let point = self.lights.point_by_area(light, u)?;
+                (Source::At(point.p), Some(point))
             }
             _ => return None,
         })
@@ -354,7 +353,7 @@ impl PathTracer<'_> {
     fn connected_path(
         &self,
         piece: &MirrorPiece,
-        (light, area_point, p_choice): (usize, Option<(Vec3, f64)>, f64),
+        (light, area_point, p_choice): (usize, Option<AreaPoint>, f64),
         (bsdf, frame, terminator): (&Bsdf, &Frame, Option<Terminator>),
         x: Vec3,
         ng: Vec3,
@@ -378,13 +377,13 @@ impl PathTracer<'_> {
                 (*intensity * (cos.powf(*falloff) * g), 1.0)
             }
             (PathLight::Directional { irradiance, .. }, _) => (*irradiance * g, 1.0),
-            (PathLight::Area { radiance, .. }, Some((n_y, pdf_area))) => {
+            (PathLight::Area { .. }, Some(AreaPoint { n: n_y, pdf_area, radiance, .. })) => {
                 let cos_y = -n_y.dot(path.to_source);
                 if cos_y <= 0.0 {
                     return Vec3::ZERO;
                 }
                 let pdf_connection = p_choice * pdf_area / (g * cos_y);
-                (*radiance * (cos_y * g / pdf_area), power_heuristic(pdf_connection, bsdf.pdf(v, l)))
+                (radiance * (cos_y * g / pdf_area), power_heuristic(pdf_connection, bsdf.pdf(v, l)))
             }
             _ => return Vec3::ZERO,
         };
@@ -408,15 +407,14 @@ impl PathTracer<'_> {
 
     /// Both legs free: `x → m` short of the mirror, `m → source` short of the light.
     fn legs_unoccluded(&self, x: Vec3, ng: Vec3, path: &MirrorPath) -> bool {
-        let short = |d: f64, p: Vec3| d * (1.0 - 1e-7) - 4.0 * ray_epsilon(p);
-        let to_mirror = short(path.dist_to_mirror, x.abs().max(path.point.abs()));
-        if !self.world.unoccluded(offset(x, ng, path.to_mirror), path.to_mirror, to_mirror) {
+        let scale = x.abs().max(path.point.abs());
+        let (from, toward, dist) = shadow_segment(x, ng, path.to_mirror, path.dist_to_mirror, scale);
+        if !self.world.unoccluded(from, toward, dist) {
             return false;
         }
-        let to_source =
-            if path.dist_to_source.is_finite() { short(path.dist_to_source, path.point) } else { f64::INFINITY };
-        let from = offset(path.point, path.normal, path.to_source);
-        self.world.unoccluded(from, path.to_source, to_source)
+        let (from, toward, dist) =
+            shadow_segment(path.point, path.normal, path.to_source, path.dist_to_source, path.point);
+        self.world.unoccluded(from, toward, dist)
     }
 
     /// The power-heuristic weight of emission at `hit`, reached through the mirror of `visit`
