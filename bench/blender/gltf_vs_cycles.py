@@ -15,6 +15,12 @@ the upper half of the texture, dielectric below, in eight stripes along u altern
 materials-maps-cycles.exr. (Rougher maps part the two renderers by Cycles' multiple-scattering
 GGX: a uniform roughness of 0.7 renders the metal 31 % brighter in red there, with or without a
 map, where single-scattering microfacets — ours, Mitsuba's — lose that light.)
+`--emission` (session 44) stands a panel behind the sphere whose Emission Color is an image of
+four stripes (red, green, blue, white, strength 6), exported as `emissiveTexture` with
+`KHR_materials_emissive_strength`, on a thin black slab that takes the light of its back (Cycles
+emits from both sides of a surface, glTF's importers from the front), and names the files
+materials-emission.glb and materials-emission-cycles.exr (test
+`blender_emissive_texture_agrees_with_cycles`; Cycles 4096 spp in 94 s).
 Needs `pip install bpy`. The committed copies live in crates/alhazen-import/tests/data/blender/
 and the test `blender_gltf_agrees_with_cycles` compares alhazen's image of the .glb with the EXR.
 """
@@ -61,7 +67,37 @@ def mapped_material(name, color, path):
     return m
 
 
-def build(maps_path=None):
+def emissive_panel(path):
+    """A 2.4 × 1.2 panel above the cube and sphere facing the camera, glowing with four stripes read from an image
+    written to `path`, on a black slab that absorbs what its back emits."""
+    n = 32
+    img = bpy.data.images.new("stripes", n, n, alpha=False)
+    stripes = [(1.0, 0.05, 0.05), (0.05, 1.0, 0.05), (0.05, 0.05, 1.0), (1.0, 1.0, 1.0)]
+    pixels = []
+    for y in range(n):
+        for x in range(n):
+            pixels += [*stripes[x * 4 // n], 1.0]
+    img.pixels = pixels
+    img.filepath_raw = path
+    img.file_format = "PNG"
+    img.save()
+    m = material("panel", (0.0, 0.0, 0.0), 0.0, 1.0)
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    tex.interpolation = "Linear"
+    p = nodes["Principled BSDF"]
+    links.new(tex.outputs["Color"], p.inputs["Emission Color"])
+    p.inputs["Emission Strength"].default_value = 6.0
+    bpy.ops.mesh.primitive_plane_add(size=1, location=(0.0, 2.2, 2.7), rotation=(math.radians(90), 0, 0))
+    bpy.context.object.scale = (2.4, 1.2, 1.0)
+    bpy.context.object.data.materials.append(m)
+    bpy.ops.mesh.primitive_cube_add(size=1, location=(0.0, 2.26, 2.7))
+    bpy.context.object.scale = (2.5, 0.1, 1.3)
+    bpy.context.object.data.materials.append(material("slab", (0.0, 0.0, 0.0), 0.0, 1.0))
+
+
+def build(maps_path=None, panel_path=None):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     bpy.ops.mesh.primitive_plane_add(size=12, location=(0, 0, 0))
@@ -75,6 +111,8 @@ def build(maps_path=None):
         bpy.context.object.data.materials.append(mapped_material("gold", gold, maps_path))
     else:
         bpy.context.object.data.materials.append(material("gold", gold, 1.0, 0.35))
+    if panel_path:
+        emissive_panel(panel_path)
     bpy.ops.object.light_add(type="POINT", location=(1.5, -3.5, 5.0))
     light = bpy.context.object.data
     light.energy = 1500.0
@@ -131,10 +169,13 @@ def main():
     ap.add_argument("--spp", type=int, default=4096)
     ap.add_argument("--size", default="160x120")
     ap.add_argument("--maps", action="store_true")
+    ap.add_argument("--emission", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    stem = "materials-maps" if a.maps else "materials"
-    scene = build(os.path.join(os.path.abspath(a.out), "metallic-roughness.png") if a.maps else None)
+    stem = "materials-maps" if a.maps else "materials-emission" if a.emission else "materials"
+    out = os.path.abspath(a.out)
+    scene = build(os.path.join(out, "metallic-roughness.png") if a.maps else None,
+                  os.path.join(out, "stripes.png") if a.emission else None)
     size = tuple(int(x) for x in a.size.split("x"))
     scene.render.resolution_x, scene.render.resolution_y = size
     glb = os.path.join(a.out, f"{stem}.glb")
