@@ -9,7 +9,9 @@
 //! `conductor`/`roughconductor` (named materials or `eta`/`k`), `dielectric`/`roughdielectric`,
 //! `thindielectric`, `plastic`/`roughplastic`, `principled`, `blendbsdf`, `twosided`,
 //! `bumpmap`, `normalmap` (a tangent-space normal map), `mask`; textures `bitmap` and `checkerboard`; emitters `area`,
-//! `point`, `spot`, `directional`, `constant`, `envmap`. Scenes of version 0.x have their
+//! `point`, `spot`, `directional`, `constant`, `envmap`. Textures are read per point where the
+//! model can (colours, principled's roughness and metallic, an area light's radiance on a
+//! mesh), by their means elsewhere (with a warning). Scenes of version 0.x have their
 //! camelCase names upgraded as Mitsuba 3 does. Everything else is a located warning.
 //!
 //! Mitsuba's camera looks along its local `+z` with `+x` to the left of the image, which is
@@ -313,6 +315,23 @@ impl Importer {
             [x] => Ok(x),
             _ => Err(ctx.err(n, format!("`{name}` must be one number"))),
         }
+    }
+
+    /// A float parameter that Mitsuba also takes as a texture (`<texture>` or a `<ref>` to
+    /// one): the number, or the texture (a bitmap read as its luminance where it has colour).
+    fn float_or_texture(&mut self, ctx: &Ctx, p: &Plugin, name: &str, default: f64) -> R<Result<f64, Texture>> {
+        let Some(n) = self.prop(p, name) else { return Ok(Ok(default)) };
+        if matches!(n.tag_name().name(), "texture" | "ref") {
+            return self.color_node(ctx, n).map(Err);
+        }
+        self.float(ctx, p, name, default).map(Ok)
+    }
+
+    /// [`Self::float_or_texture`] for a parameter the model holds constant: a texture is
+    /// replaced by its mean luminance, with a warning.
+    fn float_or_mean(&mut self, ctx: &Ctx, p: &Plugin, name: &str, default: f64) -> R<f64> {
+        let v = self.float_or_texture(ctx, p, name, default)?;
+        self.textured_mean(ctx, p, name, v)
     }
 
     fn string(&self, ctx: &Ctx, p: &Plugin, name: &str) -> R<Option<String>> {
@@ -835,12 +854,10 @@ impl Importer {
             "principled" => {
                 let base = self.color(ctx, &p, "base_color", Vec3::splat(0.8))?;
                 let mean = self.pending.texture_mean(&base, &mut self.scene)?;
-                let metallic = self.float(ctx, &p, "metallic", 0.0)?;
-                let roughness = self.float(ctx, &p, "roughness", 0.5)?;
                 let ior = self.float(ctx, &p, "eta", 1.5)?;
-                let trans = self.float(ctx, &p, "spec_trans", 0.0)?;
+                let trans = self.float_or_mean(ctx, &p, "spec_trans", 0.0)?;
                 self.warn(ctx, node, "principled is approximated by the glTF metallic–roughness model (base colour, metallic, roughness, eta, spec_trans)");
-                common::metal_rough(base, mean, metallic, roughness, ior, trans)
+                self.principled(ctx, &p, (base, mean), ior, trans)?
             }
             "blendbsdf" => {
                 let w = match self.prop(&p, "weight") {
@@ -991,14 +1008,70 @@ impl Importer {
                 return Err(ctx.err(n, format!("distribution \"{other}\" is not beckmann or ggx")));
             }
         };
-        let alpha = self.float(ctx, p, "alpha", 0.1)?;
-        let au = self.float(ctx, p, "alpha_u", alpha)?;
-        let av = self.float(ctx, p, "alpha_v", alpha)?;
+        let alpha = self.float_or_mean(ctx, p, "alpha", 0.1)?;
+        let au = self.float_or_mean(ctx, p, "alpha_u", alpha)?;
+        let av = self.float_or_mean(ctx, p, "alpha_v", alpha)?;
         self.boolean(ctx, p, "sample_visible", true)?;
         if !(au > 0.0 && av > 0.0) {
             return Err(ctx.err(p.node, "roughness `alpha` must be positive"));
         }
         Ok(Some(Microfacets { distribution, alpha_u: au, alpha_v: av, shadowing: Shadowing::Smith }))
+    }
+
+    /// Principled's metallic–roughness part: read per point where roughness or metallic is a
+    /// texture (both sampled into one map, roughness in green and metalness in blue, on the
+    /// grid of the larger image; `BsdfDesc::MetallicRoughness`) or the base colour of a metal
+    /// is; the constant mix otherwise, and under specular transmission (textures by their
+    /// means, with a warning).
+    fn principled(
+        &mut self,
+        ctx: &Ctx,
+        p: &Plugin,
+        (base, mean): (Texture, Vec3),
+        ior: f64,
+        trans: f64,
+    ) -> R<BsdfDesc> {
+        let metallic = self.float_or_texture(ctx, p, "metallic", 0.0)?;
+        let roughness = self.float_or_texture(ctx, p, "roughness", 0.5)?;
+        let scale_of = |t: &Result<f64, Texture>| match t {
+            Err(Texture::Image { scale, .. }) => Some(*scale),
+            _ => None,
+        };
+        let scales: Vec<Vec2> = [scale_of(&metallic), scale_of(&roughness)].into_iter().flatten().collect();
+        let mapped = metallic.is_err() || roughness.is_err();
+        if mapped && trans <= 0.0 && scales.windows(2).all(|w| w[0] == w[1]) {
+            for t in [&metallic, &roughness] {
+                if let Err(Texture::Image { image, .. }) = t {
+                    self.pending.load_image_now(&mut self.scene, *image)?;
+                }
+            }
+            let image = metal_rough_map(&self.scene.images, &roughness, &metallic);
+            self.scene.images.push(Arc::new(image));
+            let map = Some((self.scene.images.len() - 1, scales.first().copied().unwrap_or(Vec2::ONE)));
+            let (metallic, roughness) = (metallic.unwrap_or(1.0), roughness.unwrap_or(1.0));
+            let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
+            return Ok(BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior });
+        }
+        let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
+        let roughness = self.textured_mean(ctx, p, "roughness", roughness)?;
+        if metallic > 0.0 && trans <= 0.0 && !matches!(base, Texture::Solid(_)) {
+            // A textured metal takes each point's base colour.
+            let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
+            return Ok(BsdfDesc::MetallicRoughness { base, metallic, roughness, map: None, ior });
+        }
+        Ok(common::metal_rough(base, mean, metallic, roughness, ior, trans))
+    }
+
+    /// `v`, or the mean luminance of its texture (parameter `name`), with a warning.
+    fn textured_mean(&mut self, ctx: &Ctx, p: &Plugin, name: &str, v: Result<f64, Texture>) -> R<f64> {
+        match v {
+            Ok(x) => Ok(x),
+            Err(t) => {
+                let n = self.prop(p, name).expect("read above");
+                self.warn(ctx, n, format!("a textured `{name}` is replaced by its mean"));
+                Ok(luminance(self.pending.texture_mean(&t, &mut self.scene)?))
+            }
+        }
     }
 
     /// A `<texture>`; `linear` reads a bitmap without sRGB decoding (normal maps).
@@ -1304,4 +1377,46 @@ fn reflects_only(desc: &BsdfDesc) -> bool {
         BsdfDesc::Mix { a, b, .. } => reflects_only(a) && reflects_only(b),
         _ => true,
     }
+}
+
+/// Rec. 709 luminance: what Mitsuba reads from a colour texture where it wants a number (a
+/// grey's value exactly).
+fn luminance(c: Vec3) -> f64 {
+    if c.x == c.y && c.y == c.z { c.x } else { 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z }
+}
+
+/// The metallic–roughness map of principled's `roughness` and `metallic` (a number is 1 in
+/// the map, the factor keeping it): each texture's luminance at the centres of the texels of
+/// the larger image among them (256² for checkerboards alone), roughness in green, metalness
+/// in blue, each texture sampled at its own scale's first repeat.
+fn metal_rough_map(
+    images: &[Arc<alhazen_scene::ImageData>],
+    roughness: &Result<f64, Texture>,
+    metallic: &Result<f64, Texture>,
+) -> alhazen_scene::ImageData {
+    let size = |t: &Result<f64, Texture>| match t {
+        Err(Texture::Image { image, .. }) => (images[*image].width, images[*image].height),
+        _ => (0, 0),
+    };
+    let ((rw, rh), (mw, mh)) = (size(roughness), size(metallic));
+    let (w, h) = match (rw.max(mw), rh.max(mh)) {
+        (0, _) | (_, 0) => (256, 256),
+        wh => wh,
+    };
+    let value = |t: &Result<f64, Texture>, uv: Vec2| match t {
+        Ok(_) => 1.0,
+        Err(Texture::Image { image, .. }) => {
+            luminance(alhazen_scene::texture::eval(&Texture::Image { image: *image, scale: Vec2::ONE }, uv, images))
+        }
+        Err(other) => luminance(alhazen_scene::texture::eval(other, uv, images)),
+    };
+    let pixels = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            // Row 0 is the image's top, texture coordinate v = 1.
+            let uv = Vec2::new((x as f64 + 0.5) / w as f64, 1.0 - (y as f64 + 0.5) / h as f64);
+            [0.0, value(roughness, uv) as f32, value(metallic, uv) as f32]
+        })
+        .collect();
+    alhazen_scene::ImageData::new(w, h, pixels)
 }

@@ -1,0 +1,135 @@
+#!/usr/bin/env python3
+"""Test scenes of textures read per point, and their Mitsuba 3 references (`scalar_rgb`'s
+`path` integrator), for crates/alhazen-import/tests/mitsuba.rs:
+
+- textured-emitter: a rectangle whose radiance is a bitmap of eight colours, tilted to face
+  both a diffuse floor and the camera, so that the image shows the texture read where rays hit
+  the light and where the floor's light samples land on it (test
+  `a_textured_emitter_agrees_with_mitsuba`);
+- principled-maps: a `principled` floor whose roughness (0.8 left, 0.15 right) and metallic
+  (1 on one half, 0 on the other) are bitmaps, under a sky and a small tilted light (test
+  `principled_maps_agree_with_mitsuba`).
+
+    python3 bench/mitsuba/texture_refs.py [--spp 8192]
+
+Writes each scene's XML, its PNGs and NAME-mitsuba.exr into
+crates/alhazen-import/tests/data/mitsuba/.
+"""
+import argparse, os
+import numpy as np
+import mitsuba as mi
+
+OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "crates", "alhazen-import", "tests",
+                   "data", "mitsuba")
+
+SCENE = """<?xml version="1.0" encoding="utf-8"?>
+<!-- A rectangle light whose radiance is a bitmap (bench/mitsuba/texture_refs.py). -->
+<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="50"/>
+        <transform name="to_world"><lookat origin="0, 1.1, 3.2" target="0, 0.45, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="96"/><integer name="height" value="72"/>
+            <rfilter type="box"/><string name="pixel_format" value="rgb"/>
+        </film>
+    </sensor>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <scale x="0.9" y="0.5" z="1"/>
+            <rotate x="1" angle="60"/>
+            <translate x="0" y="1.0" z="0"/>
+        </transform>
+        <emitter type="area">
+            <texture name="radiance" type="bitmap">
+                <string name="filename" value="textured-emitter.png"/>
+                <string name="filter_type" value="bilinear"/>
+            </texture>
+        </emitter>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <scale x="2" y="2" z="2"/>
+            <rotate x="1" angle="-90"/>
+        </transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.6, 0.6, 0.6"/></bsdf>
+    </shape>
+</scene>
+"""
+
+
+PRINCIPLED = """<?xml version="1.0" encoding="utf-8"?>
+<!-- A principled floor with roughness and metallic maps (bench/mitsuba/texture_refs.py). -->
+<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="6"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world"><lookat origin="0, 1.2, 3.2" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="96"/><integer name="height" value="72"/>
+            <rfilter type="box"/><string name="pixel_format" value="rgb"/>
+        </film>
+    </sensor>
+    <emitter type="constant"><rgb name="radiance" value="0.3, 0.3, 0.3"/></emitter>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <scale x="0.6" y="0.3" z="1"/><rotate x="1" angle="150"/><translate x="0" y="1.3" z="-1.2"/>
+        </transform>
+        <emitter type="area"><rgb name="radiance" value="20, 18, 15"/></emitter>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="1.2"/><rotate x="1" angle="-90"/></transform>
+        <bsdf type="principled">
+            <rgb name="base_color" value="0.79, 0.40, 0.045"/>
+            <texture name="roughness" type="bitmap">
+                <string name="filename" value="principled-roughness.png"/><boolean name="raw" value="true"/>
+            </texture>
+            <texture name="metallic" type="bitmap">
+                <string name="filename" value="principled-metallic.png"/><boolean name="raw" value="true"/>
+            </texture>
+        </bsdf>
+    </shape>
+</scene>
+"""
+
+
+def principled(spp):
+    grey = lambda a: a[..., None].repeat(3, 2)
+    rough = np.zeros((64, 64), np.uint8)
+    rough[:, :32], rough[:, 32:] = 204, 38
+    metal = np.zeros((64, 64), np.uint8)
+    metal[:32, :] = 255
+    mi.Bitmap(grey(rough)).write(os.path.join(OUT, "principled-roughness.png"))
+    mi.Bitmap(grey(metal)).write(os.path.join(OUT, "principled-metallic.png"))
+    path = os.path.join(OUT, "principled-maps.xml")
+    with open(path, "w") as f:
+        f.write(PRINCIPLED)
+    img = mi.render(mi.load_file(path), spp=spp, seed=3)
+    mi.Bitmap(img).write(os.path.join(OUT, "principled-maps-mitsuba.exr"))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--spp", type=int, default=8192)
+    args = ap.parse_args()
+    os.makedirs(OUT, exist_ok=True)
+    # Eight colours, four across and two down, each well apart from its neighbours.
+    colours = np.array([
+        [[255, 40, 40], [40, 255, 40], [40, 40, 255], [255, 255, 255]],
+        [[255, 255, 40], [40, 255, 255], [255, 40, 255], [90, 90, 90]],
+    ], dtype=np.uint8)
+    mi.set_variant("scalar_rgb")
+    mi.Bitmap(colours, pixel_format=mi.Bitmap.PixelFormat.RGB).write(os.path.join(OUT, "textured-emitter.png"))
+    path = os.path.join(OUT, "textured-emitter.xml")
+    with open(path, "w") as f:
+        f.write(SCENE)
+    scene = mi.load_file(path)
+    img = mi.render(scene, spp=args.spp, seed=7)
+    mi.Bitmap(img).write(os.path.join(OUT, "textured-emitter-mitsuba.exr"))
+    principled(args.spp)
+
+
+if __name__ == "__main__":
+    main()
