@@ -22,20 +22,26 @@ import mitsuba as mi
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "crates", "alhazen-import", "tests",
                    "data", "mitsuba")
 
-SCENE = """<?xml version="1.0" encoding="utf-8"?>
-<!-- A rectangle light whose radiance is a bitmap (bench/mitsuba/texture_refs.py). -->
+
+def head(what, depth, fov, origin, target):
+    """A scene file's opening: its comment, the path integrator, a 96 × 72 camera."""
+    return f"""<?xml version="1.0" encoding="utf-8"?>
+<!-- {what} (bench/mitsuba/texture_refs.py). -->
 <scene version="3.0.0">
-    <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+    <integrator type="path"><integer name="max_depth" value="{depth}"/></integrator>
     <sensor type="perspective">
-        <float name="fov" value="50"/>
-        <transform name="to_world"><lookat origin="0, 1.1, 3.2" target="0, 0.45, 0" up="0, 1, 0"/></transform>
+        <float name="fov" value="{fov}"/>
+        <transform name="to_world"><lookat origin="{origin}" target="{target}" up="0, 1, 0"/></transform>
         <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
         <film type="hdrfilm">
             <integer name="width" value="96"/><integer name="height" value="72"/>
             <rfilter type="box"/><string name="pixel_format" value="rgb"/>
         </film>
     </sensor>
-    <shape type="rectangle">
+"""
+
+
+SCENE = head("A rectangle light whose radiance is a bitmap", 4, 50, "0, 1.1, 3.2", "0, 0.45, 0") + """    <shape type="rectangle">
         <transform name="to_world">
             <scale x="0.9" y="0.5" z="1"/>
             <rotate x="1" angle="60"/>
@@ -59,20 +65,7 @@ SCENE = """<?xml version="1.0" encoding="utf-8"?>
 """
 
 
-PRINCIPLED = """<?xml version="1.0" encoding="utf-8"?>
-<!-- A principled floor with roughness and metallic maps (bench/mitsuba/texture_refs.py). -->
-<scene version="3.0.0">
-    <integrator type="path"><integer name="max_depth" value="6"/></integrator>
-    <sensor type="perspective">
-        <float name="fov" value="40"/>
-        <transform name="to_world"><lookat origin="0, 1.2, 3.2" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
-        <film type="hdrfilm">
-            <integer name="width" value="96"/><integer name="height" value="72"/>
-            <rfilter type="box"/><string name="pixel_format" value="rgb"/>
-        </film>
-    </sensor>
-    <emitter type="constant"><rgb name="radiance" value="0.3, 0.3, 0.3"/></emitter>
+PRINCIPLED = head("A principled floor with roughness and metallic maps", 6, 40, "0, 1.2, 3.2", "0, 0, 0") + """    <emitter type="constant"><rgb name="radiance" value="0.3, 0.3, 0.3"/></emitter>
     <shape type="rectangle">
         <transform name="to_world">
             <scale x="0.6" y="0.3" z="1"/><rotate x="1" angle="150"/><translate x="0" y="1.3" z="-1.2"/>

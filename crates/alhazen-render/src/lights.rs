@@ -3,6 +3,8 @@
 //! meshes, boxes — and disks by area), the environment map and a coloured background
 //! (uniformly over the sphere). Lights are chosen uniformly; every density here includes that
 //! choice. Emitters of other shapes still shine when paths hit them, without light sampling.
+//! A textured emission ([`AreaTexture`]) is read per point on meshes, by the texture
+//! coordinates of the point a light sample lands on and of the point a ray hits alike.
 
 use crate::distribution::Distribution1D;
 use crate::envmap::EnvMap;
@@ -438,7 +440,8 @@ impl Lights {
     }
 
     /// A point of area light `light` chosen uniformly by area (not including the light choice):
-    /// the point, its emitting normal and the area density; `None` for other lights.
+    /// the point, its emitting normal, the area density and the radiance there; `None` for
+    /// other lights.
     pub fn point_by_area(&self, light: usize, u: Vec2) -> Option<AreaPoint> {
         match &self.lights[light] {
             PathLight::Area { emitter, radiance, texture } => {

@@ -349,7 +349,6 @@ impl Parser<'_> {
         if t.get("hsv").is_some() || t.get("hsl").is_some() {
             return Ok((n.rgb()?, None));
         }
-        // Numbers are within ±1e100, so products of two stay finite.
         let strength = t.opt_rgb("strength", Vec3::ONE)?;
         let texture = match (t.get("checker"), t.get("image")) {
             (Some(c), None) => {
@@ -374,7 +373,12 @@ impl Parser<'_> {
                 ));
             }
         };
-        Ok((crate::texture::mean(&texture, &self.scene.images), Some(texture)))
+        // An image's texels are single precision: a strength may take them past its range.
+        let mean = crate::texture::mean(&texture, &self.scene.images);
+        if !mean.is_finite() {
+            return Err(n.err("`emission`: the image's values times `strength` overflow single precision"));
+        }
+        Ok((mean, Some(texture)))
     }
 
     fn material_ref(&mut self, n: &Node, object_name: &str) -> R<MaterialId> {

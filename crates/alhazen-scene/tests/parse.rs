@@ -412,4 +412,8 @@ emission = { hsv = [0, 0, 0.5] }
     assert!(m(r#"{ checker = {}, strength = 2, image = { file = "x.png" } }"#).contains("expected a colour"));
     assert!(m(r#"{ checker = {}, strength = 1e300 }"#).contains("beyond ±1e100"));
     assert!(m(r#"{ image = { file = "none.png" } }"#).contains("none.png"));
+    let huge = "[materials.m]\nemission = { image = { file = \"screen.png\" }, strength = 1e50 }\n";
+    std::fs::write(&path, huge).unwrap();
+    let e = load_scene(&path).unwrap_err().to_string();
+    assert!(e.contains("overflow single precision") && e.contains("e.toml:2:"), "{e}");
 }
