@@ -169,16 +169,6 @@ pub(crate) fn named_ior(name: &str) -> Option<f64> {
     NAMED_IORS.iter().find(|e| e.0 == n).map(|e| e.1)
 }
 
-/// The mean colour of a texture (for parameters the model holds as constants).
-pub(crate) fn texture_mean(t: &Texture, scene: &Scene) -> Rgb {
-    alhazen_scene::texture::mean(t, &scene.images)
-}
-
-/// The mean of an image's pixels.
-pub(crate) fn image_mean(img: &alhazen_scene::ImageData) -> Rgb {
-    alhazen_scene::texture::image_mean(img)
-}
-
 /// A point light's `cos^e` falloff that best stands for a smooth fall-off from full intensity
 /// inside `inner` to zero at `outer` (half-angles, radians): the exponent that halves the
 /// intensity midway.
@@ -307,12 +297,12 @@ impl PendingFiles {
         Ok(())
     }
 
-    /// The mean colour of `t` ([`texture_mean`]), its image read first if it is pending.
+    /// The mean colour of `t` (`texture::mean`), its image read first if it is pending.
     pub fn texture_mean(&mut self, t: &Texture, scene: &mut Scene) -> Result<Rgb, SceneError> {
         if let Texture::Image { image, .. } = t {
             self.load_image_now(scene, *image)?;
         }
-        Ok(texture_mean(t, scene))
+        Ok(alhazen_scene::texture::mean(t, &scene.images))
     }
 
     /// Reads the files pushed, on all threads, into `scene`, each mesh given to `adjust` first;

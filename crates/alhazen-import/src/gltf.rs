@@ -316,21 +316,25 @@ impl Importer<'_> {
                 let scale = self.texture_scale(&info, &name);
                 let img = self.image(&info.texture(), true)?;
                 let img = scaled(img, factor);
-                let mean = common::image_mean(&img);
+                let mean = alhazen_scene::texture::image_mean(&img);
                 self.scene.images.push(img);
                 (Texture::Image { image: self.scene.images.len() - 1, scale }, mean)
             }
             None => (Texture::Solid(factor), factor),
         };
         // The emissive texture is read per point, its factor and strength multiplied in.
-        let mut emission = rgb(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0) as f64;
+        let strength = material.emissive_strength().unwrap_or(1.0) as f64;
+        let mut emission = rgb(material.emissive_factor()) * strength;
+        if !(emission.is_finite() && emission.min_element() >= 0.0) {
+            return Err(self.err(format!("{name}: the emissive factor and strength must be finite and ≥ 0")));
+        }
         let mut emission_texture = None;
         if let Some(info) = material.emissive_texture()
             && emission != Vec3::ZERO
         {
             let scale = self.texture_scale(&info, &name);
             let img = scaled(self.image(&info.texture(), true)?, emission);
-            emission = common::image_mean(&img);
+            emission = alhazen_scene::texture::image_mean(&img);
             self.scene.images.push(img);
             emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale });
         }
@@ -352,7 +356,7 @@ impl Importer<'_> {
         if let Some(info) = pbr.metallic_roughness_texture() {
             let image = self.image(&info.texture(), false)?;
             if transmission > 0.0 {
-                let mean = common::image_mean(&image);
+                let mean = alhazen_scene::texture::image_mean(&image);
                 (roughness, metallic) = (roughness * mean.y, metallic * mean.z);
                 self.warn(format!(
                     "{name}: with transmission, the metallic-roughness texture is replaced by its mean (metallic {metallic:.3}, roughness {roughness:.3})"

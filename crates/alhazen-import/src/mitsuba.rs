@@ -1382,12 +1382,13 @@ fn reflects_only(desc: &BsdfDesc) -> bool {
 /// Rec. 709 luminance: what Mitsuba reads from a colour texture where it wants a number (a
 /// grey's value exactly).
 fn luminance(c: Vec3) -> f64 {
-    if c.x == c.y && c.y == c.z { c.x } else { 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z }
+    if c.x == c.y && c.y == c.z { c.x } else { alhazen_math::color::luminance(c) }
 }
 
 /// The metallic–roughness map of principled's `roughness` and `metallic` (a number is 1 in
 /// the map, the factor keeping it): each texture's luminance at the centres of the texels of
-/// the larger image among them (256² for checkerboards alone), roughness in green, metalness
+/// a grid as wide and as tall as the widest and tallest image among them (the larger image's
+/// if that grid exceeds it fourfold; 256² for checkerboards alone), roughness in green, metalness
 /// in blue, each texture sampled at its own scale's first repeat.
 fn metal_rough_map(
     images: &[Arc<alhazen_scene::ImageData>],
@@ -1399,8 +1400,12 @@ fn metal_rough_map(
         _ => (0, 0),
     };
     let ((rw, rh), (mw, mh)) = (size(roughness), size(metallic));
+    let larger = if rw as u64 * rh as u64 >= mw as u64 * mh as u64 { (rw, rh) } else { (mw, mh) };
     let (w, h) = match (rw.max(mw), rh.max(mh)) {
         (0, _) | (_, 0) => (256, 256),
+        // Images of crossed shapes (wide and tall) would make a grid far larger than either:
+        // the larger image's own grid then (the map never outgrows 4× the larger image).
+        (w, h) if w as u64 * h as u64 > 4 * larger.0 as u64 * larger.1 as u64 => larger,
         wh => wh,
     };
     let value = |t: &Result<f64, Texture>, uv: Vec2| match t {

@@ -448,7 +448,7 @@ fn an_emissive_texture_is_read_per_point() {
                 r#""extensionsUsed": ["KHR_lights_punctual"]"#,
                 r#""extensionsUsed": ["KHR_materials_emissive_strength"]"#,
             );
-    let s = write_and_import(&[("e.gltf", json.into_bytes())]).unwrap();
+    let s = write_and_import(&[("e.gltf", json.clone().into_bytes())]).unwrap();
     assert!(s.warnings.iter().all(|w| !w.to_string().contains("emissive")), "{:?}", s.warnings);
     let mut sc = s.scene;
     let m = &sc.materials[sc.objects[0].material as usize];
@@ -471,4 +471,11 @@ fn an_emissive_texture_is_read_per_point() {
     let (left, right) = (img.get(3, 4), img.get(12, 4));
     assert!(left.x > 3.6 && left.z < 0.4 && left.y == 0.0, "{left}");
     assert!(right.z > 3.6 && right.x < 0.4 && right.y == 0.0, "{right}");
+    // A negative strength or factor is refused, named by its material.
+    for (from, to) in [("\"emissiveStrength\": 4", "\"emissiveStrength\": -4"), ("[1, 0.5, 1]", "[1, -0.5, 1]")] {
+        let bad = json.replace(from, to);
+        assert_ne!(bad, json);
+        let e = write_and_import(&[("e.gltf", bad.into_bytes())]).unwrap_err();
+        assert!(e.contains("tex: the emissive factor and strength must be finite and ≥ 0"), "{e}");
+    }
 }

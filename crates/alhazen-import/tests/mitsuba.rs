@@ -574,6 +574,17 @@ fn textured_principled_parameters_are_read_per_point() {
     let t = texels(&images, image);
     assert_eq!(t.iter().map(|p| p[2]).collect::<Vec<_>>(), vec![0.0, 0.0, 1.0, 1.0]);
     assert_eq!(t.iter().map(|p| p[1]).collect::<Vec<_>>(), vec![0.2, 0.8, 0.2, 0.8]);
+    // Crossed shapes (wide and tall) would make a grid far larger than either image: the
+    // larger image's grid instead.
+    image::GrayImage::from_pixel(512, 1, image::Luma([51])).save(dir.path().join("wide.png")).unwrap();
+    image::GrayImage::from_pixel(1, 256, image::Luma([255])).save(dir.path().join("tall.png")).unwrap();
+    let (bsdf, images, _) = load(format!(
+        "<bsdf type=\"principled\">{}{}</bsdf>",
+        bitmap("roughness", "wide.png"),
+        bitmap("metallic", "tall.png")
+    ));
+    let BsdfDesc::MetallicRoughness { map: Some((image, _)), .. } = bsdf else { panic!("{bsdf:?}") };
+    assert_eq!((images[image].width, images[image].height), (512, 1));
     // A textured metal without textured parameters: per point too.
     let (bsdf, ..) = load(
         "<bsdf type=\"principled\"><float name=\"metallic\" value=\"1\"/><texture name=\"base_color\" type=\"bitmap\">\

@@ -411,6 +411,7 @@ emission = { hsv = [0, 0, 0.5] }
     assert!(m(r#"{ checker = {}, strenght = 2 }"#).contains("strenght"));
     assert!(m(r#"{ checker = {}, strength = 2, image = { file = "x.png" } }"#).contains("expected a colour"));
     assert!(m(r#"{ checker = {}, strength = 1e300 }"#).contains("beyond ±1e100"));
+    assert!(m(r#"{ checker = {}, strength = nan }"#).contains("expected a finite number"));
     assert!(m(r#"{ image = { file = "none.png" } }"#).contains("none.png"));
     let huge = "[materials.m]\nemission = { image = { file = \"screen.png\" }, strength = 1e50 }\n";
     std::fs::write(&path, huge).unwrap();
