@@ -201,6 +201,24 @@ impl TriangleMesh {
         }
         self.normals = acc.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect();
     }
+
+    /// Vertex normals weighted by the angle each triangle makes at the vertex (Thürmer and
+    /// Wüthrich 1998, "Computing vertex normals from polygonal facets"): a vertex's normal does
+    /// not change when a neighbouring face is split. Mitsuba smooths the meshes it is given
+    /// without normals so; a vertex on no face of area gets +y.
+    pub fn compute_angle_weighted_normals(&mut self) {
+        let mut acc = vec![Vec3::ZERO; self.positions.len()];
+        for tri in &self.triangles {
+            let p = tri.map(|v| self.positions[v as usize]);
+            let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { continue };
+            for k in 0..3 {
+                let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+                let angle = a.normalize_or_zero().angle_between(b.normalize_or_zero());
+                acc[tri[k] as usize] += n * angle;
+            }
+        }
+        self.normals = acc.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect();
+    }
 }
 
 #[cfg(test)]
@@ -308,6 +326,21 @@ mod tests {
         let e = TriangleMesh::new(vec![Vec3::NAN, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap_err();
         assert_eq!(e, MeshError::NonFiniteVertex(0));
         assert_eq!(TriangleMesh::new(vec![], vec![]).unwrap_err(), MeshError::Empty);
+    }
+
+    #[test]
+    fn angle_weighted_normals_ignore_how_a_face_is_split() {
+        // A vertex at a cube's corner: three faces of equal angle, one of them split in two.
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::new(1.0, 1.0, 0.0)];
+        let faces = |split: bool| {
+            let mut t = vec![[0, 3, 1], [0, 2, 3]];
+            t.extend(if split { vec![[0, 1, 4], [0, 4, 2]] } else { vec![[0, 1, 2]] });
+            let mut m = TriangleMesh { positions: p.clone(), triangles: t, ..TriangleMesh::default() };
+            m.compute_angle_weighted_normals();
+            m.normals[0]
+        };
+        let want = Vec3::ONE.normalize();
+        assert!((faces(false) - want).length() < 1e-12 && (faces(true) - want).length() < 1e-12);
     }
 
     #[test]

@@ -229,8 +229,9 @@ struct PendingRead {
 /// What a pending file becomes.
 #[derive(Clone, Copy)]
 enum Read {
-    /// `scene.meshes[index]`, turned inside out when `flip`.
-    Mesh { index: usize, flip: bool },
+    /// `scene.meshes[index]`, turned inside out when `flip`; of a Mitsuba `serialized` file,
+    /// its mesh `part`.
+    Mesh { index: usize, flip: bool, part: Option<usize> },
     /// `scene.images[index]`: linear values (or sRGB decoded), upside down when `rows_reversed`.
     Image { index: usize, linear: bool, rows_reversed: bool },
 }
@@ -242,11 +243,19 @@ enum Loaded {
 }
 
 impl PendingFiles {
-    /// Mesh file `path` (turned inside out when `flip`) for `scene.meshes[index]`, its shape at
-    /// bytes `span` of scene file `at` (its path and text, kept only for files that name mesh
-    /// or image files: a scene's large files of inline geometry are not held to the end).
-    pub fn push_mesh(&mut self, index: usize, path: &Path, flip: bool, at: (&Path, &Arc<str>), span: Range<usize>) {
-        self.push(path, Read::Mesh { index, flip }, at, span);
+    /// Mesh file `path` (turned inside out when `flip`; of a Mitsuba `serialized` file, its
+    /// mesh `part`) for `scene.meshes[index]`, its shape at bytes `span` of scene file `at` (its
+    /// path and text, kept only for files that name mesh or image files: a scene's large files
+    /// of inline geometry are not held to the end).
+    pub fn push_mesh(
+        &mut self,
+        (index, part): (usize, Option<usize>),
+        path: &Path,
+        flip: bool,
+        at: (&Path, &Arc<str>),
+        span: Range<usize>,
+    ) {
+        self.push(path, Read::Mesh { index, flip, part }, at, span);
     }
 
     /// Image file `path`, read as linear values (else decoded from sRGB), turned upside down
@@ -316,7 +325,14 @@ impl PendingFiles {
         use rayon::prelude::*;
         let pending = std::mem::take(&mut self.reads);
         let read = |r: &PendingRead| match r.what {
-            Read::Mesh { index, flip } => Loaded::Mesh { index, flip, mesh: alhazen_scene::import::load_mesh(&r.path) },
+            Read::Mesh { index, flip, part } => {
+                let mesh = match part {
+                    None => alhazen_scene::import::load_mesh(&r.path),
+                    Some(part) => crate::serialized::load(&r.path, part)
+                        .map(|mesh| alhazen_scene::import::LoadedMesh { mesh, materials: vec![], warnings: vec![] }),
+                };
+                Loaded::Mesh { index, flip, mesh }
+            }
             Read::Image { index, linear, rows_reversed } => {
                 let image = if linear {
                     alhazen_scene::import::load_hdr_image(&r.path)

@@ -3,7 +3,7 @@
 //!
 //! * [`gltf`](mod@gltf) — glTF 2.0 (`.gltf`, `.glb`): the node hierarchy, meshes, the
 //!   metallic–roughness materials, `KHR_lights_punctual`, cameras;
-//! * [`mitsuba`] — Mitsuba 3 XML scenes (`.xml`);
+//! * [`mitsuba`] — Mitsuba 3 XML scenes (`.xml`), with their `serialized` meshes;
 //! * [`pbrt`] — pbrt-v4 scene descriptions (`.pbrt`);
 //! * anything else is alhazen's own TOML (`alhazen_scene::load_scene`).
 //!
@@ -25,6 +25,7 @@ mod common;
 pub mod gltf;
 pub mod mitsuba;
 pub mod pbrt;
+mod serialized;
 
 use alhazen_scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};

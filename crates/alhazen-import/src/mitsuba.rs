@@ -1,10 +1,11 @@
 //! Mitsuba 3 XML scenes (`.xml`), read with a real XML parser (roxmltree), every element located
 //! by line for messages.
 //!
-//! Supported: `default` parameters and `$name` substitution, `include`, `ref`/`id`; the
+//! Supported: `default` parameters and `$name` substitution, `include`, `path` (folders searched
+//! for the files named), `ref`/`id`; the
 //! `perspective` and `orthographic` sensors (`fov`, `fov_axis`, `focal_length`, `to_world` with
 //! `lookat`/`translate`/`rotate`/`scale`/`matrix`), `hdrfilm` size, the sampler's
-//! `sample_count` and `seed`, the integrator's `max_depth`; shapes `obj`, `ply`, `rectangle`,
+//! `sample_count` and `seed`, the integrator's `max_depth`; shapes `obj`, `ply`, `serialized`, `rectangle`,
 //! `cube`, `sphere`, `disk`, `cylinder`, `shapegroup`/`instance`; BSDFs `diffuse`,
 //! `conductor`/`roughconductor` (named materials or `eta`/`k`), `dielectric`/`roughdielectric`,
 //! `thindielectric`, `plastic`/`roughplastic`, `principled`, `blendbsdf`, `twosided`,
@@ -46,6 +47,8 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
         camera_seen: false,
         version_major: 3,
         pending: PendingFiles::default(),
+        search: vec![],
+        scene_dir: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.scene.render.width = 768;
@@ -54,10 +57,14 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
     let walked = imp.file(path, 0);
     // The mesh and image files met before any error of the walk are loaded (an error in one of
     // them came first in the document, so it is the one reported).
-    // Mitsuba ignores OBJ material libraries: the shape's BSDF applies to every face.
+    // Mitsuba ignores OBJ material libraries: the shape's BSDF applies to every face; it
+    // smooths a mesh without normals by the angles of its faces at each vertex.
     imp.pending.load(&mut imp.scene, |m| {
         m.material_slots.clear();
         m.material_names.clear();
+        if m.normals.is_empty() {
+            m.compute_angle_weighted_normals();
+        }
     })?;
     walked?;
     imp.finish()
@@ -76,6 +83,8 @@ enum Named {
     Bsdf(MaterialId),
     Texture(Texture),
     Group(Vec<Object>),
+    /// An `area` emitter declared apart, with its radiance, for the shapes that refer to it.
+    AreaEmitter(Texture),
     Other,
 }
 
@@ -84,7 +93,8 @@ struct Importer {
     warnings: Warnings,
     defaults: HashMap<String, String>,
     ids: HashMap<String, Named>,
-    meshes: HashMap<(PathBuf, bool), usize>,
+    /// Mesh files (a `serialized` file's mesh) and orientations, and their places.
+    meshes: HashMap<(PathBuf, Option<usize>, bool), usize>,
     default_material: Option<MaterialId>,
     /// The black BSDF of emitting shapes without one, once made.
     black_material: Option<MaterialId>,
@@ -92,6 +102,10 @@ struct Importer {
     version_major: u32,
     /// Mesh files met, loaded together once the walk is done.
     pending: PendingFiles,
+    /// The folders of `<path>` elements, the latest first.
+    search: Vec<PathBuf>,
+    /// The folder of the scene file.
+    scene_dir: PathBuf,
 }
 
 /// One file being read.
@@ -152,10 +166,36 @@ impl Importer {
         } else if depth == 0 {
             self.version_major = 3;
         }
+        // Mitsuba reads the whole tree before it makes anything, so an element may refer to
+        // one declared after it: such an element is read first.
+        let declared: HashMap<&str, Node> =
+            root.children().filter(Node::is_element).filter_map(|c| Some((c.attribute("id")?, c))).collect();
+        let mut done = HashSet::new();
         for child in root.children().filter(Node::is_element) {
-            self.top_level(&ctx, child, depth)?;
+            self.declared_first(&ctx, child, (&declared, &mut done), depth)?;
         }
         Ok(())
+    }
+
+    /// Reads top-level element `node` once, after the later elements of this file it refers to
+    /// (a cycle of references is left to report the element not yet declared).
+    fn declared_first(
+        &mut self,
+        ctx: &Ctx,
+        node: Node,
+        (declared, done): (&HashMap<&str, Node>, &mut HashSet<roxmltree::NodeId>),
+        depth: usize,
+    ) -> R<()> {
+        if !done.insert(node.id()) {
+            return Ok(());
+        }
+        for r in node.descendants().filter(|d| d.tag_name().name() == "ref") {
+            let later = r.attribute("id").filter(|id| !self.ids.contains_key(*id)).and_then(|id| declared.get(id));
+            if let Some(&target) = later {
+                self.declared_first(ctx, target, (declared, done), depth)?;
+            }
+        }
+        self.top_level(ctx, node, depth)
     }
 
     fn top_level(&mut self, ctx: &Ctx, node: Node, depth: usize) -> R<()> {
@@ -170,7 +210,7 @@ impl Importer {
                     return Err(ctx.err(node, "includes nested deeper than 16 files (an include cycle?)"));
                 }
                 let name = self.req_attr(ctx, node, "filename")?;
-                let path = common::relative_to(ctx.path, &name);
+                let path = self.resolve(ctx, &name, true);
                 self.file(&path, depth + 1).map_err(|e| match e {
                     SceneError::Io { source, .. } => {
                         ctx.err(node, format!("cannot read included file {}: {source}", path.display()))
@@ -178,6 +218,7 @@ impl Importer {
                     e => e,
                 })?;
             }
+            "path" => self.search_path(ctx, node)?,
             "integrator" => self.integrator(ctx, node)?,
             "sensor" => self.sensor(ctx, node)?,
             "bsdf" => {
@@ -205,6 +246,35 @@ impl Importer {
             }
         }
         Ok(())
+    }
+
+    /// A `<path>` element: a folder searched for the files the scene names, before those
+    /// searched already (Mitsuba's file resolver). A relative folder is taken from this file's
+    /// folder, else from those searched.
+    fn search_path(&mut self, ctx: &Ctx, node: Node) -> R<()> {
+        let value = self.req_attr(ctx, node, "value")?;
+        let own = common::relative_to(ctx.path, &value);
+        let folder = if own.is_dir() { own.clone() } else { self.resolve(ctx, &value, false) };
+        if !folder.is_dir() {
+            return Err(ctx.err(node, format!("<path>: folder {} not found", own.display())));
+        }
+        self.search.insert(0, folder);
+        Ok(())
+    }
+
+    /// Where a file named `name` in the file being read is: the first folder holding it of the
+    /// `<path>` folders (the latest first), this file's folder, the scene file's folder and the
+    /// working directory (an `include` looks in its file's folder first, as Mitsuba's does);
+    /// when none holds it, the name taken from this file's folder, for the message.
+    fn resolve(&self, ctx: &Ctx, name: &str, own_first: bool) -> PathBuf {
+        let own = common::relative_to(ctx.path, name);
+        if Path::new(name).is_absolute() {
+            return own;
+        }
+        let own_dir = ctx.path.parent().unwrap_or(Path::new("."));
+        let folders = own_first.then_some(own_dir).into_iter().chain(self.search.iter().map(PathBuf::as_path));
+        let folders = folders.chain([own_dir, self.scene_dir.as_path(), Path::new(".")]);
+        folders.map(|f| f.join(name)).find(|p| p.exists()).unwrap_or(own)
     }
 
     fn register(&mut self, ctx: &Ctx, node: Node, what: Named) -> R<()> {
@@ -427,43 +497,43 @@ impl Importer {
         }
     }
 
-    /// A spectrum: one value (grey), `λ:value` pairs (averaged over three bands), or a file
-    /// (not read: grey 0.5).
+    /// A spectrum as Mitsuba's RGB modes take it: `λ:value` pairs weighed by the CIE matching
+    /// functions (a reflectance under D65, so that a flat one is grey; an emitter's radiance as
+    /// it is), one value (grey; for an emitter, that much of the flat spectrum, slightly purple
+    /// in sRGB), or a file (not read: grey 0.5).
     fn spectrum(&mut self, ctx: &Ctx, n: Node) -> R<Vec3> {
         if self.attr(ctx, n, "filename")?.is_some() {
             self.warn(ctx, n, "spectra from files are not read; approximated by grey 0.5");
             return Ok(Vec3::splat(0.5));
         }
+        let emitted = n.parent_element().is_some_and(|p| p.tag_name().name() == "emitter");
         let v = self.req_attr(ctx, n, "value")?;
         if !v.contains(':') {
             return match self.numbers(ctx, n, &v)?[..] {
+                [x] if emitted => Ok(alhazen_math::cie::flat_emission_srgb() * x),
                 [x] => Ok(Vec3::splat(x)),
                 _ => Err(ctx.err(n, "a spectrum value is one number or `wavelength:value` pairs")),
             };
         }
-        let mut bands = [(0.0, 0.0); 3];
+        let (mut wavelengths, mut values) = (vec![], vec![]);
         for pair in v.split(',') {
             let (l, x) =
                 pair.split_once(':').ok_or_else(|| ctx.err(n, format!("`{pair}` is not `wavelength:value`")))?;
-            let l = self.numbers(ctx, n, l)?.first().copied().unwrap_or(0.0);
-            let x = self.numbers(ctx, n, x)?.first().copied().unwrap_or(0.0);
-            let band = if l >= 600.0 {
-                0
-            } else if l >= 500.0 {
-                1
-            } else {
-                2
-            };
-            bands[band].0 += x;
-            bands[band].1 += 1.0;
+            let [l, x] = [l, x].map(|t| self.numbers(ctx, n, t).map(|v| v.first().copied().unwrap_or(0.0)));
+            let (l, x) = (l?, x?);
+            if wavelengths.last().is_some_and(|&last| l <= last) {
+                return Err(ctx.err(n, "a spectrum's wavelengths must increase"));
+            }
+            wavelengths.push(l);
+            values.push(x);
         }
-        self.warn(ctx, n, "a sampled spectrum is approximated by RGB: its mean over 600–700, 500–600 and 400–500 nm");
-        let mean = |b: (f64, f64)| if b.1 > 0.0 { b.0 / b.1 } else { 0.0 };
-        Ok(Vec3::new(mean(bands[0]), mean(bands[1]), mean(bands[2])))
+        let name = n.attribute("name").unwrap_or("");
+        let bounded = !emitted && !matches!(name, "eta" | "k" | "int_ior" | "ext_ior");
+        Ok(alhazen_math::cie::spectrum_to_linear_srgb(&wavelengths, &values, emitted, bounded))
     }
 
     fn unknown_id(&self, ctx: &Ctx, n: Node, id: &str) -> SceneError {
-        let mut d = match ctx.err(n, format!("no object has id \"{id}\" (it must be declared before it is used)")) {
+        let mut d = match ctx.err(n, format!("no object has id \"{id}\"")) {
             SceneError::Syntax(d) => d,
             e => return e,
         };
@@ -942,6 +1012,21 @@ impl Importer {
         Ok((desc, bump))
     }
 
+    /// An `area` emitter's radiance, as a texture.
+    fn area_radiance(&mut self, ctx: &Ctx, node: Node) -> R<Texture> {
+        let e = self.plugin(ctx, node)?;
+        if e.kind != "area" {
+            return Err(ctx.err(node, format!("a shape can only hold an `area` emitter, not `{}`", e.kind)));
+        }
+        let radiance = self.color(ctx, &e, "radiance", Vec3::ONE)?;
+        self.unused(ctx, &e, "emitter");
+        Ok(radiance)
+    }
+
+    fn is_area_emitter_ref(&self, n: &Node) -> bool {
+        n.attribute("id").is_some_and(|id| matches!(self.ids.get(id), Some(Named::AreaEmitter(_))))
+    }
+
     fn is_texture_ref(&self, n: &Node) -> bool {
         n.attribute("id").is_some_and(|id| matches!(self.ids.get(id), Some(Named::Texture(_))))
     }
@@ -1088,7 +1173,7 @@ impl Importer {
             "bitmap" => {
                 let name =
                     self.string(ctx, &p, "filename")?.ok_or_else(|| ctx.err(node, "bitmap needs a `filename`"))?;
-                let path = common::relative_to(ctx.path, &name);
+                let path = self.resolve(ctx, &name, false);
                 let raw = self.boolean(ctx, &p, "raw", false)? || linear;
                 let hdr = matches!(
                     path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
@@ -1154,13 +1239,22 @@ impl Importer {
         }
         let flip = self.boolean(ctx, &p, "flip_normals", false)?;
         let shape = match kind.as_str() {
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 let name = self
                     .string(ctx, &p, "filename")?
                     .ok_or_else(|| ctx.err(node, format!("{kind} needs a `filename`")))?;
-                let path = common::relative_to(ctx.path, &name);
+                let path = self.resolve(ctx, &name, false);
                 let face_normals = self.boolean(ctx, &p, "face_normals", false)?;
-                let mesh = self.mesh(ctx, node, &path, flip)?;
+                let part = if kind == "serialized" {
+                    let index = self.float(ctx, &p, "shape_index", 0.0)?;
+                    if !(0.0..=u32::MAX as f64).contains(&index) || index.fract() != 0.0 {
+                        return Err(ctx.err(node, format!("shape_index {index} is not a mesh's index (0, 1, 2, …)")));
+                    }
+                    Some(index as usize)
+                } else {
+                    None
+                };
+                let mesh = self.mesh(ctx, node, (&path, part), flip)?;
                 Shape::Mesh { mesh, smooth: !face_normals }
             }
             "rectangle" => {
@@ -1188,15 +1282,12 @@ impl Importer {
                 }
                 Shape::Cylinder { base, top, radius, capped: false }
             }
-            "serialized" => {
-                return Err(ctx.err(node, "Mitsuba's serialized meshes are not supported: convert the mesh to PLY (e.g. with mitsuba's own tools or Blender)"));
-            }
             other => {
                 self.warn(ctx, node, format!("shape `{other}` is not supported; left out"));
                 return Ok(vec![]);
             }
         };
-        if flip && !matches!(kind.as_str(), "obj" | "ply" | "rectangle") {
+        if flip && !matches!(kind.as_str(), "obj" | "ply" | "serialized" | "rectangle") {
             self.warn(
                 ctx,
                 node,
@@ -1208,6 +1299,14 @@ impl Importer {
         for c in node.children().filter(Node::is_element) {
             match c.tag_name().name() {
                 "bsdf" => material = Some(self.bsdf_material(ctx, c)?),
+                "ref" if c.attribute("name") == Some("emitter") || self.is_area_emitter_ref(&c) => {
+                    let id = self.req_attr(ctx, c, "id")?;
+                    emission = Some(match self.ids.get(&id) {
+                        Some(Named::AreaEmitter(radiance)) => (radiance.clone(), c),
+                        Some(_) => return Err(ctx.err(c, format!("\"{id}\" is not an area emitter"))),
+                        None => return Err(self.unknown_id(ctx, c, &id)),
+                    });
+                }
                 "ref" if c.attribute("name").is_none_or(|n| n == "bsdf") => {
                     let id = self.req_attr(ctx, c, "id")?;
                     material = Some(match self.ids.get(&id) {
@@ -1216,24 +1315,22 @@ impl Importer {
                         None => return Err(self.unknown_id(ctx, c, &id)),
                     });
                 }
-                "emitter" => {
-                    let e = self.plugin(ctx, c)?;
-                    if e.kind != "area" {
-                        return Err(ctx.err(c, format!("a shape can only hold an `area` emitter, not `{}`", e.kind)));
-                    }
-                    // A textured radiance is read per point on meshes; other shapes shine its mean.
-                    let textured = self.color(ctx, &e, "radiance", Vec3::ONE)?;
-                    let radiance = if matches!(textured, Texture::Solid(_)) || !matches!(shape, Shape::Mesh { .. }) {
-                        (self.constant_color(ctx, &e, "radiance", Vec3::ONE)?, None)
-                    } else {
-                        (self.pending.texture_mean(&textured, &mut self.scene)?, Some(textured))
-                    };
-                    self.unused(ctx, &e, "emitter");
-                    emission = Some(radiance);
-                }
+                "emitter" => emission = Some((self.area_radiance(ctx, c)?, c)),
                 _ => {}
             }
         }
+        // A textured radiance is read per point on meshes; other shapes shine its mean.
+        let emission = match emission {
+            Some((Texture::Solid(c), _)) => Some((c, None)),
+            Some((textured, _)) if matches!(shape, Shape::Mesh { .. }) => {
+                Some((self.pending.texture_mean(&textured, &mut self.scene)?, Some(textured)))
+            }
+            Some((textured, c)) => {
+                self.warn(ctx, c, "a textured `radiance` is replaced by its mean colour on shapes other than meshes");
+                Some((self.pending.texture_mean(&textured, &mut self.scene)?, None))
+            }
+            None => None,
+        };
         // Mitsuba gives a shape without a BSDF a diffuse one of reflectance 0.5, and an emitting
         // shape one of reflectance 0: a bare light does not reflect.
         let mut material = match (material, &emission) {
@@ -1268,14 +1365,15 @@ impl Importer {
 
     /// A mesh file's place in the scene, once per file (and orientation); its triangles are
     /// read with the other files' once the walk is done.
-    fn mesh(&mut self, ctx: &Ctx, node: Node, path: &Path, flip: bool) -> R<usize> {
-        if let Some(&i) = self.meshes.get(&(path.to_path_buf(), flip)) {
+    fn mesh(&mut self, ctx: &Ctx, node: Node, (path, part): (&Path, Option<usize>), flip: bool) -> R<usize> {
+        let key = (path.to_path_buf(), part, flip);
+        if let Some(&i) = self.meshes.get(&key) {
             return Ok(i);
         }
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
-        self.meshes.insert((path.to_path_buf(), flip), index);
-        self.pending.push_mesh(index, path, flip, (ctx.path, ctx.shared), node.range());
+        self.meshes.insert(key, index);
+        self.pending.push_mesh((index, part), path, flip, (ctx.path, ctx.shared), node.range());
         Ok(index)
     }
 
@@ -1336,12 +1434,16 @@ impl Importer {
             "envmap" => {
                 let name =
                     self.string(ctx, &p, "filename")?.ok_or_else(|| ctx.err(node, "envmap needs a `filename`"))?;
-                let path = common::relative_to(ctx.path, &name);
+                let path = self.resolve(ctx, &name, false);
                 let img = alhazen_scene::import::load_hdr_image(&path).map_err(|e| ctx.err(node, e))?;
                 let scale = self.float(ctx, &p, "scale", 1.0)?;
-                let rotation = self.rotation_about_y(ctx, node, l);
+                let (rotation, up) = self.map_orientation(ctx, node, l);
                 self.scene.images.push(Arc::new(img));
-                Light::Environment { image: self.scene.images.len() - 1, scale, rotation }
+                Light::Environment { image: self.scene.images.len() - 1, scale, rotation, up }
+            }
+            "area" if node.attribute("id").is_some() => {
+                let radiance = self.area_radiance(ctx, node)?;
+                return self.register(ctx, node, Named::AreaEmitter(radiance));
             }
             "area" => return Err(ctx.err(node, "an area emitter must be nested in the <shape> it covers")),
             other => {
@@ -1356,17 +1458,20 @@ impl Importer {
 
     /// The angle of a rotation about `+y` (Mitsuba's envmap and alhazen's share the
     /// equirectangular mapping, `u` from `−z` towards `+x`); other rotations are warned about.
-    fn rotation_about_y(&mut self, ctx: &Ctx, node: Node, l: Mat3) -> f64 {
-        let angle = (l.z_axis.x).atan2(l.z_axis.z);
-        let about_y = Mat3::from_rotation_y(angle);
-        if (l - about_y).to_cols_array().iter().any(|x| x.abs() > 1e-6) {
-            self.warn(
-                ctx,
-                node,
-                "an environment map's to_world other than a rotation about +y is approximated by its turn about +y",
-            );
+    /// An environment map's `to_world` as alhazen's up axis and turn about it: the image of
+    /// `+y`, and the turn that is left once the least rotation taking `+y` there is undone. A
+    /// matrix that is not a rotation (scaled, sheared or mirrored) is taken by its columns made
+    /// orthonormal, with a warning.
+    fn map_orientation(&mut self, ctx: &Ctx, node: Node, l: Mat3) -> (f64, Vec3) {
+        let up = l.y_axis.try_normalize().unwrap_or(Vec3::Y);
+        let z = (l.z_axis - up * l.z_axis.dot(up)).try_normalize().unwrap_or_else(|| up.any_orthonormal_vector());
+        let rotation = Mat3::from_cols(up.cross(z), up, z);
+        if (l - rotation).to_cols_array().iter().any(|x| x.abs() > 1e-5) {
+            self.warn(ctx, node, "an environment map's to_world that is not a rotation is taken by its rotation");
         }
-        angle
+        let frame = alhazen_scene::texture::up_frame(up).unwrap_or(Mat3::IDENTITY);
+        let turn = frame.transpose() * rotation;
+        (turn.z_axis.x.atan2(turn.z_axis.z), up)
     }
 }
 

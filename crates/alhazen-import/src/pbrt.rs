@@ -1362,7 +1362,7 @@ impl Importer {
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert((path.to_path_buf(), reverse), index);
-        self.pending.push_mesh(index, path, reverse, (ctx.path, ctx.shared), at.clone());
+        self.pending.push_mesh((index, None), path, reverse, (ctx.path, ctx.shared), at.clone());
         Ok(index)
     }
 
@@ -1443,7 +1443,12 @@ impl Importer {
             }
         }
         self.scene.images.push(Arc::new(ImageData::new(w as u32, h as u32, pixels)));
-        self.scene.lights.push(Light::Environment { image: self.scene.images.len() - 1, scale, rotation: 0.0 });
+        self.scene.lights.push(Light::Environment {
+            image: self.scene.images.len() - 1,
+            scale,
+            rotation: 0.0,
+            up: Vec3::Y,
+        });
     }
 }
 

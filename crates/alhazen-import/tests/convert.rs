@@ -96,6 +96,7 @@ type = "environment"
 file = "sky.exr"
 scale = 0.7
 rotate_y = 31
+up = [0, 0.6, 0.8]
 [materials.tex]
 color = { image = { file = "tex.png", scale = [2, 3] } }
 bump = { height = 0.02, image = { file = "tex.png", scale = 4 } }

@@ -12,6 +12,7 @@
 //!   orthographic and perspective frustum matrices `(l, r, b, t, n, f)` and their inverses,
 //!   window→viewport, homogenisation, stereo frusta;
 //! * [`color`] — the course's sRGB transfer function and the XYZ→sRGB matrix;
+//! * [`cie`] — the CIE 1931 matching functions, illuminant D65, sampled spectra as sRGB;
 //! * [`poly`] — numerically careful real roots of low-degree polynomials;
 //! * [`exact_sum`] — order-independent exact sums of doubles (the film's pixel sums);
 //! * [`elementary`] — `exp` and `ln` that vectorise (the material kernels' Beckmann facets).
@@ -24,6 +25,7 @@
 //! ```
 
 pub mod bounds;
+pub mod cie;
 pub mod color;
 pub mod elementary;
 pub mod exact_sum;

@@ -20,7 +20,7 @@
 use crate::distribution::{Distribution1D, Slices, guide_table, search_cdf};
 use crate::prefetch::prefetch;
 use crate::shape::VectorUnit;
-use alhazen_math::{Vec2, Vec3, color::luminance};
+use alhazen_math::{Mat3, Vec2, Vec3, color::luminance};
 use alhazen_scene::ImageData;
 use std::f64::consts::PI;
 
@@ -54,13 +54,15 @@ pub struct EnvMap {
     rotation: f64,
     /// The rotation in turns.
     turns: f64,
+    /// The map's axes in the world ([`alhazen_scene::texture::up_frame`]).
+    frame: Option<Mat3>,
     /// Over rows, by their power.
     rows: Distribution1D,
 }
 
 impl EnvMap {
-    /// From a linear radiance image.
-    pub fn new(image: &ImageData, scale: f64, rotation: f64) -> Self {
+    /// From a linear radiance image, turned by `rotation` (radians) about its up axis `up`.
+    pub fn new(image: &ImageData, scale: f64, (rotation, up): (f64, Vec3)) -> Self {
         let (width, height) = (image.width as usize, image.height as usize);
         let mut texels = Vec::with_capacity(width * height);
         let mut row_power = Vec::with_capacity(height);
@@ -92,6 +94,7 @@ impl EnvMap {
             scale,
             rotation,
             turns: rotation / (2.0 * PI),
+            frame: alhazen_scene::texture::up_frame(up),
             rows: Distribution1D::new(&row_power),
         };
         if guided {
@@ -159,16 +162,23 @@ impl EnvMap {
         self.slices.of(u)
     }
 
+    /// World direction `dir` in the map's axes.
+    #[inline(always)]
+    fn in_map_axes(&self, dir: Vec3) -> Vec3 {
+        alhazen_scene::texture::into_map(self.frame, dir)
+    }
+
     #[inline(always)]
     fn to_uv(&self, dir: Vec3) -> Vec2 {
-        alhazen_scene::texture::equirect_uv(dir, self.rotation)
+        alhazen_scene::texture::equirect_uv(self.in_map_axes(dir), self.rotation)
     }
 
     /// The direction of `uv` and its polar angle's sine.
     fn to_dir(&self, uv: Vec2) -> (Vec3, f64) {
         let (st, ct) = alhazen_math::sin_cos_turns(uv.y / 2.0);
         let (sp, cp) = alhazen_math::sin_cos_turns(uv.x - self.turns);
-        (Vec3::new(st * sp, ct, -st * cp), st)
+        let dir = Vec3::new(st * sp, ct, -st * cp);
+        (self.frame.map_or(dir, |f| f * dir), st)
     }
 
     /// Radiance arriving from direction `dir` (unit, pointing away from the scene).
@@ -221,7 +231,7 @@ impl EnvMap {
 
     /// Solid-angle density of [`Self::sample`] choosing `dir`.
     pub fn pdf(&self, dir: Vec3) -> f64 {
-        self.solid_angle_density(self.texel_at(self.to_uv(dir)), polar_sine(dir))
+        self.solid_angle_density(self.texel_at(self.to_uv(dir)), polar_sine(self.in_map_axes(dir)))
     }
 
     /// [`Self::radiance`] and [`Self::pdf`] of `dir`, mapped to the image once.
@@ -257,7 +267,7 @@ impl EnvMap {
 
     /// [`Self::radiance_and_pdf`] of `dir` in its texel, `texel` ([`Self::texels_ahead`]).
     pub fn radiance_and_pdf_at(&self, dir: Vec3, texel: (usize, usize)) -> (Vec3, f64) {
-        (self.radiance_of(texel), self.solid_angle_density(texel, polar_sine(dir)))
+        (self.radiance_of(texel), self.solid_angle_density(texel, polar_sine(self.in_map_axes(dir))))
     }
 
     /// The texels of many directions, in AVX-512 or AVX2 where `unit` has them.
@@ -316,15 +326,22 @@ fn polar_sine(dir: Vec3) -> f64 {
 mod tests {
     use super::*;
 
-    fn test_map() -> EnvMap {
+    /// Upright, tilted towards `+z` (a z-up world's map) and upside down.
+    fn test_maps() -> [EnvMap; 3] {
         let (w, h) = (16u32, 8u32);
-        let pixels = (0..w * h).map(|i| [(i % 7) as f32 + 0.5, 1.0, (i % 3) as f32]).collect();
-        EnvMap::new(&ImageData::new(w, h, pixels), 2.0, 0.4)
+        let pixels: Vec<_> = (0..w * h).map(|i| [(i % 7) as f32 + 0.5, 1.0, (i % 3) as f32]).collect();
+        [Vec3::Y, Vec3::new(0.0, 0.6, 0.8), -Vec3::Y]
+            .map(|up| EnvMap::new(&ImageData::new(w, h, pixels.clone()), 2.0, (0.4, up)))
     }
 
     #[test]
     fn directions_round_trip_and_density_integrates_to_one() {
-        let m = test_map();
+        for m in test_maps() {
+            round_trip_and_unit_integral(&m);
+        }
+    }
+
+    fn round_trip_and_unit_integral(m: &EnvMap) {
         let (n, mut sum) = (400, 0.0);
         for i in 0..n {
             let z = -1.0 + 2.0 * (i as f64 + 0.5) / n as f64;
@@ -341,7 +358,12 @@ mod tests {
 
     #[test]
     fn samples_report_their_own_density_and_radiance() {
-        let m = test_map();
+        for m in test_maps() {
+            own_density_and_radiance(&m);
+        }
+    }
+
+    fn own_density_and_radiance(m: &EnvMap) {
         for k in 0..200 {
             let u = Vec2::new((k as f64 * 0.618).fract(), (k as f64 * 0.377 + 0.1).fract());
             let (d, l, pdf) = m.sample(u).unwrap();
@@ -359,14 +381,14 @@ mod tests {
         for (w, h) in [(40u32, 20u32), (8, 4)] {
             let lit = (h / 3 * w + w / 4) as usize;
             let pixels = (0..(w * h) as usize).map(|i| if i == lit { [5.0, 4.0, 3.0] } else { [0.0; 3] }).collect();
-            let m = EnvMap::new(&ImageData::new(w, h, pixels), 1.0, 0.0);
+            let m = EnvMap::new(&ImageData::new(w, h, pixels), 1.0, (0.0, Vec3::Y));
             for k in 0..100 {
                 let u = Vec2::new((k as f64 * 0.618).fract(), (k as f64 * 0.377 + 0.1).fract());
                 let (d, l, pdf) = m.sample(u).unwrap();
                 assert_eq!(l, Vec3::new(5.0, 4.0, 3.0), "{w}×{h} sample {k}");
                 assert!((m.pdf(d) - pdf).abs() < 1e-9 * pdf, "{w}×{h} sample {k}");
             }
-            let black = EnvMap::new(&ImageData::new(w, h, vec![[0.0; 3]; (w * h) as usize]), 1.0, 0.0);
+            let black = EnvMap::new(&ImageData::new(w, h, vec![[0.0; 3]; (w * h) as usize]), 1.0, (0.0, Vec3::Y));
             let (_, l, pdf) = black.sample(Vec2::new(0.3, 0.6)).unwrap();
             assert!(l == Vec3::ZERO && pdf.is_finite() && pdf > 0.0);
         }
@@ -381,7 +403,7 @@ mod tests {
         let before = crate::memory_estimate(&scene);
         scene.images.push(std::sync::Arc::new(ImageData::new(64, 32, vec![[1.0; 3]; 64 * 32])));
         let image = scene.images.len() - 1;
-        scene.lights.push(alhazen_scene::Light::Environment { image, scale: 1.0, rotation: 0.0 });
+        scene.lights.push(alhazen_scene::Light::Environment { image, scale: 1.0, rotation: 0.0, up: Vec3::Y });
         assert!(crate::memory_estimate(&scene) >= before + 64 * 32 * 18);
     }
 }

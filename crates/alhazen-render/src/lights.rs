@@ -301,9 +301,9 @@ impl Lights {
                 Light::Directional { direction, intensity } => {
                     PathLight::Directional { direction, irradiance: intensity }
                 }
-                Light::Environment { image, scale, rotation } => {
+                Light::Environment { image, scale, rotation, up } => {
                     sky = Some(lights.len() as u32);
-                    PathLight::Environment(Box::new(EnvMap::new(&scene.images[image], scale, rotation)))
+                    PathLight::Environment(Box::new(EnvMap::new(&scene.images[image], scale, (rotation, up))))
                 }
             });
         }

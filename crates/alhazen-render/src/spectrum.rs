@@ -13,24 +13,7 @@
 use alhazen_math::{Mat3, Vec3, color::xyz_to_linear_srgb};
 use std::sync::OnceLock;
 
-/// Shortest wavelength rendered, nm.
-pub const LAMBDA_MIN: f64 = 360.0;
-/// Longest wavelength rendered, nm.
-pub const LAMBDA_MAX: f64 = 830.0;
-
-fn lobe(lambda: f64, mu: f64, sigma_lo: f64, sigma_hi: f64) -> f64 {
-    let t = (lambda - mu) / if lambda < mu { sigma_lo } else { sigma_hi };
-    (-0.5 * t * t).exp()
-}
-
-/// The CIE 1931 2° colour matching functions `(x̄, ȳ, z̄)` at `lambda` nm (multi-lobe fit).
-pub fn cie_xyz(lambda: f64) -> Vec3 {
-    let x = 1.056 * lobe(lambda, 599.8, 37.9, 31.0) + 0.362 * lobe(lambda, 442.0, 16.0, 26.7)
-        - 0.065 * lobe(lambda, 501.1, 20.4, 26.2);
-    let y = 0.821 * lobe(lambda, 568.8, 46.9, 40.5) + 0.286 * lobe(lambda, 530.9, 16.3, 31.1);
-    let z = 1.217 * lobe(lambda, 437.0, 11.8, 36.0) + 0.681 * lobe(lambda, 459.0, 26.0, 13.8);
-    Vec3::new(x, y, z)
-}
+pub use alhazen_math::cie::{LAMBDA_MAX, LAMBDA_MIN, cie_xyz};
 
 fn smoothstep(x: f64) -> f64 {
     let t = x.clamp(0.0, 1.0);

@@ -339,8 +339,11 @@ pub enum Light {
         image: usize,
         /// Multiplier of the image's values.
         scale: f64,
-        /// Rotation of the map about the vertical axis, radians.
+        /// Rotation of the map about its up axis, radians.
         rotation: f64,
+        /// The map's up axis (unit): `+y` for a map upright in the scene, `+z` for one upright
+        /// in a z-up world (Blender's).
+        up: Vec3,
     },
 }
 
@@ -377,7 +380,8 @@ impl Scene {
     /// has one (nearest texel), else the background.
     pub fn sky(&self, dir: Vec3) -> Rgb {
         for l in &self.lights {
-            if let Light::Environment { image, scale, rotation } = *l {
+            if let Light::Environment { image, scale, rotation, up } = *l {
+                let dir = crate::texture::into_map(crate::texture::up_frame(up), dir);
                 return crate::texture::equirect_texel(&self.images[image], dir, rotation) * scale;
             }
         }

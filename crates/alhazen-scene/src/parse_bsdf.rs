@@ -130,9 +130,10 @@ impl Parser<'_> {
         })
     }
 
-    /// `[[light]] type = "environment"`: an equirectangular `.hdr` or `.exr` map.
+    /// `[[light]] type = "environment"`: an equirectangular `.hdr` or `.exr` map, turned by
+    /// `rotate_y` degrees about its up axis, `up` (`+y` unless given).
     pub(crate) fn environment_light(&mut self, n: &Node) -> R<Light> {
-        let t = n.table(&["type", "file", "scale", "rotate_y"])?;
+        let t = n.table(&["type", "file", "scale", "rotate_y", "up"])?;
         let file = t.req("file")?;
         let path = self.dir.join(file.str()?);
         let data = import::load_hdr_image(&path).map_err(|e| file.err(e))?;
@@ -141,6 +142,7 @@ impl Parser<'_> {
             image: self.scene.images.len() - 1,
             scale: t.get("scale").map_or(Ok(1.0), |n| n.non_negative())?,
             rotation: t.opt_f64("rotate_y", 0.0)?.to_radians(),
+            up: t.get("up").map_or(Ok(Vec3::Y), |n| n.unit_vec3())?,
         })
     }
 }

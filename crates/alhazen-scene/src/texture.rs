@@ -1,7 +1,7 @@
 //! Evaluation of surface colour textures: solid, checker, image (bilinear, repeating).
 
 use crate::{ImageData, Texture};
-use alhazen_math::{Vec2, Vec3, elementary};
+use alhazen_math::{Mat3, Vec2, Vec3, elementary};
 
 /// The colour of `tex` at texture coordinates `uv`.
 pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Vec3 {
@@ -42,6 +42,25 @@ pub fn equirect_uv(dir: Vec3, rotation: f64) -> Vec2 {
     let u = wrap_unit(phi / (2.0 * PI));
     let v = elementary::acos(dir.y.clamp(-1.0, 1.0)) / PI;
     Vec2::new(u.min(1.0 - 1e-16), v.min(1.0 - 1e-16))
+}
+
+/// The rotation taking `+y` to unit vector `up` by the least turn (about their common normal;
+/// a half turn about `+x` for `−y`): the frame of an environment map whose up axis is `up`.
+/// `None` for `+y` itself, where the map's directions are the world's.
+pub fn up_frame(up: Vec3) -> Option<Mat3> {
+    let axis = Vec3::Y.cross(up);
+    let sin = axis.length();
+    match (up == Vec3::Y, sin > 0.0) {
+        (true, _) => None,
+        (false, true) => Some(Mat3::from_axis_angle(axis / sin, sin.atan2(up.y))),
+        (false, false) => Some(Mat3::from_rotation_x(std::f64::consts::PI)),
+    }
+}
+
+/// World direction `dir` in the axes of a map of frame `frame` ([`up_frame`]).
+#[inline(always)]
+pub fn into_map(frame: Option<Mat3>, dir: Vec3) -> Vec3 {
+    frame.map_or(dir, |f| f.transpose() * dir)
 }
 
 /// The texel of an equirectangular image seen in direction `dir` (nearest lookup).

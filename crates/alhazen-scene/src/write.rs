@@ -271,11 +271,14 @@ impl Writer<'_> {
                 self.line("intensity", vec3(*intensity));
                 self.line("attenuation", att(attenuation));
             }
-            Light::Environment { image, scale, rotation } => {
+            Light::Environment { image, scale, rotation, up } => {
                 self.line("type", string("environment"));
                 self.line("file", string(&self.images[*image].clone()));
                 self.line("scale", num(*scale));
                 self.line("rotate_y", num(degrees(*rotation, |x| x)));
+                if *up != Vec3::Y {
+                    self.line("up", vec3(*up));
+                }
             }
         }
     }

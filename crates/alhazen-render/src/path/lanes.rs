@@ -1792,7 +1792,7 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
             texels.collect(),
         )));
         let image = environment.images.len() - 1;
-        environment.lights.push(alhazen_scene::Light::Environment { image, scale: 1.0, rotation: 0.3 });
+        environment.lights.push(alhazen_scene::Light::Environment { image, scale: 1.0, rotation: 0.3, up: Vec3::Y });
         // Glass whose index and its inverse do not square to exactly 1 (1.52² · (1/1.52)²):
         // Lambert vertices after it see a path's `eta_scale` off 1 in the last bit.
         let mut glass = small("cornell-rough", (16, 16, 9));
