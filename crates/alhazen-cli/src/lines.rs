@@ -18,6 +18,8 @@ pub struct LinesArgs {
     /// The scene file (TOML, glTF, Mitsuba 3 XML or pbrt-v4); not needed with --graph.
     #[arg(required_unless_present = "graph")]
     scene: Option<PathBuf>,
+    #[command(flatten)]
+    parameters: crate::SceneParameters,
     /// Output: .svg (a layer per kind of line, read as layers by Inkscape and vpype), .pdf,
     /// .hpgl or .plt (HP-GL for pen plotters: pen 1 visible, 2 reflected, 3 hidden; an
     /// anaglyph's eyes 4 and 5) or .png (an antialiased preview).
@@ -157,7 +159,7 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
     let (drawing, summary) = match (a.graph, &a.scene) {
         (Some(g), _) => graph_drawing(g, a),
         (None, Some(path)) => {
-            let scene = load(path)?;
+            let scene = load(path, &a.parameters)?;
             let opts = Options {
                 width_mm: a.width_mm,
                 feature_angle_deg: a.feature_angle,

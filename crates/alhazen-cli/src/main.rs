@@ -132,9 +132,29 @@ enum Command {
 struct ConvertArgs {
     /// The scene to convert: alhazen TOML, glTF 2.0 (.gltf/.glb), Mitsuba 3 XML (.xml) or pbrt-v4 (.pbrt).
     scene: PathBuf,
+    #[command(flatten)]
+    parameters: SceneParameters,
     /// The TOML file to write (its meshes and images go to a folder beside it, named after it).
     #[arg(short, long)]
     output: PathBuf,
+}
+
+/// Values of a Mitsuba scene's `$name` parameters, as Mitsuba's own `-D name=value`.
+#[derive(Args, Default)]
+pub(crate) struct SceneParameters {
+    /// A Mitsuba scene's parameter: `-D spp=64` gives `$spp` that value, over the scene's
+    /// `<default>` (repeat for more).
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
+    pub(crate) defines: Vec<(String, String)>,
+}
+
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    let (name, value) = s.split_once('=').ok_or_else(|| format!("`{s}` is not NAME=VALUE"))?;
+    let name = name.trim();
+    if name.is_empty() || !name.chars().all(|c| c.is_alphanumeric() || c == '_') {
+        return Err(format!("`{name}` is not a parameter name (letters, digits and _)"));
+    }
+    Ok((name.to_string(), value.to_string()))
 }
 
 /// What every image-producing command takes: the scene, the output and its size.
@@ -142,6 +162,8 @@ struct ConvertArgs {
 pub(crate) struct ImageArgs {
     /// The scene file: alhazen TOML, glTF 2.0 (.gltf/.glb), Mitsuba 3 XML (.xml) or pbrt-v4 (.pbrt).
     pub(crate) scene: PathBuf,
+    #[command(flatten)]
+    pub(crate) parameters: SceneParameters,
     /// Output image: .png (8-bit sRGB), .exr or .pfm (linear floats).
     #[arg(short, long)]
     pub(crate) output: PathBuf,
@@ -242,11 +264,20 @@ fn main() -> ExitCode {
 
 /// Reads a scene file in any format alhazen imports (TOML, glTF, Mitsuba XML, pbrt), printing
 /// what the import approximated; every problem with it is bad input (exit code 2).
-pub(crate) fn load(path: &Path) -> Result<Scene, Failure> {
-    let imported = alhazen_import::load_within(path, memory_budget()).map_err(|e| match e {
-        SceneError::Io { .. } => Failure::input(e.to_string()),
-        SceneError::Syntax(d) => Failure::input(d.to_string()),
-    })?;
+pub(crate) fn load(path: &Path, parameters: &SceneParameters) -> Result<Scene, Failure> {
+    let format = alhazen_import::SceneFormat::from_path(path);
+    if !parameters.defines.is_empty() && format != alhazen_import::SceneFormat::Mitsuba {
+        return Err(Failure::input(format!(
+            "-D gives values to a Mitsuba scene's $parameters; {} is a {} file",
+            path.display(),
+            format.name()
+        )));
+    }
+    let imported =
+        alhazen_import::load_with_parameters(path, memory_budget(), &parameters.defines).map_err(|e| match e {
+            SceneError::Io { .. } => Failure::input(e.to_string()),
+            SceneError::Syntax(d) => Failure::input(d.to_string()),
+        })?;
     for w in &imported.warnings {
         eprintln!("warning: {w}");
     }
@@ -255,7 +286,7 @@ pub(crate) fn load(path: &Path) -> Result<Scene, Failure> {
 
 /// Reads the scene and applies `--width`/`--height`, refusing sizes that cannot be allocated.
 pub(crate) fn load_sized(a: &ImageArgs) -> Result<Scene, Failure> {
-    let mut scene = load(&a.scene)?;
+    let mut scene = load(&a.scene, &a.parameters)?;
     let r = &mut scene.render;
     r.width = a.width.unwrap_or(r.width);
     r.height = a.height.unwrap_or(r.height);
@@ -301,7 +332,7 @@ fn run_convert(a: &ConvertArgs) -> Result<(), Failure> {
         return Err(Failure::input(format!("{}: the output of convert is a .toml file", a.output.display())));
     }
     check_output_dir(&a.output)?;
-    let scene = load(&a.scene)?;
+    let scene = load(&a.scene, &a.parameters)?;
     let stem = a.output.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
     let assets = a.output.with_file_name(format!("{stem}-assets"));
     let header = format!(

@@ -23,6 +23,8 @@ use std::time::Instant;
 pub(crate) struct ViewArgs {
     /// The scene file: alhazen TOML, glTF (.gltf/.glb), Mitsuba 3 XML (.xml) or pbrt-v4 (.pbrt).
     scene: PathBuf,
+    #[command(flatten)]
+    parameters: crate::SceneParameters,
     /// Window width (overrides the scene's image width).
     #[arg(long, value_parser = clap::value_parser!(u32).range(16..=8192))]
     width: Option<u32>,
@@ -121,7 +123,7 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
     if let Some(s) = &a.screenshot {
         check_output(s, false)?;
     }
-    let mut scene = load(&a.scene)?;
+    let mut scene = load(&a.scene, &a.parameters)?;
     scene.render.width = a.width.unwrap_or(scene.render.width).clamp(16, 8192);
     scene.render.height = a.height.unwrap_or(scene.render.height).clamp(16, 8192);
     let (w, h) = (scene.render.width as usize, scene.render.height as usize);

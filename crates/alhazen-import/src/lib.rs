@@ -104,6 +104,16 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
 /// [`load`], refusing geometry the scene generates beyond `memory_budget` bytes (before
 /// allocating it).
 pub fn load_within(path: &Path, memory_budget: u64) -> Result<Imported, SceneError> {
+    load_with_parameters(path, memory_budget, &[])
+}
+
+/// [`load_within`], a Mitsuba scene's `$name` parameters given `parameters`' values over its
+/// `<default>`s (Mitsuba's `-D name=value`; other formats have no parameters and ignore them).
+pub fn load_with_parameters(
+    path: &Path,
+    memory_budget: u64,
+    parameters: &[(String, String)],
+) -> Result<Imported, SceneError> {
     match SceneFormat::from_path(path) {
         SceneFormat::Alhazen => {
             let (scene, warnings) = alhazen_scene::load_scene_reporting(path, memory_budget)?;
@@ -112,7 +122,7 @@ pub fn load_within(path: &Path, memory_budget: u64) -> Result<Imported, SceneErr
             Ok(Imported { scene, warnings })
         }
         SceneFormat::Gltf => gltf::load(path),
-        SceneFormat::Mitsuba => mitsuba::load(path),
+        SceneFormat::Mitsuba => mitsuba::load_with_parameters(path, parameters),
         SceneFormat::Pbrt => pbrt::load(path),
     }
 }

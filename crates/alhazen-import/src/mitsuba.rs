@@ -36,10 +36,17 @@ type R<T> = Result<T, SceneError>;
 
 /// Reads a Mitsuba 3 XML scene.
 pub fn load(path: &Path) -> Result<Imported, SceneError> {
+    load_with_parameters(path, &[])
+}
+
+/// Reads a Mitsuba 3 XML scene, its `$name` parameters given `parameters`' values over its
+/// `<default>`s (as Mitsuba's `-D name=value`); a parameter the scene never uses is a warning.
+pub fn load_with_parameters(path: &Path, parameters: &[(String, String)]) -> Result<Imported, SceneError> {
     let mut imp = Importer {
         scene: alhazen_scene::empty_scene(),
         warnings: Warnings::default(),
-        defaults: HashMap::new(),
+        defaults: parameters.iter().cloned().collect(),
+        used: RefCell::default(),
         ids: HashMap::new(),
         meshes: HashMap::new(),
         default_material: None,
@@ -67,6 +74,11 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
         }
     })?;
     walked?;
+    for (name, _) in parameters {
+        if !imp.used.borrow().contains(name) {
+            imp.warnings.add(path, 0, format!("parameter `{name}` is given a value but the scene never uses ${name}"));
+        }
+    }
     imp.finish()
 }
 
@@ -92,6 +104,8 @@ struct Importer {
     scene: Scene,
     warnings: Warnings,
     defaults: HashMap<String, String>,
+    /// The parameters substituted somewhere.
+    used: RefCell<HashSet<String>>,
     ids: HashMap<String, Named>,
     /// Mesh files (a `serialized` file's mesh) and orientations, and their places.
     meshes: HashMap<(PathBuf, Option<usize>, bool), usize>,
@@ -303,6 +317,7 @@ impl Importer {
                 ctx.err(node, format!("${key} has no value: declare it with <default name=\"{key}\" value=\"…\"/>"))
             })?;
             out.push_str(value);
+            self.used.borrow_mut().insert(key.to_string());
             rest = &tail[len..];
         }
         out.push_str(rest);
@@ -670,15 +685,17 @@ impl Importer {
                     self.float(ctx, &p, "focus_distance", 0.0)?;
                 }
                 let axis = self.string(ctx, &p, "fov_axis")?.unwrap_or_else(|| "x".into());
-                let (fov, axis) = match self.string(ctx, &p, "focal_length")? {
-                    Some(f) if self.prop(&p, "fov").is_none() => {
-                        let mm = f.trim_end_matches("mm").trim().parse::<f64>().ok().filter(|f| *f > 0.0);
-                        let mm =
-                            mm.ok_or_else(|| ctx.err(node, format!("focal_length \"{f}\" is not a length in mm")))?;
-                        // Mitsuba measures the focal length against a 36 × 24 mm film's diagonal.
-                        (2.0 * (0.5 * 36f64.hypot(24.0) / mm).atan().to_degrees(), "diagonal".to_string())
-                    }
-                    _ => (self.float(ctx, &p, "fov", 0.0)?, axis),
+                // Without `fov`, Mitsuba's focal length, 50 mm unless given.
+                let focal_length = self.string(ctx, &p, "focal_length")?.unwrap_or_else(|| "50mm".into());
+                let (fov, axis) = if self.prop(&p, "fov").is_none() {
+                    let mm = focal_length.trim_end_matches("mm").trim().parse::<f64>().ok().filter(|f| *f > 0.0);
+                    let mm = mm.ok_or_else(|| {
+                        ctx.err(node, format!("focal_length \"{focal_length}\" is not a length in mm"))
+                    })?;
+                    // Mitsuba measures the focal length against a 36 × 24 mm film's diagonal.
+                    (2.0 * (0.5 * 36f64.hypot(24.0) / mm).atan().to_degrees(), "diagonal".to_string())
+                } else {
+                    (self.float(ctx, &p, "fov", 0.0)?, axis)
                 };
                 if !(fov > 0.0 && fov < 180.0) {
                     return Err(ctx.err(node, "a perspective sensor needs `fov` in (0, 180) degrees"));

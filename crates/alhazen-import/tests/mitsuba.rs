@@ -750,3 +750,29 @@ fn spectra_are_weighed_as_mitsuba_weighs_them() {
     let flat = s.materials[s.objects[2].material as usize].emission;
     assert!(near(flat, Vec3::new(2.40959, 1.89658, 1.81783)), "{flat}");
 }
+
+/// `-D name=value` (Mitsuba's command line, alhazen's too) gives a parameter its value over
+/// the scene's `<default>`, and the scenes that declare none render; a value the scene never
+/// uses is a warning.
+#[test]
+fn parameters_given_outside_the_file_come_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let xml = scene(
+        r#"<default name="r" value="1"/>
+        <shape type="sphere"><float name="radius" value="$r"/></shape>
+        <sensor type="perspective"><sampler type="independent"><integer name="sample_count" value="$spp"/></sampler></sensor>"#,
+    );
+    std::fs::write(dir.path().join("s.xml"), xml).unwrap();
+    let path = dir.path().join("s.xml");
+    let err = alhazen_import::load(&path).unwrap_err().to_string();
+    assert!(err.contains("$spp has no value"), "{err}");
+    let given = |p: &[(&str, &str)]| {
+        let p: Vec<(String, String)> = p.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+        alhazen_import::load_with_parameters(&path, 1 << 30, &p).unwrap()
+    };
+    let i = given(&[("spp", "12"), ("r", "0.5"), ("sp", "3")]);
+    assert_eq!(i.scene.render.spp, 12);
+    assert!(matches!(i.scene.objects[0].shape, Shape::Sphere { radius, .. } if radius == 0.5));
+    let unused: Vec<_> = i.warnings.iter().filter(|w| w.message.contains("never uses")).collect();
+    assert!(unused.len() == 1 && unused[0].message.contains("`sp`"), "{:?}", i.warnings);
+}
