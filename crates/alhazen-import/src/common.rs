@@ -131,7 +131,7 @@ pub(crate) fn mix(a: BsdfDesc, b: BsdfDesc, w: f64) -> BsdfDesc {
     } else if w <= 0.0 {
         b
     } else {
-        BsdfDesc::Mix { a: Box::new(a), b: Box::new(b), weight: w }
+        BsdfDesc::Mix { a: Box::new(a), b: Box::new(b), weight: w, weight_map: None }
     }
 }
 

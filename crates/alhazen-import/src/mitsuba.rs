@@ -951,10 +951,6 @@ impl Importer {
                     Some(n) => self.color_node(ctx, n)?,
                     None => Texture::Solid(Vec3::splat(0.5)),
                 };
-                if !matches!(w, Texture::Solid(_)) {
-                    self.warn(ctx, node, "a textured blend weight is replaced by its mean");
-                }
-                let w = self.pending.texture_mean(&w, &mut self.scene)?.x;
                 let kids: Vec<Node> = node
                     .children()
                     .filter(|c| matches!(c.tag_name().name(), "bsdf" | "ref") && c.attribute("name") != Some("weight"))
@@ -962,8 +958,12 @@ impl Importer {
                 let [a, b] = kids[..] else { return Err(ctx.err(node, "blendbsdf needs two nested BSDFs")) };
                 let (a, _) = self.bsdf_ref(ctx, a, depth + 1)?;
                 let (b, _) = self.bsdf_ref(ctx, b, depth + 1)?;
-                // Weight 0 is the first BSDF, 1 the second.
-                common::mix(b, a, w.clamp(0.0, 1.0))
+                // Weight 0 is the first BSDF, 1 the second; a textured weight is read per point
+                // (its luminance, as Mitsuba reads a colour bitmap where it wants a number).
+                match w {
+                    Texture::Solid(w) => common::mix(b, a, luminance(w).clamp(0.0, 1.0)),
+                    map => BsdfDesc::Mix { a: Box::new(b), b: Box::new(a), weight: 1.0, weight_map: Some(map) },
+                }
             }
             "bumpmap" => {
                 let tex = node.children().find(|c| {

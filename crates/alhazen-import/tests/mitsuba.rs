@@ -776,3 +776,31 @@ fn parameters_given_outside_the_file_come_first() {
     let unused: Vec<_> = i.warnings.iter().filter(|w| w.message.contains("never uses")).collect();
     assert!(unused.len() == 1 && unused[0].message.contains("`sp`"), "{:?}", i.warnings);
 }
+
+/// A `blendbsdf` whose weight is a bitmap blends per point (Mitsuba's documentation scene
+/// blends two materials through a noise image): weight 0 is the first BSDF, 1 the second.
+#[test]
+fn a_textured_blend_weight_is_read_per_point() {
+    let dir = tempfile::tempdir().unwrap();
+    // Left half black (the first BSDF), right half white (the second); read linearly.
+    let png = image::GrayImage::from_fn(4, 2, |x, _| image::Luma([if x < 2 { 0 } else { 255 }]));
+    png.save(dir.path().join("w.png")).unwrap();
+    let xml = scene(
+        r#"<shape type="rectangle"><bsdf type="blendbsdf">
+            <texture name="weight" type="bitmap"><string name="filename" value="w.png"/><boolean name="raw" value="true"/></texture>
+            <bsdf type="diffuse"><rgb name="reflectance" value="0.2"/></bsdf>
+            <bsdf type="conductor"/>
+        </bsdf></shape>"#,
+    );
+    std::fs::write(dir.path().join("s.xml"), xml).unwrap();
+    let imported = alhazen_import::load(&dir.path().join("s.xml")).unwrap();
+    assert!(!imported.warnings.iter().any(|w| w.message.contains("blend")), "{:?}", imported.warnings);
+    let s = imported.scene;
+    let m = &s.materials[s.objects[0].material as usize];
+    let at = |u: f64| match alhazen_render::bsdf::bsdf_at(m, alhazen_math::Vec2::new(u, 0.5), &s.images, alhazen_render::bsdf::ColorMode::Rgb) {
+        alhazen_render::bsdf::Bsdf::Mix(mix) => mix.weight,
+        other => panic!("not a mix: {other:?}"),
+    };
+    // The mix's `a` is Mitsuba's second BSDF (the conductor): its weight is the bitmap's.
+    assert_eq!((at(0.3), at(0.7)), (0.0, 1.0));
+}

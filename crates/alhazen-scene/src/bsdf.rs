@@ -208,6 +208,9 @@ pub enum BsdfDesc {
         b: Box<BsdfDesc>,
         /// Weight of `a`.
         weight: f64,
+        /// Where the weight varies over the surface: `weight` times the texture's luminance
+        /// at a point, clamped to `[0, 1]` (Mitsuba's `blendbsdf` with a bitmap weight).
+        weight_map: Option<Texture>,
     },
 }
 
@@ -331,7 +334,7 @@ impl BsdfDesc {
             | BsdfDesc::BlinnPhong { albedo, .. }
             | BsdfDesc::CookTorrance { albedo, .. }
             | BsdfDesc::Plastic { albedo, .. } => t(albedo),
-            BsdfDesc::Mix { a, b, .. } => a.is_textured() || b.is_textured(),
+            BsdfDesc::Mix { a, b, weight_map, .. } => a.is_textured() || b.is_textured() || weight_map.is_some(),
             BsdfDesc::MetallicRoughness { base, map, .. } => t(base) || map.is_some(),
             BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } => false,
         }

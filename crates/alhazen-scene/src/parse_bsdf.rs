@@ -41,7 +41,7 @@ impl Parser<'_> {
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
             "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior"],
-            _ => vec!["a", "b", "weight"],
+            _ => vec!["a", "b", "weight", "weight_map"],
         };
         t.check_keys(&[&["type"][..], &keys].concat())?;
         let albedo = match t.get("color") {
@@ -126,6 +126,7 @@ impl Parser<'_> {
                 a: Box::new(self.bsdf(&t.req("a")?, &albedo)?),
                 b: Box::new(self.bsdf(&t.req("b")?, &albedo)?),
                 weight: t.get("weight").map_or(Ok(0.5), |n| n.in_range(0.0, 1.0))?,
+                weight_map: t.get("weight_map").map(|n| self.texture(&n)).transpose()?,
             },
         })
     }

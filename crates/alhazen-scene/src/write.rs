@@ -430,8 +430,9 @@ impl Writer<'_> {
                 };
                 format!("{{ type = \"dielectric\", {ior}, fresnel = \"{}\", {} }}", fresnel(*fr), facets(f))
             }
-            BsdfDesc::Mix { a, b, weight } => {
-                format!("{{ type = \"mix\", a = {}, b = {}, weight = {} }}", self.bsdf(a), self.bsdf(b), num(*weight))
+            BsdfDesc::Mix { a, b, weight, weight_map } => {
+                let map = weight_map.as_ref().map_or(String::new(), |t| format!(", weight_map = {}", self.texture(t)));
+                format!("{{ type = \"mix\", a = {}, b = {}, weight = {}{map} }}", self.bsdf(a), self.bsdf(b), num(*weight))
             }
             BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior } => format!(
                 "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{} }}",

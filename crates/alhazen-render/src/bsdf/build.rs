@@ -116,8 +116,10 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             schlick: *fresnel == FresnelMode::Schlick,
             dispersive: ior.is_dispersive() && matches!(mode, ColorMode::Spectral(_)),
         }),
-        BsdfDesc::Mix { a, b, weight } => {
-            Bsdf::Mix(Box::new(Mix { a: from_desc(a, lookups, mode), b: from_desc(b, lookups, mode), weight: *weight }))
+        BsdfDesc::Mix { a, b, weight, weight_map } => {
+            let at = weight_map.as_ref().map_or(1.0, |t| alhazen_math::color::luminance((lookups.rgb)(t)));
+            let weight = (weight * at).clamp(0.0, 1.0);
+            Bsdf::Mix(Box::new(Mix { a: from_desc(a, lookups, mode), b: from_desc(b, lookups, mode), weight }))
         }
         BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
