@@ -797,10 +797,37 @@ fn a_textured_blend_weight_is_read_per_point() {
     assert!(!imported.warnings.iter().any(|w| w.message.contains("blend")), "{:?}", imported.warnings);
     let s = imported.scene;
     let m = &s.materials[s.objects[0].material as usize];
-    let at = |u: f64| match alhazen_render::bsdf::bsdf_at(m, alhazen_math::Vec2::new(u, 0.5), &s.images, alhazen_render::bsdf::ColorMode::Rgb) {
+    let at = |u: f64| match alhazen_render::bsdf::bsdf_at(
+        m,
+        alhazen_math::Vec2::new(u, 0.5),
+        &s.images,
+        alhazen_render::bsdf::ColorMode::Rgb,
+    ) {
         alhazen_render::bsdf::Bsdf::Mix(mix) => mix.weight,
         other => panic!("not a mix: {other:?}"),
     };
     // The mix's `a` is Mitsuba's second BSDF (the conductor): its weight is the bitmap's.
     assert_eq!((at(0.3), at(0.7)), (0.0, 1.0));
+}
+
+/// Every named conductor of Mitsuba's is known (tungsten, amorphous carbon, …), with the
+/// indices Mitsuba's RGB modes give it; an unknown name is a mirror with a warning.
+#[test]
+fn mitsubas_named_conductors_are_known() {
+    let conductor = |name: &str| {
+        let xml = scene(&format!(
+            r#"<shape type="sphere"><bsdf type="conductor"><string name="material" value="{name}"/></bsdf></shape>"#
+        ));
+        let i = import(&[("s.xml", &xml)]).unwrap();
+        let Some(BsdfDesc::Conductor { eta, k, .. }) =
+            i.scene.materials[i.scene.objects[0].material as usize].bsdf.clone()
+        else {
+            panic!("not a conductor")
+        };
+        (eta, k, i.warnings.iter().any(|w| w.message.contains("conductor")))
+    };
+    assert_eq!(conductor("W"), (Vec3::new(4.37082, 3.30025, 2.99841), Vec3::new(3.50064, 2.60487, 2.27323), false));
+    assert_eq!(conductor("a-C").0, Vec3::new(2.94405, 2.22714, 1.96816));
+    assert_eq!(conductor("Au").0, alhazen_scene::bsdf::metal("gold").unwrap().0);
+    assert_eq!(conductor("unobtainium"), (Vec3::ZERO, Vec3::ZERO, true));
 }

@@ -432,7 +432,12 @@ impl Writer<'_> {
             }
             BsdfDesc::Mix { a, b, weight, weight_map } => {
                 let map = weight_map.as_ref().map_or(String::new(), |t| format!(", weight_map = {}", self.texture(t)));
-                format!("{{ type = \"mix\", a = {}, b = {}, weight = {}{map} }}", self.bsdf(a), self.bsdf(b), num(*weight))
+                format!(
+                    "{{ type = \"mix\", a = {}, b = {}, weight = {}{map} }}",
+                    self.bsdf(a),
+                    self.bsdf(b),
+                    num(*weight)
+                )
             }
             BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior } => format!(
                 "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{} }}",
