@@ -979,8 +979,14 @@ impl Importer {
                     }
                 }
                 if kind == "thindielectric" {
-                    self.warn(ctx, node, "thindielectric is approximated by a smooth interface of index 1 (light passes straight through, unreflected)");
-                    BsdfDesc::Dielectric { facets: None, ior: Ior::Constant(1.0), fresnel: FresnelMode::Exact }
+                    if ior < 1.0 {
+                        self.warn(
+                            ctx,
+                            node,
+                            format!("a thin dielectric's index {ior} below 1 is taken as 1 (no reflection)"),
+                        );
+                    }
+                    BsdfDesc::ThinDielectric { ior: ior.max(1.0) }
                 } else {
                     let facets = self.facets(ctx, &p, kind == "roughdielectric")?;
                     BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact }
@@ -1564,7 +1570,7 @@ impl Importer {
 /// True when no part of the BSDF lets light through (glass is two-sided in Mitsuba too).
 fn reflects_only(desc: &BsdfDesc) -> bool {
     match desc {
-        BsdfDesc::Dielectric { .. } => false,
+        BsdfDesc::Dielectric { .. } | BsdfDesc::ThinDielectric { .. } => false,
         BsdfDesc::Mix { a, b, .. } => reflects_only(a) && reflects_only(b),
         _ => true,
     }

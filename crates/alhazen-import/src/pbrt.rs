@@ -937,9 +937,11 @@ impl Importer {
                 }
             }
             "thindielectric" => {
-                self.eta(ctx, p)?;
-                self.warn(ctx, at, "thindielectric is approximated by a smooth interface of index 1 (light passes straight through, unreflected)");
-                BsdfDesc::Dielectric { facets: None, ior: Ior::Constant(1.0), fresnel: FresnelMode::Exact }
+                let ior = self.eta(ctx, p)?;
+                if ior < 1.0 {
+                    self.warn(ctx, at, format!("a thin dielectric's eta {ior} below 1 is taken as 1 (no reflection)"));
+                }
+                BsdfDesc::ThinDielectric { ior: ior.max(1.0) }
             }
             "coateddiffuse" => {
                 let albedo = self.texture_param(ctx, p, "reflectance", Vec3::splat(0.5))?;

@@ -75,6 +75,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                         eta: 1.5,
                         schlick: false,
                         dispersive: false,
+                        thin: false,
                     }),
                 ));
             }
@@ -261,7 +262,13 @@ fn sampling_matches_the_density_of_every_bsdf_chi2() {
 
 #[test]
 fn rough_dielectric_sampling_from_inside_matches_its_density() {
-    let b = Bsdf::Dielectric(Dielectric { facets: Some(ggx(0.4)), eta: 1.5, schlick: false, dispersive: false });
+    let b = Bsdf::Dielectric(Dielectric {
+        facets: Some(ggx(0.4)),
+        eta: 1.5,
+        schlick: false,
+        dispersive: false,
+        thin: false,
+    });
     for theta in [20.0, 60.0] {
         let v = -direction(theta, 1.1);
         let p = chi2_p_value(&b, v, 400_000, 98);
@@ -307,7 +314,7 @@ fn lambert_with_albedo_one_conserves_energy_exactly() {
 fn smooth_dielectric_splits_energy_without_loss() {
     // Importance transport: reflected F plus transmitted (1 − F) once the η² of radiance is undone.
     for eta in [1.33, 1.5, 2.4] {
-        let b = Bsdf::Dielectric(Dielectric { facets: None, eta, schlick: false, dispersive: false });
+        let b = Bsdf::Dielectric(Dielectric { facets: None, eta, schlick: false, dispersive: false, thin: false });
         for v in [direction(0.0, 0.0), direction(50.0, 1.0), -direction(30.0, 2.0), -direction(70.0, 2.0)] {
             let (mut total, n) = (0.0, 20_000);
             let mut rng = Rng::for_sample(1, 1, 1, 1);
@@ -380,7 +387,8 @@ fn the_course_phong_is_not_reciprocal_but_the_normalised_one_is() {
 fn refraction_obeys_the_course_eta_squared_law() {
     // η₁² ρ(l, v) = η₂² ρ(v, l), η₁ on the light's side, η₂ on the viewer's.
     let eta = 1.5;
-    let b = Bsdf::Dielectric(Dielectric { facets: Some(ggx(0.35)), eta, schlick: false, dispersive: false });
+    let b =
+        Bsdf::Dielectric(Dielectric { facets: Some(ggx(0.35)), eta, schlick: false, dispersive: false, thin: false });
     let mut rng = Rng::for_sample(3, 3, 3, 3);
     let mut checked = 0;
     for _ in 0..500 {
@@ -428,5 +436,34 @@ fn conductor_fresnel_matches_known_values() {
     for cos in [0.2, 0.5, 0.9] {
         let dielectric = alhazen_render::optics::fresnel_dielectric(cos, 1.5);
         assert!((c(1.5, 0.0).fresnel(cos).x - dielectric).abs() < 1e-12, "κ = 0 is the course's formula");
+    }
+}
+
+/// A thin sheet of glass reflects `R' = 2R/(1 + R)` of the light from either side (`R` its
+/// faces' Fresnel reflectance), mirrored, and lets the rest through undeviated; it absorbs
+/// nothing (every sample's weight is 1).
+#[test]
+fn a_thin_sheet_reflects_both_faces_and_passes_the_rest_straight() {
+    let sheet = Dielectric { facets: None, eta: 1.5, schlick: false, dispersive: false, thin: true };
+    for (theta, side) in [(0.0, 1.0), (40.0, 1.0), (75.0, -1.0), (89.0, -1.0)] {
+        let v = direction(theta, 0.7) * Vec3::new(1.0, 1.0, side);
+        let cos = v.z.abs();
+        let r = alhazen_render::optics::fresnel_dielectric(cos, 1.5);
+        let want = 2.0 * r / (1.0 + r);
+        let n = 20_000;
+        let mut reflected = 0;
+        for k in 0..n {
+            let s = sheet.sample(v, (k as f64 + 0.5) / n as f64, Vec2::ZERO).unwrap();
+            assert!(s.delta && s.eta == 1.0);
+            assert!(((s.f * s.l.z.abs() / s.pdf) - Vec3::ONE).abs().max_element() < 1e-12);
+            if s.l.z * v.z > 0.0 {
+                reflected += 1;
+                assert!((s.l - Vec3::new(-v.x, -v.y, v.z)).length() < 1e-12);
+            } else {
+                assert_eq!(s.l, -v);
+            }
+        }
+        let got = reflected as f64 / n as f64;
+        assert!((got - want).abs() < 1e-3, "θ {theta}: reflected {got}, want {want}");
     }
 }

@@ -183,6 +183,13 @@ pub enum BsdfDesc {
         /// Exact or Schlick.
         fresnel: FresnelMode,
     },
+    /// A thin sheet of glass (a window pane): light passes straight through it, or is
+    /// reflected by its two faces and every bounce between them, `R' = 2R/(1 + R)` of it for a
+    /// face's Fresnel reflectance `R` (Mitsuba's `thindielectric`).
+    ThinDielectric {
+        /// Index of refraction of the sheet relative to the outside.
+        ior: f64,
+    },
     /// glTF 2.0's metallic–roughness material with its values read per point
     /// ([`BsdfDesc::metallic_roughness_at`]): the base colour, and metallic and roughness as
     /// their factors times the map's blue and green channels (read linearly), where there is
@@ -261,11 +268,16 @@ impl crate::model::Material {
                     None => self.mirror = Vec3::splat(0.9),
                 }
             }
-            BsdfDesc::Dielectric { ior, .. } => {
+            BsdfDesc::Dielectric { .. } | BsdfDesc::ThinDielectric { .. } => {
+                // A thin sheet bends no ray: the course's transparency through an index of 1.
+                let ior = match bsdf {
+                    BsdfDesc::Dielectric { ior, .. } => ior.nominal(),
+                    _ => 1.0,
+                };
                 self.color = Texture::Solid(Vec3::splat(0.8));
                 self.diffuse = 0.0;
                 self.transparency = Vec3::ONE;
-                self.ior = ior.nominal();
+                self.ior = ior;
                 self.specular = Vec3::ONE;
                 self.shininess = 200.0;
             }
@@ -336,7 +348,7 @@ impl BsdfDesc {
             | BsdfDesc::Plastic { albedo, .. } => t(albedo),
             BsdfDesc::Mix { a, b, weight_map, .. } => a.is_textured() || b.is_textured() || weight_map.is_some(),
             BsdfDesc::MetallicRoughness { base, map, .. } => t(base) || map.is_some(),
-            BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } => false,
+            BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } | BsdfDesc::ThinDielectric { .. } => false,
         }
     }
 

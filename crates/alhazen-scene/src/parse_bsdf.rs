@@ -28,6 +28,7 @@ impl Parser<'_> {
             "plastic",
             "conductor",
             "dielectric",
+            "thin-dielectric",
             "mix",
             "metallic-roughness",
         ])?;
@@ -41,6 +42,7 @@ impl Parser<'_> {
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
             "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior"],
+            "thin-dielectric" => vec!["ior"],
             _ => vec!["a", "b", "weight", "weight_map"],
         };
         t.check_keys(&[&["type"][..], &keys].concat())?;
@@ -114,6 +116,9 @@ impl Parser<'_> {
                 }
             }
             "dielectric" => BsdfDesc::Dielectric { facets: microfacets(&t)?, ior: ior(&t)?, fresnel: fresnel(&t)? },
+            "thin-dielectric" => {
+                BsdfDesc::ThinDielectric { ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))? }
+            }
             "metallic-roughness" => BsdfDesc::MetallicRoughness {
                 base: albedo,
                 metallic: t.get("metallic").map_or(Ok(0.0), |n| n.in_range(0.0, 1.0))?,

@@ -414,6 +414,7 @@ impl Writer<'_> {
                 fresnel(*fr),
                 facets(f)
             ),
+            BsdfDesc::ThinDielectric { ior } => format!("{{ type = \"thin-dielectric\", ior = {} }}", num(*ior)),
             BsdfDesc::Dielectric { facets: f, ior, fresnel: fr } => {
                 let ior = match ior {
                     Ior::Constant(x) => format!("ior = {}", num(*x)),

@@ -53,6 +53,7 @@ fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec
             eta: m.ior,
             schlick: m.fresnel == FresnelMode::Schlick,
             dispersive: false,
+            thin: false,
         });
     }
     let lambert = Bsdf::Lambert(Lambert { albedo: tex(&m.color) * m.diffuse });
@@ -115,7 +116,11 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             eta: mode.ior(ior),
             schlick: *fresnel == FresnelMode::Schlick,
             dispersive: ior.is_dispersive() && matches!(mode, ColorMode::Spectral(_)),
+            thin: false,
         }),
+        BsdfDesc::ThinDielectric { ior } => {
+            Bsdf::Dielectric(Dielectric { facets: None, eta: *ior, schlick: false, dispersive: false, thin: true })
+        }
         BsdfDesc::Mix { a, b, weight, weight_map } => {
             let at = weight_map.as_ref().map_or(1.0, |t| alhazen_math::color::luminance((lookups.rgb)(t)));
             let weight = (weight * at).clamp(0.0, 1.0);

@@ -29,6 +29,9 @@ pub struct Dielectric {
     pub schlick: bool,
     /// The index depends on wavelength.
     pub dispersive: bool,
+    /// A thin sheet (smooth): light passes straight through, or is reflected by both faces
+    /// and the bounces between them ([`Self::thin_sample`]).
+    pub thin: bool,
 }
 
 impl Dielectric {
@@ -102,12 +105,28 @@ impl Dielectric {
 
     /// Reflects with probability `F`, else refracts (about the normal or a sampled facet).
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
+        if self.thin {
+            return self.thin_sample(v, uc);
+        }
         if let Some(facets) = &self.facets {
             let (sampled, sample) = self.rough_sample(facets, v, uc, u);
             return sampled.then_some(sample);
         }
         let (sampled, sample) = self.smooth_sample(v, uc);
         sampled.then_some(sample)
+    }
+
+    /// A thin sheet's mirror direction, with the probability `R' = 2R/(1 + R)` that light is
+    /// reflected by its faces and the bounces between them (`R` a face's reflectance, the same
+    /// from either side), or `−v` straight through the sheet.
+    pub(crate) fn thin_sample(&self, v: Vec3, uc: f64) -> Option<BsdfSample> {
+        if v.z == 0.0 || !v.z.is_finite() {
+            return None;
+        }
+        let r = self.fresnel(v.z.abs());
+        let reflectance = 2.0 * r / (1.0 + r);
+        let (l, p) = if uc < reflectance { (reflect(v, Vec3::Z), reflectance) } else { (-v, 1.0 - reflectance) };
+        Some(BsdfSample { l, f: Vec3::splat(p / l.z.abs()), pdf: p, delta: true, eta: 1.0, dispersive: false })
     }
 
     /// The smooth boundary's mirror direction (with probability `F`, when `uc < F`) or
