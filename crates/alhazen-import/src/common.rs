@@ -169,14 +169,6 @@ pub(crate) fn named_ior(name: &str) -> Option<f64> {
     NAMED_IORS.iter().find(|e| e.0 == n).map(|e| e.1)
 }
 
-/// A point light's `cos^e` falloff that best stands for a smooth fall-off from full intensity
-/// inside `inner` to zero at `outer` (half-angles, radians): the exponent that halves the
-/// intensity midway.
-pub(crate) fn spot_exponent(inner: f64, outer: f64) -> f64 {
-    let mid = 0.5 * (inner + outer);
-    if outer - inner < 1e-6 || mid <= 0.0 { 0.0 } else { (0.5f64).ln() / mid.cos().ln() }
-}
-
 /// Checks that every number of a value is finite.
 pub(crate) fn finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())

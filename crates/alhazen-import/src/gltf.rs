@@ -527,14 +527,16 @@ impl Importer<'_> {
             Kind::Spot { inner_cone_angle, outer_cone_angle } => {
                 let (inner, outer) =
                     (inner_cone_angle as f64, (outer_cone_angle as f64).clamp(1e-4, std::f64::consts::FRAC_PI_2));
-                if outer - inner > 1e-6 {
-                    self.warn("a spot light's smooth edge is approximated by a cos^e fall-off inside the outer cone");
+                let fades = outer - inner > 1e-6;
+                if fades {
+                    self.warn("a spot light's fade between its cones (quadratic in the cosine) is approximated by a fade linear in angle");
                 }
                 Light::Spot {
                     position,
                     direction,
                     cos_cutoff: outer.cos(),
-                    falloff: common::spot_exponent(inner, outer),
+                    falloff: 0.0,
+                    cos_beam: fades.then(|| inner.max(0.0).cos()),
                     intensity: power,
                     attenuation: [1.0, 0.0, 0.0],
                 }

@@ -1491,17 +1491,18 @@ impl Importer {
                 if !(cutoff > 0.0 && cutoff < 180.0) {
                     return Err(ctx.err(node, "cutoff_angle must be in (0, 180) degrees"));
                 }
-                self.warn(
-                    ctx,
-                    node,
-                    "a spot light's smooth edge is approximated by a cos^e fall-off inside the cutoff cone",
-                );
+                if beam.is_nan() || beam <= 0.0 {
+                    return Err(ctx.err(node, "beam_width must be positive"));
+                }
                 self.prop(&p, "texture").inspect(|_| self.warn(ctx, node, "a projected spot texture is ignored"));
                 Light::Spot {
                     position: m.transform_point3(Vec3::ZERO),
                     direction: (l * Vec3::Z).normalize(),
                     cos_cutoff: cutoff.to_radians().cos(),
-                    falloff: common::spot_exponent(beam.to_radians(), cutoff.to_radians()),
+                    // Mitsuba's fade: full intensity within `beam_width`, linear in angle to
+                    // nothing at `cutoff_angle`.
+                    falloff: 0.0,
+                    cos_beam: (beam < cutoff).then(|| beam.to_radians().cos()),
                     intensity,
                     attenuation: [1.0, 0.0, 0.0],
                 }

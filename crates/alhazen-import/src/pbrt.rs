@@ -1125,12 +1125,16 @@ impl Importer {
                 if dir == Vec3::ZERO || !(cone > 0.0 && cone < 180.0) {
                     return Err(ctx.err(at.clone(), "a spot light needs from ≠ to and coneangle in (0, 180)"));
                 }
-                self.warn(ctx, at, "a spot light's smooth edge is approximated by a cos^e fall-off inside the cone");
+                let beam = (cone - delta).max(0.0);
+                if beam < cone {
+                    self.warn(ctx, at, "a spot light's fade over conedelta (smooth in the cosine) is approximated by a fade linear in angle");
+                }
                 Light::Spot {
                     position: m.transform_point3(from),
                     direction: dir,
                     cos_cutoff: cone.to_radians().cos(),
-                    falloff: common::spot_exponent((cone - delta).max(0.0).to_radians(), cone.to_radians()),
+                    falloff: 0.0,
+                    cos_beam: (beam < cone).then(|| beam.to_radians().cos()),
                     intensity,
                     attenuation: [1.0, 0.0, 0.0],
                 }

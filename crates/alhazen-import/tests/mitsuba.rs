@@ -831,3 +831,19 @@ fn mitsubas_named_conductors_are_known() {
     assert_eq!(conductor("Au").0, alhazen_scene::bsdf::metal("gold").unwrap().0);
     assert_eq!(conductor("unobtainium"), (Vec3::ZERO, Vec3::ZERO, true));
 }
+
+/// Mitsuba's spot light keeps its beam: full intensity within `beam_width`, fading linearly in
+/// angle to nothing at `cutoff_angle` (its documentation's spot scene agrees with Mitsuba).
+#[test]
+fn spot_lights_keep_their_beam() {
+    let xml = scene(
+        r#"<emitter type="spot"><float name="cutoff_angle" value="30"/><float name="beam_width" value="20"/>
+           <rgb name="intensity" value="4"/></emitter>
+           <emitter type="spot"/>"#,
+    );
+    let s = import(&[("s.xml", &xml)]).unwrap().scene;
+    let Light::Spot { cos_cutoff, falloff, cos_beam, .. } = s.lights[0] else { panic!("not a spot") };
+    assert_eq!((cos_cutoff, falloff, cos_beam), (30f64.to_radians().cos(), 0.0, Some(20f64.to_radians().cos())));
+    let Light::Spot { cos_cutoff, cos_beam, .. } = s.lights[1] else { panic!("not a spot") };
+    assert_eq!((cos_cutoff, cos_beam), (20f64.to_radians().cos(), Some(15f64.to_radians().cos())));
+}

@@ -97,13 +97,14 @@ impl<'a> Emitter<'a> {
                 let (dir, pdf) = self.direction(*position, rng)?;
                 Emission { origin: *position, dir, power: *intensity / pdf }
             }
-            PathLight::Spot { position, direction, cos_cutoff, falloff, intensity } => {
+            PathLight::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity } => {
                 let (dir, pdf) = self.direction(*position, rng)?;
                 let c = dir.dot(*direction);
                 if c < *cos_cutoff {
                     return None;
                 }
-                Emission { origin: *position, dir, power: *intensity * c.powf(*falloff) / pdf }
+                let shaped = alhazen_scene::spot_profile(c, *cos_cutoff, *falloff, *cos_beam);
+                Emission { origin: *position, dir, power: *intensity * shaped / pdf }
             }
             PathLight::Area { .. } => {
                 let point = self.lights.point_by_area(light, Vec2::new(rng.uniform(), rng.uniform()))?;

@@ -359,8 +359,9 @@ enum Source {
     /// A patch: its polygon, centre, the normal of the side it shoots from, its unshot
     /// radiosity and the points visibility rays aim at.
     Patch { poly: Polygon, centre: Vec3, normal: Vec3, radiosity: Vec3, aims: Vec<Vec3>, area: f64 },
-    /// A point or spot light: intensity, and a spot's (axis, cosine of the cut-off, exponent).
-    Point { position: Vec3, intensity: Vec3, spot: Option<(Vec3, f64, f64)> },
+    /// A point or spot light: intensity, and a spot's (axis, cosine of the cut-off, exponent,
+    /// cosine of its beam).
+    Point { position: Vec3, intensity: Vec3, spot: Option<(Vec3, f64, f64, Option<f64>)> },
     /// Parallel light from direction `towards` (unit, towards the light).
     Directional { towards: Vec3, irradiance: Vec3 },
     /// The background or environment map.
@@ -373,8 +374,8 @@ fn sources(scene: &Scene) -> Vec<Source> {
         .iter()
         .filter_map(|l| match *l {
             Light::Point { position, intensity, .. } => Some(Source::Point { position, intensity, spot: None }),
-            Light::Spot { position, direction, cos_cutoff, falloff, intensity, .. } => {
-                Some(Source::Point { position, intensity, spot: Some((direction, cos_cutoff, falloff)) })
+            Light::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity, .. } => {
+                Some(Source::Point { position, intensity, spot: Some((direction, cos_cutoff, falloff, cos_beam)) })
             }
             Light::Directional { direction, intensity } => {
                 Some(Source::Directional { towards: -direction.normalize(), irradiance: intensity })
@@ -721,9 +722,9 @@ impl Solver<'_> {
             Source::Point { position, intensity, spot } => {
                 let cone = |p: Vec3| match spot {
                     None => 1.0,
-                    Some((axis, cutoff, falloff)) => {
+                    Some((axis, cutoff, falloff, beam)) => {
                         let c = -(p - *position).normalize_or_zero().dot(*axis);
-                        if c >= *cutoff { c.powf(*falloff) } else { 0.0 }
+                        alhazen_scene::spot_profile(c, *cutoff, *falloff, *beam)
                     }
                 };
                 let g = form_factor::point_to_point(x, n, *position) * cone(x);

@@ -93,6 +93,8 @@ pub enum PathLight {
         cos_cutoff: f64,
         /// Falloff exponent.
         falloff: f64,
+        /// Cosine of the beam of full intensity ([`alhazen_scene::spot_profile`]).
+        cos_beam: Option<f64>,
         /// Intensity on the axis.
         intensity: Vec3,
     },
@@ -295,8 +297,8 @@ impl Lights {
         for l in &scene.lights {
             lights.push(match *l {
                 Light::Point { position, intensity, .. } => PathLight::Point { position, intensity },
-                Light::Spot { position, direction, cos_cutoff, falloff, intensity, .. } => {
-                    PathLight::Spot { position, direction, cos_cutoff, falloff, intensity }
+                Light::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity, .. } => {
+                    PathLight::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity }
                 }
                 Light::Directional { direction, intensity } => {
                     PathLight::Directional { direction, irradiance: intensity }
@@ -541,13 +543,13 @@ impl Lights {
         };
         match light {
             PathLight::Point { position, intensity } => delta(*position - p, *intensity),
-            PathLight::Spot { position, direction, cos_cutoff, falloff, intensity } => {
+            PathLight::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity } => {
                 let to = *position - p;
                 let cos = -to.normalize_or_zero().dot(*direction);
                 if cos < *cos_cutoff {
                     return None;
                 }
-                delta(to, *intensity * cos.powf(*falloff))
+                delta(to, *intensity * alhazen_scene::spot_profile(cos, *cos_cutoff, *falloff, *cos_beam))
             }
             PathLight::Directional { direction, irradiance } => Some(LightSample {
                 dir: -*direction,

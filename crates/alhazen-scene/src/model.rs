@@ -318,7 +318,7 @@ pub enum Light {
         /// Intensity `I^dir`.
         intensity: Rgb,
     },
-    /// A point light restricted to a cone, with falloff `cos^e` inside it.
+    /// A point light restricted to a cone, with falloff `cos^e` inside it ([`spot_profile`]).
     Spot {
         /// Position.
         position: Vec3,
@@ -328,6 +328,9 @@ pub enum Light {
         cos_cutoff: f64,
         /// Exponent of the cosine falloff.
         falloff: f64,
+        /// Cosine of the half-angle of a beam of full intensity, from whose edge the light
+        /// fades linearly in angle to nothing at the cone's (Mitsuba's spot); `None`: no fade.
+        cos_beam: Option<f64>,
         /// Emitted intensity.
         intensity: Rgb,
         /// `[a, b, c]`.
@@ -361,17 +364,36 @@ impl Light {
                 (d > 0.0).then(|| (to / d, d, *intensity / falloff(attenuation, d)))
             }
             Light::Directional { direction, intensity } => Some((-*direction, f64::INFINITY, *intensity)),
-            Light::Spot { position, direction, cos_cutoff, falloff: e, intensity, attenuation } => {
+            Light::Spot { position, direction, cos_cutoff, falloff: e, cos_beam, intensity, attenuation } => {
                 let to = *position - p;
                 let d = to.length();
                 let l = to / d;
                 let cos = -l.dot(*direction);
-                // pow(x, 1) is x: the cosine spots that stand for emitters skip libm.
-                let shaped = if *e == 1.0 { cos } else { cos.powf(*e) };
+                let shaped = spot_profile(cos, *cos_cutoff, *e, *cos_beam);
                 (d > 0.0 && cos >= *cos_cutoff).then(|| (l, d, *intensity * shaped / falloff(attenuation, d)))
             }
             Light::Environment { .. } => None,
         }
+    }
+}
+
+/// The share of a spot light's axial intensity it sends at cosine `cos` from its axis: 0
+/// outside its cone (`cos < cos_cutoff`), `cos^falloff` inside, fading where it has a beam
+/// (`cos_beam`) linearly in angle from 1 at the beam's edge to 0 at the cone's.
+#[inline]
+pub fn spot_profile(cos: f64, cos_cutoff: f64, falloff: f64, cos_beam: Option<f64>) -> f64 {
+    let inside = cos >= cos_cutoff;
+    if !inside {
+        return 0.0;
+    }
+    // pow(x, 1) is x: the cosine spots that stand for emitters skip libm.
+    let shaped = if falloff == 1.0 { cos } else { cos.powf(falloff) };
+    match cos_beam {
+        Some(beam) if cos < beam => {
+            let (theta, cutoff, inner) = (cos.clamp(-1.0, 1.0).acos(), cos_cutoff.acos(), beam.min(1.0).acos());
+            shaped * ((cutoff - theta) / (cutoff - inner)).clamp(0.0, 1.0)
+        }
+        _ => shaped,
     }
 }
 
@@ -836,5 +858,26 @@ impl PixelCodes {
             .map(|p| Some([code(0, p[0])?, code(1, p[1])?, code(2, p[2])?]))
             .collect::<Option<Vec<_>>>()?;
         Some(Self { tables, codes })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::spot_profile;
+
+    /// Mitsuba's spot: full intensity within the beam, a fade linear in angle to nothing at
+    /// the cone's edge; without a beam, `cos^e` inside the cone.
+    #[test]
+    fn spot_profiles_fade_linearly_in_angle_from_the_beam_to_the_cone() {
+        let (cone, beam) = (30f64.to_radians(), 20f64.to_radians());
+        let at = |deg: f64| spot_profile(deg.to_radians().cos(), cone.cos(), 0.0, Some(beam.cos()));
+        assert_eq!((at(0.0), at(19.9), at(30.1)), (1.0, 1.0, 0.0));
+        for (deg, want) in [(22.5, 0.75), (25.0, 0.5), (29.0, 0.1)] {
+            assert!((at(deg) - want).abs() < 1e-9, "{deg}°: {}", at(deg));
+        }
+        let c = 10f64.to_radians().cos();
+        assert_eq!(spot_profile(c, cone.cos(), 1.0, None), c);
+        assert_eq!(spot_profile(c, cone.cos(), 3.0, None), c.powf(3.0));
+        assert_eq!(spot_profile(f64::NAN, cone.cos(), 1.0, None), 0.0);
     }
 }

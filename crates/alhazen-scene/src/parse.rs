@@ -814,7 +814,7 @@ fn light(n: &Node) -> R<Light> {
     let keys: &[&str] = match kind {
         "point" => &["type", "position", "intensity", "attenuation"],
         "directional" => &["type", "direction", "intensity"],
-        _ => &["type", "position", "direction", "angle", "falloff", "intensity", "attenuation"],
+        _ => &["type", "position", "direction", "angle", "beam", "falloff", "intensity", "attenuation"],
     };
     t.check_keys(keys)?;
     let intensity = t.opt_rgb("intensity", Vec3::ONE)?;
@@ -826,6 +826,7 @@ fn light(n: &Node) -> R<Light> {
             direction: t.req("direction")?.unit_vec3()?,
             cos_cutoff: t.get("angle").map_or(Ok(30.0), |n| n.in_range(0.0, 180.0))?.to_radians().cos(),
             falloff: t.get("falloff").map_or(Ok(1.0), |n| n.non_negative())?,
+            cos_beam: t.get("beam").map(|n| n.in_range(0.0, 180.0).map(|b| b.to_radians().cos())).transpose()?,
             intensity,
             attenuation: attenuation(&t)?,
         },

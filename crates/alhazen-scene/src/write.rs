@@ -262,11 +262,14 @@ impl Writer<'_> {
                 self.line("direction", vec3(*direction));
                 self.line("intensity", vec3(*intensity));
             }
-            Light::Spot { position, direction, cos_cutoff, falloff, intensity, attenuation } => {
+            Light::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity, attenuation } => {
                 self.line("type", string("spot"));
                 self.line("position", vec3(*position));
                 self.line("direction", vec3(*direction));
                 self.line("angle", num(degrees(cos_cutoff.acos(), f64::cos)));
+                if let Some(beam) = cos_beam {
+                    self.line("beam", num(degrees(beam.acos(), f64::cos)));
+                }
                 self.line("falloff", num(*falloff));
                 self.line("intensity", vec3(*intensity));
                 self.line("attenuation", att(attenuation));
