@@ -47,6 +47,20 @@ fn white_lambert_sphere_vanishes_in_a_white_furnace() {
     assert!((c - Vec3::ONE).abs().max_element() < 0.05, "centre {c}");
 }
 
+/// A blend of a mirror (a delta lobe) and a rough coat is the blend of their images: a convex
+/// object in a furnace sees only the environment, so its image is linear in its BSDF. (Mitsuba
+/// 3's `blendbsdf` divides the delta lobe's weight by the coat's density at the mirror
+/// direction, and renders this blend 30 % dark.)
+#[test]
+fn a_blend_of_a_mirror_and_a_rough_coat_is_the_blend_of_their_images() {
+    let mirror = r#"{ type = "conductor", metal = "gold" }"#;
+    let coat = r#"{ type = "plastic", color = [0, 0, 0], ior = 1.5, roughness = 0.3 }"#;
+    let [a, b] = [mirror, coat].map(|m| mean(&furnace(&format!("bsdf = {m}"), 64)));
+    let blend = mean(&furnace(&format!("bsdf = {{ type = \"mix\", a = {mirror}, b = {coat}, weight = 0.3 }}"), 64));
+    let want = a * 0.3 + b * 0.7;
+    assert!(((blend - want) / want).abs().max_element() < 0.01, "blend {blend}, the images' blend {want}");
+}
+
 #[test]
 fn smooth_and_rough_glass_conserve_energy_in_a_white_furnace() {
     let smooth = mean(&furnace(r#"bsdf = { type = "dielectric", ior = 1.5 }"#, 64));
