@@ -583,6 +583,9 @@ impl Importer {
             wavelengths.push(l);
             values.push(x);
         }
+        if wavelengths.len() < 2 {
+            return Err(ctx.err(n, "a sampled spectrum needs two `wavelength:value` pairs or more"));
+        }
         let name = n.attribute("name").unwrap_or("");
         let bounded = !emitted && !matches!(name, "eta" | "k" | "int_ior" | "ext_ior");
         Ok(alhazen_math::cie::spectrum_to_linear_srgb(&wavelengths, &values, emitted, bounded))

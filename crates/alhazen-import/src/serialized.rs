@@ -56,8 +56,13 @@ pub(crate) fn parse(bytes: &[u8], shape: usize) -> Result<TriangleMesh, String> 
                 compressed.len()
             )
         })?;
-    let mut data = vec![0u8; size as usize];
-    z.read_exact(&mut data).map_err(|e| format!("mesh {shape} ends early or is corrupt ({e})"))?;
+    // Grown as the stream inflates: a file that claims more than it holds allocates only what
+    // it holds before it is refused.
+    let mut data = Vec::new();
+    (&mut z).take(size).read_to_end(&mut data).map_err(|e| format!("mesh {shape} is corrupt ({e})"))?;
+    if data.len() as u64 != size {
+        return Err(format!("mesh {shape} ends early: {} of its {size} bytes", data.len()));
+    }
     // The stream ends with the triangles, and its checksum holds.
     if !matches!(z.read(&mut [0]), Ok(0)) {
         return Err(format!("mesh {shape} is corrupt: its stream does not end after its triangles"));
@@ -122,7 +127,7 @@ fn offset(bytes: &[u8], version: u16, shape: usize) -> Result<usize, String> {
     };
     usize::try_from(at)
         .ok()
-        .filter(|&a| a + 4 <= bytes.len())
+        .filter(|&a| a.checked_add(4).is_some_and(|end| end <= bytes.len()))
         .ok_or_else(|| format!("mesh {shape} begins past the file's end"))
 }
 

@@ -749,6 +749,11 @@ fn spectra_are_weighed_as_mitsuba_weighs_them() {
     assert!(near(lamp, Vec3::new(20.7108, 10.8546, 2.77115)), "{lamp}");
     let flat = s.materials[s.objects[2].material as usize].emission;
     assert!(near(flat, Vec3::new(2.40959, 1.89658, 1.81783)), "{flat}");
+    for bad in ["550:1", "600:1, 500:2"] {
+        let xml = scene(&format!(r#"<bsdf type="diffuse" id="d"><spectrum name="reflectance" value="{bad}"/></bsdf>"#));
+        let err = import(&[("s.xml", &xml)]).unwrap_err();
+        assert!(err.contains("s.xml:2:") && (err.contains("two") || err.contains("increase")), "{err}");
+    }
 }
 
 /// `-D name=value` (Mitsuba's command line, alhazen's too) gives a parameter its value over

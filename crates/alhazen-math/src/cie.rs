@@ -73,8 +73,11 @@ fn weighed(w: impl Fn(f64) -> Option<f64>) -> Vec3 {
 /// between them, nothing outside them). An `emitted` spectrum is radiance: the flat spectrum
 /// of value 1 has luminance 1. Otherwise it is a reflectance seen under D65: the flat spectrum
 /// of value 1 is white (1, 1, 1). Negative components are clamped to 0, and a reflectance's
-/// to at most 1 (`bounded`).
+/// to at most 1 (`bounded`). Fewer than two wavelengths (or a value short) are black.
 pub fn spectrum_to_linear_srgb(wavelengths: &[f64], values: &[f64], emitted: bool, bounded: bool) -> Vec3 {
+    if wavelengths.len() < 2 || values.len() != wavelengths.len() {
+        return Vec3::ZERO;
+    }
     let at = |lambda: f64| {
         let k = wavelengths.partition_point(|&w| w <= lambda);
         if k == 0 || lambda > *wavelengths.last()? {
@@ -126,6 +129,8 @@ mod tests {
             "{red} {green} {blue}"
         );
         assert_eq!(spectrum_to_linear_srgb(&[850.0, 900.0], &[5.0, 5.0], true, false), Vec3::ZERO);
+        assert_eq!(spectrum_to_linear_srgb(&[550.0], &[5.0], true, false), Vec3::ZERO);
+        assert_eq!(spectrum_to_linear_srgb(&[450.0, 550.0], &[5.0], true, false), Vec3::ZERO);
         assert_eq!(d65(560.0), 100.0);
         assert!((d65(562.5) - 99.08355).abs() < 1e-9 && d65(100.0) == 0.0 && d65(830.0) == 60.3125);
     }
