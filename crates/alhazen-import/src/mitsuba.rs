@@ -130,6 +130,10 @@ const MITSUBA_METALS: &[(&str, [f64; 3], [f64; 3])] = &[
 const HARMLESS: &[&str] =
     &["pixel_format", "component_format", "file_format", "banner", "high_quality_edges", "near_clip", "far_clip", "id"];
 
+/// How many elements one element's references may read ahead of their place, one through
+/// another (a bound on the recursion, far beyond any scene's).
+const FORWARD_CHAIN: usize = 256;
+
 /// What an `id` names.
 #[derive(Clone)]
 enum Named {
@@ -227,27 +231,28 @@ impl Importer {
             root.children().filter(Node::is_element).filter_map(|c| Some((c.attribute("id")?, c))).collect();
         let mut done = HashSet::new();
         for child in root.children().filter(Node::is_element) {
-            self.declared_first(&ctx, child, (&declared, &mut done), depth)?;
+            self.declared_first(&ctx, child, (&declared, &mut done), (depth, 0))?;
         }
         Ok(())
     }
 
     /// Reads top-level element `node` once, after the later elements of this file it refers to
-    /// (a cycle of references is left to report the element not yet declared).
+    /// (a cycle of references, or a chain of more than [`FORWARD_CHAIN`], is left to report the
+    /// element not yet declared). `depth` counts includes, `chain` elements read ahead.
     fn declared_first(
         &mut self,
         ctx: &Ctx,
         node: Node,
         (declared, done): (&HashMap<&str, Node>, &mut HashSet<roxmltree::NodeId>),
-        depth: usize,
+        (depth, chain): (usize, usize),
     ) -> R<()> {
         if !done.insert(node.id()) {
             return Ok(());
         }
-        for r in node.descendants().filter(|d| d.tag_name().name() == "ref") {
+        for r in node.descendants().filter(|d| d.tag_name().name() == "ref" && chain < FORWARD_CHAIN) {
             let later = r.attribute("id").filter(|id| !self.ids.contains_key(*id)).and_then(|id| declared.get(id));
             if let Some(&target) = later {
-                self.declared_first(ctx, target, (declared, done), depth)?;
+                self.declared_first(ctx, target, (declared, done), (depth, chain + 1))?;
             }
         }
         self.top_level(ctx, node, depth)

@@ -852,3 +852,16 @@ fn spot_lights_keep_their_beam() {
     let Light::Spot { cos_cutoff, cos_beam, .. } = s.lights[1] else { panic!("not a spot") };
     assert_eq!((cos_cutoff, cos_beam), (20f64.to_radians().cos(), Some(15f64.to_radians().cos())));
 }
+
+/// A long chain of references to later elements reads without exhausting the stack: a BSDF
+/// wrapping the next, 2000 deep, each declared before what it refers to.
+#[test]
+fn long_chains_of_later_references_are_errors_not_crashes() {
+    let mut body = String::from(r#"<shape type="sphere"><ref id="b0"/></shape>"#);
+    for i in 0..2000 {
+        body += &format!(r#"<bsdf type="twosided" id="b{i}"><ref id="b{}"/></bsdf>"#, i + 1);
+    }
+    body += r#"<bsdf type="diffuse" id="b2000"/>"#;
+    let err = import(&[("s.xml", &scene(&body))]).unwrap_err();
+    assert!(err.contains("no object has id"), "{err}");
+}
