@@ -206,18 +206,31 @@ impl TriangleMesh {
     /// Wüthrich 1998, "Computing vertex normals from polygonal facets"): a vertex's normal does
     /// not change when a neighbouring face is split. Mitsuba smooths the meshes it is given
     /// without normals so; a vertex on no face of area gets +y.
+    /// The corners' weighted normals are found on all threads a block of triangles at a time,
+    /// and added to their vertices in triangle order: the same bits on any number of threads.
     pub fn compute_angle_weighted_normals(&mut self) {
-        let mut acc = vec![Vec3::ZERO; self.positions.len()];
-        for tri in &self.triangles {
+        use rayon::prelude::*;
+        const BLOCK: usize = 1 << 16;
+        let corners = |tri: &[u32; 3]| {
             let p = tri.map(|v| self.positions[v as usize]);
-            let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { continue };
-            for k in 0..3 {
+            // A triangle of no area adds nothing (its angles may be undefined).
+            let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { return [Vec3::ZERO; 3] };
+            std::array::from_fn(|k| {
                 let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
-                let angle = a.normalize_or_zero().angle_between(b.normalize_or_zero());
-                acc[tri[k] as usize] += n * angle;
+                n * a.normalize_or_zero().angle_between(b.normalize_or_zero())
+            })
+        };
+        let mut acc = vec![Vec3::ZERO; self.positions.len()];
+        let mut weighted: Vec<[Vec3; 3]> = Vec::with_capacity(BLOCK.min(self.triangles.len()));
+        for block in self.triangles.chunks(BLOCK) {
+            block.par_iter().map(corners).collect_into_vec(&mut weighted);
+            for (tri, w) in block.iter().zip(&weighted) {
+                for k in 0..3 {
+                    acc[tri[k] as usize] += w[k];
+                }
             }
         }
-        self.normals = acc.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect();
+        self.normals = acc.into_par_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect();
     }
 }
 
@@ -330,10 +343,11 @@ mod tests {
 
     #[test]
     fn angle_weighted_normals_ignore_how_a_face_is_split() {
-        // A vertex at a cube's corner: three faces of equal angle, one of them split in two.
+        // A vertex at a cube's corner: three faces of equal angle, one of them split in two; a
+        // triangle of no area (a repeated corner) adds nothing.
         let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::new(1.0, 1.0, 0.0)];
         let faces = |split: bool| {
-            let mut t = vec![[0, 3, 1], [0, 2, 3]];
+            let mut t = vec![[0, 3, 1], [0, 2, 3], [0, 0, 1]];
             t.extend(if split { vec![[0, 1, 4], [0, 4, 2]] } else { vec![[0, 1, 2]] });
             let mut m = TriangleMesh { positions: p.clone(), triangles: t, ..TriangleMesh::default() };
             m.compute_angle_weighted_normals();
