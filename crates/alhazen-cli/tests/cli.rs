@@ -1209,3 +1209,18 @@ fn a_morton_bvh_renders_the_same_image() {
     };
     assert_eq!(image("sah"), image("morton"));
 }
+
+/// `-D` takes NAME=VALUE for a Mitsuba scene: a malformed one, or one given to a scene of
+/// another format, is bad input (exit code 2) before anything is read or rendered.
+#[test]
+fn scene_parameters_are_refused_when_malformed_or_misplaced() {
+    for bad in ["spp", "=4", "s p=4"] {
+        let (code, err, written) = render(OK, &["-D", bad]);
+        assert!(
+            code == 2 && !written && (err.contains("NAME=VALUE") || err.contains("parameter name")),
+            "{bad}: {err}"
+        );
+    }
+    let (code, err, written) = render(OK, &["-D", "spp=4"]);
+    assert!(code == 2 && !written && err.contains("Mitsuba"), "{err}");
+}

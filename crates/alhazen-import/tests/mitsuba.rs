@@ -865,3 +865,16 @@ fn long_chains_of_later_references_are_errors_not_crashes() {
     let err = import(&[("s.xml", &scene(&body))]).unwrap_err();
     assert!(err.contains("no object has id"), "{err}");
 }
+
+/// A `serialized` shape's `shape_index` must be a mesh's index: negative, fractional or NaN
+/// indices are located errors, said before the file is read.
+#[test]
+fn serialized_shape_indices_are_checked() {
+    for index in ["-1", "1.5", "nan", "1e12"] {
+        let xml = scene(&format!(
+            r#"<shape type="serialized"><string name="filename" value="none.serialized"/><float name="shape_index" value="{index}"/></shape>"#
+        ));
+        let err = import(&[("s.xml", &xml)]).unwrap_err();
+        assert!(err.contains("s.xml:2:") && err.contains("shape_index"), "{index}: {err}");
+    }
+}

@@ -141,15 +141,14 @@ impl Parser<'_> {
     pub(crate) fn environment_light(&mut self, n: &Node) -> R<Light> {
         let t = n.table(&["type", "file", "scale", "rotate_y", "up"])?;
         let file = t.req("file")?;
+        // The numbers first: a mistake in them is said before the image is read.
+        let scale = t.get("scale").map_or(Ok(1.0), |n| n.non_negative())?;
+        let rotation = t.opt_f64("rotate_y", 0.0)?.to_radians();
+        let up = t.get("up").map_or(Ok(Vec3::Y), |n| n.unit_vec3())?;
         let path = self.dir.join(file.str()?);
         let data = import::load_hdr_image(&path).map_err(|e| file.err(e))?;
         self.scene.images.push(Arc::new(data));
-        Ok(Light::Environment {
-            image: self.scene.images.len() - 1,
-            scale: t.get("scale").map_or(Ok(1.0), |n| n.non_negative())?,
-            rotation: t.opt_f64("rotate_y", 0.0)?.to_radians(),
-            up: t.get("up").map_or(Ok(Vec3::Y), |n| n.unit_vec3())?,
-        })
+        Ok(Light::Environment { image: self.scene.images.len() - 1, scale, rotation, up })
     }
 }
 

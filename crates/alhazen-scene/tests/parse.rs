@@ -418,3 +418,33 @@ emission = { hsv = [0, 0, 0.5] }
     let e = load_scene(&path).unwrap_err().to_string();
     assert!(e.contains("overflow single precision") && e.contains("e.toml:2:"), "{e}");
 }
+
+/// This session's new keys refuse what they cannot mean, pointing at the value: a spot's
+/// `beam` outside 0–180° or NaN, an environment's `up` of no length or not finite, a thin
+/// sheet's `ior` below 1, a blend's `weight_map` that is not a texture.
+#[test]
+fn beams_up_axes_thin_sheets_and_weight_maps_refuse_nonsense() {
+    let spot = |beam: &str| {
+        err(&format!(
+            "[[light]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\nangle = 30\nbeam = {beam}\n"
+        ))
+    };
+    for beam in ["200", "-1", "nan"] {
+        assert!(spot(beam).contains("s.toml:6"), "beam {beam}: {}", spot(beam));
+    }
+    let sky = |up: &str| err(&format!("[[light]]\ntype = \"environment\"\nfile = \"none.exr\"\nup = {up}\n"));
+    for up in ["[0, 0, 0]", "[nan, 1, 0]", "[1, 2]"] {
+        let e = sky(up);
+        assert!(e.contains("s.toml:") && !e.contains("none.exr"), "up {up}: {e}");
+    }
+    let material = |bsdf: &str| {
+        err(&format!("[materials.m]\nbsdf = {bsdf}\n[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"m\"\n"))
+    };
+    for bsdf in [
+        r#"{ type = "thin-dielectric", ior = 0.5 }"#,
+        r#"{ type = "thin-dielectric", ior = nan }"#,
+        r#"{ type = "mix", a = { type = "lambert" }, b = { type = "lambert" }, weight_map = "noise" }"#,
+    ] {
+        assert!(material(bsdf).contains("s.toml:2"), "{bsdf}: {}", material(bsdf));
+    }
+}
