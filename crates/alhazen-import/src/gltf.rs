@@ -23,6 +23,7 @@ use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
     PerspectiveOpening, Scene, SceneError, Shape, Texture,
 };
+use gltf::material::AlphaMode;
 use gltf::mesh::Mode;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -116,10 +117,10 @@ struct Importer<'a> {
     warnings: Warnings,
     materials: HashMap<Option<usize>, MaterialId>,
     meshes: HashMap<(usize, usize), Option<usize>>,
-    images: HashMap<(usize, bool), Arc<ImageData>>,
+    images: HashMap<(usize, Decoding), Arc<ImageData>>,
     /// Images decoded ahead of the walk, on all threads, or why they could not be
     /// ([`Importer::decode_ahead`]): taken by [`Importer::image`] when the walk asks.
-    decoded: HashMap<(usize, bool), Result<ImageData, String>>,
+    decoded: HashMap<(usize, Decoding), Result<ImageData, String>>,
     camera: Option<CameraDesc>,
     bounds: Bounds3,
 }
@@ -314,7 +315,7 @@ impl Importer<'_> {
         let (base, base_mean) = match pbr.base_color_texture() {
             Some(info) => {
                 let scale = self.texture_scale(&info, &name);
-                let img = self.image(&info.texture(), true)?;
+                let img = self.image(&info.texture(), Decoding::Srgb)?;
                 let img = scaled(img, factor);
                 let mean = alhazen_scene::texture::image_mean(&img);
                 self.scene.images.push(img);
@@ -333,7 +334,7 @@ impl Importer<'_> {
             && emission != Vec3::ZERO
         {
             let scale = self.texture_scale(&info, &name);
-            let img = scaled(self.image(&info.texture(), true)?, emission);
+            let img = scaled(self.image(&info.texture(), Decoding::Srgb)?, emission);
             emission = alhazen_scene::texture::image_mean(&img);
             self.scene.images.push(img);
             emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale });
@@ -354,7 +355,7 @@ impl Importer<'_> {
         // blue), except under transmission, whose glass the model mixes in by one weight.
         let mut map = None;
         if let Some(info) = pbr.metallic_roughness_texture() {
-            let image = self.image(&info.texture(), false)?;
+            let image = self.image(&info.texture(), Decoding::Linear)?;
             if transmission > 0.0 {
                 let mean = alhazen_scene::texture::image_mean(&image);
                 (roughness, metallic) = (roughness * mean.y, metallic * mean.z);
@@ -372,16 +373,15 @@ impl Importer<'_> {
                 if nt.tex_coord() != 0 {
                     self.warn(format!("{name}: texture coordinate set {} is read as set 0", nt.tex_coord()));
                 }
-                let image = self.image(&nt.texture(), false)?;
+                let image = self.image(&nt.texture(), Decoding::Linear)?;
                 self.scene.images.push(image);
                 let image = self.scene.images.len() - 1;
                 Some(Bump { height: nt.scale() as f64, pattern: BumpPattern::NormalMap { image, scale: Vec2::ONE } })
             }
             None => None,
         };
-        if material.alpha_mode() != gltf::material::AlphaMode::Opaque {
-            self.warn(format!("{name}: alpha {:?} is not supported; the surface is opaque", material.alpha_mode()));
-        }
+        let base_scale = if let Texture::Image { scale, .. } = base { scale } else { Vec2::ONE };
+        let alpha = self.cut_out(&material, c[3] as f64, base_scale)?;
         for ext in [
             "KHR_materials_clearcoat",
             "KHR_materials_sheen",
@@ -406,6 +406,7 @@ impl Importer<'_> {
         let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
         (m.emission, m.emission_texture) = (emission, emission_texture);
         m.bump = bump;
+        m.alpha = alpha;
         let id = common::add_material(&mut self.scene, m);
         self.materials.insert(material.index(), id);
         Ok(id)
@@ -435,16 +436,50 @@ impl Importer<'_> {
         }
     }
 
-    /// A texture's image in linear RGB (decoded from sRGB when `srgb`).
-    fn image(&mut self, texture: &gltf::Texture, srgb: bool) -> R<Arc<ImageData>> {
+    /// The material's cut-out: `MASK` present where the base colour's alpha (its factor
+    /// `factor` times its texture's alpha channel) reaches `alphaCutoff`; `BLEND` that alpha as
+    /// a coverage, a ray let through with probability `1 − alpha` (Cycles' and Blender's
+    /// reading of a blended surface in a path tracer); `None` when opaque.
+    /// The base colour texture's `scale` is the coverage's.
+    fn cut_out(&mut self, material: &gltf::Material, factor: f64, scale: Vec2) -> R<Option<alhazen_scene::Alpha>> {
+        let cutoff = match material.alpha_mode() {
+            AlphaMode::Opaque => return Ok(None),
+            AlphaMode::Mask => Some(material.alpha_cutoff().unwrap_or(0.5) as f64),
+            AlphaMode::Blend => None,
+        };
+        let factor = if factor.is_finite() { factor.clamp(0.0, 1.0) } else { 1.0 };
+        let texture = match material.pbr_metallic_roughness().base_color_texture() {
+            Some(info) => {
+                let img = self.image(&info.texture(), Decoding::Alpha)?;
+                // An image without an alpha channel is present everywhere.
+                (alhazen_scene::texture::image_mean(&img).x < 1.0).then(|| {
+                    self.scene.images.push(scaled(img, Vec3::splat(factor)));
+                    Texture::Image { image: self.scene.images.len() - 1, scale }
+                })
+            }
+            None => None,
+        };
+        let coverage = match texture {
+            Some(t) => t,
+            // A constant coverage with a cutoff is all there or not at all.
+            None => Texture::Solid(Vec3::splat(cutoff.map_or(factor, |c| if factor >= c { 1.0 } else { 0.0 }))),
+        };
+        if coverage == Texture::Solid(Vec3::ONE) {
+            return Ok(None);
+        }
+        Ok(Some(alhazen_scene::Alpha { coverage, cutoff }))
+    }
+
+    /// A texture's image in linear RGB (decoded as `decoding` says).
+    fn image(&mut self, texture: &gltf::Texture, decoding: Decoding) -> R<Arc<ImageData>> {
         let source = texture.source();
-        let key = (source.index(), srgb);
+        let key = (source.index(), decoding);
         if let Some(img) = self.images.get(&key) {
             return Ok(img.clone());
         }
         let decoded = match self.decoded.remove(&key) {
             Some(ahead) => ahead,
-            None => decode_image(&source, srgb, self.base, &self.buffers),
+            None => decode_image(&source, decoding, self.base, &self.buffers),
         };
         let img = Arc::new(decoded.map_err(|e| self.err(e))?);
         self.images.insert(key, img.clone());
@@ -470,8 +505,10 @@ impl Importer<'_> {
                     pbr.metallic_roughness_texture().map(|t| t.texture()),
                     material.normal_texture().map(|t| t.texture()),
                 ];
-                wanted.extend(srgb.iter().flatten().map(|t| (t.source().index(), true)));
-                wanted.extend(linear.iter().flatten().map(|t| (t.source().index(), false)));
+                let alpha = pbr.base_color_texture().filter(|_| material.alpha_mode() != AlphaMode::Opaque);
+                wanted.extend(srgb.iter().flatten().map(|t| (t.source().index(), Decoding::Srgb)));
+                wanted.extend(linear.iter().flatten().map(|t| (t.source().index(), Decoding::Linear)));
+                wanted.extend(alpha.map(|t| (t.texture().source().index(), Decoding::Alpha)));
             }
             todo.extend(node.children().map(|c| (c, depth + 1)));
         }
@@ -479,7 +516,7 @@ impl Importer<'_> {
         let (base, buffers) = (self.base, &self.buffers);
         let decoded: Vec<_> = wanted
             .into_par_iter()
-            .filter_map(|(i, srgb)| Some(((i, srgb), decode_image(images.get(i)?, srgb, base, buffers))))
+            .filter_map(|(i, how)| Some(((i, how), decode_image(images.get(i)?, how, base, buffers))))
             .collect();
         self.decoded = decoded.into_iter().collect();
     }
@@ -585,17 +622,28 @@ fn scaled(img: Arc<ImageData>, factor: Vec3) -> Arc<ImageData> {
 /// why it could not be.
 fn decode_image(
     source: &gltf::Image,
-    srgb: bool,
+    decoding: Decoding,
     base: &Path,
     buffers: &[gltf::buffer::Data],
 ) -> Result<ImageData, String> {
     let data = gltf::image::Data::from_source(source.source(), Some(base), buffers)
         .map_err(|e| format!("image {}: {e}", source.index()))?;
-    decode(&data, srgb).ok_or_else(|| format!("image {}: unsupported pixel format", source.index()))
+    decode(&data, decoding).ok_or_else(|| format!("image {}: unsupported pixel format", source.index()))
+}
+
+/// How an image's channels are read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+enum Decoding {
+    /// Colours, decoded from sRGB (base colour, emission).
+    Srgb,
+    /// Values as they are (metallic–roughness, normals).
+    Linear,
+    /// The alpha channel, as it is, in all three (1 where the image has none).
+    Alpha,
 }
 
 /// Decoded glTF image data as linear RGB.
-fn decode(data: &gltf::image::Data, srgb: bool) -> Option<ImageData> {
+fn decode(data: &gltf::image::Data, decoding: Decoding) -> Option<ImageData> {
     use gltf::image::Format::*;
     let (channels, bytes) = match data.format {
         R8 => (1, 1),
@@ -613,8 +661,18 @@ fn decode(data: &gltf::image::Data, srgb: bool) -> Option<ImageData> {
     if data.pixels.len() != n * channels * bytes || data.width == 0 || data.height == 0 {
         return None;
     }
-    // Channel `i` of a pixel: grey images repeat their first.
-    let channel = |i: usize| if channels < 3 { 0 } else { i };
+    let srgb = decoding == Decoding::Srgb;
+    // Channel `i` of a pixel: grey images repeat their first; alpha is the last of two or four.
+    let has_alpha = channels % 2 == 0;
+    let channel = |i: usize| match decoding {
+        Decoding::Alpha if has_alpha => channels - 1,
+        _ if channels < 3 => 0,
+        _ => i,
+    };
+    if decoding == Decoding::Alpha && !has_alpha {
+        let n = data.width as usize * data.height as usize;
+        return Some(ImageData::from_codes(data.width, data.height, [1.0; 256], vec![[0; 3]; n]));
+    }
     if bytes == 1 {
         // Eight bits a channel: the 256 values decoded once, the pixels kept as their codes.
         let table = std::array::from_fn(|k| {

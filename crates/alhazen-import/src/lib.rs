@@ -114,6 +114,17 @@ pub fn load_with_parameters(
     memory_budget: u64,
     parameters: &[(String, String)],
 ) -> Result<Imported, SceneError> {
+    let mut imported = read(path, memory_budget, parameters)?;
+    let cut_outs = imported.scene.opaque_cut_outs();
+    imported.warnings.extend(cut_outs.into_iter().map(|message| Warning {
+        file: path.to_path_buf(),
+        line: 0,
+        message,
+    }));
+    Ok(imported)
+}
+
+fn read(path: &Path, memory_budget: u64, parameters: &[(String, String)]) -> Result<Imported, SceneError> {
     match SceneFormat::from_path(path) {
         SceneFormat::Alhazen => {
             let (scene, warnings) = alhazen_scene::load_scene_reporting(path, memory_budget)?;

@@ -56,6 +56,7 @@ pub fn load_with_parameters(path: &Path, parameters: &[(String, String)]) -> Res
         pending: PendingFiles::default(),
         search: vec![],
         scene_dir: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+        cut_out: None,
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.scene.render.width = 768;
@@ -165,6 +166,8 @@ struct Importer {
     search: Vec<PathBuf>,
     /// The folder of the scene file.
     scene_dir: PathBuf,
+    /// The cut-out of the `mask` met in the BSDF being read, for its material.
+    cut_out: Option<alhazen_scene::Alpha>,
 }
 
 /// One file being read.
@@ -865,11 +868,12 @@ impl Importer {
     /// A `<bsdf>` element as a new material: one-sided, as Mitsuba's are, unless wrapped in
     /// `twosided` or letting light through.
     fn bsdf_material(&mut self, ctx: &Ctx, node: Node) -> R<MaterialId> {
+        self.cut_out = None;
         let (desc, bump) = self.bsdf(ctx, node, 0)?;
         let name = self.attr(ctx, node, "id")?.unwrap_or_else(|| format!("bsdf at line {}", ctx.line(node)));
         let one_sided = !self.is_twosided(node, 0) && reflects_only(&desc);
         let mut m = alhazen_scene::Material::from_bsdf(&name, desc);
-        (m.bump, m.one_sided) = (bump, one_sided);
+        (m.bump, m.one_sided, m.alpha) = (bump, one_sided, self.cut_out.take());
         Ok(common::add_material(&mut self.scene, m))
     }
 
@@ -918,6 +922,9 @@ impl Importer {
         match self.ids.get(&id) {
             Some(Named::Bsdf(m)) => {
                 let m = &self.scene.materials[*m as usize];
+                if m.alpha.is_some() {
+                    self.cut_out = m.alpha.clone();
+                }
                 Ok((m.bsdf.clone().expect("imported materials have a BSDF"), m.bump.clone()))
             }
             Some(_) => Err(ctx.err(n, format!("\"{id}\" is not a BSDF"))),
@@ -1067,9 +1074,13 @@ impl Importer {
                 inner
             }
             "mask" => {
-                self.warn(ctx, node, "mask is not supported: the nested BSDF is used without it (opaque)");
-                p.used.borrow_mut().insert("opacity".to_string());
-                return self.inner_bsdf(ctx, node, depth);
+                // Mitsuba's opacity (0.5 unless given) picks its nested BSDF or a passage
+                // straight through, at random: a coverage without cutoff.
+                let coverage = self.color(ctx, &p, "opacity", Vec3::splat(0.5))?;
+                let inner = self.inner_bsdf(ctx, node, depth)?;
+                self.unused(ctx, &p, "bsdf");
+                self.cut_out = Some(alhazen_scene::Alpha { coverage, cutoff: None });
+                return Ok(inner);
             }
             other => {
                 self.warn(

@@ -168,6 +168,8 @@ struct State {
 }
 
 struct Importer {
+    /// Materials given a shape's cut-out: by the material and the coverage (its `Debug` text).
+    cut_materials: HashMap<(MaterialId, String), MaterialId>,
     scene: Scene,
     warnings: Warnings,
     state: State,
@@ -226,6 +228,7 @@ impl Importer {
             named_coords: HashMap::new(),
             named_materials: HashMap::new(),
             textures: HashMap::new(),
+            cut_materials: HashMap::new(),
             objects: HashMap::new(),
             defining: None,
             meshes: HashMap::new(),
@@ -1286,17 +1289,32 @@ impl Importer {
         if reverse && !matches!(shape, Shape::Mesh { .. }) {
             self.warn(ctx, at, "ReverseOrientation applies to meshes only: this shape emits from its outside");
         }
-        if self.find(p, "alpha").is_some() {
-            self.warn(ctx, at, "alpha cut-outs are not supported; the shape is opaque");
-        }
+        // pbrt's alpha: a coverage that lets a fraction of the rays through (no cutoff).
+        let coverage = self.texture_param(ctx, p, "alpha", Vec3::ONE)?;
         self.unused(ctx, p, &format!("shape \"{kind}\""));
         let mut material = self.current_material();
         if let Some(area) = self.state.area.clone() {
             material = common::emissive(&mut self.scene, material, area.radiance, None);
         }
+        if coverage != Texture::Solid(Vec3::ONE) {
+            material = self.cut_material(material, coverage);
+        }
         let (shape, transform) = common::placed_sphere(shape, transform);
         self.emit(Object { name: None, shape, transform, material, mesh_materials: vec![] });
         Ok(())
+    }
+
+    /// `material` with the cut-out `coverage` (made once per pair).
+    fn cut_material(&mut self, material: MaterialId, coverage: Texture) -> MaterialId {
+        let key = (material, format!("{coverage:?}"));
+        if let Some(&m) = self.cut_materials.get(&key) {
+            return m;
+        }
+        let mut m = self.scene.materials[material as usize].clone();
+        m.alpha = Some(alhazen_scene::Alpha { coverage, cutoff: None });
+        let id = common::add_material(&mut self.scene, m);
+        self.cut_materials.insert(key, id);
+        id
     }
 
     /// `trianglemesh` (`P`, `indices`, `N`, `uv`), `bilinearmesh` (four corners a patch, split

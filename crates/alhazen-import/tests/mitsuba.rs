@@ -878,3 +878,31 @@ fn serialized_shape_indices_are_checked() {
         assert!(err.contains("s.xml:2:") && err.contains("shape_index"), "{index}: {err}");
     }
 }
+
+/// A `mask` cuts its opacity out of the material it wraps (0.5 unless given; a `ref` to a
+/// masked BSDF keeps the cut); a masked sphere is opaque, and says so.
+#[test]
+fn masks_are_cut_outs() {
+    let body = r#"
+<bsdf type="mask" id="leaf"><float name="opacity" value="0.3"/><bsdf type="diffuse"/></bsdf>
+<bsdf type="twosided" id="card"><ref id="leaf"/></bsdf>
+<bsdf type="mask" id="half"><bsdf type="diffuse"/></bsdf>
+<shape type="rectangle"><ref id="leaf"/></shape>
+<shape type="rectangle"><ref id="card"/></shape>
+<shape type="rectangle"><ref id="half"/></shape>
+<shape type="sphere"><ref id="half"/></shape>"#;
+    let s = import(&[("m.xml", &scene(body))]).unwrap();
+    let coverage = |o: usize| {
+        let m = &s.scene.materials[s.scene.objects[o].material as usize];
+        let a = m.alpha.as_ref().expect("a cut-out");
+        assert_eq!(a.cutoff, None);
+        assert!(matches!(m.bsdf, Some(BsdfDesc::Lambert { .. })), "{:?}", m.bsdf);
+        a.coverage.clone()
+    };
+    assert_eq!(coverage(0), Texture::Solid(Vec3::splat(0.3)));
+    assert_eq!(coverage(1), Texture::Solid(Vec3::splat(0.3)));
+    assert_eq!(coverage(2), Texture::Solid(Vec3::splat(0.5)));
+    let text: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(text.iter().any(|w| w.contains("applies to meshes only")), "{text:?}");
+    assert!(!text.iter().any(|w| w.contains("mask")), "{text:?}");
+}

@@ -243,3 +243,21 @@ fn a_texture_replaced_by_its_mean_is_read_first() {
     assert_eq!(m.bsdf, Some(BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::new(1.0, 0.5, 0.0)) }));
     assert!(imported.warnings.iter().any(|w| w.to_string().contains("replaced by its mean")));
 }
+
+/// A shape's `alpha`, a number or a float texture, cuts it out (pbrt's stochastic alpha: no
+/// cutoff); shapes sharing a material and an alpha share one cut material.
+#[test]
+fn alpha_cuts_shapes_out() {
+    let quad = r#"Shape "bilinearmesh" "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0]"#;
+    let text = format!(
+        "WorldBegin\nTexture \"dots\" \"float\" \"checkerboard\" \"float tex1\" 1 \"float tex2\" 0\n\
+         {quad} \"float alpha\" 0.25\n{quad} \"float alpha\" 0.25\n{quad} \"texture alpha\" \"dots\"\n{quad}\n"
+    );
+    let s = import(&[("a.pbrt", &text)]).unwrap().scene;
+    let alpha = |o: usize| s.materials[s.objects[o].material as usize].alpha.clone();
+    let quarter = alpha(0).expect("a cut-out");
+    assert_eq!((quarter.coverage, quarter.cutoff), (Texture::Solid(Vec3::splat(0.25)), None));
+    assert_eq!(s.objects[0].material, s.objects[1].material);
+    assert!(matches!(alpha(2).map(|a| a.coverage), Some(Texture::Checker { .. })), "{:?}", alpha(2));
+    assert_eq!(alpha(3), None);
+}

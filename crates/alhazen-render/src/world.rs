@@ -10,9 +10,9 @@
 
 use crate::bvh::Bvh;
 use crate::shape::{
-    AaBox, Candidate, Cone, Csg, Cylinder, Disk, FLAT_LANES as LANES, Flat, FlatLane, FlatPacket, LaneHit, MeshAccel,
-    MeshShape, PackedFlats, Placed, Plane, RayPacket, RaysSphereHits, SPHERE_LANES, Shape, Sphere, SpherePacket,
-    SurfaceHit, VectorUnit, flat_primitives, on_triangle,
+    AaBox, AlphaMask, Candidate, Cone, Csg, Cylinder, Disk, FLAT_LANES as LANES, Flat, FlatLane, FlatPacket, LaneHit,
+    MeshAccel, MeshShape, PackedFlats, Placed, Plane, RayPacket, RaysSphereHits, SPHERE_LANES, Shape, Sphere,
+    SpherePacket, SurfaceHit, VectorUnit, flat_primitives, on_triangle,
 };
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec3};
@@ -216,7 +216,9 @@ fn build_shape(s: &scene::Shape, meshes: &[Arc<MeshAccel>]) -> Shape {
         }
         scene::Shape::Plane { point, normal } => Shape::Plane(Plane { point: *point, normal: *normal }),
         scene::Shape::Box { min, max } => Shape::Box(AaBox { min: *min, max: *max }),
-        scene::Shape::Mesh { mesh, smooth } => Shape::Mesh(MeshShape { accel: meshes[*mesh].clone(), smooth: *smooth }),
+        scene::Shape::Mesh { mesh, smooth } => {
+            Shape::Mesh(MeshShape { accel: meshes[*mesh].clone(), smooth: *smooth, alpha: None })
+        }
         scene::Shape::Csg { op, a, b } => Shape::Csg(Box::new(Csg {
             op: *op,
             a: Placed::new(build_shape(&a.shape, meshes), a.transform),
@@ -234,6 +236,8 @@ fn uses_uv(o: &scene::Object, s: &scene::Scene) -> bool {
             || m.bump.is_some()
             || m.emission_texture.is_some()
             || m.bsdf.as_ref().is_some_and(|b| b.is_textured())
+            // A box with a cut-out stays a box (opaque: cut-outs are meshes'), not six faces.
+            || m.alpha.is_some()
     })
 }
 
@@ -267,7 +271,9 @@ fn baked(mesh: &TriangleMesh, tf: &alhazen_math::Transform) -> TriangleMesh {
 /// straight into the top-level BVH.
 fn flattenable(p: &Placed) -> Option<&alhazen_geom::TriangleMesh> {
     match (&p.shape, &p.to_world) {
-        (Shape::Mesh(m), None) if m.accel.mesh.triangle_count() <= BAKE_TRIANGLES => Some(&m.accel.mesh),
+        (Shape::Mesh(m), None) if m.accel.mesh.triangle_count() <= BAKE_TRIANGLES && m.alpha.is_none() => {
+            Some(&m.accel.mesh)
+        }
         _ => None,
     }
 }
@@ -344,13 +350,28 @@ fn place(
     };
     if let Some((m, smooth)) = small {
         let accel = Arc::new(MeshAccel::with_unit(Arc::new(baked(&m, &o.transform)), unit));
-        return Placed::new(Shape::Mesh(MeshShape { accel, smooth }), alhazen_math::Transform::IDENTITY);
+        return Placed::new(Shape::Mesh(MeshShape { accel, smooth, alpha: None }), alhazen_math::Transform::IDENTITY);
     }
     if let Some(sphere) = turned_sphere(&o.shape, &o.transform) {
         // Tested in packets like any other sphere; only its parametrisation keeps the turn.
         return Placed::new(Shape::Sphere(sphere), alhazen_math::Transform::IDENTITY);
     }
     Placed::new(build_shape(&o.shape, meshes), o.transform)
+}
+
+/// [`place`], a mesh given its materials' cut-outs ([`AlphaMask`]).
+fn place_with_alpha(
+    o: &scene::Object,
+    meshes: &[Arc<MeshAccel>],
+    world_space: &[Option<alhazen_math::Transform>],
+    scene: &scene::Scene,
+    unit: VectorUnit,
+) -> Placed {
+    let mut placed = place(o, meshes, world_space, scene, unit);
+    if let Shape::Mesh(m) = &mut placed.shape {
+        m.alpha = AlphaMask::of(o, scene);
+    }
+    placed
 }
 
 impl World {
@@ -383,7 +404,7 @@ impl World {
             .objects
             .iter()
             .map(|o| WorldObject {
-                placed: Placed { uv: uses_uv(o, scene), ..place(o, &meshes, &world_space, scene, unit) },
+                placed: Placed { uv: uses_uv(o, scene), ..place_with_alpha(o, &meshes, &world_space, scene, unit) },
                 material: o.material,
                 slot_materials: o.mesh_materials.clone(),
                 tangents: std::iter::once(&o.material).chain(&o.mesh_materials).any(|&m| {

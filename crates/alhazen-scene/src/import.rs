@@ -433,6 +433,26 @@ pub fn load_image(path: &Path) -> Result<ImageData, String> {
     Ok(ImageData::from_codes(img.width(), img.height(), table, img.pixels().map(|p| p.0).collect()))
 }
 
+/// Loads a cut-out's coverage ([`crate::Alpha`]): the image's alpha channel, or its first
+/// channel where it has none, as the linear fractions the file holds (an 8-bit code `k` is
+/// `k/255`, never decoded from sRGB), in all three channels.
+pub fn load_coverage(path: &Path) -> Result<ImageData, String> {
+    let img = image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))?;
+    has_pixels(path, img.width(), img.height())?;
+    let channel = if img.color().has_alpha() { 3 } else { 0 };
+    let (w, h) = (img.width(), img.height());
+    if img.color().bytes_per_pixel() == img.color().channel_count() {
+        let table = std::array::from_fn(|k| k as f32 / 255.0);
+        let codes = img.to_rgba8().pixels().map(|p| [p.0[channel]; 3]).collect();
+        return Ok(ImageData::from_codes(w, h, table, codes));
+    }
+    let pixels: Vec<[f32; 3]> = img.to_rgba32f().pixels().map(|p| [p.0[channel]; 3]).collect();
+    if pixels.iter().any(|p| !(0.0..=1.0).contains(&p[0])) {
+        return Err(format!("{}: a coverage must lie in [0, 1]; the image has other values", path.display()));
+    }
+    Ok(ImageData::new(w, h, pixels))
+}
+
 /// Refuses an image of no pixels (a header saying 0 × 2: found by fuzzing, it made texture
 /// lookups divide by zero).
 fn has_pixels(path: &Path, w: u32, h: u32) -> Result<(), String> {

@@ -521,6 +521,23 @@ pub struct Material {
     /// behind, an opaque surface is black and ends paths, as Mitsuba's BSDFs not wrapped in
     /// `twosided` are. `false` (the default): both sides alike, the course's reading.
     pub one_sided: bool,
+    /// A cut-out: where the surface is not (leaves and lace drawn on a card). `None`: opaque
+    /// everywhere.
+    pub alpha: Option<Alpha>,
+}
+
+/// Where a surface is, point by point (glTF's `alphaMode`, pbrt's shape `alpha`, Mitsuba's
+/// `mask`): rays pass through it where it is not, in every tracer, shadow rays too. Taken by
+/// the ray tests of meshes (the renderers test every hit of a mesh with a cut-out material
+/// before taking it); other shapes are opaque.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Alpha {
+    /// The fraction of the surface present, in `[0, 1]`: the texture's first (red) channel.
+    pub coverage: Texture,
+    /// `Some(c)`: present where the coverage is at least `c`, absent elsewhere (glTF's
+    /// `MASK`). `None`: a coverage `a` between 0 and 1 lets a fraction `1 − a` of the rays
+    /// through, each ray's passage decided by a hash of the ray (pbrt's stochastic alpha).
+    pub cutoff: Option<f64>,
 }
 
 /// A displacement `d(q(u, v))` of a surface along its normal (course, §"Shading methods":
@@ -580,6 +597,7 @@ impl Default for Material {
             bsdf: None,
             bump: None,
             one_sided: false,
+            alpha: None,
         }
     }
 }
@@ -693,6 +711,28 @@ pub struct Object {
     pub material: MaterialId,
     /// Per-slot materials of a mesh from its MTL file (empty when `material` applies to all).
     pub mesh_materials: Vec<MaterialId>,
+}
+
+impl Object {
+    /// The object's materials: its own and its mesh's slots'.
+    pub fn materials(&self) -> impl Iterator<Item = MaterialId> + '_ {
+        std::iter::once(self.material).chain(self.mesh_materials.iter().copied())
+    }
+}
+
+impl Scene {
+    /// A warning per object that is not a mesh but has a material with a cut-out: renderers
+    /// cut holes in meshes only ([`Alpha`]), so it is drawn opaque.
+    pub fn opaque_cut_outs(&self) -> Vec<String> {
+        let cut = |m: MaterialId| self.materials.get(m as usize).is_some_and(|m| m.alpha.is_some());
+        let name = |i: usize, o: &Object| o.name.clone().unwrap_or_else(|| format!("object {}", i + 1));
+        self.objects
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| !matches!(o.shape, Shape::Mesh { .. }) && o.materials().any(cut))
+            .map(|(i, o)| format!("{}: a cut-out (alpha) applies to meshes only; this shape is opaque", name(i, o)))
+            .collect()
+    }
 }
 
 /// A decoded image in linear RGB, rows top to bottom. Made by [`ImageData::new`] (or

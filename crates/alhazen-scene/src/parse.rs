@@ -219,6 +219,7 @@ impl Parser<'_> {
             "anisotropy",
             "scratches",
             "one_sided",
+            "alpha",
         ];
         let t = n.table(KEYS)?;
         let plain = Material::default();
@@ -263,20 +264,49 @@ impl Parser<'_> {
             bsdf,
             bump: t.get("bump").map(|b| self.bump(&b)).transpose()?,
             one_sided: t.opt_bool("one_sided", false)?,
+            alpha: t.get("alpha").map(|a| self.alpha(&a)).transpose()?,
         })
+    }
+
+    /// `alpha = a` (a coverage in `[0, 1]`, stochastic) or `alpha = { image = { file, scale },
+    /// cutoff = c }` (the image's alpha channel, or its first where it has none; with `cutoff`,
+    /// present where the coverage is at least `c`, else stochastic).
+    fn alpha(&mut self, n: &Node) -> R<Alpha> {
+        if !n.is_table() {
+            return Ok(Alpha { coverage: Texture::Solid(Vec3::splat(n.in_range(0.0, 1.0)?)), cutoff: None });
+        }
+        let t = n.table(&["image", "cutoff"])?;
+        // The cutoff is checked before the image is read.
+        let cutoff = t.get("cutoff").map(|c| c.in_range(0.0, 1.0)).transpose()?;
+        let Some(i) = t.get("image") else {
+            return Err(n.err("`alpha`: expected a coverage in [0, 1] or { image = { file = … }, cutoff = c }"));
+        };
+        let (image, scale) = self.image_file(&i, import::load_coverage)?;
+        Ok(Alpha { coverage: Texture::Image { image, scale }, cutoff })
     }
 
     /// `{ file = "x.png", scale = s or [u, v] }`: a repeated image (its index and scale); PNG and
     /// JPEG are sRGB unless `linear` (normal maps), EXR and HDR always linear.
     pub(crate) fn image_texture(&mut self, i: &Node, linear: bool) -> R<(usize, Vec2)> {
+        self.image_file(i, |path| {
+            let linear = linear
+                || matches!(
+                    path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+                    Some("exr" | "hdr" | "pfm")
+                );
+            if linear { import::load_hdr_image(path) } else { import::load_image(path) }
+        })
+    }
+
+    /// `{ file = "x.png", scale = s or [u, v] }` read by `load`: the image's index and scale.
+    fn image_file(
+        &mut self,
+        i: &Node,
+        load: impl FnOnce(&std::path::Path) -> Result<crate::ImageData, String>,
+    ) -> R<(usize, Vec2)> {
         let i = i.table(&["file", "scale"])?;
         let file = i.req("file")?;
         let path = self.dir.join(file.str()?);
-        let linear = linear
-            || matches!(
-                path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
-                Some("exr" | "hdr" | "pfm")
-            );
         // The scale is checked before the image is read.
         let scale = match i.get("scale") {
             Some(s) if s.is_table() => return Err(s.err("`scale`: expected a number or [u, v]")),
@@ -286,8 +316,7 @@ impl Parser<'_> {
             },
             None => Vec2::ONE,
         };
-        let data = if linear { import::load_hdr_image(&path) } else { import::load_image(&path) };
-        let data = data.map_err(|e| file.err(e))?;
+        let data = load(&path).map_err(|e| file.err(e))?;
         self.scene.images.push(Arc::new(data));
         Ok((self.scene.images.len() - 1, scale))
     }

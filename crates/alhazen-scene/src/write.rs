@@ -352,6 +352,18 @@ impl Writer<'_> {
         if m.one_sided {
             self.line("one_sided", "true".to_string());
         }
+        if let Some(a) = &m.alpha {
+            let cutoff = a.cutoff.map_or(String::new(), |c| format!(", cutoff = {}", num(c)));
+            let text = match &a.coverage {
+                Texture::Image { image, scale } => format!("{{ image = {}{cutoff} }}", self.image(*image, *scale)),
+                // A constant coverage with a cutoff is all there or not at all.
+                other => {
+                    let a0 = crate::texture::mean(other, &[]).x;
+                    num(a.cutoff.map_or(a0, |c| if a0 >= c { 1.0 } else { 0.0 }))
+                }
+            };
+            self.line("alpha", text);
+        }
     }
 
     fn bsdf(&self, b: &BsdfDesc) -> String {

@@ -448,3 +448,55 @@ fn beams_up_axes_thin_sheets_and_weight_maps_refuse_nonsense() {
         assert!(material(bsdf).contains("s.toml:2"), "{bsdf}: {}", material(bsdf));
     }
 }
+
+/// `alpha`: a constant coverage, or an image's alpha channel (its first where it has none)
+/// with an optional cutoff; written back the same; out-of-range values, an image missing or
+/// a cutoff without image refused where they are written.
+#[test]
+fn alpha_cut_outs_read_write_back_and_refuse_nonsense() {
+    let dir = tempfile::tempdir().unwrap();
+    let rgba = image::RgbaImage::from_fn(2, 1, |x, _| image::Rgba([200, 100, 50, if x == 0 { 255 } else { 51 }]));
+    rgba.save(dir.path().join("leaf.png")).unwrap();
+    image::GrayImage::from_fn(2, 1, |x, _| image::Luma([if x == 0 { 0 } else { 255 }]))
+        .save(dir.path().join("grey.png"))
+        .unwrap();
+    let text = r#"
+[materials.leaf]
+alpha = { image = { file = "leaf.png", scale = 2 }, cutoff = 0.5 }
+[materials.lace]
+alpha = { image = { file = "grey.png" } }
+[materials.veil]
+alpha = 0.25
+[materials.plain]
+color = 0.5
+"#;
+    let path = dir.path().join("a.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let alpha =
+        |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().alpha.clone();
+    let coverage = |s: &alhazen_scene::Scene, name: &str| {
+        let Some(alhazen_scene::Alpha { coverage: Texture::Image { image, .. }, cutoff }) = alpha(s, name) else {
+            panic!("{name}: {:?}", alpha(s, name))
+        };
+        (s.images[image].texels().map(|t| t[0]).collect::<Vec<_>>(), cutoff)
+    };
+    // Alpha and grey values as fractions, never decoded from sRGB.
+    assert_eq!(coverage(&s, "leaf"), (vec![1.0, 0.2], Some(0.5)));
+    assert_eq!(coverage(&s, "lace"), (vec![0.0, 1.0], None));
+    let veil = alhazen_scene::Alpha { coverage: Texture::Solid(Vec3::splat(0.25)), cutoff: None };
+    assert_eq!(alpha(&s, "veil"), Some(veil.clone()));
+    assert_eq!(alpha(&s, "plain"), None);
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&again_path).unwrap();
+    assert_eq!(coverage(&again, "leaf"), coverage(&s, "leaf"));
+    assert_eq!(coverage(&again, "lace"), coverage(&s, "lace"));
+    assert_eq!((alpha(&again, "veil"), alpha(&again, "plain")), (Some(veil), None));
+    let m = |alpha: &str| err(&format!("[materials.m]\nalpha = {alpha}\n"));
+    for bad in ["1.5", "-0.1", "nan", "\"half\"", "{ cutoff = 0.5 }", "{ image = { file = \"x.png\" }, cutoff = 2 }"] {
+        assert!(m(bad).contains("s.toml:2"), "{bad}: {}", m(bad));
+    }
+    assert!(m("{ image = { file = \"none.png\" } }").contains("none.png"));
+    assert!(m("{ image = { file = \"x.png\" }, cutof = 0.5 }").contains("cutof"));
+}

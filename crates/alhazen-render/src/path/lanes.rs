@@ -1816,7 +1816,17 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
             let intensity = Vec3::splat(intensity);
             points.lights.push(alhazen_scene::Light::Point { position, intensity, attenuation: [1.0, 0.0, 0.0] });
         }
+        // Cut-outs in every surface: squares present, squares three-fifths present (a ray's
+        // passage decided by its hash); rays lost to the sky through the holes.
+        let mut cut = small("cornell-box", (16, 16, 9));
+        cut.background = sky;
+        for m in &mut cut.materials {
+            let (even, odd) = (Vec3::ONE, Vec3::splat(0.6));
+            let coverage = alhazen_scene::Texture::Checker { even, odd, size: 0.25 };
+            m.alpha = Some(alhazen_scene::Alpha { coverage, cutoff: None });
+        }
         let scenes = [
+            ("cornell-box, cut out", cut),
             ("point lights, a parallelogram and a sky", points),
             ("two lights and a sky", two_lights_and_sky),
             ("cornell-rough and a sky", rough_under_sky),

@@ -399,6 +399,33 @@ impl<L: Copy + Default> PackedFlats<L> {
         Some((self.lanes[k][h.lane], h))
     }
 
+    /// The nearest hit in packets `range` with `0 < t < t_max` that `keep` takes (ties to the
+    /// first, as [`Self::nearest`]), `keep` asked only of hits nearer than the nearest kept so
+    /// far: flat by flat in the scalar test, whose hits are the vector kernels' bits.
+    pub fn nearest_kept(
+        &self,
+        range: std::ops::Range<usize>,
+        ray: &Ray,
+        t_max: f64,
+        mut keep: impl FnMut(L, LaneHit) -> bool,
+    ) -> Option<(L, LaneHit)> {
+        let r = Ray32::new(ray);
+        let mut limit = t_max as f32;
+        let mut best = None;
+        for k in range {
+            let p = &self.packets[k];
+            for lane in 0..p.used {
+                if let Some(h) = p.planes(lane).hit(&r, limit) {
+                    let hit = (self.lanes[k][lane], LaneHit::new(lane, h));
+                    if keep(hit.0, hit.1) {
+                        (limit, best) = (h.0, Some(hit));
+                    }
+                }
+            }
+        }
+        best
+    }
+
     /// [`Self::nearest`] naming the packet (its index among all) rather than its lane's label.
     #[inline]
     pub fn nearest_packet(

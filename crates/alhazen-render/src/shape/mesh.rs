@@ -3,7 +3,9 @@
 //! use Möller–Trumbore. One [`MeshAccel`] is shared by every instance of the mesh (instancing =
 //! one mesh, many transforms).
 
-use super::{Candidate, Crossing, FlatLane, FlatPacket, PackedFlats, SurfaceHit, VectorUnit, flat_primitives};
+use super::{
+    AlphaMask, Candidate, Crossing, FlatLane, FlatPacket, LaneHit, PackedFlats, SurfaceHit, VectorUnit, flat_primitives,
+};
 use crate::bvh::Bvh;
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Ray, Vec2, Vec3};
@@ -81,6 +83,8 @@ pub struct MeshShape {
     pub accel: Arc<MeshAccel>,
     /// Interpolate vertex normals when the mesh has them.
     pub smooth: bool,
+    /// Where its materials cut holes in it (`None`: opaque everywhere).
+    pub alpha: Option<Arc<AlphaMask>>,
 }
 
 /// The point with barycentrics `(b1, b2)` on the triangle with these corners: on its plane to
@@ -215,6 +219,10 @@ impl MeshShape {
     #[allow(unsafe_code)]
     unsafe fn hit_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let a = &*self.accel;
+        if let Some(alpha) = &self.alpha {
+            // SAFETY: the caller's contract.
+            return unsafe { self.hit_kept::<AVX2>(ray, t_max, alpha) };
+        }
         let mut best = None;
         let visit = |packets, t_max| {
             let (lane, h) = a.packets.nearest(packets, ray, t_max, a.vectors)?;
@@ -224,6 +232,27 @@ impl MeshShape {
         // SAFETY: the caller's contract.
         unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
         best.map(|(lane, h)| lane.candidate(h.t, h.b1, h.b2))
+    }
+
+    /// [`Self::hit_with`] on a mesh with cut-outs: the nearest hit where `alpha` says the
+    /// surface is.
+    ///
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn hit_kept<const AVX2: bool>(&self, ray: &Ray, t_max: f64, alpha: &AlphaMask) -> Option<Candidate> {
+        let a = &*self.accel;
+        let mut best = None;
+        let visit = |packets, t_max| {
+            let covered = |lane: FlatLane, h: LaneHit| alpha.covers(&a.mesh, &lane.candidate(h.t, h.b1, h.b2), ray);
+            let (lane, h) = a.packets.nearest_kept(packets, ray, t_max, covered)?;
+            best = Some(lane.candidate(h.t, h.b1, h.b2));
+            Some(h.t)
+        };
+        // SAFETY: the caller's contract.
+        unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
+        best
     }
 
     /// True when some triangle lies on `ray` in `(0, t_max)`: [`MeshShape::hit`]`.is_some()`,
@@ -256,6 +285,18 @@ impl MeshShape {
     #[allow(unsafe_code)]
     unsafe fn blocks_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> bool {
         let a = &*self.accel;
+        if let Some(alpha) = &self.alpha {
+            // SAFETY: the caller's contract.
+            let covered = |lane: FlatLane, h: LaneHit| alpha.covers(&a.mesh, &lane.candidate(h.t, h.b1, h.b2), ray);
+            let mut blocked = false;
+            let visit = |packets, t_max| {
+                blocked = a.packets.nearest_kept(packets, ray, t_max, covered).is_some();
+                blocked.then_some(0.0)
+            };
+            // SAFETY: the caller's contract.
+            unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
+            return blocked;
+        }
         let mut blocked = false;
         let visit = |packets: std::ops::Range<usize>, t_max| {
             blocked = FlatPacket::any_of(&a.packets.packets[packets], ray, t_max, a.vectors);

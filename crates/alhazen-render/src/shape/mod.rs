@@ -5,6 +5,7 @@
 //! Rays need not have unit directions here: transformed rays keep the world parameter `t`.
 
 mod aabox;
+mod alpha;
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod avx512;
@@ -18,6 +19,7 @@ mod sphere;
 mod sphere_packet;
 
 pub use aabox::AaBox;
+pub use alpha::{AlphaMask, ray_hash};
 pub use csg::Csg;
 pub use cylinder::{Cone, Cylinder};
 pub use flat::{Flat, FlatLane, flat_primitives, parallelogram_of, parallelogram_to_triangle};

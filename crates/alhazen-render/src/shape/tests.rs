@@ -61,7 +61,7 @@ fn shapes_with_implicit() -> Vec<(Shape, Implicit)> {
             }),
         ),
         (
-            Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false }),
+            Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false, alpha: None }),
             Box::new(|p: Vec3| p.abs().max_element() - 1.0),
         ),
         (
@@ -169,7 +169,7 @@ proptest! {
     /// length (the any-hit traversal stops early but must not decide differently).
     #[test]
     fn mesh_blocks_where_it_is_hit(mesh in arb_soup(150), ray in arb_ray(), reach in 0.0..1.5f64) {
-        let shape = MeshShape { accel: Arc::new(MeshAccel::new(Arc::new(mesh))), smooth: false };
+        let shape = MeshShape { accel: Arc::new(MeshAccel::new(Arc::new(mesh))), smooth: false, alpha: None };
         let t_max = shape.hit(&ray, f64::INFINITY).map_or(10.0, |c| c.t * 2.0 * reach);
         prop_assert_eq!(shape.blocks(&ray, t_max), shape.hit(&ray, t_max).is_some(), "t_max {}", t_max);
     }
@@ -178,7 +178,7 @@ proptest! {
     #[test]
     fn mesh_packets_agree_with_every_triangle(mesh in arb_soup(150), ray in arb_ray()) {
         let mesh = Arc::new(mesh);
-        let shape = MeshShape { accel: Arc::new(MeshAccel::new(mesh.clone())), smooth: false };
+        let shape = MeshShape { accel: Arc::new(MeshAccel::new(mesh.clone())), smooth: false, alpha: None };
         let brute = (0..mesh.triangle_count())
             .filter_map(|i| mesh::triangle_hit(&ray, mesh.corners(i)).filter(|h| h.0 > 0.0).map(|h| (h.0, i)))
             .min_by(|a, b| a.0.total_cmp(&b.0));
@@ -271,7 +271,7 @@ fn tangents_are_the_derivatives_of_the_texture_parametrisation() {
     // Two nearby hits: p₂ − p₁ ≈ ∂p/∂u Δu + ∂p/∂v Δv.
     let sphere = Shape::Sphere(Sphere::new(Vec3::new(0.1, 0.2, -0.3), 1.3));
     let plane = Shape::Plane(Plane { point: Vec3::new(0.0, -1.0, 0.0), normal: Vec3::new(0.2, 1.0, 0.1).normalize() });
-    let mesh = Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false });
+    let mesh = Shape::Mesh(MeshShape { accel: unit_box_mesh(), smooth: false, alpha: None });
     for shape in [sphere, plane, mesh] {
         let origin = Vec3::new(0.3, 4.0, 3.0);
         let target = Vec3::new(0.2, -0.1, 0.15);
