@@ -2,7 +2,7 @@
 """Blender's side of the glTF validation (issue 20): build a scene with Blender's Python module,
 export it as glTF 2.0 with Blender's own exporter, and render it with Cycles as the reference.
 
-    python3 bench/blender/gltf_vs_cycles.py OUT_DIR [--spp 4096] [--size 160x120] [--maps]
+    python3 bench/blender/gltf_vs_cycles.py OUT_DIR [--spp 4096] [--size 160x120] [--maps | --emission | --alpha]
 
 writes OUT_DIR/materials.glb (what a Blender user would hand alhazen) and
 OUT_DIR/materials-cycles.exr (Cycles, CPU, 2 threads, box pixel filter of one pixel, no
@@ -21,6 +21,12 @@ four stripes (red, green, blue, white, strength 6), exported as `emissiveTexture
 emits from both sides of a surface, glTF's importers from the front), and names the files
 materials-emission.glb and materials-emission-cycles.exr (test
 `blender_emissive_texture_agrees_with_cycles`; Cycles 4096 spp in 94 s).
+`--alpha` (session 46) stands a card of leaves between the light and the cube: a green
+Principled BSDF whose Alpha is the alpha channel of a 64 × 64 image of round holes (eight by
+eight discs of radius 3 texels cut out of an opaque card, bilinear), linked straight to the
+Alpha socket, which Blender's exporter writes as `alphaMode: BLEND`; the card and the holes'
+shadow on the cube and floor test cut-outs for camera and shadow rays alike; files
+materials-alpha.glb and materials-alpha-cycles.exr (test `blender_alpha_cut_out_agrees_with_cycles`).
 Needs `pip install bpy`. The committed copies live in crates/alhazen-import/tests/data/blender/
 and the test `blender_gltf_agrees_with_cycles` compares alhazen's image of the .glb with the EXR.
 """
@@ -97,7 +103,34 @@ def emissive_panel(path):
     bpy.context.object.data.materials.append(material("slab", (0.0, 0.0, 0.0), 0.0, 1.0))
 
 
-def build(maps_path=None, panel_path=None):
+def leaf_card(path):
+    """A 1.6 × 1.6 card standing between the light and the cube, green, with round holes read
+    from the alpha channel of an image written to `path`."""
+    n = 64
+    img = bpy.data.images.new("holes", n, n, alpha=True)
+    pixels = []
+    for y in range(n):
+        for x in range(n):
+            cx, cy = (x // 8) * 8 + 3.5, (y // 8) * 8 + 3.5
+            hole = (x - cx) ** 2 + (y - cy) ** 2 <= 9.0
+            pixels += [0.2, 0.6, 0.15, 0.0 if hole else 1.0]
+    img.pixels = pixels
+    img.filepath_raw = path
+    img.file_format = "PNG"
+    img.save()
+    m = material("leaves", (0.2, 0.6, 0.15), 0.0, 0.8)
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    tex.interpolation = "Linear"
+    p = nodes["Principled BSDF"]
+    links.new(tex.outputs["Color"], p.inputs["Base Color"])
+    links.new(tex.outputs["Alpha"], p.inputs["Alpha"])
+    bpy.ops.mesh.primitive_plane_add(size=1.6, location=(-0.6, -1.6, 2.4), rotation=(math.radians(70), 0, math.radians(10)))
+    bpy.context.object.data.materials.append(m)
+
+
+def build(maps_path=None, panel_path=None, card_path=None):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     bpy.ops.mesh.primitive_plane_add(size=12, location=(0, 0, 0))
@@ -113,6 +146,8 @@ def build(maps_path=None, panel_path=None):
         bpy.context.object.data.materials.append(material("gold", gold, 1.0, 0.35))
     if panel_path:
         emissive_panel(panel_path)
+    if card_path:
+        leaf_card(card_path)
     bpy.ops.object.light_add(type="POINT", location=(1.5, -3.5, 5.0))
     light = bpy.context.object.data
     light.energy = 1500.0
@@ -170,12 +205,15 @@ def main():
     ap.add_argument("--size", default="160x120")
     ap.add_argument("--maps", action="store_true")
     ap.add_argument("--emission", action="store_true")
+    ap.add_argument("--alpha", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    stem = "materials-maps" if a.maps else "materials-emission" if a.emission else "materials"
+    stem = ("materials-maps" if a.maps else "materials-emission" if a.emission
+            else "materials-alpha" if a.alpha else "materials")
     out = os.path.abspath(a.out)
     scene = build(os.path.join(out, "metallic-roughness.png") if a.maps else None,
-                  os.path.join(out, "stripes.png") if a.emission else None)
+                  os.path.join(out, "stripes.png") if a.emission else None,
+                  os.path.join(out, "holes.png") if a.alpha else None)
     size = tuple(int(x) for x in a.size.split("x"))
     scene.render.resolution_x, scene.render.resolution_y = size
     glb = os.path.join(a.out, f"{stem}.glb")

@@ -776,3 +776,28 @@ fn frustum_culling_leaves_every_scene_unchanged() {
     }
     assert!(skipped_somewhere);
 }
+
+/// A cut-out (a checker of holes by a cutoff) in a screen before the sphere: the preview
+/// leaves out what the ray tracer sees through, in view and in its shadow maps alike.
+#[test]
+fn cut_outs_agree_with_the_ray_tracer() {
+    let text = format!(
+        "{SCENE}\n[materials.screen]\ncolor = 0.9\nalpha = 0.5\n[[object]]\nshape = \"rectangle\"\nmaterial = \"screen\"\n\
+         transform = [{{ scale = 1.2 }}, {{ translate = [-0.6, 0.9, 1.2] }}]\n"
+    );
+    let mut scene = parse_scene("cut.toml".as_ref(), &text).unwrap();
+    let screen = scene.materials.iter().position(|m| m.name == "screen").unwrap();
+    let coverage = alhazen_scene::Texture::Checker { even: Vec3::ONE, odd: Vec3::ZERO, size: 0.25 };
+    scene.materials[screen].alpha = Some(alhazen_scene::Alpha { coverage, cutoff: Some(0.5) });
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    let (fb, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    let err = relative_error(&fb, &traced);
+    eprintln!("cut-outs: mean absolute difference {:.2} % of the mean brightness", err * 100.0);
+    assert!(err < 0.02, "mean error {:.2} % of the mean brightness", err * 100.0);
+    // Without the cut-out the screen hides what the holes show.
+    scene.materials[screen].alpha = None;
+    let (whole, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    let whole_err = relative_error(&whole, &traced);
+    eprintln!("without them: {:.2} %", whole_err * 100.0);
+    assert!(whole_err > 2.0 * err.max(0.01), "the holes show nothing");
+}

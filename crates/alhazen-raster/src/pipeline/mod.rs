@@ -454,6 +454,25 @@ pub(crate) fn surface_at(t: &Triangle, b: Bary) -> (Vec3, Vec3, Vec2) {
     (p, n, interpolate(t.v.map(|v| v.uv), b))
 }
 
+/// False where a cut-out ([`alhazen_scene::Alpha`]) leaves mesh triangle `t` out at corner
+/// weights `b`: below its cutoff, or, for a coverage without one, below the threshold of a 4×4
+/// ordered dither at `pixel` (the preview's screen door for the tracers' per-ray passage).
+/// Other shapes are opaque, as in the tracers.
+pub(crate) fn present(scene: &alhazen_scene::Scene, t: &Triangle, b: Bary, (x, y): (u32, u32)) -> bool {
+    const BAYER: [[u8; 4]; 4] = [[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]];
+    let Some(alpha) = &scene.materials[t.material as usize].alpha else { return true };
+    let on_mesh =
+        scene.objects.get(t.object as usize).is_some_and(|o| matches!(o.shape, alhazen_scene::Shape::Mesh { .. }));
+    if !on_mesh {
+        return true;
+    }
+    let coverage = alhazen_scene::texture::eval(&alpha.coverage, interpolate(t.v.map(|v| v.uv), b), &scene.images).x;
+    match alpha.cutoff {
+        Some(cutoff) => coverage >= cutoff,
+        None => coverage >= 1.0 || coverage > (BAYER[(y % 4) as usize][(x % 4) as usize] as f64 + 0.5) / 16.0,
+    }
+}
+
 /// What became of a triangle in vertex processing.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Fate {
@@ -712,6 +731,7 @@ fn render_view_in(
         }
     };
     let outside = tris.len() - order.len();
+    let cut_outs = scene.materials.iter().any(|m| m.alpha.is_some());
     let painter = opts.visibility == Visibility::Bsp && prepared.bsp.is_some();
     // A lit scene's light is all in its triangles: no second passes.
     let in_mirror = in_mirror || prelit.is_some();
@@ -800,9 +820,13 @@ fn render_view_in(
                 warnock::band(&screen, bin, w, (y0, y1), set);
             } else {
                 for t in bin.iter().map(|&i| &screen[i as usize]) {
+                    let source = &tris[t.source as usize];
                     rasterize(t, w, y0, y1, |f| {
                         let k = ((f.y - y0) * w + f.x) as usize;
-                        if (painter || f.depth < depth[k]) && f.depth >= -1.0 {
+                        if (painter || f.depth < depth[k])
+                            && f.depth >= -1.0
+                            && (!cut_outs || present(scene, source, f.bary, (f.x, f.y)))
+                        {
                             depth[k] = f.depth;
                             owner[k] = (t.source, f.bary);
                         }

@@ -59,6 +59,7 @@ pub struct Shadows {
 
 /// One shadow map: the depths of `tris` but those of object `skip` (a light's own emitter).
 fn face(
+    scene: &Scene,
     tris: &[Triangle],
     skip: Option<u32>,
     frame: ViewFrame,
@@ -69,6 +70,7 @@ fn face(
 ) -> Face {
     let world_to_clip = projection * frame.world_to_view();
     let mut depth = vec![f64::INFINITY; (size * size) as usize];
+    let cut_outs = scene.materials.iter().any(|m| m.alpha.is_some());
     for t in tris.iter().filter(|t| Some(t.object) != skip) {
         let poly: Vec<ClipVertex> =
             t.v.iter().enumerate().map(|(k, v)| ClipVertex::corner(world_to_clip * v.p.extend(1.0), v.p, k)).collect();
@@ -76,7 +78,7 @@ fn face(
             rasterize(&st, size, 0, size, |f| {
                 let d = metric.of(super::raster::interpolate(t.v.map(|v| v.p), f.bary));
                 let k = (f.y * size + f.x) as usize;
-                if d < depth[k] {
+                if d < depth[k] && (!cut_outs || super::present(scene, t, f.bary, (f.x, f.y))) {
                     depth[k] = d;
                 }
             });
@@ -110,7 +112,7 @@ impl Shadows {
             let metric = Metric::From(position);
             let faces = dirs
                 .iter()
-                .map(|d| face(tris, skip, frame_towards(position, *d), p, size, 2.0 / size as f64, metric))
+                .map(|d| face(scene, tris, skip, frame_towards(position, *d), p, size, 2.0 / size as f64, metric))
                 .collect();
             Some(LightShadow { faces, metric, perspective: true })
         };
@@ -126,7 +128,16 @@ impl Shadows {
                     let metric = Metric::From(position);
                     let texel = 2.0 * (fov / 2.0).tan() / size as f64;
                     Some(LightShadow {
-                        faces: vec![face(tris, skip, frame_towards(position, direction), p, size, texel, metric)],
+                        faces: vec![face(
+                            scene,
+                            tris,
+                            skip,
+                            frame_towards(position, direction),
+                            p,
+                            size,
+                            texel,
+                            metric,
+                        )],
                         metric,
                         perspective: true,
                     })
@@ -141,6 +152,7 @@ impl Shadows {
                     let metric = Metric::Along { origin, dir: direction };
                     Some(LightShadow {
                         faces: vec![face(
+                            scene,
                             tris,
                             skip,
                             frame_towards(origin, direction),
