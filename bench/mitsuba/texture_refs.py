@@ -8,9 +8,14 @@
   `a_textured_emitter_agrees_with_mitsuba`);
 - principled-maps: a `principled` floor whose roughness (0.8 left, 0.15 right) and metallic
   (1 on one half, 0 on the other) are bitmaps, under a sky and a small tilted light (test
-  `principled_maps_agree_with_mitsuba`).
+  `principled_maps_agree_with_mitsuba`);
+- masked-card: a card of round holes (a `mask` whose opacity is a bitmap, 0 in the holes and
+  1 elsewhere, around a two-sided diffuse BSDF) under a small light, dappling the floor (test
+  `a_masked_card_agrees_with_mitsuba`). Mitsuba's shadow rays stop at a mask, so its floor's
+  light under the card comes from paths through the holes alone and converges slowly: its
+  reference takes four times the samples.
 
-    python3 bench/mitsuba/texture_refs.py [--spp 8192]
+    python3 bench/mitsuba/texture_refs.py [--spp 8192] [--only NAME]
 
 Writes each scene's XML, its PNGs and NAME-mitsuba.exr into
 crates/alhazen-import/tests/data/mitsuba/.
@@ -103,11 +108,52 @@ def principled(spp):
     mi.Bitmap(img).write(os.path.join(OUT, "principled-maps-mitsuba.exr"))
 
 
+MASKED = head("A card of round holes (a mask) over a floor", 8, 40, "0, 2, 5", "0, 0.3, 0") + """    <emitter type="constant"><rgb name="radiance" value="0.05, 0.06, 0.08"/></emitter>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="0.5"/><rotate x="1" angle="90"/><translate x="0" y="3" z="-0.3"/></transform>
+        <emitter type="area"><rgb name="radiance" value="20, 19, 17"/></emitter>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="4"/><rotate x="1" angle="-90"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.7, 0.7"/></bsdf>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="0.8"/><rotate x="1" angle="-75"/><translate x="0" y="1.4" z="0"/></transform>
+        <bsdf type="mask">
+            <texture name="opacity" type="bitmap">
+                <string name="filename" value="masked-card.png"/><boolean name="raw" value="true"/>
+            </texture>
+            <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.2, 0.6, 0.15"/></bsdf></bsdf>
+        </bsdf>
+    </shape>
+</scene>
+"""
+
+
+def masked(spp):
+    n = 64
+    y, x = np.mgrid[0:n, 0:n]
+    cx, cy = (x // 8) * 8 + 3.5, (y // 8) * 8 + 3.5
+    holes = np.where((x - cx) ** 2 + (y - cy) ** 2 <= 9.0, 0, 255).astype(np.uint8)
+    mi.Bitmap(holes[..., None], pixel_format=mi.Bitmap.PixelFormat.Y).write(os.path.join(OUT, "masked-card.png"))
+    path = os.path.join(OUT, "masked-card.xml")
+    with open(path, "w") as f:
+        f.write(MASKED)
+    img = mi.render(mi.load_file(path), spp=4 * spp, seed=5)
+    mi.Bitmap(img).write(os.path.join(OUT, "masked-card-mitsuba.exr"))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=8192)
+    ap.add_argument("--only", choices=["textured-emitter", "principled-maps", "masked-card"])
     args = ap.parse_args()
     os.makedirs(OUT, exist_ok=True)
+    mi.set_variant("scalar_rgb")
+    if args.only == "masked-card":
+        return masked(args.spp)
+    if args.only == "principled-maps":
+        return principled(args.spp)
     # Eight colours, four across and two down, each well apart from its neighbours.
     colours = np.array([
         [[255, 40, 40], [40, 255, 40], [40, 40, 255], [255, 255, 255]],
@@ -121,7 +167,9 @@ def main():
     scene = mi.load_file(path)
     img = mi.render(scene, spp=args.spp, seed=7)
     mi.Bitmap(img).write(os.path.join(OUT, "textured-emitter-mitsuba.exr"))
-    principled(args.spp)
+    if args.only is None:
+        principled(args.spp)
+        masked(args.spp)
 
 
 if __name__ == "__main__":
