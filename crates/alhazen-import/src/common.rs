@@ -221,21 +221,22 @@ struct PendingRead {
 /// What a pending file becomes.
 #[derive(Clone, Copy)]
 enum Read {
-    /// `scene.meshes[index]`, turned inside out when `flip`; of a Mitsuba `serialized` file,
-    /// its mesh `part`.
-    Mesh { index: usize, flip: bool, part: Option<usize> },
+    /// `scene.meshes[index]`, turned inside out when `flip` and its texture coordinates'
+    /// `v` turned to `1 − v` when `flip_v`; of a Mitsuba `serialized` file, its mesh `part`.
+    Mesh { index: usize, flip: bool, flip_v: bool, part: Option<usize> },
     /// `scene.images[index]`: linear values (or sRGB decoded), upside down when `rows_reversed`.
     Image { index: usize, linear: bool, rows_reversed: bool },
 }
 
 /// A pending file as read, with where it goes.
 enum Loaded {
-    Mesh { index: usize, flip: bool, mesh: Result<alhazen_scene::import::LoadedMesh, String> },
+    Mesh { index: usize, flip: bool, flip_v: bool, mesh: Result<alhazen_scene::import::LoadedMesh, String> },
     Image { index: usize, rows_reversed: bool, image: Result<alhazen_scene::ImageData, String> },
 }
 
 impl PendingFiles {
-    /// Mesh file `path` (turned inside out when `flip`; of a Mitsuba `serialized` file, its
+    /// Mesh file `path` (turned inside out when `flip`, its texture coordinates' `v` turned to
+    /// `1 − v` when `flip_v`, as Mitsuba's OBJ reader does; of a Mitsuba `serialized` file, its
     /// mesh `part`) for `scene.meshes[index]`, its shape at bytes `span` of scene file `at` (its
     /// path and text, kept only for files that name mesh or image files: a scene's large files
     /// of inline geometry are not held to the end).
@@ -243,11 +244,11 @@ impl PendingFiles {
         &mut self,
         (index, part): (usize, Option<usize>),
         path: &Path,
-        flip: bool,
+        (flip, flip_v): (bool, bool),
         at: (&Path, &Arc<str>),
         span: Range<usize>,
     ) {
-        self.push(path, Read::Mesh { index, flip, part }, at, span);
+        self.push(path, Read::Mesh { index, flip, flip_v, part }, at, span);
     }
 
     /// Image file `path`, read as linear values (else decoded from sRGB), turned upside down
@@ -317,13 +318,13 @@ impl PendingFiles {
         use rayon::prelude::*;
         let pending = std::mem::take(&mut self.reads);
         let read = |r: &PendingRead| match r.what {
-            Read::Mesh { index, flip, part } => {
+            Read::Mesh { index, flip, flip_v, part } => {
                 let mesh = match part {
                     None => alhazen_scene::import::load_mesh(&r.path),
                     Some(part) => crate::serialized::load(&r.path, part)
                         .map(|mesh| alhazen_scene::import::LoadedMesh { mesh, materials: vec![], warnings: vec![] }),
                 };
-                Loaded::Mesh { index, flip, mesh }
+                Loaded::Mesh { index, flip, flip_v, mesh }
             }
             Read::Image { index, linear, rows_reversed } => {
                 let image = if linear {
@@ -341,9 +342,12 @@ impl PendingFiles {
                 located(path, text, r.span.clone(), e)
             };
             match loaded {
-                Loaded::Mesh { index, flip, mesh } => {
+                Loaded::Mesh { index, flip, flip_v, mesh } => {
                     let mut mesh = mesh.map_err(at)?.mesh;
                     adjust(&mut mesh);
+                    if flip_v {
+                        mesh.uvs.iter_mut().for_each(|uv| uv.y = 1.0 - uv.y);
+                    }
                     if flip {
                         flip_mesh(&mut mesh);
                     }

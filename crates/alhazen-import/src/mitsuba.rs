@@ -154,7 +154,7 @@ struct Importer {
     used: RefCell<HashSet<String>>,
     ids: HashMap<String, Named>,
     /// Mesh files (a `serialized` file's mesh) and orientations, and their places.
-    meshes: HashMap<(PathBuf, Option<usize>, bool), usize>,
+    meshes: HashMap<(PathBuf, Option<usize>, (bool, bool)), usize>,
     default_material: Option<MaterialId>,
     /// The black BSDF of emitting shapes without one, once made.
     black_material: Option<MaterialId>,
@@ -1342,7 +1342,13 @@ impl Importer {
                 } else {
                     None
                 };
-                let mesh = self.mesh(ctx, node, (&path, part), flip)?;
+                // Mitsuba's OBJ reader turns `v` to `1 − v` unless told not to; its PLY
+                // reader only when told to.
+                let flip_v = match kind.as_str() {
+                    "serialized" => false,
+                    _ => self.boolean(ctx, &p, "flip_tex_coords", kind == "obj")?,
+                };
+                let mesh = self.mesh(ctx, node, (&path, part), (flip, flip_v))?;
                 Shape::Mesh { mesh, smooth: !face_normals }
             }
             "rectangle" => {
@@ -1453,15 +1459,17 @@ impl Importer {
 
     /// A mesh file's place in the scene, once per file (and orientation); its triangles are
     /// read with the other files' once the walk is done.
-    fn mesh(&mut self, ctx: &Ctx, node: Node, (path, part): (&Path, Option<usize>), flip: bool) -> R<usize> {
-        let key = (path.to_path_buf(), part, flip);
+    /// Mesh file `path` (its `part` of a `serialized` file), turned inside out when `flip`,
+    /// its texture coordinates' `v` turned to `1 − v` when `flip_v`: its place in the scene.
+    fn mesh(&mut self, ctx: &Ctx, node: Node, (path, part): (&Path, Option<usize>), flips: (bool, bool)) -> R<usize> {
+        let key = (path.to_path_buf(), part, flips);
         if let Some(&i) = self.meshes.get(&key) {
             return Ok(i);
         }
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert(key, index);
-        self.pending.push_mesh((index, part), path, flip, (ctx.path, ctx.shared), node.range());
+        self.pending.push_mesh((index, part), path, flips, (ctx.path, ctx.shared), node.range());
         Ok(index)
     }
 

@@ -1386,7 +1386,7 @@ impl Importer {
         self.scene.meshes.push(Arc::new(alhazen_geom::TriangleMesh::default()));
         let index = self.scene.meshes.len() - 1;
         self.meshes.insert((path.to_path_buf(), reverse), index);
-        self.pending.push_mesh((index, None), path, reverse, (ctx.path, ctx.shared), at.clone());
+        self.pending.push_mesh((index, None), path, (reverse, false), (ctx.path, ctx.shared), at.clone());
         Ok(index)
     }
 

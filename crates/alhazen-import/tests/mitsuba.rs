@@ -209,6 +209,29 @@ fn bitmap_textures_keep_mitsubas_orientation() {
     assert_eq!(at(0.75), Vec3::new(0.0, 0.0, 1.0), "v = 3/4 is the bottom row's blue");
 }
 
+/// Mitsuba's OBJ reader turns texture coordinate `v` to `1 − v` unless `flip_tex_coords` is
+/// false, its PLY reader only when it is true: the leaf of Mitsuba's `mask` documentation
+/// scene (an OBJ rectangle) stood upside down, its worst block 19 % off, before.
+#[test]
+fn mesh_texture_coordinates_are_flipped_as_mitsuba_flips_them() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0.25\nvt 1 0.25\nvt 0 1\nf 1/1 2/2 3/3\n";
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+               property float u\nproperty float v\nelement face 1\nproperty list uchar int vertex_indices\n\
+               end_header\n0 0 0 0 0.25\n1 0 0 1 0.25\n0 1 0 0 1\n3 0 1 2\n";
+    let shape = |kind: &str, flip: &str| {
+        format!("<shape type=\"{kind}\"><string name=\"filename\" value=\"t.{kind}\"/>{flip}</shape>")
+    };
+    let no = "<boolean name=\"flip_tex_coords\" value=\"false\"/>";
+    let yes = "<boolean name=\"flip_tex_coords\" value=\"true\"/>";
+    let body = [shape("obj", ""), shape("obj", no), shape("ply", ""), shape("ply", yes)].concat();
+    let s = import(&[("m.xml", &scene(&body)), ("t.obj", obj), ("t.ply", ply)]).unwrap().scene;
+    let first_v = |o: usize| match s.objects[o].shape {
+        Shape::Mesh { mesh, .. } => s.meshes[mesh].uvs[0].y,
+        ref other => panic!("{other:?}"),
+    };
+    assert_eq!([0, 1, 2, 3].map(first_v), [0.75, 0.25, 0.25, 0.75]);
+}
+
 /// A textured Mitsuba sphere carries Mitsuba's parametrisation: its pole along +z (v = 0),
 /// u = 0 along +x and u = 1/4 along +y; an untextured one stays a plain (packed) sphere.
 #[test]
