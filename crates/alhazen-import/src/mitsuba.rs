@@ -154,7 +154,7 @@ struct Importer {
     used: RefCell<HashSet<String>>,
     ids: HashMap<String, Named>,
     /// Mesh files (a `serialized` file's mesh) and orientations, and their places.
-    meshes: HashMap<(PathBuf, Option<usize>, (bool, bool)), usize>,
+    meshes: HashMap<MeshKey, usize>,
     default_material: Option<MaterialId>,
     /// The black BSDF of emitting shapes without one, once made.
     black_material: Option<MaterialId>,
@@ -169,6 +169,10 @@ struct Importer {
     /// The cut-out of the `mask` met in the BSDF being read, for its material.
     cut_out: Option<alhazen_scene::Alpha>,
 }
+
+/// A mesh file as placed: its path, its part of a `serialized` file, and whether it is turned
+/// inside out and its texture coordinates' `v` flipped.
+type MeshKey = (PathBuf, Option<usize>, (bool, bool));
 
 /// One file being read.
 struct Ctx<'a> {
