@@ -244,7 +244,15 @@ impl MeshShape {
     unsafe fn hit_kept<const AVX2: bool>(&self, ray: &Ray, t_max: f64, alpha: &AlphaMask) -> Option<Candidate> {
         let a = &*self.accel;
         let mut best = None;
-        let visit = |packets, t_max| {
+        let visit = |packets: std::ops::Range<usize>, t_max| {
+            // The leaf's nearest hit in vector lanes first: when the mask keeps it, it is the
+            // nearest kept (the same bits and tie rule); else flat by flat.
+            let (lane, h) = a.packets.nearest(packets.clone(), ray, t_max, a.vectors)?;
+            let nearest = lane.candidate(h.t, h.b1, h.b2);
+            if alpha.covers(&a.mesh, &nearest, ray) {
+                best = Some(nearest);
+                return Some(h.t);
+            }
             let covered = |lane: FlatLane, h: LaneHit| alpha.covers(&a.mesh, &lane.candidate(h.t, h.b1, h.b2), ray);
             let (lane, h) = a.packets.nearest_kept(packets, ray, t_max, covered)?;
             best = Some(lane.candidate(h.t, h.b1, h.b2));
@@ -289,7 +297,11 @@ impl MeshShape {
             // SAFETY: the caller's contract.
             let covered = |lane: FlatLane, h: LaneHit| alpha.covers(&a.mesh, &lane.candidate(h.t, h.b1, h.b2), ray);
             let mut blocked = false;
-            let visit = |packets, t_max| {
+            let visit = |packets: std::ops::Range<usize>, t_max| {
+                // Most leaves a shadow ray meets hold nothing on it: asked in vector lanes.
+                if !FlatPacket::any_of(&a.packets.packets[packets.clone()], ray, t_max, a.vectors) {
+                    return None;
+                }
                 blocked = a.packets.nearest_kept(packets, ray, t_max, covered).is_some();
                 blocked.then_some(0.0)
             };
