@@ -536,7 +536,11 @@ impl Importer<'_> {
                         ((r.height as f64 * aspect as f64).round() as u32).clamp(1, alhazen_scene::MAX_SIDE as u32);
                 }
                 let angle = (p.yfov() as f64).clamp(1e-3, 3.1);
-                CameraDesc::Perspective { look, opening: PerspectiveOpening::Fov { angle, horizontal: false } }
+                CameraDesc::Perspective {
+                    look,
+                    opening: PerspectiveOpening::Fov { angle, horizontal: false },
+                    lens: None,
+                }
             }
             gltf::camera::Projection::Orthographic(o) => {
                 let (x, y) = (o.xmag().abs() as f64, o.ymag().abs() as f64);
@@ -606,6 +610,7 @@ fn framing(bounds: Bounds3, aspect: f64) -> Option<CameraDesc> {
     Some(CameraDesc::Perspective {
         look: LookAt { eye, target: center, up: Vec3::Y },
         opening: PerspectiveOpening::Fov { angle: fov, horizontal: false },
+        lens: None,
     })
 }
 

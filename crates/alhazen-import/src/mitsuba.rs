@@ -735,11 +735,18 @@ impl Importer {
         let (w, h) = (self.scene.render.width as f64, self.scene.render.height as f64);
         self.scene.camera = match p.kind.as_str() {
             "perspective" | "thinlens" => {
-                if p.kind == "thinlens" {
-                    self.warn(ctx, node, "thinlens: alhazen's camera is a pinhole (no depth of field)");
-                    self.float(ctx, &p, "aperture_radius", 0.0)?;
-                    self.float(ctx, &p, "focus_distance", 0.0)?;
-                }
+                // Mitsuba's thin lens: in focus at its far clip (10⁴) unless told otherwise.
+                let lens = if p.kind == "thinlens" {
+                    let aperture = self.float(ctx, &p, "aperture_radius", f64::NAN)?;
+                    let far = self.float(ctx, &p, "far_clip", 1e4)?;
+                    let focus_distance = self.float(ctx, &p, "focus_distance", far)?;
+                    if !(aperture > 0.0 && aperture.is_finite() && focus_distance > 0.0 && focus_distance.is_finite()) {
+                        return Err(ctx.err(node, "a thinlens needs a positive `aperture_radius` and `focus_distance`"));
+                    }
+                    Some(alhazen_scene::ThinLens { aperture, focus_distance })
+                } else {
+                    None
+                };
                 let axis = self.string(ctx, &p, "fov_axis")?.unwrap_or_else(|| "x".into());
                 // Without `fov`, Mitsuba's focal length, 50 mm unless given.
                 let focal_length = self.string(ctx, &p, "focal_length")?.unwrap_or_else(|| "50mm".into());
@@ -769,7 +776,7 @@ impl Importer {
                         );
                     }
                 };
-                CameraDesc::Perspective { look, opening: PerspectiveOpening::Fov { angle, horizontal } }
+                CameraDesc::Perspective { look, opening: PerspectiveOpening::Fov { angle, horizontal }, lens }
             }
             "orthographic" => {
                 // The sensor sees [-1, 1] along its shorter axis, scaled by to_world.
@@ -781,6 +788,7 @@ impl Importer {
                 CameraDesc::Perspective {
                     look,
                     opening: PerspectiveOpening::Fov { angle: 45f64.to_radians(), horizontal: true },
+                    lens: None,
                 }
             }
         };

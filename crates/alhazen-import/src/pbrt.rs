@@ -191,7 +191,7 @@ struct Importer {
 
 #[derive(Clone, Copy)]
 enum CameraKind {
-    Perspective { fov_degrees: f64 },
+    Perspective { fov_degrees: f64, lens: Option<alhazen_scene::ThinLens> },
     Orthographic { scale: f64 },
 }
 
@@ -494,7 +494,7 @@ impl Importer {
                         if !(fov > 0.0 && fov < 180.0) {
                             return Err(ctx.err(at, "fov must be in (0, 180) degrees"));
                         }
-                        CameraKind::Perspective { fov_degrees: fov }
+                        CameraKind::Perspective { fov_degrees: fov, lens: None }
                     }
                     "orthographic" => CameraKind::Orthographic { scale: 1.0 },
                     other => {
@@ -503,13 +503,24 @@ impl Importer {
                             &at,
                             format!("camera \"{other}\" is not supported; a 90° perspective camera stands in"),
                         );
-                        CameraKind::Perspective { fov_degrees: 90.0 }
+                        CameraKind::Perspective { fov_degrees: 90.0, lens: None }
                     }
                 };
-                for key in ["lensradius", "focaldistance"] {
-                    if self.float(ctx, &mut p, key, 0.0)? != 0.0 && key == "lensradius" {
-                        self.warn(ctx, &at, "lensradius: alhazen's camera is a pinhole (no depth of field)");
+                // pbrt's thin lens: `lensradius` (0: a pinhole), in focus at `focaldistance`.
+                let aperture = self.float(ctx, &mut p, "lensradius", 0.0)?;
+                let focus_distance = self.float(ctx, &mut p, "focaldistance", 1e6)?;
+                if aperture < 0.0 || !aperture.is_finite() || !(focus_distance > 0.0 && focus_distance.is_finite()) {
+                    return Err(ctx.err(at, "a camera needs `lensradius` ≥ 0 and a positive `focaldistance`"));
+                }
+                let mut kind = kind;
+                match &mut kind {
+                    CameraKind::Perspective { lens, .. } if aperture > 0.0 => {
+                        *lens = Some(alhazen_scene::ThinLens { aperture, focus_distance });
                     }
+                    CameraKind::Orthographic { .. } if aperture > 0.0 => {
+                        self.warn(ctx, &at, "an orthographic camera's lens is not supported: everything is sharp");
+                    }
+                    _ => {}
                 }
                 self.unused(ctx, &p, "camera");
                 self.camera = Some((world_from_camera, kind));
@@ -1412,11 +1423,17 @@ impl Importer {
             target: f.transform_point3(eye + ahead),
             up: f.transform_vector3(up),
         };
+        let depth_scale = (l * Vec3::Z).length();
         self.scene.camera = match kind {
-            CameraKind::Perspective { fov_degrees } => CameraDesc::Perspective {
+            CameraKind::Perspective { fov_degrees, lens } => CameraDesc::Perspective {
                 look,
                 // pbrt's fov spans the shorter side of the image.
                 opening: PerspectiveOpening::Fov { angle: fov_degrees.to_radians(), horizontal: w < h },
+                // The lens in world units: the camera's transform may scale.
+                lens: lens.map(|lens| alhazen_scene::ThinLens {
+                    aperture: lens.aperture * right.length(),
+                    focus_distance: lens.focus_distance * depth_scale,
+                }),
             },
             CameraKind::Orthographic { scale } => {
                 CameraDesc::Orthographic { look, width: 2.0 * scale * (w / h).max(1.0) * right.length() }

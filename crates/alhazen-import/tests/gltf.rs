@@ -128,7 +128,8 @@ fn check_scene(s: &Imported) {
     assert_eq!(m.uvs[0], Vec2::new(0.0, 0.0), "v flipped: glTF's v = 1 is the image's bottom");
     assert_eq!(m.uvs[2], Vec2::new(1.0, 1.0));
     assert_eq!((sc.render.width, sc.render.height), (960, 480), "aspect ratio 2");
-    let CameraDesc::Perspective { look, opening: PerspectiveOpening::Fov { angle, horizontal: false } } = &sc.camera
+    let CameraDesc::Perspective { look, opening: PerspectiveOpening::Fov { angle, horizontal: false }, lens: None } =
+        &sc.camera
     else {
         panic!("not a vertical-fov perspective camera: {:?}", sc.camera)
     };
@@ -201,6 +202,7 @@ fn emission_lights_the_render_and_what_is_left_out_is_said() {
     sc.camera = CameraDesc::Perspective {
         look: alhazen_scene::LookAt { eye: Vec3::new(2.0, 1.0, 3.0), target: Vec3::new(2.0, 1.0, 0.0), up: Vec3::Y },
         opening: PerspectiveOpening::Fov { angle: 0.3, horizontal: false },
+        lens: None,
     };
     let img = alhazen_render::render(&sc, &|_, _| {});
     assert!((img.get(8, 4) - Vec3::splat(4.0)).abs().max_element() < 1e-9, "{}", img.get(8, 4));
@@ -241,6 +243,7 @@ fn alpha_cut_outs_let_rays_through_where_the_base_colour_is_transparent() {
     sc.camera = CameraDesc::Perspective {
         look: alhazen_scene::LookAt { eye: Vec3::new(2.0, 1.0, 3.0), target: Vec3::new(2.0, 1.0, 0.0), up: Vec3::Y },
         opening: PerspectiveOpening::Fov { angle: 0.3, horizontal: false },
+        lens: None,
     };
     for integrator in [alhazen_scene::IntegratorKind::Path, alhazen_scene::IntegratorKind::Whitted] {
         sc.render.integrator = integrator;
@@ -524,6 +527,7 @@ fn an_emissive_texture_is_read_per_point() {
     sc.camera = CameraDesc::Perspective {
         look: alhazen_scene::LookAt { eye: Vec3::new(2.0, 1.0, 3.0), target: Vec3::new(2.0, 1.0, 0.0), up: Vec3::Y },
         opening: PerspectiveOpening::Fov { angle: 0.3, horizontal: false },
+        lens: None,
     };
     let img = alhazen_render::render(&sc, &|_, _| {});
     // Pixels 3 and 12 see u ≈ 0.25 and 0.75, the two texels' centres (bilinear: a little of

@@ -29,8 +29,8 @@ fn cornell_box_xml_is_the_scene_of_its_toml_twin() {
     assert_eq!((a.render.spp, a.render.max_depth), (b.render.spp, b.render.max_depth));
     use alhazen_scene::{CameraDesc::Perspective, PerspectiveOpening::Fov};
     let (
-        Perspective { look: la, opening: Fov { angle: fa, .. } },
-        Perspective { look: lb, opening: Fov { angle: fb, .. } },
+        Perspective { look: la, opening: Fov { angle: fa, .. }, lens: None },
+        Perspective { look: lb, opening: Fov { angle: fb, .. }, lens: None },
     ) = (&a.camera, &b.camera)
     else {
         panic!("not perspective cameras")
@@ -938,4 +938,26 @@ fn masks_are_cut_outs() {
     let text: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
     assert!(text.iter().any(|w| w.contains("applies to meshes only")), "{text:?}");
     assert!(!text.iter().any(|w| w.contains("mask")), "{text:?}");
+}
+
+/// Mitsuba's `thinlens` is a thin lens of its `aperture_radius`, in focus at `focus_distance`
+/// (its far clip, 10⁴, unless given); without an aperture it is an error.
+#[test]
+fn thinlens_sensors_have_their_lens() {
+    let sensor = |params: &str| {
+        scene(&format!(
+            "<sensor type=\"thinlens\"><float name=\"fov\" value=\"40\"/>{params}\
+             <transform name=\"to_world\"><lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform></sensor>"
+        ))
+    };
+    let lens_of = |xml: &str| match import(&[("l.xml", xml)]).unwrap().scene.camera {
+        alhazen_scene::CameraDesc::Perspective { lens, .. } => lens,
+        other => panic!("{other:?}"),
+    };
+    let both = "<float name=\"aperture_radius\" value=\"0.2\"/><float name=\"focus_distance\" value=\"5.9\"/>";
+    assert_eq!(lens_of(&sensor(both)), Some(alhazen_scene::ThinLens { aperture: 0.2, focus_distance: 5.9 }));
+    let far = lens_of(&sensor("<float name=\"aperture_radius\" value=\"0.1\"/>"));
+    assert_eq!(far, Some(alhazen_scene::ThinLens { aperture: 0.1, focus_distance: 1e4 }));
+    let e = import(&[("l.xml", &sensor(""))]).unwrap_err();
+    assert!(e.contains("l.xml:2") && e.contains("aperture_radius"), "{e}");
 }

@@ -261,3 +261,20 @@ fn alpha_cuts_shapes_out() {
     assert!(matches!(alpha(2).map(|a| a.coverage), Some(Texture::Checker { .. })), "{:?}", alpha(2));
     assert_eq!(alpha(3), None);
 }
+
+/// pbrt's `lensradius` and `focaldistance` make a thin lens; a radius of 0 is a pinhole.
+#[test]
+fn lens_radius_makes_a_thin_lens() {
+    let lens_of = |camera: &str| {
+        let text =
+            format!("LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" {camera}\nWorldBegin\nShape \"sphere\"\n");
+        match import(&[("c.pbrt", &text)]).unwrap().scene.camera {
+            alhazen_scene::CameraDesc::Perspective { lens, .. } => lens,
+            other => panic!("{other:?}"),
+        }
+    };
+    let lens = lens_of("\"float lensradius\" 0.1 \"float focaldistance\" 4");
+    assert_eq!(lens, Some(alhazen_scene::ThinLens { aperture: 0.1, focus_distance: 4.0 }));
+    assert_eq!(lens_of("\"float lensradius\" 0"), None);
+    assert_eq!(lens_of(""), None);
+}

@@ -156,6 +156,14 @@ impl PixelEstimator for FinalGather<'_> {
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
         let r = &self.solution.scene.render;
         let (dx, dy) = stratified_offset(r.seed, x, y, index, r.spp);
-        self.trace(&self.camera.ray(x as f64 + dx, y as f64 + dy), r.max_depth)
+        let (fx, fy) = (x as f64 + dx, y as f64 + dy);
+        let ray = match self.camera.has_lens() {
+            true => {
+                let mut rng = alhazen_render::sampler::Rng::for_sample(r.seed ^ 0x1e45_a9e7_7b1d_0c35, x, y, index);
+                self.camera.lens_ray(fx, fy, alhazen_math::Vec2::new(rng.uniform(), rng.uniform()))
+            }
+            false => self.camera.ray(fx, fy),
+        };
+        self.trace(&ray, r.max_depth)
     }
 }

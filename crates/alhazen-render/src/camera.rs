@@ -12,13 +12,15 @@
 //!   §"Nonlinear projections"), developed flat.
 
 use alhazen_math::viewing::{Frustum, ViewFrame, stereo_frusta};
-use alhazen_math::{Mat3, Ray, Vec3, Vec4};
+use alhazen_math::{Mat3, Ray, Vec2, Vec3, Vec4};
 use alhazen_scene::CameraDesc;
 
 /// A camera ready to generate rays for a film of `film_width × film_height` pixels.
 #[derive(Clone, Debug)]
 pub struct Camera {
     kind: Kind,
+    /// A perspective camera's thin lens.
+    lens: Option<Lens>,
     /// Film width in pixels (twice the per-eye width for stereo).
     pub film_width: u32,
     /// Film height in pixels.
@@ -80,6 +82,43 @@ impl Pinhole {
     }
 }
 
+/// A thin lens in world space: its disk's axes (the view frame's `u`, `v` times the radius),
+/// the eye at its centre, and the plane in focus, `focus` along `ahead`.
+#[derive(Clone, Copy, Debug)]
+struct Lens {
+    u: Vec3,
+    v: Vec3,
+    ahead: Vec3,
+    focus: f64,
+}
+
+impl Lens {
+    /// The ray from the lens point of `sample` (in the unit square) towards where the pinhole
+    /// ray `through` meets the plane in focus.
+    fn ray(&self, through: &Ray, sample: Vec2) -> Ray {
+        let along = through.dir.dot(self.ahead);
+        if along <= 0.0 {
+            return *through;
+        }
+        let focus = through.at(self.focus / along);
+        let (x, y) = concentric_disk(sample);
+        let origin = through.origin + self.u * x + self.v * y;
+        Ray::new(origin, (focus - origin).normalize())
+    }
+}
+
+/// Shirley and Chiu's map of the unit square onto the unit disk, preserving areas.
+fn concentric_disk(s: Vec2) -> (f64, f64) {
+    let (a, b) = (2.0 * s.x - 1.0, 2.0 * s.y - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let quarter = std::f64::consts::FRAC_PI_4;
+    let (r, phi) = if a.abs() > b.abs() { (a, quarter * (b / a)) } else { (b, 2.0 * quarter - quarter * (a / b)) };
+    let (sin, cos) = phi.sin_cos();
+    (r * cos, r * sin)
+}
+
 fn frame(look: &alhazen_scene::LookAt) -> ViewFrame {
     // The scene reader has checked the frame is well defined; fall back to a fixed one anyway.
     ViewFrame::look_at(look.eye, look.target, look.up).unwrap_or(ViewFrame {
@@ -94,8 +133,15 @@ impl Camera {
     /// Builds the camera for an image of `width × height` pixels (per eye).
     pub fn new(desc: &CameraDesc, width: u32, height: u32) -> Self {
         let aspect = width as f64 / height as f64;
+        let lens = match desc {
+            CameraDesc::Perspective { look, lens: Some(l), .. } => {
+                let f = frame(look);
+                Some(Lens { u: f.u * l.aperture, v: f.v * l.aperture, ahead: -f.w, focus: l.focus_distance })
+            }
+            _ => None,
+        };
         let (kind, film_width) = match desc {
-            CameraDesc::Perspective { look, opening } => {
+            CameraDesc::Perspective { look, opening, .. } => {
                 let frustum = opening.frustum(aspect, None);
                 (Kind::Perspective(Pinhole::new(frame(look), frustum, width as f64, height as f64)), width)
             }
@@ -123,7 +169,21 @@ impl Camera {
             }
             CameraDesc::Panorama { look, angle } => (Kind::Panorama { frame: frame(look), angle: *angle }, width),
         };
-        Self { kind, film_width, film_height: height }
+        Self { kind, lens, film_width, film_height: height }
+    }
+
+    /// True when rays start on a lens: [`Self::lens_ray`] needs a second pair of numbers.
+    #[inline(always)]
+    pub fn has_lens(&self) -> bool {
+        self.lens.is_some()
+    }
+
+    /// The ray through film position `(fx, fy)` from the lens point of `sample` (in the unit
+    /// square): [`Self::ray`] without a lens.
+    #[inline]
+    pub fn lens_ray(&self, fx: f64, fy: f64, sample: Vec2) -> Ray {
+        let pinhole = self.ray(fx, fy);
+        self.lens.map_or(pinhole, |l| l.ray(&pinhole, sample))
     }
 
     /// The ray through film position `(fx, fy)` in pixels, `y` down.
@@ -173,6 +233,7 @@ mod tests {
         let desc = CameraDesc::Perspective {
             look: LOOK,
             opening: PerspectiveOpening::Fov { angle: 60f64.to_radians(), horizontal: true },
+            lens: None,
         };
         let cam = Camera::new(&desc, 400, 300);
         let (left, right) = (cam.ray(0.0, 150.0).dir, cam.ray(400.0, 150.0).dir);
@@ -188,6 +249,7 @@ mod tests {
         let desc = CameraDesc::Perspective {
             look: LOOK,
             opening: PerspectiveOpening::Frustum { lrbtn: [-0.2, 0.6, -0.3, 0.3, 1.0] },
+            lens: None,
         };
         let cam = Camera::new(&desc, 80, 60);
         // The film's top-left corner looks through (l, t, −n).
@@ -258,6 +320,42 @@ mod tests {
         let pl = l.at(5.0 / -l.dir.z);
         let pr = r.at(5.0 / -r.dir.z);
         assert!(pl.length() < 1e-9 && pr.length() < 1e-9, "{pl} {pr}");
+    }
+
+    proptest::proptest! {
+        /// Through a thin lens every ray of a film point starts on the lens (a disk of the
+        /// aperture's radius about the eye, across the view axis) and meets the pinhole ray
+        /// of that point on the plane in focus; the lens's points fill the disk uniformly
+        /// (Shirley–Chiu's map preserves area: a quarter of the square lands within half the
+        /// radius).
+        #[test]
+        fn a_thin_lens_focuses_every_ray_of_a_film_point_on_the_plane_in_focus(
+            fx in 0.0..400.0f64, fy in 0.0..300.0f64, u in 0.0..1.0f64, v in 0.0..1.0f64,
+            aperture in 0.01..0.5f64, focus_distance in 0.5..20.0f64,
+        ) {
+            let lens = alhazen_scene::ThinLens { aperture, focus_distance };
+            let look = LookAt { eye: Vec3::new(1.0, 2.0, 3.0), target: Vec3::new(-2.0, 0.5, -1.0), up: Vec3::Y };
+            let opening = PerspectiveOpening::Fov { angle: 50f64.to_radians(), horizontal: true };
+            let cam = Camera::new(&CameraDesc::Perspective { look, opening, lens: Some(lens) }, 400, 300);
+            let (pinhole, ray) = (cam.ray(fx, fy), cam.lens_ray(fx, fy, alhazen_math::Vec2::new(u, v)));
+            let ahead = (look.target - look.eye).normalize();
+            let offset = ray.origin - look.eye;
+            proptest::prop_assert!(offset.dot(ahead).abs() < 1e-12 && offset.length() <= aperture * (1.0 + 1e-12));
+            let focus = pinhole.at(focus_distance / pinhole.dir.dot(ahead));
+            let t = (focus - ray.origin).dot(ray.dir);
+            proptest::prop_assert!((ray.at(t) - focus).length() < 1e-9 * (1.0 + focus_distance), "{} {}", ray.at(t), focus);
+            let (x, y) = concentric_disk(alhazen_math::Vec2::new(u, v));
+            let inner = (u - 0.5).abs() < 0.25 && (v - 0.5).abs() < 0.25;
+            proptest::prop_assert!(!inner || x.hypot(y) <= 0.5 + 1e-12);
+        }
+    }
+
+    #[test]
+    fn without_a_lens_a_camera_draws_no_lens_point() {
+        let opening = PerspectiveOpening::Fov { angle: 1.0, horizontal: true };
+        let cam = Camera::new(&CameraDesc::Perspective { look: LOOK, opening, lens: None }, 40, 30);
+        assert!(!cam.has_lens());
+        assert_eq!(cam.lens_ray(3.5, 7.25, alhazen_math::Vec2::new(0.9, 0.1)), cam.ray(3.5, 7.25));
     }
 
     #[test]

@@ -515,10 +515,17 @@ impl PixelEstimator for PathTracer<'_> {
 }
 
 impl PathTracer<'_> {
+    /// The camera's ray through film position `(fx, fy)`: through a lens, the stream's next
+    /// pair picks the lens point (the pinhole's draws nothing, so its images keep their bits).
+    #[inline]
+    fn camera_ray(&self, fx: f64, fy: f64, s: &mut SampleStream) -> Ray {
+        if self.camera.has_lens() { self.camera.lens_ray(fx, fy, s.next_2d()) } else { self.camera.ray(fx, fy) }
+    }
+
     /// The sample of pixel `(x, y)` whose numbers `s` gives.
     fn sample_of(&self, mut s: SampleStream, x: u32, y: u32) -> Vec3 {
         let film = s.next_2d();
-        let ray = self.camera.ray(x as f64 + film.x, y as f64 + film.y);
+        let ray = self.camera_ray(x as f64 + film.x, y as f64 + film.y, &mut s);
         if self.spectral {
             let lambdas = sample_wavelengths(s.next_1d());
             let values = self.radiance(ray, ColorMode::Spectral(lambdas), &mut s);

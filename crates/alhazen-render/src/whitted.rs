@@ -159,7 +159,15 @@ pub struct WhittedEstimator<'a> {
 impl PixelEstimator for WhittedEstimator<'_> {
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
         let (dx, dy) = stratified_offset(self.seed, x, y, index, self.spp);
-        let ray = self.camera.ray(x as f64 + dx, y as f64 + dy);
+        let ray = match self.camera.has_lens() {
+            // The lens point from the sample's own numbers, apart from the pixel's strata.
+            true => {
+                let mut rng = Rng::for_sample(self.seed ^ 0x1e45_a9e7_7b1d_0c35, x, y, index);
+                let lens = alhazen_math::Vec2::new(rng.uniform(), rng.uniform());
+                self.camera.lens_ray(x as f64 + dx, y as f64 + dy, lens)
+            }
+            false => self.camera.ray(x as f64 + dx, y as f64 + dy),
+        };
         if !self.whitted.is_spectral() {
             return self.whitted.trace(&ray, 1, 1.0);
         }

@@ -132,7 +132,7 @@ impl Parser<'_> {
             2.0 * radius / d * h / (2.0 * tan_half)
         };
         match &self.scene.camera {
-            CameraDesc::Perspective { look, opening } => {
+            CameraDesc::Perspective { look, opening, .. } => {
                 let f = opening.frustum(w / h, None);
                 perspective(look.eye, (f.t - f.b) / (2.0 * f.n))
             }

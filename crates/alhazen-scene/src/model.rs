@@ -172,12 +172,14 @@ impl Axonometry {
 /// A camera description.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CameraDesc {
-    /// Pinhole perspective.
+    /// Perspective: a pinhole, or a thin lens with depth of field.
     Perspective {
         /// Placement.
         look: LookAt,
         /// Field of view or frustum.
         opening: PerspectiveOpening,
+        /// A thin lens (`None`: a pinhole, everything sharp).
+        lens: Option<ThinLens>,
     },
     /// Orthographic, `width` world units across the image.
     Orthographic {
@@ -238,10 +240,22 @@ impl CameraDesc {
             CameraDesc::Perspective {
                 look: LookAt { eye: look.eye + shift, target: look.target + shift, up: look.up },
                 opening: PerspectiveOpening::Frustum { lrbtn: [f.l, f.r, f.b, f.t, f.n] },
+                lens: None,
             }
         };
         Some([eye(-1.0, l), eye(1.0, r)])
     }
+}
+
+/// A thin lens (pbrt's and Mitsuba's `thinlens`): rays start on a disk of radius `aperture`
+/// about the eye, across the view axis, and meet where the pinhole's ray through the same film
+/// point meets the plane `focus_distance` ahead of the eye; what lies off that plane blurs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    /// The lens's radius, in world units (> 0).
+    pub aperture: f64,
+    /// The distance along the view axis to the plane in focus (> 0).
+    pub focus_distance: f64,
 }
 
 /// What a ray that hits nothing sees.

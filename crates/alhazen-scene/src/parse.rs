@@ -124,6 +124,7 @@ pub fn empty_scene() -> Scene {
         camera: CameraDesc::Perspective {
             look: LookAt { eye: Vec3::new(0.0, 0.0, 5.0), target: Vec3::ZERO, up: Vec3::Y },
             opening: PerspectiveOpening::Fov { angle: 45f64.to_radians(), horizontal: true },
+            lens: None,
         },
         background: Background::Solid(Vec3::ZERO),
         ambient: Vec3::ZERO,
@@ -747,7 +748,7 @@ fn camera(n: &Node) -> R<CameraDesc> {
         None => "perspective",
     };
     let keys: &[&str] = match kind {
-        "perspective" => &["type", "eye", "target", "up", "fov", "fov_axis", "frustum"],
+        "perspective" => &["type", "eye", "target", "up", "fov", "fov_axis", "frustum", "aperture", "focus_distance"],
         "orthographic" => &["type", "eye", "target", "up", "width"],
         "axonometric" => &["type", "style", "target", "width", "azimuth"],
         "stereo" => &["type", "eye", "target", "up", "eye_distance", "screen_distance", "screen_width"],
@@ -777,7 +778,19 @@ fn camera(n: &Node) -> R<CameraDesc> {
                     },
                 },
             };
-            CameraDesc::Perspective { look, opening }
+            let lens = match (t.get("aperture"), t.get("focus_distance")) {
+                (None, Some(f)) => return Err(f.err("`focus_distance` needs an `aperture` (the lens's radius)")),
+                (None, None) => None,
+                (Some(a), focus) => Some(ThinLens {
+                    aperture: a.positive()?,
+                    // In focus at the target unless told otherwise.
+                    focus_distance: match focus {
+                        Some(f) => f.positive()?,
+                        None => (look.target - look.eye).length(),
+                    },
+                }),
+            };
+            CameraDesc::Perspective { look, opening, lens }
         }
         "orthographic" => CameraDesc::Orthographic { look: look_at(&t)?, width: t.req("width")?.positive()? },
         "axonometric" => {

@@ -193,9 +193,13 @@ impl Writer<'_> {
     fn camera(&mut self, c: &CameraDesc) {
         self.out.push_str("\n[camera]\n");
         match c {
-            CameraDesc::Perspective { look, opening } => {
+            CameraDesc::Perspective { look, opening, lens } => {
                 self.line("type", string("perspective"));
                 self.look(look);
+                if let Some(l) = lens {
+                    self.line("aperture", num(l.aperture));
+                    self.line("focus_distance", num(l.focus_distance));
+                }
                 match *opening {
                     PerspectiveOpening::Fov { angle, horizontal } => {
                         self.line("fov", num(degrees(angle, |x| x)));

@@ -500,3 +500,32 @@ color = 0.5
     assert!(m("{ image = { file = \"none.png\" } }").contains("none.png"));
     assert!(m("{ image = { file = \"x.png\" }, cutof = 0.5 }").contains("cutof"));
 }
+
+/// A perspective camera's thin lens: `aperture` (its radius) and `focus_distance` (the
+/// target's distance unless given), written back; nonsense refused where it is written.
+#[test]
+fn thin_lenses_read_write_back_and_refuse_nonsense() {
+    let lens_of = |s: &alhazen_scene::Scene| match s.camera {
+        alhazen_scene::CameraDesc::Perspective { lens, .. } => lens,
+        ref other => panic!("{other:?}"),
+    };
+    let cam = |extra: &str| format!("[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 1]\n{extra}");
+    let s = parse_scene("l.toml".as_ref(), &cam("aperture = 0.1\n")).unwrap();
+    assert_eq!(lens_of(&s), Some(alhazen_scene::ThinLens { aperture: 0.1, focus_distance: 4.0 }));
+    let s = parse_scene("l.toml".as_ref(), &cam("aperture = 0.2\nfocus_distance = 7\n")).unwrap();
+    let lens = Some(alhazen_scene::ThinLens { aperture: 0.2, focus_distance: 7.0 });
+    assert_eq!(lens_of(&s), lens);
+    assert_eq!(lens_of(&parse_scene("l.toml".as_ref(), &cam("")).unwrap()), None);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &path, &dir.path().join("assets"), "").unwrap();
+    assert_eq!(lens_of(&load_scene(&path).unwrap()), lens);
+    for bad in ["aperture = 0\n", "aperture = -1\n", "aperture = nan\n", "aperture = 0.1\nfocus_distance = 0\n"] {
+        let e = err(&cam(bad));
+        assert!(e.contains("s.toml:4") || e.contains("s.toml:5"), "{bad}: {e}");
+    }
+    assert!(err(&cam("focus_distance = 3\n")).contains("needs an `aperture`"));
+    assert!(
+        err("[camera]\ntype = \"orthographic\"\neye = [0, 0, 5]\nwidth = 2\naperture = 0.1\n").contains("aperture")
+    );
+}

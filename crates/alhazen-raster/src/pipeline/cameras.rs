@@ -80,6 +80,7 @@ pub fn panorama(
         let desc = CameraDesc::Perspective {
             look: LookAt { eye: frame.eye, target: frame.eye + ahead, up },
             opening: PerspectiveOpening::Fov { angle: std::f64::consts::FRAC_PI_2, horizontal: true },
+            lens: None,
         };
         let (fb, s) = view(&desc, size)?;
         stats = Some(stats.map_or(s, |t| sum(t, s)));

@@ -741,8 +741,7 @@ mod tests {
             let look = alhazen_scene::LookAt { eye, target: Vec3::ZERO, up: if eye.cross(Vec3::Y).length() > 0.1 { Vec3::Y } else { Vec3::X } };
             let desc = alhazen_scene::CameraDesc::Perspective {
                 look,
-                opening: alhazen_scene::PerspectiveOpening::Fov { angle: 1.0, horizontal: true },
-            };
+                opening: alhazen_scene::PerspectiveOpening::Fov { angle: 1.0, horizontal: true }, lens: None };
             let proj = super::super::projection(&desc, 64, 64).unwrap();
             let job = Reflexes { surface: &surface, eye, proj: &proj, size: (64, 64) };
             let t = Triangle { v: p.map(vertex), material: 0, closed: false, unbounded: false, object: 0 };

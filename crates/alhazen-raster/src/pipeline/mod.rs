@@ -374,7 +374,7 @@ pub fn projection(desc: &CameraDesc, width: u32, height: u32) -> Result<Projecti
         })
     };
     let (frame, p, perspective) = match desc {
-        CameraDesc::Perspective { look, opening } => {
+        CameraDesc::Perspective { look, opening, .. } => {
             // A near plane close enough that nothing near the eye is clipped away.
             let frustum = opening.frustum(aspect, Some(1e-3));
             // The limit f → ∞ of the course's P: points at infinity (shadow volumes' far ends)

@@ -202,6 +202,7 @@ mod tests {
         let desc = CameraDesc::Perspective {
             look: LookAt { eye, target, up },
             opening: PerspectiveOpening::Fov { angle: fov_degrees.to_radians(), horizontal: true },
+            lens: None,
         };
         crate::pipeline::projection(&desc, 64, 48).unwrap().world_to_clip
     }

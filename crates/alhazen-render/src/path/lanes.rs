@@ -752,7 +752,7 @@ impl PathTracer<'_> {
     /// starts it: its film position, its camera ray.
     fn start(&self, lane: &mut LanePath, (x, y): (u32, u32)) {
         let film = lane.stream.next_2d();
-        lane.path = PathState::new(self.camera.ray(x as f64 + film.x, y as f64 + film.y));
+        lane.path = PathState::new(self.camera_ray(x as f64 + film.x, y as f64 + film.y, &mut lane.stream));
         lane.mode =
             if self.spectral { ColorMode::Spectral(sample_wavelengths(lane.stream.next_1d())) } else { ColorMode::Rgb };
     }
@@ -1825,7 +1825,13 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
             let coverage = alhazen_scene::Texture::Checker { even, odd, size: 0.25 };
             m.alpha = Some(alhazen_scene::Alpha { coverage, cutoff: None });
         }
+        // Through a thin lens: each sample's lens point drawn from its stream.
+        let mut through_lens = small("cornell-box", (16, 16, 9));
+        if let alhazen_scene::CameraDesc::Perspective { lens, .. } = &mut through_lens.camera {
+            *lens = Some(alhazen_scene::ThinLens { aperture: 0.1, focus_distance: 2.5 });
+        }
         let scenes = [
+            ("cornell-box through a lens", through_lens),
             ("cornell-box, cut out", cut),
             ("point lights, a parallelogram and a sky", points),
             ("two lights and a sky", two_lights_and_sky),
