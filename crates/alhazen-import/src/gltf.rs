@@ -285,6 +285,11 @@ impl Importer<'_> {
             Mode::TriangleFan => (2..indices.len()).map(|k| [indices[0], indices[k - 1], indices[k]]).collect(),
             _ => indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         };
+        if prim.get(&gltf::Semantic::Colors(0)).is_some() {
+            self.warn(format!(
+                "{name}: vertex colours (COLOR_0) are not supported; the base colour is used without them"
+            ));
+        }
         let mut m = TriangleMesh { positions, normals, uvs, triangles, ..Default::default() };
         if m.normals.iter().any(|n| !n.is_finite()) {
             self.warn(format!("{name} has non-finite normals; they are recomputed from the faces"));

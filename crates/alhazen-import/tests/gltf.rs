@@ -543,3 +543,12 @@ fn an_emissive_texture_is_read_per_point() {
         assert!(e.contains("tex: the emissive factor and strength must be finite and ≥ 0"), "{e}");
     }
 }
+
+/// Vertex colours are not modelled: said, not dropped silently.
+#[test]
+fn vertex_colours_are_said_to_be_left_out() {
+    let json = embedded().replace(r#""TEXCOORD_0": 2 }"#, r#""TEXCOORD_0": 2, "COLOR_0": 1 }"#);
+    let s = write_and_import(&[("c.gltf", json.into_bytes())]).unwrap();
+    let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(said.iter().any(|w| w.contains("COLOR_0")), "{said:?}");
+}
