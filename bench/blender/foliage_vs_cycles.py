@@ -15,9 +15,12 @@ sampling, 6 bounces of every kind, transparent bounces 64; writes OUT/foliage-cy
 prints its render time (scene synchronisation and BVH build included, as alhazen's includes its
 load and build). Needs `pip install bpy`.
 """
-import argparse, math, os, sys, time
+import argparse, math, os, sys
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gltf_vs_cycles import black_world, render  # noqa: E402  (Cycles' settings, shared)
 
 
 def build(out):
@@ -68,40 +71,8 @@ def build(out):
     cam.data.sensor_fit = "VERTICAL"
     cam.data.angle = math.radians(45)
     scene.camera = cam
-    world = bpy.data.worlds.new("black")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    scene.world = world
+    black_world(scene)
     return scene
-
-
-def render(scene, path, spp, size):
-    w, h = size
-    c = scene.cycles
-    scene.render.engine = "CYCLES"
-    c.device = "CPU"
-    c.samples = spp
-    c.use_adaptive_sampling = False
-    c.use_denoising = False
-    c.max_bounces = c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = 6
-    c.transparent_max_bounces = 64
-    c.caustics_reflective = c.caustics_refractive = True
-    c.blur_glossy = 0.0
-    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
-    c.pixel_filter_type = "BOX"
-    c.filter_width = 1.0
-    scene.render.threads_mode = "FIXED"
-    scene.render.threads = 2
-    scene.render.resolution_x, scene.render.resolution_y = w, h
-    scene.render.resolution_percentage = 100
-    scene.view_settings.view_transform = "Standard"
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    scene.render.image_settings.color_mode = "RGB"
-    scene.render.filepath = path
-    t0 = time.perf_counter()
-    bpy.ops.render.render(write_still=True)
-    return time.perf_counter() - t0
 
 
 def main():
@@ -116,7 +87,7 @@ def main():
     scene.render.resolution_x, scene.render.resolution_y = size
     bpy.ops.export_scene.gltf(filepath=os.path.join(out, "foliage.glb"), export_format="GLB", export_lights=True,
                               export_cameras=True, export_yup=True)
-    seconds = render(scene, os.path.join(out, "foliage-cycles.exr"), a.spp, size)
+    seconds = render(scene, os.path.join(out, "foliage-cycles.exr"), a.spp, size, bounces=6, transparent=64, depth="32")
     print(f"Cycles: {a.spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
 
 

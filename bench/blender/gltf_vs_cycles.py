@@ -73,27 +73,34 @@ def mapped_material(name, color, path):
     return m
 
 
+def saved_image(name, n, pixel, path, alpha=False):
+    """An n × n image whose pixel (x, y) (rows bottom to top) is `pixel(x, y)` (RGBA), saved
+    as a PNG at `path`."""
+    img = bpy.data.images.new(name, n, n, alpha=alpha)
+    img.pixels = [c for y in range(n) for x in range(n) for c in pixel(x, y)]
+    img.filepath_raw = path
+    img.file_format = "PNG"
+    img.save()
+    return img
+
+
+def image_node(m, img):
+    """A bilinear image texture node of `img` in material `m`, and `m`'s Principled BSDF."""
+    tex = m.node_tree.nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    tex.interpolation = "Linear"
+    return tex, m.node_tree.nodes["Principled BSDF"]
+
+
 def emissive_panel(path):
     """A 2.4 × 1.2 panel above the cube and sphere facing the camera, glowing with four stripes read from an image
     written to `path`, on a black slab that absorbs what its back emits."""
     n = 32
-    img = bpy.data.images.new("stripes", n, n, alpha=False)
     stripes = [(1.0, 0.05, 0.05), (0.05, 1.0, 0.05), (0.05, 0.05, 1.0), (1.0, 1.0, 1.0)]
-    pixels = []
-    for y in range(n):
-        for x in range(n):
-            pixels += [*stripes[x * 4 // n], 1.0]
-    img.pixels = pixels
-    img.filepath_raw = path
-    img.file_format = "PNG"
-    img.save()
+    img = saved_image("stripes", n, lambda x, y: (*stripes[x * 4 // n], 1.0), path)
     m = material("panel", (0.0, 0.0, 0.0), 0.0, 1.0)
-    nodes, links = m.node_tree.nodes, m.node_tree.links
-    tex = nodes.new("ShaderNodeTexImage")
-    tex.image = img
-    tex.interpolation = "Linear"
-    p = nodes["Principled BSDF"]
-    links.new(tex.outputs["Color"], p.inputs["Emission Color"])
+    tex, p = image_node(m, img)
+    m.node_tree.links.new(tex.outputs["Color"], p.inputs["Emission Color"])
     p.inputs["Emission Strength"].default_value = 6.0
     bpy.ops.mesh.primitive_plane_add(size=1, location=(0.0, 2.2, 2.7), rotation=(math.radians(90), 0, 0))
     bpy.context.object.scale = (2.4, 1.2, 1.0)
@@ -106,26 +113,15 @@ def emissive_panel(path):
 def leaf_card(path):
     """A 1.6 × 1.6 card standing between the light and the cube, green, with round holes read
     from the alpha channel of an image written to `path`."""
-    n = 64
-    img = bpy.data.images.new("holes", n, n, alpha=True)
-    pixels = []
-    for y in range(n):
-        for x in range(n):
-            cx, cy = (x // 8) * 8 + 3.5, (y // 8) * 8 + 3.5
-            hole = (x - cx) ** 2 + (y - cy) ** 2 <= 9.0
-            pixels += [0.2, 0.6, 0.15, 0.0 if hole else 1.0]
-    img.pixels = pixels
-    img.filepath_raw = path
-    img.file_format = "PNG"
-    img.save()
+    def pixel(x, y):
+        cx, cy = (x // 8) * 8 + 3.5, (y // 8) * 8 + 3.5
+        return (0.2, 0.6, 0.15, 0.0 if (x - cx) ** 2 + (y - cy) ** 2 <= 9.0 else 1.0)
+
+    img = saved_image("holes", 64, pixel, path, alpha=True)
     m = material("leaves", (0.2, 0.6, 0.15), 0.0, 0.8)
-    nodes, links = m.node_tree.nodes, m.node_tree.links
-    tex = nodes.new("ShaderNodeTexImage")
-    tex.image = img
-    tex.interpolation = "Linear"
-    p = nodes["Principled BSDF"]
-    links.new(tex.outputs["Color"], p.inputs["Base Color"])
-    links.new(tex.outputs["Alpha"], p.inputs["Alpha"])
+    tex, p = image_node(m, img)
+    m.node_tree.links.new(tex.outputs["Color"], p.inputs["Base Color"])
+    m.node_tree.links.new(tex.outputs["Alpha"], p.inputs["Alpha"])
     bpy.ops.mesh.primitive_plane_add(size=1.6, location=(-0.6, -1.6, 2.4), rotation=(math.radians(70), 0, math.radians(10)))
     bpy.context.object.data.materials.append(m)
 
@@ -159,24 +155,31 @@ def build(maps_path=None, panel_path=None, card_path=None):
     cam.data.lens = 35
     cam.data.sensor_fit = "HORIZONTAL"
     scene.camera = cam
+    black_world(scene)
+    return scene
+
+
+def black_world(scene):
+    """No light from the world: what a glTF file, which has no world, holds."""
     world = bpy.data.worlds.new("black")
     world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.world = world
-    return scene
 
 
-def render(scene, path, spp, size):
+def render(scene, path, spp, size, bounces=8, transparent=8, depth="16"):
+    """Renders `scene` with Cycles (CPU, 2 threads, box filter of one pixel, no denoiser, no
+    adaptive sampling, `bounces` of every kind, `transparent` transparent bounces) to the EXR
+    `path` of `depth` bits; returns the seconds `bpy.ops.render.render` took."""
     w, h = size
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
     scene.cycles.samples = spp
     scene.cycles.use_adaptive_sampling = False
     scene.cycles.use_denoising = False
-    scene.cycles.max_bounces = 8
-    scene.cycles.diffuse_bounces = 8
-    scene.cycles.glossy_bounces = 8
-    scene.cycles.transmission_bounces = 8
+    c = scene.cycles
+    c.max_bounces = c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = bounces
+    c.transparent_max_bounces = transparent
     scene.cycles.caustics_reflective = True
     scene.cycles.caustics_refractive = True
     scene.cycles.blur_glossy = 0.0
@@ -190,7 +193,7 @@ def render(scene, path, spp, size):
     scene.render.resolution_percentage = 100
     scene.view_settings.view_transform = "Standard"
     scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "16"
+    scene.render.image_settings.color_depth = depth
     scene.render.image_settings.color_mode = "RGB"
     scene.render.filepath = path
     t0 = time.perf_counter()

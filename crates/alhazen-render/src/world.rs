@@ -278,6 +278,14 @@ fn flattenable(p: &Placed) -> Option<&alhazen_geom::TriangleMesh> {
     }
 }
 
+/// `placed` (object `o`'s shape), a mesh given its materials' cut-outs ([`AlphaMask`]).
+fn with_cut_outs(mut placed: Placed, o: &scene::Object, scene: &scene::Scene) -> Placed {
+    if let Shape::Mesh(m) = &mut placed.shape {
+        m.alpha = AlphaMask::of(o, scene);
+    }
+    placed
+}
+
 fn turned_sphere(shape: &scene::Shape, t: &alhazen_math::Transform) -> Option<Sphere> {
     let scene::Shape::Sphere { center, radius } = shape else { return None };
     Sphere::placed(*center, *radius, t)
@@ -359,21 +367,6 @@ fn place(
     Placed::new(build_shape(&o.shape, meshes), o.transform)
 }
 
-/// [`place`], a mesh given its materials' cut-outs ([`AlphaMask`]).
-fn place_with_alpha(
-    o: &scene::Object,
-    meshes: &[Arc<MeshAccel>],
-    world_space: &[Option<alhazen_math::Transform>],
-    scene: &scene::Scene,
-    unit: VectorUnit,
-) -> Placed {
-    let mut placed = place(o, meshes, world_space, scene, unit);
-    if let Shape::Mesh(m) = &mut placed.shape {
-        m.alpha = AlphaMask::of(o, scene);
-    }
-    placed
-}
-
 impl World {
     /// Places every object of `scene` and builds the BVH, for this processor's widest kernel.
     pub fn build(scene: &scene::Scene) -> Self {
@@ -404,7 +397,10 @@ impl World {
             .objects
             .iter()
             .map(|o| WorldObject {
-                placed: Placed { uv: uses_uv(o, scene), ..place_with_alpha(o, &meshes, &world_space, scene, unit) },
+                placed: Placed {
+                    uv: uses_uv(o, scene),
+                    ..with_cut_outs(place(o, &meshes, &world_space, scene, unit), o, scene)
+                },
                 material: o.material,
                 slot_materials: o.mesh_materials.clone(),
                 tangents: std::iter::once(&o.material).chain(&o.mesh_materials).any(|&m| {

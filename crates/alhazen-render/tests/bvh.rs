@@ -131,20 +131,7 @@ proptest! {
         rays in prop::collection::vec(((-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64), (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64)), 32),
     ) {
         // A random soup of 600 small triangles (more than a mesh baked into the world).
-        let mut state = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
-        let mut positions = vec![];
-        for _ in 0..600 {
-            let c = Vec3::new(next(), next(), next()) * 2.0;
-            positions.extend([c, c + Vec3::new(next(), next(), next()) * 0.3, c + Vec3::new(next(), next(), next()) * 0.3]);
-        }
-        let triangles = (0..600u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
-        let mesh = std::sync::Arc::new(alhazen_geom::TriangleMesh::new(positions, triangles).unwrap());
+        let mesh = triangle_soup(seed, 600);
         let unit = alhazen_render::shape::VectorUnit::detect();
         let shape = |method| alhazen_render::shape::MeshShape {
             accel: std::sync::Arc::new(alhazen_render::shape::MeshAccel::with_build(mesh.clone(), unit, method)),
