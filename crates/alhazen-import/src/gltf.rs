@@ -680,8 +680,8 @@ fn decode(data: &gltf::image::Data, decoding: Decoding) -> Option<ImageData> {
         _ => i,
     };
     if decoding == Decoding::Alpha && !has_alpha {
-        let n = data.width as usize * data.height as usize;
-        return Some(ImageData::from_codes(data.width, data.height, [1.0; 256], vec![[0; 3]; n]));
+        // Present everywhere: one texel says so (the material then has no cut-out).
+        return Some(ImageData::from_codes(1, 1, [1.0; 256], vec![[0; 3]]));
     }
     if bytes == 1 {
         // Eight bits a channel: the 256 values decoded once, the pixels kept as their codes.

@@ -278,10 +278,16 @@ fn flattenable(p: &Placed) -> Option<&alhazen_geom::TriangleMesh> {
     }
 }
 
-/// `placed` (object `o`'s shape), a mesh given its materials' cut-outs ([`AlphaMask`]).
-fn with_cut_outs(mut placed: Placed, o: &scene::Object, scene: &scene::Scene) -> Placed {
+/// `placed` (object `o`'s shape), a mesh given its materials' cut-outs ([`AlphaMask`]), whose
+/// coverages name `images`.
+fn with_cut_outs(
+    mut placed: Placed,
+    o: &scene::Object,
+    scene: &scene::Scene,
+    images: &Arc<Vec<Arc<alhazen_scene::ImageData>>>,
+) -> Placed {
     if let Shape::Mesh(m) = &mut placed.shape {
-        m.alpha = AlphaMask::of(o, scene);
+        m.alpha = AlphaMask::of(o, scene, images);
     }
     placed
 }
@@ -393,13 +399,14 @@ impl World {
             };
             scene.meshes.par_iter().zip(&world_space).map(accel).collect()
         };
+        let images = Arc::new(scene.images.clone());
         let objects: Vec<WorldObject> = scene
             .objects
             .iter()
             .map(|o| WorldObject {
                 placed: Placed {
                     uv: uses_uv(o, scene),
-                    ..with_cut_outs(place(o, &meshes, &world_space, scene, unit), o, scene)
+                    ..with_cut_outs(place(o, &meshes, &world_space, scene, unit), o, scene, &images)
                 },
                 material: o.material,
                 slot_materials: o.mesh_materials.clone(),

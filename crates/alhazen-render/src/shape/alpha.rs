@@ -20,25 +20,26 @@ pub struct AlphaMask {
     slots: Vec<Option<Alpha>>,
     /// The cut-out of slots past `slots` (the object's own material).
     others: Option<Alpha>,
-    /// The scene's images, which the coverages name.
-    images: Vec<Arc<ImageData>>,
+    /// The scene's images, which the coverages name (one list shared by every mask).
+    images: Arc<Vec<Arc<ImageData>>>,
 }
 
 impl AlphaMask {
-    /// The cut-outs of `object` (a mesh) in `scene`; `None` when all its materials are opaque.
-    pub fn of(object: &scene::Object, scene: &scene::Scene) -> Option<Arc<Self>> {
+    /// The cut-outs of `object` (a mesh) in `scene`, whose `images` they name; `None` when
+    /// all its materials are opaque.
+    pub fn of(object: &scene::Object, scene: &scene::Scene, images: &Arc<Vec<Arc<ImageData>>>) -> Option<Arc<Self>> {
         let alpha = |m: u32| scene.materials.get(m as usize).and_then(|m| m.alpha.clone());
         let slots: Vec<Option<Alpha>> = object.mesh_materials.iter().map(|&m| alpha(m)).collect();
         let others = alpha(object.material);
         if others.is_none() && slots.iter().all(Option::is_none) {
             return None;
         }
-        Some(Arc::new(Self { slots, others, images: scene.images.clone() }))
+        Some(Arc::new(Self { slots, others, images: images.clone() }))
     }
 
     /// One cut-out for every slot (`alpha`'s coverage naming `images`).
     pub fn uniform(alpha: Alpha, images: Vec<Arc<ImageData>>) -> Self {
-        Self { slots: vec![], others: Some(alpha), images }
+        Self { slots: vec![], others: Some(alpha), images: Arc::new(images) }
     }
 
     /// True when the surface is present at hit `c` of `ray` on `mesh` (`c.aux` its triangle).
