@@ -76,6 +76,11 @@ fn face_normal([a, b, c]: [Vec3; 3]) -> Vec3 {
     (b - a).cross(c - a).normalize_or_zero()
 }
 
+/// Whether `alpha` keeps hit `h` of flat `lane` of `a`'s mesh on `ray`.
+fn covered<'a>(a: &'a MeshAccel, alpha: &'a AlphaMask, ray: &'a Ray) -> impl Fn(FlatLane, LaneHit) -> bool + 'a {
+    move |lane, h| alpha.covers(&a.mesh, &lane.candidate(h.t, h.b1, h.b2), ray)
+}
+
 /// An instance of a mesh.
 #[derive(Clone, Debug)]
 pub struct MeshShape {
@@ -253,8 +258,7 @@ impl MeshShape {
                 best = Some(nearest);
                 return Some(h.t);
             }
-            let covered = |lane: FlatLane, h: LaneHit| alpha.covers(&a.mesh, &lane.candidate(h.t, h.b1, h.b2), ray);
-            let (lane, h) = a.packets.nearest_kept(packets, ray, t_max, covered)?;
+            let (lane, h) = a.packets.nearest_kept(packets, ray, t_max, covered(a, alpha, ray))?;
             best = Some(lane.candidate(h.t, h.b1, h.b2));
             Some(h.t)
         };
@@ -295,23 +299,34 @@ impl MeshShape {
         let a = &*self.accel;
         if let Some(alpha) = &self.alpha {
             // SAFETY: the caller's contract.
-            let covered = |lane: FlatLane, h: LaneHit| alpha.covers(&a.mesh, &lane.candidate(h.t, h.b1, h.b2), ray);
-            let mut blocked = false;
-            let visit = |packets: std::ops::Range<usize>, t_max| {
-                // Most leaves a shadow ray meets hold nothing on it: asked in vector lanes.
-                if !FlatPacket::any_of(&a.packets.packets[packets.clone()], ray, t_max, a.vectors) {
-                    return None;
-                }
-                blocked = a.packets.nearest_kept(packets, ray, t_max, covered).is_some();
-                blocked.then_some(0.0)
-            };
-            // SAFETY: the caller's contract.
-            unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
-            return blocked;
+            return unsafe { self.blocks_kept::<AVX2>(ray, t_max, alpha) };
         }
         let mut blocked = false;
         let visit = |packets: std::ops::Range<usize>, t_max| {
             blocked = FlatPacket::any_of(&a.packets.packets[packets], ray, t_max, a.vectors);
+            blocked.then_some(0.0)
+        };
+        // SAFETY: the caller's contract.
+        unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
+        blocked
+    }
+
+    /// [`Self::blocks_with`] on a mesh with cut-outs: some hit in `(0, t_max)` where `alpha`
+    /// says the surface is.
+    ///
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn blocks_kept<const AVX2: bool>(&self, ray: &Ray, t_max: f64, alpha: &AlphaMask) -> bool {
+        let a = &*self.accel;
+        let mut blocked = false;
+        let visit = |packets: std::ops::Range<usize>, t_max| {
+            // Most leaves a shadow ray meets hold nothing on it: asked in vector lanes.
+            if !FlatPacket::any_of(&a.packets.packets[packets.clone()], ray, t_max, a.vectors) {
+                return None;
+            }
+            blocked = a.packets.nearest_kept(packets, ray, t_max, covered(a, alpha, ray)).is_some();
             blocked.then_some(0.0)
         };
         // SAFETY: the caller's contract.
