@@ -120,11 +120,15 @@ pub enum PathLight {
     Background(Background),
 }
 
-/// An area light's radiance point by point: its texture, the scene's images, and each
-/// triangle's texture coordinates (in the order of [`Emitter::Triangles`]' corners).
+/// An area light's radiance point by point: its texture, its cut-out, the scene's images, and
+/// each triangle's texture coordinates (in the order of [`Emitter::Triangles`]' corners).
 #[derive(Clone, Debug)]
 pub struct AreaTexture {
     texture: Texture,
+    /// Where the emitting surface is not: a point drawn in a hole sends nothing, and where a
+    /// coverage `a` lets rays through, `a` of the radiance — what rays that hit the light
+    /// there see on average.
+    cut_out: Option<alhazen_scene::Alpha>,
     images: Vec<Arc<ImageData>>,
     uvs: Vec<[Vec2; 3]>,
 }
@@ -134,7 +138,11 @@ impl AreaTexture {
     #[inline]
     fn radiance(&self, (i, b): (usize, [f64; 3])) -> Vec3 {
         let [a, c, d] = self.uvs[i];
-        alhazen_scene::texture::eval(&self.texture, a * b[0] + c * b[1] + d * b[2], &self.images)
+        let uv = a * b[0] + c * b[1] + d * b[2];
+        let radiance = alhazen_scene::texture::eval(&self.texture, uv, &self.images);
+        let Some(cut) = &self.cut_out else { return radiance };
+        let coverage = alhazen_scene::texture::eval(&cut.coverage, uv, &self.images).x;
+        radiance * cut.cutoff.map_or(coverage.clamp(0.0, 1.0), |c| if coverage >= c { 1.0 } else { 0.0 })
     }
 }
 
@@ -209,9 +217,15 @@ pub struct Lights {
     has_environment: bool,
 }
 
-/// The world-space triangles of an emitting mesh object whose radiance is `texture`, with
-/// their texture coordinates (never a parallelogram: its two triangles' coordinates may differ).
-fn textured_emitter_of(scene: &Scene, o: &alhazen_scene::Object, texture: &Texture) -> Option<(Emitter, AreaTexture)> {
+/// The world-space triangles of an emitting mesh object whose radiance is `texture`, cut out by
+/// `cut_out`, with their texture coordinates (never a parallelogram: its two triangles'
+/// coordinates may differ).
+fn textured_emitter_of(
+    scene: &Scene,
+    o: &alhazen_scene::Object,
+    texture: &Texture,
+    cut_out: Option<&alhazen_scene::Alpha>,
+) -> Option<(Emitter, AreaTexture)> {
     let Shape::Mesh { mesh, .. } = &o.shape else { return None };
     let m = &scene.meshes[*mesh];
     let mirroring = o.transform.is_mirroring();
@@ -221,7 +235,8 @@ fn textured_emitter_of(scene: &Scene, o: &alhazen_scene::Object, texture: &Textu
     let tris: Vec<[Vec3; 3]> =
         indices.iter().map(|tri| tri.map(|i| o.transform.point(m.positions[i as usize]))).collect();
     let emitter = triangles_emitter(tris)?;
-    Some((emitter, AreaTexture { texture: texture.clone(), images: scene.images.clone(), uvs }))
+    let cut_out = cut_out.cloned();
+    Some((emitter, AreaTexture { texture: texture.clone(), cut_out, images: scene.images.clone(), uvs }))
 }
 
 /// Triangles chosen by area, when they have any.
@@ -321,7 +336,14 @@ impl Lights {
             if radiance == Vec3::ZERO {
                 continue;
             }
-            let textured = m.emission_texture.as_ref().and_then(|t| textured_emitter_of(scene, o, t));
+            // Read per point where the emission varies or a cut-out takes parts of it away.
+            let textured = match (&m.emission_texture, &m.alpha) {
+                (None, None) => None,
+                (texture, cut_out) => {
+                    let texture = texture.clone().unwrap_or(Texture::Solid(radiance));
+                    textured_emitter_of(scene, o, &texture, cut_out.as_ref())
+                }
+            };
             let light = match textured {
                 Some((emitter, t)) => Some(PathLight::Area { emitter, radiance, texture: Some(Box::new(t)) }),
                 None => emitter_of(scene, o).map(|emitter| PathLight::Area { emitter, radiance, texture: None }),
