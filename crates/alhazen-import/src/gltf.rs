@@ -319,12 +319,12 @@ impl Importer<'_> {
         let factor = rgb([c[0], c[1], c[2]]);
         let (base, base_mean) = match pbr.base_color_texture() {
             Some(info) => {
-                let scale = self.texture_scale(&info, &name);
+                let (scale, offset) = self.texture_placement(&info, &name);
                 let img = self.image(&info.texture(), Decoding::Srgb)?;
                 let img = scaled(img, factor);
                 let mean = alhazen_scene::texture::image_mean(&img);
                 self.scene.images.push(img);
-                (Texture::Image { image: self.scene.images.len() - 1, scale }, mean)
+                (Texture::Image { image: self.scene.images.len() - 1, scale, offset }, mean)
             }
             None => (Texture::Solid(factor), factor),
         };
@@ -338,11 +338,11 @@ impl Importer<'_> {
         if let Some(info) = material.emissive_texture()
             && emission != Vec3::ZERO
         {
-            let scale = self.texture_scale(&info, &name);
+            let (scale, offset) = self.texture_placement(&info, &name);
             let img = scaled(self.image(&info.texture(), Decoding::Srgb)?, emission);
             emission = alhazen_scene::texture::image_mean(&img);
             self.scene.images.push(img);
-            emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale });
+            emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset });
         }
         let transmission = material.transmission().map_or(0.0, |t| {
             if t.transmission_texture().is_some() {
@@ -368,7 +368,10 @@ impl Importer<'_> {
                     "{name}: with transmission, the metallic-roughness texture is replaced by its mean (metallic {metallic:.3}, roughness {roughness:.3})"
                 ));
             } else {
-                let scale = self.texture_scale(&info, &name);
+                let (scale, offset) = self.texture_placement(&info, &name);
+                if offset != Vec2::ZERO {
+                    self.warn(format!("{name}: the metallic-roughness texture's offset is not supported; ignored"));
+                }
                 self.scene.images.push(image);
                 map = Some((self.scene.images.len() - 1, scale));
             }
@@ -385,8 +388,9 @@ impl Importer<'_> {
             }
             None => None,
         };
-        let base_scale = if let Texture::Image { scale, .. } = base { scale } else { Vec2::ONE };
-        let alpha = self.cut_out(&material, c[3] as f64, base_scale)?;
+        let placement =
+            if let Texture::Image { scale, offset, .. } = base { (scale, offset) } else { (Vec2::ONE, Vec2::ZERO) };
+        let alpha = self.cut_out(&material, c[3] as f64, placement)?;
         for ext in [
             "KHR_materials_clearcoat",
             "KHR_materials_sheen",
@@ -417,9 +421,11 @@ impl Importer<'_> {
         Ok(id)
     }
 
-    /// `KHR_texture_transform`'s scale (offsets and rotations are warned about) and the
-    /// sampler's wrapping.
-    fn texture_scale(&mut self, info: &gltf::texture::Info, name: &str) -> Vec2 {
+    /// `KHR_texture_transform`'s scale and offset in alhazen's texture coordinates (rotations
+    /// are warned about), and the sampler's wrapping. glTF reads its image at `uv·s + o` with
+    /// `v` down; alhazen's `v = 1 − v_glTF` is up, so the same texel is at `uv·s + (o_u, 1 − s_v
+    /// − o_v)` (kept in [0, 1): the images repeat).
+    fn texture_placement(&mut self, info: &gltf::texture::Info, name: &str) -> (Vec2, Vec2) {
         let sampler = info.texture().sampler();
         use gltf::texture::WrappingMode::Repeat;
         if sampler.wrap_s() != Repeat || sampler.wrap_t() != Repeat {
@@ -430,14 +436,15 @@ impl Importer<'_> {
         }
         match info.texture_transform() {
             Some(t) => {
-                if t.offset() != [0.0, 0.0] || t.rotation() != 0.0 {
+                if t.rotation() != 0.0 {
                     self.warn(format!(
-                        "{name}: texture offsets and rotations are not supported; only the scale is used"
+                        "{name}: texture rotations are not supported; only the scale and offset are used"
                     ));
                 }
-                Vec2::new(t.scale()[0] as f64, t.scale()[1] as f64)
+                let ([su, sv], [ou, ov]) = (t.scale().map(f64::from), t.offset().map(f64::from));
+                (Vec2::new(su, sv), Vec2::new(ou, 1.0 - sv - ov).map(|x| x.rem_euclid(1.0)))
             }
-            None => Vec2::ONE,
+            None => (Vec2::ONE, Vec2::ZERO),
         }
     }
 
@@ -445,8 +452,13 @@ impl Importer<'_> {
     /// `factor` times its texture's alpha channel) reaches `alphaCutoff`; `BLEND` that alpha as
     /// a coverage, a ray let through with probability `1 − alpha` (Cycles' and Blender's
     /// reading of a blended surface in a path tracer); `None` when opaque.
-    /// The base colour texture's `scale` is the coverage's.
-    fn cut_out(&mut self, material: &gltf::Material, factor: f64, scale: Vec2) -> R<Option<alhazen_scene::Alpha>> {
+    /// The base colour texture's `(scale, offset)` are the coverage's.
+    fn cut_out(
+        &mut self,
+        material: &gltf::Material,
+        factor: f64,
+        (scale, offset): (Vec2, Vec2),
+    ) -> R<Option<alhazen_scene::Alpha>> {
         let cutoff = match material.alpha_mode() {
             AlphaMode::Opaque => return Ok(None),
             AlphaMode::Mask => Some(material.alpha_cutoff().unwrap_or(0.5) as f64),
@@ -459,7 +471,7 @@ impl Importer<'_> {
                 // An image without an alpha channel is present everywhere.
                 (alhazen_scene::texture::image_mean(&img).x < 1.0).then(|| {
                     self.scene.images.push(scaled(img, Vec3::splat(factor)));
-                    Texture::Image { image: self.scene.images.len() - 1, scale }
+                    Texture::Image { image: self.scene.images.len() - 1, scale, offset }
                 })
             }
             None => None,

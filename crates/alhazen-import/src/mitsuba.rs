@@ -1051,7 +1051,10 @@ impl Importer {
                 let scale = self.float(ctx, &p, "scale", 1.0)?;
                 let (inner, _) = self.inner_bsdf(ctx, node, depth)?;
                 bump = match tex {
-                    Texture::Image { image, scale: s } => {
+                    Texture::Image { image, scale: s, offset } => {
+                        if offset != Vec2::ZERO {
+                            self.warn(ctx, node, "a bump map's to_uv shift is not supported; ignored");
+                        }
                         Some(Bump { height: scale, pattern: BumpPattern::Image { image, scale: s } })
                     }
                     _ => {
@@ -1075,7 +1078,10 @@ impl Importer {
                 p.used.borrow_mut().insert("normalmap".to_string());
                 let (inner, _) = self.inner_bsdf(ctx, node, depth)?;
                 bump = match tex {
-                    Texture::Image { image, scale } => {
+                    Texture::Image { image, scale, offset } => {
+                        if offset != Vec2::ZERO {
+                            self.warn(ctx, node, "a normal map's to_uv shift is not supported; ignored");
+                        }
                         Some(Bump { height: 1.0, pattern: BumpPattern::NormalMap { image, scale } })
                     }
                     _ => {
@@ -1263,12 +1269,15 @@ impl Importer {
     fn texture(&mut self, ctx: &Ctx, node: Node, linear: bool) -> R<Texture> {
         let p = self.plugin(ctx, node)?;
         let uv = self.matrix(ctx, &p, "to_uv")?;
-        let scale = Vec2::new(uv.x_axis.x, uv.y_axis.y);
-        let is_scale = uv.w_axis.truncate() == Vec3::ZERO && uv.x_axis.y == 0.0 && uv.y_axis.x == 0.0;
+        // A scale then a shift (Mitsuba reads its image at to_uv · uv, `v` down, as alhazen
+        // reads the image turned upside down at `uv`): the same numbers.
+        let (scale, offset) = (Vec2::new(uv.x_axis.x, uv.y_axis.y), Vec2::new(uv.w_axis.x, uv.w_axis.y));
+        let is_scale = uv.x_axis.y == 0.0 && uv.y_axis.x == 0.0 && offset.is_finite();
         if !is_scale || scale.x == 0.0 || scale.y == 0.0 {
-            self.warn(ctx, node, "to_uv other than a scale is not supported; ignored");
+            self.warn(ctx, node, "to_uv other than a scale and a shift is not supported; ignored");
         }
-        let scale = if is_scale && scale.x != 0.0 && scale.y != 0.0 { scale } else { Vec2::ONE };
+        let (scale, offset) =
+            if is_scale && scale.x != 0.0 && scale.y != 0.0 { (scale, offset) } else { (Vec2::ONE, Vec2::ZERO) };
         let t = match p.kind.as_str() {
             "bitmap" => {
                 let name =
@@ -1289,9 +1298,12 @@ impl Importer {
                     self.warn(ctx, node, format!("wrap_mode \"{w}\": alhazen's image textures repeat"));
                 }
                 self.string(ctx, &p, "filter_type")?;
-                Texture::Image { image: index, scale }
+                Texture::Image { image: index, scale, offset }
             }
             "checkerboard" => {
+                if offset != Vec2::ZERO {
+                    self.warn(ctx, node, "a checkerboard's to_uv shift is not supported; ignored");
+                }
                 let even = self.constant_color(ctx, &p, "color0", Vec3::splat(0.4))?;
                 let odd = self.constant_color(ctx, &p, "color1", Vec3::splat(0.2))?;
                 if scale.x != scale.y {
@@ -1624,9 +1636,11 @@ fn metal_rough_map(
     };
     let value = |t: &Result<f64, Texture>, uv: Vec2| match t {
         Ok(_) => 1.0,
-        Err(Texture::Image { image, .. }) => {
-            luminance(alhazen_scene::texture::eval(&Texture::Image { image: *image, scale: Vec2::ONE }, uv, images))
-        }
+        Err(Texture::Image { image, .. }) => luminance(alhazen_scene::texture::eval(
+            &Texture::Image { image: *image, scale: Vec2::ONE, offset: Vec2::ZERO },
+            uv,
+            images,
+        )),
         Err(other) => luminance(alhazen_scene::texture::eval(other, uv, images)),
     };
     let pixels = (0..h)

@@ -139,12 +139,12 @@ fn check_scene(s: &Imported) {
     assert_eq!(position, Vec3::new(0.0, 3.0, 0.0));
     assert!((intensity - Vec3::new(1.0, 0.5, 0.25)).abs().max_element() < 1e-6, "683 cd = 1 W/sr");
     // The base colour: the texture times the factor (0.5, 1, 1), in a dielectric-over-diffuse BSDF.
-    let Some(BsdfDesc::CookTorrance { albedo: Texture::Image { image, scale }, .. }) =
+    let Some(BsdfDesc::CookTorrance { albedo: Texture::Image { image, scale, offset }, .. }) =
         &sc.materials[o.material as usize].bsdf
     else {
         panic!("not a textured dielectric: {:?}", sc.materials[o.material as usize].bsdf)
     };
-    assert_eq!(*scale, Vec2::ONE);
+    assert_eq!((*scale, *offset), (Vec2::ONE, Vec2::ZERO));
     assert_eq!(sc.images[*image].texels().collect::<Vec<_>>(), vec![[0.5, 0.0, 0.0], [0.0, 0.0, 1.0]]);
 }
 
@@ -516,7 +516,7 @@ fn an_emissive_texture_is_read_per_point() {
     let mut sc = s.scene;
     let m = &sc.materials[sc.objects[0].material as usize];
     assert_eq!(m.emission, Vec3::new(2.0, 0.0, 2.0));
-    let Some(Texture::Image { image, scale }) = m.emission_texture else { panic!("{:?}", m.emission_texture) };
+    let Some(Texture::Image { image, scale, .. }) = m.emission_texture else { panic!("{:?}", m.emission_texture) };
     assert_eq!(
         (sc.images[image].texels().collect::<Vec<_>>(), scale),
         (vec![[4.0, 0.0, 0.0], [0.0, 0.0, 4.0]], Vec2::ONE)
@@ -551,4 +551,38 @@ fn vertex_colours_are_said_to_be_left_out() {
     let s = write_and_import(&[("c.gltf", json.into_bytes())]).unwrap();
     let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
     assert!(said.iter().any(|w| w.contains("COLOR_0")), "{said:?}");
+}
+
+/// `KHR_texture_transform`'s scale and offset place the image as glTF places it: on a 2×2
+/// image (red, green over blue, white), the point of glTF coordinates (½, ½) reads, scaled by ½
+/// and shifted by (0, ½), the blue texel's centre (¼, ¾), shifted by (½, 0) the green's (¾, ¼).
+/// (With the offset ignored and the scale taken about alhazen's flipped `v`, a scale of ½ also
+/// moved the image by half its height.)
+#[test]
+fn texture_transforms_place_the_image_as_gltf_does() {
+    let img = image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255]).unwrap();
+    let mut four = std::io::Cursor::new(vec![]);
+    img.write_to(&mut four, image::ImageFormat::Png).unwrap();
+    let texel_at_centre = |offset: &str| {
+        let json = embedded()
+            .replace(&base64(&png()), &base64(four.get_ref()))
+            .replace(r#""baseColorFactor": [0.5, 1, 1, 1]"#, r#""baseColorFactor": [1, 1, 1, 1]"#)
+            .replace(
+                r#""baseColorTexture": { "index": 0 }"#,
+                &format!(
+                    r#""baseColorTexture": {{ "index": 0, "extensions": {{ "KHR_texture_transform": {{ "scale": [0.5, 0.5], "offset": {offset} }} }} }}"#
+                ),
+            )
+            .replace(r#""extensionsUsed": ["KHR_lights_punctual"]"#, r#""extensionsUsed": ["KHR_lights_punctual", "KHR_texture_transform"]"#);
+        let s = write_and_import(&[("t.gltf", json.into_bytes())]).unwrap();
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        let sc = s.scene;
+        let Some(BsdfDesc::CookTorrance { albedo, .. }) = &sc.materials[sc.objects[0].material as usize].bsdf else {
+            panic!()
+        };
+        // glTF's (½, ½) is alhazen's (½, 1 − ½).
+        alhazen_scene::texture::eval(albedo, Vec2::new(0.5, 0.5), &sc.images)
+    };
+    assert_eq!(texel_at_centre("[0, 0.5]"), Vec3::new(0.0, 0.0, 1.0), "blue");
+    assert_eq!(texel_at_centre("[0.5, 0]"), Vec3::new(0.0, 1.0, 0.0), "green");
 }

@@ -466,6 +466,9 @@ pub enum Texture {
         image: usize,
         /// Repeats per texture unit in u and v.
         scale: Vec2,
+        /// Shift of the image in its own units (a fraction of it per unit), after `scale`: the
+        /// image is read at `uv · scale + offset`.
+        offset: Vec2,
     },
 }
 

@@ -282,14 +282,26 @@ impl Parser<'_> {
         let Some(i) = t.get("image") else {
             return Err(n.err("`alpha`: expected a coverage in [0, 1] or { image = { file = … }, cutoff = c }"));
         };
-        let (image, scale) = self.image_file(&i, import::load_coverage)?;
-        Ok(Alpha { coverage: Texture::Image { image, scale }, cutoff })
+        let (image, scale, offset) = self.image_file(&i, true, import::load_coverage)?;
+        Ok(Alpha { coverage: Texture::Image { image, scale, offset }, cutoff })
     }
 
     /// `{ file = "x.png", scale = s or [u, v] }`: a repeated image (its index and scale); PNG and
     /// JPEG are sRGB unless `linear` (normal maps), EXR and HDR always linear.
     pub(crate) fn image_texture(&mut self, i: &Node, linear: bool) -> R<(usize, Vec2)> {
-        self.image_file(i, |path| {
+        self.image_of(i, linear, false).map(|(image, scale, _)| (image, scale))
+    }
+
+    /// [`Self::image_texture`] of a colour, which may be shifted too: `{ file, scale, offset =
+    /// [u, v] }` (the image read at `uv · scale + offset`).
+    fn placed_image(&mut self, i: &Node) -> R<Texture> {
+        let (image, scale, offset) = self.image_of(i, false, true)?;
+        Ok(Texture::Image { image, scale, offset })
+    }
+
+    /// An image table (with an `offset` where `offset` allows), read linearly or as sRGB.
+    fn image_of(&mut self, i: &Node, linear: bool, offset: bool) -> R<(usize, Vec2, Vec2)> {
+        self.image_file(i, offset, |path| {
             let linear = linear
                 || matches!(
                     path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
@@ -299,13 +311,15 @@ impl Parser<'_> {
         })
     }
 
-    /// `{ file = "x.png", scale = s or [u, v] }` read by `load`: the image's index and scale.
+    /// `{ file = "x.png", scale = s or [u, v] }` (and `offset = [u, v]` where `offset`
+    /// allows) read by `load`: the image's index, scale and offset.
     fn image_file(
         &mut self,
         i: &Node,
+        offset: bool,
         load: impl FnOnce(&std::path::Path) -> Result<crate::ImageData, String>,
-    ) -> R<(usize, Vec2)> {
-        let i = i.table(&["file", "scale"])?;
+    ) -> R<(usize, Vec2, Vec2)> {
+        let i = i.table(if offset { &["file", "scale", "offset"] } else { &["file", "scale"] })?;
         let file = i.req("file")?;
         let path = self.dir.join(file.str()?);
         // The scale is checked before the image is read.
@@ -317,9 +331,10 @@ impl Parser<'_> {
             },
             None => Vec2::ONE,
         };
+        let offset = i.get("offset").map_or(Ok(Vec2::ZERO), |o| o.numbers::<2>().map(Vec2::from_array))?;
         let data = load(&path).map_err(|e| file.err(e))?;
         self.scene.images.push(Arc::new(data));
-        Ok((self.scene.images.len() - 1, scale))
+        Ok((self.scene.images.len() - 1, scale, offset))
     }
 
     /// `bump = { height = h, waves = size }` or `bump = { height = h, image = { file, scale } }`.
@@ -362,8 +377,7 @@ impl Parser<'_> {
             });
         }
         if let Some(i) = t.get("image") {
-            let (image, scale) = self.image_texture(&i, false)?;
-            return Ok(Texture::Image { image, scale });
+            return self.placed_image(&i);
         }
         Err(n.err("`color`: expected a colour, { hsv = [h, s, v] }, { hsl = [h, s, l] }, { checker = {...} } or { image = {...} }"))
     }
@@ -390,12 +404,12 @@ impl Parser<'_> {
                 }
             }
             (None, Some(i)) => {
-                let (image, scale) = self.image_texture(&i, false)?;
-                if strength != Vec3::ONE {
+                let placed = self.placed_image(&i)?;
+                if let (Texture::Image { image, .. }, true) = (&placed, strength != Vec3::ONE) {
                     let factor = strength.as_vec3().to_array();
-                    self.scene.images[image] = Arc::new(self.scene.images[image].channels_scaled(factor));
+                    self.scene.images[*image] = Arc::new(self.scene.images[*image].channels_scaled(factor));
                 }
-                Texture::Image { image, scale }
+                placed
             }
             _ => {
                 return Err(n.err(

@@ -12,7 +12,8 @@ pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Ve
             let parity = |t: f64| (t / size).floor().rem_euclid(2.0);
             if parity(uv.x) == parity(uv.y) { *even } else { *odd }
         }
-        Texture::Image { image, scale } => bilinear(&images[*image], uv * *scale),
+        Texture::Image { image, scale, offset } if *offset == Vec2::ZERO => bilinear(&images[*image], uv * *scale),
+        Texture::Image { image, scale, offset } => bilinear(&images[*image], uv * *scale + *offset),
     }
 }
 
@@ -259,7 +260,7 @@ mod tests {
     #[test]
     fn image_lookup_hits_pixel_centres() {
         let img = ImageData::new(2, 1, vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
-        let t = Texture::Image { image: 0, scale: Vec2::ONE };
+        let t = Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO };
         let imgs = [std::sync::Arc::new(img)];
         assert_eq!(eval(&t, Vec2::new(0.25, 0.5), &imgs), Vec3::X);
         assert_eq!(eval(&t, Vec2::new(0.75, 0.5), &imgs), Vec3::Z);

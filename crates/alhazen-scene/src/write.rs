@@ -312,8 +312,19 @@ impl Writer<'_> {
             Texture::Checker { even, odd, size } => {
                 format!("{{ checker = {{ even = {}, odd = {}, size = {} }} }}", vec3(*even), vec3(*odd), num(*size))
             }
-            Texture::Image { image, scale } => format!("{{ image = {} }}", self.image(*image, *scale)),
+            Texture::Image { image, scale, offset } => {
+                format!("{{ image = {} }}", self.placed_image(*image, *scale, *offset))
+            }
         }
+    }
+
+    /// [`Self::image`] shifted by `offset` (written only where it is not zero).
+    fn placed_image(&self, image: usize, scale: Vec2, offset: Vec2) -> String {
+        let table = self.image(image, scale);
+        if offset == Vec2::ZERO {
+            return table;
+        }
+        format!("{}, offset = [{}, {}] }}", table.trim_end_matches(" }"), num(offset.x), num(offset.y))
     }
 
     fn image(&self, image: usize, scale: Vec2) -> String {
@@ -359,7 +370,9 @@ impl Writer<'_> {
         if let Some(a) = &m.alpha {
             let cutoff = a.cutoff.map_or(String::new(), |c| format!(", cutoff = {}", num(c)));
             let text = match &a.coverage {
-                Texture::Image { image, scale } => format!("{{ image = {}{cutoff} }}", self.image(*image, *scale)),
+                Texture::Image { image, scale, offset } => {
+                    format!("{{ image = {}{cutoff} }}", self.placed_image(*image, *scale, *offset))
+                }
                 // A constant coverage with a cutoff is all there or not at all.
                 other => {
                     let a0 = crate::texture::mean(other, &[]).x;

@@ -384,7 +384,7 @@ emission = { hsv = [0, 0, 0.5] }
     let mat = |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().clone();
     let screen = mat(&s, "screen");
     assert_eq!(screen.emission, Vec3::new(2.0, 0.0, 2.0));
-    let Some(Texture::Image { image, scale }) = screen.emission_texture else {
+    let Some(Texture::Image { image, scale, .. }) = screen.emission_texture else {
         panic!("{:?}", screen.emission_texture)
     };
     assert_eq!(scale, alhazen_math::Vec2::new(2.0, 1.0));
@@ -528,4 +528,29 @@ fn thin_lenses_read_write_back_and_refuse_nonsense() {
     assert!(
         err("[camera]\ntype = \"orthographic\"\neye = [0, 0, 5]\nwidth = 2\naperture = 0.1\n").contains("aperture")
     );
+}
+
+/// A colour image may be shifted (`offset = [u, v]`, after `scale`), and is written back so;
+/// a bump or normal map may not (its table refuses the key).
+#[test]
+fn image_offsets_read_write_back_and_are_refused_where_unsupported() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_fn(2, 1, |x, _| image::Rgb([x as u8 * 255, 0, 0])).save(dir.path().join("t.png")).unwrap();
+    let text = "[materials.m]\ncolor = { image = { file = \"t.png\", scale = 2, offset = [0.25, 0.5] } }\n";
+    let path = dir.path().join("o.toml");
+    std::fs::write(&path, text).unwrap();
+    let placed = |s: &alhazen_scene::Scene| match &s.materials.iter().find(|m| m.name == "m").unwrap().color {
+        Texture::Image { scale, offset, .. } => (*scale, *offset),
+        other => panic!("{other:?}"),
+    };
+    let s = load_scene(&path).unwrap();
+    let expected = (alhazen_math::Vec2::splat(2.0), alhazen_math::Vec2::new(0.25, 0.5));
+    assert_eq!(placed(&s), expected);
+    let again = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again, &dir.path().join("assets"), "").unwrap();
+    assert_eq!(placed(&load_scene(&again).unwrap()), expected);
+    let bump = "[materials.m]\nbump = { height = 0.1, image = { file = \"t.png\", offset = [0.5, 0] } }\n";
+    std::fs::write(&path, bump).unwrap();
+    let e = load_scene(&path).unwrap_err().to_string();
+    assert!(e.contains("offset") && e.contains("o.toml:2"), "{e}");
 }
