@@ -230,8 +230,12 @@ fn textured_emitter_of(
     let m = &scene.meshes[*mesh];
     let mirroring = o.transform.is_mirroring();
     let indices: Vec<[u32; 3]> = m.triangles.iter().map(|&tri| outside_first(tri, mirroring)).collect();
-    let uv = |i: u32| m.uvs.get(i as usize).copied().unwrap_or(Vec2::ZERO);
-    let uvs = indices.iter().map(|tri| tri.map(uv)).collect();
+    // A mesh without texture coordinates is parametrised by each triangle's barycentrics, as
+    // its ray tests report them: its corners at (0, 0), (1, 0), (0, 1), in the same order.
+    let uvs = match m.uvs.is_empty() {
+        true => vec![outside_first([Vec2::ZERO, Vec2::X, Vec2::Y], mirroring); indices.len()],
+        false => indices.iter().map(|tri| tri.map(|i| m.uvs[i as usize])).collect(),
+    };
     let tris: Vec<[Vec3; 3]> =
         indices.iter().map(|tri| tri.map(|i| o.transform.point(m.positions[i as usize]))).collect();
     let emitter = triangles_emitter(tris)?;

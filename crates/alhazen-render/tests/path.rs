@@ -344,3 +344,50 @@ transform = [{{ rotate_x = 90 }}, {{ translate = [0, 1, 0] }}]
         assert!(((a - b) / b).abs().max_element() < 0.03, "{integrator:?}: cut {a} against half {b}");
     }
 }
+
+/// A lamp without texture coordinates, cut out by a fine checker (half of it holes, by a
+/// cutoff), lights a floor as a whole lamp of half the radiance: its light samples read the
+/// coverage at the triangles' barycentrics, where its ray tests read it. (They read (0, 0),
+/// a present square, everywhere: 1.5 times too bright.)
+#[test]
+fn a_cut_out_lamp_without_texture_coordinates_reads_its_barycentrics() {
+    let positions = vec![Vec3::new(-0.5, 1.0, -0.5), Vec3::new(0.5, 1.0, -0.5), Vec3::new(0.0, 1.0, 0.5)];
+    let lamp = alhazen_geom::TriangleMesh::new(positions, vec![[0, 1, 2]]).unwrap();
+    let text = r#"
+[render]
+width = 32
+height = 32
+spp = 64
+max_depth = 3
+integrator = "path"
+[camera]
+eye = [0, 0.6, 3.5]
+target = [0, 0, 0]
+fov = 50
+[materials.floor]
+color = 0.8
+[materials.lamp]
+emission = 4
+color = 0
+[[object]]
+shape = "plane"
+material = "floor"
+"#;
+    let mut cut = parse_scene("lamp.toml".as_ref(), text).unwrap();
+    cut.meshes.push(std::sync::Arc::new(lamp));
+    let lamp_material = cut.materials.iter().position(|m| m.name == "lamp").unwrap() as u32;
+    cut.objects.push(alhazen_scene::Object {
+        name: None,
+        shape: alhazen_scene::Shape::Mesh { mesh: cut.meshes.len() - 1, smooth: false },
+        transform: alhazen_math::Transform::IDENTITY,
+        material: lamp_material,
+        mesh_materials: vec![],
+    });
+    let mut half = cut.clone();
+    half.materials[lamp_material as usize].emission = Vec3::splat(2.0);
+    let coverage = alhazen_scene::Texture::Checker { even: Vec3::ONE, odd: Vec3::ZERO, size: 0.02 };
+    cut.materials[lamp_material as usize].alpha = Some(alhazen_scene::Alpha { coverage, cutoff: Some(0.5) });
+    let (a, b) = (mean(&render(&cut, &|_, _| {})), mean(&render(&half, &|_, _| {})));
+    assert!(b.x > 0.01, "lit {b}");
+    assert!(((a - b) / b).abs().max_element() < 0.03, "cut {a} against half {b}");
+}
