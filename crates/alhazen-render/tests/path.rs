@@ -302,15 +302,11 @@ transform = [{{ scale = [{sx}, {sy}, 1] }}, {{ rotate_x = {tilt} }}, {{ rotate_y
     }
 }
 
-/// A lamp half cut out (a coverage of 0.5, each ray's passage decided by its hash) lights a
-/// floor as a lamp of half the radiance does: light samples drawn on it send half its radiance,
-/// as rays that hit it see on average; the path and Whitted tracers alike. (Sent whole, the
-/// image came out 1.41 times too bright.) The lamp is black: a half-present lamp reflects half.
-#[test]
-fn a_cut_out_lamp_sends_the_light_of_what_is_left() {
-    let scene = |lamp: &str| {
-        let text = format!(
-            r#"
+/// A floor seen from low down under a lamp of material `lamp` (black, emitting), with `more`
+/// objects (TOML).
+fn under_a_lamp(lamp: &str, more: &str) -> alhazen_scene::Scene {
+    let text = format!(
+        r#"
 [render]
 width = 32
 height = 32
@@ -324,19 +320,26 @@ fov = 50
 [materials.floor]
 color = 0.8
 [materials.lamp]
+color = 0
 {lamp}
 [[object]]
 shape = "plane"
 material = "floor"
-[[object]]
-shape = "rectangle"
-material = "lamp"
-transform = [{{ rotate_x = 90 }}, {{ translate = [0, 1, 0] }}]
-"#
-        );
-        parse_scene("lamp.toml".as_ref(), &text).unwrap()
-    };
-    let (mut cut, mut half) = (scene("emission = 4\ncolor = 0\nalpha = 0.5\n"), scene("emission = 2\ncolor = 0\n"));
+{more}"#
+    );
+    parse_scene("lamp.toml".as_ref(), &text).unwrap()
+}
+
+/// A lamp half cut out (a coverage of 0.5, each ray's passage decided by its hash) lights a
+/// floor as a lamp of half the radiance does: light samples drawn on it send half its radiance,
+/// as rays that hit it see on average; the path and Whitted tracers alike. (Sent whole, the
+/// image came out 1.41 times too bright.) The lamp is black: a half-present lamp reflects half.
+#[test]
+fn a_cut_out_lamp_sends_the_light_of_what_is_left() {
+    let rectangle = "[[object]]\nshape = \"rectangle\"\nmaterial = \"lamp\"\n\
+                     transform = [{ rotate_x = 90 }, { translate = [0, 1, 0] }]\n";
+    let (mut cut, mut half) =
+        (under_a_lamp("emission = 4\nalpha = 0.5", rectangle), under_a_lamp("emission = 2", rectangle));
     for integrator in [alhazen_scene::IntegratorKind::Path, alhazen_scene::IntegratorKind::Whitted] {
         (cut.render.integrator, half.render.integrator) = (integrator, integrator);
         let (a, b) = (mean(&render(&cut, &|_, _| {})), mean(&render(&half, &|_, _| {})));
@@ -353,27 +356,7 @@ transform = [{{ rotate_x = 90 }}, {{ translate = [0, 1, 0] }}]
 fn a_cut_out_lamp_without_texture_coordinates_reads_its_barycentrics() {
     let positions = vec![Vec3::new(-0.5, 1.0, -0.5), Vec3::new(0.5, 1.0, -0.5), Vec3::new(0.0, 1.0, 0.5)];
     let lamp = alhazen_geom::TriangleMesh::new(positions, vec![[0, 1, 2]]).unwrap();
-    let text = r#"
-[render]
-width = 32
-height = 32
-spp = 64
-max_depth = 3
-integrator = "path"
-[camera]
-eye = [0, 0.6, 3.5]
-target = [0, 0, 0]
-fov = 50
-[materials.floor]
-color = 0.8
-[materials.lamp]
-emission = 4
-color = 0
-[[object]]
-shape = "plane"
-material = "floor"
-"#;
-    let mut cut = parse_scene("lamp.toml".as_ref(), text).unwrap();
+    let mut cut = under_a_lamp("emission = 4", "");
     cut.meshes.push(std::sync::Arc::new(lamp));
     let lamp_material = cut.materials.iter().position(|m| m.name == "lamp").unwrap() as u32;
     cut.objects.push(alhazen_scene::Object {
