@@ -488,40 +488,36 @@ impl Importer {
                     return Err(ctx.err(at, "the camera transform is singular"));
                 }
                 self.named_coords.insert("camera".into(), world_from_camera);
-                let kind = match kind.as_str() {
-                    "perspective" => {
-                        let fov = self.float(ctx, &mut p, "fov", 90.0)?;
-                        if !(fov > 0.0 && fov < 180.0) {
-                            return Err(ctx.err(at, "fov must be in (0, 180) degrees"));
-                        }
-                        CameraKind::Perspective { fov_degrees: fov, lens: None }
-                    }
-                    "orthographic" => CameraKind::Orthographic { scale: 1.0 },
-                    other => {
-                        self.warn(
-                            ctx,
-                            &at,
-                            format!("camera \"{other}\" is not supported; a 90° perspective camera stands in"),
-                        );
-                        CameraKind::Perspective { fov_degrees: 90.0, lens: None }
-                    }
-                };
                 // pbrt's thin lens: `lensradius` (0: a pinhole), in focus at `focaldistance`.
                 let aperture = self.float(ctx, &mut p, "lensradius", 0.0)?;
                 let focus_distance = self.float(ctx, &mut p, "focaldistance", 1e6)?;
                 if aperture < 0.0 || !aperture.is_finite() || !(focus_distance > 0.0 && focus_distance.is_finite()) {
                     return Err(ctx.err(at, "a camera needs `lensradius` ≥ 0 and a positive `focaldistance`"));
                 }
-                let mut kind = kind;
-                match &mut kind {
-                    CameraKind::Perspective { lens, .. } if aperture > 0.0 => {
-                        *lens = Some(alhazen_scene::ThinLens { aperture, focus_distance });
+                let lens = (aperture > 0.0).then_some(alhazen_scene::ThinLens { aperture, focus_distance });
+                let kind = match kind.as_str() {
+                    "perspective" => {
+                        let fov = self.float(ctx, &mut p, "fov", 90.0)?;
+                        if !(fov > 0.0 && fov < 180.0) {
+                            return Err(ctx.err(at, "fov must be in (0, 180) degrees"));
+                        }
+                        CameraKind::Perspective { fov_degrees: fov, lens }
                     }
-                    CameraKind::Orthographic { .. } if aperture > 0.0 => {
-                        self.warn(ctx, &at, "an orthographic camera's lens is not supported: everything is sharp");
+                    "orthographic" => {
+                        if lens.is_some() {
+                            self.warn(ctx, &at, "an orthographic camera's lens is not supported: everything is sharp");
+                        }
+                        CameraKind::Orthographic { scale: 1.0 }
                     }
-                    _ => {}
-                }
+                    other => {
+                        self.warn(
+                            ctx,
+                            &at,
+                            format!("camera \"{other}\" is not supported; a 90° perspective camera stands in"),
+                        );
+                        CameraKind::Perspective { fov_degrees: 90.0, lens }
+                    }
+                };
                 self.unused(ctx, &p, "camera");
                 self.camera = Some((world_from_camera, kind));
             }
