@@ -319,7 +319,7 @@ impl Importer<'_> {
         let factor = rgb([c[0], c[1], c[2]]);
         let (base, base_mean) = match pbr.base_color_texture() {
             Some(info) => {
-                let (scale, offset) = self.texture_placement(&info, &name);
+                let (scale, offset) = self.texture_placement(&info, &name)?;
                 let img = self.image(&info.texture(), Decoding::Srgb)?;
                 let img = scaled(img, factor);
                 let mean = alhazen_scene::texture::image_mean(&img);
@@ -338,7 +338,7 @@ impl Importer<'_> {
         if let Some(info) = material.emissive_texture()
             && emission != Vec3::ZERO
         {
-            let (scale, offset) = self.texture_placement(&info, &name);
+            let (scale, offset) = self.texture_placement(&info, &name)?;
             let img = scaled(self.image(&info.texture(), Decoding::Srgb)?, emission);
             emission = alhazen_scene::texture::image_mean(&img);
             self.scene.images.push(img);
@@ -368,7 +368,7 @@ impl Importer<'_> {
                     "{name}: with transmission, the metallic-roughness texture is replaced by its mean (metallic {metallic:.3}, roughness {roughness:.3})"
                 ));
             } else {
-                let (scale, offset) = self.texture_placement(&info, &name);
+                let (scale, offset) = self.texture_placement(&info, &name)?;
                 if offset != Vec2::ZERO {
                     self.warn(format!("{name}: the metallic-roughness texture's offset is not supported; ignored"));
                 }
@@ -425,7 +425,7 @@ impl Importer<'_> {
     /// are warned about), and the sampler's wrapping. glTF reads its image at `uv·s + o` with
     /// `v` down; alhazen's `v = 1 − v_glTF` is up, so the same texel is at `uv·s + (o_u, 1 − s_v
     /// − o_v)` (kept in [0, 1): the images repeat).
-    fn texture_placement(&mut self, info: &gltf::texture::Info, name: &str) -> (Vec2, Vec2) {
+    fn texture_placement(&mut self, info: &gltf::texture::Info, name: &str) -> R<(Vec2, Vec2)> {
         let sampler = info.texture().sampler();
         use gltf::texture::WrappingMode::Repeat;
         if sampler.wrap_s() != Repeat || sampler.wrap_t() != Repeat {
@@ -442,9 +442,14 @@ impl Importer<'_> {
                     ));
                 }
                 let ([su, sv], [ou, ov]) = (t.scale().map(f64::from), t.offset().map(f64::from));
-                (Vec2::new(su, sv), Vec2::new(ou, 1.0 - sv - ov).map(|x| x.rem_euclid(1.0)))
+                // Texture coordinates times the scale stay far inside single precision's range.
+                if ![su, sv, ou, ov].iter().all(|x| x.is_finite() && x.abs() <= 1e6) {
+                    return Err(self
+                        .err(format!("{name}: KHR_texture_transform's scale and offset must be numbers within ±10⁶")));
+                }
+                Ok((Vec2::new(su, sv), Vec2::new(ou, 1.0 - sv - ov).map(|x| x.rem_euclid(1.0))))
             }
-            None => (Vec2::ONE, Vec2::ZERO),
+            None => Ok((Vec2::ONE, Vec2::ZERO)),
         }
     }
 
@@ -461,7 +466,14 @@ impl Importer<'_> {
     ) -> R<Option<alhazen_scene::Alpha>> {
         let cutoff = match material.alpha_mode() {
             AlphaMode::Opaque => return Ok(None),
-            AlphaMode::Mask => Some(material.alpha_cutoff().unwrap_or(0.5) as f64),
+            AlphaMode::Mask => {
+                let cutoff = material.alpha_cutoff().unwrap_or(0.5) as f64;
+                if !(cutoff >= 0.0 && cutoff.is_finite()) {
+                    let name = material.name().unwrap_or("a material");
+                    return Err(self.err(format!("{name}: alphaCutoff {cutoff} must be a number ≥ 0")));
+                }
+                Some(cutoff)
+            }
             AlphaMode::Blend => None,
         };
         let factor = if factor.is_finite() { factor.clamp(0.0, 1.0) } else { 1.0 };

@@ -586,3 +586,31 @@ fn texture_transforms_place_the_image_as_gltf_does() {
     assert_eq!(texel_at_centre("[0, 0.5]"), Vec3::new(0.0, 0.0, 1.0), "blue");
     assert_eq!(texel_at_centre("[0.5, 0]"), Vec3::new(0.0, 1.0, 0.0), "green");
 }
+
+/// A negative alpha cutoff and a texture transform beyond ±10⁶ are refused, named by their
+/// material.
+#[test]
+fn cut_out_and_texture_transform_nonsense_is_refused() {
+    let with = |extra: &str, texture_extension: &str| {
+        let json = embedded()
+            .replace(r#""roughnessFactor": 0.5 }"#, &format!(r#""roughnessFactor": 0.5 }}, {extra}"#))
+            .replace(
+                r#""baseColorTexture": { "index": 0 }"#,
+                &format!(r#""baseColorTexture": {{ "index": 0 {texture_extension} }}"#),
+            )
+            .replace(
+                r#""extensionsUsed": ["KHR_lights_punctual"]"#,
+                r#""extensionsUsed": ["KHR_lights_punctual", "KHR_texture_transform"]"#,
+            );
+        write_and_import(&[("n.gltf", json.into_bytes())]).map(|_| ()).unwrap_err()
+    };
+    let e = with(r#""alphaMode": "MASK", "alphaCutoff": -0.5"#, "");
+    assert!(e.contains("tex") && e.contains("alphaCutoff"), "{e}");
+    for transform in [r#""scale": [1e300, 1]"#, r#""offset": [0, -2e6]"#] {
+        let e = with(
+            r#""alphaMode": "OPAQUE""#,
+            &format!(r#", "extensions": {{ "KHR_texture_transform": {{ {transform} }} }}"#),
+        );
+        assert!(e.contains("tex") && e.contains("KHR_texture_transform"), "{transform}: {e}");
+    }
+}

@@ -961,3 +961,19 @@ fn thinlens_sensors_have_their_lens() {
     let e = import(&[("l.xml", &sensor(""))]).unwrap_err();
     assert!(e.contains("l.xml:2") && e.contains("aperture_radius"), "{e}");
 }
+
+/// A thin lens of no, negative or infinite radius, or in focus at no distance, is a located
+/// error.
+#[test]
+fn thinlens_nonsense_is_refused() {
+    for params in [
+        "<float name=\"aperture_radius\" value=\"-0.1\"/>",
+        "<float name=\"aperture_radius\" value=\"0\"/>",
+        "<float name=\"aperture_radius\" value=\"inf\"/>",
+        "<float name=\"aperture_radius\" value=\"0.1\"/><float name=\"focus_distance\" value=\"-1\"/>",
+    ] {
+        let xml = scene(&format!("<sensor type=\"thinlens\">{params}</sensor>"));
+        let e = import(&[("l.xml", &xml)]).unwrap_err();
+        assert!(e.contains("l.xml:2") && (e.contains("aperture_radius") || e.contains("inf")), "{params}: {e}");
+    }
+}

@@ -278,3 +278,14 @@ fn lens_radius_makes_a_thin_lens() {
     assert_eq!(lens_of("\"float lensradius\" 0"), None);
     assert_eq!(lens_of(""), None);
 }
+
+/// A negative or non-finite lens radius, and a focal distance that is not positive, are
+/// located errors.
+#[test]
+fn lens_nonsense_is_refused() {
+    for camera in ["\"float lensradius\" -0.1", "\"float lensradius\" 0.1 \"float focaldistance\" 0"] {
+        let text = format!("Camera \"perspective\" {camera}\nWorldBegin\nShape \"sphere\"\n");
+        let e = import(&[("c.pbrt", &text)]).unwrap_err();
+        assert!(e.contains("c.pbrt:1") && e.contains("lensradius"), "{camera}: {e}");
+    }
+}

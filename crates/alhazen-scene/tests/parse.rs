@@ -549,6 +549,12 @@ fn image_offsets_read_write_back_and_are_refused_where_unsupported() {
     let again = dir.path().join("again.toml");
     alhazen_scene::write::write_scene(&s, &again, &dir.path().join("assets"), "").unwrap();
     assert_eq!(placed(&load_scene(&again).unwrap()), expected);
+    for bad in ["[nan, 0]", "[0.5]", "[1e300, 0]", "0.5"] {
+        let text = format!("[materials.m]\ncolor = {{ image = {{ file = \"t.png\", offset = {bad} }} }}\n");
+        std::fs::write(&path, text).unwrap();
+        let e = load_scene(&path).unwrap_err().to_string();
+        assert!(e.contains("o.toml:2") && !e.contains("cannot load"), "{bad}: {e}");
+    }
     let bump = "[materials.m]\nbump = { height = 0.1, image = { file = \"t.png\", offset = [0.5, 0] } }\n";
     std::fs::write(&path, bump).unwrap();
     let e = load_scene(&path).unwrap_err().to_string();
