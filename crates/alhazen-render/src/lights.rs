@@ -141,7 +141,7 @@ impl AreaTexture {
         let uv = a * b[0] + c * b[1] + d * b[2];
         let radiance = alhazen_scene::texture::eval(&self.texture, uv, &self.images);
         let Some(cut) = &self.cut_out else { return radiance };
-        let coverage = alhazen_scene::texture::eval(&cut.coverage, uv, &self.images).x;
+        let coverage = alhazen_scene::texture::coverage(cut, uv, &self.images);
         radiance * cut.cutoff.map_or(coverage.clamp(0.0, 1.0), |c| if coverage >= c { 1.0 } else { 0.0 })
     }
 }

@@ -17,6 +17,12 @@ pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Ve
     }
 }
 
+/// The fraction of a cut-out surface ([`crate::Alpha`]) present at texture coordinates `uv`:
+/// its coverage texture's first channel.
+pub fn coverage(alpha: &crate::Alpha, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> f64 {
+    eval(&alpha.coverage, uv, images).x
+}
+
 /// The mean colour of `tex` over its texture space: an image's pixels' mean, a checker's two
 /// colours' mean.
 pub fn mean(tex: &Texture, images: &[std::sync::Arc<ImageData>]) -> Vec3 {

@@ -466,7 +466,7 @@ pub(crate) fn present(scene: &alhazen_scene::Scene, t: &Triangle, b: Bary, (x, y
     if !on_mesh {
         return true;
     }
-    let coverage = alhazen_scene::texture::eval(&alpha.coverage, interpolate(t.v.map(|v| v.uv), b), &scene.images).x;
+    let coverage = alhazen_scene::texture::coverage(alpha, interpolate(t.v.map(|v| v.uv), b), &scene.images);
     match alpha.cutoff {
         Some(cutoff) => coverage >= cutoff,
         None => coverage >= 1.0 || coverage > (BAYER[(y % 4) as usize][(x % 4) as usize] as f64 + 0.5) / 16.0,

@@ -9,7 +9,7 @@
 
 use super::Candidate;
 use alhazen_geom::TriangleMesh;
-use alhazen_math::{Ray, Vec2};
+use alhazen_math::Ray;
 use alhazen_scene::{self as scene, Alpha, ImageData};
 use std::sync::Arc;
 
@@ -47,23 +47,13 @@ impl AlphaMask {
         let tri = c.aux as usize;
         let slot = mesh.material_slots.get(tri).copied().unwrap_or(0) as usize;
         let Some(alpha) = self.slots.get(slot).unwrap_or(&self.others) else { return true };
-        let coverage = alhazen_scene::texture::eval(&alpha.coverage, uv_at(mesh, c), &self.images).x;
+        let coverage =
+            alhazen_scene::texture::coverage(alpha, super::mesh::uv_at(mesh, c.aux as usize, c.bary), &self.images);
         match alpha.cutoff {
             Some(cutoff) => coverage >= cutoff,
             None => coverage >= 1.0 || (coverage > 0.0 && ray_hash(ray, c.t) < coverage),
         }
     }
-}
-
-/// The texture coordinates at hit `c` (its barycentrics where the mesh has none), as
-/// [`super::MeshShape`]'s surface reports them.
-fn uv_at(mesh: &TriangleMesh, c: &Candidate) -> Vec2 {
-    let [b1, b2] = c.bary;
-    if mesh.uvs.is_empty() {
-        return Vec2::new(b1, b2);
-    }
-    let [i0, i1, i2] = mesh.triangles[c.aux as usize].map(|i| i as usize);
-    mesh.uvs[i0] * (1.0 - b1 - b2) + mesh.uvs[i1] * b1 + mesh.uvs[i2] * b2
 }
 
 /// A number in `[0, 1)` from the bits of `ray` and of the distance `t` of one of its hits

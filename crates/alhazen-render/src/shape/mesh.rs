@@ -81,6 +81,17 @@ fn covered<'a>(a: &'a MeshAccel, alpha: &'a AlphaMask, ray: &'a Ray) -> impl Fn(
     move |lane, h| alpha.covers(&a.mesh, &lane.candidate(h.t, h.b1, h.b2), ray)
 }
 
+/// The texture coordinates of `mesh`'s triangle `tri` at barycentric `[b1, b2]` (those
+/// barycentrics where the mesh has none).
+#[inline]
+pub(super) fn uv_at(mesh: &TriangleMesh, tri: usize, [b1, b2]: [f64; 2]) -> Vec2 {
+    if mesh.uvs.is_empty() {
+        return Vec2::new(b1, b2);
+    }
+    let [i0, i1, i2] = mesh.triangles[tri].map(|i| i as usize);
+    mesh.uvs[i0] * (1.0 - b1 - b2) + mesh.uvs[i1] * b1 + mesh.uvs[i2] * b2
+}
+
 /// An instance of a mesh.
 #[derive(Clone, Debug)]
 pub struct MeshShape {
@@ -152,12 +163,7 @@ impl MeshShape {
         let m = &self.accel.mesh;
         let idx = m.triangles[tri].map(|i| i as usize);
         let (n, ns, slot) = self.normals_and_slot(tri, b1, b2);
-        let b0 = 1.0 - b1 - b2;
-        let uv = if m.uvs.is_empty() {
-            Vec2::new(b1, b2)
-        } else {
-            m.uvs[idx[0]] * b0 + m.uvs[idx[1]] * b1 + m.uvs[idx[2]] * b2
-        };
+        let uv = uv_at(m, tri, [b1, b2]);
         let p = on_triangle(idx.map(|i| m.positions[i]), b1, b2);
         SurfaceHit { t, p, n, ns, uv, slot, dpduv: [Vec3::ZERO; 2] }
     }
