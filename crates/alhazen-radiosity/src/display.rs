@@ -14,8 +14,8 @@ use crate::solve::Solution;
 use alhazen_math::{Ray, Vec2, Vec3};
 use alhazen_render::Camera;
 use alhazen_render::film::PixelEstimator;
+use alhazen_render::film::filter::FilmSampler;
 use alhazen_render::optics::{fresnel_dielectric, reflect, refract};
-use alhazen_render::sampler::stratified_offset;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
@@ -107,13 +107,19 @@ pub struct FinalGather<'a> {
     pub solution: &'a Solution,
     /// The camera.
     pub camera: Camera,
+    /// Where the pixel filter places each sample, and its weight.
+    pub film: FilmSampler,
 }
 
 impl<'a> FinalGather<'a> {
     /// The scene's camera at its image size.
     pub fn new(solution: &'a Solution) -> Self {
         let r = &solution.scene.render;
-        Self { solution, camera: Camera::new(&solution.scene.camera, r.width, r.height) }
+        Self {
+            solution,
+            camera: Camera::new(&solution.scene.camera, r.width, r.height),
+            film: FilmSampler::new(&r.filter),
+        }
     }
 
     /// The radiance along `ray`, following mirrors and glass `depth` more times.
@@ -155,15 +161,14 @@ impl<'a> FinalGather<'a> {
 impl PixelEstimator for FinalGather<'_> {
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
         let r = &self.solution.scene.render;
-        let (dx, dy) = stratified_offset(r.seed, x, y, index, r.spp);
-        let (fx, fy) = (x as f64 + dx, y as f64 + dy);
+        let (fx, fy, weight) = self.film.stratified(r.seed, (x, y), index, r.spp);
         let ray = match self.camera.has_lens() {
             true => {
                 let mut rng = alhazen_render::sampler::Rng::for_sample(r.seed ^ 0x1e45_a9e7_7b1d_0c35, x, y, index);
-                self.camera.lens_ray(fx, fy, alhazen_math::Vec2::new(rng.uniform(), rng.uniform()))
+                self.camera.pixel_lens_ray(x, fx, fy, alhazen_math::Vec2::new(rng.uniform(), rng.uniform()))
             }
-            false => self.camera.ray(fx, fy),
+            false => self.camera.pixel_ray(x, fx, fy),
         };
-        self.trace(&ray, r.max_depth)
+        self.trace(&ray, r.max_depth) * weight
     }
 }

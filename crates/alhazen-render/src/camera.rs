@@ -186,6 +186,28 @@ impl Camera {
         self.lens.map_or(pinhole, |l| l.ray(&pinhole, sample))
     }
 
+    /// [`Self::ray`] for a sample of a pixel of column `column`, placed at `(fx, fy)` by a pixel
+    /// filter (perhaps beyond the pixel): a stereo pair's eye is the pixel's, a sample beyond
+    /// its image's edge seeing on through the same eye (as beyond any image's edge), never the
+    /// other eye's view.
+    #[inline]
+    pub fn pixel_ray(&self, column: u32, fx: f64, fy: f64) -> Ray {
+        match &self.kind {
+            Kind::Stereo { left, right } => {
+                let half = self.film_width / 2;
+                if column < half { left.ray(fx, fy) } else { right.ray(fx - half as f64, fy) }
+            }
+            _ => self.ray(fx, fy),
+        }
+    }
+
+    /// [`Self::lens_ray`] for a sample of a pixel of column `column`, as [`Self::pixel_ray`].
+    #[inline]
+    pub fn pixel_lens_ray(&self, column: u32, fx: f64, fy: f64, sample: Vec2) -> Ray {
+        let pinhole = self.pixel_ray(column, fx, fy);
+        self.lens.map_or(pinhole, |l| l.ray(&pinhole, sample))
+    }
+
     /// The ray through film position `(fx, fy)` in pixels, `y` down.
     #[inline(always)]
     pub fn ray(&self, fx: f64, fy: f64) -> Ray {
@@ -320,6 +342,21 @@ mod tests {
         let pl = l.at(5.0 / -l.dir.z);
         let pr = r.at(5.0 / -r.dir.z);
         assert!(pl.length() < 1e-9 && pr.length() < 1e-9, "{pl} {pr}");
+    }
+
+    /// A filtered sample of a stereo pixel beside the seam, placed across it, is still seen by
+    /// its pixel's eye (the other eye's view must not bleed in).
+    #[test]
+    fn a_stereo_pixel_keeps_its_eye_beyond_the_seam() {
+        let desc = CameraDesc::Stereo { look: LOOK, eye_distance: 0.5, screen_distance: 5.0, screen_width: 4.0 };
+        let cam = Camera::new(&desc, 100, 50);
+        let (left_eye, right_eye) = (cam.ray(10.0, 25.0).origin, cam.ray(110.0, 25.0).origin);
+        assert_eq!(cam.pixel_ray(99, 100.7, 25.0).origin, left_eye);
+        assert_eq!(cam.pixel_ray(100, 99.2, 25.0).origin, right_eye);
+        assert_eq!(cam.ray(100.7, 25.0).origin, right_eye);
+        // Within the pixel, the ray of `ray` itself.
+        assert_eq!(cam.pixel_ray(99, 99.5, 25.0), cam.ray(99.5, 25.0));
+        assert_eq!(cam.pixel_ray(100, 100.5, 25.0), cam.ray(100.5, 25.0));
     }
 
     proptest::proptest! {

@@ -147,9 +147,13 @@ fn with_estimator_in<T>(scene: &Scene, world: &World, work: &dyn Fn(&dyn film::P
     let s = &scene.render;
     let camera = Camera::new(&scene.camera, s.width, s.height);
     match s.integrator {
-        IntegratorKind::Whitted => {
-            work(&WhittedEstimator { whitted: Whitted::new(scene, world), camera: &camera, spp: s.spp, seed: s.seed })
-        }
+        IntegratorKind::Whitted => work(&WhittedEstimator {
+            whitted: Whitted::new(scene, world),
+            camera: &camera,
+            spp: s.spp,
+            seed: s.seed,
+            film: film::filter::FilmSampler::new(&s.filter),
+        }),
         // Photon mapping and radiosity live in crates above this one (`alhazen render` runs
         // them); here the path tracer renders what the photon map converges to and radiosity
         // approximates.

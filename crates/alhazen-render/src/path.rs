@@ -63,6 +63,8 @@ pub struct PathTracer<'a> {
     mirrors: Option<mirrors::MirrorConnections>,
     /// Light through specular surfaces onto non-specular ones, estimated elsewhere.
     caustics: Option<&'a dyn CausticEstimate>,
+    /// Where the pixel filter places each sample, and its weight.
+    film: crate::film::filter::FilmSampler,
 }
 
 /// Light that reached non-specular surfaces through specular (delta) ones only, from the lights
@@ -242,6 +244,7 @@ impl<'a> PathTracer<'a> {
             material_kernels: vec![],
             mirrors,
             caustics: None,
+            film: crate::film::filter::FilmSampler::new(&scene.render.filter),
         };
         tracer.lane_lights = lanes::lane_lights(&tracer.lights);
         tracer.material_kernels = lanes::material_kernels(&tracer);
@@ -515,24 +518,29 @@ impl PixelEstimator for PathTracer<'_> {
 }
 
 impl PathTracer<'_> {
-    /// The camera's ray through film position `(fx, fy)`: through a lens, the stream's next
-    /// pair picks the lens point (the pinhole's draws nothing, so its images keep their bits).
+    /// The camera's ray through film position `(fx, fy)` of a sample of a pixel in column `x`:
+    /// through a lens, the stream's next pair picks the lens point (the pinhole's draws nothing,
+    /// so its images keep their bits).
     #[inline]
-    fn camera_ray(&self, fx: f64, fy: f64, s: &mut SampleStream) -> Ray {
-        if self.camera.has_lens() { self.camera.lens_ray(fx, fy, s.next_2d()) } else { self.camera.ray(fx, fy) }
+    fn camera_ray(&self, x: u32, (fx, fy): (f64, f64), s: &mut SampleStream) -> Ray {
+        match self.camera.has_lens() {
+            true => self.camera.pixel_lens_ray(x, fx, fy, s.next_2d()),
+            false => self.camera.pixel_ray(x, fx, fy),
+        }
     }
 
     /// The sample of pixel `(x, y)` whose numbers `s` gives.
     fn sample_of(&self, mut s: SampleStream, x: u32, y: u32) -> Vec3 {
-        let film = s.next_2d();
-        let ray = self.camera_ray(x as f64 + film.x, y as f64 + film.y, &mut s);
-        if self.spectral {
+        let (fx, fy, weight) = self.film.place(x, y, s.next_2d());
+        let ray = self.camera_ray(x, (fx, fy), &mut s);
+        let value = if self.spectral {
             let lambdas = sample_wavelengths(s.next_1d());
             let values = self.radiance(ray, ColorMode::Spectral(lambdas), &mut s);
             spectrum_to_rgb(values, &lambdas)
         } else {
             self.radiance(ray, ColorMode::Rgb, &mut s)
-        }
+        };
+        value * weight
     }
 }
 

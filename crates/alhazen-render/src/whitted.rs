@@ -18,7 +18,6 @@ use crate::film::PixelEstimator;
 use crate::lights::{Lights, PathLight};
 use crate::optics::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use crate::sampler::Rng;
-use crate::sampler::stratified_offset;
 use crate::shape::ray_epsilon;
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::texture;
@@ -154,28 +153,30 @@ pub struct WhittedEstimator<'a> {
     pub spp: u32,
     /// Seed.
     pub seed: u64,
+    /// Where the pixel filter places each sample, and its weight.
+    pub film: crate::film::filter::FilmSampler,
 }
 
 impl PixelEstimator for WhittedEstimator<'_> {
     fn sample(&self, x: u32, y: u32, index: u32) -> Vec3 {
-        let (dx, dy) = stratified_offset(self.seed, x, y, index, self.spp);
+        let (fx, fy, weight) = self.film.stratified(self.seed, (x, y), index, self.spp);
         let ray = match self.camera.has_lens() {
             // The lens point from the sample's own numbers, apart from the pixel's strata.
             true => {
                 let mut rng = Rng::for_sample(self.seed ^ 0x1e45_a9e7_7b1d_0c35, x, y, index);
                 let lens = alhazen_math::Vec2::new(rng.uniform(), rng.uniform());
-                self.camera.lens_ray(x as f64 + dx, y as f64 + dy, lens)
+                self.camera.pixel_lens_ray(x, fx, fy, lens)
             }
-            false => self.camera.ray(x as f64 + dx, y as f64 + dy),
+            false => self.camera.pixel_ray(x, fx, fy),
         };
         if !self.whitted.is_spectral() {
-            return self.whitted.trace(&ray, 1, 1.0);
+            return self.whitted.trace(&ray, 1, 1.0) * weight;
         }
         // The wavelengths stratified over the pixel's samples, jittered per sample.
         let jitter = Rng::for_sample(self.seed ^ 0x5eed_1a4b_da00, x, y, index).uniform();
         let lambdas = sample_wavelengths((index as f64 + jitter) / self.spp as f64);
         let channels = Channels { mode: ColorMode::Spectral(lambdas), hero_only: false };
-        spectrum_to_rgb(self.whitted.trace_in(&ray, 1, 1.0, channels), &lambdas)
+        spectrum_to_rgb(self.whitted.trace_in(&ray, 1, 1.0, channels), &lambdas) * weight
     }
 }
 

@@ -79,6 +79,8 @@ pub struct RenderSettings {
     /// Join lights to non-specular points through sphere, cylinder and plane mirrors exactly
     /// (specular connections, both ray tracers).
     pub mirror_connections: bool,
+    /// How each pixel weighs the film positions of its samples.
+    pub filter: PixelFilter,
 }
 
 impl Default for RenderSettings {
@@ -92,8 +94,176 @@ impl Default for RenderSettings {
             integrator: IntegratorKind::Whitted,
             sampler: SamplerKind::Sobol,
             mirror_connections: true,
+            filter: PixelFilter::PIXEL,
         }
     }
+}
+
+/// The pixel reconstruction filter: the weight a pixel gives a sample at offset `(x, y)` from
+/// its centre, in pixels — separable, the product of one profile along `x` and one along `y`,
+/// each zero beyond its radius (Mitchell and Netravali 1988, "Reconstruction filters in
+/// computer graphics"; the filters of pbrt-v4 and Mitsuba 3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PixelFilter {
+    /// Equal weight out to `radius` (0.5: the pixel's own square).
+    Box {
+        /// Along `x` and `y`, in pixels.
+        radius: [f64; 2],
+    },
+    /// `1 − |x|/r`.
+    Tent {
+        /// `r` along `x` and `y`.
+        radius: [f64; 2],
+    },
+    /// `exp(−x²/2σ²) − exp(−r²/2σ²)`.
+    Gaussian {
+        /// `σ`, in pixels.
+        sigma: f64,
+        /// `r` along `x` and `y`.
+        radius: [f64; 2],
+    },
+    /// Mitchell and Netravali's cubic of parameters `B, C` over `|2x/r| ≤ 2` (`B = 0, C = ½`:
+    /// Catmull–Rom); negative lobes.
+    Mitchell {
+        /// `B`.
+        b: f64,
+        /// `C`.
+        c: f64,
+        /// `r` along `x` and `y`.
+        radius: [f64; 2],
+    },
+    /// The Blackman–Harris window over `[−r, r]`, `a₀ − a₁ cos θ + a₂ cos 2θ − a₃ cos 3θ` with
+    /// `θ = π(x/r + 1)` (Harris 1978; Blender Cycles' default filter, `r` its "width").
+    BlackmanHarris {
+        /// `r` along `x` and `y`.
+        radius: [f64; 2],
+    },
+    /// Lanczos' windowed sinc, `sinc(x) · sinc(x/τ)` with `sinc(x) = sin(πx)/(πx)`; negative lobes.
+    Lanczos {
+        /// `τ`, the window's width.
+        tau: f64,
+        /// Where the profile is cut, along `x` and `y`.
+        radius: [f64; 2],
+    },
+}
+
+/// The largest filter radius, in pixels: a sample then lands at most this far from its pixel.
+pub const MAX_FILTER_RADIUS: f64 = 16.0;
+
+impl PixelFilter {
+    /// The box of one pixel: each sample anywhere in its own pixel, all weighed alike.
+    pub const PIXEL: Self = Self::Box { radius: [0.5; 2] };
+
+    /// The names of the filters, for [`Self::named`].
+    pub const NAMES: [&str; 7] = ["box", "tent", "gaussian", "blackman-harris", "mitchell", "catmull-rom", "lanczos"];
+
+    /// The filter of this name with its default parameters (the scene format's).
+    pub fn named(name: &str) -> Option<Self> {
+        Some(match name {
+            "box" => Self::PIXEL,
+            "tent" => Self::Tent { radius: [1.0; 2] },
+            "gaussian" => Self::Gaussian { sigma: 0.5, radius: [1.5; 2] },
+            "blackman-harris" => Self::BlackmanHarris { radius: [1.5; 2] },
+            "mitchell" => Self::Mitchell { b: 1.0 / 3.0, c: 1.0 / 3.0, radius: [2.0; 2] },
+            "catmull-rom" => Self::Mitchell { b: 0.0, c: 0.5, radius: [2.0; 2] },
+            "lanczos" => Self::Lanczos { tau: 3.0, radius: [3.0; 2] },
+            _ => return None,
+        })
+    }
+
+    /// The radii along `x` and `y`.
+    pub fn radius(&self) -> [f64; 2] {
+        match *self {
+            Self::Box { radius }
+            | Self::Tent { radius }
+            | Self::BlackmanHarris { radius }
+            | Self::Gaussian { radius, .. }
+            | Self::Mitchell { radius, .. }
+            | Self::Lanczos { radius, .. } => radius,
+        }
+    }
+
+    /// The profile along `axis` (0: `x`, 1: `y`) at offset `x` from the centre.
+    pub fn profile(&self, axis: usize, x: f64) -> f64 {
+        let r = self.radius()[axis];
+        let x = x.abs();
+        if x > r {
+            return 0.0;
+        }
+        match *self {
+            Self::Box { .. } => 1.0,
+            Self::Tent { .. } => 1.0 - x / r,
+            Self::Gaussian { sigma, .. } => {
+                let g = |x: f64| (-x * x / (2.0 * sigma * sigma)).exp();
+                (g(x) - g(r)).max(0.0)
+            }
+            Self::BlackmanHarris { .. } => {
+                let t = std::f64::consts::PI * (x / r + 1.0);
+                0.35875 - 0.48829 * t.cos() + 0.14128 * (2.0 * t).cos() - 0.01168 * (3.0 * t).cos()
+            }
+            Self::Mitchell { b, c, .. } => mitchell(b, c, 2.0 * x / r),
+            Self::Lanczos { tau, .. } => sinc(x) * sinc(x / tau),
+        }
+    }
+
+    /// Why the filter cannot be used, if it cannot: a radius outside `(0, MAX_FILTER_RADIUS]`,
+    /// a parameter not finite or out of range, or a profile whose integral is not at least a
+    /// hundredth of its magnitude's (its samples' weights would be huge and of both signs).
+    pub fn problem(&self) -> Option<String> {
+        match *self {
+            Self::Gaussian { sigma, .. } if !(sigma > 0.0 && sigma <= MAX_FILTER_RADIUS) => {
+                return Some(format!("a Gaussian filter's sigma must lie in (0, {MAX_FILTER_RADIUS}], found {sigma}"));
+            }
+            Self::Mitchell { b, c, .. } if !(b.abs() <= 100.0 && c.abs() <= 100.0) => {
+                return Some(format!("a Mitchell filter's B and C must be finite numbers within ±100, found {b}, {c}"));
+            }
+            Self::Lanczos { tau, .. } if !(0.01..=MAX_FILTER_RADIUS).contains(&tau) => {
+                return Some(format!("a Lanczos filter's tau must lie in [0.01, {MAX_FILTER_RADIUS}], found {tau}"));
+            }
+            _ => {}
+        }
+        let radius = self.radius();
+        if !radius.iter().all(|r| *r > 0.0 && *r <= MAX_FILTER_RADIUS) {
+            return Some(format!(
+                "a pixel filter's radius must lie in (0, {MAX_FILTER_RADIUS}] pixels, found {} × {}",
+                radius[0], radius[1]
+            ));
+        }
+        for axis in 0..2 {
+            // The midpoint rule over a fine grid.
+            let (r, n) = (radius[axis], 4096);
+            let h = 2.0 * r / n as f64;
+            let values = (0..n).map(|i| self.profile(axis, -r + (i as f64 + 0.5) * h));
+            let (signed, magnitude) = values.fold((0.0, 0.0), |(s, m), v| (s + v * h, m + v.abs() * h));
+            if signed.is_nan() || signed < 0.01 * magnitude || magnitude <= 0.0 {
+                return Some(format!(
+                    "this pixel filter's weights along {} sum to {signed:.3e} against {magnitude:.3e} in magnitude: \
+                     its negative lobes would cancel its positive ones (a pixel divides by the sum)",
+                    ["x", "y"][axis]
+                ));
+            }
+        }
+        None
+    }
+}
+
+/// Mitchell and Netravali's cubic at `x` (zero beyond `|x| = 2`).
+fn mitchell(b: f64, c: f64, x: f64) -> f64 {
+    let x = x.abs();
+    let v = if x < 1.0 {
+        (12.0 - 9.0 * b - 6.0 * c) * x * x * x + (-18.0 + 12.0 * b + 6.0 * c) * x * x + (6.0 - 2.0 * b)
+    } else if x < 2.0 {
+        (-b - 6.0 * c) * x * x * x + (6.0 * b + 30.0 * c) * x * x + (-12.0 * b - 48.0 * c) * x + (8.0 * b + 24.0 * c)
+    } else {
+        0.0
+    };
+    v / 6.0
+}
+
+/// `sin(πx)/(πx)`, 1 at 0.
+fn sinc(x: f64) -> f64 {
+    let px = std::f64::consts::PI * x;
+    if px.abs() < 1e-8 { 1.0 } else { px.sin() / px }
 }
 
 /// Where the camera stands.

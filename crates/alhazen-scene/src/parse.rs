@@ -708,7 +708,17 @@ impl<'a, 'i> Node<'a, 'i> {
 }
 
 fn render_settings(n: &Node) -> R<RenderSettings> {
-    let t = n.table(&["width", "height", "spp", "max_depth", "seed", "integrator", "sampler", "mirror_connections"])?;
+    let t = n.table(&[
+        "width",
+        "height",
+        "spp",
+        "max_depth",
+        "seed",
+        "integrator",
+        "sampler",
+        "mirror_connections",
+        "filter",
+    ])?;
     let d = RenderSettings::default();
     let r = RenderSettings {
         width: t.get("width").map_or(Ok(d.width as u64), |n| n.integer(1, MAX_SIDE))? as u32,
@@ -733,6 +743,7 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
             None => d.sampler,
         },
         mirror_connections: t.opt_bool("mirror_connections", d.mirror_connections)?,
+        filter: t.get("filter").map_or(Ok(d.filter), |n| pixel_filter(&n))?,
     };
     if r.width as u64 * r.height as u64 > MAX_PIXELS {
         return Err(t
@@ -740,6 +751,47 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
             .err(format!("{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate", r.width, r.height)));
     }
     Ok(r)
+}
+
+/// `filter = "NAME"` (its defaults) or `{ type = "NAME", radius = r or [rx, ry], … }`.
+fn pixel_filter(n: &Node) -> R<PixelFilter> {
+    if !n.is_table() {
+        let name = n.choice(&PixelFilter::NAMES)?;
+        return PixelFilter::named(name).ok_or_else(|| n.err(format!("`filter`: unknown filter \"{name}\"")));
+    }
+    let t = n.table(&["type", "radius", "sigma", "b", "c", "tau"])?;
+    let kind = t.req("type")?.choice(&PixelFilter::NAMES)?;
+    t.check_keys(match kind {
+        "gaussian" => &["type", "radius", "sigma"],
+        "mitchell" => &["type", "radius", "b", "c"],
+        "lanczos" => &["type", "radius", "tau"],
+        _ => &["type", "radius"],
+    })?;
+    let sigma = t.opt_f64("sigma", 0.5)?;
+    let tau = t.opt_f64("tau", 3.0)?;
+    let radius = match t.get("radius") {
+        Some(r) if r.is_array() => Some(r.numbers::<2>()?),
+        Some(r) => Some([r.f64()?; 2]),
+        None => None,
+    };
+    let default = PixelFilter::named(kind).map_or([2.0; 2], |f| f.radius());
+    let filter = match kind {
+        "gaussian" => PixelFilter::Gaussian { sigma, radius: radius.unwrap_or([3.0 * sigma; 2]) },
+        "mitchell" => PixelFilter::Mitchell {
+            b: t.opt_f64("b", 1.0 / 3.0)?,
+            c: t.opt_f64("c", 1.0 / 3.0)?,
+            radius: radius.unwrap_or(default),
+        },
+        "lanczos" => PixelFilter::Lanczos { tau, radius: radius.unwrap_or([tau; 2]) },
+        "catmull-rom" => PixelFilter::Mitchell { b: 0.0, c: 0.5, radius: radius.unwrap_or(default) },
+        "tent" => PixelFilter::Tent { radius: radius.unwrap_or(default) },
+        "blackman-harris" => PixelFilter::BlackmanHarris { radius: radius.unwrap_or(default) },
+        _ => PixelFilter::Box { radius: radius.unwrap_or(default) },
+    };
+    match filter.problem() {
+        Some(why) => Err(n.err(format!("`filter`: {why}"))),
+        None => Ok(filter),
+    }
 }
 
 fn look_at(t: &Table) -> R<LookAt> {

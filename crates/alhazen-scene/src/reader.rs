@@ -235,6 +235,10 @@ impl<'a, 'i> Node<'a, 'i> {
     pub fn is_table(&self) -> bool {
         matches!(self.v, DeValue::Table(_))
     }
+
+    pub fn is_array(&self) -> bool {
+        matches!(self.v, DeValue::Array(_))
+    }
 }
 
 /// A table with its span and the name it is known by in messages.

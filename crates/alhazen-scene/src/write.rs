@@ -182,6 +182,9 @@ impl Writer<'_> {
         if !r.mirror_connections {
             self.line("mirror_connections", "false".to_string());
         }
+        if r.filter != PixelFilter::PIXEL {
+            self.line("filter", pixel_filter(&r.filter));
+        }
     }
 
     fn look(&mut self, l: &LookAt) {
@@ -613,4 +616,25 @@ fn write_exr(img: &ImageData, path: &Path) -> Result<(), WriteError> {
         .ok_or_else(|| WriteError::Unsupported(format!("image {}: size and pixels disagree", path.display())))?;
     buf.save_with_format(path, image::ImageFormat::OpenExr)
         .map_err(|e| WriteError::Io(path.to_path_buf(), std::io::Error::other(e)))
+}
+
+/// A pixel filter as an inline table that reads back to the same numbers.
+fn pixel_filter(f: &PixelFilter) -> String {
+    let radius = |[x, y]: [f64; 2]| if x == y { num(x) } else { format!("[{}, {}]", num(x), num(y)) };
+    match *f {
+        PixelFilter::Box { radius: r } => format!("{{ type = \"box\", radius = {} }}", radius(r)),
+        PixelFilter::Tent { radius: r } => format!("{{ type = \"tent\", radius = {} }}", radius(r)),
+        PixelFilter::BlackmanHarris { radius: r } => {
+            format!("{{ type = \"blackman-harris\", radius = {} }}", radius(r))
+        }
+        PixelFilter::Gaussian { sigma, radius: r } => {
+            format!("{{ type = \"gaussian\", sigma = {}, radius = {} }}", num(sigma), radius(r))
+        }
+        PixelFilter::Mitchell { b, c, radius: r } => {
+            format!("{{ type = \"mitchell\", b = {}, c = {}, radius = {} }}", num(b), num(c), radius(r))
+        }
+        PixelFilter::Lanczos { tau, radius: r } => {
+            format!("{{ type = \"lanczos\", tau = {}, radius = {} }}", num(tau), radius(r))
+        }
+    }
 }

@@ -560,3 +560,51 @@ fn image_offsets_read_write_back_and_are_refused_where_unsupported() {
     let e = load_scene(&path).unwrap_err().to_string();
     assert!(e.contains("offset") && e.contains("o.toml:2"), "{e}");
 }
+
+/// A pixel filter by name (its defaults) or as a table; written back to the same numbers;
+/// mistakes located and explained.
+#[test]
+fn pixel_filters_read_write_back_and_refuse_mistakes() {
+    use alhazen_scene::PixelFilter;
+    let filter = |v: &str| parse_scene("f.toml".as_ref(), &format!("[render]\nfilter = {v}\n")).unwrap().render.filter;
+    assert_eq!(parse_scene("f.toml".as_ref(), "").unwrap().render.filter, PixelFilter::PIXEL);
+    assert_eq!(filter("\"box\""), PixelFilter::PIXEL);
+    assert_eq!(filter("\"gaussian\""), PixelFilter::Gaussian { sigma: 0.5, radius: [1.5; 2] });
+    assert_eq!(
+        filter("{ type = \"gaussian\", sigma = 0.25 }"),
+        PixelFilter::Gaussian { sigma: 0.25, radius: [0.75; 2] }
+    );
+    assert_eq!(filter("\"tent\""), PixelFilter::Tent { radius: [1.0; 2] });
+    assert_eq!(filter("{ type = \"blackman-harris\", radius = 2 }"), PixelFilter::BlackmanHarris { radius: [2.0; 2] });
+    assert_eq!(filter("\"catmull-rom\""), PixelFilter::Mitchell { b: 0.0, c: 0.5, radius: [2.0; 2] });
+    assert_eq!(filter("{ type = \"lanczos\", tau = 2 }"), PixelFilter::Lanczos { tau: 2.0, radius: [2.0; 2] });
+    let written = [
+        PixelFilter::Box { radius: [1.0, 0.5] },
+        PixelFilter::BlackmanHarris { radius: [1.5; 2] },
+        PixelFilter::Mitchell { b: 1.0 / 3.0, c: 1.0 / 3.0, radius: [2.0; 2] },
+        PixelFilter::Gaussian { sigma: 0.3, radius: [1.1, 0.9] },
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for f in written {
+        let mut s = parse_scene("f.toml".as_ref(), "").unwrap();
+        s.render.filter = f;
+        let path = dir.path().join("again.toml");
+        alhazen_scene::write::write_scene(&s, &path, &dir.path().join("assets"), "").unwrap();
+        assert_eq!(load_scene(&path).unwrap().render.filter, f);
+    }
+    for (bad, says) in [
+        ("\"gauss\"", "did you mean \"gaussian\""),
+        ("{ type = \"box\", sigma = 1 }", "unknown key `sigma`"),
+        ("{ radius = 1 }", "required key `type`"),
+        ("{ type = \"tent\", radius = 0 }", "radius must lie in (0, 16]"),
+        ("{ type = \"tent\", radius = [1, 40] }", "radius must lie in (0, 16]"),
+        ("{ type = \"gaussian\", sigma = -1 }", "sigma must lie in"),
+        ("{ type = \"lanczos\", tau = 0 }", "tau must lie in"),
+        ("{ type = \"mitchell\", b = 1e300 }", "beyond ±1e100"),
+        ("{ type = \"mitchell\", c = 1000 }", "B and C must be finite"),
+        ("3", "expected a string"),
+    ] {
+        let e = err(&format!("[render]\nfilter = {bad}\n"));
+        assert!(e.contains(says) && e.contains(":2:"), "{bad}: {e}");
+    }
+}

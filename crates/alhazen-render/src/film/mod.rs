@@ -5,6 +5,7 @@
 //! different machines, shares of the samples ([`part`]), or resumed from a checkpoint — merges
 //! to the bits of the render made at once.
 
+pub mod filter;
 pub mod part;
 
 use alhazen_math::Vec3;

@@ -331,6 +331,8 @@ struct LanePath {
     stream: SampleStream,
     /// RGB, or the wavelengths of a spectral sample.
     mode: ColorMode,
+    /// The pixel filter's weight of the sample.
+    weight: f64,
 }
 
 /// What a material kernel's vertex gathers through mirrors, from [`PathTracer::kernel_vertex`]
@@ -348,15 +350,16 @@ impl LanePath {
     fn idle() -> Self {
         let path = PathState::new(Ray::new(Vec3::ZERO, Vec3::Z));
         let stream = SampleStream::default();
-        Self { live: false, job: 0, path, stream, mode: ColorMode::Rgb }
+        Self { live: false, job: 0, path, stream, mode: ColorMode::Rgb, weight: 1.0 }
     }
 
-    /// The sample's value: its radiance, in RGB.
+    /// The sample's value: its radiance, in RGB, times its filter weight.
     fn value(&self) -> Vec3 {
-        match self.mode {
+        let l = match self.mode {
             ColorMode::Spectral(lambdas) => spectrum_to_rgb(self.path.l, &lambdas),
             ColorMode::Rgb => self.path.l,
-        }
+        };
+        l * self.weight
     }
 }
 
@@ -751,8 +754,9 @@ impl PathTracer<'_> {
     /// Starts `lane`'s path in pixel `(x, y)`, its stream restarted, as [`Self::sample_of`]
     /// starts it: its film position, its camera ray.
     fn start(&self, lane: &mut LanePath, (x, y): (u32, u32)) {
-        let film = lane.stream.next_2d();
-        lane.path = PathState::new(self.camera_ray(x as f64 + film.x, y as f64 + film.y, &mut lane.stream));
+        let (fx, fy, weight) = self.film.place(x, y, lane.stream.next_2d());
+        lane.weight = weight;
+        lane.path = PathState::new(self.camera_ray(x, (fx, fy), &mut lane.stream));
         lane.mode =
             if self.spectral { ColorMode::Spectral(sample_wavelengths(lane.stream.next_1d())) } else { ColorMode::Rgb };
     }
@@ -1830,7 +1834,11 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         if let alhazen_scene::CameraDesc::Perspective { lens, .. } = &mut through_lens.camera {
             *lens = Some(alhazen_scene::ThinLens { aperture: 0.1, focus_distance: 2.5 });
         }
+        // Through a filter of negative lobes: the samples placed beyond their pixels, weighed ±.
+        let mut filtered = small("cornell-box", (16, 16, 9));
+        filtered.render.filter = alhazen_scene::PixelFilter::Mitchell { b: 0.0, c: 0.5, radius: [2.0, 1.5] };
         let scenes = [
+            ("cornell-box through a Catmull–Rom filter", filtered),
             ("cornell-box through a lens", through_lens),
             ("cornell-box, cut out", cut),
             ("point lights, a parallelogram and a sky", points),
