@@ -167,10 +167,11 @@ def black_world(scene):
     scene.world = world
 
 
-def render(scene, path, spp, size, bounces=8, transparent=8, depth="16"):
-    """Renders `scene` with Cycles (CPU, 2 threads, box filter of one pixel, no denoiser, no
-    adaptive sampling, `bounces` of every kind, `transparent` transparent bounces) to the EXR
-    `path` of `depth` bits; returns the seconds `bpy.ops.render.render` took."""
+def render(scene, path, spp, size, bounces=8, transparent=8, depth="16", pixel_filter=("BOX", 1.0)):
+    """Renders `scene` with Cycles (CPU, 2 threads, `pixel_filter` — by default the box of one
+    pixel —, no denoiser, no adaptive sampling, `bounces` of every kind, `transparent`
+    transparent bounces) to the EXR `path` of `depth` bits; returns the seconds
+    `bpy.ops.render.render` took."""
     w, h = size
     scene.render.engine = "CYCLES"
     scene.cycles.device = "CPU"
@@ -185,8 +186,7 @@ def render(scene, path, spp, size, bounces=8, transparent=8, depth="16"):
     scene.cycles.blur_glossy = 0.0
     scene.cycles.sample_clamp_direct = 0.0
     scene.cycles.sample_clamp_indirect = 0.0
-    scene.cycles.pixel_filter_type = "BOX"
-    scene.cycles.filter_width = 1.0
+    scene.cycles.pixel_filter_type, scene.cycles.filter_width = pixel_filter
     scene.render.threads_mode = "FIXED"
     scene.render.threads = 2
     scene.render.resolution_x, scene.render.resolution_y = w, h

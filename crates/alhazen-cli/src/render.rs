@@ -41,6 +41,11 @@ pub(crate) struct RenderArgs {
     /// The path tracer's sampler (overrides the scene).
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
+    /// The pixel reconstruction filter, with its default parameters (overrides the scene's,
+    /// e.g. the Gaussian an imported Mitsuba or pbrt scene gets when it names none): `box` is
+    /// each sample anywhere in its own pixel.
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(alhazen_scene::PixelFilter::NAMES))]
+    filter: Option<String>,
     /// Do not join lights to surfaces through sphere, cylinder and plane mirrors exactly (for
     /// comparison: caustics are then left to sampled paths, and lost under Whitted).
     #[arg(long)]
@@ -137,6 +142,9 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
     }
     if a.no_mirror_connections {
         r.mirror_connections = false;
+    }
+    if let Some(f) = a.filter.as_deref().and_then(alhazen_scene::PixelFilter::named) {
+        r.filter = f;
     }
     if let Some(s) = a.sampler {
         r.sampler = match s {
@@ -529,6 +537,21 @@ impl Progress {
     }
 }
 
+/// A pixel filter in a few words, e.g. `gaussian filter (σ 0.5, radius 2)`.
+fn describe_filter(f: &alhazen_scene::PixelFilter) -> String {
+    use alhazen_scene::PixelFilter as F;
+    let r = f.radius();
+    let radius = if r[0] == r[1] { format!("radius {}", r[0]) } else { format!("radius {} × {}", r[0], r[1]) };
+    match *f {
+        F::Box { .. } => format!("box filter ({radius})"),
+        F::Tent { .. } => format!("tent filter ({radius})"),
+        F::BlackmanHarris { .. } => format!("blackman-harris filter ({radius})"),
+        F::Gaussian { sigma, .. } => format!("gaussian filter (σ {sigma}, {radius})"),
+        F::Mitchell { b, c, .. } => format!("mitchell filter (B {b:.3}, C {c:.3}, {radius})"),
+        F::Lanczos { tau, .. } => format!("lanczos filter (τ {tau}, {radius})"),
+    }
+}
+
 /// The summary line on stderr: what was rendered, in how long (`elapsed` in all, the part of it
 /// that built the world when one was built), on how many threads, to which file.
 fn summary(
@@ -577,8 +600,12 @@ fn summary(
         ),
     };
     let building = world_time.map_or(String::new(), |t| format!(", {:.3} s of it building the world", t.as_secs_f64()));
+    let filter = match r.filter {
+        alhazen_scene::PixelFilter::PIXEL => String::new(),
+        f => format!(", {}", describe_filter(&f)),
+    };
     eprintln!(
-        "rendered {} ({}×{}, {} spp, depth {}, {integrator}{what}) in {:.3} s on {threads} thread{}{building} → {}",
+        "rendered {} ({}×{}, {} spp, depth {}, {integrator}{filter}{what}) in {:.3} s on {threads} thread{}{building} → {}",
         a.image.scene.display(),
         plan.width,
         plan.height,

@@ -24,7 +24,7 @@ use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
 use alhazen_scene::{
     Background, Bump, BumpPattern, CameraDesc, FresnelMode, IntegratorKind, Light, LookAt, MaterialId, Object,
-    PerspectiveOpening, SamplerKind, Scene, SceneError, Shape, Texture,
+    PerspectiveOpening, PixelFilter, SamplerKind, Scene, SceneError, Shape, Texture,
 };
 use roxmltree::Node;
 use std::cell::RefCell;
@@ -714,6 +714,9 @@ impl Importer {
         }
         self.camera_seen = true;
         let p = self.plugin(ctx, node)?;
+        // Mitsuba's default pixel filter (a film's `rfilter` replaces it): its Gaussian of
+        // standard deviation ½ pixel, cut at four.
+        self.scene.render.filter = PixelFilter::Gaussian { sigma: 0.5, radius: [2.0; 2] };
         for child in node.children().filter(Node::is_element) {
             match child.tag_name().name() {
                 "film" => self.film(ctx, child)?,
@@ -808,21 +811,8 @@ impl Importer {
         if (self.scene.render.width as u64) * (self.scene.render.height as u64) > alhazen_scene::MAX_PIXELS {
             return Err(ctx.err(node, "the film has more pixels than alhazen can allocate"));
         }
-        match node.children().find(|c| c.tag_name().name() == "rfilter") {
-            Some(f) if f.attribute("type") == Some("box") => {}
-            Some(f) => {
-                let kind = f.attribute("type").unwrap_or("?");
-                self.warn(
-                    ctx,
-                    f,
-                    format!("pixel filter `{kind}`: alhazen averages each pixel's samples with a box filter"),
-                );
-            }
-            None => self.warn(
-                ctx,
-                node,
-                "Mitsuba's default pixel filter is a Gaussian: alhazen averages each pixel's samples with a box filter",
-            ),
+        if let Some(f) = node.children().find(|c| c.tag_name().name() == "rfilter") {
+            self.scene.render.filter = self.rfilter(ctx, f)?;
         }
         for crop in ["crop_width", "crop_height", "crop_offset_x", "crop_offset_y"] {
             if let Some(n) = self.prop(&p, crop) {
@@ -831,6 +821,43 @@ impl Importer {
         }
         self.unused(ctx, &p, "film");
         Ok(())
+    }
+
+    /// A film's `rfilter`: Mitsuba's box (its own pixel), tent, Gaussian (cut at four standard
+    /// deviations), Mitchell–Netravali, Catmull–Rom and Lanczos filters.
+    fn rfilter(&mut self, ctx: &Ctx, node: Node) -> R<PixelFilter> {
+        let p = self.plugin(ctx, node)?;
+        let filter = match p.kind.as_str() {
+            "box" => PixelFilter::PIXEL,
+            "tent" => PixelFilter::Tent { radius: [self.float(ctx, &p, "radius", 1.0)?; 2] },
+            "gaussian" => {
+                let sigma = self.float(ctx, &p, "stddev", 0.5)?;
+                PixelFilter::Gaussian { sigma, radius: [4.0 * sigma; 2] }
+            }
+            "mitchell" => PixelFilter::Mitchell {
+                b: self.float(ctx, &p, "B", 1.0 / 3.0)?,
+                c: self.float(ctx, &p, "C", 1.0 / 3.0)?,
+                radius: [2.0; 2],
+            },
+            "catmullrom" => PixelFilter::Mitchell { b: 0.0, c: 0.5, radius: [2.0; 2] },
+            "lanczos" => {
+                let lobes = self.float(ctx, &p, "lobes", 3.0)?;
+                PixelFilter::Lanczos { tau: lobes, radius: [lobes; 2] }
+            }
+            other => {
+                return Err(ctx.err(
+                    node,
+                    format!(
+                        "unknown pixel filter `{other}`; expected one of box, tent, gaussian, mitchell, catmullrom, lanczos"
+                    ),
+                ));
+            }
+        };
+        if let Some(why) = filter.problem() {
+            return Err(ctx.err(node, why));
+        }
+        self.unused(ctx, &p, "rfilter");
+        Ok(filter)
     }
 
     fn sampler(&mut self, ctx: &Ctx, node: Node) -> R<()> {

@@ -23,7 +23,7 @@ use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Ior};
 use alhazen_scene::{
     Background, Bump, BumpPattern, CameraDesc, FresnelMode, ImageData, IntegratorKind, Light, LookAt, MaterialId,
-    Object, PerspectiveOpening, Scene, SceneError, Shape, Texture,
+    Object, PerspectiveOpening, PixelFilter, Scene, SceneError, Shape, Texture,
 };
 use std::collections::HashMap;
 use std::ops::Range;
@@ -220,6 +220,8 @@ impl Importer {
         scene.render.height = 720;
         scene.render.spp = 16;
         scene.render.max_depth = 5;
+        // pbrt-v4's default pixel filter.
+        scene.render.filter = PixelFilter::Gaussian { sigma: 0.5, radius: [1.5; 2] };
         Self {
             scene,
             warnings: Warnings::default(),
@@ -462,7 +464,13 @@ impl Importer {
                 self.warn(ctx, &at, "Attribute defaults are not supported; ignored");
                 drop(p);
             }
-            "Option" | "ColorSpace" | "PixelFilter" | "Accelerator" | "MakeNamedMedium" | "MediumInterface" => {
+            "PixelFilter" => {
+                let (kind, _) = self.string_arg(ctx, tokens, i, word, &at)?;
+                let mut p = self.params(ctx, tokens, i)?;
+                self.scene.render.filter = self.pixel_filter(ctx, &at, &kind, &mut p)?;
+                self.unused(ctx, &p, "PixelFilter");
+            }
+            "Option" | "ColorSpace" | "Accelerator" | "MakeNamedMedium" | "MediumInterface" => {
                 if word != "MediumInterface" {
                     let _ = self.string_arg(ctx, tokens, i, word, &at)?;
                 }
@@ -474,7 +482,6 @@ impl Importer {
                     self.params(ctx, tokens, i)?;
                 }
                 let why = match word {
-                    "PixelFilter" => "alhazen averages each pixel's samples with a box filter",
                     "MakeNamedMedium" | "MediumInterface" => "alhazen renders no participating media",
                     _ => "not supported",
                 };
@@ -832,6 +839,39 @@ impl Importer {
                 }
             },
             other => Err(ctx.err(q.span.clone(), format!("\"{}\" cannot be a colour of type {other}", q.name))),
+        }
+    }
+
+    /// pbrt-v4's `PixelFilter`: box, gaussian, mitchell, sinc (Lanczos) and triangle, with
+    /// their radii along `x` and `y`.
+    fn pixel_filter(&self, ctx: &Ctx, at: &Range<usize>, kind: &str, p: &mut Params) -> R<PixelFilter> {
+        let default_radius = match kind {
+            "box" => 0.5,
+            "gaussian" => 1.5,
+            "sinc" => 4.0,
+            _ => 2.0,
+        };
+        let radius = [self.float(ctx, p, "xradius", default_radius)?, self.float(ctx, p, "yradius", default_radius)?];
+        let filter = match kind {
+            "box" => PixelFilter::Box { radius },
+            "gaussian" => PixelFilter::Gaussian { sigma: self.float(ctx, p, "sigma", 0.5)?, radius },
+            "mitchell" => PixelFilter::Mitchell {
+                b: self.float(ctx, p, "B", 1.0 / 3.0)?,
+                c: self.float(ctx, p, "C", 1.0 / 3.0)?,
+                radius,
+            },
+            "sinc" => PixelFilter::Lanczos { tau: self.float(ctx, p, "tau", 3.0)?, radius },
+            "triangle" => PixelFilter::Tent { radius },
+            other => {
+                return Err(ctx.err(
+                    at.clone(),
+                    format!("unknown PixelFilter \"{other}\"; expected one of box, gaussian, mitchell, sinc, triangle"),
+                ));
+            }
+        };
+        match filter.problem() {
+            Some(why) => Err(ctx.err(at.clone(), why)),
+            None => Ok(filter),
         }
     }
 

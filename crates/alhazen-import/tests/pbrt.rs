@@ -289,3 +289,33 @@ fn lens_nonsense_is_refused() {
         assert!(e.contains("c.pbrt:1") && e.contains("lensradius"), "{camera}: {e}");
     }
 }
+
+/// pbrt-v4's pixel filters with their own defaults (a Gaussian when the file names none), and a
+/// filter alhazen does not know is a located error.
+#[test]
+fn pixel_filters_are_pbrt_s() {
+    use alhazen_scene::PixelFilter;
+    let filter = |line: &str| {
+        let text = format!("{line}\nCamera \"perspective\"\nWorldBegin\n");
+        import(&[("f.pbrt", &text)]).map(|s| {
+            assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+            s.scene.render.filter
+        })
+    };
+    assert_eq!(filter(""), Ok(PixelFilter::Gaussian { sigma: 0.5, radius: [1.5; 2] }));
+    assert_eq!(filter("PixelFilter \"box\""), Ok(PixelFilter::PIXEL));
+    assert_eq!(filter("PixelFilter \"triangle\" \"float xradius\" 1"), Ok(PixelFilter::Tent { radius: [1.0, 2.0] }));
+    assert_eq!(
+        filter("PixelFilter \"gaussian\" \"float sigma\" 0.3 \"float yradius\" 1"),
+        Ok(PixelFilter::Gaussian { sigma: 0.3, radius: [1.5, 1.0] })
+    );
+    assert_eq!(
+        filter("PixelFilter \"mitchell\" \"float B\" 0 \"float C\" 0.5"),
+        Ok(PixelFilter::Mitchell { b: 0.0, c: 0.5, radius: [2.0; 2] })
+    );
+    assert_eq!(filter("PixelFilter \"sinc\""), Ok(PixelFilter::Lanczos { tau: 3.0, radius: [4.0; 2] }));
+    let e = filter("PixelFilter \"blackman\"").unwrap_err();
+    assert!(e.contains("f.pbrt:1:") && e.contains("unknown PixelFilter \"blackman\""), "{e}");
+    let e = filter("PixelFilter \"box\" \"float xradius\" 0").unwrap_err();
+    assert!(e.contains("f.pbrt:1:") && e.contains("radius must lie in"), "{e}");
+}
