@@ -9,6 +9,9 @@
 - principled-maps: a `principled` floor whose roughness (0.8 left, 0.15 right) and metallic
   (1 on one half, 0 on the other) are bitmaps, under a sky and a small tilted light (test
   `principled_maps_agree_with_mitsuba`);
+- turned-texture: a rectangle light whose radiance is a smoothly repeating image of waves
+  (red along u, green along v, blue along the diagonal) placed by a `to_uv` of a scale, a
+  rotation and a translation, seen directly (test `a_turned_texture_agrees_with_mitsuba`);
 - masked-card: a card of round holes (a `mask` whose opacity is a bitmap, 0 in the holes and
   1 elsewhere, around a two-sided diffuse BSDF) under a small light, dappling the floor (test
   `a_masked_card_agrees_with_mitsuba`). Mitsuba's shadow rays stop at a mask, so its floor's
@@ -143,15 +146,55 @@ def masked(spp):
     mi.Bitmap(img).write(os.path.join(OUT, "masked-card-mitsuba.exr"))
 
 
+TURNED = """<?xml version="1.0" encoding="utf-8"?>
+<!-- A rectangle light whose radiance image is scaled, turned and moved by to_uv (bench/mitsuba/texture_refs.py). -->
+<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="1"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="25"/>
+        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="64"/><integer name="height" value="64"/>
+            <rfilter type="box"/><string name="pixel_format" value="rgb"/>
+        </film>
+    </sensor>
+    <shape type="rectangle">
+        <emitter type="area">
+            <texture name="radiance" type="bitmap">
+                <string name="filename" value="turned-texture.png"/>
+                <transform name="to_uv"><scale x="1.5" y="0.75"/><rotate z="1" angle="30"/><translate x="0.15" y="0.3"/></transform>
+            </texture>
+        </emitter>
+    </shape>
+</scene>
+"""
+
+
+def turned(spp):
+    n, t = 32, 2 * np.pi / 32
+    x, y = np.meshgrid(np.arange(n), np.arange(n))
+    waves = np.stack([0.5 + 0.4 * np.sin(t * x), 0.5 + 0.4 * np.sin(t * y + 1.0), 0.5 + 0.4 * np.cos(t * (x + y))], -1)
+    mi.Bitmap((waves * 255 + 0.5).astype(np.uint8), pixel_format=mi.Bitmap.PixelFormat.RGB).write(
+        os.path.join(OUT, "turned-texture.png"))
+    path = os.path.join(OUT, "turned-texture.xml")
+    with open(path, "w") as f:
+        f.write(TURNED)
+    img = mi.render(mi.load_file(path), spp=spp, seed=9)
+    mi.Bitmap(img).write(os.path.join(OUT, "turned-texture-mitsuba.exr"))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=8192)
-    ap.add_argument("--only", choices=["textured-emitter", "principled-maps", "masked-card"])
+    ap.add_argument("--only", choices=["textured-emitter", "principled-maps", "masked-card", "turned-texture"])
     args = ap.parse_args()
     os.makedirs(OUT, exist_ok=True)
     mi.set_variant("scalar_rgb")
     if args.only == "masked-card":
         return masked(args.spp)
+    if args.only == "turned-texture":
+        return turned(args.spp)
     if args.only == "principled-maps":
         return principled(args.spp)
     # Eight colours, four across and two down, each well apart from its neighbours.
@@ -170,6 +213,7 @@ def main():
     if args.only is None:
         principled(args.spp)
         masked(args.spp)
+        turned(args.spp)
 
 
 if __name__ == "__main__":

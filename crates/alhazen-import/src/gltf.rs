@@ -319,12 +319,12 @@ impl Importer<'_> {
         let factor = rgb([c[0], c[1], c[2]]);
         let (base, base_mean) = match pbr.base_color_texture() {
             Some(info) => {
-                let (scale, offset) = self.texture_placement(&info, &name)?;
+                let (scale, offset, rotation) = self.texture_placement(&info, &name)?;
                 let img = self.image(&info.texture(), Decoding::Srgb)?;
                 let img = scaled(img, factor);
                 let mean = alhazen_scene::texture::image_mean(&img);
                 self.scene.images.push(img);
-                (Texture::Image { image: self.scene.images.len() - 1, scale, offset }, mean)
+                (Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation }, mean)
             }
             None => (Texture::Solid(factor), factor),
         };
@@ -338,11 +338,11 @@ impl Importer<'_> {
         if let Some(info) = material.emissive_texture()
             && emission != Vec3::ZERO
         {
-            let (scale, offset) = self.texture_placement(&info, &name)?;
+            let (scale, offset, rotation) = self.texture_placement(&info, &name)?;
             let img = scaled(self.image(&info.texture(), Decoding::Srgb)?, emission);
             emission = alhazen_scene::texture::image_mean(&img);
             self.scene.images.push(img);
-            emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset });
+            emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation });
         }
         let transmission = material.transmission().map_or(0.0, |t| {
             if t.transmission_texture().is_some() {
@@ -368,9 +368,11 @@ impl Importer<'_> {
                     "{name}: with transmission, the metallic-roughness texture is replaced by its mean (metallic {metallic:.3}, roughness {roughness:.3})"
                 ));
             } else {
-                let (scale, offset) = self.texture_placement(&info, &name)?;
-                if offset != Vec2::ZERO {
-                    self.warn(format!("{name}: the metallic-roughness texture's offset is not supported; ignored"));
+                let (scale, offset, rotation) = self.texture_placement(&info, &name)?;
+                if offset != Vec2::ZERO || rotation != 0.0 {
+                    self.warn(format!(
+                        "{name}: the metallic-roughness texture's offset and rotation are not supported; ignored"
+                    ));
                 }
                 self.scene.images.push(image);
                 map = Some((self.scene.images.len() - 1, scale));
@@ -388,8 +390,10 @@ impl Importer<'_> {
             }
             None => None,
         };
-        let placement =
-            if let Texture::Image { scale, offset, .. } = base { (scale, offset) } else { (Vec2::ONE, Vec2::ZERO) };
+        let placement = match base {
+            Texture::Image { scale, offset, rotation, .. } => (scale, offset, rotation),
+            _ => (Vec2::ONE, Vec2::ZERO, 0.0),
+        };
         let alpha = self.cut_out(&material, c[3] as f64, placement)?;
         for ext in [
             "KHR_materials_clearcoat",
@@ -421,11 +425,16 @@ impl Importer<'_> {
         Ok(id)
     }
 
-    /// `KHR_texture_transform`'s scale and offset in alhazen's texture coordinates (rotations
-    /// are warned about), and the sampler's wrapping. glTF reads its image at `uv·s + o` with
-    /// `v` down; alhazen's `v = 1 − v_glTF` is up, so the same texel is at `uv·s + (o_u, 1 − s_v
-    /// − o_v)` (kept in [0, 1): the images repeat).
-    fn texture_placement(&mut self, info: &gltf::texture::Info, name: &str) -> R<(Vec2, Vec2)> {
+    /// `KHR_texture_transform`'s scale, offset and rotation in alhazen's texture coordinates, and
+    /// the sampler's wrapping. glTF reads its image at `o + R·(s ⊙ uv)` with `v` down, `R` the
+    /// matrix `[[cos ϑ, sin ϑ], [−sin ϑ, cos ϑ]]` of a `rotation` ϑ — as Blender's exporter
+    /// writes it and three.js reads it (the extension's GLSL sample reads the transpose; Cycles'
+    /// images of exported scenes agree with this reading, test
+    /// `blender_texture_transform_agrees_with_cycles`); alhazen's `v = 1 − v_glTF` is up, and
+    /// flipping `v` on both sides makes `R` a counter-clockwise turn by ϑ: the same texel is at
+    /// `R(ϑ)·(s ⊙ uv) + (o_u + s_v sin ϑ, 1 − o_v − s_v cos ϑ)` (the shift kept in [0, 1): the
+    /// images repeat) — a Blender Mapping node's own scale, rotation and location.
+    fn texture_placement(&mut self, info: &gltf::texture::Info, name: &str) -> R<(Vec2, Vec2, f64)> {
         let sampler = info.texture().sampler();
         use gltf::texture::WrappingMode::Repeat;
         if sampler.wrap_s() != Repeat || sampler.wrap_t() != Repeat {
@@ -436,20 +445,22 @@ impl Importer<'_> {
         }
         match info.texture_transform() {
             Some(t) => {
-                if t.rotation() != 0.0 {
-                    self.warn(format!(
-                        "{name}: texture rotations are not supported; only the scale and offset are used"
-                    ));
-                }
                 let ([su, sv], [ou, ov]) = (t.scale().map(f64::from), t.offset().map(f64::from));
+                let turn = t.rotation() as f64;
                 // Texture coordinates times the scale stay far inside single precision's range.
-                if ![su, sv, ou, ov].iter().all(|x| x.is_finite() && x.abs() <= 1e6) {
-                    return Err(self
-                        .err(format!("{name}: KHR_texture_transform's scale and offset must be numbers within ±10⁶")));
+                if ![su, sv, ou, ov, turn].iter().all(|x| x.is_finite() && x.abs() <= 1e6) {
+                    return Err(self.err(format!(
+                        "{name}: KHR_texture_transform's scale, offset and rotation must be numbers within ±10⁶"
+                    )));
                 }
-                Ok((Vec2::new(su, sv), Vec2::new(ou, 1.0 - sv - ov).map(|x| x.rem_euclid(1.0))))
+                if turn == 0.0 {
+                    return Ok((Vec2::new(su, sv), Vec2::new(ou, 1.0 - sv - ov).map(|x| x.rem_euclid(1.0)), 0.0));
+                }
+                let (sin, cos) = turn.sin_cos();
+                let offset = Vec2::new(ou + sv * sin, 1.0 - ov - sv * cos).map(|x| x.rem_euclid(1.0));
+                Ok((Vec2::new(su, sv), offset, turn.to_degrees()))
             }
-            None => Ok((Vec2::ONE, Vec2::ZERO)),
+            None => Ok((Vec2::ONE, Vec2::ZERO, 0.0)),
         }
     }
 
@@ -462,7 +473,7 @@ impl Importer<'_> {
         &mut self,
         material: &gltf::Material,
         factor: f64,
-        (scale, offset): (Vec2, Vec2),
+        (scale, offset, rotation): (Vec2, Vec2, f64),
     ) -> R<Option<alhazen_scene::Alpha>> {
         let cutoff = match material.alpha_mode() {
             AlphaMode::Opaque => return Ok(None),
@@ -483,7 +494,7 @@ impl Importer<'_> {
                 // An image without an alpha channel is present everywhere.
                 (alhazen_scene::texture::image_mean(&img).x < 1.0).then(|| {
                     self.scene.images.push(scaled(img, Vec3::splat(factor)));
-                    Texture::Image { image: self.scene.images.len() - 1, scale, offset }
+                    Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation }
                 })
             }
             None => None,

@@ -1078,9 +1078,9 @@ impl Importer {
                 let scale = self.float(ctx, &p, "scale", 1.0)?;
                 let (inner, _) = self.inner_bsdf(ctx, node, depth)?;
                 bump = match tex {
-                    Texture::Image { image, scale: s, offset } => {
-                        if offset != Vec2::ZERO {
-                            self.warn(ctx, node, "a bump map's to_uv shift is not supported; ignored");
+                    Texture::Image { image, scale: s, offset, rotation } => {
+                        if offset != Vec2::ZERO || rotation != 0.0 {
+                            self.warn(ctx, node, "a bump map's to_uv shift and rotation are not supported; ignored");
                         }
                         Some(Bump { height: scale, pattern: BumpPattern::Image { image, scale: s } })
                     }
@@ -1105,9 +1105,9 @@ impl Importer {
                 p.used.borrow_mut().insert("normalmap".to_string());
                 let (inner, _) = self.inner_bsdf(ctx, node, depth)?;
                 bump = match tex {
-                    Texture::Image { image, scale, offset } => {
-                        if offset != Vec2::ZERO {
-                            self.warn(ctx, node, "a normal map's to_uv shift is not supported; ignored");
+                    Texture::Image { image, scale, offset, rotation } => {
+                        if offset != Vec2::ZERO || rotation != 0.0 {
+                            self.warn(ctx, node, "a normal map's to_uv shift and rotation are not supported; ignored");
                         }
                         Some(Bump { height: 1.0, pattern: BumpPattern::NormalMap { image, scale } })
                     }
@@ -1296,15 +1296,15 @@ impl Importer {
     fn texture(&mut self, ctx: &Ctx, node: Node, linear: bool) -> R<Texture> {
         let p = self.plugin(ctx, node)?;
         let uv = self.matrix(ctx, &p, "to_uv")?;
-        // A scale then a shift (Mitsuba reads its image at to_uv · uv, `v` down, as alhazen
-        // reads the image turned upside down at `uv`): the same numbers.
-        let (scale, offset) = (Vec2::new(uv.x_axis.x, uv.y_axis.y), Vec2::new(uv.w_axis.x, uv.w_axis.y));
-        let is_scale = uv.x_axis.y == 0.0 && uv.y_axis.x == 0.0 && offset.is_finite();
-        if !is_scale || scale.x == 0.0 || scale.y == 0.0 {
-            self.warn(ctx, node, "to_uv other than a scale and a shift is not supported; ignored");
-        }
-        let (scale, offset) =
-            if is_scale && scale.x != 0.0 && scale.y != 0.0 { (scale, offset) } else { (Vec2::ONE, Vec2::ZERO) };
+        // A scale, a turn and a shift (Mitsuba reads its image at to_uv · uv, `v` down, as
+        // alhazen reads the image turned upside down at `uv`): the same numbers.
+        let (scale, offset, rotation) = match uv_placement(&uv) {
+            Some(placement) => placement,
+            None => {
+                self.warn(ctx, node, "to_uv other than a scale, a rotation and a shift is not supported; ignored");
+                (Vec2::ONE, Vec2::ZERO, 0.0)
+            }
+        };
         let t = match p.kind.as_str() {
             "bitmap" => {
                 let name =
@@ -1325,11 +1325,11 @@ impl Importer {
                     self.warn(ctx, node, format!("wrap_mode \"{w}\": alhazen's image textures repeat"));
                 }
                 self.string(ctx, &p, "filter_type")?;
-                Texture::Image { image: index, scale, offset }
+                Texture::Image { image: index, scale, offset, rotation }
             }
             "checkerboard" => {
-                if offset != Vec2::ZERO {
-                    self.warn(ctx, node, "a checkerboard's to_uv shift is not supported; ignored");
+                if offset != Vec2::ZERO || rotation != 0.0 {
+                    self.warn(ctx, node, "a checkerboard's to_uv shift and rotation are not supported; ignored");
                 }
                 let even = self.constant_color(ctx, &p, "color0", Vec3::splat(0.4))?;
                 let odd = self.constant_color(ctx, &p, "color1", Vec3::splat(0.2))?;
@@ -1664,7 +1664,7 @@ fn metal_rough_map(
     let value = |t: &Result<f64, Texture>, uv: Vec2| match t {
         Ok(_) => 1.0,
         Err(Texture::Image { image, .. }) => luminance(alhazen_scene::texture::eval(
-            &Texture::Image { image: *image, scale: Vec2::ONE, offset: Vec2::ZERO },
+            &Texture::Image { image: *image, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 },
             uv,
             images,
         )),
@@ -1679,4 +1679,26 @@ fn metal_rough_map(
         })
         .collect();
     alhazen_scene::ImageData::new(w, h, pixels)
+}
+/// A `to_uv` matrix as a scale, then a turn (degrees, counter-clockwise), then a shift — what
+/// `<scale>`, `<rotate>` and `<translate>` written in that order make —, or `None` for any
+/// other (a shear, a turn before an unequal scale, a projection, a zero scale).
+fn uv_placement(m: &Mat4) -> Option<(Vec2, Vec2, f64)> {
+    let (a, b) = (Vec2::new(m.x_axis.x, m.x_axis.y), Vec2::new(m.y_axis.x, m.y_axis.y));
+    let offset = Vec2::new(m.w_axis.x, m.w_axis.y);
+    if !(offset.is_finite() && a.is_finite() && b.is_finite()) || a.length() == 0.0 || b.length() == 0.0 {
+        return None;
+    }
+    if a.y == 0.0 && b.x == 0.0 {
+        // A plain scale keeps its numbers exactly.
+        return Some((Vec2::new(a.x, b.y), offset, 0.0));
+    }
+    // Columns `s_u (cos φ, sin φ)` and `s_v (−sin φ, cos φ)`: at right angles.
+    if a.dot(b).abs() > 1e-9 * a.length() * b.length() {
+        return None;
+    }
+    let angle = a.y.atan2(a.x);
+    let (sin, cos) = angle.sin_cos();
+    let scale = Vec2::new(a.length(), b.dot(Vec2::new(-sin, cos)));
+    Some((scale, offset, angle.to_degrees()))
 }

@@ -1110,7 +1110,7 @@ impl Importer {
                 if self.boolean(ctx, p, "invert", false)? {
                     self.warn(ctx, at, "invert is not supported; ignored");
                 }
-                Texture::Image { image: index, scale: Vec2::new(us, vs), offset: Vec2::ZERO }
+                Texture::Image { image: index, scale: Vec2::new(us, vs), offset: Vec2::ZERO, rotation: 0.0 }
             }
             "checkerboard" => {
                 let (us, vs) = (self.float(ctx, p, "uscale", 1.0)?, self.float(ctx, p, "vscale", 1.0)?);

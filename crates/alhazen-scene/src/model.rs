@@ -636,9 +636,12 @@ pub enum Texture {
         image: usize,
         /// Repeats per texture unit in u and v.
         scale: Vec2,
-        /// Shift of the image in its own units (a fraction of it per unit), after `scale`: the
-        /// image is read at `uv · scale + offset`.
+        /// Shift of the image in its own units (a fraction of it per unit), after `scale` and
+        /// `rotation`: the image is read at `R(rotation) · (uv · scale) + offset`.
         offset: Vec2,
+        /// Turn of the scaled coordinates in degrees, counter-clockwise (u right, v up) about
+        /// the origin, before `offset`.
+        rotation: f64,
     },
 }
 

@@ -282,26 +282,28 @@ impl Parser<'_> {
         let Some(i) = t.get("image") else {
             return Err(n.err("`alpha`: expected a coverage in [0, 1] or { image = { file = … }, cutoff = c }"));
         };
-        let (image, scale, offset) = self.image_file(&i, true, import::load_coverage)?;
-        Ok(Alpha { coverage: Texture::Image { image, scale, offset }, cutoff })
+        let (image, scale, offset, rotation) = self.image_file(&i, true, import::load_coverage)?;
+        Ok(Alpha { coverage: Texture::Image { image, scale, offset, rotation }, cutoff })
     }
 
     /// `{ file = "x.png", scale = s or [u, v] }`: a repeated image (its index and scale); PNG and
     /// JPEG are sRGB unless `linear` (normal maps), EXR and HDR always linear.
     pub(crate) fn image_texture(&mut self, i: &Node, linear: bool) -> R<(usize, Vec2)> {
-        self.image_of(i, linear, false).map(|(image, scale, _)| (image, scale))
+        self.image_of(i, linear, false).map(|(image, scale, ..)| (image, scale))
     }
 
-    /// [`Self::image_texture`] of a colour, which may be shifted too: `{ file, scale, offset =
-    /// [u, v] }` (the image read at `uv · scale + offset`).
+    /// [`Self::image_texture`] of a colour, which may be turned and shifted too: `{ file, scale,
+    /// rotation = degrees, offset = [u, v] }` (the image read at `R(rotation) · (uv · scale) +
+    /// offset`).
     fn placed_image(&mut self, i: &Node) -> R<Texture> {
-        let (image, scale, offset) = self.image_of(i, false, true)?;
-        Ok(Texture::Image { image, scale, offset })
+        let (image, scale, offset, rotation) = self.image_of(i, false, true)?;
+        Ok(Texture::Image { image, scale, offset, rotation })
     }
 
-    /// An image table (with an `offset` where `offset` allows), read linearly or as sRGB.
-    fn image_of(&mut self, i: &Node, linear: bool, offset: bool) -> R<(usize, Vec2, Vec2)> {
-        self.image_file(i, offset, |path| {
+    /// An image table (with an `offset` and a `rotation` where `placed` allows), read linearly
+    /// or as sRGB.
+    fn image_of(&mut self, i: &Node, linear: bool, placed: bool) -> R<(usize, Vec2, Vec2, f64)> {
+        self.image_file(i, placed, |path| {
             let linear = linear
                 || matches!(
                     path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
@@ -311,15 +313,15 @@ impl Parser<'_> {
         })
     }
 
-    /// `{ file = "x.png", scale = s or [u, v] }` (and `offset = [u, v]` where `offset`
-    /// allows) read by `load`: the image's index, scale and offset.
+    /// `{ file = "x.png", scale = s or [u, v] }` (and `offset = [u, v]`, `rotation = degrees`
+    /// where `placed` allows) read by `load`: the image's index, scale, offset and rotation.
     fn image_file(
         &mut self,
         i: &Node,
-        offset: bool,
+        placed: bool,
         load: impl FnOnce(&std::path::Path) -> Result<crate::ImageData, String>,
-    ) -> R<(usize, Vec2, Vec2)> {
-        let i = i.table(if offset { &["file", "scale", "offset"] } else { &["file", "scale"] })?;
+    ) -> R<(usize, Vec2, Vec2, f64)> {
+        let i = i.table(if placed { &["file", "scale", "offset", "rotation"] } else { &["file", "scale"] })?;
         let file = i.req("file")?;
         let path = self.dir.join(file.str()?);
         // The scale is checked before the image is read.
@@ -332,9 +334,10 @@ impl Parser<'_> {
             None => Vec2::ONE,
         };
         let offset = i.get("offset").map_or(Ok(Vec2::ZERO), |o| o.numbers::<2>().map(Vec2::from_array))?;
+        let rotation = i.get("rotation").map_or(Ok(0.0), |r| r.in_range(-36000.0, 36000.0))?;
         let data = load(&path).map_err(|e| file.err(e))?;
         self.scene.images.push(Arc::new(data));
-        Ok((self.scene.images.len() - 1, scale, offset))
+        Ok((self.scene.images.len() - 1, scale, offset, rotation))
     }
 
     /// `bump = { height = h, waves = size }` or `bump = { height = h, image = { file, scale } }`.

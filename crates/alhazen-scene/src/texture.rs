@@ -12,8 +12,15 @@ pub fn eval(tex: &Texture, uv: Vec2, images: &[std::sync::Arc<ImageData>]) -> Ve
             let parity = |t: f64| (t / size).floor().rem_euclid(2.0);
             if parity(uv.x) == parity(uv.y) { *even } else { *odd }
         }
-        Texture::Image { image, scale, offset } if *offset == Vec2::ZERO => bilinear(&images[*image], uv * *scale),
-        Texture::Image { image, scale, offset } => bilinear(&images[*image], uv * *scale + *offset),
+        Texture::Image { image, scale, offset, rotation: 0.0 } if *offset == Vec2::ZERO => {
+            bilinear(&images[*image], uv * *scale)
+        }
+        Texture::Image { image, scale, offset, rotation: 0.0 } => bilinear(&images[*image], uv * *scale + *offset),
+        Texture::Image { image, scale, offset, rotation } => {
+            let (sin, cos) = alhazen_math::sin_cos_turns(rotation / 360.0);
+            let p = uv * *scale;
+            bilinear(&images[*image], Vec2::new(cos * p.x - sin * p.y, sin * p.x + cos * p.y) + *offset)
+        }
     }
 }
 
@@ -266,10 +273,36 @@ mod tests {
     #[test]
     fn image_lookup_hits_pixel_centres() {
         let img = ImageData::new(2, 1, vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
-        let t = Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO };
+        let t = Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 };
         let imgs = [std::sync::Arc::new(img)];
         assert_eq!(eval(&t, Vec2::new(0.25, 0.5), &imgs), Vec3::X);
         assert_eq!(eval(&t, Vec2::new(0.75, 0.5), &imgs), Vec3::Z);
+    }
+
+    /// A turned image is read where the scaled coordinates turn to, counter-clockwise (a
+    /// quarter turn takes `u` to `v`), then shifted.
+    #[test]
+    fn a_turned_image_is_read_at_the_turned_coordinates() {
+        let img = ImageData::new(4, 4, (0..16).map(|i| [i as f32, 0.0, 0.0]).collect());
+        let imgs = [std::sync::Arc::new(img)];
+        let at = |rotation: f64, uv: Vec2| {
+            let t = Texture::Image { image: 0, scale: Vec2::new(0.5, 0.25), offset: Vec2::new(0.1, 0.2), rotation };
+            eval(&t, uv, &imgs)
+        };
+        let plain = |uv: Vec2| {
+            eval(&Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 }, uv, &imgs)
+        };
+        for uv in [Vec2::new(0.3, 0.7), Vec2::new(1.4, -0.2), Vec2::new(0.05, 0.9)] {
+            let p = uv * Vec2::new(0.5, 0.25);
+            assert!((at(90.0, uv) - plain(Vec2::new(-p.y, p.x) + Vec2::new(0.1, 0.2))).length() < 1e-9);
+            assert!((at(180.0, uv) - plain(-p + Vec2::new(0.1, 0.2))).length() < 1e-9);
+            let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+            assert!(
+                (at(30.0, uv) - plain(Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y) + Vec2::new(0.1, 0.2))).length()
+                    < 1e-9
+            );
+            assert_eq!(at(0.0, uv), plain(p + Vec2::new(0.1, 0.2)));
+        }
     }
 }
 

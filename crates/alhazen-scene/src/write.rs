@@ -315,19 +315,23 @@ impl Writer<'_> {
             Texture::Checker { even, odd, size } => {
                 format!("{{ checker = {{ even = {}, odd = {}, size = {} }} }}", vec3(*even), vec3(*odd), num(*size))
             }
-            Texture::Image { image, scale, offset } => {
-                format!("{{ image = {} }}", self.placed_image(*image, *scale, *offset))
+            Texture::Image { image, scale, offset, rotation } => {
+                format!("{{ image = {} }}", self.placed_image(*image, *scale, *offset, *rotation))
             }
         }
     }
 
-    /// [`Self::image`] shifted by `offset` (written only where it is not zero).
-    fn placed_image(&self, image: usize, scale: Vec2, offset: Vec2) -> String {
-        let table = self.image(image, scale);
-        if offset == Vec2::ZERO {
-            return table;
+    /// [`Self::image`] turned by `rotation` and shifted by `offset` (each written only where it
+    /// is not zero).
+    fn placed_image(&self, image: usize, scale: Vec2, offset: Vec2, rotation: f64) -> String {
+        let mut table = self.image(image, scale).trim_end_matches(" }").to_string();
+        if rotation != 0.0 {
+            table += &format!(", rotation = {}", num(rotation));
         }
-        format!("{}, offset = [{}, {}] }}", table.trim_end_matches(" }"), num(offset.x), num(offset.y))
+        if offset != Vec2::ZERO {
+            table += &format!(", offset = [{}, {}]", num(offset.x), num(offset.y));
+        }
+        table + " }"
     }
 
     fn image(&self, image: usize, scale: Vec2) -> String {
@@ -373,8 +377,8 @@ impl Writer<'_> {
         if let Some(a) = &m.alpha {
             let cutoff = a.cutoff.map_or(String::new(), |c| format!(", cutoff = {}", num(c)));
             let text = match &a.coverage {
-                Texture::Image { image, scale, offset } => {
-                    format!("{{ image = {}{cutoff} }}", self.placed_image(*image, *scale, *offset))
+                Texture::Image { image, scale, offset, rotation } => {
+                    format!("{{ image = {}{cutoff} }}", self.placed_image(*image, *scale, *offset, *rotation))
                 }
                 // A constant coverage with a cutoff is all there or not at all.
                 other => {

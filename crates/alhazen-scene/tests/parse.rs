@@ -530,21 +530,22 @@ fn thin_lenses_read_write_back_and_refuse_nonsense() {
     );
 }
 
-/// A colour image may be shifted (`offset = [u, v]`, after `scale`), and is written back so;
-/// a bump or normal map may not (its table refuses the key).
+/// A colour image may be turned and shifted (`rotation = degrees`, `offset = [u, v]`, after
+/// `scale`), and is written back so; a bump or normal map may not (its table refuses the keys).
 #[test]
 fn image_offsets_read_write_back_and_are_refused_where_unsupported() {
     let dir = tempfile::tempdir().unwrap();
     image::RgbImage::from_fn(2, 1, |x, _| image::Rgb([x as u8 * 255, 0, 0])).save(dir.path().join("t.png")).unwrap();
-    let text = "[materials.m]\ncolor = { image = { file = \"t.png\", scale = 2, offset = [0.25, 0.5] } }\n";
+    let text =
+        "[materials.m]\ncolor = { image = { file = \"t.png\", scale = 2, offset = [0.25, 0.5], rotation = -30.5 } }\n";
     let path = dir.path().join("o.toml");
     std::fs::write(&path, text).unwrap();
     let placed = |s: &alhazen_scene::Scene| match &s.materials.iter().find(|m| m.name == "m").unwrap().color {
-        Texture::Image { scale, offset, .. } => (*scale, *offset),
+        Texture::Image { scale, offset, rotation, .. } => (*scale, *offset, *rotation),
         other => panic!("{other:?}"),
     };
     let s = load_scene(&path).unwrap();
-    let expected = (alhazen_math::Vec2::splat(2.0), alhazen_math::Vec2::new(0.25, 0.5));
+    let expected = (alhazen_math::Vec2::splat(2.0), alhazen_math::Vec2::new(0.25, 0.5), -30.5);
     assert_eq!(placed(&s), expected);
     let again = dir.path().join("again.toml");
     alhazen_scene::write::write_scene(&s, &again, &dir.path().join("assets"), "").unwrap();
@@ -555,10 +556,18 @@ fn image_offsets_read_write_back_and_are_refused_where_unsupported() {
         let e = load_scene(&path).unwrap_err().to_string();
         assert!(e.contains("o.toml:2") && !e.contains("cannot load"), "{bad}: {e}");
     }
-    let bump = "[materials.m]\nbump = { height = 0.1, image = { file = \"t.png\", offset = [0.5, 0] } }\n";
-    std::fs::write(&path, bump).unwrap();
-    let e = load_scene(&path).unwrap_err().to_string();
-    assert!(e.contains("offset") && e.contains("o.toml:2"), "{e}");
+    for bad in ["nan", "\"30\"", "1e9"] {
+        let text = format!("[materials.m]\ncolor = {{ image = {{ file = \"t.png\", rotation = {bad} }} }}\n");
+        std::fs::write(&path, text).unwrap();
+        let e = load_scene(&path).unwrap_err().to_string();
+        assert!(e.contains("o.toml:2") && e.contains("rotation"), "{bad}: {e}");
+    }
+    for key in ["offset = [0.5, 0]", "rotation = 90"] {
+        let bump = format!("[materials.m]\nbump = {{ height = 0.1, image = {{ file = \"t.png\", {key} }} }}\n");
+        std::fs::write(&path, bump).unwrap();
+        let e = load_scene(&path).unwrap_err().to_string();
+        assert!(e.contains(key.split(' ').next().unwrap()) && e.contains("o.toml:2"), "{e}");
+    }
 }
 
 /// A pixel filter by name (its defaults) or as a table; written back to the same numbers;

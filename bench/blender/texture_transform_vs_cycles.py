@@ -1,0 +1,76 @@
+#!/usr/bin/env python3
+"""A texture placed by a Mapping node — scaled, turned and moved, as Blender users place wood
+grain and tiles — through Blender's glTF exporter (which writes it as `KHR_texture_transform`
+scale, rotation and offset) against Cycles: an emitting panel facing the camera whose Emission
+Color is a smoothly repeating image of waves (red along u, green along v, blue along the
+diagonal), for the test
+`blender_texture_transform_agrees_with_cycles` (crates/alhazen-import/tests/gltf.rs).
+
+    python3 bench/blender/texture_transform_vs_cycles.py OUT_DIR [--spp 1024]
+
+Writes OUT_DIR/texture-transform.glb and OUT_DIR/texture-transform-cycles.exr (64 × 64, CPU,
+2 threads, box filter of one pixel, no bounces: the panel's emission alone). Needs
+`pip install bpy`.
+"""
+import argparse, math, os, sys
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gltf_vs_cycles import black_world, image_node, material, render, saved_image  # noqa: E402
+
+
+def waves(x, y):
+    """Texel (x, y) of a 32 × 32 image that repeats smoothly: red waves along u, green along v,
+    blue along the diagonal — each direction its own colour, so a turn or a shift shows, and
+    neighbouring texels close, so Cycles' interpolation of 8-bit sRGB texels before decoding
+    them (where alhazen decodes, then interpolates) differs from ours by little."""
+    t = 2 * math.pi / 32
+    return (0.5 + 0.4 * math.sin(t * x), 0.5 + 0.4 * math.sin(t * y + 1.0), 0.5 + 0.4 * math.cos(t * (x + y)), 1.0)
+
+
+def build(out):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    img = saved_image("waves", 32, waves, os.path.join(out, "waves.png"))
+    m = material("panel", (0.0, 0.0, 0.0), 0.0, 1.0)
+    tex, p = image_node(m, img)
+    coords = m.node_tree.nodes.new("ShaderNodeTexCoord")
+    mapping = m.node_tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Location"].default_value = (0.15, 0.3, 0.0)
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30))
+    mapping.inputs["Scale"].default_value = (1.5, 0.75, 1.0)
+    m.node_tree.links.new(coords.outputs["UV"], mapping.inputs["Vector"])
+    m.node_tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    m.node_tree.links.new(tex.outputs["Color"], p.inputs["Emission Color"])
+    p.inputs["Emission Strength"].default_value = 1.0
+    bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
+    bpy.context.object.data.materials.append(m)
+    bpy.ops.object.camera_add(location=(0.0, -4.0, 0.0), rotation=(math.radians(90), 0, 0))
+    cam = bpy.context.object
+    cam.data.sensor_fit = "HORIZONTAL"
+    cam.data.angle = math.radians(25)
+    scene.camera = cam
+    black_world(scene)
+    return scene
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("out")
+    ap.add_argument("--spp", type=int, default=1024)
+    a = ap.parse_args()
+    out = os.path.abspath(a.out)
+    os.makedirs(out, exist_ok=True)
+    scene = build(out)
+    size = (64, 64)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    bpy.ops.export_scene.gltf(filepath=os.path.join(out, "texture-transform.glb"), export_format="GLB",
+                              export_cameras=True, export_yup=True)
+    seconds = render(scene, os.path.join(out, "texture-transform-cycles.exr"), a.spp, size, bounces=0, transparent=0,
+                     depth="32")
+    print(f"Cycles: {a.spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
