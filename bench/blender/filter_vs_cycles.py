@@ -16,7 +16,7 @@ import argparse, math, os, sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import black_world, render  # noqa: E402
+from gltf_vs_cycles import export_and_render_emission, front_camera  # noqa: E402
 
 
 def panel(name, size, angle, at, color, strength):
@@ -40,12 +40,7 @@ def build():
     panel("square", (0.5, 0.5), 25, (-0.4, 0.1), (1.0, 0.5, 0.25), 4.0)
     panel("bar", (0.04, 0.5), 10, (0.45, 0.0), (1.0 / 3, 1.0, 1.0 / 6), 3.0)
     panel("spot", (0.08, 0.08), 0, (0.2, -0.45), (1.0, 1.0, 1.0), 8.0)
-    bpy.ops.object.camera_add(location=(0.0, -4.0, 0.0), rotation=(math.radians(90), 0, 0))
-    cam = bpy.context.object
-    cam.data.sensor_fit = "HORIZONTAL"
-    cam.data.angle = math.radians(30)
-    scene.camera = cam
-    black_world(scene)
+    front_camera(scene, 30)
     return scene
 
 
@@ -54,16 +49,8 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=16384)
     a = ap.parse_args()
-    out = os.path.abspath(a.out)
-    os.makedirs(out, exist_ok=True)
-    scene = build()
-    size = (64, 48)
-    scene.render.resolution_x, scene.render.resolution_y = size
-    bpy.ops.export_scene.gltf(filepath=os.path.join(out, "filter.glb"), export_format="GLB", export_cameras=True,
-                              export_yup=True)
-    seconds = render(scene, os.path.join(out, "filter-cycles.exr"), a.spp, size, bounces=0, transparent=0,
-                     depth="32", pixel_filter=("BLACKMAN_HARRIS", 1.5))
-    print(f"Cycles: {a.spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
+    export_and_render_emission(build(), os.path.abspath(a.out), "filter", (64, 48), a.spp,
+                               pixel_filter=("BLACKMAN_HARRIS", 1.5))
 
 
 if __name__ == "__main__":

@@ -159,6 +159,30 @@ def build(maps_path=None, panel_path=None, card_path=None):
     return scene
 
 
+def front_camera(scene, fov_degrees):
+    """A camera 4 units in front of the origin (at y = −4, looking along +y), `fov_degrees`
+    across the image's width, and a black world: the view of panels standing in the plane
+    y = 0."""
+    bpy.ops.object.camera_add(location=(0.0, -4.0, 0.0), rotation=(math.radians(90), 0, 0))
+    cam = bpy.context.object
+    cam.data.sensor_fit = "HORIZONTAL"
+    cam.data.angle = math.radians(fov_degrees)
+    scene.camera = cam
+    black_world(scene)
+
+
+def export_and_render_emission(scene, out, stem, size, spp, pixel_filter=("BOX", 1.0)):
+    """Writes OUT/STEM.glb (Blender's glTF exporter, with cameras) and OUT/STEM-cycles.exr:
+    Cycles without bounces (what emitters show directly), 32-bit, through `pixel_filter`."""
+    os.makedirs(out, exist_ok=True)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB", export_cameras=True,
+                              export_yup=True)
+    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), spp, size, bounces=0, transparent=0, depth="32",
+                     pixel_filter=pixel_filter)
+    print(f"Cycles: {spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
+
+
 def black_world(scene):
     """No light from the world: what a glTF file, which has no world, holds."""
     world = bpy.data.worlds.new("black")

@@ -17,7 +17,7 @@ import argparse, math, os, sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import black_world, image_node, material, render, saved_image  # noqa: E402
+from gltf_vs_cycles import export_and_render_emission, front_camera, image_node, material, saved_image  # noqa: E402
 
 
 def waves(x, y):
@@ -46,12 +46,7 @@ def build(out):
     p.inputs["Emission Strength"].default_value = 1.0
     bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
     bpy.context.object.data.materials.append(m)
-    bpy.ops.object.camera_add(location=(0.0, -4.0, 0.0), rotation=(math.radians(90), 0, 0))
-    cam = bpy.context.object
-    cam.data.sensor_fit = "HORIZONTAL"
-    cam.data.angle = math.radians(25)
-    scene.camera = cam
-    black_world(scene)
+    front_camera(scene, 25)
     return scene
 
 
@@ -62,14 +57,7 @@ def main():
     a = ap.parse_args()
     out = os.path.abspath(a.out)
     os.makedirs(out, exist_ok=True)
-    scene = build(out)
-    size = (64, 64)
-    scene.render.resolution_x, scene.render.resolution_y = size
-    bpy.ops.export_scene.gltf(filepath=os.path.join(out, "texture-transform.glb"), export_format="GLB",
-                              export_cameras=True, export_yup=True)
-    seconds = render(scene, os.path.join(out, "texture-transform-cycles.exr"), a.spp, size, bounces=0, transparent=0,
-                     depth="32")
-    print(f"Cycles: {a.spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
+    export_and_render_emission(build(out), out, "texture-transform", (64, 64), a.spp)
 
 
 if __name__ == "__main__":
