@@ -383,6 +383,9 @@ impl Importer<'_> {
                 if nt.tex_coord() != 0 {
                     self.warn(format!("{name}: texture coordinate set {} is read as set 0", nt.tex_coord()));
                 }
+                if nt.extension_value("KHR_texture_transform").is_some() {
+                    self.warn(format!("{name}: the normal texture's KHR_texture_transform is not supported; ignored"));
+                }
                 let image = self.image(&nt.texture(), Decoding::Linear)?;
                 self.scene.images.push(image);
                 let image = self.scene.images.len() - 1;

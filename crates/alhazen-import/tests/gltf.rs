@@ -172,18 +172,20 @@ fn external_buffers_are_read_beside_the_file() {
 #[test]
 fn emission_lights_the_render_and_what_is_left_out_is_said() {
     let extra = r#", "emissiveFactor": [1, 1, 1], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4 } },
-                     "normalTexture": { "index": 0, "scale": 0.5 }, "alphaMode": "BLEND""#;
+                     "normalTexture": { "index": 0, "scale": 0.5, "extensions": { "KHR_texture_transform": { "rotation": 1 } } },
+                     "alphaMode": "BLEND""#;
     let json = document(
         &format!(r#", "uri": "data:application/octet-stream;base64,{}""#, base64(&quad_buffer())),
         extra,
     )
     .replace(
         r#""extensionsUsed": ["KHR_lights_punctual"]"#,
-        r#""extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_sheen"]"#,
+        r#""extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_sheen", "KHR_texture_transform"]"#,
     );
     let s = write_and_import(&[("e.gltf", json.into_bytes())]).unwrap();
     let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
     assert!(said.iter().any(|w| w.contains("KHR_materials_sheen is not supported")), "{said:?}");
+    assert!(said.iter().any(|w| w.contains("normal texture's KHR_texture_transform is not supported")), "{said:?}");
     let mut sc = s.scene;
     let m = &sc.materials[sc.objects[0].material as usize];
     assert_eq!(m.emission, Vec3::splat(4.0));
