@@ -1099,10 +1099,9 @@ impl Importer {
                 // Read with the other files once the walk is done.
                 let (images, file) = (&mut self.scene.images, (ctx.path, ctx.shared));
                 let index = self.pending.push_image(images, &path, (linear, false), file, at.clone());
+                // pbrt's (u, v) mapping reads the image at (s·u + Δu, t·v + Δv), `v` up as here.
                 let (us, vs) = (self.float(ctx, p, "uscale", 1.0)?, self.float(ctx, p, "vscale", 1.0)?);
-                if self.float(ctx, p, "udelta", 0.0)? != 0.0 || self.float(ctx, p, "vdelta", 0.0)? != 0.0 {
-                    self.warn(ctx, at, "udelta/vdelta offsets are not supported; ignored");
-                }
+                let offset = Vec2::new(self.float(ctx, p, "udelta", 0.0)?, self.float(ctx, p, "vdelta", 0.0)?);
                 if let Some(w) = self.string(ctx, p, "wrap")?.filter(|w| w != "repeat") {
                     self.warn(ctx, at, format!("wrap \"{w}\": alhazen's image textures repeat"));
                 }
@@ -1110,7 +1109,7 @@ impl Importer {
                 if self.boolean(ctx, p, "invert", false)? {
                     self.warn(ctx, at, "invert is not supported; ignored");
                 }
-                Texture::Image { image: index, scale: Vec2::new(us, vs), offset: Vec2::ZERO, rotation: 0.0 }
+                Texture::Image { image: index, scale: Vec2::new(us, vs), offset, rotation: 0.0 }
             }
             "checkerboard" => {
                 let (us, vs) = (self.float(ctx, p, "uscale", 1.0)?, self.float(ctx, p, "vscale", 1.0)?);
