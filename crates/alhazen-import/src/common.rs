@@ -252,7 +252,8 @@ impl PendingFiles {
     }
 
     /// Image file `path`, read as linear values (else decoded from sRGB), turned upside down
-    /// when `rows_reversed`; named at bytes `span` of scene file `at`. Its place in `images` (a
+    /// when `rows_reversed`; named at bytes `span` of scene file `at`. (Its placeholder's `wrap`,
+    /// set by the caller, is kept when the image is read.) Its place in `images` (a
     /// placeholder until [`Self::load`]) is returned.
     pub fn push_image(
         &mut self,
@@ -295,7 +296,9 @@ impl PendingFiles {
             let (path, text) = &self.files[r.file];
             located(path, text, r.span.clone(), e)
         })?;
-        scene.images[index] = Arc::new(if rows_reversed { image.rows_reversed() } else { image });
+        let image = if rows_reversed { image.rows_reversed() } else { image };
+        // The placeholder holds the wrap the texture asked for.
+        scene.images[index] = Arc::new(image.with_wrap(scene.images[index].wrap));
         Ok(())
     }
 
@@ -355,7 +358,8 @@ impl PendingFiles {
                 }
                 Loaded::Image { index, rows_reversed, image } => {
                     let image = image.map_err(at)?;
-                    scene.images[index] = Arc::new(if rows_reversed { image.rows_reversed() } else { image });
+                    let image = if rows_reversed { image.rows_reversed() } else { image };
+                    scene.images[index] = Arc::new(image.with_wrap(scene.images[index].wrap));
                 }
             }
         }

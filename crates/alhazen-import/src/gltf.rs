@@ -21,7 +21,7 @@ use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
-    PerspectiveOpening, Scene, SceneError, Shape, Texture,
+    PerspectiveOpening, Scene, SceneError, Shape, Texture, Wrap,
 };
 use gltf::material::AlphaMode;
 use gltf::mesh::Mode;
@@ -321,7 +321,7 @@ impl Importer<'_> {
             Some(info) => {
                 let (scale, offset, rotation) = self.texture_placement(&info, &name)?;
                 let img = self.image(&info.texture(), Decoding::Srgb)?;
-                let img = scaled(img, factor);
+                let img = wrapped(scaled(img, factor), &info.texture());
                 let mean = alhazen_scene::texture::image_mean(&img);
                 self.scene.images.push(img);
                 (Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation }, mean)
@@ -339,7 +339,7 @@ impl Importer<'_> {
             && emission != Vec3::ZERO
         {
             let (scale, offset, rotation) = self.texture_placement(&info, &name)?;
-            let img = scaled(self.image(&info.texture(), Decoding::Srgb)?, emission);
+            let img = wrapped(scaled(self.image(&info.texture(), Decoding::Srgb)?, emission), &info.texture());
             emission = alhazen_scene::texture::image_mean(&img);
             self.scene.images.push(img);
             emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation });
@@ -374,7 +374,7 @@ impl Importer<'_> {
                         "{name}: the metallic-roughness texture's offset and rotation are not supported; ignored"
                     ));
                 }
-                self.scene.images.push(image);
+                self.scene.images.push(wrapped(image, &info.texture()));
                 map = Some((self.scene.images.len() - 1, scale));
             }
         }
@@ -438,11 +438,6 @@ impl Importer<'_> {
     /// `R(ϑ)·(s ⊙ uv) + (o_u + s_v sin ϑ, 1 − o_v − s_v cos ϑ)` (the shift kept in [0, 1): the
     /// images repeat) — a Blender Mapping node's own scale, rotation and location.
     fn texture_placement(&mut self, info: &gltf::texture::Info, name: &str) -> R<(Vec2, Vec2, f64)> {
-        let sampler = info.texture().sampler();
-        use gltf::texture::WrappingMode::Repeat;
-        if sampler.wrap_s() != Repeat || sampler.wrap_t() != Repeat {
-            self.warn(format!("{name}: clamped or mirrored texture wrapping is rendered as repeat"));
-        }
         if info.tex_coord() != 0 {
             self.warn(format!("{name}: texture coordinate set {} is read as set 0", info.tex_coord()));
         }
@@ -496,7 +491,7 @@ impl Importer<'_> {
                 let img = self.image(&info.texture(), Decoding::Alpha)?;
                 // An image without an alpha channel is present everywhere.
                 (alhazen_scene::texture::image_mean(&img).x < 1.0).then(|| {
-                    self.scene.images.push(scaled(img, Vec3::splat(factor)));
+                    self.scene.images.push(wrapped(scaled(img, Vec3::splat(factor)), &info.texture()));
                     Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation }
                 })
             }
@@ -658,6 +653,23 @@ fn framing(bounds: Bounds3, aspect: f64) -> Option<CameraDesc> {
 }
 
 /// An image multiplied by `factor` (the base-colour factor glTF applies to its texture).
+/// `img` read beyond `[0, 1]` as `texture`'s sampler says (glTF's `wrapS`, `wrapT`; a copy
+/// only where that is not the image's own, repeat).
+fn wrapped(mut img: Arc<ImageData>, texture: &gltf::Texture) -> Arc<ImageData> {
+    use gltf::texture::WrappingMode;
+    let wrap = |m: WrappingMode| match m {
+        WrappingMode::Repeat => Wrap::Repeat,
+        WrappingMode::ClampToEdge => Wrap::Clamp,
+        WrappingMode::MirroredRepeat => Wrap::Mirror,
+    };
+    let sampler = texture.sampler();
+    let wanted = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
+    if img.wrap != wanted {
+        Arc::make_mut(&mut img).wrap = wanted;
+    }
+    img
+}
+
 fn scaled(img: Arc<ImageData>, factor: Vec3) -> Arc<ImageData> {
     if factor == Vec3::ONE {
         // The decoded image itself, not a copy of its pixels.

@@ -24,7 +24,7 @@ use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
 use alhazen_scene::{
     Background, Bump, BumpPattern, CameraDesc, FresnelMode, IntegratorKind, Light, LookAt, MaterialId, Object,
-    PerspectiveOpening, PixelFilter, SamplerKind, Scene, SceneError, Shape, Texture,
+    PerspectiveOpening, PixelFilter, SamplerKind, Scene, SceneError, Shape, Texture, Wrap,
 };
 use roxmltree::Node;
 use std::cell::RefCell;
@@ -1321,9 +1321,17 @@ impl Importer {
                 // coordinate the texel Mitsuba shows it.
                 let (images, at) = (&mut self.scene.images, (ctx.path, ctx.shared));
                 let index = self.pending.push_image(images, &path, (hdr || raw, true), at, node.range());
-                if let Some(w) = self.string(ctx, &p, "wrap_mode")?.filter(|w| w != "repeat") {
-                    self.warn(ctx, node, format!("wrap_mode \"{w}\": alhazen's image textures repeat"));
-                }
+                let wrap = match self.string(ctx, &p, "wrap_mode")?.as_deref() {
+                    None | Some("repeat") => Wrap::Repeat,
+                    Some("mirror") => Wrap::Mirror,
+                    Some("clamp") => Wrap::Clamp,
+                    Some(other) => {
+                        return Err(
+                            ctx.err(node, format!("unknown wrap_mode \"{other}\"; expected repeat, mirror or clamp"))
+                        );
+                    }
+                };
+                std::sync::Arc::make_mut(&mut self.scene.images[index]).wrap = [wrap; 2];
                 self.string(ctx, &p, "filter_type")?;
                 Texture::Image { image: index, scale, offset, rotation }
             }

@@ -23,7 +23,7 @@ use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Ior};
 use alhazen_scene::{
     Background, Bump, BumpPattern, CameraDesc, FresnelMode, ImageData, IntegratorKind, Light, LookAt, MaterialId,
-    Object, PerspectiveOpening, PixelFilter, Scene, SceneError, Shape, Texture,
+    Object, PerspectiveOpening, PixelFilter, Scene, SceneError, Shape, Texture, Wrap,
 };
 use std::collections::HashMap;
 use std::ops::Range;
@@ -1102,9 +1102,16 @@ impl Importer {
                 // pbrt's (u, v) mapping reads the image at (s·u + Δu, t·v + Δv), `v` up as here.
                 let (us, vs) = (self.float(ctx, p, "uscale", 1.0)?, self.float(ctx, p, "vscale", 1.0)?);
                 let offset = Vec2::new(self.float(ctx, p, "udelta", 0.0)?, self.float(ctx, p, "vdelta", 0.0)?);
-                if let Some(w) = self.string(ctx, p, "wrap")?.filter(|w| w != "repeat") {
-                    self.warn(ctx, at, format!("wrap \"{w}\": alhazen's image textures repeat"));
-                }
+                let wrap = match self.string(ctx, p, "wrap")?.as_deref() {
+                    None | Some("repeat") => Wrap::Repeat,
+                    Some("black") => Wrap::Black,
+                    Some("clamp") => Wrap::Clamp,
+                    Some(w) => {
+                        self.warn(ctx, at, format!("wrap \"{w}\" is read as repeat"));
+                        Wrap::Repeat
+                    }
+                };
+                std::sync::Arc::make_mut(&mut self.scene.images[index]).wrap = [wrap; 2];
                 self.string(ctx, p, "filter")?;
                 if self.boolean(ctx, p, "invert", false)? {
                     self.warn(ctx, at, "invert is not supported; ignored");

@@ -695,3 +695,22 @@ fn blender_texture_transform_agrees_with_cycles() {
     eprintln!("mean relative difference {turned:.4} (without the turn: {unturned:.4})");
     assert!(turned < 0.01 && unturned > 10.0 * turned, "{turned} {unturned}");
 }
+
+/// A texture's sampler wraps its image as glTF says: `CLAMP_TO_EDGE` (33071) and
+/// `MIRRORED_REPEAT` (33648) along `s` (u) and `t` (v), without a warning.
+#[test]
+fn samplers_wrap_their_images() {
+    let json = embedded().replace(
+        r#""textures": [{ "source": 0 }]"#,
+        r#""textures": [{ "source": 0, "sampler": 0 }], "samplers": [{ "wrapS": 33071, "wrapT": 33648 }]"#,
+    );
+    let s = write_and_import(&[("w.gltf", json.into_bytes())]).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let sc = s.scene;
+    let Some(BsdfDesc::CookTorrance { albedo: Texture::Image { image, .. }, .. }) =
+        &sc.materials[sc.objects[0].material as usize].bsdf
+    else {
+        panic!("not a textured dielectric")
+    };
+    assert_eq!(sc.images[*image].wrap, [alhazen_scene::Wrap::Clamp, alhazen_scene::Wrap::Mirror]);
+}

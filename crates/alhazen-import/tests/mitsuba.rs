@@ -1092,3 +1092,24 @@ fn a_turned_texture_agrees_with_mitsuba() {
     eprintln!("mean relative difference {turned:.4} (without the turn: {unturned:.4})");
     assert!(turned < 0.01 && unturned > 10.0 * turned, "{turned} {unturned}");
 }
+
+/// A bitmap's `wrap_mode` (repeat, mirror, clamp) wraps its image; another is a located error.
+#[test]
+fn bitmaps_wrap_as_their_wrap_mode_says() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([0, 255, 0])).save(dir.path().join("g.png")).unwrap();
+    let load = |mode: &str| {
+        let text = scene(&format!(
+            r#"<shape type="rectangle"><bsdf type="diffuse"><texture type="bitmap" name="reflectance">
+               <string name="filename" value="g.png"/><string name="wrap_mode" value="{mode}"/></texture></bsdf></shape>"#
+        ));
+        std::fs::write(dir.path().join("w.xml"), text).unwrap();
+        alhazen_import::load(&dir.path().join("w.xml")).map(|s| s.scene.images[0].wrap).map_err(|e| e.to_string())
+    };
+    use alhazen_scene::Wrap;
+    assert_eq!(load("clamp"), Ok([Wrap::Clamp; 2]));
+    assert_eq!(load("mirror"), Ok([Wrap::Mirror; 2]));
+    assert_eq!(load("repeat"), Ok([Wrap::Repeat; 2]));
+    let e = load("wrap").unwrap_err();
+    assert!(e.contains("w.xml:2:") && e.contains("unknown wrap_mode"), "{e}");
+}

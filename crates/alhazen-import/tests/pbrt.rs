@@ -222,10 +222,10 @@ fn image_maps_load_after_the_walk_and_an_unreadable_one_is_located() {
     let s = load(&body).unwrap().scene;
     assert_eq!(s.images.len(), 1);
     assert_eq!((s.images[0].width, s.images[0].texel(1)), (2, [0.0, 1.0, 0.0]));
-    // pbrt's (u, v) mapping: scaled, then shifted by `udelta`, `vdelta`.
+    // pbrt's (u, v) mapping: scaled, then shifted by `udelta`, `vdelta`; and its wrap.
     let placed = load(&body.replace(
         "green.png\"",
-        "green.png\" \"float uscale\" 2 \"float vscale\" 3 \"float udelta\" 0.25 \"float vdelta\" -0.5",
+        "green.png\" \"float uscale\" 2 \"float vscale\" 3 \"float udelta\" 0.25 \"float vdelta\" -0.5 \"string wrap\" \"black\"",
     ))
     .unwrap();
     assert!(!placed.warnings.iter().any(|w| w.to_string().contains("delta")), "{:?}", placed.warnings);
@@ -235,6 +235,7 @@ fn image_maps_load_after_the_walk_and_an_unreadable_one_is_located() {
     });
     let Some((scale, offset)) = albedo else { panic!("{:?}", placed.scene.materials) };
     assert_eq!((*scale, *offset), (alhazen_math::Vec2::new(2.0, 3.0), alhazen_math::Vec2::new(0.25, -0.5)));
+    assert_eq!(placed.scene.images[0].wrap, [alhazen_scene::Wrap::Black; 2], "pbrt's wrap");
     let err = load(&format!("WorldBegin\n{}\nNamedMaterial \"glod\"", texture("missing.png"))).unwrap_err();
     assert!(err.contains("a.pbrt:2:") && err.contains("cannot load image"), "{err}");
 }

@@ -936,6 +936,44 @@ pub struct ImageData {
     /// Height in pixels.
     pub height: u32,
     texels: Texels,
+    /// How a texture reads it beyond `[0, 1]` along `u` and along `v`.
+    pub wrap: [Wrap; 2],
+}
+
+/// How an image texture is read beyond `[0, 1]` along one axis (glTF's and OpenGL's wrap
+/// modes, Mitsuba's `wrap_mode`, pbrt's `wrap`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Wrap {
+    /// The image repeats.
+    #[default]
+    Repeat,
+    /// The edge texels stretch outwards.
+    Clamp,
+    /// The image repeats mirrored, every other copy turned over.
+    Mirror,
+    /// Black beyond the image.
+    Black,
+}
+
+impl Wrap {
+    /// The names the scene format gives the modes.
+    pub const NAMES: [&str; 4] = ["repeat", "clamp", "mirror", "black"];
+
+    /// The mode of one of [`Self::NAMES`].
+    pub fn named(name: &str) -> Option<Self> {
+        Some(match name {
+            "repeat" => Self::Repeat,
+            "clamp" => Self::Clamp,
+            "mirror" => Self::Mirror,
+            "black" => Self::Black,
+            _ => return None,
+        })
+    }
+
+    /// Its name in the scene format.
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
 }
 
 /// How an image keeps its pixels: a texture's cost in a render is its cache footprint, and an
@@ -957,7 +995,8 @@ struct PixelCodes {
 
 impl PartialEq for ImageData {
     fn eq(&self, other: &Self) -> bool {
-        (self.width, self.height) == (other.width, other.height) && self.texels().eq(other.texels())
+        (self.width, self.height, self.wrap) == (other.width, other.height, other.wrap)
+            && self.texels().eq(other.texels())
     }
 }
 
@@ -968,6 +1007,7 @@ impl std::fmt::Debug for ImageData {
             .field("height", &self.height)
             .field("pixels", &self.texels().collect::<Vec<_>>())
             .field("has_codes", &self.has_codes())
+            .field("wrap", &self.wrap)
             .finish()
     }
 }
@@ -976,12 +1016,19 @@ impl ImageData {
     /// The image of `pixels` (`width × height`, rows top to bottom).
     pub fn new(width: u32, height: u32, pixels: Vec<[f32; 3]>) -> Self {
         let texels = PixelCodes::of(&pixels).map_or(Texels::Floats(pixels), Texels::Codes);
-        Self { width, height, texels }
+        Self { width, height, texels, wrap: [Wrap::Repeat; 2] }
+    }
+
+    /// The image read with `wrap` beyond `[0, 1]`.
+    pub fn with_wrap(mut self, wrap: [Wrap; 2]) -> Self {
+        self.wrap = wrap;
+        self
     }
 
     /// The image whose pixel channels are `table[code]`: an 8-bit image and its decoding.
     pub fn from_codes(width: u32, height: u32, table: [f32; 256], codes: Vec<[u8; 3]>) -> Self {
-        Self { width, height, texels: Texels::Codes(PixelCodes { tables: Box::new([table; 3]), codes }) }
+        let texels = Texels::Codes(PixelCodes { tables: Box::new([table; 3]), codes });
+        Self { width, height, texels, wrap: [Wrap::Repeat; 2] }
     }
 
     /// The number of pixels.
@@ -1005,7 +1052,7 @@ impl ImageData {
             Texels::Floats(p) => Texels::Floats(rows_reversed(&p, w)),
             Texels::Codes(c) => Texels::Codes(PixelCodes { codes: rows_reversed(&c.codes, w), tables: c.tables }),
         };
-        Self { width: self.width, height: self.height, texels }
+        Self { width: self.width, height: self.height, texels, wrap: self.wrap }
     }
 
     /// The image with each pixel's channels multiplied by `factor`'s (`p[c] · factor[c]` in
@@ -1018,7 +1065,8 @@ impl ImageData {
             }
             Texels::Codes(c) => {
                 let tables = Box::new(std::array::from_fn(|k| c.tables[k].map(|v| v * factor[k])));
-                Self { width, height, texels: Texels::Codes(PixelCodes { tables, codes: c.codes.clone() }) }
+                let texels = Texels::Codes(PixelCodes { tables, codes: c.codes.clone() });
+                Self { width, height, texels, wrap: self.wrap }
             }
         }
     }

@@ -313,15 +313,16 @@ impl Parser<'_> {
         })
     }
 
-    /// `{ file = "x.png", scale = s or [u, v] }` (and `offset = [u, v]`, `rotation = degrees`
-    /// where `placed` allows) read by `load`: the image's index, scale, offset and rotation.
+    /// `{ file = "x.png", scale = s or [u, v] }` (and `offset = [u, v]`, `rotation = degrees`,
+    /// `wrap = mode or [u, v]` where `placed` allows) read by `load`: the image's index (read
+    /// with its wrap), scale, offset and rotation.
     fn image_file(
         &mut self,
         i: &Node,
         placed: bool,
         load: impl FnOnce(&std::path::Path) -> Result<crate::ImageData, String>,
     ) -> R<(usize, Vec2, Vec2, f64)> {
-        let i = i.table(if placed { &["file", "scale", "offset", "rotation"] } else { &["file", "scale"] })?;
+        let i = i.table(if placed { &["file", "scale", "offset", "rotation", "wrap"] } else { &["file", "scale"] })?;
         let file = i.req("file")?;
         let path = self.dir.join(file.str()?);
         // The scale is checked before the image is read.
@@ -335,7 +336,18 @@ impl Parser<'_> {
         };
         let offset = i.get("offset").map_or(Ok(Vec2::ZERO), |o| o.numbers::<2>().map(Vec2::from_array))?;
         let rotation = i.get("rotation").map_or(Ok(0.0), |r| r.in_range(-36000.0, 36000.0))?;
-        let data = load(&path).map_err(|e| file.err(e))?;
+        let wrap = match i.get("wrap") {
+            None => [crate::Wrap::Repeat; 2],
+            Some(w) if w.is_array() => {
+                let items = w.array()?;
+                if items.len() != 2 {
+                    return Err(w.err("`wrap`: expected a mode or [u, v] modes"));
+                }
+                [wrap_mode(&items[0])?, wrap_mode(&items[1])?]
+            }
+            Some(w) => [wrap_mode(&w)?; 2],
+        };
+        let data = load(&path).map_err(|e| file.err(e))?.with_wrap(wrap);
         self.scene.images.push(Arc::new(data));
         Ok((self.scene.images.len() - 1, scale, offset, rotation))
     }
@@ -754,6 +766,12 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
             .err(format!("{}×{} pixels is more than the {MAX_PIXELS} this renderer can allocate", r.width, r.height)));
     }
     Ok(r)
+}
+
+/// One of [`crate::Wrap::NAMES`].
+fn wrap_mode(n: &Node) -> R<crate::Wrap> {
+    let name = n.choice(&crate::Wrap::NAMES)?;
+    crate::Wrap::named(name).ok_or_else(|| n.err(format!("`wrap`: unknown mode \"{name}\"")))
 }
 
 /// `filter = "NAME"` (its defaults) or `{ type = "NAME", radius = r or [rx, ry], … }`.

@@ -1,6 +1,6 @@
 //! Evaluation of surface colour textures: solid, checker, image (bilinear, repeating).
 
-use crate::{ImageData, Texture};
+use crate::{ImageData, Texture, Wrap};
 use alhazen_math::{Mat3, Vec2, Vec3, elementary};
 
 /// The colour of `tex` at texture coordinates `uv`.
@@ -119,6 +119,9 @@ fn floor_small(x: f64) -> f64 {
 }
 
 fn bilinear(img: &ImageData, uv: Vec2) -> Vec3 {
+    if img.wrap != [Wrap::Repeat; 2] {
+        return bilinear_wrapped(img, uv);
+    }
     let (w, h) = (img.width as i64, img.height as i64);
     // v = 0 is the bottom row of the image.
     let x = wrap_unit(uv.x) * w as f64 - 0.5;
@@ -143,6 +146,49 @@ fn bilinear(img: &ImageData, uv: Vec2) -> Vec3 {
     let top = v(a) * (1.0 - fx) + v(b) * fx;
     let bottom = v(c) * (1.0 - fx) + v(d) * fx;
     top * (1.0 - fy) + bottom * fy
+}
+
+/// [`bilinear`] for an image that does not repeat along some axis: each axis's two texels and
+/// the weight of the second, by its [`Wrap`] (`None`: a black texel beyond the image).
+fn bilinear_wrapped(img: &ImageData, uv: Vec2) -> Vec3 {
+    // Along `v` the image's rows run down from `v = 1`.
+    let ([left, right], fx) = taps(uv.x, img.width as i64, img.wrap[0]);
+    let ([upper, lower], fy) = taps(1.0 - uv.y, img.height as i64, img.wrap[1]);
+    let texel = |i: Option<i64>, j: Option<i64>| match (i, j) {
+        (Some(i), Some(j)) => {
+            let p = img.texel((j * img.width as i64 + i) as usize);
+            Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+        }
+        _ => Vec3::ZERO,
+    };
+    let top = texel(left, upper) * (1.0 - fx) + texel(right, upper) * fx;
+    let bottom = texel(left, lower) * (1.0 - fx) + texel(right, lower) * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
+/// The two texels (of `size`) a coordinate `t` (the image spanning `[0, 1]`, texel centres at
+/// `(k + ½) / size`) falls between, and the weight of the second.
+fn taps(t: f64, size: i64, wrap: Wrap) -> ([Option<i64>; 2], f64) {
+    let t = match wrap {
+        Wrap::Repeat => wrap_unit(t),
+        Wrap::Mirror => {
+            let r = t.rem_euclid(2.0);
+            if r > 1.0 { 2.0 - r } else { r }
+        }
+        // Beyond the image by more than a texel, everything is the edge's (or black): kept
+        // small, so the texel index is a small integer.
+        Wrap::Clamp | Wrap::Black => t.clamp(-1.0, 2.0),
+    };
+    let x = t * size as f64 - 0.5;
+    let x0 = floor_small(x);
+    let k = x0 as i64;
+    let index = |k: i64| match wrap {
+        Wrap::Repeat => Some(k.rem_euclid(size)),
+        // Mirrored, the texel beyond an edge is the edge's own.
+        Wrap::Clamp | Wrap::Mirror => Some(k.clamp(0, size - 1)),
+        Wrap::Black => (0..size).contains(&k).then_some(k),
+    };
+    ([index(k), index(k + 1)], x - x0)
 }
 
 #[cfg(test)]
@@ -277,6 +323,34 @@ mod tests {
         let imgs = [std::sync::Arc::new(img)];
         assert_eq!(eval(&t, Vec2::new(0.25, 0.5), &imgs), Vec3::X);
         assert_eq!(eval(&t, Vec2::new(0.75, 0.5), &imgs), Vec3::Z);
+    }
+
+    /// Beyond `[0, 1]`, a clamped image keeps its edge texels, a mirrored one turns over, a
+    /// black one fades to black within half a texel; inside, every mode reads what the
+    /// repeating image reads.
+    #[test]
+    fn wrap_modes_read_beyond_the_image_as_named() {
+        let img = ImageData::new(4, 1, (0..4).map(|i| [i as f32 + 1.0, 0.0, 0.0]).collect());
+        let read = |wrap: Wrap, u: f64| {
+            let imgs = [std::sync::Arc::new(img.clone().with_wrap([wrap, Wrap::Repeat]))];
+            eval(
+                &Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 },
+                Vec2::new(u, 0.5),
+                &imgs,
+            )
+            .x
+        };
+        for u in [0.125, 0.3, 0.5, 0.6, 0.875] {
+            for wrap in [Wrap::Clamp, Wrap::Mirror, Wrap::Black] {
+                assert_eq!(read(wrap, u), read(Wrap::Repeat, u), "{wrap:?} at {u}");
+            }
+        }
+        // Texel centres at 1/8, 3/8, 5/8, 7/8 hold 1, 2, 3, 4.
+        assert_eq!((read(Wrap::Clamp, 1.6), read(Wrap::Clamp, -3.0), read(Wrap::Clamp, 1e300)), (4.0, 1.0, 4.0));
+        assert_eq!((read(Wrap::Mirror, 1.125), read(Wrap::Mirror, 1.875), read(Wrap::Mirror, -0.125)), (4.0, 1.0, 1.0));
+        assert_eq!((read(Wrap::Black, 1.5), read(Wrap::Black, -0.5)), (0.0, 0.0));
+        assert_eq!(read(Wrap::Black, 0.0), 0.5, "half the edge texel, half black");
+        assert_eq!(read(Wrap::Repeat, 0.0), 2.5, "half the edge texel, half the other edge's");
     }
 
     /// A turned image is read where the scaled coordinates turn to, counter-clockwise (a

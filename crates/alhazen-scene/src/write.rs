@@ -62,7 +62,8 @@ pub fn write_scene(scene: &Scene, path: &Path, assets: &Path, header: &str) -> R
 
 /// The TOML text of `scene`, naming image `i` by `images[i]` and mesh `i` by `meshes[i]`.
 pub fn to_toml(scene: &Scene, images: &[String], meshes: &[String], header: &str) -> Result<String, WriteError> {
-    let mut w = Writer { out: String::new(), images, material_names: vec![] };
+    let wraps = scene.images.iter().map(|i| i.wrap).collect();
+    let mut w = Writer { out: String::new(), images, wraps, material_names: vec![] };
     for line in header.lines() {
         let _ = writeln!(w.out, "# {line}");
     }
@@ -92,6 +93,8 @@ pub fn to_toml(scene: &Scene, images: &[String], meshes: &[String], header: &str
 struct Writer<'a> {
     out: String,
     images: &'a [String],
+    /// Each image's wrap modes (written with the textures that place it).
+    wraps: Vec<[Wrap; 2]>,
     material_names: Vec<String>,
 }
 
@@ -330,6 +333,11 @@ impl Writer<'_> {
         }
         if offset != Vec2::ZERO {
             table += &format!(", offset = [{}, {}]", num(offset.x), num(offset.y));
+        }
+        match self.wraps.get(image).copied().unwrap_or_default() {
+            [Wrap::Repeat, Wrap::Repeat] => {}
+            [u, v] if u == v => table += &format!(", wrap = {}", string(u.name())),
+            [u, v] => table += &format!(", wrap = [{}, {}]", string(u.name()), string(v.name())),
         }
         table + " }"
     }

@@ -1,7 +1,7 @@
 //! The scene reader on real files and on the mistakes users make.
 
 use alhazen_math::Vec3;
-use alhazen_scene::{CameraDesc, Light, PerspectiveOpening, Shape, Texture, load_scene, parse_scene};
+use alhazen_scene::{CameraDesc, Light, PerspectiveOpening, Shape, Texture, Wrap, load_scene, parse_scene};
 use std::path::Path;
 
 fn err(text: &str) -> String {
@@ -555,6 +555,21 @@ fn image_offsets_read_write_back_and_are_refused_where_unsupported() {
         std::fs::write(&path, text).unwrap();
         let e = load_scene(&path).unwrap_err().to_string();
         assert!(e.contains("o.toml:2") && !e.contains("cannot load"), "{bad}: {e}");
+    }
+    // Wrap modes, one for both axes or one each, written back so.
+    for (wrap, want) in [("\"clamp\"", [Wrap::Clamp; 2]), ("[\"mirror\", \"black\"]", [Wrap::Mirror, Wrap::Black])] {
+        let text = format!("[materials.m]\ncolor = {{ image = {{ file = \"t.png\", wrap = {wrap} }} }}\n");
+        std::fs::write(&path, text).unwrap();
+        let s = load_scene(&path).unwrap();
+        assert_eq!(s.images[0].wrap, want);
+        alhazen_scene::write::write_scene(&s, &again, &dir.path().join("assets"), "").unwrap();
+        assert_eq!(load_scene(&again).unwrap().images[0].wrap, want);
+    }
+    for bad in ["\"clmap\"", "[\"clamp\"]", "3"] {
+        let text = format!("[materials.m]\ncolor = {{ image = {{ file = \"t.png\", wrap = {bad} }} }}\n");
+        std::fs::write(&path, text).unwrap();
+        let e = load_scene(&path).unwrap_err().to_string();
+        assert!(e.contains("o.toml:2") && e.contains("wrap"), "{bad}: {e}");
     }
     for bad in ["nan", "\"30\"", "1e9"] {
         let text = format!("[materials.m]\ncolor = {{ image = {{ file = \"t.png\", rotation = {bad} }} }}\n");
