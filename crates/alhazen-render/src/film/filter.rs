@@ -40,11 +40,6 @@ impl FilmSampler {
         Self { axes: Some([0, 1].map(|axis| Staircase::new(filter, axis))) }
     }
 
-    /// The box of one pixel.
-    pub fn pixel() -> Self {
-        Self { axes: None }
-    }
-
     /// Film position and weight of sample `index` of `spp` of pixel `(x, y)` placed by the
     /// pixel's strata ([`stratified_offset`]); a lone sample is the pixel's centre, weight 1 (a
     /// point sample, not a draw from the filter).
