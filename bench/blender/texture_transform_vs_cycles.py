@@ -6,7 +6,11 @@ Color is a smoothly repeating image of waves (red along u, green along v, blue a
 diagonal), for the test
 `blender_texture_transform_agrees_with_cycles` (crates/alhazen-import/tests/gltf.rs).
 
-    python3 bench/blender/texture_transform_vs_cycles.py OUT_DIR [--spp 1024]
+    python3 bench/blender/texture_transform_vs_cycles.py OUT_DIR [--spp 1024] [--extension EXTEND|MIRROR]
+
+`--extension` sets the image node's extension (Blender's Extend and Mirror, exported as the
+sampler's CLAMP_TO_EDGE and MIRRORED_REPEAT: the wrap modes, test
+`blender_wrap_modes_agree_with_cycles`) and names the files texture-extend / texture-mirror.
 
 Writes OUT_DIR/texture-transform.glb and OUT_DIR/texture-transform-cycles.exr (64 × 64, CPU,
 2 threads, box filter of one pixel, no bounces: the panel's emission alone). Needs
@@ -29,12 +33,13 @@ def waves(x, y):
     return (0.5 + 0.4 * math.sin(t * x), 0.5 + 0.4 * math.sin(t * y + 1.0), 0.5 + 0.4 * math.cos(t * (x + y)), 1.0)
 
 
-def build(out):
+def build(out, extension="REPEAT"):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     img = saved_image("waves", 32, waves, os.path.join(out, "waves.png"))
     m = material("panel", (0.0, 0.0, 0.0), 0.0, 1.0)
     tex, p = image_node(m, img)
+    tex.extension = extension
     coords = m.node_tree.nodes.new("ShaderNodeTexCoord")
     mapping = m.node_tree.nodes.new("ShaderNodeMapping")
     mapping.inputs["Location"].default_value = (0.15, 0.3, 0.0)
@@ -54,10 +59,12 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=1024)
+    ap.add_argument("--extension", choices=["REPEAT", "EXTEND", "MIRROR"], default="REPEAT")
     a = ap.parse_args()
     out = os.path.abspath(a.out)
     os.makedirs(out, exist_ok=True)
-    export_and_render_emission(build(out), out, "texture-transform", (64, 64), a.spp)
+    stem = "texture-transform" if a.extension == "REPEAT" else f"texture-{a.extension.lower()}"
+    export_and_render_emission(build(out, a.extension), out, stem, (64, 64), a.spp)
 
 
 if __name__ == "__main__":
