@@ -1113,3 +1113,34 @@ fn bitmaps_wrap_as_their_wrap_mode_says() {
     let e = load("wrap").unwrap_err();
     assert!(e.contains("w.xml:2:") && e.contains("unknown wrap_mode"), "{e}");
 }
+
+/// A `to_uv` that is not a scale, then a turn, then a shift (a shear; a turn before an unequal
+/// scale) is warned about and left out: the image is read as it is.
+#[test]
+fn to_uv_beyond_scale_turn_and_shift_is_warned() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([0, 255, 0])).save(dir.path().join("g.png")).unwrap();
+    let load = |to_uv: &str| {
+        let text = scene(&format!(
+            r#"<shape type="rectangle"><bsdf type="diffuse"><texture type="bitmap" name="reflectance">
+               <string name="filename" value="g.png"/><transform name="to_uv">{to_uv}</transform></texture></bsdf></shape>"#
+        ));
+        std::fs::write(dir.path().join("u.xml"), text).unwrap();
+        let s = alhazen_import::load(&dir.path().join("u.xml")).unwrap();
+        let warned =
+            s.warnings.iter().any(|w| w.to_string().contains("to_uv other than a scale, a rotation and a shift"));
+        let Some(BsdfDesc::Lambert { albedo: Texture::Image { scale, offset, rotation, .. } }) =
+            &s.scene.materials[1].bsdf
+        else {
+            panic!("{:?}", s.scene.materials)
+        };
+        (warned, (*scale, *offset, *rotation))
+    };
+    let plain = (alhazen_math::Vec2::ONE, alhazen_math::Vec2::ZERO, 0.0);
+    assert_eq!(load(r#"<matrix value="1 0.5 0 0  0 1 0 0  0 0 1 0  0 0 0 1"/>"#), (true, plain));
+    assert_eq!(load(r#"<rotate z="1" angle="30"/><scale x="2" y="1"/>"#), (true, plain));
+    let (warned, (scale, offset, rotation)) =
+        load(r#"<scale x="2" y="1"/><rotate z="1" angle="90"/><translate x="0.5"/>"#);
+    assert!(!warned && (scale - alhazen_math::Vec2::new(2.0, 1.0)).length() < 1e-12 && (rotation - 90.0).abs() < 1e-12);
+    assert!((offset - alhazen_math::Vec2::new(0.5, 0.0)).length() < 1e-12);
+}

@@ -236,6 +236,9 @@ fn image_maps_load_after_the_walk_and_an_unreadable_one_is_located() {
     let Some((scale, offset)) = albedo else { panic!("{:?}", placed.scene.materials) };
     assert_eq!((*scale, *offset), (alhazen_math::Vec2::new(2.0, 3.0), alhazen_math::Vec2::new(0.25, -0.5)));
     assert_eq!(placed.scene.images[0].wrap, [alhazen_scene::Wrap::Black; 2], "pbrt's wrap");
+    let octahedral = load(&body.replace("green.png\"", "green.png\" \"string wrap\" \"octahedralsphere\"")).unwrap();
+    assert_eq!(octahedral.scene.images[0].wrap, [alhazen_scene::Wrap::Repeat; 2]);
+    assert!(octahedral.warnings.iter().any(|w| w.to_string().contains("\"octahedralsphere\" is read as repeat")));
     let err = load(&format!("WorldBegin\n{}\nNamedMaterial \"glod\"", texture("missing.png"))).unwrap_err();
     assert!(err.contains("a.pbrt:2:") && err.contains("cannot load image"), "{err}");
 }
