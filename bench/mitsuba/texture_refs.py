@@ -16,7 +16,11 @@
   1 elsewhere, around a two-sided diffuse BSDF) under a small light, dappling the floor (test
   `a_masked_card_agrees_with_mitsuba`). Mitsuba's shadow rays stop at a mask, so its floor's
   light under the card comes from paths through the holes alone and converges slowly: its
-  reference takes four times the samples.
+  reference takes four times the samples;
+- vertex-colors: a PLY panel of 12 × 12 quads (triangulated) whose vertices carry float
+  `red`, `green`, `blue` colours, a diffuse BSDF whose reflectance is the `mesh_attribute`
+  `vertex_color`, under a constant white sky (radiance 1): facing the camera, the panel shows
+  its interpolated colours themselves (test `vertex_colors_agree_with_mitsuba`).
 
     python3 bench/mitsuba/texture_refs.py [--spp 8192] [--only NAME]
 
@@ -184,10 +188,61 @@ def turned(spp):
     mi.Bitmap(img).write(os.path.join(OUT, "turned-texture-mitsuba.exr"))
 
 
+VERTEX_COLORS = """<?xml version="1.0" encoding="utf-8"?>
+<!-- A diffuse panel coloured by its PLY vertex colours under a white sky (bench/mitsuba/texture_refs.py). -->
+<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="25"/>
+        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+        <film type="hdrfilm">
+            <integer name="width" value="64"/><integer name="height" value="64"/>
+            <rfilter type="box"/><string name="pixel_format" value="rgb"/>
+        </film>
+    </sensor>
+    <emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>
+    <shape type="ply">
+        <string name="filename" value="vertex-colors.ply"/>
+        <bsdf type="diffuse">
+            <texture name="reflectance" type="mesh_attribute"><string name="name" value="vertex_color"/></texture>
+        </bsdf>
+    </shape>
+</scene>
+"""
+
+
+def vertex_colors(spp):
+    """The panel as an ASCII PLY: (x, y) in [−1, 1]², z = 0, facing +z; colours varying
+    smoothly from vertex to vertex (red along x, green along y, blue along the diagonal)."""
+    cuts = 12
+    xs = np.linspace(-1.0, 1.0, cuts + 1)
+    verts = [(x, y) for y in xs for x in xs]
+    paint = lambda x, y: (0.5 + 0.4 * np.sin(2.0 * x), 0.5 + 0.4 * np.sin(1.7 * y + 0.5), 0.5 + 0.4 * np.cos(1.3 * (x + y)))
+    faces = []
+    for j in range(cuts):
+        for i in range(cuts):
+            a, b, c, d = j * (cuts + 1) + i, j * (cuts + 1) + i + 1, (j + 1) * (cuts + 1) + i + 1, (j + 1) * (cuts + 1) + i
+            faces += [(a, b, c), (a, c, d)]
+    lines = ["ply", "format ascii 1.0", f"element vertex {len(verts)}", "property float x", "property float y",
+             "property float z", "property float red", "property float green", "property float blue",
+             f"element face {len(faces)}", "property list uchar int vertex_indices", "end_header"]
+    lines += [f"{x:.6f} {y:.6f} 0 " + " ".join(f"{c:.6f}" for c in paint(x, y)) for x, y in verts]
+    lines += [f"3 {a} {b} {c}" for a, b, c in faces]
+    with open(os.path.join(OUT, "vertex-colors.ply"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    path = os.path.join(OUT, "vertex-colors.xml")
+    with open(path, "w") as f:
+        f.write(VERTEX_COLORS)
+    img = mi.render(mi.load_file(path), spp=spp, seed=11)
+    mi.Bitmap(img).write(os.path.join(OUT, "vertex-colors-mitsuba.exr"))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=8192)
-    ap.add_argument("--only", choices=["textured-emitter", "principled-maps", "masked-card", "turned-texture"])
+    ap.add_argument("--only", choices=["textured-emitter", "principled-maps", "masked-card", "turned-texture",
+                                       "vertex-colors"])
     args = ap.parse_args()
     os.makedirs(OUT, exist_ok=True)
     mi.set_variant("scalar_rgb")
@@ -195,6 +250,8 @@ def main():
         return masked(args.spp)
     if args.only == "turned-texture":
         return turned(args.spp)
+    if args.only == "vertex-colors":
+        return vertex_colors(args.spp)
     if args.only == "principled-maps":
         return principled(args.spp)
     # Eight colours, four across and two down, each well apart from its neighbours.
@@ -214,6 +271,7 @@ def main():
         principled(args.spp)
         masked(args.spp)
         turned(args.spp)
+        vertex_colors(args.spp)
 
 
 if __name__ == "__main__":

@@ -147,7 +147,7 @@ fn write_solution(s: &Solution, file: alhazen_render::output::PendingFile, path:
     let triangles = ply::lit_triangles(s);
     let fingerprint = ply::scene_fingerprint(&s.scene);
     let shown = |t: &ply::LitTriangle, k: usize| {
-        alhazen_radiosity::display::shown(&s.scene, t.material, t.uv[k], t.irradiance[k], t.front)
+        alhazen_radiosity::display::shown(&s.scene, t.material, (t.uv[k], t.color[k]), t.irradiance[k], t.front)
     };
     file.finish(|f| ply::write(&mut BufWriter::new(f), &triangles, fingerprint, shown))
         .map_err(|e| Failure::work(format!("cannot write {}: {e}", path.display())))
@@ -184,7 +184,7 @@ pub(crate) fn prepare_solution(path: &Path, scene: &Scene) -> Result<alhazen_ras
         .triangles
         .iter()
         .map(|t| {
-            let v = std::array::from_fn(|k| Vertex { p: t.p[k], n: t.n[k], uv: t.uv[k] });
+            let v = std::array::from_fn(|k| Vertex { p: t.p[k], n: t.n[k], uv: t.uv[k], color: t.color[k] });
             let tri = Triangle { v, material: t.material, closed: true, unbounded: false, object: t.object };
             (tri, Prelit { irradiance: t.irradiance, front: t.front })
         })

@@ -40,6 +40,8 @@ pub enum MeshError {
     NonFiniteVertex(usize),
     /// Per-vertex attribute arrays differ in length from the positions.
     AttributeLength(&'static str),
+    /// A vertex colour is negative, NaN or infinite.
+    BadColor(usize),
     /// No triangles.
     Empty,
 }
@@ -52,6 +54,7 @@ impl std::fmt::Display for MeshError {
             }
             Self::NonFiniteVertex(i) => write!(f, "vertex {i} has a non-finite coordinate"),
             Self::AttributeLength(a) => write!(f, "the {a} array does not match the vertex count"),
+            Self::BadColor(i) => write!(f, "vertex {i}'s colour is not finite and ≥ 0"),
             Self::Empty => write!(f, "the mesh has no triangles"),
         }
     }
@@ -59,8 +62,8 @@ impl std::fmt::Display for MeshError {
 
 impl std::error::Error for MeshError {}
 
-/// An indexed triangle mesh with optional per-vertex normals and texture coordinates, and an
-/// optional per-triangle material slot.
+/// An indexed triangle mesh with optional per-vertex normals, texture coordinates and colours,
+/// and an optional per-triangle material slot.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleMesh {
     /// Vertex positions.
@@ -69,6 +72,10 @@ pub struct TriangleMesh {
     pub normals: Vec<Vec3>,
     /// Per-vertex texture coordinates (same length as `positions`) or empty.
     pub uvs: Vec<Vec2>,
+    /// Per-vertex linear RGB colours (same length as `positions`) or empty: what a material
+    /// with `vertex_colors` multiplies its base colour by (glTF's `COLOR_0`, a PLY's `red`,
+    /// `green`, `blue`).
+    pub colors: Vec<Vec3>,
     /// Vertex indices, counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
     /// Per-triangle material slot (index into `material_names`) or empty.
@@ -104,6 +111,12 @@ impl TriangleMesh {
         }
         if !self.uvs.is_empty() && self.uvs.len() != self.positions.len() {
             return Err(MeshError::AttributeLength("texture coordinate"));
+        }
+        if !self.colors.is_empty() && self.colors.len() != self.positions.len() {
+            return Err(MeshError::AttributeLength("colour"));
+        }
+        if let Some(i) = self.colors.iter().position(|c| !(c.is_finite() && c.min_element() >= 0.0)) {
+            return Err(MeshError::BadColor(i));
         }
         if !self.material_slots.is_empty() && self.material_slots.len() != self.triangles.len() {
             return Err(MeshError::AttributeLength("material slot"));

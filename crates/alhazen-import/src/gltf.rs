@@ -212,6 +212,10 @@ impl Importer<'_> {
             };
             let Some(index) = index else { continue };
             let material = self.material(prim.material())?;
+            // glTF multiplies every base colour by COLOR_0 where a primitive has it.
+            if !self.scene.meshes[index].colors.is_empty() {
+                self.scene.materials[material as usize].vertex_colors = true;
+            }
             self.bounds = self.bounds.union(t.bounds(&self.scene.meshes[index].bounds()));
             self.scene.objects.push(Object {
                 name: mesh.name().map(str::to_string),
@@ -250,6 +254,7 @@ impl Importer<'_> {
             .read_tex_coords(0)
             .map(|t| t.into_f32().map(|v| Vec2::new(v[0] as f64, 1.0 - v[1] as f64)).collect())
             .unwrap_or_default();
+        let rgba: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|c| c.into_rgba_f32().collect());
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..positions.len() as u32).collect(),
@@ -285,12 +290,8 @@ impl Importer<'_> {
             Mode::TriangleFan => (2..indices.len()).map(|k| [indices[0], indices[k - 1], indices[k]]).collect(),
             _ => indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         };
-        if prim.get(&gltf::Semantic::Colors(0)).is_some() {
-            self.warn(format!(
-                "{name}: vertex colours (COLOR_0) are not supported; the base colour is used without them"
-            ));
-        }
-        let mut m = TriangleMesh { positions, normals, uvs, triangles, ..Default::default() };
+        let colors = self.vertex_colors(rgba, prim, &name)?;
+        let mut m = TriangleMesh { positions, normals, uvs, colors, triangles, ..Default::default() };
         if m.normals.iter().any(|n| !n.is_finite()) {
             self.warn(format!("{name} has non-finite normals; they are recomputed from the faces"));
             m.normals.clear();
@@ -303,6 +304,26 @@ impl Importer<'_> {
         }
         m.validate().map_err(|e| self.err(format!("{name}: {e}")))?;
         Ok(Some(m))
+    }
+
+    /// `COLOR_0` (read as RGBA, integers normalised as the accessor says) as linear RGB, which
+    /// multiplies the base colour; empty without it. Its alpha is left out, with a warning
+    /// where it is not 1.
+    fn vertex_colors(&mut self, rgba: Option<Vec<[f32; 4]>>, prim: &gltf::Primitive, name: &str) -> R<Vec<Vec3>> {
+        let Some(rgba) = rgba else { return Ok(vec![]) };
+        let want = prim.get(&gltf::Semantic::Colors(0)).map_or(0, |a| a.count());
+        if rgba.len() != want {
+            return Err(self
+                .err(format!("{name}: its COLOR_0 accessor has {want} elements but its buffer holds {}", rgba.len())));
+        }
+        if rgba.iter().any(|c| c[3] != 1.0) {
+            self.warn(format!("{name}: the alpha of its vertex colours (COLOR_0) is not supported; ignored"));
+        }
+        let colors: Vec<Vec3> = rgba.iter().map(|c| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64)).collect();
+        if colors.iter().any(|c| !(c.is_finite() && c.min_element() >= 0.0)) {
+            return Err(self.err(format!("{name}: its vertex colours (COLOR_0) must be finite and ≥ 0")));
+        }
+        Ok(colors)
     }
 
     // ---- materials -----------------------------------------------------------------------------

@@ -57,6 +57,7 @@ pub fn load_with_parameters(path: &Path, parameters: &[(String, String)]) -> Res
         search: vec![],
         scene_dir: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
         cut_out: None,
+        vertex_colored: false,
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.scene.render.width = 768;
@@ -168,6 +169,8 @@ struct Importer {
     scene_dir: PathBuf,
     /// The cut-out of the `mask` met in the BSDF being read, for its material.
     cut_out: Option<alhazen_scene::Alpha>,
+    /// The BSDF being read takes a colour from its mesh's `vertex_color` attribute.
+    vertex_colored: bool,
 }
 
 /// A mesh file as placed: its path, its part of a `serialized` file, and whether it is turned
@@ -907,12 +910,13 @@ impl Importer {
     /// A `<bsdf>` element as a new material: one-sided, as Mitsuba's are, unless wrapped in
     /// `twosided` or letting light through.
     fn bsdf_material(&mut self, ctx: &Ctx, node: Node) -> R<MaterialId> {
-        self.cut_out = None;
+        (self.cut_out, self.vertex_colored) = (None, false);
         let (desc, bump) = self.bsdf(ctx, node, 0)?;
         let name = self.attr(ctx, node, "id")?.unwrap_or_else(|| format!("bsdf at line {}", ctx.line(node)));
         let one_sided = !self.is_twosided(node, 0) && reflects_only(&desc);
         let mut m = alhazen_scene::Material::from_bsdf(&name, desc);
         (m.bump, m.one_sided, m.alpha) = (bump, one_sided, self.cut_out.take());
+        m.vertex_colors = std::mem::take(&mut self.vertex_colored);
         Ok(common::add_material(&mut self.scene, m))
     }
 
@@ -1345,6 +1349,23 @@ impl Importer {
                     self.warn(ctx, node, "a checkerboard scaled differently in u and v uses the mean scale");
                 }
                 Texture::Checker { even, odd, size: 1.0 / (scale.x + scale.y) }
+            }
+            "mesh_attribute" => {
+                let name = self.string(ctx, &p, "name")?.unwrap_or_default();
+                let scale = self.float(ctx, &p, "scale", 1.0)?;
+                if name != "vertex_color" {
+                    self.warn(
+                        ctx,
+                        node,
+                        format!(
+                            "mesh attribute `{name}` is not supported (only vertex_color); approximated by grey 0.5"
+                        ),
+                    );
+                    return Ok(Texture::Solid(Vec3::splat(0.5)));
+                }
+                // The material multiplies its base colour by the mesh's colours.
+                self.vertex_colored = true;
+                Texture::Solid(Vec3::splat(scale))
             }
             other => {
                 self.warn(ctx, node, format!("texture `{other}` is not supported; approximated by grey 0.5"));

@@ -42,7 +42,7 @@ pub fn reflex_fills(scene: &Scene, mirrors: &[Mirror], view: &View) -> Vec<Fill>
             let material = &scene.materials[object.material as usize];
             triangles
                 .into_iter()
-                .flat_map(|t| reflect_triangle(scene, &mirrors[m], view, &t, &material.color))
+                .flat_map(|t| reflect_triangle(scene, &mirrors[m], view, &t, material))
                 .collect::<Vec<_>>()
         })
         .collect();
@@ -57,7 +57,7 @@ fn reflect_triangle(
     mirror: &Mirror,
     view: &View,
     t: &[Vertex; 3],
-    color: &alhazen_scene::Texture,
+    material: &alhazen_scene::Material,
 ) -> Vec<Reflected> {
     let viewer = view.viewer();
     let corners = t.map(|v| v.p);
@@ -70,7 +70,7 @@ fn reflect_triangle(
     let mut out = vec![];
     for piece in split_polygon(&corners, &lines) {
         for small in subdivided(piece, mirror, 0) {
-            if let Some(r) = reflect_polygon(scene, mirror, view, &small, t, color) {
+            if let Some(r) = reflect_polygon(scene, mirror, view, &small, t, material) {
                 out.push(r);
             }
         }
@@ -130,7 +130,7 @@ fn reflect_polygon(
     view: &View,
     poly: &[Vec3],
     t: &[Vertex; 3],
-    color: &alhazen_scene::Texture,
+    material: &alhazen_scene::Material,
 ) -> Option<Reflected> {
     let mut outline = vec![];
     for (i, a) in poly.iter().enumerate() {
@@ -149,20 +149,22 @@ fn reflect_polygon(
         points.push(view.to_paper(r));
     }
     let centre = poly.iter().sum::<Vec3>() / poly.len() as f64;
-    let rgb = alhazen_scene::texture::eval(color, uv_at(t, centre), &scene.images);
+    let (uv, vertex_color) = at(t, centre);
+    let rgb = alhazen_scene::texture::eval(&material.color, uv, &scene.images) * material.vertex_tint(vertex_color);
     let srgb = rgb.to_array().map(|c| alhazen_math::color::srgb_encode(c.clamp(0.0, 1.0)));
     Some(Reflected { fill: Fill { points, rgb: srgb }, path: path / outline.len() as f64 })
 }
 
-/// Texture coordinates at `p` in triangle `t` (barycentric).
-fn uv_at(t: &[Vertex; 3], p: Vec3) -> Vec2 {
+/// Texture coordinates and vertex colour at `p` in triangle `t` (barycentric).
+fn at(t: &[Vertex; 3], p: Vec3) -> (Vec2, Vec3) {
     let (a, b, c) = (t[0].p, t[1].p, t[2].p);
     let n = (b - a).cross(c - a);
     let area = n.length_squared();
     if area <= 0.0 {
-        return t[0].uv;
+        return (t[0].uv, t[0].color);
     }
     let wa = (c - b).cross(p - b).dot(n) / area;
     let wb = (a - c).cross(p - c).dot(n) / area;
-    t[0].uv * wa + t[1].uv * wb + t[2].uv * (1.0 - wa - wb)
+    let wc = 1.0 - wa - wb;
+    (t[0].uv * wa + t[1].uv * wb + t[2].uv * wc, t[0].color * wa + t[1].color * wb + t[2].color * wc)
 }

@@ -190,8 +190,9 @@ thread_local! {
 /// Bounding spheres of the objects whose materials have a delta lobe (mirrors, smooth glass);
 /// `None` when one of them is unbounded (a plane mirror), so photons cannot be aimed.
 fn specular_targets(scene: &Scene, world: &World) -> Option<Vec<Target>> {
-    let specular =
-        |m: u32| bsdf_at(&scene.materials[m as usize], Vec2::ZERO, &scene.images, ColorMode::Rgb).has_delta_lobe();
+    let specular = |m: u32| {
+        bsdf_at(&scene.materials[m as usize], Vec2::ZERO, Vec3::ONE, &scene.images, ColorMode::Rgb).has_delta_lobe()
+    };
     let mut targets = vec![];
     for o in world.objects() {
         let materials = std::iter::once(o.material).chain(o.slot_materials.iter().copied());
@@ -223,7 +224,7 @@ impl Tracer<'_> {
         for bounce in 0..self.max_depth {
             let Some(wh) = self.world.intersect(&ray, f64::INFINITY) else { return };
             let m = &self.scene.materials[wh.material as usize];
-            let bsdf = bsdf_at(m, wh.hit.uv, &self.scene.images, ColorMode::Rgb);
+            let bsdf = bsdf_at(m, wh.hit.uv, wh.hit.color, &self.scene.images, ColorMode::Rgb);
             let wi = -ray.dir;
             let (mut ng, mut ns) = (wh.hit.n, shading_normal(&wh.hit, m, &self.scene.images));
             if !bsdf.transmits() && ng.dot(wi) < 0.0 {

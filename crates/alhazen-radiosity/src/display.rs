@@ -87,16 +87,23 @@ impl Solution {
     /// surface triangle `t` from its front or back: emission (front only) plus the diffuse
     /// reflection `ρ(uv) Ẽ/π`.
     pub fn radiance(&self, t: usize, b: [f64; 2], uv: Vec2, side: usize) -> Vec3 {
-        let material = self.triangles[t].material;
-        shown(&self.scene, material, uv, self.irradiance(t, b, side) / PI, side == 0)
+        let tri = &self.triangles[t];
+        shown(&self.scene, tri.material, (uv, tri.color_at(b)), self.irradiance(t, b, side) / PI, side == 0)
     }
 }
 
-/// The radiance shown where material `material` (texture coordinates `uv`) receives the
-/// irradiance `e_over_pi · π`: its emission on the front, and `ρ(uv) · e_over_pi`.
-pub fn shown(scene: &alhazen_scene::Scene, material: u32, uv: Vec2, e_over_pi: Vec3, front: bool) -> Vec3 {
+/// The radiance shown where material `material` (texture coordinates `uv`, vertex colour
+/// `color`) receives the irradiance `e_over_pi · π`: its emission on the front, and
+/// `ρ(uv) · e_over_pi`.
+pub fn shown(
+    scene: &alhazen_scene::Scene,
+    material: u32,
+    (uv, color): (Vec2, Vec3),
+    e_over_pi: Vec3,
+    front: bool,
+) -> Vec3 {
     let m = &scene.materials[material as usize];
-    let rho = alhazen_scene::texture::eval(&m.color, uv, &scene.images) * m.diffuse;
+    let rho = alhazen_scene::texture::eval(&m.color, uv, &scene.images) * m.vertex_tint(color) * m.diffuse;
     let emitted = if front { m.emission } else { Vec3::ZERO };
     emitted + rho.clamp(Vec3::ZERO, Vec3::ONE) * e_over_pi
 }

@@ -20,6 +20,8 @@ pub struct InputTriangle {
     pub n: [Vec3; 3],
     /// Texture coordinates at the corners.
     pub uv: [Vec2; 3],
+    /// Vertex colours at the corners (white where the mesh has none).
+    pub color: [Vec3; 3],
     /// Unit geometric normal (the front).
     pub normal: Vec3,
     /// Area.
@@ -49,6 +51,12 @@ impl InputTriangle {
     #[inline]
     pub fn uv_at(&self, b: [f64; 2]) -> Vec2 {
         self.uv[0] + (self.uv[1] - self.uv[0]) * b[0] + (self.uv[2] - self.uv[0]) * b[1]
+    }
+
+    /// Vertex colour at `(b1, b2)`.
+    #[inline]
+    pub fn color_at(&self, b: [f64; 2]) -> Vec3 {
+        self.color[0] + (self.color[1] - self.color[0]) * b[0] + (self.color[2] - self.color[0]) * b[1]
     }
 
     /// Shading normal at `(b1, b2)`.
@@ -98,7 +106,7 @@ pub fn surfaces(scene: &Scene) -> Surfaces {
     let mut out = Vec::with_capacity(tess.triangles.len());
     let mut planes = 0;
     for t in tess.triangles.iter().filter(|t| !t.unbounded) {
-        push(&mut out, t.v.map(|v| (v.p, v.n, v.uv)), (t.material, t.object, t.closed));
+        push(&mut out, t.v.map(|v| (v.p, v.n, v.uv, v.color)), (t.material, t.object, t.closed));
     }
     for (i, o) in scene.objects.iter().enumerate() {
         if let Shape::Plane { point, normal } = o.shape {
@@ -106,14 +114,17 @@ pub fn surfaces(scene: &Scene) -> Surfaces {
             let (point, normal) = (o.transform.point(point), o.transform.normal(normal).normalize());
             planes += 1;
             for corners in plane_square(point, normal, center, size) {
-                push(&mut out, corners, (material, i as u32, false));
+                push(&mut out, corners.map(|(p, n, uv)| (p, n, uv, Vec3::ONE)), (material, i as u32, false));
             }
         }
     }
     Surfaces { triangles: out, planes, plane_side: size, skipped: tess.skipped }
 }
 
-fn push(out: &mut Vec<InputTriangle>, v: [(Vec3, Vec3, Vec2); 3], (material, object, closed): (u32, u32, bool)) {
+/// A corner: position, shading normal, texture coordinates, vertex colour.
+type Corner = (Vec3, Vec3, Vec2, Vec3);
+
+fn push(out: &mut Vec<InputTriangle>, v: [Corner; 3], (material, object, closed): (u32, u32, bool)) {
     let p = v.map(|c| c.0);
     let cross = (p[1] - p[0]).cross(p[2] - p[0]);
     let area = 0.5 * cross.length();
@@ -122,7 +133,8 @@ fn push(out: &mut Vec<InputTriangle>, v: [(Vec3, Vec3, Vec2); 3], (material, obj
     }
     let normal = cross.normalize();
     let n = v.map(|c| if c.1.dot(normal) > 0.0 { c.1.normalize() } else { normal });
-    out.push(InputTriangle { p, n, uv: v.map(|c| c.2), normal, area, material, object, closed });
+    let (uv, color) = (v.map(|c| c.2), v.map(|c| c.3));
+    out.push(InputTriangle { p, n, uv, color, normal, area, material, object, closed });
 }
 
 /// The square of side `size` of the plane `(point, normal)` centred where `center` projects,
@@ -408,6 +420,7 @@ mod tests {
             p: [Vec3::new(1.0, 0.0, 0.0), Vec3::new(3.0, 1.0, 0.5), Vec3::new(0.0, 2.0, 1.0)],
             n: [Vec3::Z; 3],
             uv: [Vec2::ZERO; 3],
+            color: [Vec3::ONE; 3],
             normal: Vec3::Z,
             area: 1.0,
             material: 0,

@@ -5,6 +5,8 @@
 //! * `x y z`, `nx ny nz` (the side's shading normal), `s t` (texture coordinates),
 //! * `irradiance_r irradiance_g irradiance_b`: the vertex-averaged irradiance over π, what the
 //!   preview multiplies by the material's `ρ(uv)` per pixel,
+//! * `color_r color_g color_b`: the mesh's vertex colour there (linear; white where it has
+//!   none), which tints `ρ` of a material with vertex colours,
 //! * `red green blue`: the radiance shown at the vertex, 8-bit sRGB, for other programs;
 //!
 //! and per face `material` and `object` (indices of the scene's) and `front` (1 when the face
@@ -28,6 +30,8 @@ pub struct LitTriangle {
     pub uv: [Vec2; 3],
     /// Irradiance over π at the corners.
     pub irradiance: [Vec3; 3],
+    /// Vertex colours at the corners.
+    pub color: [Vec3; 3],
     /// Scene material.
     pub material: u32,
     /// Scene object.
@@ -46,7 +50,7 @@ pub struct LitMesh {
 }
 
 const MAGIC: &str = "alhazen radiosity solution";
-const VERTEX_PROPERTIES: [&str; 14] = [
+const VERTEX_PROPERTIES: [&str; 17] = [
     "float x",
     "float y",
     "float z",
@@ -58,12 +62,15 @@ const VERTEX_PROPERTIES: [&str; 14] = [
     "float irradiance_r",
     "float irradiance_g",
     "float irradiance_b",
+    "float color_r",
+    "float color_g",
+    "float color_b",
     "uchar red",
     "uchar green",
     "uchar blue",
     // (the face properties follow in the header)
 ];
-const VERTEX_BYTES: usize = 11 * 4 + 3;
+const VERTEX_BYTES: usize = 14 * 4 + 3;
 const FACE_BYTES: usize = 1 + 12 + 4 + 4 + 1;
 
 /// A hash of what a solution depends on in `scene`: its surfaces, materials, lights and
@@ -95,6 +102,7 @@ pub fn lit_triangles(solution: &Solution) -> Vec<LitTriangle> {
                     n: node.bary.map(|b| tri.normal_at(b) * sign),
                     uv: node.bary.map(|b| tri.uv_at(b)),
                     irradiance: e,
+                    color: node.bary.map(|b| tri.color_at(b)),
                     material: tri.material,
                     object: tri.object,
                     front: side == 0,
@@ -104,6 +112,7 @@ pub fn lit_triangles(solution: &Solution) -> Vec<LitTriangle> {
                     lit.n.swap(1, 2);
                     lit.uv.swap(1, 2);
                     lit.irradiance.swap(1, 2);
+                    lit.color.swap(1, 2);
                 }
                 out.push(lit);
             }
@@ -136,7 +145,8 @@ pub fn write(
     for t in triangles {
         for k in 0..3 {
             let floats = [t.p[k].to_array(), t.n[k].to_array()].concat();
-            for x in floats.iter().chain(&[t.uv[k].x, t.uv[k].y]).chain(&t.irradiance[k].to_array()) {
+            let lit = [t.irradiance[k].to_array(), t.color[k].to_array()].concat();
+            for x in floats.iter().chain(&[t.uv[k].x, t.uv[k].y]).chain(&lit) {
                 buf.extend((*x as f32).to_le_bytes());
             }
             let c = shown(t, k);
@@ -212,11 +222,12 @@ pub fn read(bytes: &[u8]) -> Result<LitMesh, String> {
             n: v.map(|b| vec(b, 3)),
             uv: v.map(|b| Vec2::new(f32_at(b, 6), f32_at(b, 7))),
             irradiance: v.map(|b| vec(b, 8)),
+            color: v.map(|b| vec(b, 11)),
             material: material as u32,
             object: object as u32,
             front: f[21] != 0,
         };
-        let finite = t.p.iter().chain(&t.n).chain(&t.irradiance).all(|x| x.is_finite());
+        let finite = t.p.iter().chain(&t.n).chain(&t.irradiance).chain(&t.color).all(|x| x.is_finite());
         if !finite || t.uv.iter().any(|x| !x.is_finite()) {
             return Err(format!("triangle {i}: a value is not a finite number"));
         }
@@ -235,6 +246,7 @@ mod tests {
             n: [Vec3::Z; 3],
             uv: [Vec2::ZERO, Vec2::X, Vec2::Y],
             irradiance: [Vec3::new(0.5, 0.25, 0.125), Vec3::ONE, Vec3::ZERO],
+            color: [Vec3::ONE, Vec3::new(0.25, 0.5, 1.0), Vec3::ONE],
             material: 2,
             object: 7,
             front: false,

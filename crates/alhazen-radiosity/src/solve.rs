@@ -252,7 +252,9 @@ fn fit_patch_size(tris: &[InputTriangle], mut size: f64) -> f64 {
 fn reflectance(scene: &Scene, tri: &InputTriangle, bary: [[f64; 2]; 3]) -> Vec3 {
     let m = &scene.materials[tri.material as usize];
     let c = [0, 1].map(|k| (bary[0][k] + bary[1][k] + bary[2][k]) / 3.0);
-    let at = |b: [f64; 2]| alhazen_scene::texture::eval(&m.color, tri.uv_at(b), &scene.images);
+    let at = |b: [f64; 2]| {
+        alhazen_scene::texture::eval(&m.color, tri.uv_at(b), &scene.images) * m.vertex_tint(tri.color_at(b))
+    };
     let halfway = |i: usize| [0, 1].map(|k| 0.5 * (c[k] + bary[i][k]));
     let sum = at(c) + at(halfway(0)) + at(halfway(1)) + at(halfway(2));
     (sum * 0.25 * m.diffuse).clamp(Vec3::ZERO, Vec3::ONE)

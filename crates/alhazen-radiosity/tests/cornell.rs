@@ -142,3 +142,55 @@ fn the_hemicube_agrees_with_the_closed_form() {
         }
     }
 }
+
+/// A floor painted red by its vertex colours (a white material with `vertex_colors`) under a
+/// lamp facing it bleeds red onto a white panel above the lamp, which only the floor lights;
+/// the same floor without its colours bleeds grey. The floor itself shows red.
+#[test]
+fn vertex_colours_bleed_onto_their_neighbours() {
+    let text = r#"
+[camera]
+eye = [0, 1, 4]
+target = [0, 1, 0]
+[materials.white]
+color = 0.8
+vertex_colors = true
+[materials.lamp]
+emission = [5, 5, 5]
+[[object]]
+shape = "rectangle"
+material = "white"
+transform = [{ scale = 2 }, { rotate_x = -90 }]
+[[object]]
+shape = "disk"
+center = [0, 2, 0]
+normal = [0, -1, 0]
+radius = 0.5
+material = "lamp"
+[[object]]
+shape = "rectangle"
+material = "white"
+transform = [{ rotate_x = 90 }, { translate = [0, 2.5, 0] }]
+"#;
+    let mut scene = alhazen_scene::parse_scene("painted.toml".as_ref(), text).unwrap();
+    let alhazen_scene::Shape::Mesh { mesh, .. } = scene.objects[0].shape else { panic!("not a mesh") };
+    // The floor and the panel share the rectangle: the panel is given its own white copy.
+    let mut floor = (*scene.meshes[mesh]).clone();
+    floor.colors = vec![Vec3::new(1.0, 0.1, 0.1); floor.positions.len()];
+    scene.meshes.push(std::sync::Arc::new(floor));
+    scene.objects[0].shape = alhazen_scene::Shape::Mesh { mesh: scene.meshes.len() - 1, smooth: true };
+    let bled = |scene: &alhazen_scene::Scene| {
+        let s = alhazen_radiosity::solve(scene, &Default::default(), &|_, _| {}).unwrap();
+        let panel = s.triangles.iter().position(|t| t.normal.y < -0.9 && t.p[0].y > 2.4).unwrap();
+        let floor = s.triangles.iter().position(|t| t.normal.y > 0.9 && t.p[0].y.abs() < 1e-9).unwrap();
+        let b = [1.0 / 3.0; 2];
+        let uv = alhazen_math::Vec2::ZERO;
+        (s.irradiance(panel, s.triangles[panel].barycentric(s.triangles[panel].at(b)), 0), s.radiance(floor, b, uv, 0))
+    };
+    let (painted, red) = bled(&scene);
+    assert!(painted.x > 5.0 * painted.y && red.x > 5.0 * red.y, "{painted} {red}");
+    let last = scene.meshes.len() - 1;
+    std::sync::Arc::make_mut(&mut scene.meshes[last]).colors.clear();
+    let (plain, grey) = bled(&scene);
+    assert!((plain.x - plain.y).abs() < 1e-9 * plain.x && (grey.x - grey.y).abs() < 1e-9 * grey.x, "{plain} {grey}");
+}

@@ -801,3 +801,29 @@ fn cut_outs_agree_with_the_ray_tracer() {
     eprintln!("without them: {:.2} %", whole_err * 100.0);
     assert!(whole_err > 2.0 * err.max(0.01), "the holes show nothing");
 }
+
+/// A screen whose four corners are painted red, green, blue and white (vertex colours, which
+/// its material multiplies its colour by): the preview interpolates them as the ray tracer
+/// does; drawn without them it is off.
+#[test]
+fn vertex_colours_agree_with_the_ray_tracer() {
+    let text = format!(
+        "{SCENE}\n[materials.screen]\ncolor = 0.9\nvertex_colors = true\n[[object]]\nshape = \"rectangle\"\n\
+         material = \"screen\"\ntransform = [{{ scale = 1.2 }}, {{ translate = [-0.6, 0.9, 1.2] }}]\n"
+    );
+    let mut scene = parse_scene("painted.toml".as_ref(), &text).unwrap();
+    let screen = scene.objects.last().unwrap();
+    let alhazen_scene::Shape::Mesh { mesh, .. } = screen.shape else { panic!("the rectangle is not a mesh") };
+    let corners = [Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE];
+    std::sync::Arc::make_mut(&mut scene.meshes[mesh]).colors = corners.to_vec();
+    let traced = alhazen_render::render(&scene, &|_, _| {});
+    let (fb, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    let err = relative_error(&fb, &traced);
+    eprintln!("vertex colours: mean absolute difference {:.2} % of the mean brightness", err * 100.0);
+    assert!(err < 0.02, "mean error {:.2} % of the mean brightness", err * 100.0);
+    std::sync::Arc::make_mut(&mut scene.meshes[mesh]).colors.clear();
+    let (plain, _) = render_scene(&scene, &RasterOptions::default()).unwrap();
+    let plain_err = relative_error(&plain, &traced);
+    eprintln!("without them: {:.2} %", plain_err * 100.0);
+    assert!(plain_err > 2.0 * err.max(0.01), "the colours show nothing");
+}

@@ -221,8 +221,9 @@ impl<'a> PathTracer<'a> {
             .iter()
             .map(|m| {
                 let untextured = matches!(m.color, alhazen_scene::Texture::Solid(_))
-                    && m.bsdf.as_ref().is_none_or(|b| !b.is_textured());
-                untextured.then(|| bsdf_at(m, Vec2::ZERO, &scene.images, ColorMode::Rgb))
+                    && m.bsdf.as_ref().is_none_or(|b| !b.is_textured())
+                    && !m.vertex_colors;
+                untextured.then(|| bsdf_at(m, Vec2::ZERO, Vec3::ONE, &scene.images, ColorMode::Rgb))
             })
             .collect();
         let lights = Lights::build(scene);
@@ -316,7 +317,7 @@ impl<'a> PathTracer<'a> {
         }
         let bsdf = match (&self.uniform_bsdfs[wh.material as usize], mode) {
             (Some(b), ColorMode::Rgb) => Cow::Borrowed(b),
-            _ => Cow::Owned(bsdf_at(m, wh.hit.uv, &self.scene.images, mode)),
+            _ => Cow::Owned(bsdf_at(m, wh.hit.uv, wh.hit.color, &self.scene.images, mode)),
         };
         if self.spectral && !path.hero_only && is_dispersive(&bsdf) {
             // Wavelength-dependent paths: only the hero survives (×3 keeps it unbiased).

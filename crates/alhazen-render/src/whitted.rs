@@ -247,7 +247,7 @@ impl<'a> Whitted<'a> {
         if n.dot(v) <= 0.0 {
             n = ng;
         }
-        let a = ch.c(texture::eval(&m.color, h.uv, &self.scene.images)) * m.diffuse;
+        let a = ch.c(texture::eval(&m.color, h.uv, &self.scene.images) * m.vertex_tint(h.color)) * m.diffuse;
         let at = Shading { m, a, p: h.p, n, ng, v, ch };
         let mut color = a * ch.c(self.scene.ambient) + self.direct(&at);
         if !self.emitters.is_empty() {

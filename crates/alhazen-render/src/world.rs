@@ -262,6 +262,7 @@ fn baked(mesh: &TriangleMesh, tf: &alhazen_math::Transform) -> TriangleMesh {
         normals,
         triangles,
         uvs: mesh.uvs.clone(),
+        colors: mesh.colors.clone(),
         material_slots: mesh.material_slots.clone(),
         material_names: mesh.material_names.clone(),
     }
@@ -466,7 +467,7 @@ impl World {
     fn flat_shading(&self, lane: Lane) -> Option<FlatShading> {
         let o = &self.objects[lane.object as usize];
         let Shape::Mesh(mesh) = &o.placed.shape else { return None };
-        if o.placed.uv || o.tangents {
+        if o.placed.uv || o.tangents || !mesh.accel.mesh.colors.is_empty() {
             return None;
         }
         let first = lane.flat.triangle as usize;

@@ -58,6 +58,7 @@ fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     let mut mesh = TriangleMesh::default();
     let mut any_normals = true;
     let mut any_uvs = true;
+    let mut any_colors = true;
     for m in &models {
         let mm = &m.mesh;
         let base = mesh.positions.len() as u32;
@@ -71,6 +72,12 @@ fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
         if any_uvs {
             mesh.uvs.extend(mm.texcoords.chunks_exact(2).map(|v| Vec2::new(v[0] as f64, v[1] as f64)));
         }
+        // `v x y z r g b`: sRGB fractions, as Blender's OBJ reader takes them.
+        any_colors &= mm.vertex_color.len() == mm.positions.len();
+        if any_colors {
+            let linear = |c: &[f32]| Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64).map(srgb_to_linear);
+            mesh.colors.extend(mm.vertex_color.chunks_exact(3).map(linear));
+        }
         let slot = mm.material_id.map_or(u32::MAX, |i| i as u32);
         for tri in mm.indices.chunks_exact(3) {
             mesh.triangles.push([base + tri[0], base + tri[1], base + tri[2]]);
@@ -83,7 +90,12 @@ fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     if !any_uvs {
         mesh.uvs.clear();
     }
-    let materials: Vec<Material> = mtl.iter().map(mtl_material).collect();
+    if !any_colors {
+        mesh.colors.clear();
+    }
+    // A mesh's colours show through its own materials, as OBJ viewers show them.
+    let colored = |m: Material| Material { vertex_colors: !mesh.colors.is_empty(), ..m };
+    let materials: Vec<Material> = mtl.iter().map(mtl_material).map(colored).collect();
     if materials.is_empty() || mesh.material_slots.iter().all(|s| *s == u32::MAX) {
         mesh.material_slots.clear();
     } else {
@@ -153,6 +165,17 @@ enum PlyType {
 }
 
 impl PlyType {
+    /// The largest code of an unsigned integer type (a colour channel's full scale); `None`
+    /// for the others.
+    fn full_scale(self) -> Option<f64> {
+        match self {
+            Self::U8 => Some(255.0),
+            Self::U16 => Some(65535.0),
+            Self::U32 => Some(u32::MAX as f64),
+            _ => None,
+        }
+    }
+
     fn parse(s: &str) -> Option<Self> {
         Some(match s {
             "char" | "int8" => Self::I8,
@@ -237,8 +260,10 @@ impl PlyReader<'_> {
     }
 }
 
-/// Parses a PLY file: `vertex` (x, y, z, optional nx ny nz, u v / s t) and `face`
-/// (`vertex_indices` or `vertex_index` lists, fan-triangulated); other elements are skipped.
+/// Parses a PLY file: `vertex` (x, y, z, optional nx ny nz, u v / s t, red green blue / r g b)
+/// and `face` (`vertex_indices` or `vertex_index` lists, fan-triangulated); other elements are
+/// skipped. Colours in unsigned integers are sRGB codes (as scanners, MeshLab and Blender
+/// write them), decoded to linear; in floating point they are linear (as Mitsuba reads them).
 pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
     let (format, elements, body) = parse_ply_header(bytes)?;
     let mut rd = PlyReader { format, bytes: body, pos: 0 };
@@ -247,6 +272,8 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
         let idx = |n: &str| el.props.iter().position(|p| p.name == n);
         let (xyz, nrm) = ([idx("x"), idx("y"), idx("z")], [idx("nx"), idx("ny"), idx("nz")]);
         let uv = [idx("u").or(idx("s")).or(idx("texture_u")), idx("v").or(idx("t")).or(idx("texture_v"))];
+        let rgb = [idx("red").or(idx("r")), idx("green").or(idx("g")), idx("blue").or(idx("b"))];
+        let decode = rgb.map(|c| c.map(|i| el.props[i].ty.full_scale()));
         let face_list = idx("vertex_indices").or(idx("vertex_index"));
         if el.name == "vertex" && xyz.iter().any(Option::is_none) {
             return Err("the vertex element lacks x, y or z".into());
@@ -296,6 +323,13 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
                 }
                 if let [Some(u), Some(v)] = uv.map(g) {
                     mesh.uvs.push(Vec2::new(u, v));
+                }
+                if let [Some(r), Some(g), Some(b)] = rgb.map(g) {
+                    let linear = |x: f64, k: usize| match decode[k].flatten() {
+                        Some(full) => srgb_to_linear(x / full),
+                        None => x,
+                    };
+                    mesh.colors.push(Vec3::new(linear(r, 0), linear(g, 1), linear(b, 2)));
                 }
             } else if face {
                 if face_list.is_none() {

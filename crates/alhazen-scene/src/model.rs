@@ -445,6 +445,13 @@ pub enum Background {
 }
 
 impl Material {
+    /// What the base colour is multiplied by at a point whose (interpolated) vertex colour is
+    /// `color`: `color` with [`Self::vertex_colors`], else white.
+    #[inline]
+    pub fn vertex_tint(&self, color: Rgb) -> Rgb {
+        if self.vertex_colors { color } else { Vec3::ONE }
+    }
+
     /// The course's highlight factor for light from `l` seen from `v` at normal `n` (all unit,
     /// `n` on the viewer's side): Phong `max(0, ⟨r, v⟩)^m`, or Blinn–Phong `⟨ĥ, n⟩^{2m}` with the
     /// course's anisotropic `ĥ ∝ P₀w + P₁w + a·P₂w`, `w = l + v` (projections on `n`, on the
@@ -711,6 +718,10 @@ pub struct Material {
     /// behind, an opaque surface is black and ends paths, as Mitsuba's BSDFs not wrapped in
     /// `twosided` are. `false` (the default): both sides alike, the course's reading.
     pub one_sided: bool,
+    /// The base colour (`color`, a BSDF's albedo or diffuse colour, a conductor's tint, a
+    /// metallic-roughness base) is multiplied by the mesh's vertex colours where it has them
+    /// (glTF's `COLOR_0`, Mitsuba's `mesh_attribute` `vertex_color`), white elsewhere.
+    pub vertex_colors: bool,
     /// A cut-out: where the surface is not (leaves and lace drawn on a card). `None`: opaque
     /// everywhere.
     pub alpha: Option<Alpha>,
@@ -787,6 +798,7 @@ impl Default for Material {
             bsdf: None,
             bump: None,
             one_sided: false,
+            vertex_colors: false,
             alpha: None,
         }
     }

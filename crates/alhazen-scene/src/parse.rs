@@ -221,6 +221,7 @@ impl Parser<'_> {
             "scratches",
             "one_sided",
             "alpha",
+            "vertex_colors",
         ];
         let t = n.table(KEYS)?;
         let plain = Material::default();
@@ -265,6 +266,7 @@ impl Parser<'_> {
             bsdf,
             bump: t.get("bump").map(|b| self.bump(&b)).transpose()?,
             one_sided: t.opt_bool("one_sided", false)?,
+            vertex_colors: t.opt_bool("vertex_colors", false)?,
             alpha: t.get("alpha").map(|a| self.alpha(&a)).transpose()?,
         })
     }

@@ -382,6 +382,9 @@ impl Writer<'_> {
         if m.one_sided {
             self.line("one_sided", "true".to_string());
         }
+        if m.vertex_colors {
+            self.line("vertex_colors", "true".to_string());
+        }
         if let Some(a) = &m.alpha {
             let cutoff = a.cutoff.map_or(String::new(), |c| format!(", cutoff = {}", num(c)));
             let text = match &a.coverage {
@@ -603,6 +606,10 @@ pub fn ply_bytes(m: &alhazen_geom::TriangleMesh) -> Vec<u8> {
     if !m.uvs.is_empty() {
         h.push_str("property double u\nproperty double v\n");
     }
+    // Linear colours in floating point (read back as they are, not as sRGB codes).
+    if !m.colors.is_empty() {
+        h.push_str("property double red\nproperty double green\nproperty double blue\n");
+    }
     let _ = write!(h, "element face {}\nproperty list uchar uint vertex_indices\nend_header\n", m.triangles.len());
     let mut out = h.into_bytes();
     for i in 0..m.positions.len() {
@@ -613,6 +620,9 @@ pub fn ply_bytes(m: &alhazen_geom::TriangleMesh) -> Vec<u8> {
         }
         if !m.uvs.is_empty() {
             m.uvs[i].to_array().into_iter().for_each(&mut put);
+        }
+        if !m.colors.is_empty() {
+            m.colors[i].to_array().into_iter().for_each(&mut put);
         }
     }
     for t in &m.triangles {

@@ -632,3 +632,59 @@ fn pixel_filters_read_write_back_and_refuse_mistakes() {
         assert!(e.contains(says) && e.contains(":2:"), "{bad}: {e}");
     }
 }
+
+/// Vertex colours: a PLY's unsigned `red green blue` are sRGB codes and its float `r g b` linear,
+/// an OBJ's `v x y z r g b` sRGB fractions (its MTL-less mesh takes the object's material, which
+/// says whether it uses them); `vertex_colors` and the colours survive writing the scene back;
+/// a negative colour and a flag that is not a boolean are refused with their place.
+#[test]
+fn vertex_colours_read_from_ply_and_obj_write_back_and_bad_ones_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = |props: &str, rows: [&str; 3]| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n{props}\
+             element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 {}\n1 0 0 {}\n0 1 0 {}\n3 0 1 2\n",
+            rows[0], rows[1], rows[2]
+        )
+    };
+    let bytes = "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+    std::fs::write(dir.path().join("codes.ply"), ply(bytes, ["255 128 0", "0 0 0", "10 20 30"])).unwrap();
+    let floats = "property float r\nproperty float g\nproperty float b\n";
+    std::fs::write(dir.path().join("linear.ply"), ply(floats, ["0.25 0.5 1", "2 0 0", "0 0 0"])).unwrap();
+    std::fs::write(dir.path().join("painted.obj"), "v 0 0 0 1 0.5 0\nv 1 0 0 0 0 0\nv 0 1 0 1 1 1\nf 1 2 3\n").unwrap();
+    let text = "[materials.painted]\ncolor = 0.8\nvertex_colors = true\n\
+                [meshes.codes]\nfile = \"codes.ply\"\n[meshes.linear]\nfile = \"linear.ply\"\n\
+                [meshes.obj]\nfile = \"painted.obj\"\n\
+                [[object]]\nshape = \"mesh\"\nmesh = \"codes\"\nmaterial = \"painted\"\n\
+                [[object]]\nshape = \"mesh\"\nmesh = \"linear\"\nmaterial = \"painted\"\n\
+                [[object]]\nshape = \"mesh\"\nmesh = \"obj\"\nmaterial = \"painted\"\n";
+    let path = dir.path().join("painted.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let srgb = alhazen_math::color::srgb_to_linear;
+    // The objects' meshes, in the order written.
+    let mesh = |s: &alhazen_scene::Scene, name: &str| {
+        let k = ["codes", "linear", "obj"].iter().position(|n| *n == name).unwrap();
+        let Shape::Mesh { mesh, .. } = s.objects[k].shape else { panic!("not a mesh") };
+        s.meshes[mesh].colors.clone()
+    };
+    assert_eq!(mesh(&s, "codes")[0], Vec3::new(1.0, srgb(128.0 / 255.0), 0.0));
+    assert_eq!(mesh(&s, "codes")[2], Vec3::new(srgb(10.0 / 255.0), srgb(20.0 / 255.0), srgb(30.0 / 255.0)));
+    assert_eq!(mesh(&s, "linear"), vec![Vec3::new(0.25, 0.5, 1.0), Vec3::new(2.0, 0.0, 0.0), Vec3::ZERO]);
+    assert_eq!(mesh(&s, "obj")[0], Vec3::new(1.0, srgb(0.5f32 as f64), 0.0));
+    assert!(s.materials.iter().find(|m| m.name == "painted").unwrap().vertex_colors);
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&again_path).unwrap();
+    assert!(again.materials.iter().find(|m| m.name == "painted").unwrap().vertex_colors);
+    let colors = |s: &alhazen_scene::Scene| s.meshes.iter().map(|m| m.colors.clone()).collect::<Vec<_>>();
+    assert_eq!(colors(&again), colors(&s));
+    // A negative colour is refused, naming the file.
+    std::fs::write(dir.path().join("linear.ply"), ply(floats, ["0.25 -0.5 1", "2 0 0", "0 0 0"])).unwrap();
+    let e = load_scene(&path).unwrap_err().to_string();
+    assert!(e.contains("linear.ply") && e.contains("colour"), "{e}");
+    for bad in ["1", "\"yes\""] {
+        let e = err(&format!("[materials.card]\nvertex_colors = {bad}\n"));
+        assert!(e.contains("vertex_colors") && e.contains(":2:"), "{bad}: {e}");
+    }
+}

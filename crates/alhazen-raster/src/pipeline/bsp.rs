@@ -45,7 +45,12 @@ pub enum Viewer {
 }
 
 fn lerp(a: &Vertex, b: &Vertex, t: f64) -> Vertex {
-    Vertex { p: a.p.lerp(b.p, t), n: a.n.lerp(b.n, t).normalize_or_zero(), uv: a.uv.lerp(b.uv, t) }
+    Vertex {
+        p: a.p.lerp(b.p, t),
+        n: a.n.lerp(b.n, t).normalize_or_zero(),
+        uv: a.uv.lerp(b.uv, t),
+        color: a.color.lerp(b.color, t),
+    }
 }
 
 /// Splits a triangle by the plane into the polygons in front and behind.

@@ -40,8 +40,15 @@ impl CsgBodies {
             return None;
         }
         let m = &scene.materials[hit.material as usize];
-        let color =
-            shade::shade(scene, m, p, hit.hit.ns, proj.to_viewer(p), Vec2::new(hit.hit.uv.x, hit.hit.uv.y), light);
+        let color = shade::shade(
+            scene,
+            m,
+            p,
+            hit.hit.ns,
+            proj.to_viewer(p),
+            shade::base_color(scene, m, Vec2::new(hit.hit.uv.x, hit.hit.uv.y), hit.hit.color),
+            light,
+        );
         Some((z, color))
     }
 }

@@ -15,6 +15,8 @@ pub struct Vertex {
     pub n: Vec3,
     /// Texture coordinates.
     pub uv: Vec2,
+    /// Vertex colour (white where the mesh has none).
+    pub color: Vec3,
 }
 
 /// A world-space triangle with its material and whether it belongs to a closed surface (only
@@ -50,7 +52,7 @@ fn grid(rows: usize, cols: usize, f: impl Fn(f64, f64) -> (Vec3, Vec3, Vec2)) ->
     let at = |i: usize, j: usize| {
         let (u, v) = (j as f64 / cols as f64, i as f64 / rows as f64);
         let (p, n, uv) = f(u, v);
-        Vertex { p, n, uv }
+        Vertex { p, n, uv, color: Vec3::ONE }
     };
     let mut out = Vec::with_capacity(rows * cols * 2);
     for i in 0..rows {
@@ -78,14 +80,15 @@ fn disk(center: Vec3, normal: Vec3, radius: f64) -> Vec<[Vertex; 3]> {
 /// A disk in the plane of `s, t` facing `normal` (`±s × t`): the rim points are those of the
 /// side of a cylinder built on the same `s, t`, so caps and side share their edges exactly.
 fn disk_in(center: Vec3, (s, t): (Vec3, Vec3), normal: Vec3, radius: f64) -> Vec<[Vertex; 3]> {
-    let c = Vertex { p: center, n: normal, uv: Vec2::splat(0.5) };
+    let c = Vertex { p: center, n: normal, uv: Vec2::splat(0.5), color: Vec3::ONE };
     let facing_st = s.cross(t).dot(normal) > 0.0;
     (0..SEGMENTS)
         .map(|k| {
             let at = |k: usize| {
                 let a = 2.0 * PI * (k % SEGMENTS) as f64 / SEGMENTS as f64;
                 let d = s * a.cos() + t * a.sin();
-                Vertex { p: center + d * radius, n: normal, uv: Vec2::new(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin()) }
+                let uv = Vec2::new(0.5 + 0.5 * a.cos(), 0.5 + 0.5 * a.sin());
+                Vertex { p: center + d * radius, n: normal, uv, color: Vec3::ONE }
             };
             if facing_st { [c, at(k), at(k + 1)] } else { [c, at(k + 1), at(k)] }
         })
@@ -173,7 +176,8 @@ fn object_triangles(scene: &Scene, shape: &Shape) -> Option<Vec<[Vertex; 3]>> {
                         let i = i as usize;
                         let n = if *smooth && !m.normals.is_empty() { m.normals[i] } else { flat };
                         let uv = m.uvs.get(i).copied().unwrap_or(Vec2::ZERO);
-                        Vertex { p: m.positions[i], n, uv }
+                        let color = m.colors.get(i).copied().unwrap_or(Vec3::ONE);
+                        Vertex { p: m.positions[i], n, uv, color }
                     })
                 })
                 .collect()
@@ -199,7 +203,7 @@ pub fn triangle_count(scene: &Scene, shape: &Shape) -> u64 {
 }
 
 fn place(tri: [Vertex; 3], tf: &Transform) -> [Vertex; 3] {
-    let mut t = tri.map(|v| Vertex { p: tf.point(v.p), n: tf.normal(v.n).normalize_or_zero(), uv: v.uv });
+    let mut t = tri.map(|v| Vertex { p: tf.point(v.p), n: tf.normal(v.n).normalize_or_zero(), ..v });
     // A mirroring transform reverses the winding.
     if tf.vector(Vec3::X).cross(tf.vector(Vec3::Y)).dot(tf.vector(Vec3::Z)) < 0.0 {
         t.swap(1, 2);

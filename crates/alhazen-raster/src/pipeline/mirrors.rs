@@ -423,14 +423,12 @@ fn plane_rings(tris: &[Triangle], (centre, size): (Vec3, f64)) -> Vec<(Triangle,
         let foot = centre - n * n.dot(centre - a.p);
         // Texture coordinates are affine in the position on the plane.
         let weights = plane_weights(t.v.map(|v| v.p));
-        let uv_at = |p: Vec3| {
-            let [al, be] = weights(p);
-            a.uv + (b.uv - a.uv) * al + (c.uv - a.uv) * be
-        };
         let at = |r: f64, k: usize| {
             let phi = std::f64::consts::TAU * k as f64 / 48.0;
             let p = foot + (e1 * phi.cos() + e2 * phi.sin()) * r;
-            Vertex { p, n, uv: uv_at(p) }
+            let [al, be] = weights(p);
+            let uv = a.uv + (b.uv - a.uv) * al + (c.uv - a.uv) * be;
+            Vertex { p, n, uv, color: a.color + (b.color - a.color) * al + (c.color - a.color) * be }
         };
         let mut radii = vec![0.0];
         let mut r = size / 50.0;
@@ -491,7 +489,8 @@ fn corner_reflexes(tris: &[&Triangle], which: &[u32], surface: &Curved, eye: Vec
 fn reflected_color(scene: &Scene, t: &Triangle, b: Bary, at: Vec3, light: &shade::Lighting) -> Vec3 {
     let m = &scene.materials[t.material as usize];
     let (p, n, uv) = super::surface_at(t, b);
-    shade::shade(scene, m, p, n, (at - p).normalize_or_zero(), uv, light)
+    let base = shade::base_color(scene, m, uv, super::color_at(t, b));
+    shade::shade(scene, m, p, n, (at - p).normalize_or_zero(), base, light)
 }
 
 /// The weights of a triangle's own corners.
@@ -543,7 +542,7 @@ impl Reflexes<'_> {
             let b = weights(q);
             let (_, n, uv) = super::surface_at(t, b);
             let known = t.v.iter().position(|v| v.p == q).map(|k| corners[k]);
-            (Vertex { p: q, n, uv }, b, known.unwrap_or_else(|| self.reflex(q)))
+            (Vertex { p: q, n, uv, color: super::color_at(t, b) }, b, known.unwrap_or_else(|| self.reflex(q)))
         };
         let mut out = vec![];
         for poly in polygons {
@@ -594,6 +593,7 @@ impl Reflexes<'_> {
             p: (a.p + b.p) / 2.0,
             n: (a.n + b.n).normalize_or_zero(),
             uv: (a.uv + b.uv) / 2.0,
+            color: (a.color + b.color) / 2.0,
         };
         let m = [mid(&v[1], &v[2]), mid(&v[2], &v[0]), mid(&v[0], &v[1])];
         let half = |x: Bary, y: Bary| [(x[0] + y[0]) / 2.0, (x[1] + y[1]) / 2.0];
@@ -668,6 +668,7 @@ impl Reflexes<'_> {
                     p: v[k].p + (v[j].p - v[k].p) * t,
                     n: (v[k].n + (v[j].n - v[k].n) * t).normalize_or_zero(),
                     uv: v[k].uv + (v[j].uv - v[k].uv) * t,
+                    color: v[k].color + (v[j].color - v[k].color) * t,
                 };
                 if !self.surface.shows_itself(self.eye, q.p) {
                     return;
@@ -719,7 +720,7 @@ mod tests {
     use proptest::prelude::*;
 
     fn vertex(p: Vec3) -> Vertex {
-        Vertex { p, n: Vec3::Y, uv: Vec2::new(p.x, p.z) }
+        Vertex { p, n: Vec3::Y, uv: Vec2::new(p.x, p.z), color: Vec3::ONE }
     }
 
     proptest! {

@@ -454,6 +454,11 @@ pub(crate) fn surface_at(t: &Triangle, b: Bary) -> (Vec3, Vec3, Vec2) {
     (p, n, interpolate(t.v.map(|v| v.uv), b))
 }
 
+/// A triangle's vertex colour at corner weights `b`.
+pub(crate) fn color_at(t: &Triangle, b: Bary) -> Vec3 {
+    interpolate(t.v.map(|v| v.color), b)
+}
+
 /// False where a cut-out ([`alhazen_scene::Alpha`]) leaves mesh triangle `t` out at corner
 /// weights `b`: below its cutoff, or, for a coverage without one, below the threshold of a 4×4
 /// ordered dither at `pixel` (the preview's screen door for the tracers' per-ray passage).
@@ -541,7 +546,7 @@ fn bumped(scene: &Scene, m: &alhazen_scene::Material, t: &Triangle, uv: Vec2, n:
 /// radiosity solution, with the texture per pixel).
 fn lit_color(scene: &Scene, t: &Triangle, lit: &Prelit, b: Bary) -> Vec3 {
     let m = &scene.materials[t.material as usize];
-    let rho = alhazen_scene::texture::eval(&m.color, interpolate(t.v.map(|v| v.uv), b), &scene.images) * m.diffuse;
+    let rho = shade::base_color(scene, m, interpolate(t.v.map(|v| v.uv), b), color_at(t, b)) * m.diffuse;
     let e = interpolate(lit.irradiance, b).max(Vec3::ZERO);
     let emitted = if lit.front { m.emission } else { Vec3::ZERO };
     emitted + rho.clamp(Vec3::ZERO, Vec3::ONE) * e
@@ -594,7 +599,8 @@ fn fragment_color(
                 corner_light.of(src, || t.v.map(|v| shade::lighting(scene, m, v.p, v.n, proj.to_viewer(v.p), &frame)));
             let (p, n, uv) = surface_at(t, b);
             let light = (interpolate(corners.map(|c| c.0), b), interpolate(corners.map(|c| c.1), b));
-            shade::combine(scene, m, light, n, proj.to_viewer(p), uv, shadows)
+            let base = shade::base_color(scene, m, uv, color_at(t, b));
+            shade::combine(scene, m, light, n, proj.to_viewer(p), base, shadows)
         }
         Shading::Flat => {
             let [a, b, c] = t.v;
@@ -602,12 +608,14 @@ fn fragment_color(
             let n = (b.p - a.p).cross(c.p - a.p).normalize_or_zero();
             let uv = (a.uv + b.uv + c.uv) / 3.0;
             let n = bumped(scene, m, t, uv, n);
-            shade::shade(scene, m, centroid, n, proj.to_viewer(centroid), uv, shadows)
+            let base = shade::base_color(scene, m, uv, (a.color + b.color + c.color) / 3.0);
+            shade::shade(scene, m, centroid, n, proj.to_viewer(centroid), base, shadows)
         }
         Shading::Phong => {
             let (p, n, uv) = surface_at(t, b);
             let n = bumped(scene, m, t, uv, n);
-            shade::shade(scene, m, p, n, proj.to_viewer(p), uv, shadows)
+            let base = shade::base_color(scene, m, uv, color_at(t, b));
+            shade::shade(scene, m, p, n, proj.to_viewer(p), base, shadows)
         }
     }
 }

@@ -208,7 +208,7 @@ mod tests {
     }
 
     fn triangle(p: [Vec3; 3]) -> Triangle {
-        let v = |p: Vec3| Vertex { p, n: Vec3::Z, uv: Vec2::ZERO };
+        let v = |p: Vec3| Vertex { p, n: Vec3::Z, uv: Vec2::ZERO, color: Vec3::ONE };
         Triangle { v: p.map(v), material: 0, closed: false, unbounded: false, object: 0 }
     }
 

@@ -79,10 +79,10 @@ pub fn combine(
     (diffuse, specular): (Vec3, Vec3),
     n: Vec3,
     v: Vec3,
-    uv: Vec2,
+    base: Vec3,
     extra: &Lighting,
 ) -> Vec3 {
-    let a = alhazen_scene::texture::eval(&m.color, uv, &scene.images) * m.diffuse;
+    let a = base * m.diffuse;
     let mut c = a * diffuse + specular + m.emission;
     let n = if n.dot(v) < 0.0 { -n } else { n };
     // Glossy reflection of the environment by the split sum, with the Beckmann roughness that
@@ -105,7 +105,13 @@ pub fn combine(
     c
 }
 
-/// Radiance towards the viewer at `p`, lit per point.
-pub fn shade(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, uv: Vec2, extra: &Lighting) -> Vec3 {
-    combine(scene, m, lighting(scene, m, p, n, v, extra), n, v, uv, extra)
+/// Radiance towards the viewer at `p`, lit per point; `base` is the material's colour there
+/// ([`base_color`]).
+pub fn shade(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, base: Vec3, extra: &Lighting) -> Vec3 {
+    combine(scene, m, lighting(scene, m, p, n, v, extra), n, v, base, extra)
+}
+
+/// The colour `a` of `m` at texture coordinates `uv` where the vertex colour is `color`.
+pub fn base_color(scene: &Scene, m: &Material, uv: Vec2, color: Vec3) -> Vec3 {
+    alhazen_scene::texture::eval(&m.color, uv, &scene.images) * m.vertex_tint(color)
 }

@@ -34,12 +34,16 @@ impl ColorMode {
     }
 }
 
-/// The BSDF of `m` at texture coordinates `uv`.
-pub fn bsdf_at(m: &Material, uv: Vec2, images: &[Arc<ImageData>], mode: ColorMode) -> Bsdf {
+/// The BSDF of `m` at texture coordinates `uv` where the vertex colour is `color` (white
+/// where the surface has none). A material with `vertex_colors` multiplies by it every colour
+/// that is its base colour: albedos, diffuse colours, a metal's tint, a metallic-roughness
+/// base (glTF's reading of `COLOR_0`).
+pub fn bsdf_at(m: &Material, uv: Vec2, color: Vec3, images: &[Arc<ImageData>], mode: ColorMode) -> Bsdf {
+    let tint = m.vertex_tint(color);
     let rgb = |t: &alhazen_scene::Texture| texture::eval(t, uv, images);
-    let tex = |t: &alhazen_scene::Texture| mode.color(rgb(t));
+    let tex = |t: &alhazen_scene::Texture| mode.color(rgb(t) * tint);
     match &m.bsdf {
-        Some(desc) => from_desc(desc, &Lookups { tex: &tex, rgb: &rgb }, mode),
+        Some(desc) => from_desc(desc, &Lookups { tex: &tex, rgb: &rgb, tint }, mode),
         None => whitted_equivalent(m, &tex, mode),
     }
 }
@@ -71,10 +75,12 @@ fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec
     Bsdf::Mix(Box::new(Mix { a: mirror, b: lambert, weight: w }))
 }
 
-/// A point's texture lookups: colours in the path's channels, and as stored (linear RGB).
+/// A point's texture lookups: base colours in the path's channels (times the vertex colour),
+/// and textures as stored (linear RGB); the vertex colour that tints base colours.
 struct Lookups<'a> {
     tex: &'a dyn Fn(&alhazen_scene::Texture) -> Vec3,
     rgb: &'a dyn Fn(&alhazen_scene::Texture) -> Vec3,
+    tint: Vec3,
 }
 
 fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
@@ -108,7 +114,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             facets: facets.as_ref().map(Microfacet::new),
             eta: mode.color(*eta),
             k: mode.color(*k),
-            tint: mode.color(*tint),
+            tint: mode.color(*tint * lookups.tint),
             schlick: *fresnel == FresnelMode::Schlick,
         }),
         BsdfDesc::Dielectric { facets, ior, fresnel } => Bsdf::Dielectric(Dielectric {
@@ -136,8 +142,12 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                     rotation: 0.0,
                 })
             });
-            let (metal, coating, weight) =
-                BsdfDesc::metallic_roughness_at((lookups.rgb)(base), metallic * texel.z, roughness * texel.y, *ior);
+            let (metal, coating, weight) = BsdfDesc::metallic_roughness_at(
+                (lookups.rgb)(base) * lookups.tint,
+                metallic * texel.z,
+                roughness * texel.y,
+                *ior,
+            );
             let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
             Bsdf::Mix(Box::new(Mix { a, b, weight }))
         }

@@ -482,7 +482,7 @@ impl Kernel {
 pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<Kernel> {
     let scene_allows = !tracer.spectral;
     let images = &tracer.scene.images;
-    let kernel = |m| kernel_of(&crate::bsdf::bsdf_at(m, Vec2::ZERO, images, ColorMode::Rgb), m);
+    let kernel = |m| kernel_of(&crate::bsdf::bsdf_at(m, Vec2::ZERO, Vec3::ONE, images, ColorMode::Rgb), m);
     tracer.scene.materials.iter().map(|m| if scene_allows { kernel(m) } else { Kernel::General }).collect()
 }
 
@@ -787,7 +787,7 @@ impl PathTracer<'_> {
         let bsdf = match &self.uniform_bsdfs[wh.material as usize] {
             Some(bsdf) => bsdf,
             None => {
-                at_hit = crate::bsdf::bsdf_at(m, wh.hit.uv, &self.scene.images, ColorMode::Rgb);
+                at_hit = crate::bsdf::bsdf_at(m, wh.hit.uv, wh.hit.color, &self.scene.images, ColorMode::Rgb);
                 // Textures vary colours only: the kind of BSDF, and so its kernel, is the same
                 // at every point of the surface (`bsdf::build` branches on none of them).
                 debug_assert_eq!(kernel_of(&at_hit, m), material);
@@ -1896,7 +1896,7 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         // The texels' centres (read exactly), and points between them.
         for i in 0..64 {
             let uv = Vec2::new((i % 8 + 1) as f64 / 8.0, (i / 8 + 1) as f64 / 8.0);
-            let bsdf = crate::bsdf::bsdf_at(m, uv, &scene.images, ColorMode::Rgb);
+            let bsdf = crate::bsdf::bsdf_at(m, uv, Vec3::ONE, &scene.images, ColorMode::Rgb);
             assert_eq!(kernel_of(&bsdf, m), Kernel::MetallicRoughness, "{uv}");
             let Bsdf::Mix(mix) = &bsdf else { panic!("{bsdf:?}") };
             let Bsdf::Conductor(Conductor { facets: Some(f), .. }) = &mix.a else { panic!("{bsdf:?}") };

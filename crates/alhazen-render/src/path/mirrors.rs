@@ -400,7 +400,7 @@ impl PathTracer<'_> {
             (Some(b), ColorMode::Rgb) => std::borrow::Cow::Borrowed(b),
             _ => {
                 let m = &self.scene.materials[material as usize];
-                std::borrow::Cow::Owned(bsdf_at(m, Vec2::ZERO, &self.scene.images, mode))
+                std::borrow::Cow::Owned(bsdf_at(m, Vec2::ZERO, Vec3::ONE, &self.scene.images, mode))
             }
         }
     }

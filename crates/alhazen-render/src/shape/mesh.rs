@@ -92,6 +92,17 @@ pub(super) fn uv_at(mesh: &TriangleMesh, tri: usize, [b1, b2]: [f64; 2]) -> Vec2
     mesh.uvs[i0] * (1.0 - b1 - b2) + mesh.uvs[i1] * b1 + mesh.uvs[i2] * b2
 }
 
+/// The vertex colour of `mesh`'s triangle `tri` at barycentric `[b1, b2]` (white where the
+/// mesh has none).
+#[inline]
+fn color_at(mesh: &TriangleMesh, tri: usize, [b1, b2]: [f64; 2]) -> Vec3 {
+    if mesh.colors.is_empty() {
+        return Vec3::ONE;
+    }
+    let [i0, i1, i2] = mesh.triangles[tri].map(|i| i as usize);
+    mesh.colors[i0] * (1.0 - b1 - b2) + mesh.colors[i1] * b1 + mesh.colors[i2] * b2
+}
+
 /// An instance of a mesh.
 #[derive(Clone, Debug)]
 pub struct MeshShape {
@@ -165,7 +176,7 @@ impl MeshShape {
         let (n, ns, slot) = self.normals_and_slot(tri, b1, b2);
         let uv = uv_at(m, tri, [b1, b2]);
         let p = on_triangle(idx.map(|i| m.positions[i]), b1, b2);
-        SurfaceHit { t, p, n, ns, uv, slot, dpduv: [Vec3::ZERO; 2] }
+        SurfaceHit { t, p, n, ns, uv, slot, dpduv: [Vec3::ZERO; 2], color: color_at(m, tri, [b1, b2]) }
     }
 
     /// `∂p/∂u`, `∂p/∂v` of triangle `tri` from its texture coordinates (its barycentric

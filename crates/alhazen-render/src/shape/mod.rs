@@ -50,12 +50,14 @@ pub struct SurfaceHit {
     /// lobes: filled in by [`crate::World`] for objects whose material has a bump map or
     /// anisotropic microfacets (zero otherwise, and for shapes without them).
     pub dpduv: [Vec3; 2],
+    /// The vertex colour of a mesh with colours, interpolated; white elsewhere.
+    pub color: Vec3,
 }
 
 impl SurfaceHit {
     /// A hit whose shading normal is its geometric normal.
     pub fn flat(t: f64, p: Vec3, n: Vec3, uv: Vec2) -> Self {
-        Self { t, p, n, ns: n, uv, slot: 0, dpduv: [Vec3::ZERO; 2] }
+        Self { t, p, n, ns: n, uv, slot: 0, dpduv: [Vec3::ZERO; 2], color: Vec3::ONE }
     }
 }
 
