@@ -11,7 +11,10 @@ dielectric layers. The panel is a 12 × 12 grid of triangles (triangulated here,
 renderers split each quad along the same diagonal) whose colours vary smoothly from vertex to
 vertex (red along x, green along z, blue along the diagonal), linear float colours.
 
-    python3 bench/blender/vertex_colors_vs_cycles.py OUT_DIR [--spp 256]
+    python3 bench/blender/vertex_colors_vs_cycles.py OUT_DIR [--spp 256] [--byte]
+
+`--byte` paints an 8-bit colour attribute instead (Blender stores it as sRGB codes; its
+exporter writes COLOR_0 linear either way) and names the files vertex-colors-byte.
 
 Writes OUT_DIR/vertex-colors.glb and OUT_DIR/vertex-colors-cycles.exr (64 × 64, CPU, 2
 threads, box filter of one pixel, one bounce). The .glb has no world: alhazen lights a glTF
@@ -33,7 +36,7 @@ def paint(x, z):
     return (0.5 + 0.4 * math.sin(2.0 * x), 0.5 + 0.4 * math.sin(1.7 * z + 0.5), 0.5 + 0.4 * math.cos(1.3 * (x + z)), 1.0)
 
 
-def painted_panel():
+def painted_panel(kind="FLOAT_COLOR"):
     """A 2 × 2 grid of CUTS × CUTS quads in the plane y = 0 facing −y, triangulated, its
     vertices painted by `paint` into a float colour attribute."""
     bm = bmesh.new()
@@ -42,7 +45,7 @@ def painted_panel():
     mesh = bpy.data.meshes.new("painted")
     bm.to_mesh(mesh)
     bm.free()
-    attr = mesh.color_attributes.new("Col", "FLOAT_COLOR", "POINT")
+    attr = mesh.color_attributes.new("Col", kind, "POINT")
     for v, c in zip(mesh.vertices, attr.data):
         c.color = paint(v.co.x, v.co.y)
     mesh.color_attributes.active_color = attr
@@ -53,7 +56,7 @@ def painted_panel():
     return obj
 
 
-def build():
+def build(kind="FLOAT_COLOR"):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     m = material("painted mirror", (1.0, 1.0, 1.0), 1.0, 0.0)
@@ -61,7 +64,7 @@ def build():
     attribute = m.node_tree.nodes.new("ShaderNodeVertexColor")
     attribute.layer_name = "Col"
     m.node_tree.links.new(attribute.outputs["Color"], p.inputs["Base Color"])
-    painted_panel().data.materials.append(m)
+    painted_panel(kind).data.materials.append(m)
     front_camera(scene, 25)
     world = scene.world.node_tree.nodes["Background"]
     world.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
@@ -73,14 +76,16 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=256)
+    ap.add_argument("--byte", action="store_true")
     a = ap.parse_args()
+    stem = "vertex-colors-byte" if a.byte else "vertex-colors"
     out = os.path.abspath(a.out)
     os.makedirs(out, exist_ok=True)
-    scene = build()
+    scene = build("BYTE_COLOR" if a.byte else "FLOAT_COLOR")
     scene.render.resolution_x, scene.render.resolution_y = 64, 64
-    bpy.ops.export_scene.gltf(filepath=os.path.join(out, "vertex-colors.glb"), export_format="GLB",
+    bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB",
                               export_cameras=True, export_yup=True)
-    seconds = render(scene, os.path.join(out, "vertex-colors-cycles.exr"), a.spp, (64, 64), bounces=1, transparent=0,
+    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), a.spp, (64, 64), bounces=1, transparent=0,
                      depth="32")
     print(f"Cycles: {a.spp} spp at 64x64 on 2 threads in {seconds:.2f} s", file=sys.stderr)
 
