@@ -390,27 +390,25 @@ impl Importer<'_> {
                 ));
             } else {
                 let (scale, offset, rotation) = self.texture_placement(&info, &name)?;
-                if offset != Vec2::ZERO || rotation != 0.0 {
-                    self.warn(format!(
-                        "{name}: the metallic-roughness texture's offset and rotation are not supported; ignored"
-                    ));
-                }
                 self.scene.images.push(wrapped(image, &info.texture()));
-                map = Some((self.scene.images.len() - 1, scale));
+                map = Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation });
             }
         }
         let bump = match material.normal_texture() {
             Some(nt) => {
-                if nt.tex_coord() != 0 {
-                    self.warn(format!("{name}: texture coordinate set {} is read as set 0", nt.tex_coord()));
-                }
-                if nt.extension_value("KHR_texture_transform").is_some() {
-                    self.warn(format!("{name}: the normal texture's KHR_texture_transform is not supported; ignored"));
-                }
-                let image = self.image(&nt.texture(), Decoding::Linear)?;
+                // The normal texture's info has no typed transform: read from its JSON.
+                let transform = nt.extension_value("KHR_texture_transform").map(|t| {
+                    let pair = |key: &str, default: f64| {
+                        let at = |k: usize| t.get(key).and_then(|v| v.get(k)).and_then(|x| x.as_f64());
+                        [at(0).unwrap_or(default), at(1).unwrap_or(default)]
+                    };
+                    (pair("scale", 1.0), pair("offset", 0.0), t.get("rotation").and_then(|r| r.as_f64()).unwrap_or(0.0))
+                });
+                let (scale, offset, rotation) = self.placement(nt.tex_coord(), transform, &name)?;
+                let image = wrapped(self.image(&nt.texture(), Decoding::Linear)?, &nt.texture());
                 self.scene.images.push(image);
-                let image = self.scene.images.len() - 1;
-                Some(Bump { height: nt.scale() as f64, pattern: BumpPattern::NormalMap { image, scale: Vec2::ONE } })
+                let map = Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation };
+                Some(Bump { height: nt.scale() as f64, pattern: BumpPattern::NormalMap { map } })
             }
             None => None,
         };
@@ -459,13 +457,25 @@ impl Importer<'_> {
     /// `R(ϑ)·(s ⊙ uv) + (o_u + s_v sin ϑ, 1 − o_v − s_v cos ϑ)` (the shift kept in [0, 1): the
     /// images repeat) — a Blender Mapping node's own scale, rotation and location.
     fn texture_placement(&mut self, info: &gltf::texture::Info, name: &str) -> R<(Vec2, Vec2, f64)> {
-        if info.tex_coord() != 0 {
-            self.warn(format!("{name}: texture coordinate set {} is read as set 0", info.tex_coord()));
+        let transform = info
+            .texture_transform()
+            .map(|t| (t.scale().map(f64::from), t.offset().map(f64::from), t.rotation() as f64));
+        self.placement(info.tex_coord(), transform, name)
+    }
+
+    /// [`Self::texture_placement`] from a texture's coordinate set and its transform's scale,
+    /// offset and rotation.
+    fn placement(
+        &mut self,
+        tex_coord: u32,
+        transform: Option<([f64; 2], [f64; 2], f64)>,
+        name: &str,
+    ) -> R<(Vec2, Vec2, f64)> {
+        if tex_coord != 0 {
+            self.warn(format!("{name}: texture coordinate set {tex_coord} is read as set 0"));
         }
-        match info.texture_transform() {
-            Some(t) => {
-                let ([su, sv], [ou, ov]) = (t.scale().map(f64::from), t.offset().map(f64::from));
-                let turn = t.rotation() as f64;
+        match transform {
+            Some(([su, sv], [ou, ov], turn)) => {
                 // Texture coordinates times the scale stay far inside single precision's range.
                 if ![su, sv, ou, ov, turn].iter().all(|x| x.is_finite() && x.abs() <= 1e6) {
                     return Err(self.err(format!(

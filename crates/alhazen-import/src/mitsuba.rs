@@ -1109,12 +1109,7 @@ impl Importer {
                 p.used.borrow_mut().insert("normalmap".to_string());
                 let (inner, _) = self.inner_bsdf(ctx, node, depth)?;
                 bump = match tex {
-                    Texture::Image { image, scale, offset, rotation } => {
-                        if offset != Vec2::ZERO || rotation != 0.0 {
-                            self.warn(ctx, node, "a normal map's to_uv shift and rotation are not supported; ignored");
-                        }
-                        Some(Bump { height: 1.0, pattern: BumpPattern::NormalMap { image, scale } })
-                    }
+                    map @ Texture::Image { .. } => Some(Bump { height: 1.0, pattern: BumpPattern::NormalMap { map } }),
                     _ => {
                         self.warn(ctx, node, "only bitmap textures can be normal maps; the normal map is ignored");
                         None
@@ -1255,13 +1250,15 @@ impl Importer {
     ) -> R<BsdfDesc> {
         let metallic = self.float_or_texture(ctx, p, "metallic", 0.0)?;
         let roughness = self.float_or_texture(ctx, p, "roughness", 0.5)?;
-        let scale_of = |t: &Result<f64, Texture>| match t {
-            Err(Texture::Image { scale, .. }) => Some(*scale),
+        // The bitmaps' placements (scale, shift, turn): one map serves both where they agree.
+        let placement_of = |t: &Result<f64, Texture>| match t {
+            Err(Texture::Image { scale, offset, rotation, .. }) => Some((*scale, *offset, *rotation)),
             _ => None,
         };
-        let scales: Vec<Vec2> = [scale_of(&metallic), scale_of(&roughness)].into_iter().flatten().collect();
+        let placements: Vec<(Vec2, Vec2, f64)> =
+            [placement_of(&metallic), placement_of(&roughness)].into_iter().flatten().collect();
         let mapped = metallic.is_err() || roughness.is_err();
-        if mapped && trans <= 0.0 && scales.windows(2).all(|w| w[0] == w[1]) {
+        if mapped && trans <= 0.0 && placements.windows(2).all(|w| w[0] == w[1]) {
             for t in [&metallic, &roughness] {
                 if let Err(Texture::Image { image, .. }) = t {
                     self.pending.load_image_now(&mut self.scene, *image)?;
@@ -1269,7 +1266,8 @@ impl Importer {
             }
             let image = metal_rough_map(&self.scene.images, &roughness, &metallic);
             self.scene.images.push(Arc::new(image));
-            let map = Some((self.scene.images.len() - 1, scales.first().copied().unwrap_or(Vec2::ONE)));
+            let (scale, offset, rotation) = placements.first().copied().unwrap_or((Vec2::ONE, Vec2::ZERO, 0.0));
+            let map = Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation });
             let (metallic, roughness) = (metallic.unwrap_or(1.0), roughness.unwrap_or(1.0));
             let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
             return Ok(BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior });

@@ -947,7 +947,17 @@ impl Importer {
                 let img = alhazen_scene::import::load_hdr_image(&path).map_err(|e| ctx.err(at.clone(), e))?;
                 self.scene.images.push(Arc::new(img));
                 let image = self.scene.images.len() - 1;
-                Some(Bump { height: 1.0, pattern: BumpPattern::NormalMap { image, scale: Vec2::ONE } })
+                Some(Bump {
+                    height: 1.0,
+                    pattern: BumpPattern::NormalMap {
+                        map: alhazen_scene::Texture::Image {
+                            image,
+                            scale: Vec2::ONE,
+                            offset: Vec2::ZERO,
+                            rotation: 0.0,
+                        },
+                    },
+                })
             }
             None => None,
         };

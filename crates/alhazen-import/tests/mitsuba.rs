@@ -590,7 +590,7 @@ fn textured_principled_parameters_are_read_per_point() {
         "<bsdf type=\"principled\">{}<float name=\"metallic\" value=\"0.7\"/></bsdf>",
         bitmap("roughness", "rough.png")
     ));
-    let BsdfDesc::MetallicRoughness { metallic, roughness, map: Some((image, _)), .. } = bsdf else {
+    let BsdfDesc::MetallicRoughness { metallic, roughness, map: Some(Texture::Image { image, .. }), .. } = bsdf else {
         panic!("{bsdf:?}")
     };
     assert_eq!((metallic, roughness), (0.7, 1.0));
@@ -602,7 +602,9 @@ fn textured_principled_parameters_are_read_per_point() {
         bitmap("roughness", "rough.png"),
         bitmap("metallic", "metal.png")
     ));
-    let BsdfDesc::MetallicRoughness { metallic, map: Some((image, _)), .. } = bsdf else { panic!("{bsdf:?}") };
+    let BsdfDesc::MetallicRoughness { metallic, map: Some(Texture::Image { image, .. }), .. } = bsdf else {
+        panic!("{bsdf:?}")
+    };
     assert_eq!(metallic, 1.0);
     let t = texels(&images, image);
     assert_eq!(t.iter().map(|p| p[2]).collect::<Vec<_>>(), vec![0.0, 0.0, 1.0, 1.0]);
@@ -616,7 +618,7 @@ fn textured_principled_parameters_are_read_per_point() {
         bitmap("roughness", "wide.png"),
         bitmap("metallic", "tall.png")
     ));
-    let BsdfDesc::MetallicRoughness { map: Some((image, _)), .. } = bsdf else { panic!("{bsdf:?}") };
+    let BsdfDesc::MetallicRoughness { map: Some(Texture::Image { image, .. }), .. } = bsdf else { panic!("{bsdf:?}") };
     assert_eq!((images[image].width, images[image].height), (512, 1));
     // A textured metal without textured parameters: per point too.
     let (bsdf, ..) = load(

@@ -6,7 +6,7 @@
 
 use crate::model::{FresnelMode, Rgb, Texture};
 
-use alhazen_math::{Vec2, Vec3};
+use alhazen_math::Vec3;
 
 /// The microfacet normal distribution `D`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -201,9 +201,9 @@ pub enum BsdfDesc {
         metallic: f64,
         /// Perceptual roughness factor (`α = roughness²`).
         roughness: f64,
-        /// The metallic–roughness map: an image ([`crate::Scene::images`]) and its repeats per
-        /// texture unit in u and v.
-        map: Option<(usize, Vec2)>,
+        /// The metallic–roughness map: an image texture ([`Texture::Image`], read linearly)
+        /// with its own placement (scale, turn, shift).
+        map: Option<Texture>,
         /// The coating's index of refraction.
         ior: f64,
     },

@@ -768,12 +768,13 @@ pub enum BumpPattern {
     },
     /// A tangent-space normal map (glTF, Mitsuba `normalmap`, pbrt `normalmap`): each texel's
     /// linear RGB `c` is the normal `2c − 1` in the frame of `∂p/∂u`, the bitangent and `n`;
-    /// the bump's `height` scales its tangential part (glTF's `normalTexture.scale`).
+    /// the bump's `height` scales its tangential part (glTF's `normalTexture.scale`). The frame
+    /// is the surface's own: a turned map's texels are read turned, its vectors are not (as
+    /// Blender's Normal Map node, which takes the UV map's tangent, reads them).
     NormalMap {
-        /// Index into [`Scene::images`] (linear values, not sRGB).
-        image: usize,
-        /// Repeats per texture unit.
-        scale: Vec2,
+        /// The map: an image texture ([`Texture::Image`], linear values, not sRGB) with its
+        /// placement (scale, turn, shift).
+        map: Texture,
     },
 }
 

@@ -302,6 +302,12 @@ impl Parser<'_> {
         Ok(Texture::Image { image, scale, offset, rotation })
     }
 
+    /// [`Self::placed_image`] read linearly (metallic–roughness maps, normal maps).
+    pub(crate) fn linear_placed_image(&mut self, i: &Node) -> R<Texture> {
+        let (image, scale, offset, rotation) = self.image_of(i, true, true)?;
+        Ok(Texture::Image { image, scale, offset, rotation })
+    }
+
     /// An image table (with an `offset` and a `rotation` where `placed` allows), read linearly
     /// or as sRGB.
     fn image_of(&mut self, i: &Node, linear: bool, placed: bool) -> R<(usize, Vec2, Vec2, f64)> {
@@ -364,10 +370,7 @@ impl Parser<'_> {
                 let (image, scale) = self.image_texture(&i, false)?;
                 BumpPattern::Image { image, scale }
             }
-            (None, None, Some(i)) => {
-                let (image, scale) = self.image_texture(&i, true)?;
-                BumpPattern::NormalMap { image, scale }
-            }
+            (None, None, Some(i)) => BumpPattern::NormalMap { map: self.linear_placed_image(&i)? },
             _ => {
                 return Err(n.err(
                     "a bump needs exactly one of `waves = size`, `image = { file = … }` or `normal_map = { file = … }`",

@@ -124,7 +124,7 @@ impl Parser<'_> {
                 metallic: t.get("metallic").map_or(Ok(0.0), |n| n.in_range(0.0, 1.0))?,
                 roughness: t.get("roughness").map_or(Ok(0.5), |n| n.in_range(0.0, 1.0))?,
                 // Read linearly, as glTF's metallic-roughness textures are.
-                map: t.get("map").map(|m| self.image_texture(&m, true)).transpose()?,
+                map: t.get("map").map(|m| self.linear_placed_image(&m)).transpose()?,
                 ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
             },
             _ => BsdfDesc::Mix {

@@ -443,8 +443,8 @@ pub fn bumped_normal(
         crate::BumpPattern::Image { image, scale } => {
             0.5 / (images[*image].width.max(images[*image].height) as f64 * scale.max_element())
         }
-        crate::BumpPattern::NormalMap { image, scale } => {
-            return mapped_normal(bilinear(&images[*image], uv * *scale), bump.height, n, pu, pv);
+        crate::BumpPattern::NormalMap { map } => {
+            return mapped_normal(eval(map, uv, images), bump.height, n, pu, pv);
         }
     };
     let d = |du: f64, dv: f64| bump.height * bump_value(&bump.pattern, uv + Vec2::new(du, dv), images);
@@ -475,12 +475,13 @@ mod bump_tests {
         // A flat normal map (texel (½, ½, 1)) leaves the normal alone; a tilted texel tilts it
         // towards ∂p/∂u, by its strength.
         let img = |c: [f32; 3]| std::sync::Arc::new(ImageData::new(1, 1, vec![c]));
-        let map = Bump { height: 1.0, pattern: BumpPattern::NormalMap { image: 0, scale: Vec2::ONE } };
+        let image = Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 };
+        let map = Bump { height: 1.0, pattern: BumpPattern::NormalMap { map: image } };
         let flat = bumped_normal(&map, Vec2::new(0.3, 0.3), Vec3::Z, Vec3::X * 2.0, Vec3::Y, &[img([0.5, 0.5, 1.0])]);
         assert!((flat - Vec3::Z).length() < 1e-12, "{flat}");
         let tilted = bumped_normal(&map, Vec2::ZERO, Vec3::Z, Vec3::X, -Vec3::Y, &[img([1.0, 0.5, 0.5])]);
         assert!((tilted - Vec3::X).length() < 1e-12, "{tilted}");
-        let half = Bump { height: 0.5, ..map };
+        let half = Bump { height: 0.5, ..map.clone() };
         let mixed = bumped_normal(&half, Vec2::ZERO, Vec3::Z, Vec3::X, Vec3::Y, &[img([0.5, 1.0, 1.0])]);
         assert!((mixed - Vec3::new(0.0, 0.5, 1.0).normalize()).length() < 1e-12, "{mixed}");
         // Zero height leaves the normal alone.

@@ -342,6 +342,16 @@ impl Writer<'_> {
         table + " }"
     }
 
+    /// A map's image table (`{ file, scale, … }`: metallic–roughness and normal maps are
+    /// images).
+    fn map_image(&self, map: &Texture) -> String {
+        match map {
+            Texture::Image { image, scale, offset, rotation } => self.placed_image(*image, *scale, *offset, *rotation),
+            // (The readers make images only; another texture is written as a texture.)
+            other => self.texture(other),
+        }
+    }
+
     fn image(&self, image: usize, scale: Vec2) -> String {
         format!("{{ file = {}, scale = [{}, {}] }}", string(&self.images[image]), num(scale.x), num(scale.y))
     }
@@ -371,7 +381,7 @@ impl Writer<'_> {
             let pattern = match &b.pattern {
                 BumpPattern::Waves { size } => format!("waves = {}", num(*size)),
                 BumpPattern::Image { image, scale } => format!("image = {}", self.image(*image, *scale)),
-                BumpPattern::NormalMap { image, scale } => format!("normal_map = {}", self.image(*image, *scale)),
+                BumpPattern::NormalMap { map } => format!("normal_map = {}", self.map_image(map)),
             };
             self.line("bump", format!("{{ height = {}, {pattern} }}", num(b.height)));
         }
@@ -496,7 +506,7 @@ impl Writer<'_> {
                 num(*metallic),
                 num(*roughness),
                 num(*ior),
-                map.map_or(String::new(), |(image, scale)| format!(", map = {}", self.image(image, scale)))
+                map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m)))
             ),
         }
     }

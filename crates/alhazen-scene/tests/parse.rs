@@ -218,7 +218,9 @@ bsdf = { type = "metallic-roughness", color = [0.9, 0.6, 0.2], metallic = 1, rou
         panic!()
     };
     assert_eq!((metallic, roughness, ior), (0.0, 0.5, 1.5));
-    let Some(BsdfDesc::MetallicRoughness { metallic, roughness, map: Some((image, scale)), .. }) = mat(&s, "worn")
+    let Some(BsdfDesc::MetallicRoughness {
+        metallic, roughness, map: Some(Texture::Image { image, scale, .. }), ..
+    }) = mat(&s, "worn")
     else {
         panic!()
     };

@@ -134,14 +134,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
         }
         BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
-            let texel = map.map_or(Vec3::ONE, |(image, scale)| {
-                (lookups.rgb)(&alhazen_scene::Texture::Image {
-                    image,
-                    scale,
-                    offset: alhazen_math::Vec2::ZERO,
-                    rotation: 0.0,
-                })
-            });
+            let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
             let (metal, coating, weight) = BsdfDesc::metallic_roughness_at(
                 (lookups.rgb)(base) * lookups.tint,
                 metallic * texel.z,

@@ -1716,7 +1716,12 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         let material = mapped_material(&scene);
         let bsdf = scene.materials[material].bsdf.as_mut();
         let Some(alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { map, .. }) = bsdf else { panic!("{bsdf:?}") };
-        *map = Some((image, alhazen_math::Vec2::ONE));
+        *map = Some(alhazen_scene::Texture::Image {
+            image,
+            scale: alhazen_math::Vec2::ONE,
+            offset: alhazen_math::Vec2::ZERO,
+            rotation: 0.0,
+        });
         scene
     }
 

@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""A metallic–roughness map placed by a Mapping node — scaled, turned and moved, as Blender users
+tile a whole PBR texture set — through Blender's glTF exporter (which writes the node as the
+`metallicRoughnessTexture`'s `KHR_texture_transform`) against Cycles, for the test
+`blender_map_transform_agrees_with_cycles` (crates/alhazen-import/tests/gltf.rs).
+
+A smooth panel (roughness 0) of a copper base colour faces the camera, lit by a sun 30° off its
+normal in a black world; its metalness is read from the blue channel of a smoothly repeating
+image of waves (along u, and along the diagonal), through a Mapping node of location
+(0.15, 0.3), rotation 30° and scale (1.5, 0.75). Where it is metal, the panel mirrors the black
+world (the sun's reflection misses the camera); where it is dielectric, its diffuse layer shows
+the sun's light. Without the placement the waves of metal land elsewhere.
+
+    python3 bench/blender/map_transform_vs_cycles.py OUT_DIR [--spp 256] [--normal]
+
+`--normal` places a normal map instead (files normal-transform.*): a smooth grey dielectric
+panel whose Normal Map node (tangent space, strength 1) reads a smoothly repeating image of
+bumps through the same Mapping node, exported as the `normalTexture`'s transform. Cycles reads
+the texels at the mapped coordinates and takes their vectors in the frame of the UV map's
+tangent (the Mapping node turns where the map is read, not the vectors), as alhazen does.
+
+Writes OUT_DIR/map-transform.glb and OUT_DIR/map-transform-cycles.exr (64 × 64, CPU, 2 threads,
+box filter of one pixel, two bounces). Needs `pip install bpy`.
+"""
+import argparse, math, os, sys
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gltf_vs_cycles import front_camera, material, render, saved_image  # noqa: E402
+
+
+def waves(x, y):
+    """Texel (x, y) of a 32 × 32 map that repeats smoothly: roughness 0 (green), metalness
+    (blue) in waves along u and along the diagonal."""
+    t = 2 * math.pi / 32
+    return (0.0, 0.0, 0.5 + 0.25 * math.sin(t * x) + 0.25 * math.cos(t * (x + 2 * y)), 1.0)
+
+
+def build(out):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    img = saved_image("waves", 32, waves, os.path.join(out, "map-waves.png"))
+    img.colorspace_settings.name = "Non-Color"
+    m = material("copper", (0.95, 0.64, 0.54), 1.0, 1.0)
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    tex.interpolation = "Linear"
+    split = nodes.new("ShaderNodeSeparateColor")
+    links.new(tex.outputs["Color"], split.inputs["Color"])
+    p = nodes["Principled BSDF"]
+    links.new(split.outputs["Green"], p.inputs["Roughness"])
+    links.new(split.outputs["Blue"], p.inputs["Metallic"])
+    coords = nodes.new("ShaderNodeTexCoord")
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.inputs["Location"].default_value = (0.15, 0.3, 0.0)
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30))
+    mapping.inputs["Scale"].default_value = (1.5, 0.75, 1.0)
+    links.new(coords.outputs["UV"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
+    bpy.context.object.data.materials.append(m)
+    front_camera(scene, 25)
+    # A sun 30° above the camera's axis: the dielectric's diffuse shows it, the smooth metal
+    # reflects it away from the camera and shows the black world.
+    bpy.ops.object.light_add(type="SUN", rotation=(math.radians(60), 0.0, 0.0))
+    bpy.context.object.data.energy = 3.0
+    bpy.context.object.data.angle = 0.0
+    return scene
+
+
+def bumps(x, y):
+    """Texel (x, y) of a 32 × 32 tangent-space normal map that repeats smoothly: the normal of
+    the height field h = 0.12 (sin(2πx/32) + cos(2π(x + 2y)/32)) in texels' units of 1/32,
+    encoded as (n + 1)/2."""
+    t = 2 * math.pi / 32
+    # ∂h/∂u and ∂h/∂v with u = x/32, v = y/32.
+    du = 0.12 * 32 * t * (math.cos(t * x) - math.sin(t * (x + 2 * y)))
+    dv = 0.12 * 32 * t * (-2 * math.sin(t * (x + 2 * y)))
+    n = (-du, -dv, 1.0)
+    length = math.sqrt(sum(c * c for c in n))
+    return (*(0.5 + 0.5 * c / length for c in n), 1.0)
+
+
+def build_normal(out):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    img = saved_image("bumps", 32, bumps, os.path.join(out, "normal-bumps.png"))
+    img.colorspace_settings.name = "Non-Color"
+    m = material("grey", (0.7, 0.7, 0.7), 0.0, 0.0)
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    tex = nodes.new("ShaderNodeTexImage")
+    tex.image = img
+    tex.interpolation = "Linear"
+    normal_map = nodes.new("ShaderNodeNormalMap")
+    links.new(tex.outputs["Color"], normal_map.inputs["Color"])
+    links.new(normal_map.outputs["Normal"], nodes["Principled BSDF"].inputs["Normal"])
+    coords = nodes.new("ShaderNodeTexCoord")
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.inputs["Location"].default_value = (0.15, 0.3, 0.0)
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30))
+    mapping.inputs["Scale"].default_value = (1.5, 0.75, 1.0)
+    links.new(coords.outputs["UV"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
+    bpy.context.object.data.materials.append(m)
+    front_camera(scene, 25)
+    bpy.ops.object.light_add(type="SUN", rotation=(math.radians(60), 0.0, math.radians(20)))
+    bpy.context.object.data.energy = 3.0
+    bpy.context.object.data.angle = 0.0
+    return scene
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("out")
+    ap.add_argument("--spp", type=int, default=256)
+    ap.add_argument("--normal", action="store_true")
+    a = ap.parse_args()
+    out = os.path.abspath(a.out)
+    os.makedirs(out, exist_ok=True)
+    scene = build_normal(out) if a.normal else build(out)
+    stem = "normal-transform" if a.normal else "map-transform"
+    scene.render.resolution_x, scene.render.resolution_y = 64, 64
+    bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB",
+                              export_cameras=True, export_lights=True, export_yup=True)
+    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), a.spp, (64, 64), bounces=2, transparent=0,
+                     depth="32")
+    print(f"Cycles: {a.spp} spp at 64x64 on 2 threads in {seconds:.2f} s", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
