@@ -23,6 +23,7 @@ use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
     PerspectiveOpening, Scene, SceneError, Shape, Texture, Wrap,
 };
+use gltf::accessor::DataType;
 use gltf::material::AlphaMode;
 use gltf::mesh::Mode;
 use rayon::prelude::*;
@@ -42,7 +43,11 @@ const KNOWN: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_emissive_strength",
     "KHR_texture_transform",
+    "KHR_mesh_quantization",
 ];
+
+/// Extensions alhazen reads without the glTF reader's support.
+const READ_HERE: &[&str] = &["KHR_mesh_quantization"];
 
 /// Reads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<Imported, SceneError> {
@@ -61,10 +66,14 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
 }
 
 fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
-    let gltf =
-        gltf::Gltf::from_slice(bytes).map_err(|e| error(path, bytes, format!("not a valid glTF 2.0 file: {e}")))?;
+    let invalid = |e: gltf::Error| error(path, bytes, format!("not a valid glTF 2.0 file: {e}"));
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+    // The reader's validation refuses required extensions it does not know; those alhazen
+    // reads itself are taken off that list first.
+    let mut json = gltf.document.into_json();
+    json.extensions_required.retain(|e| !READ_HERE.contains(&e.as_str()));
+    let document = gltf::Document::from_json(json).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let document = gltf.document;
     let buffers = gltf::import_buffers(&document, Some(base), gltf.blob)
         .map_err(|e| error(path, bytes, format!("cannot read its buffers: {e}")))?;
     let mut imp = Importer {
@@ -241,19 +250,33 @@ impl Importer<'_> {
         }
         let buffers = &self.buffers;
         let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| self.err(format!("{name} has no POSITION attribute")))?
-            .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
-            .collect();
-        let normals: Vec<Vec3> = reader
-            .read_normals()
-            .map(|n| n.map(|v| Vec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect())
-            .unwrap_or_default();
-        let uvs: Vec<Vec2> = reader
-            .read_tex_coords(0)
-            .map(|t| t.into_f32().map(|v| Vec2::new(v[0] as f64, 1.0 - v[1] as f64)).collect())
-            .unwrap_or_default();
+        // Integer attributes (KHR_mesh_quantization) are decoded here: the reader would take
+        // their bytes for floats.
+        let quantized = |sem: gltf::Semantic| prim.get(&sem).filter(|a| a.data_type() != DataType::F32);
+        let positions: Vec<Vec3> = match quantized(gltf::Semantic::Positions) {
+            Some(a) => self.integers::<3>(&a, &name, "POSITION")?.into_iter().map(Vec3::from_array).collect(),
+            None => reader
+                .read_positions()
+                .ok_or_else(|| self.err(format!("{name} has no POSITION attribute")))?
+                .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                .collect(),
+        };
+        let normals: Vec<Vec3> = match quantized(gltf::Semantic::Normals) {
+            Some(a) => self.integers::<3>(&a, &name, "NORMAL")?.into_iter().map(Vec3::from_array).collect(),
+            None => reader
+                .read_normals()
+                .map(|n| n.map(|v| Vec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect())
+                .unwrap_or_default(),
+        };
+        let uvs: Vec<Vec2> = match quantized(gltf::Semantic::TexCoords(0)) {
+            Some(a) => {
+                self.integers::<2>(&a, &name, "TEXCOORD_0")?.into_iter().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect()
+            }
+            None => reader
+                .read_tex_coords(0)
+                .map(|t| t.into_f32().map(|v| Vec2::new(v[0] as f64, 1.0 - v[1] as f64)).collect())
+                .unwrap_or_default(),
+        };
         let rgba: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|c| c.into_rgba_f32().collect());
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
@@ -304,6 +327,49 @@ impl Importer<'_> {
         }
         m.validate().map_err(|e| self.err(format!("{name}: {e}")))?;
         Ok(Some(m))
+    }
+
+    /// The `N`-component elements of accessor `a` of integer components (KHR_mesh_quantization:
+    /// bytes and shorts, signed or not, normalised to [0, 1] or [−1, 1] where the accessor says,
+    /// else their values), read through its buffer view's stride. Sparse ones, and views that
+    /// stop short, are refused.
+    fn integers<const N: usize>(&self, a: &gltf::Accessor, name: &str, what: &str) -> R<Vec<[f64; N]>> {
+        let bad = |why: &str| self.err(format!("{name}: its {what} accessor {why}"));
+        if a.dimensions().multiplicity() != N {
+            return Err(bad(&format!("must have {N} components")));
+        }
+        if a.sparse().is_some() {
+            return Err(bad("is sparse and quantized, which alhazen cannot read"));
+        }
+        let view = a.view().ok_or_else(|| bad("has no buffer view"))?;
+        let data = self.buffers.get(view.buffer().index()).map(|d| &d.0[..]).unwrap_or_default();
+        let size = a.data_type().size();
+        let stride = view.stride().unwrap_or(size * N);
+        let start = view.offset() + a.offset();
+        let end = match a.count() {
+            0 => start,
+            n => start + stride * (n - 1) + size * N,
+        };
+        if end > view.offset() + view.length() || end > data.len() {
+            return Err(bad(&format!("has {} elements but its buffer holds fewer", a.count())));
+        }
+        let normalized = a.normalized();
+        let component = |at: usize| -> f64 {
+            let b = &data[at..at + size];
+            match (a.data_type(), normalized) {
+                (DataType::I8, false) => b[0] as i8 as f64,
+                (DataType::I8, true) => (b[0] as i8 as f64 / 127.0).max(-1.0),
+                (DataType::U8, false) => b[0] as f64,
+                (DataType::U8, true) => b[0] as f64 / 255.0,
+                (DataType::I16, false) => i16::from_le_bytes([b[0], b[1]]) as f64,
+                (DataType::I16, true) => (i16::from_le_bytes([b[0], b[1]]) as f64 / 32767.0).max(-1.0),
+                (DataType::U16, false) => u16::from_le_bytes([b[0], b[1]]) as f64,
+                (DataType::U16, true) => u16::from_le_bytes([b[0], b[1]]) as f64 / 65535.0,
+                (DataType::U32, _) => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                (DataType::F32, _) => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            }
+        };
+        Ok((0..a.count()).map(|i| std::array::from_fn(|k| component(start + i * stride + k * size))).collect())
     }
 
     /// `COLOR_0` (read as RGBA, integers normalised as the accessor says) as linear RGB, which

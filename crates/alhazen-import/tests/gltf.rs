@@ -818,3 +818,65 @@ fn samplers_wrap_their_images() {
     };
     assert_eq!(sc.images[*image].wrap, [alhazen_scene::Wrap::Clamp, alhazen_scene::Wrap::Mirror]);
 }
+
+/// `KHR_mesh_quantization` (gltfpack's and glTF-Transform's compact meshes): positions as
+/// normalised shorts in strides of 8 bytes, normals as normalised bytes, texture coordinates as
+/// normalised unsigned shorts read as the float quad's; a quantized accessor that runs past its
+/// view is refused.
+#[test]
+fn quantized_meshes_read_as_their_floats() {
+    let mut b = vec![];
+    for p in [[0i16, 0, 0], [32767, 0, 0], [32767, 32767, 0], [0, 32767, 0]] {
+        p.iter().for_each(|x| b.extend(x.to_le_bytes()));
+        b.extend([0, 0]);
+    }
+    for _ in 0..4 {
+        b.extend([0u8, 0, 127, 0]);
+    }
+    for uv in [[0u16, 65535], [65535, 65535], [65535, 0], [0, 0]] {
+        uv.iter().for_each(|x| b.extend(x.to_le_bytes()));
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        b.extend(i.to_le_bytes());
+    }
+    let uri = format!(r#", "uri": "data:application/octet-stream;base64,{}""#, base64(&b));
+    let json = document(&uri, "")
+        .replace(
+            r#""extensionsUsed": ["KHR_lights_punctual"]"#,
+            r#""extensionsUsed": ["KHR_lights_punctual", "KHR_mesh_quantization"], "extensionsRequired": ["KHR_mesh_quantization"]"#,
+        )
+        .replace(r#""byteLength": 140"#, r#""byteLength": 76"#)
+        .replace(
+            r#"{ "buffer": 0, "byteOffset": 0, "byteLength": 48 },
+    { "buffer": 0, "byteOffset": 48, "byteLength": 48 },
+    { "buffer": 0, "byteOffset": 96, "byteLength": 32 },
+    { "buffer": 0, "byteOffset": 128, "byteLength": 12 }"#,
+            r#"{ "buffer": 0, "byteOffset": 0, "byteLength": 32, "byteStride": 8 },
+    { "buffer": 0, "byteOffset": 32, "byteLength": 16, "byteStride": 4 },
+    { "buffer": 0, "byteOffset": 48, "byteLength": 16 },
+    { "buffer": 0, "byteOffset": 64, "byteLength": 12 }"#,
+        )
+        .replace(
+            r#"{ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
+    { "bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3" },
+    { "bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2" },"#,
+            r#"{ "bufferView": 0, "componentType": 5122, "normalized": true, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
+    { "bufferView": 1, "componentType": 5120, "normalized": true, "count": 4, "type": "VEC3" },
+    { "bufferView": 2, "componentType": 5123, "normalized": true, "count": 4, "type": "VEC2" },"#,
+        );
+    assert!(json.contains("5122") && json.contains(r#""byteStride": 8"#));
+    let s = write_and_import(&[("q.gltf", json.clone().into_bytes())]).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    check_scene(&s);
+    let floats = write_and_import(&[("f.gltf", embedded().into_bytes())]).unwrap();
+    assert_eq!(s.scene.meshes[0].positions, floats.scene.meshes[0].positions);
+    assert_eq!(s.scene.meshes[0].normals, floats.scene.meshes[0].normals);
+    assert_eq!(s.scene.meshes[0].uvs, floats.scene.meshes[0].uvs);
+    // Four positions in strides of 8 need 30 bytes of their view.
+    let short = json.replace(
+        r#""byteOffset": 0, "byteLength": 32, "byteStride": 8"#,
+        r#""byteOffset": 0, "byteLength": 28, "byteStride": 8"#,
+    );
+    let e = write_and_import(&[("s.gltf", short.into_bytes())]).unwrap_err();
+    assert!(e.contains("POSITION accessor") && e.contains("holds fewer"), "{e}");
+}
