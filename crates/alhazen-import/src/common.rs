@@ -97,20 +97,22 @@ pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb, textu
 
 /// The glTF 2.0 metallic–roughness model (also Mitsuba's `principled` and pbrt's
 /// `coateddiffuse` reduced to it): a metal whose normal-incidence reflectance is the base
-/// colour (Schlick), mixed by `metallic` with a dielectric coating of index `ior` over a
-/// Lambertian base, both with GGX roughness `α = roughness²`; `transmission` mixes in rough glass.
+/// colour (Schlick), mixed by `metallic` with a dielectric coating (`coat`) over a Lambertian
+/// base, both with GGX roughness `α = roughness²`; `transmission` mixes in rough glass of index
+/// `ior`.
 pub(crate) fn metal_rough(
     base: Texture,
     base_mean: Rgb,
     metallic: f64,
     roughness: f64,
-    ior: f64,
+    (ior, coat): (f64, Coat),
     transmission: f64,
 ) -> BsdfDesc {
     // The model at a point of colour `base_mean`, its coating given the texture itself, its
     // metal smooth where the roughness is below the facets' least `α` (a material with a
     // single value need not keep the same lobes everywhere).
-    let (mut metal, mut plastic, _) = BsdfDesc::metallic_roughness_at(base_mean, metallic, roughness, ior);
+    let (mut metal, mut plastic, _) =
+        BsdfDesc::metallic_roughness_at(base_mean, metallic, roughness, coat.ior, coat.specular);
     let alpha = (roughness * roughness).clamp(0.0, 1.0);
     let facets = (alpha > 1e-3).then(|| ggx(alpha, alpha));
     if let BsdfDesc::Conductor { facets: f, .. } = &mut metal {
@@ -122,6 +124,22 @@ pub(crate) fn metal_rough(
     let opaque = mix(metal, plastic, metallic);
     let glass = BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact };
     mix(glass, opaque, transmission * (1.0 - metallic))
+}
+
+/// The opaque coating of the metallic–roughness model: its index (glTF's, or the one whose
+/// normal-incidence reflectance `KHR_materials_specular`'s colour factor scales it to) and the
+/// strength of its specular lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Coat {
+    pub ior: f64,
+    pub specular: f64,
+}
+
+impl Coat {
+    /// The plain coating of index `ior`.
+    pub fn of(ior: f64) -> Self {
+        Coat { ior, specular: 1.0 }
+    }
 }
 
 /// `w·a + (1 − w)·b`, or the one that has all the weight.

@@ -44,6 +44,7 @@ const KNOWN: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_texture_transform",
     "KHR_mesh_quantization",
+    "KHR_materials_specular",
 ];
 
 /// Extensions alhazen reads without the glTF reader's support.
@@ -487,7 +488,6 @@ impl Importer<'_> {
             "KHR_materials_clearcoat",
             "KHR_materials_sheen",
             "KHR_materials_volume",
-            "KHR_materials_specular",
             "KHR_materials_iridescence",
             "KHR_materials_anisotropy",
         ] {
@@ -499,10 +499,12 @@ impl Importer<'_> {
         // Per point where the map or a textured metal's colour varies (glTF's metal takes each
         // texel's base colour), else the constant mix (and its glass under transmission).
         let textured_metal = metallic > 0.0 && transmission <= 0.0 && !matches!(base, Texture::Solid(_));
+        let coat = self.coat(&material, ior, &name);
         let bsdf = if map.is_some() || textured_metal {
-            alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior }
+            let (ior, specular) = (coat.ior, coat.specular);
+            alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular }
         } else {
-            common::metal_rough(base, base_mean, metallic, roughness, ior, transmission.clamp(0.0, 1.0))
+            common::metal_rough(base, base_mean, metallic, roughness, (ior, coat), transmission.clamp(0.0, 1.0))
         };
         let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
         (m.emission, m.emission_texture) = (emission, emission_texture);
@@ -511,6 +513,25 @@ impl Importer<'_> {
         let id = common::add_material(&mut self.scene, m);
         self.materials.insert(material.index(), id);
         Ok(id)
+    }
+
+    /// The opaque coating under `KHR_materials_specular`: `specularFactor` the specular lobe's
+    /// strength, `specularColorFactor` (its mean, with a warning where it is coloured) scaling
+    /// the normal-incidence reflectance `((ior − 1)/(ior + 1))²`, at most 1 — read as the
+    /// coating of the index with that reflectance. Its textures are left out (warning).
+    fn coat(&mut self, material: &gltf::Material, ior: f64, name: &str) -> common::Coat {
+        let Some(s) = material.specular() else { return common::Coat::of(ior) };
+        if s.specular_texture().is_some() || s.specular_color_texture().is_some() {
+            self.warn(format!("{name}: KHR_materials_specular's textures are not supported; its factors are used"));
+        }
+        let color = s.specular_color_factor().map(f64::from);
+        if color.iter().any(|&c| (c - color[0]).abs() > 1e-6) {
+            self.warn(format!("{name}: a coloured specularColorFactor is read as its mean"));
+        }
+        let scale = color.iter().sum::<f64>() / 3.0;
+        let f0 = (((ior - 1.0) / (ior + 1.0)).powi(2) * scale).clamp(0.0, 0.99);
+        let ior = if scale == 1.0 { ior } else { (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()) };
+        common::Coat { ior: ior.max(1.0), specular: (s.specular_factor() as f64).clamp(0.0, 1.0) }
     }
 
     /// `KHR_texture_transform`'s scale, offset and rotation in alhazen's texture coordinates, and

@@ -206,6 +206,10 @@ pub enum BsdfDesc {
         map: Option<Texture>,
         /// The coating's index of refraction.
         ior: f64,
+        /// The strength of the coating's specular lobe (glTF's `KHR_materials_specular`
+        /// `specularFactor`, 1 without it): Cook–Torrance's `ks`, the diffuse weighted by
+        /// `1 − specular·F(0)`.
+        specular: f64,
     },
     /// `weight · a + (1 − weight) · b`.
     Mix {
@@ -281,10 +285,10 @@ impl crate::model::Material {
                 self.specular = Vec3::ONE;
                 self.shininess = 200.0;
             }
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, ior, .. } => {
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, ior, specular, .. } => {
                 // As the importers' material of these factors is followed: its metal where there
                 // is metal, else its coating, of colour `base`.
-                let (metal, coating) = metallic_roughness_lobes(Vec3::ONE, *roughness, *ior);
+                let (metal, coating) = metallic_roughness_lobes(Vec3::ONE, *roughness, *ior, *specular);
                 if *metallic > 0.0 {
                     self.follow(&metal);
                 } else {
@@ -298,7 +302,7 @@ impl crate::model::Material {
 }
 
 /// The metal and the coating of [`BsdfDesc::metallic_roughness_at`].
-fn metallic_roughness_lobes(base: Rgb, roughness: f64, ior: f64) -> (BsdfDesc, BsdfDesc) {
+fn metallic_roughness_lobes(base: Rgb, roughness: f64, ior: f64, specular: f64) -> (BsdfDesc, BsdfDesc) {
     let alpha = (roughness * roughness).clamp(0.0, 1.0);
     let metal = BsdfDesc::Conductor {
         facets: Some(ggx(alpha, alpha)),
@@ -310,8 +314,8 @@ fn metallic_roughness_lobes(base: Rgb, roughness: f64, ior: f64) -> (BsdfDesc, B
     let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
     let coating = BsdfDesc::CookTorrance {
         albedo: Texture::Solid(base),
-        kd: 1.0 - f0,
-        ks: 1.0,
+        kd: 1.0 - specular * f0,
+        ks: specular,
         facets: ggx(alpha.max(0.01), alpha.max(0.01)),
         ior,
         fresnel: FresnelMode::Exact,
@@ -354,12 +358,19 @@ impl BsdfDesc {
 
     /// glTF 2.0's metallic–roughness model at a point of base colour `base`, as the parts of a
     /// mix: a metal whose normal-incidence reflectance is `base` (Schlick's term), its weight
-    /// `metallic`, and Cook–Torrance over Lambert (a coating of index `ior`), both on GGX facets
-    /// of `α = roughness²`. Every point has the same lobes — a mix even where `metallic` is 0
-    /// or 1, facets of `α ≥ 10⁻³` even where `roughness` is 0 (the coating's `α ≥ 0.01`, as the
-    /// importers' constant materials) — so a surface's kind of BSDF never changes.
-    pub fn metallic_roughness_at(base: Rgb, metallic: f64, roughness: f64, ior: f64) -> (BsdfDesc, BsdfDesc, f64) {
-        let (metal, coating) = metallic_roughness_lobes(base, roughness, ior);
+    /// `metallic`, and Cook–Torrance over Lambert (a coating of index `ior`, its specular lobe
+    /// of strength `specular`), both on GGX facets of `α = roughness²`. Every point has the same
+    /// lobes — a mix even where `metallic` is 0 or 1, facets of `α ≥ 10⁻³` even where
+    /// `roughness` is 0 (the coating's `α ≥ 0.01`, as the importers' constant materials) — so a
+    /// surface's kind of BSDF never changes.
+    pub fn metallic_roughness_at(
+        base: Rgb,
+        metallic: f64,
+        roughness: f64,
+        ior: f64,
+        specular: f64,
+    ) -> (BsdfDesc, BsdfDesc, f64) {
+        let (metal, coating) = metallic_roughness_lobes(base, roughness, ior, specular);
         (metal, coating, metallic.clamp(0.0, 1.0))
     }
 

@@ -41,7 +41,7 @@ impl Parser<'_> {
             "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
-            "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior"],
+            "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior", "specular"],
             "thin-dielectric" => vec!["ior"],
             _ => vec!["a", "b", "weight", "weight_map"],
         };
@@ -126,6 +126,7 @@ impl Parser<'_> {
                 // Read linearly, as glTF's metallic-roughness textures are.
                 map: t.get("map").map(|m| self.linear_placed_image(&m)).transpose()?,
                 ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
+                specular: t.get("specular").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
             },
             _ => BsdfDesc::Mix {
                 a: Box::new(self.bsdf(&t.req("a")?, &albedo)?),

@@ -500,12 +500,13 @@ impl Writer<'_> {
                     num(*weight)
                 )
             }
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior } => format!(
-                "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{} }}",
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular } => format!(
+                "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{} }}",
                 self.texture(base),
                 num(*metallic),
                 num(*roughness),
                 num(*ior),
+                if *specular == 1.0 { String::new() } else { format!(", specular = {}", num(*specular)) },
                 map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m)))
             ),
         }

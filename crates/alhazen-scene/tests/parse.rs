@@ -690,3 +690,26 @@ fn vertex_colours_read_from_ply_and_obj_write_back_and_bad_ones_are_refused() {
         assert!(e.contains("vertex_colors") && e.contains(":2:"), "{bad}: {e}");
     }
 }
+
+/// A metallic–roughness coating's `specular` strength: 1 unless given, written back when it is
+/// not 1, refused outside [0, 1] with its place.
+#[test]
+fn metallic_roughness_specular_reads_writes_back_and_is_checked() {
+    use alhazen_scene::bsdf::BsdfDesc;
+    let text = "[materials.matte]\nbsdf = { type = \"metallic-roughness\", specular = 0.25 }\n\
+                [materials.plain]\nbsdf = { type = \"metallic-roughness\" }\n";
+    let s = parse_scene("s.toml".as_ref(), text).unwrap();
+    let specular =
+        |s: &alhazen_scene::Scene, name: &str| match &s.materials.iter().find(|m| m.name == name).unwrap().bsdf {
+            Some(BsdfDesc::MetallicRoughness { specular, .. }) => *specular,
+            other => panic!("{other:?}"),
+        };
+    assert_eq!((specular(&s, "matte"), specular(&s, "plain")), (0.25, 1.0));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&path).unwrap();
+    assert_eq!((specular(&again, "matte"), specular(&again, "plain")), (0.25, 1.0));
+    let e = err("[materials.m]\nbsdf = { type = \"metallic-roughness\", specular = 1.5 }\n");
+    assert!(e.contains(":2:") && e.contains("specular"), "{e}");
+}

@@ -132,7 +132,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             let weight = (weight * at).clamp(0.0, 1.0);
             Bsdf::Mix(Box::new(Mix { a: from_desc(a, lookups, mode), b: from_desc(b, lookups, mode), weight }))
         }
-        BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior } => {
+        BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
             let (metal, coating, weight) = BsdfDesc::metallic_roughness_at(
@@ -140,6 +140,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                 metallic * texel.z,
                 roughness * texel.y,
                 *ior,
+                *specular,
             );
             let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
             Bsdf::Mix(Box::new(Mix { a, b, weight }))
