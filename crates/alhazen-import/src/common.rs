@@ -6,7 +6,7 @@
 use crate::Warning;
 use alhazen_math::Transform;
 use alhazen_math::Vec3;
-use alhazen_scene::bsdf::{BsdfDesc, Ior};
+use alhazen_scene::bsdf::{BsdfDesc, Ior, MetalRoughness};
 pub(crate) use alhazen_scene::bsdf::{eta_from_f0, ggx};
 use alhazen_scene::{Diagnostic, FresnelMode, Material, MaterialId, Rgb, Scene, SceneError, Shape, Texture};
 use std::collections::HashSet;
@@ -97,22 +97,21 @@ pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb, textu
 
 /// The glTF 2.0 metallic–roughness model (also Mitsuba's `principled` and pbrt's
 /// `coateddiffuse` reduced to it): a metal whose normal-incidence reflectance is the base
-/// colour (Schlick), mixed by `metallic` with a dielectric coating (`coat`) over a Lambertian
-/// base, both with GGX roughness `α = roughness²`; `transmission` mixes in rough glass of index
+/// colour (Schlick), mixed by `metallic` with a dielectric coating over a Lambertian base (the
+/// coating's index and strength and the metal's multiple scattering: `lobes`), both with GGX roughness `α = roughness²`; `transmission` mixes in rough glass of index
 /// `ior`.
 pub(crate) fn metal_rough(
     base: Texture,
     base_mean: Rgb,
     metallic: f64,
     roughness: f64,
-    (ior, coat): (f64, Coat),
+    (ior, lobes): (f64, MetalRoughness),
     transmission: f64,
 ) -> BsdfDesc {
     // The model at a point of colour `base_mean`, its coating given the texture itself, its
     // metal smooth where the roughness is below the facets' least `α` (a material with a
     // single value need not keep the same lobes everywhere).
-    let (mut metal, mut plastic, _) =
-        BsdfDesc::metallic_roughness_at(base_mean, metallic, roughness, coat.ior, coat.specular);
+    let (mut metal, mut plastic, _) = BsdfDesc::metallic_roughness_at(base_mean, metallic, roughness, lobes);
     let alpha = (roughness * roughness).clamp(0.0, 1.0);
     let facets = (alpha > 1e-3).then(|| ggx(alpha, alpha));
     if let BsdfDesc::Conductor { facets: f, .. } = &mut metal {
@@ -126,20 +125,10 @@ pub(crate) fn metal_rough(
     mix(glass, opaque, transmission * (1.0 - metallic))
 }
 
-/// The opaque coating of the metallic–roughness model: its index (glTF's, or the one whose
-/// normal-incidence reflectance `KHR_materials_specular`'s colour factor scales it to) and the
-/// strength of its specular lobe.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Coat {
-    pub ior: f64,
-    pub specular: f64,
-}
-
-impl Coat {
-    /// The plain coating of index `ior`.
-    pub fn of(ior: f64) -> Self {
-        Coat { ior, specular: 1.0 }
-    }
+/// The plain lobes of the metallic–roughness model: a coating of index `ior` at full
+/// strength, a metal of single scattering (as Mitsuba's and pbrt's).
+pub(crate) fn plain_lobes(ior: f64) -> MetalRoughness {
+    MetalRoughness { ior, specular: 1.0, multiscatter: false }
 }
 
 /// `w·a + (1 − w)·b`, or the one that has all the weight.

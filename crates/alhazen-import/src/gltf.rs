@@ -19,6 +19,7 @@ use crate::Imported;
 use crate::common::{self, Warnings};
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Mat4, Transform, Vec2, Vec3};
+use alhazen_scene::bsdf::{BsdfDesc, MetalRoughness};
 use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
     PerspectiveOpening, Scene, SceneError, Shape, Texture, Wrap,
@@ -499,12 +500,12 @@ impl Importer<'_> {
         // Per point where the map or a textured metal's colour varies (glTF's metal takes each
         // texel's base colour), else the constant mix (and its glass under transmission).
         let textured_metal = metallic > 0.0 && transmission <= 0.0 && !matches!(base, Texture::Solid(_));
-        let coat = self.coat(&material, ior, &name);
+        let lobes = self.lobes(&material, ior, &name);
         let bsdf = if map.is_some() || textured_metal {
-            let (ior, specular) = (coat.ior, coat.specular);
-            alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular }
+            let (ior, specular, multiscatter) = (lobes.ior, lobes.specular, lobes.multiscatter);
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter }
         } else {
-            common::metal_rough(base, base_mean, metallic, roughness, (ior, coat), transmission.clamp(0.0, 1.0))
+            common::metal_rough(base, base_mean, metallic, roughness, (ior, lobes), transmission.clamp(0.0, 1.0))
         };
         let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
         (m.emission, m.emission_texture) = (emission, emission_texture);
@@ -515,12 +516,15 @@ impl Importer<'_> {
         Ok(id)
     }
 
-    /// The opaque coating under `KHR_materials_specular`: `specularFactor` the specular lobe's
-    /// strength, `specularColorFactor` (its mean, with a warning where it is coloured) scaling
-    /// the normal-incidence reflectance `((ior − 1)/(ior + 1))²`, at most 1 — read as the
-    /// coating of the index with that reflectance. Its textures are left out (warning).
-    fn coat(&mut self, material: &gltf::Material, ior: f64, name: &str) -> common::Coat {
-        let Some(s) = material.specular() else { return common::Coat::of(ior) };
+    /// The metallic–roughness lobes: the metal gives back the light of several facets, as
+    /// Blender's Principled BSDF (multiple-scattering GGX by default) does; the opaque coating
+    /// under `KHR_materials_specular`: `specularFactor` the specular lobe's strength,
+    /// `specularColorFactor` (its mean, with a warning where it is coloured) scaling the
+    /// normal-incidence reflectance `((ior − 1)/(ior + 1))²`, at most 1 — read as the coating of
+    /// the index with that reflectance. Its textures are left out (warning).
+    fn lobes(&mut self, material: &gltf::Material, ior: f64, name: &str) -> MetalRoughness {
+        let plain = MetalRoughness { multiscatter: true, ..common::plain_lobes(ior) };
+        let Some(s) = material.specular() else { return plain };
         if s.specular_texture().is_some() || s.specular_color_texture().is_some() {
             self.warn(format!("{name}: KHR_materials_specular's textures are not supported; its factors are used"));
         }
@@ -531,7 +535,7 @@ impl Importer<'_> {
         let scale = color.iter().sum::<f64>() / 3.0;
         let f0 = (((ior - 1.0) / (ior + 1.0)).powi(2) * scale).clamp(0.0, 0.99);
         let ior = if scale == 1.0 { ior } else { (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()) };
-        common::Coat { ior: ior.max(1.0), specular: (s.specular_factor() as f64).clamp(0.0, 1.0) }
+        MetalRoughness { ior: ior.max(1.0), specular: (s.specular_factor() as f64).clamp(0.0, 1.0), ..plain }
     }
 
     /// `KHR_texture_transform`'s scale, offset and rotation in alhazen's texture coordinates, and

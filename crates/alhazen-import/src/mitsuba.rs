@@ -997,7 +997,7 @@ impl Importer {
                     ),
                     None => (Vec3::ZERO, Vec3::ZERO),
                 };
-                BsdfDesc::Conductor { facets, eta, k, tint, fresnel: FresnelMode::Exact }
+                BsdfDesc::Conductor { facets, eta, k, tint, fresnel: FresnelMode::Exact, multiscatter: false }
             }
             "dielectric" | "roughdielectric" | "thindielectric" => {
                 let ior = self.ior(ctx, &p, 1.5046)?;
@@ -1270,16 +1270,32 @@ impl Importer {
             let map = Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation });
             let (metallic, roughness) = (metallic.unwrap_or(1.0), roughness.unwrap_or(1.0));
             let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
-            return Ok(BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular: 1.0 });
+            return Ok(BsdfDesc::MetallicRoughness {
+                base,
+                metallic,
+                roughness,
+                map,
+                ior,
+                specular: 1.0,
+                multiscatter: false,
+            });
         }
         let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
         let roughness = self.textured_mean(ctx, p, "roughness", roughness)?;
         if metallic > 0.0 && trans <= 0.0 && !matches!(base, Texture::Solid(_)) {
             // A textured metal takes each point's base colour.
             let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
-            return Ok(BsdfDesc::MetallicRoughness { base, metallic, roughness, map: None, ior, specular: 1.0 });
+            return Ok(BsdfDesc::MetallicRoughness {
+                base,
+                metallic,
+                roughness,
+                map: None,
+                ior,
+                specular: 1.0,
+                multiscatter: false,
+            });
         }
-        Ok(common::metal_rough(base, mean, metallic, roughness, (ior, common::Coat::of(ior)), trans))
+        Ok(common::metal_rough(base, mean, metallic, roughness, (ior, common::plain_lobes(ior)), trans))
     }
 
     /// `v`, or the mean luminance of its texture (parameter `name`), with a warning.

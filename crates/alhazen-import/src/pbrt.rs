@@ -986,7 +986,7 @@ impl Importer {
                 };
                 let fresnel =
                     if self.find(p, "reflectance").is_some() { FresnelMode::Schlick } else { FresnelMode::Exact };
-                BsdfDesc::Conductor { facets: facets(rough), eta, k, tint: Vec3::ONE, fresnel }
+                BsdfDesc::Conductor { facets: facets(rough), eta, k, tint: Vec3::ONE, fresnel, multiscatter: false }
             }
             "dielectric" => {
                 let rough = self.roughness(ctx, p)?;

@@ -66,8 +66,23 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                         k: Vec3::new(3.9, 2.45, 2.14),
                         tint: Vec3::ONE,
                         schlick: false,
+                        multiscatter: false,
                     }),
                 ));
+                // The light of several facets (GGX's; other facets take single scattering).
+                for schlick in [false, true].into_iter().filter(|_| d == Distribution::TrowbridgeReitz) {
+                    list.push((
+                        format!("rough conductor {name} m={a}, several facets, schlick {schlick}"),
+                        Bsdf::Conductor(Conductor {
+                            facets: Some(facets(d, a, 0.7 * a, Shadowing::Smith)),
+                            eta: Vec3::new(0.2, 0.92, 1.1),
+                            k: Vec3::new(3.9, 2.45, 2.14),
+                            tint: Vec3::ONE,
+                            schlick,
+                            multiscatter: true,
+                        }),
+                    ));
+                }
                 list.push((
                     format!("rough dielectric {name} m={a}"),
                     Bsdf::Dielectric(Dielectric {
@@ -89,6 +104,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
             k: Vec3::splat(3.0),
             tint: Vec3::ONE,
             schlick: true,
+            multiscatter: false,
         }),
     ));
     list.push(("rough plastic ggx m=0.2".into(), Bsdf::Plastic(Plastic::new(albedo, 1.49, Some(ggx(0.2)), false))));
@@ -111,6 +127,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 k: Vec3::splat(3.0),
                 tint: Vec3::ONE,
                 schlick: false,
+                multiscatter: false,
             }),
             weight: 0.4,
         })),
@@ -426,6 +443,7 @@ fn conductor_fresnel_matches_known_values() {
         k: Vec3::splat(k),
         tint: Vec3::ONE,
         schlick: false,
+        multiscatter: false,
     };
     let f = c(1.5, 0.0).fresnel(1.0).x;
     assert!((f - 0.04).abs() < 1e-12);
@@ -466,4 +484,47 @@ fn a_thin_sheet_reflects_both_faces_and_passes_the_rest_straight() {
         let got = reflected as f64 / n as f64;
         assert!((got - want).abs() < 1e-3, "θ {theta}: reflected {got}, want {want}");
     }
+}
+
+/// A white rough metal (a mirror's Fresnel term, 1 at every angle) that gives back the light of
+/// several facets reflects all the light at every angle and roughness — a white furnace — where
+/// single scattering loses up to half of it on the roughest facets.
+#[test]
+fn several_facets_give_the_white_furnace_back_its_light() {
+    use alhazen_render::bsdf::Conductor;
+    let white = |alpha: f64, multiscatter: bool| {
+        Bsdf::Conductor(Conductor {
+            facets: Some(facets(Distribution::TrowbridgeReitz, alpha, alpha, Shadowing::Smith)),
+            eta: Vec3::ZERO,
+            k: Vec3::ZERO,
+            tint: Vec3::ONE,
+            schlick: false,
+            multiscatter,
+        })
+    };
+    // The albedo towards `v` by sampling: the mean of f·cos/pdf over a stratified grid.
+    let albedo = |b: &Bsdf, v: Vec3| {
+        let n = 128;
+        let mut sum = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let u = Vec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+                let uc = ((i * n + j) as f64 * 0.618_033_988_749_894_9).fract();
+                if let Some(s) = b.sample(v, uc, u) {
+                    sum += s.f.x * s.l.z.abs() / s.pdf;
+                }
+            }
+        }
+        sum / (n * n) as f64
+    };
+    for alpha in [0.1, 0.4, 0.7, 1.0] {
+        for theta in [0.0, 40.0, 75.0, 85.0, 88.0] {
+            let v = direction(theta, 0.3);
+            let (single, several) = (albedo(&white(alpha, false), v), albedo(&white(alpha, true), v));
+            assert!((several - 1.0).abs() < 0.03, "α {alpha}, ϑ {theta}: {several} (single {single})");
+            assert!(several >= single - 1e-9, "α {alpha}, ϑ {theta}: {several} < {single}");
+        }
+    }
+    let v = direction(40.0, 0.3);
+    assert!(albedo(&white(1.0, false), v) < 0.75, "the roughest single scattering loses light");
 }

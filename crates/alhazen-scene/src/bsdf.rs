@@ -173,6 +173,10 @@ pub enum BsdfDesc {
         tint: Rgb,
         /// Exact or Schlick (from the normal-incidence reflectance).
         fresnel: FresnelMode,
+        /// Rough: the light that meets several facets is given back (Kulla and Conty's lobe,
+        /// the energy Cycles' multiple-scattering GGX keeps); false: single scattering, as
+        /// pbrt and Mitsuba.
+        multiscatter: bool,
     },
     /// Glass and the like: reflection and refraction with the course's transmission term.
     Dielectric {
@@ -210,6 +214,8 @@ pub enum BsdfDesc {
         /// `specularFactor`, 1 without it): Cook–Torrance's `ks`, the diffuse weighted by
         /// `1 − specular·F(0)`.
         specular: f64,
+        /// The metal's light of several facets ([`BsdfDesc::Conductor`]'s `multiscatter`).
+        multiscatter: bool,
     },
     /// `weight · a + (1 − weight) · b`.
     Mix {
@@ -285,10 +291,11 @@ impl crate::model::Material {
                 self.specular = Vec3::ONE;
                 self.shininess = 200.0;
             }
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, ior, specular, .. } => {
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, ior, specular, multiscatter, .. } => {
                 // As the importers' material of these factors is followed: its metal where there
                 // is metal, else its coating, of colour `base`.
-                let (metal, coating) = metallic_roughness_lobes(Vec3::ONE, *roughness, *ior, *specular);
+                let lobes = MetalRoughness { ior: *ior, specular: *specular, multiscatter: *multiscatter };
+                let (metal, coating) = metallic_roughness_lobes(Vec3::ONE, *roughness, lobes);
                 if *metallic > 0.0 {
                     self.follow(&metal);
                 } else {
@@ -302,7 +309,8 @@ impl crate::model::Material {
 }
 
 /// The metal and the coating of [`BsdfDesc::metallic_roughness_at`].
-fn metallic_roughness_lobes(base: Rgb, roughness: f64, ior: f64, specular: f64) -> (BsdfDesc, BsdfDesc) {
+fn metallic_roughness_lobes(base: Rgb, roughness: f64, lobes: MetalRoughness) -> (BsdfDesc, BsdfDesc) {
+    let MetalRoughness { ior, specular, multiscatter } = lobes;
     let alpha = (roughness * roughness).clamp(0.0, 1.0);
     let metal = BsdfDesc::Conductor {
         facets: Some(ggx(alpha, alpha)),
@@ -310,6 +318,7 @@ fn metallic_roughness_lobes(base: Rgb, roughness: f64, ior: f64, specular: f64) 
         k: Vec3::ZERO,
         tint: Vec3::ONE,
         fresnel: FresnelMode::Schlick,
+        multiscatter,
     };
     let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
     let coating = BsdfDesc::CookTorrance {
@@ -321,6 +330,18 @@ fn metallic_roughness_lobes(base: Rgb, roughness: f64, ior: f64, specular: f64) 
         fresnel: FresnelMode::Exact,
     };
     (metal, coating)
+}
+
+/// What shapes the metallic–roughness model's lobes besides its colour, metalness and
+/// roughness: the coating's index and specular strength, the metal's multiple scattering.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MetalRoughness {
+    /// The coating's index of refraction.
+    pub ior: f64,
+    /// The coating's specular strength.
+    pub specular: f64,
+    /// The metal gives back the light of several facets.
+    pub multiscatter: bool,
 }
 
 /// GGX microfacets with Smith shadowing, `α` clamped away from 0 (where the distribution
@@ -367,10 +388,9 @@ impl BsdfDesc {
         base: Rgb,
         metallic: f64,
         roughness: f64,
-        ior: f64,
-        specular: f64,
+        lobes: MetalRoughness,
     ) -> (BsdfDesc, BsdfDesc, f64) {
-        let (metal, coating) = metallic_roughness_lobes(base, roughness, ior, specular);
+        let (metal, coating) = metallic_roughness_lobes(base, roughness, lobes);
         (metal, coating, metallic.clamp(0.0, 1.0))
     }
 

@@ -39,9 +39,9 @@ impl Parser<'_> {
             "blinn-phong" => vec!["color", "kd", "ks", "exponent", "anisotropy", "scratches"],
             "cook-torrance" => [&["color", "kd", "ks", "ior", "fresnel"][..], MICROFACET_KEYS].concat(),
             "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
-            "conductor" => [&["metal", "eta", "k", "tint", "fresnel"][..], MICROFACET_KEYS].concat(),
+            "conductor" => [&["metal", "eta", "k", "tint", "fresnel", "multiscatter"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
-            "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior", "specular"],
+            "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior", "specular", "multiscatter"],
             "thin-dielectric" => vec!["ior"],
             _ => vec!["a", "b", "weight", "weight_map"],
         };
@@ -101,7 +101,9 @@ impl Parser<'_> {
                     ),
                 };
                 let facets = microfacets(&t)?;
-                BsdfDesc::Conductor { facets, eta, k, tint: t.opt_rgb("tint", Vec3::ONE)?, fresnel: fresnel(&t)? }
+                let (tint, fresnel, multiscatter) =
+                    (t.opt_rgb("tint", Vec3::ONE)?, fresnel(&t)?, t.opt_bool("multiscatter", false)?);
+                BsdfDesc::Conductor { facets, eta, k, tint, fresnel, multiscatter }
             }
             "plastic" => {
                 let facets = microfacets(&t)?;
@@ -127,6 +129,7 @@ impl Parser<'_> {
                 map: t.get("map").map(|m| self.linear_placed_image(&m)).transpose()?,
                 ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
                 specular: t.get("specular").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
+                multiscatter: t.opt_bool("multiscatter", false)?,
             },
             _ => BsdfDesc::Mix {
                 a: Box::new(self.bsdf(&t.req("a")?, &albedo)?),

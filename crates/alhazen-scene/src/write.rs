@@ -466,13 +466,14 @@ impl Writer<'_> {
                 num(*ior),
                 facets(f)
             ),
-            BsdfDesc::Conductor { facets: f, eta, k, tint, fresnel: fr } => format!(
-                "{{ type = \"conductor\", eta = {}, k = {}, tint = {}, fresnel = \"{}\", {} }}",
+            BsdfDesc::Conductor { facets: f, eta, k, tint, fresnel: fr, multiscatter } => format!(
+                "{{ type = \"conductor\", eta = {}, k = {}, tint = {}, fresnel = \"{}\", {}{} }}",
                 vec3(*eta),
                 vec3(*k),
                 vec3(*tint),
                 fresnel(*fr),
-                facets(f)
+                facets(f),
+                if *multiscatter { ", multiscatter = true" } else { "" }
             ),
             BsdfDesc::ThinDielectric { ior } => format!("{{ type = \"thin-dielectric\", ior = {} }}", num(*ior)),
             BsdfDesc::Dielectric { facets: f, ior, fresnel: fr } => {
@@ -500,13 +501,14 @@ impl Writer<'_> {
                     num(*weight)
                 )
             }
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular } => format!(
-                "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{} }}",
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter } => format!(
+                "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{} }}",
                 self.texture(base),
                 num(*metallic),
                 num(*roughness),
                 num(*ior),
                 if *specular == 1.0 { String::new() } else { format!(", specular = {}", num(*specular)) },
+                if *multiscatter { ", multiscatter = true" } else { "" },
                 map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m)))
             ),
         }

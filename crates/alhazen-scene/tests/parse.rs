@@ -713,3 +713,33 @@ fn metallic_roughness_specular_reads_writes_back_and_is_checked() {
     let e = err("[materials.m]\nbsdf = { type = \"metallic-roughness\", specular = 1.5 }\n");
     assert!(e.contains(":2:") && e.contains("specular"), "{e}");
 }
+
+/// `multiscatter` on a conductor and on the metallic–roughness model: false unless given,
+/// written back, refused when not a boolean.
+#[test]
+fn multiscatter_reads_writes_back_and_is_checked() {
+    use alhazen_scene::bsdf::BsdfDesc;
+    let text = "[materials.gold]\nbsdf = { type = \"conductor\", metal = \"gold\", roughness = 0.4, multiscatter = true }\n\
+                [materials.mr]\nbsdf = { type = \"metallic-roughness\", metallic = 1, multiscatter = true }\n\
+                [materials.plain]\nbsdf = { type = \"conductor\", roughness = 0.4 }\n";
+    let flags = |s: &alhazen_scene::Scene| {
+        s.materials
+            .iter()
+            .filter_map(|m| match &m.bsdf {
+                Some(BsdfDesc::Conductor { multiscatter, .. } | BsdfDesc::MetallicRoughness { multiscatter, .. }) => {
+                    Some((m.name.clone(), *multiscatter))
+                }
+                _ => None,
+            })
+            .collect::<Vec<_>>()
+    };
+    let s = parse_scene("s.toml".as_ref(), text).unwrap();
+    let want = vec![("gold".to_string(), true), ("mr".to_string(), true), ("plain".to_string(), false)];
+    assert_eq!(flags(&s), want);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &path, &dir.path().join("assets"), "").unwrap();
+    assert_eq!(flags(&load_scene(&path).unwrap()), want);
+    let e = err("[materials.m]\nbsdf = { type = \"conductor\", multiscatter = 1 }\n");
+    assert!(e.contains(":2:") && e.contains("multiscatter"), "{e}");
+}

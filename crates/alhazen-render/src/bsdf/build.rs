@@ -71,6 +71,7 @@ fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec
         k: Vec3::ZERO,
         tint: mode.color(m.mirror / w),
         schlick: false,
+        multiscatter: false,
     });
     Bsdf::Mix(Box::new(Mix { a: mirror, b: lambert, weight: w }))
 }
@@ -110,12 +111,13 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
         BsdfDesc::Plastic { albedo, ior, facets, nonlinear } => {
             Bsdf::Plastic(Plastic::new(tex(albedo), *ior, facets.as_ref().map(Microfacet::new), *nonlinear))
         }
-        BsdfDesc::Conductor { facets, eta, k, tint, fresnel } => Bsdf::Conductor(Conductor {
+        BsdfDesc::Conductor { facets, eta, k, tint, fresnel, multiscatter } => Bsdf::Conductor(Conductor {
             facets: facets.as_ref().map(Microfacet::new),
             eta: mode.color(*eta),
             k: mode.color(*k),
             tint: mode.color(*tint * lookups.tint),
             schlick: *fresnel == FresnelMode::Schlick,
+            multiscatter: *multiscatter,
         }),
         BsdfDesc::Dielectric { facets, ior, fresnel } => Bsdf::Dielectric(Dielectric {
             facets: facets.as_ref().map(Microfacet::new),
@@ -132,15 +134,14 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             let weight = (weight * at).clamp(0.0, 1.0);
             Bsdf::Mix(Box::new(Mix { a: from_desc(a, lookups, mode), b: from_desc(b, lookups, mode), weight }))
         }
-        BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular } => {
+        BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
             let (metal, coating, weight) = BsdfDesc::metallic_roughness_at(
                 (lookups.rgb)(base) * lookups.tint,
                 metallic * texel.z,
                 roughness * texel.y,
-                *ior,
-                *specular,
+                alhazen_scene::bsdf::MetalRoughness { ior: *ior, specular: *specular, multiscatter: *multiscatter },
             );
             let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
             Bsdf::Mix(Box::new(Mix { a, b, weight }))

@@ -7,7 +7,7 @@
 //! `tint` (a multiplier, 1 is physical), Fresnel mode. `η = κ = 0` is an ideal mirror (`F = tint`).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, MicrofacetLobes, half_vector, reflect, same_side};
+use super::{BsdfSample, MicrofacetLobes, reflect, same_side};
 use alhazen_math::{Vec2, Vec3};
 
 /// A conductor.
@@ -23,6 +23,9 @@ pub struct Conductor {
     pub tint: Vec3,
     /// Schlick instead of the exact formula.
     pub schlick: bool,
+    /// A rough conductor adds the light that meets several facets (Kulla and Conty's lobe,
+    /// [`super::multiscatter`]), as Cycles' multiple-scattering GGX gives it back.
+    pub multiscatter: bool,
 }
 
 /// Unpolarised reflectance of a conductor `η + iκ` at incidence cosine `cos_i`:
@@ -77,37 +80,77 @@ impl Conductor {
         if mirror { self.tint } else { f }
     }
 
-    /// `D G F / (4⟨l,n⟩⟨v,n⟩)`; 0 for a smooth metal.
+    /// `D G F / (4⟨l,n⟩⟨v,n⟩)` (plus the light of several facets with
+    /// [`Self::multiscatter`]); 0 for a smooth metal.
     pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
-        let Some(f) = &self.facets else { return Vec3::ZERO };
-        if !same_side(v, l) {
-            return Vec3::ZERO;
-        }
-        let Some(h) = half_vector(v, l) else { return Vec3::ZERO };
-        self.fresnel(h.dot(l)) * (f.d(h) * f.g(v, l, h) / (4.0 * l.z.abs() * v.z.abs()))
+        self.eval_pdf(v, l).0
     }
 
-    /// The facet's density over `4⟨h,v⟩`.
+    /// The facet's density over `4⟨h,v⟩` (mixed with the cosine density of the light of
+    /// several facets, in proportion to the two lobes' albedos, with [`Self::multiscatter`]).
     pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        let Some(f) = &self.facets else { return 0.0 };
-        if !same_side(v, l) {
-            return 0.0;
-        }
-        let Some(h) = half_vector(v, l) else { return 0.0 };
-        f.pdf_h_from(v, h, f.d(h)) / (4.0 * h.dot(v).abs())
+        self.eval_pdf(v, l).1
     }
 
     /// [`Self::eval`] and [`Self::pdf`] with the half vector and `D` found once (the same numbers).
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
         let Some(f) = &self.facets else { return (Vec3::ZERO, 0.0) };
-        self.rough_eval_pdf(f, v, l)
+        let (value, pdf) = self.rough_eval_pdf(f, v, l);
+        let Some(ms) = self.multiple_scattering(v) else { return (value, pdf) };
+        if !same_side(v, l) {
+            return (Vec3::ZERO, 0.0);
+        }
+        let p = ms.choice(self.fresnel(v.z));
+        (value + ms.eval(l), (1.0 - p) * pdf + p * super::cosine_pdf(v, l))
     }
 
-    /// The mirror direction, or reflection about a sampled facet.
-    pub fn sample(&self, v: Vec3, _uc: f64, u: Vec2) -> Option<BsdfSample> {
+    /// The mirror direction, or reflection about a sampled facet (or, with
+    /// [`Self::multiscatter`], by `uc`, a cosine-weighted direction for the light of several
+    /// facets), valued as the whole BSDF.
+    pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let Some(facets) = &self.facets else { return Some(self.smooth_sample(v)) };
-        let (sampled, sample) = self.rough_sample(facets, v, 0.0, u);
-        sampled.then_some(sample)
+        let Some(ms) = self.multiple_scattering(v) else {
+            let (sampled, sample) = self.rough_sample(facets, v, 0.0, u);
+            return sampled.then_some(sample);
+        };
+        let l = if uc < ms.choice(self.fresnel(v.z)) {
+            super::cosine_hemisphere(u, v)
+        } else {
+            let (sampled, sample) = self.rough_sample(facets, v, 0.0, u);
+            if !sampled {
+                return None;
+            }
+            sample.l
+        };
+        let (f, pdf) = self.eval_pdf(v, l);
+        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+
+    /// The lobe of the light of several facets seen from `v`: a rough conductor's with
+    /// [`Self::multiscatter`] on Trowbridge–Reitz (GGX) facets with Smith's shadowing, whose
+    /// albedo is tabulated; else none.
+    pub(crate) fn multiple_scattering(&self, v: Vec3) -> Option<super::multiscatter::MultipleScattering> {
+        use alhazen_scene::bsdf::{Distribution, Shadowing};
+        let ggx =
+            |f: &&super::Microfacet| f.distribution == Distribution::TrowbridgeReitz && f.shadowing == Shadowing::Smith;
+        let f = self.facets.as_ref().filter(|_| self.multiscatter).filter(ggx)?;
+        let alpha = (f.alpha_u * f.alpha_v).sqrt();
+        Some(super::multiscatter::MultipleScattering::new(alpha, v, self.fresnel_average()))
+    }
+
+    /// The cosine-weighted mean of [`Self::fresnel`]: `F0 + (1 − F0)/21` for Schlick's term,
+    /// the tint for an ideal mirror, by quadrature for the exact formula.
+    fn fresnel_average(&self) -> Vec3 {
+        if self.eta == Vec3::ZERO && self.k == Vec3::ZERO {
+            return self.tint;
+        }
+        if self.schlick {
+            let channels = |v: Vec3| [v.x, v.y, v.z, 0.0];
+            let f0 = fresnel_conductor_channels(1.0, channels(self.eta), channels(self.k));
+            let avg = |i: usize| f0[i] + (1.0 - f0[i]) / 21.0;
+            return Vec3::new(avg(0), avg(1), avg(2)) * self.tint;
+        }
+        super::multiscatter::fresnel_average(|c| self.fresnel(c))
     }
 
     /// The smooth conductor's mirror direction, weighted by the Fresnel term.

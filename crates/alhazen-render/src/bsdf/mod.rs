@@ -16,6 +16,7 @@ mod lambert;
 pub mod layered;
 pub mod microfacet;
 mod mix;
+mod multiscatter;
 mod oren_nayar;
 mod phong;
 mod plastic;
@@ -128,7 +129,10 @@ impl Bsdf {
 
     /// True when `sample` uses its lobe choice `uc` (several lobes to pick from).
     pub fn chooses_lobe(&self) -> bool {
-        !matches!(self, Bsdf::Lambert(_) | Bsdf::OrenNayar(_) | Bsdf::Conductor(_))
+        match self {
+            Bsdf::Conductor(c) => c.multiple_scattering(Vec3::Z).is_some(),
+            _ => !matches!(self, Bsdf::Lambert(_) | Bsdf::OrenNayar(_)),
+        }
     }
 
     /// True when every lobe is a delta (no light sampling helps).

@@ -490,6 +490,8 @@ pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<Kernel> {
 fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
     match bsdf {
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
+        // The light of several facets is the general kernel's.
+        Bsdf::Conductor(c) if c.multiple_scattering(Vec3::Z).is_some() => Kernel::General,
         Bsdf::Conductor(c) => match (c.facets.map(|_| conductor_facets(c)), c.schlick) {
             (None, false) => Kernel::SmoothConductor,
             (None, true) => Kernel::SmoothSchlickConductor,
@@ -548,6 +550,7 @@ fn metallic_roughness(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &CookTorran
     match (&mix.a, &mix.b) {
         (Bsdf::Conductor(c), Bsdf::CookTorrance(base))
             if c.schlick
+                && !c.multiscatter
                 && conductor_facets(c) == Some(false)
                 && c.facets.is_some_and(|f| f.alpha_u == f.alpha_v)
                 && cook_torrance_facets(base) == Some(false) =>
@@ -1147,7 +1150,7 @@ impl RoughBsdf for Conductor {
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        Conductor { facets: Some(facets), eta, k, tint, schlick: false }
+        Conductor { facets: Some(facets), eta, k, tint, schlick: false, multiscatter: false }
     }
 }
 
@@ -1170,7 +1173,7 @@ impl RoughBsdf for SchlickConductor {
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        SchlickConductor(Conductor { facets: Some(facets), eta, k, tint, schlick: true })
+        SchlickConductor(Conductor { facets: Some(facets), eta, k, tint, schlick: true, multiscatter: false })
     }
 }
 
@@ -1252,7 +1255,7 @@ impl<const SCHLICK: bool> LaneBsdf for SmoothConductor<SCHLICK> {
     #[inline(always)]
     fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        (true, Conductor { facets: None, eta, k, tint, schlick: SCHLICK }.smooth_sample(wv))
+        (true, Conductor { facets: None, eta, k, tint, schlick: SCHLICK, multiscatter: false }.smooth_sample(wv))
     }
 }
 
@@ -1300,7 +1303,7 @@ impl LambertMirror {
     #[inline(always)]
     fn at(v: &Vertices, i: usize) -> (Conductor, crate::bsdf::Lambert, f64) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        let mirror = Conductor { facets: None, eta, k, tint, schlick: false };
+        let mirror = Conductor { facets: None, eta, k, tint, schlick: false, multiscatter: false };
         (mirror, crate::bsdf::Lambert { albedo: get(&v.albedo, i) }, v.mix_weight[i])
     }
 }
@@ -1342,7 +1345,7 @@ impl MetallicRoughness {
     fn at(v: &Vertices, i: usize) -> ((Conductor, Microfacet), (CookTorrance, Microfacet), f64) {
         let metal_facets = Microfacet::smith::<false>(v.alpha[0][i], v.alpha[0][i]);
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        let metal = Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true };
+        let metal = Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true, multiscatter: false };
         let base_facets = Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]);
         let lobe = CookTorranceLobe { facets: base_facets, ior: v.ior[i], schlick: false };
         let base = CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe };
