@@ -174,13 +174,47 @@ def front_camera(scene, fov_degrees):
 def export_and_render_emission(scene, out, stem, size, spp, pixel_filter=("BOX", 1.0)):
     """Writes OUT/STEM.glb (Blender's glTF exporter, with cameras) and OUT/STEM-cycles.exr:
     Cycles without bounces (what emitters show directly), 32-bit, through `pixel_filter`."""
+    export_and_render(scene, out, stem, size, spp, bounces=0, pixel_filter=pixel_filter)
+
+
+def export_and_render(scene, out, stem, size, spp, bounces, pixel_filter=("BOX", 1.0), glb=True):
+    """Writes OUT/STEM.glb (Blender's glTF exporter, with cameras and lights; left out when
+    not `glb`) and OUT/STEM-cycles.exr: Cycles with `bounces`, 32-bit, through `pixel_filter`."""
     os.makedirs(out, exist_ok=True)
     scene.render.resolution_x, scene.render.resolution_y = size
-    bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB", export_cameras=True,
-                              export_yup=True)
-    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), spp, size, bounces=0, transparent=0, depth="32",
-                     pixel_filter=pixel_filter)
+    if glb:
+        bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB",
+                                  export_cameras=True, export_lights=True, export_yup=True)
+    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), spp, size, bounces=bounces, transparent=0,
+                     depth="32", pixel_filter=pixel_filter)
     print(f"Cycles: {spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
+
+
+def white_world(scene):
+    """A uniform white world of strength 1: the sky alhazen gives a glTF without lights."""
+    world = scene.world.node_tree.nodes["Background"]
+    world.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    world.inputs["Strength"].default_value = 1.0
+
+
+def sun(rotation_degrees, energy=3.0):
+    """A sun of `energy` W/m², of no angular size, turned by `rotation_degrees` (Euler XYZ)."""
+    bpy.ops.object.light_add(type="SUN", rotation=tuple(math.radians(a) for a in rotation_degrees))
+    bpy.context.object.data.energy = energy
+    bpy.context.object.data.angle = 0.0
+
+
+def mapped(m, tex):
+    """Feeds image node `tex` of material `m` the UV coordinates through a Mapping node of
+    location (0.15, 0.3), rotation 30° and scale (1.5, 0.75)."""
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    coords = nodes.new("ShaderNodeTexCoord")
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.inputs["Location"].default_value = (0.15, 0.3, 0.0)
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30))
+    mapping.inputs["Scale"].default_value = (1.5, 0.75, 1.0)
+    links.new(coords.outputs["UV"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
 
 
 def black_world(scene):

@@ -27,7 +27,7 @@ import argparse, math, os, sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import front_camera, material, render, saved_image  # noqa: E402
+from gltf_vs_cycles import export_and_render, front_camera, image_node, mapped, material, saved_image, sun  # noqa: E402
 
 
 def waves(x, y):
@@ -43,30 +43,18 @@ def build(out):
     img = saved_image("waves", 32, waves, os.path.join(out, "map-waves.png"))
     img.colorspace_settings.name = "Non-Color"
     m = material("copper", (0.95, 0.64, 0.54), 1.0, 1.0)
-    nodes, links = m.node_tree.nodes, m.node_tree.links
-    tex = nodes.new("ShaderNodeTexImage")
-    tex.image = img
-    tex.interpolation = "Linear"
-    split = nodes.new("ShaderNodeSeparateColor")
-    links.new(tex.outputs["Color"], split.inputs["Color"])
-    p = nodes["Principled BSDF"]
-    links.new(split.outputs["Green"], p.inputs["Roughness"])
-    links.new(split.outputs["Blue"], p.inputs["Metallic"])
-    coords = nodes.new("ShaderNodeTexCoord")
-    mapping = nodes.new("ShaderNodeMapping")
-    mapping.inputs["Location"].default_value = (0.15, 0.3, 0.0)
-    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30))
-    mapping.inputs["Scale"].default_value = (1.5, 0.75, 1.0)
-    links.new(coords.outputs["UV"], mapping.inputs["Vector"])
-    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    tex, p = image_node(m, img)
+    split = m.node_tree.nodes.new("ShaderNodeSeparateColor")
+    m.node_tree.links.new(tex.outputs["Color"], split.inputs["Color"])
+    m.node_tree.links.new(split.outputs["Green"], p.inputs["Roughness"])
+    m.node_tree.links.new(split.outputs["Blue"], p.inputs["Metallic"])
+    mapped(m, tex)
     bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
     bpy.context.object.data.materials.append(m)
     front_camera(scene, 25)
     # A sun 30° above the camera's axis: the dielectric's diffuse shows it, the smooth metal
     # reflects it away from the camera and shows the black world.
-    bpy.ops.object.light_add(type="SUN", rotation=(math.radians(60), 0.0, 0.0))
-    bpy.context.object.data.energy = 3.0
-    bpy.context.object.data.angle = 0.0
+    sun((60, 0, 0))
     return scene
 
 
@@ -89,26 +77,15 @@ def build_normal(out):
     img = saved_image("bumps", 32, bumps, os.path.join(out, "normal-bumps.png"))
     img.colorspace_settings.name = "Non-Color"
     m = material("grey", (0.7, 0.7, 0.7), 0.0, 0.0)
-    nodes, links = m.node_tree.nodes, m.node_tree.links
-    tex = nodes.new("ShaderNodeTexImage")
-    tex.image = img
-    tex.interpolation = "Linear"
-    normal_map = nodes.new("ShaderNodeNormalMap")
-    links.new(tex.outputs["Color"], normal_map.inputs["Color"])
-    links.new(normal_map.outputs["Normal"], nodes["Principled BSDF"].inputs["Normal"])
-    coords = nodes.new("ShaderNodeTexCoord")
-    mapping = nodes.new("ShaderNodeMapping")
-    mapping.inputs["Location"].default_value = (0.15, 0.3, 0.0)
-    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30))
-    mapping.inputs["Scale"].default_value = (1.5, 0.75, 1.0)
-    links.new(coords.outputs["UV"], mapping.inputs["Vector"])
-    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    tex, p = image_node(m, img)
+    normal_map = m.node_tree.nodes.new("ShaderNodeNormalMap")
+    m.node_tree.links.new(tex.outputs["Color"], normal_map.inputs["Color"])
+    m.node_tree.links.new(normal_map.outputs["Normal"], p.inputs["Normal"])
+    mapped(m, tex)
     bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
     bpy.context.object.data.materials.append(m)
     front_camera(scene, 25)
-    bpy.ops.object.light_add(type="SUN", rotation=(math.radians(60), 0.0, math.radians(20)))
-    bpy.context.object.data.energy = 3.0
-    bpy.context.object.data.angle = 0.0
+    sun((60, 0, 20))
     return scene
 
 
@@ -122,12 +99,7 @@ def main():
     os.makedirs(out, exist_ok=True)
     scene = build_normal(out) if a.normal else build(out)
     stem = "normal-transform" if a.normal else "map-transform"
-    scene.render.resolution_x, scene.render.resolution_y = 64, 64
-    bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB",
-                              export_cameras=True, export_lights=True, export_yup=True)
-    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), a.spp, (64, 64), bounces=2, transparent=0,
-                     depth="32")
-    print(f"Cycles: {a.spp} spp at 64x64 on 2 threads in {seconds:.2f} s", file=sys.stderr)
+    export_and_render(scene, out, stem, (64, 64), a.spp, bounces=2)
 
 
 if __name__ == "__main__":

@@ -13,12 +13,12 @@ instead (rough-metals-single-cycles.exr), which alhazen's metals without the lob
 facets match. The .glb has no world: alhazen lights a glTF without lights by a uniform white
 sky, the world given to Cycles here. Needs `pip install bpy`.
 """
-import argparse, math, os, sys
+import argparse, os, sys
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import front_camera, material, render  # noqa: E402
+from gltf_vs_cycles import export_and_render, front_camera, material, white_world  # noqa: E402
 
 
 def build(distribution):
@@ -31,9 +31,7 @@ def build(distribution):
         bpy.ops.object.shade_smooth()
         bpy.context.object.data.materials.append(m)
     front_camera(scene, 40)
-    world = scene.world.node_tree.nodes["Background"]
-    world.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    world.inputs["Strength"].default_value = 1.0
+    white_world(scene)
     return scene
 
 
@@ -46,14 +44,8 @@ def main():
     out = os.path.abspath(a.out)
     os.makedirs(out, exist_ok=True)
     scene = build("GGX" if a.single else "MULTI_GGX")
-    scene.render.resolution_x, scene.render.resolution_y = 96, 32
-    if not a.single:
-        bpy.ops.export_scene.gltf(filepath=os.path.join(out, "rough-metals.glb"), export_format="GLB",
-                                  export_cameras=True, export_yup=True)
     stem = "rough-metals-single" if a.single else "rough-metals"
-    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), a.spp, (96, 32), bounces=8, transparent=0,
-                     depth="32")
-    print(f"Cycles: {a.spp} spp at 96x32 on 2 threads in {seconds:.2f} s", file=sys.stderr)
+    export_and_render(scene, out, stem, (96, 32), a.spp, bounces=8, glb=not a.single)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ import argparse, math, os, sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import front_camera, material, render  # noqa: E402
+from gltf_vs_cycles import export_and_render, front_camera, material, sun  # noqa: E402
 
 
 def build(level):
@@ -30,9 +30,7 @@ def build(level):
     bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
     bpy.context.object.data.materials.append(m)
     front_camera(scene, 25)
-    bpy.ops.object.light_add(type="SUN", rotation=(math.radians(82), 0.0, math.radians(6)))
-    bpy.context.object.data.energy = 3.0
-    bpy.context.object.data.angle = 0.0
+    sun((82, 0, 6))
     return scene
 
 
@@ -46,12 +44,7 @@ def main():
     os.makedirs(out, exist_ok=True)
     scene = build(a.level)
     stem = f"specular-{a.level:g}"
-    scene.render.resolution_x, scene.render.resolution_y = 64, 64
-    bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB",
-                              export_cameras=True, export_lights=True, export_yup=True)
-    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), a.spp, (64, 64), bounces=2, transparent=0,
-                     depth="32")
-    print(f"Cycles: {a.spp} spp at 64x64 on 2 threads in {seconds:.2f} s", file=sys.stderr)
+    export_and_render(scene, out, stem, (64, 64), a.spp, bounces=2)
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ import argparse, math, os, sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import export_and_render_emission, front_camera, image_node, material, saved_image  # noqa: E402
+from gltf_vs_cycles import export_and_render_emission, front_camera, image_node, mapped, material, saved_image  # noqa: E402
 
 
 def waves(x, y):
@@ -40,13 +40,7 @@ def build(out, extension="REPEAT"):
     m = material("panel", (0.0, 0.0, 0.0), 0.0, 1.0)
     tex, p = image_node(m, img)
     tex.extension = extension
-    coords = m.node_tree.nodes.new("ShaderNodeTexCoord")
-    mapping = m.node_tree.nodes.new("ShaderNodeMapping")
-    mapping.inputs["Location"].default_value = (0.15, 0.3, 0.0)
-    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30))
-    mapping.inputs["Scale"].default_value = (1.5, 0.75, 1.0)
-    m.node_tree.links.new(coords.outputs["UV"], mapping.inputs["Vector"])
-    m.node_tree.links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    mapped(m, tex)
     m.node_tree.links.new(tex.outputs["Color"], p.inputs["Emission Color"])
     p.inputs["Emission Strength"].default_value = 1.0
     bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))

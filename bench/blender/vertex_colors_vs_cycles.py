@@ -26,7 +26,7 @@ import bpy
 import bmesh
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import front_camera, material, render  # noqa: E402
+from gltf_vs_cycles import export_and_render, front_camera, material, white_world  # noqa: E402
 
 CUTS = 12
 
@@ -66,9 +66,7 @@ def build(kind="FLOAT_COLOR"):
     m.node_tree.links.new(attribute.outputs["Color"], p.inputs["Base Color"])
     painted_panel(kind).data.materials.append(m)
     front_camera(scene, 25)
-    world = scene.world.node_tree.nodes["Background"]
-    world.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    world.inputs["Strength"].default_value = 1.0
+    white_world(scene)
     return scene
 
 
@@ -82,12 +80,7 @@ def main():
     out = os.path.abspath(a.out)
     os.makedirs(out, exist_ok=True)
     scene = build("BYTE_COLOR" if a.byte else "FLOAT_COLOR")
-    scene.render.resolution_x, scene.render.resolution_y = 64, 64
-    bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB",
-                              export_cameras=True, export_yup=True)
-    seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), a.spp, (64, 64), bounces=1, transparent=0,
-                     depth="32")
-    print(f"Cycles: {a.spp} spp at 64x64 on 2 threads in {seconds:.2f} s", file=sys.stderr)
+    export_and_render(scene, out, stem, (64, 64), a.spp, bounces=1)
 
 
 if __name__ == "__main__":

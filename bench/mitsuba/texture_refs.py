@@ -35,8 +35,8 @@ OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "crat
                    "data", "mitsuba")
 
 
-def head(what, depth, fov, origin, target):
-    """A scene file's opening: its comment, the path integrator, a 96 × 72 camera."""
+def head(what, depth, fov, origin, target, size=(96, 72)):
+    """A scene file's opening: its comment, the path integrator, a camera of `size` pixels."""
     return f"""<?xml version="1.0" encoding="utf-8"?>
 <!-- {what} (bench/mitsuba/texture_refs.py). -->
 <scene version="3.0.0">
@@ -46,7 +46,7 @@ def head(what, depth, fov, origin, target):
         <transform name="to_world"><lookat origin="{origin}" target="{target}" up="0, 1, 0"/></transform>
         <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
         <film type="hdrfilm">
-            <integer name="width" value="96"/><integer name="height" value="72"/>
+            <integer name="width" value="{size[0]}"/><integer name="height" value="{size[1]}"/>
             <rfilter type="box"/><string name="pixel_format" value="rgb"/>
         </film>
     </sensor>
@@ -188,20 +188,8 @@ def turned(spp):
     mi.Bitmap(img).write(os.path.join(OUT, "turned-texture-mitsuba.exr"))
 
 
-VERTEX_COLORS = """<?xml version="1.0" encoding="utf-8"?>
-<!-- A diffuse panel coloured by its PLY vertex colours under a white sky (bench/mitsuba/texture_refs.py). -->
-<scene version="3.0.0">
-    <integrator type="path"><integer name="max_depth" value="2"/></integrator>
-    <sensor type="perspective">
-        <float name="fov" value="25"/>
-        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
-        <film type="hdrfilm">
-            <integer name="width" value="64"/><integer name="height" value="64"/>
-            <rfilter type="box"/><string name="pixel_format" value="rgb"/>
-        </film>
-    </sensor>
-    <emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>
+VERTEX_COLORS = head("A diffuse panel coloured by its PLY vertex colours under a white sky", 2, 25, "0, 0, 4",
+                     "0, 0, 0", (64, 64)) + """    <emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>
     <shape type="ply">
         <string name="filename" value="vertex-colors.ply"/>
         <bsdf type="diffuse">
