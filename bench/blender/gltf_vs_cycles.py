@@ -190,6 +190,14 @@ def export_and_render(scene, out, stem, size, spp, bounces, pixel_filter=("BOX",
     print(f"Cycles: {spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)
 
 
+def facing_panel(scene, m, fov_degrees=25):
+    """A 2 × 2 panel of material `m` standing in the plane y = 0, facing the camera of
+    `front_camera(scene, fov_degrees)`."""
+    bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
+    bpy.context.object.data.materials.append(m)
+    front_camera(scene, fov_degrees)
+
+
 def white_world(scene):
     """A uniform white world of strength 1: the sky alhazen gives a glTF without lights."""
     world = scene.world.node_tree.nodes["Background"]

@@ -27,7 +27,7 @@ import argparse, math, os, sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import export_and_render, front_camera, image_node, mapped, material, saved_image, sun  # noqa: E402
+from gltf_vs_cycles import export_and_render, facing_panel, image_node, mapped, material, saved_image, sun  # noqa: E402
 
 
 def waves(x, y):
@@ -49,9 +49,7 @@ def build(out):
     m.node_tree.links.new(split.outputs["Green"], p.inputs["Roughness"])
     m.node_tree.links.new(split.outputs["Blue"], p.inputs["Metallic"])
     mapped(m, tex)
-    bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
-    bpy.context.object.data.materials.append(m)
-    front_camera(scene, 25)
+    facing_panel(scene, m)
     # A sun 30° above the camera's axis: the dielectric's diffuse shows it, the smooth metal
     # reflects it away from the camera and shows the black world.
     sun((60, 0, 0))
@@ -82,9 +80,7 @@ def build_normal(out):
     m.node_tree.links.new(tex.outputs["Color"], normal_map.inputs["Color"])
     m.node_tree.links.new(normal_map.outputs["Normal"], p.inputs["Normal"])
     mapped(m, tex)
-    bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
-    bpy.context.object.data.materials.append(m)
-    front_camera(scene, 25)
+    facing_panel(scene, m)
     sun((60, 0, 20))
     return scene
 

@@ -14,12 +14,12 @@ Writes OUT_DIR/specular-LEVEL.glb and OUT_DIR/specular-LEVEL-cycles.exr (64 × 6
 threads, box filter of one pixel, two bounces; LEVEL as given, e.g. specular-0, specular-1).
 Needs `pip install bpy`.
 """
-import argparse, math, os, sys
+import argparse, os, sys
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import export_and_render, front_camera, material, sun  # noqa: E402
+from gltf_vs_cycles import export_and_render, facing_panel, material, sun  # noqa: E402
 
 
 def build(level):
@@ -27,9 +27,7 @@ def build(level):
     scene = bpy.context.scene
     m = material("grey", (0.5, 0.5, 0.5), 0.0, 0.4)
     m.node_tree.nodes["Principled BSDF"].inputs["Specular IOR Level"].default_value = level
-    bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
-    bpy.context.object.data.materials.append(m)
-    front_camera(scene, 25)
+    facing_panel(scene, m)
     sun((82, 0, 6))
     return scene
 

@@ -21,7 +21,7 @@ import argparse, math, os, sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import export_and_render_emission, front_camera, image_node, mapped, material, saved_image  # noqa: E402
+from gltf_vs_cycles import export_and_render_emission, facing_panel, image_node, mapped, material, saved_image  # noqa: E402
 
 
 def waves(x, y):
@@ -43,9 +43,7 @@ def build(out, extension="REPEAT"):
     mapped(m, tex)
     m.node_tree.links.new(tex.outputs["Color"], p.inputs["Emission Color"])
     p.inputs["Emission Strength"].default_value = 1.0
-    bpy.ops.mesh.primitive_plane_add(size=2, location=(0.0, 0.0, 0.0), rotation=(math.radians(90), 0, 0))
-    bpy.context.object.data.materials.append(m)
-    front_camera(scene, 25)
+    facing_panel(scene, m)
     return scene
 
 

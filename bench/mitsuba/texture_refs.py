@@ -150,20 +150,8 @@ def masked(spp):
     mi.Bitmap(img).write(os.path.join(OUT, "masked-card-mitsuba.exr"))
 
 
-TURNED = """<?xml version="1.0" encoding="utf-8"?>
-<!-- A rectangle light whose radiance image is scaled, turned and moved by to_uv (bench/mitsuba/texture_refs.py). -->
-<scene version="3.0.0">
-    <integrator type="path"><integer name="max_depth" value="1"/></integrator>
-    <sensor type="perspective">
-        <float name="fov" value="25"/>
-        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
-        <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
-        <film type="hdrfilm">
-            <integer name="width" value="64"/><integer name="height" value="64"/>
-            <rfilter type="box"/><string name="pixel_format" value="rgb"/>
-        </film>
-    </sensor>
-    <shape type="rectangle">
+TURNED = head("A rectangle light whose radiance image is scaled, turned and moved by to_uv", 1, 25, "0, 0, 4",
+              "0, 0, 0", (64, 64)) + """    <shape type="rectangle">
         <emitter type="area">
             <texture name="radiance" type="bitmap">
                 <string name="filename" value="turned-texture.png"/>

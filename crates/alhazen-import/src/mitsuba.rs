@@ -1367,6 +1367,9 @@ impl Importer {
             "mesh_attribute" => {
                 let name = self.string(ctx, &p, "name")?.unwrap_or_default();
                 let scale = self.float(ctx, &p, "scale", 1.0)?;
+                if !(scale.is_finite() && (0.0..=1e6).contains(&scale)) {
+                    return Err(ctx.err(node, "a mesh_attribute's `scale` must be a number in [0, 10⁶]"));
+                }
                 if name != "vertex_color" {
                     self.warn(
                         ctx,

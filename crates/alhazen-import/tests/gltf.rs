@@ -980,3 +980,34 @@ fn specular_factors_shape_the_coating() {
     assert!(said.iter().any(|w| w.contains("coloured specularColorFactor")), "{said:?}");
     assert!(said.iter().any(|w| w.contains("KHR_materials_specular's textures")), "{said:?}");
 }
+
+/// `COLOR_0` that is negative or NaN is refused, naming the primitive; an alpha other than 1 is
+/// warned about and left out.
+#[test]
+fn bad_vertex_colours_are_refused_and_their_alpha_is_said() {
+    let with_colors = |colors: &[[f32; 4]]| {
+        let mut b = quad_buffer();
+        colors.iter().flatten().for_each(|x| b.extend(x.to_le_bytes()));
+        let uri = format!(r#", "uri": "data:application/octet-stream;base64,{}""#, base64(&b));
+        document(&uri, "")
+            .replace(r#""byteLength": 140"#, r#""byteLength": 204"#)
+            .replace(
+                r#"{ "buffer": 0, "byteOffset": 128, "byteLength": 12 }"#,
+                r#"{ "buffer": 0, "byteOffset": 128, "byteLength": 12 }, { "buffer": 0, "byteOffset": 140, "byteLength": 64 }"#,
+            )
+            .replace(
+                r#"{ "bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR" }"#,
+                r#"{ "bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR" }, { "bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC4" }"#,
+            )
+            .replace(r#""TEXCOORD_0": 2 }"#, r#""TEXCOORD_0": 2, "COLOR_0": 4 }"#)
+    };
+    let s = write_and_import(&[("a.gltf", with_colors(&[[1.0, 0.5, 0.0, 0.5]; 4]).into_bytes())]).unwrap();
+    let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(said.iter().any(|w| w.contains("alpha of its vertex colours")), "{said:?}");
+    assert_eq!(s.scene.meshes[0].colors, vec![Vec3::new(1.0, 0.5, 0.0); 4]);
+    for bad in [-0.5, f32::NAN] {
+        let json = with_colors(&[[1.0, 1.0, 1.0, 1.0], [bad, 0.0, 0.0, 1.0], [1.0; 4], [1.0; 4]]);
+        let e = write_and_import(&[("b.gltf", json.into_bytes())]).unwrap_err();
+        assert!(e.contains("\"quad\" primitive 0") && e.contains("must be finite and ≥ 0"), "{bad}: {e}");
+    }
+}

@@ -1173,3 +1173,27 @@ fn to_uv_beyond_scale_turn_and_shift_is_warned() {
     assert!(!warned && (scale - alhazen_math::Vec2::new(2.0, 1.0)).length() < 1e-12 && (rotation - 90.0).abs() < 1e-12);
     assert!((offset - alhazen_math::Vec2::new(0.5, 0.0)).length() < 1e-12);
 }
+
+/// A `mesh_attribute` other than `vertex_color` is warned about (grey 0.5) with its line; a
+/// `scale` that is negative, NaN or huge is refused with its place.
+#[test]
+fn mesh_attributes_other_than_vertex_colours_and_bad_scales_are_said() {
+    let attribute = |name: &str, scale: &str| {
+        scene(&format!(
+            "<shape type=\"sphere\">\n<bsdf type=\"diffuse\">\n<texture name=\"reflectance\" type=\"mesh_attribute\">\n\
+             <string name=\"name\" value=\"{name}\"/>\n<float name=\"scale\" value=\"{scale}\"/>\n</texture>\n</bsdf>\n</shape>"
+        ))
+    };
+    let s = import(&[("a.xml", &attribute("vertex_uv2", "1"))]).unwrap();
+    let text: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(text.iter().any(|w| w.contains("a.xml:4:") && w.contains("mesh attribute `vertex_uv2`")), "{text:?}");
+    assert!(s.scene.materials.iter().all(|m| !m.vertex_colors));
+    let s = import(&[("b.xml", &attribute("vertex_color", "0.5"))]).unwrap();
+    assert!(s.scene.materials.iter().any(|m| m.vertex_colors));
+    for bad in ["-1", "1e9"] {
+        let e = import(&[("c.xml", &attribute("vertex_color", bad))]).unwrap_err();
+        assert!(e.contains("c.xml:4:") && e.contains("mesh_attribute's `scale`"), "{bad}: {e}");
+    }
+    let e = import(&[("d.xml", &attribute("vertex_color", "nan"))]).unwrap_err();
+    assert!(e.contains("d.xml:6:") && e.contains("not a finite number"), "{e}");
+}
