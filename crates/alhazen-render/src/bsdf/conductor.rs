@@ -95,8 +95,19 @@ impl Conductor {
     /// [`Self::eval`] and [`Self::pdf`] with the half vector and `D` found once (the same numbers).
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
         let Some(f) = &self.facets else { return (Vec3::ZERO, 0.0) };
-        let (value, pdf) = self.rough_eval_pdf(f, v, l);
-        let Some(ms) = self.multiple_scattering(v) else { return (value, pdf) };
+        self.eval_pdf_with(f, self.multiple_scattering(v).as_ref(), v, l)
+    }
+
+    /// [`Self::eval_pdf`] on `facets` with the lobe of several facets `ms` seen from `v`.
+    fn eval_pdf_with(
+        &self,
+        facets: &Microfacet,
+        ms: Option<&super::multiscatter::MultipleScattering>,
+        v: Vec3,
+        l: Vec3,
+    ) -> (Vec3, f64) {
+        let (value, pdf) = self.rough_eval_pdf(facets, v, l);
+        let Some(ms) = ms else { return (value, pdf) };
         if !same_side(v, l) {
             return (Vec3::ZERO, 0.0);
         }
@@ -122,7 +133,7 @@ impl Conductor {
             }
             sample.l
         };
-        let (f, pdf) = self.eval_pdf(v, l);
+        let (f, pdf) = self.eval_pdf_with(facets, Some(&ms), v, l);
         (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 
