@@ -35,12 +35,12 @@ OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "crat
                    "data", "mitsuba")
 
 
-def head(what, depth, fov, origin, target, size=(96, 72)):
-    """A scene file's opening: its comment, the path integrator, a camera of `size` pixels."""
+def head(what, depth, fov, origin, target, size=(96, 72), integrator="path", script="texture_refs.py"):
+    """A scene file's opening: its comment, the integrator, a camera of `size` pixels."""
     return f"""<?xml version="1.0" encoding="utf-8"?>
-<!-- {what} (bench/mitsuba/texture_refs.py). -->
+<!-- {what} (bench/mitsuba/{script}). -->
 <scene version="3.0.0">
-    <integrator type="path"><integer name="max_depth" value="{depth}"/></integrator>
+    <integrator type="{integrator}"><integer name="max_depth" value="{depth}"/></integrator>
     <sensor type="perspective">
         <float name="fov" value="{fov}"/>
         <transform name="to_world"><lookat origin="{origin}" target="{target}" up="0, 1, 0"/></transform>

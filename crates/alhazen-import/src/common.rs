@@ -95,6 +95,18 @@ pub(crate) fn emissive(scene: &mut Scene, base: MaterialId, emission: Rgb, textu
     add_material(scene, m)
 }
 
+/// Material `base` with an inside that absorbs `absorption` per unit length (a dielectric's:
+/// tinted glass, a coloured liquid), a copy of it where it absorbed otherwise.
+pub(crate) fn absorbing(scene: &mut Scene, base: MaterialId, absorption: Rgb) -> MaterialId {
+    if scene.materials[base as usize].absorption == absorption {
+        return base;
+    }
+    let mut m = scene.materials[base as usize].clone();
+    m.name = format!("{} (absorbing)", m.name);
+    m.absorption = absorption;
+    add_material(scene, m)
+}
+
 /// The glTF 2.0 metallic–roughness model (also Mitsuba's `principled` and pbrt's
 /// `coateddiffuse` reduced to it): a metal whose normal-incidence reflectance is the base
 /// colour (Schlick), mixed by `metallic` with a dielectric coating over a Lambertian base (the

@@ -144,6 +144,9 @@ enum Named {
     Group(Vec<Object>),
     /// An `area` emitter declared apart, with its radiance, for the shapes that refer to it.
     AreaEmitter(Texture),
+    /// A medium declared apart: its absorption per unit length (`None`: a medium alhazen does
+    /// not render, warned where it was declared).
+    Medium(Option<Vec3>),
     Other,
 }
 
@@ -308,8 +311,12 @@ impl Importer {
                 }
             }
             "emitter" => self.emitter(ctx, node)?,
+            "medium" => {
+                let m = self.medium(ctx, node)?;
+                self.register(ctx, node, Named::Medium(m))?;
+            }
             other => {
-                self.warn(ctx, node, format!("<{other}> is not supported (alhazen renders no participating media, phase functions or volumes); ignored"));
+                self.warn(ctx, node, format!("<{other}> is not supported (alhazen renders no scattering media, phase functions or volumes); ignored"));
                 if node.attribute("id").is_some() {
                     self.register(ctx, node, Named::Other)?;
                 }
@@ -427,7 +434,10 @@ impl Importer {
             if used.contains(&name) || HARMLESS.contains(&name.as_str()) {
                 continue;
             }
-            if matches!(c.tag_name().name(), "bsdf" | "texture" | "ref" | "emitter" | "rfilter" | "sampler" | "film") {
+            if matches!(
+                c.tag_name().name(),
+                "bsdf" | "texture" | "ref" | "emitter" | "rfilter" | "sampler" | "film" | "medium"
+            ) {
                 continue;
             }
             self.warn(ctx, c, format!("property `{name}` of {what} `{}` is not supported; ignored", p.kind));
@@ -1487,7 +1497,18 @@ impl Importer {
         }
         let mut material = None;
         let mut emission = None;
+        let mut interior = None;
         for c in node.children().filter(Node::is_element) {
+            let side = c.attribute("name").filter(|n| matches!(*n, "interior" | "exterior"));
+            if let ("medium" | "ref", Some(side)) = (c.tag_name().name(), side) {
+                let absorption = self.medium_of(ctx, c)?;
+                if side == "interior" {
+                    interior = absorption.map(|a| (a, c));
+                } else if absorption.is_some() {
+                    self.warn(ctx, c, "an exterior medium is not rendered (alhazen renders absorption inside dielectrics only); ignored");
+                }
+                continue;
+            }
             match c.tag_name().name() {
                 "bsdf" => material = Some(self.bsdf_material(ctx, c)?),
                 "ref" if c.attribute("name") == Some("emitter") || self.is_area_emitter_ref(&c) => {
@@ -1532,6 +1553,9 @@ impl Importer {
         if let Some((e, texture)) = emission {
             material = common::emissive(&mut self.scene, material, e, texture);
         }
+        if let Some((absorption, c)) = interior {
+            material = self.absorbing(ctx, c, material, absorption);
+        }
         self.unused(ctx, &p, "shape");
         let name = self.attr(ctx, node, "id")?;
         let (shape, transform) = match shape {
@@ -1545,6 +1569,90 @@ impl Importer {
             shape => common::placed_sphere(shape, transform),
         };
         Ok(vec![Object { name, shape, transform, material, mesh_materials: vec![] }])
+    }
+
+    /// A shape's `interior` or `exterior` medium (a `<medium>`, or a `<ref>` to one): its
+    /// absorption, `None` where alhazen does not render it (warned).
+    fn medium_of(&mut self, ctx: &Ctx, c: Node) -> R<Option<Vec3>> {
+        if c.tag_name().name() == "medium" {
+            return self.medium(ctx, c);
+        }
+        let id = self.req_attr(ctx, c, "id")?;
+        match self.ids.get(&id) {
+            Some(Named::Medium(m)) => Ok(*m),
+            Some(_) => Err(ctx.err(c, format!("\"{id}\" is not a medium"))),
+            None => Err(self.unknown_id(ctx, c, &id)),
+        }
+    }
+
+    /// A `homogeneous` medium as alhazen renders it: the absorption `σ_a = scale·σ_t·(1 −
+    /// albedo)` per unit length (Beer–Lambert) inside the dielectric it fills. Scattering is
+    /// not rendered (a warning where the albedo is not 0); other media are left out (`None`).
+    fn medium(&mut self, ctx: &Ctx, node: Node) -> R<Option<Vec3>> {
+        let p = self.plugin(ctx, node)?;
+        if p.kind != "homogeneous" {
+            let why = "alhazen renders the absorption of homogeneous media only";
+            self.warn(ctx, node, format!("medium `{}` is not supported ({why}); ignored", p.kind));
+            return Ok(None);
+        }
+        let sigma_t = self.medium_value(ctx, &p, "sigma_t", 1.0)?;
+        // Mitsuba's default albedo scatters three quarters of what meets the medium.
+        let albedo = self.medium_value(ctx, &p, "albedo", 0.75)?;
+        let scale = self.float(ctx, &p, "scale", 1.0)?;
+        self.boolean(ctx, &p, "has_spectral_extinction", true)?;
+        let valid =
+            sigma_t.min_element() >= 0.0 && scale >= 0.0 && albedo.min_element() >= 0.0 && albedo.max_element() <= 1.0;
+        let absorption = sigma_t * scale * (Vec3::ONE - albedo);
+        if !(valid && absorption.is_finite() && absorption.max_element() <= 1e12) {
+            return Err(ctx.err(node, "a homogeneous medium needs sigma_t ≥ 0, scale ≥ 0 and an albedo within [0, 1]"));
+        }
+        if albedo != Vec3::ZERO && sigma_t * scale != Vec3::ZERO {
+            self.warn(ctx, node, format!(
+                "the medium scatters (albedo {:.3} {:.3} {:.3}): alhazen renders its absorption σ_t·(1 − albedo) only, not its scattering",
+                albedo.x, albedo.y, albedo.z
+            ));
+        }
+        self.unused(ctx, &p, "medium");
+        Ok(Some(absorption))
+    }
+
+    /// A medium's `sigma_t` or `albedo`: a number, a colour, or a `constvolume` of one.
+    fn medium_value(&mut self, ctx: &Ctx, p: &Plugin, name: &str, default: f64) -> R<Vec3> {
+        let Some(mut n) = self.prop(p, name) else { return Ok(Vec3::splat(default)) };
+        if n.tag_name().name() == "volume" {
+            let volume = self.plugin(ctx, n)?;
+            if volume.kind != "constvolume" {
+                let what = format!(
+                    "volume `{}` is not supported: a medium's `{name}` must be a number, a colour or a constvolume",
+                    volume.kind
+                );
+                return Err(ctx.err(n, what));
+            }
+            let Some(value) = self.prop(&volume, "value") else { return Ok(Vec3::ONE) };
+            self.unused(ctx, &volume, "volume");
+            n = value;
+        }
+        match self.color_node(ctx, n)? {
+            Texture::Solid(c) => Ok(c),
+            _ => Err(ctx.err(n, format!("a medium's `{name}` must be a number or a colour, not a texture"))),
+        }
+    }
+
+    /// Material `m` with an inside absorbing `absorption` per unit length, where it is a
+    /// dielectric's (elsewhere the medium is left out, warned at `c`).
+    fn absorbing(&mut self, ctx: &Ctx, c: Node, m: MaterialId, absorption: Vec3) -> MaterialId {
+        if absorption == Vec3::ZERO {
+            return m;
+        }
+        if !self.scene.materials[m as usize].bsdf.as_ref().is_some_and(BsdfDesc::refracts) {
+            self.warn(
+                ctx,
+                c,
+                "an interior medium is rendered inside dielectrics only (this shape's BSDF does not refract); ignored",
+            );
+            return m;
+        }
+        common::absorbing(&mut self.scene, m, absorption)
     }
 
     /// True when material `m` looks at its surface's parametrisation (textures, bump maps,

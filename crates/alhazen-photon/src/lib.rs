@@ -224,6 +224,9 @@ impl Tracer<'_> {
         for bounce in 0..self.max_depth {
             let Some(wh) = self.world.intersect(&ray, f64::INFINITY) else { return };
             let m = &self.scene.materials[wh.material as usize];
+            if let Some(kept) = alhazen_render::optics::absorbed_inside(m, &wh.hit, ray.dir, ColorMode::Rgb) {
+                power *= kept;
+            }
             let bsdf = bsdf_at(m, wh.hit.uv, wh.hit.color, &self.scene.images, ColorMode::Rgb);
             let wi = -ray.dir;
             let (mut ng, mut ns) = (wh.hit.n, shading_normal(&wh.hit, m, &self.scene.images));

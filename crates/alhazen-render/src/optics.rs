@@ -27,6 +27,28 @@ pub fn refract(i: Vec3, n: Vec3, eta: f64) -> Option<Vec3> {
 }
 
 /// The course's Fresnel factor for unpolarised light,
+/// Beer–Lambert: the share of light kept over a distance `d` through a medium absorbing
+/// `sigma` per unit length (per channel; the lecture's coloured glass).
+#[inline]
+pub fn beer(sigma: Vec3, d: f64) -> Vec3 {
+    if sigma == Vec3::ZERO { Vec3::ONE } else { (-sigma * d).exp() }
+}
+
+/// What a ray keeps of its light after crossing the inside of `m` to meet its surface at `hit`
+/// from behind (the geometric normal's back: the ray leaves the object there, having travelled
+/// `hit.t` — a unit direction's length — inside): Beer–Lambert's transmittance of `m`'s
+/// absorption in `mode`'s channels. `None` where `m` absorbs nothing or the ray arrives from
+/// outside. (The path and photon tracers apply it at every vertex; Whitted on its own.)
+#[inline(always)]
+pub fn absorbed_inside(
+    m: &alhazen_scene::Material,
+    hit: &crate::shape::SurfaceHit,
+    dir: Vec3,
+    mode: crate::bsdf::ColorMode,
+) -> Option<Vec3> {
+    (m.absorption != Vec3::ZERO && hit.n.dot(dir) >= 0.0).then(|| beer(mode.color(m.absorption), hit.t))
+}
+
 /// `F = ½ (g−c)²/(g+c)² (1 + (c(g+c)−1)²/(c(g−c)+1)²)` with `c = cos θ` and
 /// `g = √(η² + c² − 1)`, `η = η₂/η₁`. The seed prints `g = √(η² + c²) − 1`, which gives
 /// `F(0°) ≠ ((η−1)/(η+1))²`; the `−1` belongs under the root (see the tests). Returns 1 under

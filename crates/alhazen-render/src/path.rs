@@ -307,11 +307,14 @@ impl<'a> PathTracer<'a> {
             }
             return;
         };
+        let m = &self.scene.materials[wh.material as usize];
+        if let Some(kept) = crate::optics::absorbed_inside(m, &wh.hit, path.ray.dir, mode) {
+            path.beta *= kept;
+        }
         if !(path.caustic_chain && self.caustics.is_some()) {
             let h = HitPoint::from(wh);
             path.l += path.beta * self.emitted(&h, wh.hit.uv, &path.ray, &path.prev, path.visit.as_ref(), mode);
         }
-        let m = &self.scene.materials[wh.material as usize];
         if path.depth == max_depth || seen_from_behind(m, wh, path.ray.dir) {
             return;
         }

@@ -139,10 +139,6 @@ impl Shading<'_> {
     }
 }
 
-fn beer(sigma: Vec3, d: f64) -> Vec3 {
-    if sigma == Vec3::ZERO { Vec3::ONE } else { (-sigma * d).exp() }
-}
-
 /// Whitted over a camera with stratified pixel samples.
 pub struct WhittedEstimator<'a> {
     /// The integrator.
@@ -265,7 +261,7 @@ impl<'a> Whitted<'a> {
         }
         if !front {
             // The ray travelled h.t inside this object's medium.
-            color *= beer(ch.c(m.absorption), h.t);
+            color *= crate::optics::beer(ch.c(m.absorption), h.t);
         }
         color
     }
@@ -380,7 +376,7 @@ impl<'a> Whitted<'a> {
             let eta = if entering { m.ior } else { 1.0 / m.ior };
             through *= ch.c(m.transparency) * (1.0 - fresnel(m, cos_n, eta));
             if !entering {
-                through *= beer(ch.c(m.absorption), wh.hit.t);
+                through *= crate::optics::beer(ch.c(m.absorption), wh.hit.t);
             }
             if through.max_element() < 1e-6 {
                 return Vec3::ZERO;

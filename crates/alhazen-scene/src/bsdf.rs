@@ -407,6 +407,16 @@ impl BsdfDesc {
         }
     }
 
+    /// True when some part of it refracts light into a solid inside (a dielectric: its inside
+    /// may absorb, `Material::absorption`; a thin sheet has none).
+    pub fn refracts(&self) -> bool {
+        match self {
+            BsdfDesc::Dielectric { .. } => true,
+            BsdfDesc::Mix { a, b, .. } => a.refracts() || b.refracts(),
+            _ => false,
+        }
+    }
+
     /// True when some part of it refracts with a wavelength-dependent index.
     pub fn is_dispersive(&self) -> bool {
         match self {

@@ -853,6 +853,10 @@ impl PathTracer<'_> {
                 return None;
             }
         }
+        // As `vertex` weighs a path that crossed an absorbing inside, before its emission.
+        if let Some(kept) = crate::optics::absorbed_inside(m, &wh.hit, path.ray.dir, ColorMode::Rgb) {
+            path.beta *= kept;
+        }
         let h = HitPoint::from(wh);
         path.l += path.beta * self.emitted(&h, wh.hit.uv, &path.ray, &path.prev, path.visit.as_ref(), ColorMode::Rgb);
         // As `vertex` records a mirror's visit, from the previous vertex as it was. (Without
@@ -1553,7 +1557,8 @@ mod tests {
     /// A scene of every kind of material and light: Lambert, Oren–Nayar, Cook–Torrance and
     /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
     /// and bump-mapped, one of Beckmann facets) and a smooth one, rough plastics (one textured,
-    /// one of Beckmann facets) and a smooth one, Beckmann glass, a mirror
+    /// one of Beckmann facets) and a smooth one, Beckmann glass, glass that absorbs (rough
+    /// and smooth), a mirror
     /// (with specular connections) and a Lambert surface with a mirror's gloss (the course's
     /// Whitted material), a glTF metallic–roughness mix, Schlick conductors (a glTF metal's; rough and smooth),
     /// spheres, boxes and a plane, an emitting box (triangles)
@@ -1640,12 +1645,12 @@ material = { bsdf = { type = "conductor", roughness = [0.05, 0.35], distribution
 shape = "sphere"
 center = [0.3, 0.5, 1.2]
 radius = 0.5
-material = { bsdf = { type = "dielectric", roughness = 0.15, distribution = "ggx", ior = 1.5 } }
+material = { bsdf = { type = "dielectric", roughness = 0.15, distribution = "ggx", ior = 1.5 }, absorption = [0.2, 0.9, 1.6] }
 [[object]]
 shape = "sphere"
 center = [-2.2, 0.4, 1.5]
 radius = 0.4
-material = { bsdf = { type = "dielectric", ior = 1.5 } }
+material = { bsdf = { type = "dielectric", ior = 1.5 }, absorption = [1.5, 0.4, 0.1] }
 [[object]]
 shape = "sphere"
 center = [1.6, 0.6, -0.8]
