@@ -8,7 +8,9 @@
 //! `conductor`, `dielectric`, `thindielectric`, `coateddiffuse`, `coatedconductor`,
 //! `diffusetransmission`, `mix`), `Texture` (`imagemap`, `checkerboard`, `scale`, `constant`),
 //! `LightSource` (`point`, `spot`, `distant`, `infinite`), `AreaLightSource "diffuse"`,
-//! `ReverseOrientation`, `Include`/`Import`. Everything else is a located warning.
+//! `ReverseOrientation`, `Include`/`Import`, `MakeNamedMedium "homogeneous"` with
+//! `MediumInterface` (a dielectric's or `interface`'s absorbing inside). Everything else is a
+//! located warning.
 //!
 //! **Handedness.** pbrt's camera space has `+x` to the right of the image, `+y` up, `+z` ahead,
 //! so a plain `LookAt` shows the mirror image of what a right-handed camera with the same eye,
@@ -165,6 +167,8 @@ struct State {
     reverse: bool,
     material: Option<MaterialId>,
     area: Option<AreaLight>,
+    /// The inside medium of the shapes that follow (`MediumInterface`), by name.
+    interior: Option<String>,
 }
 
 struct Importer {
@@ -176,6 +180,9 @@ struct Importer {
     stack: Vec<(State, bool)>,
     named_coords: HashMap<String, Mat4>,
     named_materials: HashMap<String, MaterialId>,
+    /// Named media: their absorption per unit length (`None`: a medium alhazen does not
+    /// render, warned where it was made).
+    media: HashMap<String, Option<Vec3>>,
     textures: HashMap<String, Texture>,
     objects: HashMap<String, Vec<Object>>,
     defining: Option<(String, Vec<Object>)>,
@@ -225,7 +232,8 @@ impl Importer {
         Self {
             scene,
             warnings: Warnings::default(),
-            state: State { ctm: Mat4::IDENTITY, reverse: false, material: None, area: None },
+            state: State { ctm: Mat4::IDENTITY, reverse: false, material: None, area: None, interior: None },
+            media: HashMap::new(),
             stack: vec![],
             named_coords: HashMap::new(),
             named_materials: HashMap::new(),
@@ -470,22 +478,38 @@ impl Importer {
                 self.scene.render.filter = self.pixel_filter(ctx, &at, &kind, &mut p)?;
                 self.unused(ctx, &p, "PixelFilter");
             }
-            "Option" | "ColorSpace" | "Accelerator" | "MakeNamedMedium" | "MediumInterface" => {
-                if word != "MediumInterface" {
-                    let _ = self.string_arg(ctx, tokens, i, word, &at)?;
-                }
-                if word == "MediumInterface" {
-                    while let Some(Token { tok: Tok::Str(_), .. }) = tokens.get(*i) {
+            "MakeNamedMedium" => {
+                let (name, _) = self.string_arg(ctx, tokens, i, word, &at)?;
+                let mut p = self.params(ctx, tokens, i)?;
+                let medium = self.medium(ctx, &at, &mut p)?;
+                self.media.insert(name, medium);
+            }
+            "MediumInterface" => {
+                let (inside, _) = self.string_arg(ctx, tokens, i, word, &at)?;
+                // One name: the same medium on both sides.
+                let outside = match tokens.get(*i) {
+                    Some(Token { tok: Tok::Str(s), .. }) => {
                         *i += 1;
+                        s.clone()
                     }
-                } else if word != "ColorSpace" {
+                    _ => inside.clone(),
+                };
+                if !outside.is_empty() {
+                    let why = "alhazen renders absorption inside dielectrics only";
+                    self.warn(
+                        ctx,
+                        &at,
+                        format!("MediumInterface: the outside medium \"{outside}\" is not rendered ({why}); ignored"),
+                    );
+                }
+                self.state.interior = (!inside.is_empty()).then_some(inside);
+            }
+            "Option" | "ColorSpace" | "Accelerator" => {
+                let _ = self.string_arg(ctx, tokens, i, word, &at)?;
+                if word != "ColorSpace" {
                     self.params(ctx, tokens, i)?;
                 }
-                let why = match word {
-                    "MakeNamedMedium" | "MediumInterface" => "alhazen renders no participating media",
-                    _ => "not supported",
-                };
-                self.warn(ctx, &at, format!("{word}: {why}; ignored"));
+                self.warn(ctx, &at, format!("{word}: not supported; ignored"));
             }
             "Camera" => {
                 let (kind, _) = self.string_arg(ctx, tokens, i, word, &at)?;
@@ -1362,9 +1386,68 @@ impl Importer {
         if coverage != Texture::Solid(Vec3::ONE) {
             material = self.cut_material(material, coverage);
         }
+        if let Some(name) = self.state.interior.clone() {
+            material = self.absorbing(ctx, at, material, &name)?;
+        }
         let (shape, transform) = common::placed_sphere(shape, transform);
         self.emit(Object { name: None, shape, transform, material, mesh_materials: vec![] });
         Ok(())
+    }
+
+    /// A `homogeneous` medium as alhazen renders it: its absorption `scale·σ_a` per unit length
+    /// (Beer–Lambert) inside the dielectric (or `interface`) it fills. Scattering (`sigma_s`, 1
+    /// by default as in pbrt) is not rendered: warned where it is not 0. Other media are left
+    /// out (`None`, warned).
+    fn medium(&mut self, ctx: &Ctx, at: &Range<usize>, p: &mut Params) -> R<Option<Vec3>> {
+        let kind =
+            self.string(ctx, p, "type")?.ok_or_else(|| ctx.err(at.clone(), "MakeNamedMedium needs \"string type\""))?;
+        if kind != "homogeneous" {
+            p.used.iter_mut().for_each(|u| *u = true);
+            let why = "alhazen renders the absorption of homogeneous media only";
+            self.warn(ctx, at, format!("medium \"{kind}\" is not supported ({why}); ignored"));
+            return Ok(None);
+        }
+        if let Some(preset) = self.string(ctx, p, "preset")? {
+            self.warn(ctx, at, format!("medium preset \"{preset}\" is not supported; sigma_a and sigma_s are used"));
+        }
+        let sigma_a = self.color(ctx, p, "sigma_a", Vec3::ONE)?;
+        let sigma_s = self.color(ctx, p, "sigma_s", Vec3::ONE)?;
+        let scale = self.float(ctx, p, "scale", 1.0)?;
+        let absorption = sigma_a * scale;
+        let valid = sigma_a.min_element() >= 0.0 && sigma_s.min_element() >= 0.0 && scale >= 0.0;
+        if !(valid && absorption.is_finite() && absorption.max_element() <= 1e12) {
+            return Err(ctx.err(at.clone(), "a homogeneous medium needs sigma_a ≥ 0, sigma_s ≥ 0 and scale ≥ 0"));
+        }
+        if sigma_s * scale != Vec3::ZERO {
+            self.warn(
+                ctx,
+                at,
+                "the medium scatters (sigma_s > 0; pbrt's default is 1): alhazen renders its absorption only",
+            );
+        }
+        for k in ["g", "Lescale"] {
+            self.float(ctx, p, k, 0.0)?;
+        }
+        if self.color(ctx, p, "Le", Vec3::ZERO)? != Vec3::ZERO {
+            self.warn(ctx, at, "a medium's emission (Le) is not rendered");
+        }
+        self.unused(ctx, p, "medium \"homogeneous\"");
+        Ok(Some(absorption))
+    }
+
+    /// `material` filled with the medium `name` (the shape's inside): its absorption, where the
+    /// material refracts (elsewhere the medium is left out, warned).
+    fn absorbing(&mut self, ctx: &Ctx, at: &Range<usize>, material: MaterialId, name: &str) -> R<MaterialId> {
+        let absorption = *self.media.get(name).ok_or_else(|| {
+            ctx.err(at.clone(), format!("MediumInterface names the medium \"{name}\", which no MakeNamedMedium made"))
+        })?;
+        let Some(absorption) = absorption.filter(|a| *a != Vec3::ZERO) else { return Ok(material) };
+        if !self.scene.materials[material as usize].bsdf.as_ref().is_some_and(BsdfDesc::refracts) {
+            let why = "rendered inside dielectrics and interface materials only";
+            self.warn(ctx, at, format!("the medium \"{name}\" inside this shape is not rendered ({why})"));
+            return Ok(material);
+        }
+        Ok(common::absorbing(&mut self.scene, material, absorption))
     }
 
     /// `material` with the cut-out `coverage` (made once per pair).

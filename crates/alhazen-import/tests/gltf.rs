@@ -981,6 +981,44 @@ fn specular_factors_shape_the_coating() {
     assert!(said.iter().any(|w| w.contains("KHR_materials_specular's textures")), "{said:?}");
 }
 
+/// `KHR_materials_volume` under transmission: the inside absorbs `−ln(attenuationColor) /
+/// attenuationDistance` per unit length; a thin-walled material (thickness 0), an infinite
+/// distance or an opaque material absorbs nothing; bad values are refused.
+#[test]
+fn volume_attenuation_is_the_inside_s_absorption() {
+    let absorbing = |transmission: f64, volume: &str| {
+        let json = embedded().replace(
+            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
+            &format!(
+                r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "extensions": {{ "KHR_materials_transmission": {{ "transmissionFactor": {transmission} }}, "KHR_materials_volume": {volume} }}"#
+            ),
+        );
+        let s = write_and_import(&[("s.gltf", json.into_bytes())])?;
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        Ok::<_, String>(s.scene.materials[s.scene.objects[0].material as usize].absorption)
+    };
+    let a =
+        absorbing(1.0, r#"{ "thicknessFactor": 0.1, "attenuationDistance": 2, "attenuationColor": [0.5, 1, 0.25] }"#);
+    let want = Vec3::new(std::f64::consts::LN_2 / 2.0, 0.0, std::f64::consts::LN_2);
+    assert!(a.as_ref().is_ok_and(|a| (*a - want).length() < 1e-6), "{a:?}");
+    assert_eq!(absorbing(1.0, r#"{ "attenuationDistance": 2, "attenuationColor": [0.5, 0.5, 0.5] }"#), Ok(Vec3::ZERO));
+    assert_eq!(absorbing(1.0, r#"{ "thicknessFactor": 1, "attenuationColor": [0.5, 0.5, 0.5] }"#), Ok(Vec3::ZERO));
+    let opaque = r#"{ "thicknessFactor": 1, "attenuationDistance": 1, "attenuationColor": [0.5, 0.5, 0.5] }"#;
+    assert_eq!(absorbing(0.0, opaque), Ok(Vec3::ZERO));
+    let black = absorbing(1.0, r#"{ "thicknessFactor": 1, "attenuationDistance": 1, "attenuationColor": [0, 1, 1] }"#);
+    assert!(black.as_ref().is_ok_and(|a| a.x.is_finite() && a.x > 60.0), "{black:?}");
+    for bad in [
+        r#"{ "thicknessFactor": 1, "attenuationDistance": 0 }"#,
+        r#"{ "thicknessFactor": -1 }"#,
+        r#"{ "thicknessFactor": 1, "attenuationColor": [2, 1, 1] }"#,
+        r#"{ "thicknessFactor": 1, "attenuationColor": [1, 1] }"#,
+        r#"{ "thicknessFactor": "thick" }"#,
+    ] {
+        let e = absorbing(1.0, bad).unwrap_err();
+        assert!(e.contains("KHR_materials_volume needs"), "{bad}: {e}");
+    }
+}
+
 /// `COLOR_0` that is negative or NaN is refused, naming the primitive; an alpha other than 1 is
 /// warned about and left out.
 #[test]

@@ -141,6 +141,68 @@ Shape "sphere""#,
     assert_eq!(s.materials[s.objects[1].material as usize].emission, Vec3::ZERO);
 }
 
+/// `MakeNamedMedium "homogeneous"` inside a dielectric or an `interface` (`MediumInterface`,
+/// part of the attributes) absorbs `scale·σ_a`; its scattering (pbrt's default `sigma_s` 1) is
+/// warned about; other media, outside media and media in opaque shapes are warned and left
+/// out; an unknown medium and bad values are located errors.
+#[test]
+fn homogeneous_media_absorb_inside_glass() {
+    let imported = import(&[(
+        "m.pbrt",
+        r#"WorldBegin
+MakeNamedMedium "tea" "string type" "homogeneous" "rgb sigma_a" [0.5 1 2] "rgb sigma_s" [0 0 0] "float scale" 2
+MakeNamedMedium "smoke" "string type" "homogeneous"
+MakeNamedMedium "cloud" "string type" "nanovdb" "string filename" "cloud.nvdb"
+AttributeBegin
+  MediumInterface "tea" ""
+  Material "dielectric"
+  Shape "sphere"
+  Material "interface"
+  Shape "sphere"
+  Material "diffuse"
+  Shape "sphere"
+AttributeEnd
+Material "dielectric"
+Shape "sphere"
+MediumInterface "smoke"
+Shape "sphere"
+MediumInterface "cloud" ""
+Shape "sphere""#,
+    )])
+    .unwrap();
+    let s = &imported.scene;
+    let absorption: Vec<Vec3> = s.objects.iter().map(|o| s.materials[o.material as usize].absorption).collect();
+    let tea = Vec3::new(1.0, 2.0, 4.0);
+    assert_eq!(absorption, vec![tea, tea, Vec3::ZERO, Vec3::ZERO, Vec3::splat(1.0), Vec3::ZERO]);
+    let said: Vec<String> = imported.warnings.iter().map(|w| w.to_string()).collect();
+    for (line, says) in [
+        (3, "the medium scatters"),
+        (4, "medium \"nanovdb\" is not supported"),
+        (12, "the medium \"tea\" inside this shape is not rendered"),
+        (16, "the outside medium \"smoke\" is not rendered"),
+    ] {
+        assert!(said.iter().any(|w| w.contains(&format!("m.pbrt:{line}")) && w.contains(says)), "{says}: {said:?}");
+    }
+    for (text, expected) in [
+        (
+            "WorldBegin\nMediumInterface \"ink\" \"\"\nMaterial \"dielectric\"\nShape \"sphere\"",
+            "a.pbrt:4:7: MediumInterface names the medium \"ink\"",
+        ),
+        (
+            "WorldBegin\nMakeNamedMedium \"m\" \"rgb sigma_a\" [1 1 1]",
+            "a.pbrt:2:1: MakeNamedMedium needs \"string type\"",
+        ),
+        (
+            "WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [-1 1 1]",
+            "needs sigma_a ≥ 0",
+        ),
+        ("WorldBegin\nMakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float scale\" -2", "scale ≥ 0"),
+    ] {
+        let err = import(&[("a.pbrt", text)]).expect_err(expected);
+        assert!(err.contains(expected), "expected {expected:?} in:\n{err}");
+    }
+}
+
 /// Mesh files are read together after the walk, yet each lands where its shape is, a file
 /// shared by two shapes is read once, and an unreadable one is the error, at its shape, even
 /// when a later directive is wrong too.
