@@ -7,10 +7,9 @@ against a white emitting panel behind it, in a black world (so that nothing but 
 light through the glass reaches the camera there).
 
 glTF absorbs `−ln(c)·ρ` per unit length, Cycles `(1 − c)·ρ`: through d units of glass alhazen's
-image of the exported file is Cycles' times `exp(−d·ρ·(−ln c − (1 − c)))` per channel. The
-script prints both images' means over the cube's middle and that ratio against the predicted
-one (d = the cube's side). For the test `blender_volume_differs_from_cycles_as_glTF_says`
-(crates/alhazen-import/tests/gltf.rs).
+image of the exported file is Cycles' times `exp(−d·ρ·(−ln c − (1 − c)))` per channel (d = the
+cube's side), which the script prints; the test `blender_volume_differs_from_cycles_as_gltf_says`
+(crates/alhazen-import/tests/gltf.rs) measures it over the cube's middle.
 
     python3 bench/blender/volume_vs_cycles.py OUT_DIR [--spp 1024]
 
