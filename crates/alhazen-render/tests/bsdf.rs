@@ -66,7 +66,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                         k: Vec3::new(3.9, 2.45, 2.14),
                         tint: Vec3::ONE,
                         schlick: false,
-                        multiscatter: false,
+                        multiscatter: None,
                     }),
                 ));
                 // The light of several facets (GGX's; other facets take single scattering).
@@ -79,8 +79,9 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                             k: Vec3::new(3.9, 2.45, 2.14),
                             tint: Vec3::ONE,
                             schlick,
-                            multiscatter: true,
-                        }),
+                            multiscatter: None,
+                        }
+                        .with_several_facets()),
                     ));
                 }
                 list.push((
@@ -104,7 +105,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
             k: Vec3::splat(3.0),
             tint: Vec3::ONE,
             schlick: true,
-            multiscatter: false,
+            multiscatter: None,
         }),
     ));
     list.push(("rough plastic ggx m=0.2".into(), Bsdf::Plastic(Plastic::new(albedo, 1.49, Some(ggx(0.2)), false))));
@@ -127,7 +128,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 k: Vec3::splat(3.0),
                 tint: Vec3::ONE,
                 schlick: false,
-                multiscatter: false,
+                multiscatter: None,
             }),
             weight: 0.4,
         })),
@@ -443,7 +444,7 @@ fn conductor_fresnel_matches_known_values() {
         k: Vec3::splat(k),
         tint: Vec3::ONE,
         schlick: false,
-        multiscatter: false,
+        multiscatter: None,
     };
     let f = c(1.5, 0.0).fresnel(1.0).x;
     assert!((f - 0.04).abs() < 1e-12);

@@ -71,7 +71,7 @@ fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec
         k: Vec3::ZERO,
         tint: mode.color(m.mirror / w),
         schlick: false,
-        multiscatter: false,
+        multiscatter: None,
     });
     Bsdf::Mix(Box::new(Mix { a: mirror, b: lambert, weight: w }))
 }
@@ -111,14 +111,17 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
         BsdfDesc::Plastic { albedo, ior, facets, nonlinear } => {
             Bsdf::Plastic(Plastic::new(tex(albedo), *ior, facets.as_ref().map(Microfacet::new), *nonlinear))
         }
-        BsdfDesc::Conductor { facets, eta, k, tint, fresnel, multiscatter } => Bsdf::Conductor(Conductor {
-            facets: facets.as_ref().map(Microfacet::new),
-            eta: mode.color(*eta),
-            k: mode.color(*k),
-            tint: mode.color(*tint * lookups.tint),
-            schlick: *fresnel == FresnelMode::Schlick,
-            multiscatter: *multiscatter,
-        }),
+        BsdfDesc::Conductor { facets, eta, k, tint, fresnel, multiscatter } => {
+            let c = Conductor {
+                facets: facets.as_ref().map(Microfacet::new),
+                eta: mode.color(*eta),
+                k: mode.color(*k),
+                tint: mode.color(*tint * lookups.tint),
+                schlick: *fresnel == FresnelMode::Schlick,
+                multiscatter: None,
+            };
+            Bsdf::Conductor(if *multiscatter { c.with_several_facets() } else { c })
+        }
         BsdfDesc::Dielectric { facets, ior, fresnel } => Bsdf::Dielectric(Dielectric {
             facets: facets.as_ref().map(Microfacet::new),
             eta: mode.ior(ior),

@@ -24,8 +24,10 @@ pub struct Conductor {
     /// Schlick instead of the exact formula.
     pub schlick: bool,
     /// A rough conductor adds the light that meets several facets (Kulla and Conty's lobe,
-    /// [`super::multiscatter`]), as Cycles' multiple-scattering GGX gives it back.
-    pub multiscatter: bool,
+    /// [`super::multiscatter`]), as Cycles' multiple-scattering GGX gives it back: the lobe's
+    /// terms that do not depend on the directions ([`Self::with_several_facets`]); `None`:
+    /// single scattering.
+    pub multiscatter: Option<super::SeveralFacets>,
 }
 
 /// Unpolarised reflectance of a conductor `η + iκ` at incidence cosine `cos_i`:
@@ -95,24 +97,31 @@ impl Conductor {
     /// [`Self::eval`] and [`Self::pdf`] with the half vector and `D` found once (the same numbers).
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
         let Some(f) = &self.facets else { return (Vec3::ZERO, 0.0) };
-        self.eval_pdf_with(f, self.multiple_scattering(v).as_ref(), v, l)
+        let lobe = self.lobe_seen_from(v);
+        self.eval_pdf_with(f, lobe.as_ref().map(|(ms, p)| (ms, *p)), v, l)
     }
 
-    /// [`Self::eval_pdf`] on `facets` with the lobe of several facets `ms` seen from `v`.
+    /// [`Self::eval_pdf`] on `facets` with the lobe of several facets `ms` seen from `v` and
+    /// the probability of sampling it.
     fn eval_pdf_with(
         &self,
         facets: &Microfacet,
-        ms: Option<&super::multiscatter::MultipleScattering>,
+        ms: Option<(&super::multiscatter::MultipleScattering, f64)>,
         v: Vec3,
         l: Vec3,
     ) -> (Vec3, f64) {
         let (value, pdf) = self.rough_eval_pdf(facets, v, l);
-        let Some(ms) = ms else { return (value, pdf) };
+        let Some((ms, p)) = ms else { return (value, pdf) };
         if !same_side(v, l) {
             return (Vec3::ZERO, 0.0);
         }
-        let p = ms.choice(self.fresnel(v.z));
         (value + ms.eval(l), (1.0 - p) * pdf + p * super::cosine_pdf(v, l))
+    }
+
+    /// The lobe of several facets seen from `v` and the probability of sampling it.
+    fn lobe_seen_from(&self, v: Vec3) -> Option<(super::multiscatter::MultipleScattering, f64)> {
+        let ms = self.multiple_scattering(v)?;
+        Some((ms, ms.choice(self.fresnel(v.z))))
     }
 
     /// The mirror direction, or reflection about a sampled facet (or, with
@@ -120,11 +129,11 @@ impl Conductor {
     /// facets), valued as the whole BSDF.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let Some(facets) = &self.facets else { return Some(self.smooth_sample(v)) };
-        let Some(ms) = self.multiple_scattering(v) else {
+        let Some((ms, p)) = self.lobe_seen_from(v) else {
             let (sampled, sample) = self.rough_sample(facets, v, 0.0, u);
             return sampled.then_some(sample);
         };
-        let l = if uc < ms.choice(self.fresnel(v.z)) {
+        let l = if uc < p {
             super::cosine_hemisphere(u, v)
         } else {
             let (sampled, sample) = self.rough_sample(facets, v, 0.0, u);
@@ -133,20 +142,27 @@ impl Conductor {
             }
             sample.l
         };
-        let (f, pdf) = self.eval_pdf_with(facets, Some(&ms), v, l);
+        let (f, pdf) = self.eval_pdf_with(facets, Some((&ms, p)), v, l);
         (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 
-    /// The lobe of the light of several facets seen from `v`: a rough conductor's with
-    /// [`Self::multiscatter`] on Trowbridge–Reitz (GGX) facets with Smith's shadowing, whose
-    /// albedo is tabulated; else none.
+    /// The lobe of the light of several facets seen from `v`, with [`Self::multiscatter`].
     pub(crate) fn multiple_scattering(&self, v: Vec3) -> Option<super::multiscatter::MultipleScattering> {
+        Some(self.multiscatter?.seen_from(v))
+    }
+
+    /// This conductor giving back the light of several facets: the lobe's terms found, where
+    /// its facets are Trowbridge–Reitz (GGX) with Smith's shadowing, whose albedo is tabulated
+    /// (else single scattering: `None`).
+    pub fn with_several_facets(self) -> Self {
         use alhazen_scene::bsdf::{Distribution, Shadowing};
         let ggx =
             |f: &&super::Microfacet| f.distribution == Distribution::TrowbridgeReitz && f.shadowing == Shadowing::Smith;
-        let f = self.facets.as_ref().filter(|_| self.multiscatter).filter(ggx)?;
-        let alpha = (f.alpha_u * f.alpha_v).sqrt();
-        Some(super::multiscatter::MultipleScattering::new(alpha, v, self.fresnel_average()))
+        let lobe = self.facets.as_ref().filter(ggx).map(|f| {
+            let alpha = (f.alpha_u * f.alpha_v).sqrt();
+            super::SeveralFacets::new(alpha, self.fresnel_average())
+        });
+        Conductor { multiscatter: lobe, ..self }
     }
 
     /// The cosine-weighted mean of [`Self::fresnel`]: `F0 + (1 − F0)/21` for Schlick's term,

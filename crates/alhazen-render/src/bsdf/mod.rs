@@ -29,6 +29,7 @@ pub use dielectric::Dielectric;
 pub use lambert::Lambert;
 pub use microfacet::Microfacet;
 pub use mix::Mix;
+pub use multiscatter::SeveralFacets;
 pub(crate) use mix::{blend, blend_density};
 pub use oren_nayar::OrenNayar;
 pub use phong::{Phong, PhongLobe};

@@ -98,38 +98,52 @@ fn average(alpha: f64) -> f64 {
     t.average[i] * (1.0 - fy) + t.average[i + 1] * fy
 }
 
-/// The compensating lobe of facets of roughness `alpha` (for two roughnesses, their geometric
-/// mean) under a Fresnel term `fresnel(cos)`.
+/// What the compensating lobe of a material keeps whatever the directions: the facets'
+/// roughness `alpha` (for two roughnesses, their geometric mean), `E_avg(α)`, and
+/// `F_ms / (π (1 − E_avg))` for its Fresnel term's mean. Found once per material (or per
+/// point of a textured one), not at every evaluation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeveralFacets {
+    alpha: f64,
+    e_avg: f64,
+    scale: Vec3,
+}
+
+impl SeveralFacets {
+    /// The lobe of facets of roughness `alpha` under a Fresnel term of cosine-weighted mean
+    /// `f_avg` ([`fresnel_average`]).
+    pub(crate) fn new(alpha: f64, f_avg: Vec3) -> Self {
+        let e_avg = average(alpha);
+        let f_ms = f_avg * f_avg * e_avg / (Vec3::ONE - f_avg * (1.0 - e_avg));
+        let scale = if e_avg < 1.0 { f_ms / (PI * (1.0 - e_avg)) } else { Vec3::ZERO };
+        SeveralFacets { alpha, e_avg, scale }
+    }
+
+    /// The lobe seen from `v` (local frame).
+    pub(crate) fn seen_from(&self, v: Vec3) -> MultipleScattering {
+        MultipleScattering { lost_v: 1.0 - lookup(v.z.abs(), self.alpha), lobe: *self }
+    }
+}
+
+/// The compensating lobe seen from one direction.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct MultipleScattering {
     /// `1 − E(μ_v)`: the energy the single-scattering lobe loses towards `v`.
     lost_v: f64,
-    alpha: f64,
-    /// `F_ms / (π (1 − E_avg))`.
-    scale: Vec3,
+    lobe: SeveralFacets,
 }
 
 impl MultipleScattering {
-    /// The lobe seen from `v` (local frame) under a Fresnel term of cosine-weighted mean
-    /// `f_avg` ([`fresnel_average`]).
-    pub(crate) fn new(alpha: f64, v: Vec3, f_avg: Vec3) -> Self {
-        let e_avg = average(alpha);
-        let f_ms = f_avg * f_avg * e_avg / (Vec3::ONE - f_avg * (1.0 - e_avg));
-        let scale = if e_avg < 1.0 { f_ms / (PI * (1.0 - e_avg)) } else { Vec3::ZERO };
-        MultipleScattering { lost_v: 1.0 - lookup(v.z.abs(), alpha), alpha, scale }
-    }
-
     /// `f_ms(v, l)` for `l` on `v`'s side.
     pub(crate) fn eval(&self, l: Vec3) -> Vec3 {
-        self.scale * (self.lost_v * (1.0 - lookup(l.z.abs(), self.alpha)))
+        self.lobe.scale * (self.lost_v * (1.0 - lookup(l.z.abs(), self.lobe.alpha)))
     }
 
     /// The probability of sampling this lobe rather than the single-scattering one, whose
     /// Fresnel term towards `v` is `f_v`: their albedos' shares (`F_ms (1 − E(μ_v))` against
     /// about `F(μ_v) E(μ_v)`, mean channels).
     pub(crate) fn choice(&self, f_v: Vec3) -> f64 {
-        let e_avg = average(self.alpha);
-        let multiple = (self.scale * (PI * (1.0 - e_avg) * self.lost_v)).element_sum() / 3.0;
+        let multiple = (self.lobe.scale * (PI * (1.0 - self.lobe.e_avg) * self.lost_v)).element_sum() / 3.0;
         let single = f_v.element_sum() / 3.0 * (1.0 - self.lost_v);
         super::lobe_probability(multiple, single)
     }

@@ -550,7 +550,7 @@ fn metallic_roughness(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &CookTorran
     match (&mix.a, &mix.b) {
         (Bsdf::Conductor(c), Bsdf::CookTorrance(base))
             if c.schlick
-                && !c.multiscatter
+                && c.multiscatter.is_none()
                 && conductor_facets(c) == Some(false)
                 && c.facets.is_some_and(|f| f.alpha_u == f.alpha_v)
                 && cook_torrance_facets(base) == Some(false) =>
@@ -1154,7 +1154,7 @@ impl RoughBsdf for Conductor {
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        Conductor { facets: Some(facets), eta, k, tint, schlick: false, multiscatter: false }
+        Conductor { facets: Some(facets), eta, k, tint, schlick: false, multiscatter: None }
     }
 }
 
@@ -1177,7 +1177,7 @@ impl RoughBsdf for SchlickConductor {
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        SchlickConductor(Conductor { facets: Some(facets), eta, k, tint, schlick: true, multiscatter: false })
+        SchlickConductor(Conductor { facets: Some(facets), eta, k, tint, schlick: true, multiscatter: None })
     }
 }
 
@@ -1259,7 +1259,7 @@ impl<const SCHLICK: bool> LaneBsdf for SmoothConductor<SCHLICK> {
     #[inline(always)]
     fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        (true, Conductor { facets: None, eta, k, tint, schlick: SCHLICK, multiscatter: false }.smooth_sample(wv))
+        (true, Conductor { facets: None, eta, k, tint, schlick: SCHLICK, multiscatter: None }.smooth_sample(wv))
     }
 }
 
@@ -1307,7 +1307,7 @@ impl LambertMirror {
     #[inline(always)]
     fn at(v: &Vertices, i: usize) -> (Conductor, crate::bsdf::Lambert, f64) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        let mirror = Conductor { facets: None, eta, k, tint, schlick: false, multiscatter: false };
+        let mirror = Conductor { facets: None, eta, k, tint, schlick: false, multiscatter: None };
         (mirror, crate::bsdf::Lambert { albedo: get(&v.albedo, i) }, v.mix_weight[i])
     }
 }
@@ -1349,7 +1349,7 @@ impl MetallicRoughness {
     fn at(v: &Vertices, i: usize) -> ((Conductor, Microfacet), (CookTorrance, Microfacet), f64) {
         let metal_facets = Microfacet::smith::<false>(v.alpha[0][i], v.alpha[0][i]);
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        let metal = Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true, multiscatter: false };
+        let metal = Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true, multiscatter: None };
         let base_facets = Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]);
         let lobe = CookTorranceLobe { facets: base_facets, ior: v.ior[i], schlick: false };
         let base = CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe };
