@@ -73,15 +73,17 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 for schlick in [false, true].into_iter().filter(|_| d == Distribution::TrowbridgeReitz) {
                     list.push((
                         format!("rough conductor {name} m={a}, several facets, schlick {schlick}"),
-                        Bsdf::Conductor(Conductor {
-                            facets: Some(facets(d, a, 0.7 * a, Shadowing::Smith)),
-                            eta: Vec3::new(0.2, 0.92, 1.1),
-                            k: Vec3::new(3.9, 2.45, 2.14),
-                            tint: Vec3::ONE,
-                            schlick,
-                            multiscatter: None,
-                        }
-                        .with_several_facets()),
+                        Bsdf::Conductor(
+                            Conductor {
+                                facets: Some(facets(d, a, 0.7 * a, Shadowing::Smith)),
+                                eta: Vec3::new(0.2, 0.92, 1.1),
+                                k: Vec3::new(3.9, 2.45, 2.14),
+                                tint: Vec3::ONE,
+                                schlick,
+                                multiscatter: None,
+                            }
+                            .with_several_facets(),
+                        ),
                     ));
                 }
                 list.push((
@@ -494,14 +496,15 @@ fn a_thin_sheet_reflects_both_faces_and_passes_the_rest_straight() {
 fn several_facets_give_the_white_furnace_back_its_light() {
     use alhazen_render::bsdf::Conductor;
     let white = |alpha: f64, multiscatter: bool| {
-        Bsdf::Conductor(Conductor {
+        let c = Conductor {
             facets: Some(facets(Distribution::TrowbridgeReitz, alpha, alpha, Shadowing::Smith)),
             eta: Vec3::ZERO,
             k: Vec3::ZERO,
             tint: Vec3::ONE,
             schlick: false,
-            multiscatter,
-        })
+            multiscatter: None,
+        };
+        Bsdf::Conductor(if multiscatter { c.with_several_facets() } else { c })
     };
     // The albedo towards `v` by sampling: the mean of f·cos/pdf over a stratified grid.
     let albedo = |b: &Bsdf, v: Vec3| {

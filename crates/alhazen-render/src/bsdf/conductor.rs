@@ -63,6 +63,17 @@ fn fresnel_conductor_channels(cos_i: f64, eta: [f64; 4], k: [f64; 4]) -> [f64; 4
     out
 }
 
+/// [`fresnel_conductor_channels`] at normal incidence, where it is
+/// `((η − 1)² + κ²) / ((η + 1)² + κ²)`: no square root (Schlick's term starts from it at every
+/// evaluation).
+#[inline(always)]
+fn normal_reflectance_channels(eta: [f64; 4], k: [f64; 4]) -> [f64; 4] {
+    std::array::from_fn(|i| {
+        let (below, above, k2) = (eta[i] - 1.0, eta[i] + 1.0, k[i] * k[i]);
+        ((below * below + k2) / (above * above + k2)).clamp(0.0, 1.0)
+    })
+}
+
 impl Conductor {
     /// `F` per channel at `cos`; `η = κ = 0` stands for an ideal mirror of reflectance `tint`.
     /// Computed whole, then chosen (no early return: the path tracer's lanes run it for eight
@@ -72,7 +83,7 @@ impl Conductor {
         let mirror = self.eta == Vec3::ZERO && self.k == Vec3::ZERO;
         let channels = |v: Vec3| [v.x, v.y, v.z, 0.0];
         let f = if self.schlick {
-            let f0 = fresnel_conductor_channels(1.0, channels(self.eta), channels(self.k));
+            let f0 = normal_reflectance_channels(channels(self.eta), channels(self.k));
             let f = |i: usize| f0[i] + (1.0 - f0[i]) * (1.0 - cos.abs().min(1.0)).powi(5);
             Vec3::new(f(0), f(1), f(2)) * self.tint
         } else {
@@ -173,7 +184,7 @@ impl Conductor {
         }
         if self.schlick {
             let channels = |v: Vec3| [v.x, v.y, v.z, 0.0];
-            let f0 = fresnel_conductor_channels(1.0, channels(self.eta), channels(self.k));
+            let f0 = normal_reflectance_channels(channels(self.eta), channels(self.k));
             let avg = |i: usize| f0[i] + (1.0 - f0[i]) / 21.0;
             return Vec3::new(avg(0), avg(1), avg(2)) * self.tint;
         }
@@ -267,6 +278,13 @@ mod tests {
         fn real_form_is_the_complex_form(c in 0.0..=1.0f64, eta in 0.05..5.0f64, k in 0.0..10.0f64) {
             let (a, b) = (fresnel_conductor(c, eta, k), complex_form(c, eta, k));
             proptest::prop_assert!((a - b).abs() <= 1e-12 + 1e-9 * b, "c {} η {} κ {}: {} vs {}", c, eta, k, a, b);
+        }
+
+        /// At normal incidence the square-root-free form is the general one.
+        #[test]
+        fn normal_reflectance_is_the_reflectance_at_normal_incidence(eta in 0.0..20.0f64, k in 0.0..20.0f64) {
+            let (a, b) = (normal_reflectance_channels([eta; 4], [k; 4])[0], fresnel_conductor_channels(1.0, [eta; 4], [k; 4])[0]);
+            proptest::prop_assert!((a - b).abs() <= 1e-14 + 1e-12 * b, "η {} κ {}: {} vs {}", eta, k, a, b);
         }
     }
 }
