@@ -80,11 +80,32 @@ fn single_scattering_albedo(mu: f64, alpha: f64) -> f64 {
 }
 
 /// Bilinear lookup of the table at `(mu, alpha)`.
+#[cfg(test)]
 fn lookup(mu: f64, alpha: f64) -> f64 {
+    lookup_in(mu, Row::at(alpha))
+}
+
+/// Where a roughness falls between the table's rows: the lower row and the weight of the next.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Row {
+    i: usize,
+    fy: f64,
+}
+
+impl Row {
+    fn at(alpha: f64) -> Row {
+        let y = alpha.max(0.0).sqrt().min(1.0) * (N - 1) as f64;
+        let i = (y as usize).min(N - 2);
+        Row { i, fy: y - i as f64 }
+    }
+}
+
+/// Bilinear lookup of the table at `mu` between the rows of `row`.
+fn lookup_in(mu: f64, Row { i, fy }: Row) -> f64 {
     let t = tables();
-    let (x, y) = (mu.clamp(0.0, 1.0) * (N - 1) as f64, alpha.max(0.0).sqrt().min(1.0) * (N - 1) as f64);
-    let (j, i) = ((x as usize).min(N - 2), (y as usize).min(N - 2));
-    let (fx, fy) = (x - j as f64, y - i as f64);
+    let x = mu.clamp(0.0, 1.0) * (N - 1) as f64;
+    let j = (x as usize).min(N - 2);
+    let fx = x - j as f64;
     let row = |i: usize| t.albedo[i][j] * (1.0 - fx) + t.albedo[i][j + 1] * fx;
     row(i) * (1.0 - fy) + row(i + 1) * fy
 }
@@ -98,13 +119,13 @@ fn average(alpha: f64) -> f64 {
     t.average[i] * (1.0 - fy) + t.average[i + 1] * fy
 }
 
-/// What the compensating lobe of a material keeps whatever the directions: the facets'
-/// roughness `alpha` (for two roughnesses, their geometric mean), `E_avg(α)`, and
+/// What the compensating lobe of a material keeps whatever the directions: where the facets'
+/// roughness `alpha` (for two roughnesses, their geometric mean) falls in the table, `E_avg(α)`, and
 /// `F_ms / (π (1 − E_avg))` for its Fresnel term's mean. Found once per material (or per
 /// point of a textured one), not at every evaluation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeveralFacets {
-    alpha: f64,
+    row: Row,
     e_avg: f64,
     scale: Vec3,
 }
@@ -116,12 +137,12 @@ impl SeveralFacets {
         let e_avg = average(alpha);
         let f_ms = f_avg * f_avg * e_avg / (Vec3::ONE - f_avg * (1.0 - e_avg));
         let scale = if e_avg < 1.0 { f_ms / (PI * (1.0 - e_avg)) } else { Vec3::ZERO };
-        SeveralFacets { alpha, e_avg, scale }
+        SeveralFacets { row: Row::at(alpha), e_avg, scale }
     }
 
     /// The lobe seen from `v` (local frame).
     pub(crate) fn seen_from(&self, v: Vec3) -> MultipleScattering {
-        MultipleScattering { lost_v: 1.0 - lookup(v.z.abs(), self.alpha), lobe: *self }
+        MultipleScattering { lost_v: 1.0 - lookup_in(v.z.abs(), self.row), lobe: *self }
     }
 }
 
@@ -136,7 +157,7 @@ pub(crate) struct MultipleScattering {
 impl MultipleScattering {
     /// `f_ms(v, l)` for `l` on `v`'s side.
     pub(crate) fn eval(&self, l: Vec3) -> Vec3 {
-        self.lobe.scale * (self.lost_v * (1.0 - lookup(l.z.abs(), self.lobe.alpha)))
+        self.lobe.scale * (self.lost_v * (1.0 - lookup_in(l.z.abs(), self.lobe.row)))
     }
 
     /// The probability of sampling this lobe rather than the single-scattering one, whose
