@@ -59,6 +59,9 @@ pub struct PathTracer<'a> {
     lane_lights: Option<Vec<lanes::LaneLight>>,
     /// Per material: the lanes' kernel for its vertices.
     material_kernels: Vec<lanes::Kernel>,
+    /// Some material's inside absorbs (`Material::absorption`): paths leaving an object are
+    /// weighed by what they kept inside it. (Without, no vertex asks.)
+    absorbing: bool,
     /// Specular connections through the scene's sphere, cylinder and plane mirrors, if any.
     mirrors: Option<mirrors::MirrorConnections>,
     /// Light through specular surfaces onto non-specular ones, estimated elsewhere.
@@ -243,6 +246,7 @@ impl<'a> PathTracer<'a> {
             in_lanes: false,
             lane_lights: None,
             material_kernels: vec![],
+            absorbing: scene.materials.iter().any(|m| m.absorption != Vec3::ZERO),
             mirrors,
             caustics: None,
             film: crate::film::filter::FilmSampler::new(&scene.render.filter),
@@ -308,7 +312,9 @@ impl<'a> PathTracer<'a> {
             return;
         };
         let m = &self.scene.materials[wh.material as usize];
-        if let Some(kept) = crate::optics::absorbed_inside(m, &wh.hit, path.ray.dir, mode) {
+        if self.absorbing
+            && let Some(kept) = crate::optics::absorbed_inside(m, &wh.hit, path.ray.dir, mode)
+        {
             path.beta *= kept;
         }
         if !(path.caustic_chain && self.caustics.is_some()) {

@@ -854,7 +854,9 @@ impl PathTracer<'_> {
             }
         }
         // As `vertex` weighs a path that crossed an absorbing inside, before its emission.
-        if let Some(kept) = crate::optics::absorbed_inside(m, &wh.hit, path.ray.dir, ColorMode::Rgb) {
+        if self.absorbing
+            && let Some(kept) = crate::optics::absorbed_inside(m, &wh.hit, path.ray.dir, ColorMode::Rgb)
+        {
             path.beta *= kept;
         }
         let h = HitPoint::from(wh);
