@@ -8,7 +8,7 @@
 //! through the metallic–roughness model (`common::metal_rough`): the base-colour texture and
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
 //! `KHR_materials_emissive_strength`, a transmitting material's absorbing inside with
-//! `KHR_materials_volume`; a metallic–roughness texture, and a textured metal's
+//! `KHR_materials_volume`, a clear coat with `KHR_materials_clearcoat`; a metallic–roughness texture, and a textured metal's
 //! colour, are read per point (`BsdfDesc::MetallicRoughness`, the model at each point), by
 //! their means under transmission; so is an emission texture (its factor and strength
 //! multiplied in).
@@ -48,6 +48,7 @@ const KNOWN: &[&str] = &[
     "KHR_mesh_quantization",
     "KHR_materials_specular",
     "KHR_materials_volume",
+    "KHR_materials_clearcoat",
 ];
 
 /// Extensions alhazen reads without the glTF reader's support.
@@ -487,9 +488,7 @@ impl Importer<'_> {
             _ => (Vec2::ONE, Vec2::ZERO, 0.0),
         };
         let alpha = self.cut_out(&material, c[3] as f64, placement)?;
-        for ext in
-            ["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence", "KHR_materials_anisotropy"]
-        {
+        for ext in ["KHR_materials_sheen", "KHR_materials_iridescence", "KHR_materials_anisotropy"] {
             if material.extension_value(ext).is_some() {
                 self.warn(format!("{name}: {ext} is not supported; ignored"));
             }
@@ -505,6 +504,7 @@ impl Importer<'_> {
         } else {
             common::metal_rough(base, base_mean, metallic, roughness, (ior, lobes), transmission.clamp(0.0, 1.0))
         };
+        let bsdf = self.clearcoat(&material, bsdf, &name)?;
         let refracts = bsdf.refracts();
         let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
         (m.emission, m.emission_texture) = (emission, emission_texture);
@@ -516,6 +516,34 @@ impl Importer<'_> {
         let id = common::add_material(&mut self.scene, m);
         self.materials.insert(material.index(), id);
         Ok(id)
+    }
+
+    /// `bsdf` under `KHR_materials_clearcoat`'s coat: of weight `clearcoatFactor`, GGX facets
+    /// of `α = clearcoatRoughnessFactor²` (at least 0.01, a clear coat), index 1.5 (glTF's);
+    /// none where the factor is 0. Its textures and normal map are left out (warning: the
+    /// factors are used).
+    fn clearcoat(&mut self, material: &gltf::Material, bsdf: BsdfDesc, name: &str) -> R<BsdfDesc> {
+        let Some(c) = material.extension_value("KHR_materials_clearcoat") else { return Ok(bsdf) };
+        let number = |key: &str| match c.get(key) {
+            None => Some(0.0),
+            Some(x) => x.as_f64().filter(|x| (0.0..=1.0).contains(x)),
+        };
+        let (Some(weight), Some(roughness)) = (number("clearcoatFactor"), number("clearcoatRoughnessFactor")) else {
+            return Err(self.err(format!(
+                "{name}: KHR_materials_clearcoat's clearcoatFactor and clearcoatRoughnessFactor must be numbers within [0, 1]"
+            )));
+        };
+        if ["clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"]
+            .iter()
+            .any(|k| c.get(*k).is_some())
+        {
+            self.warn(format!("{name}: KHR_materials_clearcoat's textures are not supported; its factors are used"));
+        }
+        if weight == 0.0 {
+            return Ok(bsdf);
+        }
+        let alpha = (roughness * roughness).max(0.01);
+        Ok(BsdfDesc::Coated { base: Box::new(bsdf), weight, facets: alhazen_scene::bsdf::ggx(alpha, alpha), ior: 1.5 })
     }
 
     /// The absorption per unit length of a transmitting material's inside under

@@ -217,6 +217,19 @@ pub enum BsdfDesc {
         /// The metal's light of several facets ([`BsdfDesc::Conductor`]'s `multiscatter`).
         multiscatter: bool,
     },
+    /// A clear coat over `base` (car paint, lacquer; glTF's `KHR_materials_clearcoat`): a
+    /// dielectric microfacet layer of `weight` reflecting `weight·D G F/(4⟨l,n⟩⟨v,n⟩)`, the
+    /// base below weighted by one minus the coat's albedo towards the viewer.
+    Coated {
+        /// What lies under the coat.
+        base: Box<BsdfDesc>,
+        /// The coat's weight in `[0, 1]`.
+        weight: f64,
+        /// The coat's facets (GGX in the importers; at least `α = 0.01`).
+        facets: Microfacets,
+        /// The coat's index of refraction (1.5 in glTF).
+        ior: f64,
+    },
     /// `weight · a + (1 − weight) · b`.
     Mix {
         /// First BSDF.
@@ -304,6 +317,7 @@ impl crate::model::Material {
                 }
             }
             BsdfDesc::Mix { a, .. } => self.follow(a),
+            BsdfDesc::Coated { base, .. } => self.follow(base),
         }
     }
 }
@@ -372,6 +386,7 @@ impl BsdfDesc {
             | BsdfDesc::CookTorrance { albedo, .. }
             | BsdfDesc::Plastic { albedo, .. } => t(albedo),
             BsdfDesc::Mix { a, b, weight_map, .. } => a.is_textured() || b.is_textured() || weight_map.is_some(),
+            BsdfDesc::Coated { base, .. } => base.is_textured(),
             BsdfDesc::MetallicRoughness { base, map, .. } => t(base) || map.is_some(),
             BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } | BsdfDesc::ThinDielectric { .. } => false,
         }
@@ -403,6 +418,7 @@ impl BsdfDesc {
             BsdfDesc::CookTorrance { facets, .. } => two(facets),
             BsdfDesc::Conductor { facets: Some(f), .. } | BsdfDesc::Dielectric { facets: Some(f), .. } => two(f),
             BsdfDesc::Mix { a, b, .. } => a.is_anisotropic() || b.is_anisotropic(),
+            BsdfDesc::Coated { base, facets, .. } => base.is_anisotropic() || two(facets),
             _ => false,
         }
     }
@@ -413,6 +429,7 @@ impl BsdfDesc {
         match self {
             BsdfDesc::Dielectric { .. } => true,
             BsdfDesc::Mix { a, b, .. } => a.refracts() || b.refracts(),
+            BsdfDesc::Coated { base, .. } => base.refracts(),
             _ => false,
         }
     }
@@ -422,6 +439,7 @@ impl BsdfDesc {
         match self {
             BsdfDesc::Dielectric { ior, .. } => ior.is_dispersive(),
             BsdfDesc::Mix { a, b, .. } => a.is_dispersive() || b.is_dispersive(),
+            BsdfDesc::Coated { base, .. } => base.is_dispersive(),
             _ => false,
         }
     }

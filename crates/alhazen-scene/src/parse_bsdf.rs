@@ -31,6 +31,7 @@ impl Parser<'_> {
             "thin-dielectric",
             "mix",
             "metallic-roughness",
+            "coated",
         ])?;
         let keys: Vec<&str> = match kind {
             "lambert" => vec!["color"],
@@ -43,6 +44,7 @@ impl Parser<'_> {
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
             "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior", "specular", "multiscatter"],
             "thin-dielectric" => vec!["ior"],
+            "coated" => [&["base", "weight", "ior"][..], MICROFACET_KEYS].concat(),
             _ => vec!["a", "b", "weight", "weight_map"],
         };
         t.check_keys(&[&["type"][..], &keys].concat())?;
@@ -131,6 +133,22 @@ impl Parser<'_> {
                 specular: t.get("specular").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
                 multiscatter: t.opt_bool("multiscatter", false)?,
             },
+            "coated" => {
+                // The coat is rough (a near-mirror at its least roughness): its albedo and
+                // sampling are those of microfacets.
+                let facets = microfacets(&t)?.unwrap_or(default_facets(0.01));
+                if facets.alpha_u.min(facets.alpha_v) < 0.01 {
+                    return Err(t
+                        .req("roughness")?
+                        .err("a coat's `roughness` is at least 0.01 (0.01: a clear, glossy coat)"));
+                }
+                BsdfDesc::Coated {
+                    base: Box::new(self.bsdf(&t.req("base")?, &albedo)?),
+                    weight: t.get("weight").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
+                    facets,
+                    ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
+                }
+            }
             _ => BsdfDesc::Mix {
                 a: Box::new(self.bsdf(&t.req("a")?, &albedo)?),
                 b: Box::new(self.bsdf(&t.req("b")?, &albedo)?),

@@ -501,6 +501,13 @@ impl Writer<'_> {
                     num(*weight)
                 )
             }
+            BsdfDesc::Coated { base, weight, facets: f, ior } => format!(
+                "{{ type = \"coated\", base = {}, weight = {}, ior = {}, {} }}",
+                self.bsdf(base),
+                num(*weight),
+                num(*ior),
+                facets(&Some(*f))
+            ),
             BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter } => format!(
                 "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{} }}",
                 self.texture(base),

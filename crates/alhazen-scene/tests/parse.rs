@@ -743,3 +743,35 @@ fn multiscatter_reads_writes_back_and_is_checked() {
     let e = err("[materials.m]\nbsdf = { type = \"conductor\", multiscatter = 1 }\n");
     assert!(e.contains(":2:") && e.contains("multiscatter"), "{e}");
 }
+
+/// `type = "coated"`: a clear coat over any BSDF (weight 1, roughness 0.01, index 1.5 unless
+/// given), written back the same; a coat smoother than 0.01, a base missing or a weight
+/// outside [0, 1] refused where they are written.
+#[test]
+fn coats_read_write_back_and_refuse_nonsense() {
+    use alhazen_scene::bsdf::BsdfDesc;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("c.toml");
+    let text = "[materials.paint]\nbsdf = { type = \"coated\", base = { type = \"lambert\", color = [0.6, 0.1, 0.1] }, roughness = 0.05 }\n";
+    std::fs::write(&path, text).unwrap();
+    let coat = |s: &alhazen_scene::Scene| s.materials.iter().find(|m| m.name == "paint").unwrap().bsdf.clone().unwrap();
+    let s = load_scene(&path).unwrap();
+    let read = coat(&s);
+    let BsdfDesc::Coated { base, weight, facets, ior } = &read else { panic!("{read:?}") };
+    assert!(matches!(**base, BsdfDesc::Lambert { .. }), "{base:?}");
+    assert_eq!((*weight, facets.alpha_u, *ior), (1.0, 0.05, 1.5));
+    let again = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again, &dir.path().join("assets"), "").unwrap();
+    assert_eq!(coat(&load_scene(&again).unwrap()), read);
+    let material = |bsdf: &str| {
+        err(&format!("[materials.m]\nbsdf = {bsdf}\n[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"m\"\n"))
+    };
+    for (bsdf, says) in [
+        (r#"{ type = "coated", base = { type = "lambert" }, roughness = 0.001 }"#, "at least 0.01"),
+        (r#"{ type = "coated", roughness = 0.1 }"#, "base"),
+        (r#"{ type = "coated", base = { type = "lambert" }, weight = 1.5 }"#, "weight"),
+    ] {
+        let e = material(bsdf);
+        assert!(e.contains("s.toml:2") && e.contains(says), "{bsdf}: {e}");
+    }
+}

@@ -32,7 +32,7 @@ impl CookTorranceLobe {
     /// whole and then chosen — no early return where `v` and `l` are opposite — so that the
     /// path tracer's lanes evaluate it for eight directions at once.
     #[inline(always)]
-    fn value_pdf(&self, v: Vec3, l: Vec3) -> (f64, f64) {
+    pub(crate) fn value_pdf(&self, v: Vec3, l: Vec3) -> (f64, f64) {
         let h = (v + l).normalize_or_zero();
         let met = h != Vec3::ZERO;
         let h = h * h.z.signum();

@@ -9,6 +9,7 @@
 
 mod blinn_phong;
 mod build;
+mod coated;
 mod conductor;
 mod cook_torrance;
 mod dielectric;
@@ -23,6 +24,7 @@ mod plastic;
 
 pub use blinn_phong::{BlinnPhong, BlinnPhongLobe};
 pub use build::{ColorMode, bsdf_at, is_anisotropic, tangent_at};
+pub use coated::Coated;
 pub use conductor::Conductor;
 pub use cook_torrance::{CookTorrance, CookTorranceLobe};
 pub use dielectric::Dielectric;
@@ -76,6 +78,8 @@ pub enum Bsdf {
     Dielectric(Dielectric),
     /// Blend of two.
     Mix(Box<Mix>),
+    /// A base under a clear coat.
+    Coated(Box<Coated>),
 }
 
 macro_rules! dispatch {
@@ -90,6 +94,7 @@ macro_rules! dispatch {
             Bsdf::Conductor($b) => $e,
             Bsdf::Dielectric($b) => $e,
             Bsdf::Mix($b) => $e,
+            Bsdf::Coated($b) => $e,
         }
     };
 }
@@ -114,6 +119,7 @@ impl Bsdf {
             Bsdf::Plastic(p) => p.eval_pdf(v, l),
             Bsdf::CookTorrance(c) => c.rough_eval_pdf(&c.lobe.facets, v, l),
             Bsdf::Mix(m) => m.eval_pdf(v, l),
+            Bsdf::Coated(c) => c.eval_pdf(v, l),
             _ => (self.eval(v, l), self.pdf(v, l)),
         }
     }
@@ -154,6 +160,7 @@ impl Bsdf {
             Bsdf::Plastic(p) => p.has_mirror(),
             Bsdf::Dielectric(d) => d.facets.is_none(),
             Bsdf::Mix(m) => m.a.has_delta_lobe() || m.b.has_delta_lobe(),
+            Bsdf::Coated(c) => c.base.has_delta_lobe(),
             _ => false,
         }
     }
@@ -164,6 +171,7 @@ impl Bsdf {
         match self {
             Bsdf::Conductor(c) if c.facets.is_none() => c.fresnel(cos),
             Bsdf::Mix(m) => m.a.mirror_reflectance(cos) * m.weight + m.b.mirror_reflectance(cos) * (1.0 - m.weight),
+            Bsdf::Coated(c) => c.base.mirror_reflectance(cos) * (1.0 - c.coat_albedo_at(cos)),
             _ => Vec3::ZERO,
         }
     }
@@ -173,6 +181,7 @@ impl Bsdf {
         match self {
             Bsdf::Dielectric(_) => true,
             Bsdf::Mix(m) => m.a.transmits() || m.b.transmits(),
+            Bsdf::Coated(c) => c.base.transmits(),
             _ => false,
         }
     }

@@ -79,9 +79,9 @@ fn single_scattering_albedo(mu: f64, alpha: f64) -> f64 {
     (sum / (STRATA * STRATA) as f64).clamp(0.0, 1.0)
 }
 
-/// Bilinear lookup of the table at `(mu, alpha)`.
-#[cfg(test)]
-fn lookup(mu: f64, alpha: f64) -> f64 {
+/// Bilinear lookup of the table at `(mu, alpha)`: the share of the light arriving along `μ`
+/// that facets of roughness `alpha` reflect once (with `F = 1`).
+pub(crate) fn lookup(mu: f64, alpha: f64) -> f64 {
     lookup_in(mu, Row::at(alpha))
 }
 

@@ -1,0 +1,92 @@
+//! A clear coat over another scattering function: car paint, varnished wood, lacquered metal
+//! (glTF's `KHR_materials_clearcoat`, Blender's Principled Coat). A dielectric microfacet layer
+//! of weight `w` reflects `w·ρ_c` (Cook–Torrance's `D G F / (4⟨l,n⟩⟨v,n⟩)`, exact Fresnel
+//! factor of the coat's index); the base below receives what the coat lets through towards the
+//! viewer, `1 − w·E_c(μ_v)`, where `E_c` is the coat's directional albedo — the facets'
+//! single-scattering albedo (tabulated in [`super::multiscatter`]) times the Fresnel factor at
+//! the viewing angle:
+//!
+//! `ρ(v, l) = w·ρ_c(v, l) + (1 − w·E_c(μ_v))·ρ_base(v, l)`.
+//!
+//! This is the glTF specification's layering (its `fresnel_coat`, with the albedo in place of
+//! Schlick's factor) and Cycles' (its base weighted by one minus the coat's albedo towards the
+//! viewer); the light the coat reflects back down onto the base is left out, as both do.
+//!
+//! Parameters: the base BSDF, the coat's weight `w ∈ [0, 1]`, its facets and index.
+
+use super::cook_torrance::CookTorranceLobe;
+use super::layered::SpecularLobe;
+use super::{Bsdf, BsdfSample, same_side};
+use crate::optics::fresnel_dielectric;
+use alhazen_math::{Vec2, Vec3};
+
+/// A base under a clear coat.
+#[derive(Clone, Debug)]
+pub struct Coated {
+    /// What lies under the coat.
+    pub base: Bsdf,
+    /// The coat's microfacet lobe (its Fresnel factor exact).
+    pub coat: CookTorranceLobe,
+    /// The coat's weight `w ∈ [0, 1]`.
+    pub weight: f64,
+}
+
+impl Coated {
+    /// `w·E_c(μ_v)`: the share of the light leaving towards `v` that the coat reflects.
+    fn coat_albedo(&self, v: Vec3) -> f64 {
+        self.coat_albedo_at(v.z)
+    }
+
+    /// [`Self::coat_albedo`] towards a direction of cosine `cos` with the normal.
+    pub(crate) fn coat_albedo_at(&self, cos: f64) -> f64 {
+        let mu = cos.abs().min(1.0);
+        let alpha = (self.coat.facets.alpha_u * self.coat.facets.alpha_v).sqrt();
+        self.weight * super::multiscatter::lookup(mu, alpha) * fresnel_dielectric(mu, self.coat.ior)
+    }
+
+    /// The probability of sampling the coat rather than the base: its albedo's share, at
+    /// least a fifth of its weight (a glossy coat over a bright base still gets its
+    /// reflections sampled).
+    fn coat_choice(&self, albedo: f64) -> f64 {
+        albedo.max(0.2 * self.weight).min(0.9)
+    }
+
+    /// `ρ(v, l)`.
+    pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
+        self.eval_pdf(v, l).0
+    }
+
+    /// The mixture of the coat's and the base's densities.
+    pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
+        self.eval_pdf(v, l).1
+    }
+
+    /// [`Self::eval`] and [`Self::pdf`] at once.
+    pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let albedo = self.coat_albedo(v);
+        let q = self.coat_choice(albedo);
+        let (fb, pb) = self.base.eval_pdf(v, l);
+        let (fc, pc) = if same_side(v, l) { self.coat.value_pdf(v, l) } else { (0.0, 0.0) };
+        (fb * (1.0 - albedo) + Vec3::splat(self.weight * fc), q * pc + (1.0 - q) * pb)
+    }
+
+    /// The coat's facet reflection by `uc` below its share, else the base's sample (`uc`
+    /// rescaled for it); a delta sample of the base keeps its own weight under the coat.
+    pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
+        let albedo = self.coat_albedo(v);
+        let q = self.coat_choice(albedo);
+        let l = if uc < q {
+            self.coat.sample(v, u)?
+        } else {
+            let mut s = self.base.sample(v, ((uc - q) / (1.0 - q)).min(1.0 - 1e-16), u)?;
+            if s.delta {
+                s.f *= 1.0 - albedo;
+                s.pdf *= 1.0 - q;
+                return Some(s);
+            }
+            s.l
+        };
+        let (f, pdf) = self.eval_pdf(v, l);
+        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+}
