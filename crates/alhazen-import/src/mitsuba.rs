@@ -1058,8 +1058,20 @@ impl Importer {
                 let mean = self.pending.texture_mean(&base, &mut self.scene)?;
                 let ior = self.float(ctx, &p, "eta", 1.5)?;
                 let trans = self.float_or_mean(ctx, &p, "spec_trans", 0.0)?;
-                self.warn(ctx, node, "principled is approximated by the glTF metallic–roughness model (base colour, metallic, roughness, eta, spec_trans)");
-                self.principled(ctx, &p, (base, mean), ior, trans)?
+                self.warn(ctx, node, "principled is approximated by the glTF metallic–roughness model (base colour, metallic, roughness, eta, spec_trans; a clear coat for clearcoat)");
+                let bsdf = self.principled(ctx, &p, (base, mean), ior, trans)?;
+                // Its clear coat: GTR1 facets of α from 0.1 to 0.001 with `clearcoat_gloss`, a
+                // quarter of `clearcoat` strong, read as a coat of GGX facets (α at least 0.01).
+                let clearcoat = self.float_or_mean(ctx, &p, "clearcoat", 0.0)?;
+                let gloss = self.float_or_mean(ctx, &p, "clearcoat_gloss", 0.0)?;
+                self.float(ctx, &p, "clearcoat_sampling_rate", 1.0)?;
+                if clearcoat > 0.0 {
+                    let alpha = (0.1 + (0.001 - 0.1) * gloss.clamp(0.0, 1.0)).max(0.01);
+                    let (weight, facets) = ((0.25 * clearcoat).min(1.0), common::ggx(alpha, alpha));
+                    BsdfDesc::Coated { base: Box::new(bsdf), weight, facets, ior: 1.5 }
+                } else {
+                    bsdf
+                }
             }
             "blendbsdf" => {
                 let w = match self.prop(&p, "weight") {

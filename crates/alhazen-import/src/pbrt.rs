@@ -929,15 +929,27 @@ impl Importer {
     /// pbrt's roughness (`roughness` or `uroughness`/`vroughness`), remapped to α as pbrt
     /// does unless `remaproughness` is false; `None` when smooth.
     fn roughness(&mut self, ctx: &Ctx, p: &mut Params) -> R<Option<(f64, f64)>> {
-        let r = self.float(ctx, p, "roughness", 0.0)?;
-        let (u, v) = (self.float(ctx, p, "uroughness", r)?, self.float(ctx, p, "vroughness", r)?);
+        self.roughness_of(ctx, p, "")
+    }
+
+    /// [`Self::roughness`] of a layer's parameters, named with `prefix` (`"interface."`,
+    /// `"conductor."`).
+    fn roughness_of(&mut self, ctx: &Ctx, p: &mut Params, prefix: &str) -> R<Option<(f64, f64)>> {
+        let r = self.float(ctx, p, &format!("{prefix}roughness"), 0.0)?;
+        let u = self.float(ctx, p, &format!("{prefix}uroughness"), r)?;
+        let v = self.float(ctx, p, &format!("{prefix}vroughness"), r)?;
         let remap = self.boolean(ctx, p, "remaproughness", true)?;
         let alpha = |x: f64| if remap { x.max(0.0).sqrt() } else { x.max(0.0) };
         Ok((u > 0.0 || v > 0.0).then(|| (alpha(u), alpha(v))))
     }
 
     fn eta(&mut self, ctx: &Ctx, p: &mut Params) -> R<f64> {
-        let Some(q) = self.find(p, "eta") else { return Ok(1.5) };
+        self.eta_of(ctx, p, "eta")
+    }
+
+    /// [`Self::eta`] of the parameter `name`.
+    fn eta_of(&mut self, ctx: &Ctx, p: &mut Params, name: &str) -> R<f64> {
+        let Some(q) = self.find(p, name) else { return Ok(1.5) };
         match &q.values[..] {
             [Value::Num(x)] if *x > 0.0 => Ok(*x),
             [Value::Str(name)] => {
@@ -955,7 +967,7 @@ impl Importer {
                     }
                 }
             }
-            _ => Err(ctx.err(q.span, "\"eta\" must be a positive number or a named spectrum")),
+            _ => Err(ctx.err(q.span, format!("\"{name}\" must be a positive number or a named spectrum"))),
         }
     }
 
@@ -996,21 +1008,41 @@ impl Importer {
         Ok(match kind {
             "diffuse" => BsdfDesc::Lambert { albedo: self.texture_param(ctx, p, "reflectance", Vec3::splat(0.5))? },
             "conductor" | "coatedconductor" => {
-                if kind == "coatedconductor" {
-                    self.warn(ctx, at, "coatedconductor is approximated by its conductor without the coating");
-                    for k in ["interface.roughness", "interface.eta", "thickness", "conductor.eta", "conductor.k"] {
-                        self.find(p, k);
-                    }
-                }
-                let rough = self.roughness(ctx, p)?;
+                // A coated conductor's metal parameters are named `conductor.*`.
+                let metal = if kind == "coatedconductor" { "conductor." } else { "" };
+                let rough = self.roughness_of(ctx, p, metal)?;
                 let (eta, k) = if let Some(q) = self.find(p, "reflectance") {
                     (common::eta_from_f0(self.color_of(ctx, &q)?), Vec3::ZERO)
                 } else {
-                    (self.metal_spectrum(ctx, p, "eta", 0)?, self.metal_spectrum(ctx, p, "k", 1)?)
+                    let (eta, k) = (format!("{metal}eta"), format!("{metal}k"));
+                    (self.metal_spectrum(ctx, p, &eta, 0)?, self.metal_spectrum(ctx, p, &k, 1)?)
                 };
                 let fresnel =
                     if self.find(p, "reflectance").is_some() { FresnelMode::Schlick } else { FresnelMode::Exact };
-                BsdfDesc::Conductor { facets: facets(rough), eta, k, tint: Vec3::ONE, fresnel, multiscatter: false }
+                let conductor = BsdfDesc::Conductor {
+                    facets: facets(rough),
+                    eta,
+                    k,
+                    tint: Vec3::ONE,
+                    fresnel,
+                    multiscatter: false,
+                };
+                if kind == "conductor" {
+                    return Ok(conductor);
+                }
+                // The interface as a clear coat (at least α = 0.01: pbrt's default is smooth).
+                let (u, v) = self.roughness_of(ctx, p, "interface.")?.unwrap_or((0.01, 0.01));
+                let ior = self.eta_of(ctx, p, "interface.eta")?;
+                for k in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
+                    self.find(p, k);
+                }
+                self.warn(ctx, at, "coatedconductor is approximated by a clear coat over its conductor: its interface's reflection, and the conductor under what the interface lets through (not pbrt's light bouncing between the layers)");
+                BsdfDesc::Coated {
+                    base: Box::new(conductor),
+                    weight: 1.0,
+                    facets: common::ggx(u.max(0.01), v.max(0.01)),
+                    ior,
+                }
             }
             "dielectric" => {
                 let rough = self.roughness(ctx, p)?;

@@ -398,3 +398,28 @@ fn pixel_filters_are_pbrt_s() {
     let e = filter("PixelFilter \"box\" \"float xradius\" 0").unwrap_err();
     assert!(e.contains("f.pbrt:1:") && e.contains("radius must lie in"), "{e}");
 }
+
+/// `coatedconductor`: its interface as a clear coat (`interface.roughness`, `interface.eta`)
+/// over the conductor of its `conductor.*` parameters (they were read as a plain conductor's,
+/// and the coat dropped), with a warning that pbrt's bouncing between the layers is left out.
+#[test]
+fn a_coated_conductor_is_its_conductor_under_a_clear_coat() {
+    use alhazen_scene::bsdf::{BsdfDesc, METALS};
+    let imported = import(&[(
+        "c.pbrt",
+        r#"WorldBegin
+Material "coatedconductor" "spectrum conductor.eta" "metal-Au-eta" "spectrum conductor.k" "metal-Au-k"
+  "float conductor.roughness" 0.04 "float interface.eta" 1.6 "float thickness" 0.02
+Shape "sphere""#,
+    )])
+    .unwrap();
+    let s = &imported.scene;
+    let bsdf = s.materials[s.objects[0].material as usize].bsdf.clone().unwrap();
+    let BsdfDesc::Coated { base, weight, facets, ior } = bsdf else { panic!("{bsdf:?}") };
+    assert_eq!((weight, facets.alpha_u, ior), (1.0, 0.01, 1.6));
+    let BsdfDesc::Conductor { facets: Some(metal), eta, .. } = *base else { panic!("{base:?}") };
+    assert!((metal.alpha_u - 0.2).abs() < 1e-12 && eta == Vec3::from_array(METALS[0].1), "{metal:?} {eta}");
+    let said: Vec<String> = imported.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(said.iter().any(|w| w.contains("c.pbrt:2") && w.contains("clear coat over its conductor")), "{said:?}");
+    assert!(!said.iter().any(|w| w.contains("is not supported")), "{said:?}");
+}
