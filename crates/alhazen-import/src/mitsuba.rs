@@ -58,6 +58,8 @@ pub fn load_with_parameters(path: &Path, parameters: &[(String, String)]) -> Res
         scene_dir: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
         cut_out: None,
         vertex_colored: false,
+        integrator_kind: None,
+        absorbing: false,
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.scene.render.width = 768;
@@ -174,6 +176,10 @@ struct Importer {
     cut_out: Option<alhazen_scene::Alpha>,
     /// The BSDF being read takes a colour from its mesh's `vertex_color` attribute.
     vertex_colored: bool,
+    /// The integrator's plugin, and whether some shape's inside absorbs (told apart at the
+    /// end: Mitsuba's integrators other than `volpath` ignore media).
+    integrator_kind: Option<String>,
+    absorbing: bool,
 }
 
 /// A mesh file as placed: its path, its part of a `serialized` file, and whether it is turned
@@ -209,6 +215,15 @@ impl Importer {
     fn finish(mut self) -> R<Imported> {
         if !self.camera_seen {
             self.warnings.add(Path::new("scene"), 0, "the scene has no sensor: alhazen's default camera is used");
+        }
+        let volumetric = self.integrator_kind.as_deref().is_some_and(|k| k.starts_with("volpath"));
+        if self.absorbing && !volumetric {
+            let kind = self.integrator_kind.as_deref().unwrap_or("path");
+            self.warnings.add(
+                Path::new("scene"),
+                0,
+                format!("alhazen renders the absorption of the scene's interior media, which Mitsuba's `{kind}` integrator ignores (its `volpath` renders them)"),
+            );
         }
         Ok(Imported { scene: self.scene, warnings: self.warnings.into_vec() })
     }
@@ -701,6 +716,8 @@ impl Importer {
 
     fn integrator(&mut self, ctx: &Ctx, node: Node) -> R<()> {
         let p = self.plugin(ctx, node)?;
+        // A wrapping integrator (`aov`, `moment`) reads its inner one next: the last is the one.
+        self.integrator_kind = Some(p.kind.clone());
         let depth = self.float(ctx, &p, "max_depth", -1.0)?;
         let r = &mut self.scene.render;
         r.integrator = IntegratorKind::Path;
@@ -1664,6 +1681,7 @@ impl Importer {
             );
             return m;
         }
+        self.absorbing = true;
         common::absorbing(&mut self.scene, m, absorption)
     }
 

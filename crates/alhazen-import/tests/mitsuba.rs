@@ -299,6 +299,13 @@ fn media_absorb_inside_glass_and_mistakes_are_located() {
     ));
     assert!((a - Vec3::splat(0.5)).length() < 1e-12, "{a}");
     assert!(w.iter().any(|w| w.contains("m.xml:4") && w.contains("the medium scatters")), "{w:?}");
+    // Mitsuba's `path` integrator (the default) ignores media, its `volpath` does not.
+    assert!(w.iter().any(|w| w.contains("Mitsuba's `path` integrator ignores")), "{w:?}");
+    let volpath = scene(&format!(
+        "<integrator type=\"volpath\"/>\n<shape type=\"sphere\">{glass}<medium type=\"homogeneous\" name=\"interior\"/></shape>"
+    ));
+    let w: Vec<String> = import(&[("v.xml", &volpath)]).unwrap().warnings.iter().map(|w| w.to_string()).collect();
+    assert!(!w.iter().any(|w| w.contains("integrator ignores")), "{w:?}");
     let (a, w) = absorption(with(glass, "<medium type=\"heterogeneous\" name=\"interior\"/>"));
     assert_eq!(a, Vec3::ZERO);
     assert!(w.iter().any(|w| w.contains("medium `heterogeneous` is not supported")), "{w:?}");
