@@ -139,12 +139,12 @@ fn catalogue() -> Vec<(String, Bsdf)> {
     let coat = |alpha: f64| alhazen_render::bsdf::CookTorranceLobe { facets: ggx(alpha), ior: 1.5, schlick: false };
     list.push((
         "coated lambert, coat ggx m=0.05".into(),
-        Bsdf::Coated(Box::new(Coated { base: Bsdf::Lambert(Lambert { albedo }), coat: coat(0.05), weight: 1.0 })),
+        Bsdf::Coated(Box::new(Coated::new(Bsdf::Lambert(Lambert { albedo }), coat(0.05), 1.0))),
     ));
     list.push((
         "coated rough conductor, coat ggx m=0.3 weight 0.5".into(),
-        Bsdf::Coated(Box::new(Coated {
-            base: Bsdf::Conductor(Conductor {
+        Bsdf::Coated(Box::new(Coated::new(
+            Bsdf::Conductor(Conductor {
                 facets: Some(ggx(0.2)),
                 eta: Vec3::new(0.2, 0.92, 1.1),
                 k: Vec3::new(3.9, 2.45, 2.14),
@@ -152,9 +152,9 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 schlick: false,
                 multiscatter: None,
             }),
-            coat: coat(0.3),
-            weight: 0.5,
-        })),
+            coat(0.3),
+            0.5,
+        ))),
     ));
     list
 }

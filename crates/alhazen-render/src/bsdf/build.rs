@@ -137,11 +137,11 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             let weight = (weight * at).clamp(0.0, 1.0);
             Bsdf::Mix(Box::new(Mix { a: from_desc(a, lookups, mode), b: from_desc(b, lookups, mode), weight }))
         }
-        BsdfDesc::Coated { base, weight, facets, ior } => Bsdf::Coated(Box::new(super::Coated {
-            base: from_desc(base, lookups, mode),
-            coat: CookTorranceLobe { facets: Microfacet::new(facets), ior: *ior, schlick: false },
-            weight: *weight,
-        })),
+        BsdfDesc::Coated { base, weight, facets, ior } => Bsdf::Coated(Box::new(super::Coated::new(
+            from_desc(base, lookups, mode),
+            CookTorranceLobe { facets: Microfacet::new(facets), ior: *ior, schlick: false },
+            *weight,
+        ))),
         BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));

@@ -16,6 +16,7 @@
 
 use super::cook_torrance::CookTorranceLobe;
 use super::layered::SpecularLobe;
+use super::multiscatter::{Row, lookup_in};
 use super::{Bsdf, BsdfSample, same_side};
 use crate::optics::fresnel_dielectric;
 use alhazen_math::{Vec2, Vec3};
@@ -29,19 +30,23 @@ pub struct Coated {
     pub coat: CookTorranceLobe,
     /// The coat's weight `w ∈ [0, 1]`.
     pub weight: f64,
+    /// Where the coat's roughness (for two, their geometric mean) falls in the albedo table:
+    /// found once, not at every evaluation.
+    row: Row,
 }
 
 impl Coated {
-    /// `w·E_c(μ_v)`: the share of the light leaving towards `v` that the coat reflects.
-    fn coat_albedo(&self, v: Vec3) -> f64 {
-        self.coat_albedo_at(v.z)
+    /// `base` under `coat` of weight `weight`.
+    pub fn new(base: Bsdf, coat: CookTorranceLobe, weight: f64) -> Self {
+        let row = Row::at((coat.facets.alpha_u * coat.facets.alpha_v).sqrt());
+        Coated { base, coat, weight, row }
     }
 
-    /// [`Self::coat_albedo`] towards a direction of cosine `cos` with the normal.
-    pub(crate) fn coat_albedo_at(&self, cos: f64) -> f64 {
+    /// `w·E_c(μ)`: the share of the light leaving along a direction of cosine `cos` with the
+    /// normal that the coat reflects.
+    pub(crate) fn coat_albedo(&self, cos: f64) -> f64 {
         let mu = cos.abs().min(1.0);
-        let alpha = (self.coat.facets.alpha_u * self.coat.facets.alpha_v).sqrt();
-        self.weight * super::multiscatter::lookup(mu, alpha) * fresnel_dielectric(mu, self.coat.ior)
+        self.weight * lookup_in(mu, self.row) * fresnel_dielectric(mu, self.coat.ior)
     }
 
     /// The probability of sampling the coat rather than the base: its albedo's share, at
@@ -63,7 +68,7 @@ impl Coated {
 
     /// [`Self::eval`] and [`Self::pdf`] at once.
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
-        let albedo = self.coat_albedo(v);
+        let albedo = self.coat_albedo(v.z);
         let q = self.coat_choice(albedo);
         let (fb, pb) = self.base.eval_pdf(v, l);
         let (fc, pc) = if same_side(v, l) { self.coat.value_pdf(v, l) } else { (0.0, 0.0) };
@@ -73,7 +78,7 @@ impl Coated {
     /// The coat's facet reflection by `uc` below its share, else the base's sample (`uc`
     /// rescaled for it); a delta sample of the base keeps its own weight under the coat.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
-        let albedo = self.coat_albedo(v);
+        let albedo = self.coat_albedo(v.z);
         let q = self.coat_choice(albedo);
         let l = if uc < q {
             self.coat.sample(v, u)?

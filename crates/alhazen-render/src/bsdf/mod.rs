@@ -171,7 +171,7 @@ impl Bsdf {
         match self {
             Bsdf::Conductor(c) if c.facets.is_none() => c.fresnel(cos),
             Bsdf::Mix(m) => m.a.mirror_reflectance(cos) * m.weight + m.b.mirror_reflectance(cos) * (1.0 - m.weight),
-            Bsdf::Coated(c) => c.base.mirror_reflectance(cos) * (1.0 - c.coat_albedo_at(cos)),
+            Bsdf::Coated(c) => c.base.mirror_reflectance(cos) * (1.0 - c.coat_albedo(cos)),
             _ => Vec3::ZERO,
         }
     }

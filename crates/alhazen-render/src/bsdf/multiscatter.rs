@@ -79,21 +79,21 @@ fn single_scattering_albedo(mu: f64, alpha: f64) -> f64 {
     (sum / (STRATA * STRATA) as f64).clamp(0.0, 1.0)
 }
 
-/// Bilinear lookup of the table at `(mu, alpha)`: the share of the light arriving along `μ`
-/// that facets of roughness `alpha` reflect once (with `F = 1`).
-pub(crate) fn lookup(mu: f64, alpha: f64) -> f64 {
+/// Bilinear lookup of the table at `(mu, alpha)`.
+#[cfg(test)]
+fn lookup(mu: f64, alpha: f64) -> f64 {
     lookup_in(mu, Row::at(alpha))
 }
 
 /// Where a roughness falls between the table's rows: the lower row and the weight of the next.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Row {
+pub(crate) struct Row {
     i: usize,
     fy: f64,
 }
 
 impl Row {
-    fn at(alpha: f64) -> Row {
+    pub(crate) fn at(alpha: f64) -> Row {
         let y = alpha.max(0.0).sqrt().min(1.0) * (N - 1) as f64;
         let i = (y as usize).min(N - 2);
         Row { i, fy: y - i as f64 }
@@ -101,7 +101,7 @@ impl Row {
 }
 
 /// Bilinear lookup of the table at `mu` between the rows of `row`.
-fn lookup_in(mu: f64, Row { i, fy }: Row) -> f64 {
+pub(crate) fn lookup_in(mu: f64, Row { i, fy }: Row) -> f64 {
     let t = tables();
     let x = mu.clamp(0.0, 1.0) * (N - 1) as f64;
     let j = (x as usize).min(N - 2);
