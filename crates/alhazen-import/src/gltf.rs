@@ -576,8 +576,9 @@ impl Importer<'_> {
         if thickness == 0.0 || distance == f64::INFINITY {
             return Ok(Vec3::ZERO);
         }
-        // A channel of colour 0 keeps nothing: as dark as a finite number allows.
-        Ok(Vec3::from_array(color.map(|c| -c.max(1e-30).ln() / distance)))
+        // A channel of colour 0, or a vanishing distance, keeps nothing: at most 10¹² per unit
+        // length (as a Mitsuba or pbrt medium), finite.
+        Ok(Vec3::from_array(color.map(|c| (-c.max(1e-30).ln() / distance).min(1e12))))
     }
 
     /// The metallic–roughness lobes: the metal gives back the light of several facets, as

@@ -1087,6 +1087,9 @@ fn volume_attenuation_is_the_inside_s_absorption() {
     assert_eq!(absorbing(0.0, opaque), Ok(Vec3::ZERO));
     let black = absorbing(1.0, r#"{ "thicknessFactor": 1, "attenuationDistance": 1, "attenuationColor": [0, 1, 1] }"#);
     assert!(black.as_ref().is_ok_and(|a| a.x.is_finite() && a.x > 60.0), "{black:?}");
+    let thin =
+        absorbing(1.0, r#"{ "thicknessFactor": 1, "attenuationDistance": 1e-320, "attenuationColor": [0.5, 1, 1] }"#);
+    assert_eq!(thin, Ok(Vec3::new(1e12, 0.0, 0.0)));
     for bad in [
         r#"{ "thicknessFactor": 1, "attenuationDistance": 0 }"#,
         r#"{ "thicknessFactor": -1 }"#,
