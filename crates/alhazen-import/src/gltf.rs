@@ -8,8 +8,9 @@
 //! through the metallic–roughness model (`common::metal_rough`): the base-colour texture and
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
 //! `KHR_materials_emissive_strength`, a transmitting material's absorbing inside with
-//! `KHR_materials_volume`, a clear coat with `KHR_materials_clearcoat`; a metallic–roughness texture, and a textured metal's
-//! colour, are read per point (`BsdfDesc::MetallicRoughness`, the model at each point), by
+//! `KHR_materials_volume`, a clear coat with `KHR_materials_clearcoat`, brushed facets with
+//! `KHR_materials_anisotropy`; a metallic–roughness texture, a textured metal's colour and
+//! stretched facets are read per point (`BsdfDesc::MetallicRoughness`, the model at each point), by
 //! their means under transmission; so is an emission texture (its factor and strength
 //! multiplied in).
 //! `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the 683 lm/W
@@ -20,7 +21,7 @@ use crate::Imported;
 use crate::common::{self, Warnings};
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Mat4, Transform, Vec2, Vec3};
-use alhazen_scene::bsdf::{BsdfDesc, MetalRoughness};
+use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, MetalRoughness};
 use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
     PerspectiveOpening, Scene, SceneError, Shape, Texture, Wrap,
@@ -49,6 +50,7 @@ const KNOWN: &[&str] = &[
     "KHR_materials_specular",
     "KHR_materials_volume",
     "KHR_materials_clearcoat",
+    "KHR_materials_anisotropy",
 ];
 
 /// Extensions alhazen reads without the glTF reader's support.
@@ -488,7 +490,7 @@ impl Importer<'_> {
             _ => (Vec2::ONE, Vec2::ZERO, 0.0),
         };
         let alpha = self.cut_out(&material, c[3] as f64, placement)?;
-        for ext in ["KHR_materials_sheen", "KHR_materials_iridescence", "KHR_materials_anisotropy"] {
+        for ext in ["KHR_materials_sheen", "KHR_materials_iridescence"] {
             if material.extension_value(ext).is_some() {
                 self.warn(format!("{name}: {ext} is not supported; ignored"));
             }
@@ -497,10 +499,17 @@ impl Importer<'_> {
         // Per point where the map or a textured metal's colour varies (glTF's metal takes each
         // texel's base colour), else the constant mix (and its glass under transmission).
         let textured_metal = metallic > 0.0 && transmission <= 0.0 && !matches!(base, Texture::Solid(_));
-        let lobes = self.lobes(&material, ior, &name);
-        let bsdf = if map.is_some() || textured_metal {
-            let (ior, specular, multiscatter) = (lobes.ior, lobes.specular, lobes.multiscatter);
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter }
+        let mut lobes = self.lobes(&material, ior, &name);
+        lobes.anisotropy = self.anisotropy(&material, &name)?;
+        if lobes.anisotropy.is_anisotropic() && transmission > 0.0 {
+            self.warn(format!("{name}: KHR_materials_anisotropy under transmission is not supported; ignored"));
+            lobes.anisotropy = Anisotropy::default();
+        }
+        // Stretched facets turn with the surface's tangent: read per point.
+        let per_point = map.is_some() || textured_metal || lobes.anisotropy.is_anisotropic();
+        let bsdf = if per_point {
+            let MetalRoughness { ior, specular, multiscatter, anisotropy } = lobes;
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter, anisotropy }
         } else {
             common::metal_rough(base, base_mean, metallic, roughness, (ior, lobes), transmission.clamp(0.0, 1.0))
         };
@@ -516,6 +525,32 @@ impl Importer<'_> {
         let id = common::add_material(&mut self.scene, m);
         self.materials.insert(material.index(), id);
         Ok(id)
+    }
+
+    /// `KHR_materials_anisotropy`'s facets stretched along a direction of brushing:
+    /// `anisotropyStrength` `s` stretches them to `α_t = α + (1 − α)s²` along the tangent turned
+    /// by `anisotropyRotation` (radians, towards the bitangent), `α_b = α` across it. Its
+    /// texture is left out (warning: the factors are used).
+    fn anisotropy(&mut self, material: &gltf::Material, name: &str) -> R<Anisotropy> {
+        let Some(a) = material.extension_value("KHR_materials_anisotropy") else { return Ok(Anisotropy::default()) };
+        let number = |key: &str, range: std::ops::RangeInclusive<f64>| match a.get(key) {
+            None => Some(0.0),
+            Some(x) => x.as_f64().filter(|x| range.contains(x)),
+        };
+        let turn = std::f64::consts::TAU;
+        let (Some(strength), Some(rotation)) =
+            (number("anisotropyStrength", 0.0..=1.0), number("anisotropyRotation", -1e6..=1e6))
+        else {
+            return Err(self.err(format!(
+                "{name}: KHR_materials_anisotropy's anisotropyStrength must be a number within [0, 1] and anisotropyRotation a number of radians"
+            )));
+        };
+        if a.get("anisotropyTexture").is_some() {
+            self.warn(format!("{name}: KHR_materials_anisotropy's texture is not supported; its factors are used"));
+        }
+        // Within (−π, π]: a turn's worth more is the same direction.
+        let rotation = rotation - turn * (rotation / turn).round();
+        Ok(Anisotropy { strength, rotation, model: AnisotropyModel::Gltf })
     }
 
     /// `bsdf` under `KHR_materials_clearcoat`'s coat: of weight `clearcoatFactor`, GGX facets

@@ -21,7 +21,7 @@
 use crate::Imported;
 use crate::common::{self, PendingFiles, Warnings, flip_mesh, located};
 use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
-use alhazen_scene::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
+use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
 use alhazen_scene::{
     Background, Bump, BumpPattern, CameraDesc, FresnelMode, IntegratorKind, Light, LookAt, MaterialId, Object,
     PerspectiveOpening, PixelFilter, SamplerKind, Scene, SceneError, Shape, Texture, Wrap,
@@ -1075,8 +1075,15 @@ impl Importer {
                 let mean = self.pending.texture_mean(&base, &mut self.scene)?;
                 let ior = self.float(ctx, &p, "eta", 1.5)?;
                 let trans = self.float_or_mean(ctx, &p, "spec_trans", 0.0)?;
-                self.warn(ctx, node, "principled is approximated by the glTF metallic–roughness model (base colour, metallic, roughness, eta, spec_trans; a clear coat for clearcoat)");
-                let bsdf = self.principled(ctx, &p, (base, mean), ior, trans)?;
+                self.warn(ctx, node, "principled is approximated by the glTF metallic–roughness model (base colour, metallic, roughness, anisotropic, eta, spec_trans; a clear coat for clearcoat)");
+                let anisotropic = self.float_or_mean(ctx, &p, "anisotropic", 0.0)?;
+                if !(0.0..=1.0).contains(&anisotropic) {
+                    return Err(
+                        ctx.err(node, format!("principled: `anisotropic` must lie within [0, 1] (got {anisotropic})"))
+                    );
+                }
+                let anisotropy = Anisotropy { strength: anisotropic, rotation: 0.0, model: AnisotropyModel::Disney };
+                let bsdf = self.principled(ctx, &p, (base, mean), (ior, anisotropy), trans)?;
                 // Its clear coat: GTR1 facets of α from 0.1 to 0.001 with `clearcoat_gloss`, a
                 // quarter of `clearcoat` strong, read as a coat of GGX facets (α at least 0.01).
                 let clearcoat = self.float_or_mean(ctx, &p, "clearcoat", 0.0)?;
@@ -1284,9 +1291,16 @@ impl Importer {
         ctx: &Ctx,
         p: &Plugin,
         (base, mean): (Texture, Vec3),
-        ior: f64,
+        (ior, anisotropy): (f64, Anisotropy),
         trans: f64,
     ) -> R<BsdfDesc> {
+        let anisotropy = if anisotropy.is_anisotropic() && trans > 0.0 {
+            let n = self.prop(p, "anisotropic").expect("read above");
+            self.warn(ctx, n, "`anisotropic` under specular transmission is not supported; ignored");
+            Anisotropy::default()
+        } else {
+            anisotropy
+        };
         let metallic = self.float_or_texture(ctx, p, "metallic", 0.0)?;
         let roughness = self.float_or_texture(ctx, p, "roughness", 0.5)?;
         // The bitmaps' placements (scale, shift, turn): one map serves both where they agree.
@@ -1317,12 +1331,15 @@ impl Importer {
                 ior,
                 specular: 1.0,
                 multiscatter: false,
+                anisotropy,
             });
         }
         let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
         let roughness = self.textured_mean(ctx, p, "roughness", roughness)?;
-        if metallic > 0.0 && trans <= 0.0 && !matches!(base, Texture::Solid(_)) {
-            // A textured metal takes each point's base colour.
+        let textured_metal = metallic > 0.0 && trans <= 0.0 && !matches!(base, Texture::Solid(_));
+        if textured_metal || anisotropy.is_anisotropic() {
+            // A textured metal takes each point's base colour; stretched facets turn with the
+            // surface's tangent.
             let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
             return Ok(BsdfDesc::MetallicRoughness {
                 base,
@@ -1332,6 +1349,7 @@ impl Importer {
                 ior,
                 specular: 1.0,
                 multiscatter: false,
+                anisotropy,
             });
         }
         Ok(common::metal_rough(base, mean, metallic, roughness, (ior, common::plain_lobes(ior)), trans))

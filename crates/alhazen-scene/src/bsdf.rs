@@ -216,6 +216,9 @@ pub enum BsdfDesc {
         specular: f64,
         /// The metal's light of several facets ([`BsdfDesc::Conductor`]'s `multiscatter`).
         multiscatter: bool,
+        /// Facets stretched along a direction of brushing (glTF's `KHR_materials_anisotropy`,
+        /// principled's `anisotropic`); none by default.
+        anisotropy: Anisotropy,
     },
     /// A clear coat over `base` (car paint, lacquer; glTF's `KHR_materials_clearcoat`): a
     /// dielectric microfacet layer of `weight` reflecting `weight·D G F/(4⟨l,n⟩⟨v,n⟩)`, the
@@ -304,10 +307,17 @@ impl crate::model::Material {
                 self.specular = Vec3::ONE;
                 self.shininess = 200.0;
             }
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, ior, specular, multiscatter, .. } => {
+            BsdfDesc::MetallicRoughness {
+                base, metallic, roughness, ior, specular, multiscatter, anisotropy, ..
+            } => {
                 // As the importers' material of these factors is followed: its metal where there
                 // is metal, else its coating, of colour `base`.
-                let lobes = MetalRoughness { ior: *ior, specular: *specular, multiscatter: *multiscatter };
+                let lobes = MetalRoughness {
+                    ior: *ior,
+                    specular: *specular,
+                    multiscatter: *multiscatter,
+                    anisotropy: *anisotropy,
+                };
                 let (metal, coating) = metallic_roughness_lobes(Vec3::ONE, *roughness, lobes);
                 if *metallic > 0.0 {
                     self.follow(&metal);
@@ -324,10 +334,11 @@ impl crate::model::Material {
 
 /// The metal and the coating of [`BsdfDesc::metallic_roughness_at`].
 fn metallic_roughness_lobes(base: Rgb, roughness: f64, lobes: MetalRoughness) -> (BsdfDesc, BsdfDesc) {
-    let MetalRoughness { ior, specular, multiscatter } = lobes;
+    let MetalRoughness { ior, specular, multiscatter, anisotropy } = lobes;
     let alpha = (roughness * roughness).clamp(0.0, 1.0);
+    let (along, across) = anisotropy.alphas(alpha);
     let metal = BsdfDesc::Conductor {
-        facets: Some(ggx(alpha, alpha)),
+        facets: Some(ggx(along, across)),
         eta: eta_from_f0(base),
         k: Vec3::ZERO,
         tint: Vec3::ONE,
@@ -339,11 +350,57 @@ fn metallic_roughness_lobes(base: Rgb, roughness: f64, lobes: MetalRoughness) ->
         albedo: Texture::Solid(base),
         kd: 1.0 - specular * f0,
         ks: specular,
-        facets: ggx(alpha.max(0.01), alpha.max(0.01)),
+        facets: ggx(along.max(0.01), across.max(0.01)),
         ior,
         fresnel: FresnelMode::Exact,
     };
     (metal, coating)
+}
+
+/// How a metallic–roughness surface's facets stretch along a direction of brushing: the
+/// roughness `α_t` along it and `α_b` across it, from the surface's `α` and `strength`.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Anisotropy {
+    /// 0: isotropic; at most 1.
+    pub strength: f64,
+    /// The direction of brushing: the tangent (`∂p/∂u`) turned about the normal towards the
+    /// bitangent by this angle, in radians.
+    pub rotation: f64,
+    /// How `strength` stretches the facets.
+    pub model: AnisotropyModel,
+}
+
+/// The two readings of an anisotropy `s` the importers meet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum AnisotropyModel {
+    /// glTF's `KHR_materials_anisotropy`: `α_t = α + (1 − α)s²`, `α_b = α`.
+    #[default]
+    Gltf,
+    /// Disney's principled BRDF (Burley 2012; Mitsuba's `principled`, Cycles' Principled
+    /// BSDF): `α_t = α/a`, `α_b = α·a` with the aspect `a = √(1 − 0.9s)`.
+    Disney,
+}
+
+impl Anisotropy {
+    /// `(α_t, α_b)` of a surface of roughness `α` (both `α` when isotropic).
+    pub fn alphas(&self, alpha: f64) -> (f64, f64) {
+        let s = self.strength.clamp(0.0, 1.0);
+        if s == 0.0 {
+            return (alpha, alpha);
+        }
+        match self.model {
+            AnisotropyModel::Gltf => (alpha + (1.0 - alpha) * s * s, alpha),
+            AnisotropyModel::Disney => {
+                let aspect = (1.0 - 0.9 * s).sqrt();
+                (alpha / aspect, alpha * aspect)
+            }
+        }
+    }
+
+    /// True when the facets are stretched.
+    pub fn is_anisotropic(&self) -> bool {
+        self.strength > 0.0
+    }
 }
 
 /// What shapes the metallic–roughness model's lobes besides its colour, metalness and
@@ -356,6 +413,8 @@ pub struct MetalRoughness {
     pub specular: f64,
     /// The metal gives back the light of several facets.
     pub multiscatter: bool,
+    /// Its facets' stretch.
+    pub anisotropy: Anisotropy,
 }
 
 /// GGX microfacets with Smith shadowing, `α` clamped away from 0 (where the distribution
@@ -419,6 +478,7 @@ impl BsdfDesc {
             BsdfDesc::Conductor { facets: Some(f), .. } | BsdfDesc::Dielectric { facets: Some(f), .. } => two(f),
             BsdfDesc::Mix { a, b, .. } => a.is_anisotropic() || b.is_anisotropic(),
             BsdfDesc::Coated { base, facets, .. } => base.is_anisotropic() || two(facets),
+            BsdfDesc::MetallicRoughness { anisotropy, .. } => anisotropy.is_anisotropic(),
             _ => false,
         }
     }

@@ -11,6 +11,24 @@ use std::sync::Arc;
 
 const MICROFACET_KEYS: &[&str] = &["roughness", "distribution", "shadowing"];
 
+/// A metallic–roughness surface's `anisotropy`: its strength, or `{ strength, rotation =
+/// degrees, model = "gltf" | "disney" }`.
+fn anisotropy(n: &Node) -> R<Anisotropy> {
+    if !n.is_table() {
+        return Ok(Anisotropy { strength: n.in_range(0.0, 1.0)?, ..Anisotropy::default() });
+    }
+    let t = n.table(&["strength", "rotation", "model"])?;
+    let model = match t.get("model").map_or(Ok("gltf"), |m| m.choice(&["gltf", "disney"]))? {
+        "gltf" => AnisotropyModel::Gltf,
+        _ => AnisotropyModel::Disney,
+    };
+    Ok(Anisotropy {
+        strength: t.req("strength")?.in_range(0.0, 1.0)?,
+        rotation: t.get("rotation").map_or(Ok(0.0), |r| r.in_range(-360.0, 360.0))?.to_radians(),
+        model,
+    })
+}
+
 fn names<T>(list: &[(&'static str, T, T)]) -> Vec<&'static str> {
     list.iter().map(|e| e.0).collect()
 }
@@ -42,7 +60,9 @@ impl Parser<'_> {
             "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel", "multiscatter"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
-            "metallic-roughness" => vec!["color", "metallic", "roughness", "map", "ior", "specular", "multiscatter"],
+            "metallic-roughness" => {
+                vec!["color", "metallic", "roughness", "map", "ior", "specular", "multiscatter", "anisotropy"]
+            }
             "thin-dielectric" => vec!["ior"],
             "coated" => [&["base", "weight", "ior"][..], MICROFACET_KEYS].concat(),
             _ => vec!["a", "b", "weight", "weight_map"],
@@ -132,6 +152,7 @@ impl Parser<'_> {
                 ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
                 specular: t.get("specular").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
                 multiscatter: t.opt_bool("multiscatter", false)?,
+                anisotropy: t.get("anisotropy").map_or(Ok(Anisotropy::default()), |n| anisotropy(&n))?,
             },
             "coated" => {
                 // The coat is rough (a near-mirror at its least roughness): its albedo and

@@ -7,7 +7,7 @@
 //! whose conversion gives back the same radians where one exists, so reading the file again
 //! gives the same scene (tested: `tests/write.rs`).
 
-use crate::bsdf::{BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
+use crate::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
 use crate::model::*;
 use alhazen_math::{Vec2, Vec3};
 use std::collections::HashMap;
@@ -126,6 +126,22 @@ fn string(s: &str) -> String {
 
 /// The degrees that `to_radians` (then `f`) maps back to exactly `f(radians)`, when a few ulps
 /// around the conversion find them; else the nearest degrees.
+/// A metallic–roughness surface's `anisotropy` entry (after a comma), empty when isotropic.
+fn anisotropy_entry(a: &Anisotropy) -> String {
+    if *a == Anisotropy::default() {
+        return String::new();
+    }
+    let model = match a.model {
+        AnisotropyModel::Gltf => "gltf",
+        AnisotropyModel::Disney => "disney",
+    };
+    format!(
+        ", anisotropy = {{ strength = {}, rotation = {}, model = \"{model}\" }}",
+        num(a.strength),
+        num(degrees(a.rotation, |x| x))
+    )
+}
+
 fn degrees(radians: f64, f: impl Fn(f64) -> f64) -> f64 {
     let target = f(radians);
     let mut d = radians.to_degrees();
@@ -508,16 +524,19 @@ impl Writer<'_> {
                 num(*ior),
                 facets(&Some(*f))
             ),
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter } => format!(
-                "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{} }}",
-                self.texture(base),
-                num(*metallic),
-                num(*roughness),
-                num(*ior),
-                if *specular == 1.0 { String::new() } else { format!(", specular = {}", num(*specular)) },
-                if *multiscatter { ", multiscatter = true" } else { "" },
-                map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m)))
-            ),
+            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter, anisotropy } => {
+                format!(
+                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{} }}",
+                    self.texture(base),
+                    num(*metallic),
+                    num(*roughness),
+                    num(*ior),
+                    if *specular == 1.0 { String::new() } else { format!(", specular = {}", num(*specular)) },
+                    if *multiscatter { ", multiscatter = true" } else { "" },
+                    map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m))),
+                    anisotropy_entry(anisotropy)
+                )
+            }
         }
     }
 

@@ -235,6 +235,64 @@ bsdf = { type = "metallic-roughness", color = [0.9, 0.6, 0.2], metallic = 1, rou
     }
 }
 
+/// A metallic–roughness surface's `anisotropy`: a strength (glTF's stretch, no turn) or a
+/// table of strength, rotation in degrees and model; the same after writing the scene back
+/// out; mistakes located.
+#[test]
+fn metallic_roughness_anisotropy_reads_and_writes_back() {
+    use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc};
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"
+[materials.brushed]
+bsdf = { type = "metallic-roughness", metallic = 1, roughness = 0.3, anisotropy = 0.6 }
+[materials.turned]
+bsdf = { type = "metallic-roughness", metallic = 1, anisotropy = { strength = 0.9, rotation = 30, model = "disney" } }
+"#;
+    let path = dir.path().join("a.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let anisotropy =
+        |s: &alhazen_scene::Scene, name: &str| match &s.materials.iter().find(|m| m.name == name).unwrap().bsdf {
+            Some(BsdfDesc::MetallicRoughness { anisotropy, .. }) => *anisotropy,
+            other => panic!("{other:?}"),
+        };
+    assert_eq!(anisotropy(&s, "brushed"), Anisotropy { strength: 0.6, rotation: 0.0, model: AnisotropyModel::Gltf });
+    let turned = anisotropy(&s, "turned");
+    assert_eq!((turned.strength, turned.rotation, turned.model), (0.9, 30f64.to_radians(), AnisotropyModel::Disney));
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&again_path).unwrap();
+    for name in ["brushed", "turned"] {
+        assert_eq!(anisotropy(&s, name), anisotropy(&again, name));
+    }
+    for (bad, says) in [
+        ("anisotropy = 1.5", "1.5"),
+        (r#"anisotropy = { strength = 0.5, model = "ward" }"#, "\"gltf\", \"disney\""),
+        (r#"anisotropy = { rotation = 10 }"#, "strength"),
+    ] {
+        let text = format!("[materials.m]\nbsdf = {{ type = \"metallic-roughness\", {bad} }}\n");
+        std::fs::write(&path, &text).unwrap();
+        let e = load_scene(&path).unwrap_err().to_string();
+        assert!(e.contains("a.toml:2:") && e.contains(says), "{bad}: {e}");
+    }
+}
+
+/// glTF's stretch `α_t = α + (1 − α)s²`, `α_b = α`; Disney's `α/a`, `α·a` with
+/// `a = √(1 − 0.9s)`; none at strength 0.
+#[test]
+fn anisotropy_stretches_the_roughness() {
+    use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel};
+    let at = |strength: f64, model| Anisotropy { strength, rotation: 0.0, model };
+    assert_eq!(at(0.0, AnisotropyModel::Gltf).alphas(0.2), (0.2, 0.2));
+    assert_eq!(at(0.0, AnisotropyModel::Disney).alphas(0.2), (0.2, 0.2));
+    assert_eq!(at(0.5, AnisotropyModel::Gltf).alphas(0.2), (0.2 + 0.8 * 0.25, 0.2));
+    assert_eq!(at(1.0, AnisotropyModel::Gltf).alphas(0.2), (1.0, 0.2));
+    let (along, across) = at(0.9, AnisotropyModel::Disney).alphas(0.16);
+    let aspect = (1.0f64 - 0.81).sqrt();
+    assert_eq!((along, across), (0.16 / aspect, 0.16 * aspect));
+    assert!(!at(0.0, AnisotropyModel::Disney).is_anisotropic() && at(0.1, AnisotropyModel::Gltf).is_anisotropic());
+}
+
 /// Plastic: smooth by default (Mitsuba's polypropylene coat), rough with a roughness, and the
 /// same after writing the scene back out.
 #[test]

@@ -142,14 +142,19 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             CookTorranceLobe { facets: Microfacet::new(facets), ior: *ior, schlick: false },
             *weight,
         ))),
-        BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter } => {
+        BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter, anisotropy } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
             let (metal, coating, weight) = BsdfDesc::metallic_roughness_at(
                 (lookups.rgb)(base) * lookups.tint,
                 metallic * texel.z,
                 roughness * texel.y,
-                alhazen_scene::bsdf::MetalRoughness { ior: *ior, specular: *specular, multiscatter: *multiscatter },
+                alhazen_scene::bsdf::MetalRoughness {
+                    ior: *ior,
+                    specular: *specular,
+                    multiscatter: *multiscatter,
+                    anisotropy: *anisotropy,
+                },
             );
             let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
             Bsdf::Mix(Box::new(Mix { a, b, weight }))
@@ -157,20 +162,73 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
     }
 }
 
-/// The world-space tangent that anisotropic lobes align with at a point whose `∂p/∂u` is
-/// `dpdu`: Blinn–Phong's scratches, else `∂p/∂u` for anisotropic microfacets (as pbrt and
-/// Mitsuba orient them); `None` for isotropic BSDFs, whose frame may turn freely about the
-/// normal, and where `∂p/∂u` is unknown (zero).
-pub fn tangent_at(m: &Material, dpdu: Vec3) -> Option<Vec3> {
+/// The world-space tangent that anisotropic lobes align with at a point of normal `n` whose
+/// `∂p/∂u` and `∂p/∂v` are `dpduv`: Blinn–Phong's scratches, else `∂p/∂u` for anisotropic
+/// microfacets (as pbrt and Mitsuba orient them), turned about `n` by a metallic–roughness
+/// surface's rotation ([`turned_tangent`]); `None` for isotropic BSDFs, whose frame may turn
+/// freely about the normal, and where `∂p/∂u` is unknown (zero).
+pub fn tangent_at(m: &Material, dpduv: [Vec3; 2], n: Vec3) -> Option<Vec3> {
+    let dpdu = dpduv[0];
     match &m.bsdf {
         Some(BsdfDesc::BlinnPhong { scratches, .. }) => Some(*scratches),
+        Some(BsdfDesc::MetallicRoughness { anisotropy, .. }) if anisotropy.is_anisotropic() && dpdu != Vec3::ZERO => {
+            Some(turned_tangent(dpduv, n, anisotropy.rotation))
+        }
         Some(desc) if desc.is_anisotropic() && dpdu != Vec3::ZERO => Some(dpdu),
         _ => None,
     }
+}
+
+/// `∂p/∂u` turned about `n` by `angle` towards the bitangent, as glTF's
+/// `KHR_materials_anisotropy` turns it: `t cos θ + b sin θ` with `t` the part of `∂p/∂u`
+/// across `n` and `b = ±n × t`, on the side of `∂p/∂v` (texture coordinates mirrored turn
+/// the other way).
+pub fn turned_tangent([dpdu, dpdv]: [Vec3; 2], n: Vec3, angle: f64) -> Vec3 {
+    if angle == 0.0 {
+        return dpdu;
+    }
+    let t = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
+    let b = n.cross(t);
+    let b = if b.dot(dpdv) < 0.0 { -b } else { b };
+    let (sin, cos) = angle.sin_cos();
+    let turned = t * cos + b * sin;
+    if turned == Vec3::ZERO { dpdu } else { turned }
 }
 
 /// True when `m`'s lobes turn with the tangent (Blinn–Phong's scratches, microfacets of two
 /// roughnesses): its hits need `∂p/∂u`.
 pub fn is_anisotropic(m: &Material) -> bool {
     m.bsdf.as_ref().is_some_and(BsdfDesc::is_anisotropic)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit(v: [f64; 3]) -> Option<Vec3> {
+        Vec3::from_array(v).try_normalize()
+    }
+
+    proptest::proptest! {
+        /// The turned tangent lies across the normal, at `angle` from `∂p/∂u`'s part across it,
+        /// turned towards `∂p/∂v`'s side; no turn leaves `∂p/∂u` as it is.
+        #[test]
+        fn the_tangent_turns_about_the_normal_towards_dpdv(
+            n in proptest::array::uniform3(-1.0..1.0f64),
+            dpdu in proptest::array::uniform3(-1.0..1.0f64),
+            dpdv in proptest::array::uniform3(-1.0..1.0f64),
+            angle in -3.1..3.1f64,
+        ) {
+            let (Some(n), dpdu, dpdv) = (unit(n), Vec3::from_array(dpdu), Vec3::from_array(dpdv)) else { return Ok(()) };
+            let t = dpdu - n * n.dot(dpdu);
+            let b = n.cross(t);
+            proptest::prop_assume!(t.length() > 0.1 && b.dot(dpdv).abs() > 0.1);
+            proptest::prop_assert_eq!(turned_tangent([dpdu, dpdv], n, 0.0), dpdu);
+            let turned = turned_tangent([dpdu, dpdv], n, angle);
+            proptest::prop_assert!((turned.length() - 1.0).abs() < 1e-9 && turned.dot(n).abs() < 1e-9);
+            let (t, b) = (t.normalize(), b.normalize() * b.dot(dpdv).signum());
+            proptest::prop_assert!((turned.dot(t) - angle.cos()).abs() < 1e-9);
+            proptest::prop_assert!((turned.dot(b) - angle.sin()).abs() < 1e-9);
+        }
+    }
 }
