@@ -51,10 +51,11 @@ const KNOWN: &[&str] = &[
     "KHR_materials_volume",
     "KHR_materials_clearcoat",
     "KHR_materials_anisotropy",
+    "EXT_texture_webp",
 ];
 
 /// Extensions alhazen reads without the glTF reader's support.
-const READ_HERE: &[&str] = &["KHR_mesh_quantization"];
+const READ_HERE: &[&str] = &["KHR_mesh_quantization", "EXT_texture_webp"];
 
 /// Reads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<Imported, SceneError> {
@@ -79,6 +80,14 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
     // reads itself are taken off that list first.
     let mut json = gltf.document.into_json();
     json.extensions_required.retain(|e| !READ_HERE.contains(&e.as_str()));
+    // A texture's `EXT_texture_webp` image, which glTF prefers to its fallback (and which may
+    // be its only image), becomes its source.
+    for texture in &mut json.textures {
+        let webp = texture.extensions.as_ref().and_then(|e| e.others.get("EXT_texture_webp"));
+        if let Some(i) = webp.and_then(|w| w.get("source")).and_then(|i| i.as_u64()) {
+            texture.source = gltf::json::Index::new(i.min(u32::MAX as u64 - 1) as u32);
+        }
+    }
     let document = gltf::Document::from_json(json).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
     let buffers = gltf::import_buffers(&document, Some(base), gltf.blob)
@@ -908,9 +917,59 @@ fn decode_image(
     base: &Path,
     buffers: &[gltf::buffer::Data],
 ) -> Result<ImageData, String> {
-    let data = gltf::image::Data::from_source(source.source(), Some(base), buffers)
-        .map_err(|e| format!("image {}: {e}", source.index()))?;
+    let data = match webp_bytes(source, base, buffers) {
+        Some(bytes) => decode_webp(&bytes?),
+        None => gltf::image::Data::from_source(source.source(), Some(base), buffers).map_err(|e| e.to_string()),
+    }
+    .map_err(|e| format!("image {}: {e}", source.index()))?;
     decode(&data, decoding).ok_or_else(|| format!("image {}: unsupported pixel format", source.index()))
+}
+
+/// The encoded bytes of a WebP image (`EXT_texture_webp`: MIME type `image/webp`, or a file
+/// named `.webp`) — from its buffer view, data URI or file —, or why they cannot be read;
+/// `None` for other images, which the glTF reader decodes.
+fn webp_bytes(source: &gltf::Image, base: &Path, buffers: &[gltf::buffer::Data]) -> Option<Result<Vec<u8>, String>> {
+    use base64::Engine as _;
+    match source.source() {
+        gltf::image::Source::View { view, mime_type } => (mime_type == "image/webp").then(|| {
+            let bytes = buffers.get(view.buffer().index()).map(|b| &b.0[..]).unwrap_or(&[]);
+            bytes
+                .get(view.offset()..view.offset() + view.length())
+                .map(<[u8]>::to_vec)
+                .ok_or_else(|| format!("its buffer view reaches beyond its buffer ({} bytes)", bytes.len()))
+        }),
+        gltf::image::Source::Uri { uri, mime_type } => {
+            let data = uri.strip_prefix("data:");
+            let webp = match data {
+                Some(d) => d.starts_with("image/webp"),
+                None => mime_type == Some("image/webp") || uri.to_ascii_lowercase().ends_with(".webp"),
+            };
+            webp.then(|| match data {
+                Some(d) => {
+                    let encoded = d.split_once(";base64,").map(|(_, b)| b).ok_or("a WebP data URI must be base64")?;
+                    base64::engine::general_purpose::STANDARD.decode(encoded).map_err(|e| format!("its data URI: {e}"))
+                }
+                None => {
+                    let name = urlencoding::decode(uri).map_err(|e| format!("its URI: {e}"))?;
+                    let path = base.join(&*name);
+                    std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+                }
+            })
+        }
+    }
+}
+
+/// A WebP image's pixels, eight bits a channel (with alpha where it has one).
+fn decode_webp(bytes: &[u8]) -> Result<gltf::image::Data, String> {
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::WebP)
+        .map_err(|e| format!("not a readable WebP image: {e}"))?;
+    let (width, height) = (img.width(), img.height());
+    let (pixels, format) = if img.color().has_alpha() {
+        (img.into_rgba8().into_raw(), gltf::image::Format::R8G8B8A8)
+    } else {
+        (img.into_rgb8().into_raw(), gltf::image::Format::R8G8B8)
+    };
+    Ok(gltf::image::Data { pixels, format, width, height })
 }
 
 /// How an image's channels are read.

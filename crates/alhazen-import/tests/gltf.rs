@@ -1057,6 +1057,70 @@ fn panel_against_cycles(stem: &str, change: impl Fn(&mut alhazen_scene::Scene)) 
     (as_imported, changed)
 }
 
+/// A 2×1 lossless WebP: green on the left, white on the right.
+fn webp() -> Vec<u8> {
+    let mut out = vec![];
+    image::codecs::webp::WebPEncoder::new_lossless(&mut out)
+        .encode(&[0, 255, 0, 255, 255, 255], 2, 1, image::ExtendedColorType::Rgb8)
+        .unwrap();
+    out
+}
+
+/// The base colour's texels of the first object's material (linear, times the factor).
+fn base_texels(s: &Imported) -> Vec<[f32; 3]> {
+    let sc = &s.scene;
+    match &sc.materials[sc.objects[0].material as usize].bsdf {
+        Some(BsdfDesc::CookTorrance { albedo: Texture::Image { image, .. }, .. }) => {
+            sc.images[*image].texels().collect()
+        }
+        other => panic!("not a textured dielectric: {other:?}"),
+    }
+}
+
+/// `EXT_texture_webp` (as Blender's exporter writes it with its WebP image format): a
+/// texture's WebP image is read — required or beside a fallback, which it takes the place of
+/// — from a data URI, a file (its name percent-decoded) or a `.glb`'s buffer view, the same
+/// texels as the pixels encoded; a corrupt one is an error naming the image.
+#[test]
+fn webp_textures_are_read_wherever_they_are() {
+    let want = vec![[0.0, 1.0, 0.0], [0.5, 1.0, 1.0]];
+    let with_webp = |json: String, texture: &str, webp_image: &str| {
+        json.replace(r#""textures": [{ "source": 0 }]"#, &format!(r#""textures": [{texture}]"#))
+            .replace(r#""images": [{ "uri": "#, &format!(r#""images": [{webp_image}, {{ "uri": "#))
+            .replace(r#""extensionsUsed": ["KHR_lights_punctual"],"#, r#""extensionsUsed": ["KHR_lights_punctual", "EXT_texture_webp"], "extensionsRequired": ["EXT_texture_webp"],"#)
+    };
+    let only_webp = r#"{ "extensions": { "EXT_texture_webp": { "source": 0 } } }"#;
+    let beside_fallback = r#"{ "source": 1, "extensions": { "EXT_texture_webp": { "source": 0 } } }"#;
+    let data_uri = format!(r#"{{ "uri": "data:image/webp;base64,{}" }}"#, base64(&webp()));
+    for texture in [only_webp, beside_fallback] {
+        let s = write_and_import(&[("w.gltf", with_webp(embedded(), texture, &data_uri).into_bytes())]).unwrap();
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+        assert_eq!(base_texels(&s), want, "{texture}");
+    }
+    let file = r#"{ "uri": "brushed%20steel.webp" }"#;
+    let s = write_and_import(&[
+        ("w.gltf", with_webp(embedded(), only_webp, file).into_bytes()),
+        ("brushed steel.webp", webp()),
+    ])
+    .unwrap();
+    assert_eq!(base_texels(&s), want);
+    // A .glb: the WebP after the quad in the binary chunk, in a buffer view of its own.
+    let mut bin = quad_buffer();
+    bin.extend(webp());
+    let view = r#"{ "bufferView": 4, "mimeType": "image/webp" }"#;
+    let json = with_webp(document("", ""), only_webp, view)
+        .replace(r#""byteLength": 140 "#, &format!(r#""byteLength": {} "#, bin.len()))
+        .replace(
+            r#"{ "buffer": 0, "byteOffset": 128, "byteLength": 12 }"#,
+            &format!(r#"{{ "buffer": 0, "byteOffset": 128, "byteLength": 12 }}, {{ "buffer": 0, "byteOffset": 140, "byteLength": {} }}"#, bin.len() - 140),
+        );
+    let s = write_and_import(&[("w.glb", glb(&json, &bin))]).unwrap();
+    assert_eq!(base_texels(&s), want);
+    let corrupt = format!(r#"{{ "uri": "data:image/webp;base64,{}" }}"#, base64(b"RIFF....WEBPVP8L not really"));
+    let e = write_and_import(&[("w.gltf", with_webp(embedded(), only_webp, &corrupt).into_bytes())]).unwrap_err();
+    assert!(e.contains("w.gltf") && e.contains("image 0") && e.contains("WebP"), "{e}");
+}
+
 /// A texture's sampler wraps its image as glTF says: `CLAMP_TO_EDGE` (33071) and
 /// `MIRRORED_REPEAT` (33648) along `s` (u) and `t` (v), without a warning.
 #[test]
