@@ -94,6 +94,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
         .map_err(|e| error(path, bytes, format!("cannot read its buffers: {e}")))?;
     let mut imp = Importer {
         path,
+        textures: document.textures().collect(),
         bytes,
         buffers,
         base,
@@ -135,6 +136,8 @@ fn error(path: &Path, bytes: &[u8], message: impl Into<String>) -> SceneError {
 
 struct Importer<'a> {
     path: &'a Path,
+    /// The file's textures, for those named by extensions the reader does not know.
+    textures: Vec<gltf::Texture<'a>>,
     bytes: &'a [u8],
     buffers: Vec<gltf::buffer::Data>,
     base: &'a Path,
@@ -479,13 +482,7 @@ impl Importer<'_> {
         let bump = match material.normal_texture() {
             Some(nt) => {
                 // The normal texture's info has no typed transform: read from its JSON.
-                let transform = nt.extension_value("KHR_texture_transform").map(|t| {
-                    let pair = |key: &str, default: f64| {
-                        let at = |k: usize| t.get(key).and_then(|v| v.get(k)).and_then(|x| x.as_f64());
-                        [at(0).unwrap_or(default), at(1).unwrap_or(default)]
-                    };
-                    (pair("scale", 1.0), pair("offset", 0.0), t.get("rotation").and_then(|r| r.as_f64()).unwrap_or(0.0))
-                });
+                let transform = nt.extension_value("KHR_texture_transform").map(json_transform);
                 let (scale, offset, rotation) = self.placement(nt.tex_coord(), transform, &name)?;
                 let image = wrapped(self.image(&nt.texture(), Decoding::Linear)?, &nt.texture());
                 self.scene.images.push(image);
@@ -509,16 +506,27 @@ impl Importer<'_> {
         // texel's base colour), else the constant mix (and its glass under transmission).
         let textured_metal = metallic > 0.0 && transmission <= 0.0 && !matches!(base, Texture::Solid(_));
         let mut lobes = self.lobes(&material, ior, &name);
-        lobes.anisotropy = self.anisotropy(&material, &name)?;
+        let mut anisotropy_map;
+        (lobes.anisotropy, anisotropy_map) = self.anisotropy(&material, &name)?;
         if lobes.anisotropy.is_anisotropic() && transmission > 0.0 {
             self.warn(format!("{name}: KHR_materials_anisotropy under transmission is not supported; ignored"));
-            lobes.anisotropy = Anisotropy::default();
+            (lobes.anisotropy, anisotropy_map) = (Anisotropy::default(), None);
         }
         // Stretched facets turn with the surface's tangent: read per point.
         let per_point = map.is_some() || textured_metal || lobes.anisotropy.is_anisotropic();
         let bsdf = if per_point {
             let MetalRoughness { ior, specular, multiscatter, anisotropy } = lobes;
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter, anisotropy }
+            BsdfDesc::MetallicRoughness {
+                base,
+                metallic,
+                roughness,
+                map,
+                ior,
+                specular,
+                multiscatter,
+                anisotropy,
+                anisotropy_map,
+            }
         } else {
             common::metal_rough(base, base_mean, metallic, roughness, (ior, lobes), transmission.clamp(0.0, 1.0))
         };
@@ -538,10 +546,13 @@ impl Importer<'_> {
 
     /// `KHR_materials_anisotropy`'s facets stretched along a direction of brushing:
     /// `anisotropyStrength` `s` stretches them to `α_t = α + (1 − α)s²` along the tangent turned
-    /// by `anisotropyRotation` (radians, towards the bitangent), `α_b = α` across it. Its
-    /// texture is left out (warning: the factors are used).
-    fn anisotropy(&mut self, material: &gltf::Material, name: &str) -> R<Anisotropy> {
-        let Some(a) = material.extension_value("KHR_materials_anisotropy") else { return Ok(Anisotropy::default()) };
+    /// by `anisotropyRotation` (radians, towards the bitangent), `α_b = α` across it; its
+    /// texture (linear, placed by its own `KHR_texture_transform` and sampler) turns the
+    /// direction further and scales the strength per point.
+    fn anisotropy(&mut self, material: &gltf::Material, name: &str) -> R<(Anisotropy, Option<Texture>)> {
+        let Some(a) = material.extension_value("KHR_materials_anisotropy") else {
+            return Ok((Anisotropy::default(), None));
+        };
         let number = |key: &str, range: std::ops::RangeInclusive<f64>| match a.get(key) {
             None => Some(0.0),
             Some(x) => x.as_f64().filter(|x| range.contains(x)),
@@ -554,12 +565,31 @@ impl Importer<'_> {
                 "{name}: KHR_materials_anisotropy's anisotropyStrength must be a number within [0, 1] and anisotropyRotation a number of radians"
             )));
         };
-        if a.get("anisotropyTexture").is_some() {
-            self.warn(format!("{name}: KHR_materials_anisotropy's texture is not supported; its factors are used"));
-        }
         // Within (−π, π]: a turn's worth more is the same direction.
         let rotation = rotation - turn * (rotation / turn).round();
-        Ok(Anisotropy { strength, rotation, model: AnisotropyModel::Gltf })
+        let anisotropy = Anisotropy { strength, rotation, model: AnisotropyModel::Gltf };
+        let map = match a.get("anisotropyTexture") {
+            Some(info) if strength > 0.0 => Some(self.texture_of_info(info, name, "anisotropyTexture")?),
+            _ => None,
+        };
+        Ok((anisotropy, map))
+    }
+
+    /// The linear image texture a JSON `textureInfo` of an extension names (`index`,
+    /// `texCoord`, `KHR_texture_transform`), placed and wrapped as glTF says.
+    fn texture_of_info(&mut self, info: &serde_json::Value, name: &str, what: &str) -> R<Texture> {
+        let index = info.get("index").and_then(|i| i.as_u64());
+        let tex_coord = info.get("texCoord").map_or(Some(0), |t| t.as_u64());
+        let (Some(texture), Some(tex_coord)) =
+            (index.and_then(|i| self.textures.get(i as usize)).cloned(), tex_coord.and_then(|t| u32::try_from(t).ok()))
+        else {
+            return Err(self.err(format!("{name}: {what} must name one of the file's textures")));
+        };
+        let transform = info.get("extensions").and_then(|e| e.get("KHR_texture_transform")).map(json_transform);
+        let (scale, offset, rotation) = self.placement(tex_coord, transform, name)?;
+        let image = wrapped(self.image(&texture, Decoding::Linear)?, &texture);
+        self.scene.images.push(image);
+        Ok(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation })
     }
 
     /// `bsdf` under `KHR_materials_clearcoat`'s coat: of weight `clearcoatFactor`, GGX facets
@@ -907,6 +937,16 @@ fn scaled(img: Arc<ImageData>, factor: Vec3) -> Arc<ImageData> {
         return img;
     }
     Arc::new(img.channels_scaled(factor.to_array().map(|x| x as f32)))
+}
+
+/// A `KHR_texture_transform` read from its JSON (for texture infos the reader does not type):
+/// scale, offset and rotation, glTF's defaults where absent.
+fn json_transform(t: &serde_json::Value) -> ([f64; 2], [f64; 2], f64) {
+    let pair = |key: &str, default: f64| {
+        let at = |k: usize| t.get(key).and_then(|v| v.get(k)).and_then(|x| x.as_f64());
+        [at(0).unwrap_or(default), at(1).unwrap_or(default)]
+    };
+    (pair("scale", 1.0), pair("offset", 0.0), t.get("rotation").and_then(|r| r.as_f64()).unwrap_or(0.0))
 }
 
 /// Image `source` read (from its file, data URI or buffer view) and decoded to linear RGB, or

@@ -1332,6 +1332,7 @@ impl Importer {
                 specular: 1.0,
                 multiscatter: false,
                 anisotropy,
+                anisotropy_map: None,
             });
         }
         let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
@@ -1350,6 +1351,7 @@ impl Importer {
                 specular: 1.0,
                 multiscatter: false,
                 anisotropy,
+                anisotropy_map: None,
             });
         }
         Ok(common::metal_rough(base, mean, metallic, roughness, (ior, common::plain_lobes(ior)), trans))

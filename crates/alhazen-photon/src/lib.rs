@@ -243,7 +243,8 @@ impl Tracer<'_> {
             if !bsdf.has_delta_lobe() {
                 return;
             }
-            let frame = tangent_at(m, wh.hit.dpduv, wh.hit.n).map_or_else(|| Frame::around(ns), |t| Frame::new(ns, t));
+            let frame =
+                tangent_at(m, &wh.hit, &self.scene.images).map_or_else(|| Frame::around(ns), |t| Frame::new(ns, t));
             let Some(bs) = bsdf.sample(frame.to_local(wi), rng.uniform(), Vec2::new(rng.uniform(), rng.uniform()))
             else {
                 return;

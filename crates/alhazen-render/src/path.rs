@@ -335,7 +335,7 @@ impl<'a> PathTracer<'a> {
         }
         out.beta = path.beta;
         let wo = -path.ray.dir;
-        let (frame, ng, terminator) = self.shading_frame(wh, &bsdf, wo, tangent_at(m, wh.hit.dpduv, wh.hit.n));
+        let (frame, ng, terminator) = self.shading_frame(wh, &bsdf, wo, tangent_at(m, &wh.hit, &self.scene.images));
         let v = frame.to_local(wo);
         // One pair picks the light and the BSDF lobe, drawn only when there is a choice;
         // one pair each places the points.

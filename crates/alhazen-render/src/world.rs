@@ -1029,7 +1029,7 @@ mod tests {
             let ray = Ray::new(Vec3::new(0.3, 0.4, -5.0), Vec3::Z);
             let hit = world.intersect(&ray, f64::INFINITY).unwrap().hit;
             let tangent =
-                crate::bsdf::tangent_at(&scene.materials[scene.objects[0].material as usize], hit.dpduv, hit.n);
+                crate::bsdf::tangent_at(&scene.materials[scene.objects[0].material as usize], &hit, &scene.images);
             assert_eq!(tangent.is_some(), anisotropic, "{roughness}");
             if let Some(t) = tangent {
                 assert!(t.dot(hit.n).abs() < 1e-12 && t.y.abs() < 1e-12 && t.length() > 0.0, "{t}");

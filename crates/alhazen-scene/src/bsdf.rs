@@ -219,6 +219,11 @@ pub enum BsdfDesc {
         /// Facets stretched along a direction of brushing (glTF's `KHR_materials_anisotropy`,
         /// principled's `anisotropic`); none by default.
         anisotropy: Anisotropy,
+        /// Where the brushing varies over the surface (glTF's `anisotropyTexture`, read
+        /// linearly): each texel's red and green `2c − 1` the direction in the frame of the
+        /// tangent and bitangent (turned further by the rotation), its blue multiplying the
+        /// strength.
+        anisotropy_map: Option<Texture>,
     },
     /// A clear coat over `base` (car paint, lacquer; glTF's `KHR_materials_clearcoat`): a
     /// dielectric microfacet layer of `weight` reflecting `weight·D G F/(4⟨l,n⟩⟨v,n⟩)`, the
@@ -401,6 +406,15 @@ impl Anisotropy {
     pub fn is_anisotropic(&self) -> bool {
         self.strength > 0.0
     }
+
+    /// The stretch at a point whose `anisotropyTexture` texel is `texel` (linear RGB): the
+    /// strength times its blue, the rotation turned further by the direction of its red and
+    /// green (`2c − 1` along the tangent and the bitangent; none where that is zero).
+    pub fn at_texel(&self, texel: Vec3) -> Anisotropy {
+        let (x, y) = (2.0 * texel.x - 1.0, 2.0 * texel.y - 1.0);
+        let turn = if x == 0.0 && y == 0.0 { 0.0 } else { y.atan2(x) };
+        Anisotropy { strength: self.strength * texel.z.clamp(0.0, 1.0), rotation: self.rotation + turn, ..*self }
+    }
 }
 
 /// What shapes the metallic–roughness model's lobes besides its colour, metalness and
@@ -446,7 +460,9 @@ impl BsdfDesc {
             | BsdfDesc::Plastic { albedo, .. } => t(albedo),
             BsdfDesc::Mix { a, b, weight_map, .. } => a.is_textured() || b.is_textured() || weight_map.is_some(),
             BsdfDesc::Coated { base, .. } => base.is_textured(),
-            BsdfDesc::MetallicRoughness { base, map, .. } => t(base) || map.is_some(),
+            BsdfDesc::MetallicRoughness { base, map, anisotropy_map, .. } => {
+                t(base) || map.is_some() || anisotropy_map.is_some()
+            }
             BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } | BsdfDesc::ThinDielectric { .. } => false,
         }
     }

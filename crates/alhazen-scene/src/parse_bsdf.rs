@@ -11,29 +11,30 @@ use std::sync::Arc;
 
 const MICROFACET_KEYS: &[&str] = &["roughness", "distribution", "shadowing"];
 
-/// A metallic–roughness surface's `anisotropy`: its strength, or `{ strength, rotation =
-/// degrees, model = "gltf" | "disney" }`.
-fn anisotropy(n: &Node) -> R<Anisotropy> {
-    if !n.is_table() {
-        return Ok(Anisotropy { strength: n.in_range(0.0, 1.0)?, ..Anisotropy::default() });
-    }
-    let t = n.table(&["strength", "rotation", "model"])?;
-    let model = match t.get("model").map_or(Ok("gltf"), |m| m.choice(&["gltf", "disney"]))? {
-        "gltf" => AnisotropyModel::Gltf,
-        _ => AnisotropyModel::Disney,
-    };
-    Ok(Anisotropy {
-        strength: t.req("strength")?.in_range(0.0, 1.0)?,
-        rotation: t.get("rotation").map_or(Ok(0.0), |r| r.in_range(-360.0, 360.0))?.to_radians(),
-        model,
-    })
-}
-
 fn names<T>(list: &[(&'static str, T, T)]) -> Vec<&'static str> {
     list.iter().map(|e| e.0).collect()
 }
 
 impl Parser<'_> {
+    /// A metallic–roughness surface's `anisotropy`: its strength, or `{ strength, rotation =
+    /// degrees, model = "gltf" | "disney", map = image }` (the map read linearly).
+    fn anisotropy(&mut self, n: &Node) -> R<(Anisotropy, Option<Texture>)> {
+        if !n.is_table() {
+            return Ok((Anisotropy { strength: n.in_range(0.0, 1.0)?, ..Anisotropy::default() }, None));
+        }
+        let t = n.table(&["strength", "rotation", "model", "map"])?;
+        let model = match t.get("model").map_or(Ok("gltf"), |m| m.choice(&["gltf", "disney"]))? {
+            "gltf" => AnisotropyModel::Gltf,
+            _ => AnisotropyModel::Disney,
+        };
+        let anisotropy = Anisotropy {
+            strength: t.req("strength")?.in_range(0.0, 1.0)?,
+            rotation: t.get("rotation").map_or(Ok(0.0), |r| r.in_range(-360.0, 360.0))?.to_radians(),
+            model,
+        };
+        Ok((anisotropy, t.get("map").map(|m| self.linear_placed_image(&m)).transpose()?))
+    }
+
     /// A `bsdf` table; `albedo` is the material's `color`, the default albedo.
     pub(crate) fn bsdf(&mut self, n: &Node, albedo: &Texture) -> R<BsdfDesc> {
         let t = n.table_any()?;
@@ -143,17 +144,24 @@ impl Parser<'_> {
             "thin-dielectric" => {
                 BsdfDesc::ThinDielectric { ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))? }
             }
-            "metallic-roughness" => BsdfDesc::MetallicRoughness {
-                base: albedo,
-                metallic: t.get("metallic").map_or(Ok(0.0), |n| n.in_range(0.0, 1.0))?,
-                roughness: t.get("roughness").map_or(Ok(0.5), |n| n.in_range(0.0, 1.0))?,
-                // Read linearly, as glTF's metallic-roughness textures are.
-                map: t.get("map").map(|m| self.linear_placed_image(&m)).transpose()?,
-                ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
-                specular: t.get("specular").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
-                multiscatter: t.opt_bool("multiscatter", false)?,
-                anisotropy: t.get("anisotropy").map_or(Ok(Anisotropy::default()), |n| anisotropy(&n))?,
-            },
+            "metallic-roughness" => {
+                let (anisotropy, anisotropy_map) = match t.get("anisotropy") {
+                    Some(n) => self.anisotropy(&n)?,
+                    None => (Anisotropy::default(), None),
+                };
+                BsdfDesc::MetallicRoughness {
+                    base: albedo,
+                    metallic: t.get("metallic").map_or(Ok(0.0), |n| n.in_range(0.0, 1.0))?,
+                    roughness: t.get("roughness").map_or(Ok(0.5), |n| n.in_range(0.0, 1.0))?,
+                    // Read linearly, as glTF's metallic-roughness textures are.
+                    map: t.get("map").map(|m| self.linear_placed_image(&m)).transpose()?,
+                    ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
+                    specular: t.get("specular").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
+                    multiscatter: t.opt_bool("multiscatter", false)?,
+                    anisotropy,
+                    anisotropy_map,
+                }
+            }
             "coated" => {
                 // The coat is rough (a near-mirror at its least roughness): its albedo and
                 // sampling are those of microfacets.

@@ -126,22 +126,6 @@ fn string(s: &str) -> String {
 
 /// The degrees that `to_radians` (then `f`) maps back to exactly `f(radians)`, when a few ulps
 /// around the conversion find them; else the nearest degrees.
-/// A metallic–roughness surface's `anisotropy` entry (after a comma), empty when isotropic.
-fn anisotropy_entry(a: &Anisotropy) -> String {
-    if *a == Anisotropy::default() {
-        return String::new();
-    }
-    let model = match a.model {
-        AnisotropyModel::Gltf => "gltf",
-        AnisotropyModel::Disney => "disney",
-    };
-    format!(
-        ", anisotropy = {{ strength = {}, rotation = {}, model = \"{model}\" }}",
-        num(a.strength),
-        num(degrees(a.rotation, |x| x))
-    )
-}
-
 fn degrees(radians: f64, f: impl Fn(f64) -> f64) -> f64 {
     let target = f(radians);
     let mut d = radians.to_degrees();
@@ -360,6 +344,24 @@ impl Writer<'_> {
 
     /// A map's image table (`{ file, scale, … }`: metallic–roughness and normal maps are
     /// images).
+    /// A metallic–roughness surface's `anisotropy` entry (after a comma), empty when isotropic
+    /// and unmapped.
+    fn anisotropy_entry(&self, a: &Anisotropy, map: Option<&Texture>) -> String {
+        if *a == Anisotropy::default() && map.is_none() {
+            return String::new();
+        }
+        let model = match a.model {
+            AnisotropyModel::Gltf => "gltf",
+            AnisotropyModel::Disney => "disney",
+        };
+        format!(
+            ", anisotropy = {{ strength = {}, rotation = {}, model = \"{model}\"{} }}",
+            num(a.strength),
+            num(degrees(a.rotation, |x| x)),
+            map.map_or(String::new(), |m| format!(", map = {}", self.map_image(m)))
+        )
+    }
+
     fn map_image(&self, map: &Texture) -> String {
         match map {
             Texture::Image { image, scale, offset, rotation } => self.placed_image(*image, *scale, *offset, *rotation),
@@ -524,7 +526,17 @@ impl Writer<'_> {
                 num(*ior),
                 facets(&Some(*f))
             ),
-            BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter, anisotropy } => {
+            BsdfDesc::MetallicRoughness {
+                base,
+                metallic,
+                roughness,
+                map,
+                ior,
+                specular,
+                multiscatter,
+                anisotropy,
+                anisotropy_map,
+            } => {
                 format!(
                     "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{} }}",
                     self.texture(base),
@@ -534,7 +546,7 @@ impl Writer<'_> {
                     if *specular == 1.0 { String::new() } else { format!(", specular = {}", num(*specular)) },
                     if *multiscatter { ", multiscatter = true" } else { "" },
                     map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m))),
-                    anisotropy_entry(anisotropy)
+                    self.anisotropy_entry(anisotropy, anisotropy_map.as_ref())
                 )
             }
         }

@@ -247,7 +247,10 @@ fn metallic_roughness_anisotropy_reads_and_writes_back() {
 bsdf = { type = "metallic-roughness", metallic = 1, roughness = 0.3, anisotropy = 0.6 }
 [materials.turned]
 bsdf = { type = "metallic-roughness", metallic = 1, anisotropy = { strength = 0.9, rotation = 30, model = "disney" } }
+[materials.mapped]
+bsdf = { type = "metallic-roughness", metallic = 1, anisotropy = { strength = 0.5, map = { file = "dir.png", scale = 2 } } }
 "#;
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 200])).save(dir.path().join("dir.png")).unwrap();
     let path = dir.path().join("a.toml");
     std::fs::write(&path, text).unwrap();
     let s = load_scene(&path).unwrap();
@@ -259,12 +262,21 @@ bsdf = { type = "metallic-roughness", metallic = 1, anisotropy = { strength = 0.
     assert_eq!(anisotropy(&s, "brushed"), Anisotropy { strength: 0.6, rotation: 0.0, model: AnisotropyModel::Gltf });
     let turned = anisotropy(&s, "turned");
     assert_eq!((turned.strength, turned.rotation, turned.model), (0.9, 30f64.to_radians(), AnisotropyModel::Disney));
+    let map = |s: &alhazen_scene::Scene, name: &str| match &s.materials.iter().find(|m| m.name == name).unwrap().bsdf {
+        Some(BsdfDesc::MetallicRoughness { anisotropy_map: Some(Texture::Image { image, scale, .. }), .. }) => {
+            (s.images[*image].texel(0), *scale)
+        }
+        other => panic!("{other:?}"),
+    };
+    // Read linearly: 128/255, not its sRGB decoding.
+    assert_eq!(map(&s, "mapped"), ([1.0, 128.0 / 255.0, 200.0 / 255.0], alhazen_math::Vec2::splat(2.0)));
     let again_path = dir.path().join("again.toml");
     alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
     let again = load_scene(&again_path).unwrap();
-    for name in ["brushed", "turned"] {
+    for name in ["brushed", "turned", "mapped"] {
         assert_eq!(anisotropy(&s, name), anisotropy(&again, name));
     }
+    assert_eq!(map(&s, "mapped"), map(&again, "mapped"));
     for (bad, says) in [
         ("anisotropy = 1.5", "1.5"),
         (r#"anisotropy = { strength = 0.5, model = "ward" }"#, "\"gltf\", \"disney\""),
@@ -291,6 +303,13 @@ fn anisotropy_stretches_the_roughness() {
     let aspect = (1.0f64 - 0.81).sqrt();
     assert_eq!((along, across), (0.16 / aspect, 0.16 * aspect));
     assert!(!at(0.0, AnisotropyModel::Disney).is_anisotropic() && at(0.1, AnisotropyModel::Gltf).is_anisotropic());
+    // A map's texel: red and green the direction `2c − 1` (turning the rotation further), blue
+    // the strength's factor.
+    let turned =
+        Anisotropy { rotation: 0.5, ..at(0.8, AnisotropyModel::Gltf) }.at_texel(alhazen_math::Vec3::new(0.5, 1.0, 0.5));
+    assert_eq!((turned.strength, turned.rotation), (0.4, 0.5 + std::f64::consts::FRAC_PI_2));
+    let flat = at(0.8, AnisotropyModel::Gltf).at_texel(alhazen_math::Vec3::new(0.5, 0.5, 1.0));
+    assert_eq!((flat.strength, flat.rotation), (0.8, 0.0));
 }
 
 /// Plastic: smooth by default (Mitsuba's polypropylene coat), rough with a roughness, and the

@@ -142,9 +142,20 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             CookTorranceLobe { facets: Microfacet::new(facets), ior: *ior, schlick: false },
             *weight,
         ))),
-        BsdfDesc::MetallicRoughness { base, metallic, roughness, map, ior, specular, multiscatter, anisotropy } => {
+        BsdfDesc::MetallicRoughness {
+            base,
+            metallic,
+            roughness,
+            map,
+            ior,
+            specular,
+            multiscatter,
+            anisotropy,
+            anisotropy_map,
+        } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
+            let anisotropy = anisotropy_map.as_ref().map_or(*anisotropy, |m| anisotropy.at_texel((lookups.rgb)(m)));
             let (metal, coating, weight) = BsdfDesc::metallic_roughness_at(
                 (lookups.rgb)(base) * lookups.tint,
                 metallic * texel.z,
@@ -153,7 +164,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                     ior: *ior,
                     specular: *specular,
                     multiscatter: *multiscatter,
-                    anisotropy: *anisotropy,
+                    anisotropy,
                 },
             );
             let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
@@ -162,17 +173,24 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
     }
 }
 
-/// The world-space tangent that anisotropic lobes align with at a point of normal `n` whose
-/// `∂p/∂u` and `∂p/∂v` are `dpduv`: Blinn–Phong's scratches, else `∂p/∂u` for anisotropic
-/// microfacets (as pbrt and Mitsuba orient them), turned about `n` by a metallic–roughness
-/// surface's rotation ([`turned_tangent`]); `None` for isotropic BSDFs, whose frame may turn
-/// freely about the normal, and where `∂p/∂u` is unknown (zero).
-pub fn tangent_at(m: &Material, dpduv: [Vec3; 2], n: Vec3) -> Option<Vec3> {
-    let dpdu = dpduv[0];
+/// The world-space tangent that anisotropic lobes align with at `hit`: Blinn–Phong's
+/// scratches, else `∂p/∂u` for anisotropic microfacets (as pbrt and Mitsuba orient them),
+/// turned about the normal by a metallic–roughness surface's rotation and its map's direction
+/// there ([`turned_tangent`], [`alhazen_scene::bsdf::Anisotropy::at_texel`]); `None` for
+/// isotropic BSDFs, whose frame may turn freely about the normal, and where `∂p/∂u` is
+/// unknown (zero).
+pub fn tangent_at(m: &Material, hit: &crate::shape::SurfaceHit, images: &[Arc<ImageData>]) -> Option<Vec3> {
+    let dpdu = hit.dpduv[0];
     match &m.bsdf {
         Some(BsdfDesc::BlinnPhong { scratches, .. }) => Some(*scratches),
-        Some(BsdfDesc::MetallicRoughness { anisotropy, .. }) if anisotropy.is_anisotropic() && dpdu != Vec3::ZERO => {
-            Some(turned_tangent(dpduv, n, anisotropy.rotation))
+        Some(BsdfDesc::MetallicRoughness { anisotropy, anisotropy_map, .. })
+            if anisotropy.is_anisotropic() && dpdu != Vec3::ZERO =>
+        {
+            let rotation = match anisotropy_map {
+                Some(map) => anisotropy.at_texel(texture::eval(map, hit.uv, images)).rotation,
+                None => anisotropy.rotation,
+            };
+            Some(turned_tangent(hit.dpduv, hit.n, rotation))
         }
         Some(desc) if desc.is_anisotropic() && dpdu != Vec3::ZERO => Some(dpdu),
         _ => None,

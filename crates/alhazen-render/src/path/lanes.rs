@@ -808,13 +808,13 @@ impl PathTracer<'_> {
                 set(&mut v.k, i, c.k);
                 set(&mut v.tint, i, c.tint);
                 if let Some(facets) = &c.facets {
-                    set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv, wh.hit.n));
+                    set_facets(v, i, facets, crate::bsdf::tangent_at(m, &wh.hit, &self.scene.images));
                 }
             }
             Bsdf::Dielectric(d) => {
                 v.ior[i] = d.eta;
                 if let Some(facets) = &d.facets {
-                    set_facets(v, i, facets, crate::bsdf::tangent_at(m, wh.hit.dpduv, wh.hit.n));
+                    set_facets(v, i, facets, crate::bsdf::tangent_at(m, &wh.hit, &self.scene.images));
                 }
             }
             Bsdf::CookTorrance(c) => {
@@ -947,7 +947,7 @@ impl PathTracer<'_> {
             let m = &self.scene.materials[wh.material as usize];
             let wo = -path.ray.dir;
             let (frame, ng, terminator) =
-                self.shading_frame(wh, bsdf, wo, crate::bsdf::tangent_at(m, wh.hit.dpduv, wh.hit.n));
+                self.shading_frame(wh, bsdf, wo, crate::bsdf::tangent_at(m, &wh.hit, &self.scene.images));
             super::mirrors::VertexShading { frame, ng, terminator, v: frame.to_local(wo) }
         };
         Some(self.mirror_connections(c, bsdf, shading, wh.hit.p, wh.object, ColorMode::Rgb, s))
