@@ -54,9 +54,6 @@ const KNOWN: &[&str] = &[
     "EXT_texture_webp",
 ];
 
-/// Extensions alhazen reads without the glTF reader's support.
-const READ_HERE: &[&str] = &["KHR_mesh_quantization", "EXT_texture_webp"];
-
 /// Reads a glTF 2.0 file.
 pub fn load(path: &Path) -> Result<Imported, SceneError> {
     let bytes = common::read_bytes(path)?;
@@ -76,10 +73,14 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
 fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
     let invalid = |e: gltf::Error| error(path, bytes, format!("not a valid glTF 2.0 file: {e}"));
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
-    // The reader's validation refuses required extensions it does not know; those alhazen
-    // reads itself are taken off that list first.
+    // A required extension alhazen cannot read is said before the reader's validation (which
+    // would name the textures a required image format leaves without a source); the rest
+    // alhazen reads, some without the reader's support, whose validation would refuse them.
     let mut json = gltf.document.into_json();
-    json.extensions_required.retain(|e| !READ_HERE.contains(&e.as_str()));
+    if let Some(e) = json.extensions_required.iter().find(|e| !KNOWN.contains(&e.as_str())) {
+        return Err(error(path, bytes, format!("the file requires extension {e}, which alhazen cannot read")));
+    }
+    json.extensions_required.clear();
     // A texture's `EXT_texture_webp` image, which glTF prefers to its fallback (and which may
     // be its only image), becomes its source.
     for texture in &mut json.textures {
@@ -108,7 +109,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
         bounds: Bounds3::EMPTY,
     };
     imp.scene.render.integrator = IntegratorKind::Path;
-    imp.extensions(&document)?;
+    imp.extensions(&document);
     let scene = document.default_scene().or_else(|| document.scenes().next());
     let Some(scene) = scene else { return Err(error(path, bytes, "the file has no scene")) };
     imp.decode_ahead(&document, &scene);
@@ -162,18 +163,14 @@ impl Importer<'_> {
         error(self.path, self.bytes, message)
     }
 
-    fn extensions(&mut self, doc: &gltf::Document) -> R<()> {
-        for e in doc.extensions_required() {
-            if !KNOWN.contains(&e) {
-                return Err(self.err(format!("the file requires extension {e}, which alhazen cannot read")));
-            }
-        }
+    /// Warns about the extensions the file uses that alhazen ignores (those it requires are
+    /// read or refused before).
+    fn extensions(&mut self, doc: &gltf::Document) {
         for e in doc.extensions_used() {
             if !KNOWN.contains(&e) {
                 self.warn(format!("extension {e} is not supported; ignored"));
             }
         }
-        Ok(())
     }
 
     fn finish(mut self) -> R<Imported> {
