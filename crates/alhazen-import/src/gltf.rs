@@ -21,7 +21,7 @@ use crate::Imported;
 use crate::common::{self, Warnings};
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Mat4, Transform, Vec2, Vec3};
-use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, MetalRoughness};
+use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Ior, MetalRoughness};
 use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
     PerspectiveOpening, Scene, SceneError, Shape, Texture, Wrap,
@@ -52,6 +52,7 @@ const KNOWN: &[&str] = &[
     "KHR_materials_clearcoat",
     "KHR_materials_anisotropy",
     "EXT_texture_webp",
+    "KHR_materials_dispersion",
 ];
 
 /// Reads a glTF 2.0 file.
@@ -525,7 +526,12 @@ impl Importer<'_> {
                 anisotropy_map,
             }
         } else {
-            common::metal_rough(base, base_mean, metallic, roughness, (ior, lobes), transmission.clamp(0.0, 1.0))
+            let bsdf =
+                common::metal_rough(base, base_mean, metallic, roughness, (ior, lobes), transmission.clamp(0.0, 1.0));
+            match self.dispersion(&material, ior, &name)? {
+                Some(cauchy) => glass_of_index(bsdf, cauchy),
+                None => bsdf,
+            }
         };
         let bsdf = self.clearcoat(&material, bsdf, &name)?;
         let refracts = bsdf.refracts();
@@ -587,6 +593,39 @@ impl Importer<'_> {
         let image = wrapped(self.image(&texture, Decoding::Linear)?, &texture);
         self.scene.images.push(image);
         Ok(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation })
+    }
+
+    /// `KHR_materials_dispersion`'s index of refraction by wavelength, Cauchy's two terms
+    /// through `n_d` = `ior` at 587.6 nm with the Abbe number `V_d = 20/dispersion`:
+    /// `n(λ) = n_d + (n_d − 1)/V_d · (523 655/λ² − 1.5168)` (λ in nm). None without it or at 0
+    /// (no dispersion). A dispersion so strong that the index would fall below 1 within the
+    /// visible range (360–830 nm; glTF clamps it at 1 there) is lowered to the strongest that
+    /// keeps it above, with a warning.
+    fn dispersion(&mut self, material: &gltf::Material, ior: f64, name: &str) -> R<Option<Ior>> {
+        let Some(d) = material.extension_value("KHR_materials_dispersion") else { return Ok(None) };
+        let dispersion = match d.get("dispersion") {
+            None => 0.0,
+            Some(x) => x.as_f64().filter(|x| (0.0..=1e6).contains(x)).ok_or_else(|| {
+                self.err(format!("{name}: KHR_materials_dispersion's dispersion must be a number ≥ 0"))
+            })?,
+        };
+        if dispersion == 0.0 || ior <= 1.0 {
+            return Ok(None);
+        }
+        // n(λ) falls with λ: its least is at the longest wavelength.
+        let reach = 1.5168 - 523_655.0 / (alhazen_math::cie::LAMBDA_MAX * alhazen_math::cie::LAMBDA_MAX);
+        let strongest = 20.0 * 0.999 / reach;
+        let dispersion = if dispersion > strongest {
+            self.warn(format!(
+                "{name}: KHR_materials_dispersion's dispersion {dispersion} would take the index below 1; {strongest:.3} is used"
+            ));
+            strongest
+        } else {
+            dispersion
+        };
+        let k = (ior - 1.0) * dispersion / 20.0;
+        // Cauchy's `A + B/λ²` with λ in micrometres.
+        Ok(Some(Ior::Cauchy { a: ior - 1.5168 * k, b: 0.523655 * k }))
     }
 
     /// `bsdf` under `KHR_materials_clearcoat`'s coat: of weight `clearcoatFactor`, GGX facets
@@ -934,6 +973,20 @@ fn scaled(img: Arc<ImageData>, factor: Vec3) -> Arc<ImageData> {
         return img;
     }
     Arc::new(img.channels_scaled(factor.to_array().map(|x| x as f32)))
+}
+
+/// `bsdf` with its glass (the dielectric that transmission mixes in) of index `ior`.
+fn glass_of_index(bsdf: BsdfDesc, ior: Ior) -> BsdfDesc {
+    match bsdf {
+        BsdfDesc::Dielectric { facets, fresnel, .. } => BsdfDesc::Dielectric { facets, ior, fresnel },
+        BsdfDesc::Mix { a, b, weight, weight_map } => BsdfDesc::Mix {
+            a: Box::new(glass_of_index(*a, ior)),
+            b: Box::new(glass_of_index(*b, ior)),
+            weight,
+            weight_map,
+        },
+        other => other,
+    }
 }
 
 /// A `KHR_texture_transform` read from its JSON (for texture infos the reader does not type):

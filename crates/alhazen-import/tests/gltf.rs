@@ -954,6 +954,52 @@ fn an_anisotropy_map_turns_the_brushing() {
     assert_eq!(both, half_turn);
 }
 
+/// `KHR_materials_dispersion`: the transmitting glass's index follows Cauchy's two terms
+/// through `ior` at 587.6 nm, spread `n_F − n_C = (ior − 1)/V_d` with `V_d = 20/dispersion`
+/// (the scene then renders spectrally); none at 0; a dispersion that would take the index
+/// below 1 in the visible range lowered, said; a negative one refused.
+#[test]
+fn dispersion_spreads_the_glass_index_by_wavelength() {
+    let read = |ext: &str| {
+        let json = embedded().replace(
+            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
+            &format!(
+                r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "extensions": {{ "KHR_materials_transmission": {{ "transmissionFactor": 1 }}, "KHR_materials_ior": {{ "ior": 1.6 }}, "KHR_materials_dispersion": {ext} }}"#
+            ),
+        );
+        let s = write_and_import(&[("d.gltf", json.into_bytes())])?;
+        let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+        Ok::<_, String>((s.scene.materials[s.scene.objects[0].material as usize].bsdf.clone().unwrap(), said))
+    };
+    let glass_ior = |bsdf: &BsdfDesc| -> alhazen_scene::bsdf::Ior {
+        match bsdf {
+            BsdfDesc::Dielectric { ior, .. } => *ior,
+            BsdfDesc::Mix { a, .. } => match **a {
+                BsdfDesc::Dielectric { ior, .. } => ior,
+                _ => panic!("{bsdf:?}"),
+            },
+            _ => panic!("{bsdf:?}"),
+        }
+    };
+    let (bsdf, said) = read(r#"{ "dispersion": 0.5 }"#).unwrap();
+    assert!(said.is_empty(), "{said:?}");
+    let ior = glass_ior(&bsdf);
+    assert!(bsdf.is_dispersive(), "{bsdf:?}");
+    assert!((ior.at(587.6) - 1.6).abs() < 1e-3, "{}", ior.at(587.6));
+    let spread = ior.at(486.1) - ior.at(656.3);
+    let want = 0.6 / (20.0 / 0.5);
+    assert!((spread - want).abs() < 1e-3 * want, "{spread} {want}");
+    let (bsdf, _) = read(r#"{ "dispersion": 0 }"#).unwrap();
+    let plain = matches!(glass_ior(&bsdf), alhazen_scene::bsdf::Ior::Constant(n) if (n - 1.6).abs() < 1e-6);
+    assert!(!bsdf.is_dispersive() && plain, "{bsdf:?}");
+    let (bsdf, said) = read(r#"{ "dispersion": 1000 }"#).unwrap();
+    assert!(said.iter().any(|w| w.contains("would take the index below 1")), "{said:?}");
+    let lowest = glass_ior(&bsdf).at(alhazen_math::cie::LAMBDA_MAX);
+    assert!(lowest > 1.0 && lowest < 1.001, "{lowest}");
+    let e = read(r#"{ "dispersion": -1 }"#).unwrap_err();
+    assert!(e.contains("dispersion must be a number ≥ 0"), "{e}");
+}
+
 /// Gold spheres of roughness 0.3, 0.6 and 0.9 under a white sky (`bench/blender/
 /// multiscatter_vs_cycles.py`), Cycles' default Multiscatter GGX: alhazen's metals from a glTF
 /// give back the light of several facets, within 3 % of Cycles over the spheres (measured:
