@@ -4,7 +4,9 @@
 //! The default scene's node hierarchy is walked with each node's TRS or matrix composed onto
 //! its parent's (the course's scene graph); every mesh primitive becomes one shared mesh
 //! (positions, normals, first texture coordinates — `v` flipped, glTF's origin being the image's
-//! top — indices; strips and fans unrolled), instanced by every node that uses it. Materials map
+//! top — indices; strips and fans unrolled), instanced by every node that uses it — except
+//! where a node poses it (a skin, by linear blend skinning with its joints' world transforms;
+//! morph targets of non-zero weight): that node's mesh is its own, its vertices moved. Materials map
 //! through the metallic–roughness model (`common::metal_rough`): the base-colour texture and
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
 //! `KHR_materials_emissive_strength`, a transmitting material's absorbing inside with
@@ -96,6 +98,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
         .map_err(|e| error(path, bytes, format!("cannot read its buffers: {e}")))?;
     let mut imp = Importer {
         path,
+        worlds: HashMap::new(),
         textures: document.textures().collect(),
         bytes,
         buffers,
@@ -113,6 +116,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
     imp.extensions(&document);
     let scene = document.default_scene().or_else(|| document.scenes().next());
     let Some(scene) = scene else { return Err(error(path, bytes, "the file has no scene")) };
+    imp.worlds = node_worlds(&scene);
     imp.decode_ahead(&document, &scene);
     for node in scene.nodes() {
         imp.node(&node, Mat4::IDENTITY, 0)?;
@@ -138,6 +142,8 @@ fn error(path: &Path, bytes: &[u8], message: impl Into<String>) -> SceneError {
 
 struct Importer<'a> {
     path: &'a Path,
+    /// Every node's transform to the world (a skin's joints are placed by theirs).
+    worlds: HashMap<usize, Mat4>,
     /// The file's textures, for those named by extensions the reader does not know.
     textures: Vec<gltf::Texture<'a>>,
     bytes: &'a [u8],
@@ -201,7 +207,15 @@ impl Importer<'_> {
         let local = Mat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
         let world = parent * local;
         if let Some(mesh) = node.mesh() {
-            match Transform::from_matrix(world) {
+            let weights: Vec<f64> =
+                node.weights().or(mesh.weights()).map_or(vec![], |w| w.iter().map(|&x| x as f64).collect());
+            // A skinned mesh is placed by its joints alone (glTF ignores its node's transform).
+            let skin = node.skin().map(|skin| self.joint_matrices(&skin)).transpose()?;
+            let placed = if skin.is_some() { Mat4::IDENTITY } else { world };
+            match Transform::from_matrix(placed) {
+                Ok(t) if skin.is_some() || weights.iter().any(|w| *w != 0.0) => {
+                    self.posed_mesh(&mesh, t, &weights, skin.as_deref())?
+                }
                 Ok(t) => self.mesh(&mesh, t)?,
                 Err(e) => self.warn(format!("node {} is left out: its transform {e}", node.index())),
             }
@@ -237,21 +251,152 @@ impl Importer<'_> {
                 }
             };
             let Some(index) = index else { continue };
-            let material = self.material(prim.material())?;
-            // glTF multiplies every base colour by COLOR_0 where a primitive has it.
-            if !self.scene.meshes[index].colors.is_empty() {
-                self.scene.materials[material as usize].vertex_colors = true;
-            }
-            self.bounds = self.bounds.union(t.bounds(&self.scene.meshes[index].bounds()));
-            self.scene.objects.push(Object {
-                name: mesh.name().map(str::to_string),
-                shape: Shape::Mesh { mesh: index, smooth: true },
-                transform: t,
-                material,
-                mesh_materials: vec![],
-            });
+            self.place_mesh(mesh, &prim, index, t)?;
         }
         Ok(())
+    }
+
+    /// An object of scene mesh `index` (the primitive's) with its material, placed by `t`.
+    fn place_mesh(&mut self, mesh: &gltf::Mesh, prim: &gltf::Primitive, index: usize, t: Transform) -> R<()> {
+        let material = self.material(prim.material())?;
+        // glTF multiplies every base colour by COLOR_0 where a primitive has it.
+        if !self.scene.meshes[index].colors.is_empty() {
+            self.scene.materials[material as usize].vertex_colors = true;
+        }
+        self.bounds = self.bounds.union(t.bounds(&self.scene.meshes[index].bounds()));
+        self.scene.objects.push(Object {
+            name: mesh.name().map(str::to_string),
+            shape: Shape::Mesh { mesh: index, smooth: true },
+            transform: t,
+            material,
+            mesh_materials: vec![],
+        });
+        Ok(())
+    }
+
+    /// A mesh as its node shows it: each primitive's vertices moved by its morph targets
+    /// (`weights`) and then by its skin (`joints`: each joint's world transform times its
+    /// inverse bind matrix), a mesh of its own placed by `t`.
+    fn posed_mesh(&mut self, mesh: &gltf::Mesh, t: Transform, weights: &[f64], joints: Option<&[Mat4]>) -> R<()> {
+        for prim in mesh.primitives() {
+            let Some(mut m) = self.primitive(mesh, &prim)? else { continue };
+            let name = format!("mesh {} primitive {}", mesh.index(), prim.index());
+            self.morph(&prim, &mut m, weights, &name)?;
+            if let Some(joints) = joints {
+                self.skin(&prim, &mut m, joints, &name)?;
+            }
+            m.validate().map_err(|e| self.err(format!("{name} as posed: {e}")))?;
+            self.scene.meshes.push(Arc::new(m));
+            let index = self.scene.meshes.len() - 1;
+            self.place_mesh(mesh, &prim, index, t)?;
+        }
+        Ok(())
+    }
+
+    /// Moves `m`'s positions and normals by the primitive's morph targets times `weights`
+    /// (glTF's `p + Σ wᵢ·Δpᵢ`).
+    fn morph(&mut self, prim: &gltf::Primitive, m: &mut TriangleMesh, weights: &[f64], name: &str) -> R<()> {
+        let targets: Vec<_> = prim.morph_targets().collect();
+        if weights.iter().all(|w| *w == 0.0) {
+            return Ok(());
+        }
+        if weights.len() > targets.len() {
+            return Err(self.err(format!("{name}: {} morph weights for {} targets", weights.len(), targets.len())));
+        }
+        for (target, &w) in targets.iter().zip(weights).filter(|(_, w)| **w != 0.0) {
+            for (accessor, values) in [(target.positions(), &mut m.positions), (target.normals(), &mut m.normals)] {
+                let (Some(a), false) = (accessor, values.is_empty()) else { continue };
+                let deltas = self.vec3s(&a, name, "morph target")?;
+                if deltas.len() != values.len() {
+                    return Err(self.err(format!(
+                        "{name}: a morph target moves {} of its {} vertices",
+                        deltas.len(),
+                        values.len()
+                    )));
+                }
+                values.iter_mut().zip(&deltas).for_each(|(v, d)| *v += *d * w);
+            }
+        }
+        m.normals.iter_mut().for_each(|n| *n = n.normalize_or_zero());
+        Ok(())
+    }
+
+    /// Moves `m`'s vertices by linear blend skinning: each by its joints' matrices
+    /// (`JOINTS_n`, `WEIGHTS_n`, sets 0 and 1) weighted, normals by the blend's inverse
+    /// transpose.
+    fn skin(&mut self, prim: &gltf::Primitive, m: &mut TriangleMesh, joints: &[Mat4], name: &str) -> R<()> {
+        let mut blends = vec![Mat4::ZERO; m.positions.len()];
+        let mut any = false;
+        for set in 0..2 {
+            let (Some(j), Some(w)) = (prim.get(&gltf::Semantic::Joints(set)), prim.get(&gltf::Semantic::Weights(set)))
+            else {
+                continue;
+            };
+            let (j, w) = (self.integers::<4>(&j, name, "JOINTS")?, self.integers::<4>(&w, name, "WEIGHTS")?);
+            if j.len() != blends.len() || w.len() != blends.len() {
+                return Err(
+                    self.err(format!("{name}: its JOINTS_{set} and WEIGHTS_{set} must have one element per vertex"))
+                );
+            }
+            for ((blend, j), w) in blends.iter_mut().zip(&j).zip(&w) {
+                for k in 0..4 {
+                    let joint = joints.get(j[k] as usize).ok_or_else(|| {
+                        self.err(format!("{name}: joint {} is not one of its skin's {}", j[k], joints.len()))
+                    })?;
+                    if !(w[k].is_finite() && w[k] >= 0.0) {
+                        return Err(self.err(format!("{name}: its skin weights must be finite and ≥ 0")));
+                    }
+                    *blend += *joint * w[k];
+                }
+            }
+            any = true;
+        }
+        if !any {
+            return Err(self.err(format!("{name}: its node has a skin but the primitive no JOINTS_0 and WEIGHTS_0")));
+        }
+        for (i, blend) in blends.iter().enumerate() {
+            // Weights that do not sum to 1 are normalised; none leaves the vertex where it is.
+            let total = blend.row(3).w;
+            let blend = if total > 0.0 { *blend * (1.0 / total) } else { Mat4::IDENTITY };
+            m.positions[i] = blend.transform_point3(m.positions[i]);
+            if let Some(n) = m.normals.get_mut(i) {
+                let linear = alhazen_math::Mat3::from_mat4(blend);
+                let normals = if linear.determinant() != 0.0 { linear.inverse().transpose() } else { linear };
+                *n = (normals * *n).normalize_or_zero();
+            }
+        }
+        Ok(())
+    }
+
+    /// A skin's joint matrices: each joint node's world transform times its inverse bind
+    /// matrix (identity where the skin has none).
+    fn joint_matrices(&mut self, skin: &gltf::Skin) -> R<Vec<Mat4>> {
+        let name = format!("skin {}", skin.index());
+        let inverse_binds = match skin.inverse_bind_matrices() {
+            Some(a) => self.integers::<16>(&a, &name, "inverseBindMatrices")?,
+            None => vec![Mat4::IDENTITY.to_cols_array(); skin.joints().count()],
+        };
+        if inverse_binds.len() < skin.joints().count() {
+            return Err(self.err(format!("{name}: fewer inverse bind matrices than joints")));
+        }
+        skin.joints()
+            .zip(inverse_binds)
+            .map(|(joint, ib)| match self.worlds.get(&joint.index()) {
+                Some(world) => Ok(*world * Mat4::from_cols_array(&ib)),
+                None => Err(self.err(format!("{name}: joint node {} is not in the scene", joint.index()))),
+            })
+            .collect()
+    }
+
+    /// The `VEC3` elements of accessor `a`, floats or quantized integers.
+    fn vec3s(&self, a: &gltf::Accessor, name: &str, what: &str) -> R<Vec<Vec3>> {
+        if a.data_type() != DataType::F32 || a.sparse().is_none() {
+            return Ok(self.integers::<3>(a, name, what)?.into_iter().map(Vec3::from_array).collect());
+        }
+        let buffers = &self.buffers;
+        let iter = gltf::accessor::Iter::<[f32; 3]>::new(a.clone(), |b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let values = iter.ok_or_else(|| self.err(format!("{name}: its {what} accessor cannot be read")))?;
+        Ok(values.map(|v| Vec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect())
     }
 
     /// A primitive's triangles; `None` (with a warning) for points and lines.
@@ -973,6 +1118,22 @@ fn scaled(img: Arc<ImageData>, factor: Vec3) -> Arc<ImageData> {
         return img;
     }
     Arc::new(img.channels_scaled(factor.to_array().map(|x| x as f32)))
+}
+
+/// Every node of `scene` with its transform to the world (its ancestors' times its own);
+/// nodes nested deeper than 256 levels are left out (the walk refuses them).
+fn node_worlds(scene: &gltf::Scene) -> HashMap<usize, Mat4> {
+    let mut worlds = HashMap::new();
+    let mut todo: Vec<(gltf::Node, Mat4, usize)> = scene.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    while let Some((node, parent, depth)) = todo.pop() {
+        if depth > 256 || worlds.contains_key(&node.index()) {
+            continue;
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        worlds.insert(node.index(), world);
+        todo.extend(node.children().map(|c| (c, world, depth + 1)));
+    }
+    worlds
 }
 
 /// `bsdf` with its glass (the dielectric that transmission mixes in) of index `ior`.
