@@ -6,7 +6,8 @@
 //! (positions, normals, first texture coordinates — `v` flipped, glTF's origin being the image's
 //! top — indices; strips and fans unrolled), instanced by every node that uses it — except
 //! where a node poses it (a skin, by linear blend skinning with its joints' world transforms;
-//! morph targets of non-zero weight): that node's mesh is its own, its vertices moved. Materials map
+//! morph targets of non-zero weight): that node's mesh is its own, its vertices moved; a node's
+//! `EXT_mesh_gpu_instancing` instances are objects of its one mesh. Materials map
 //! through the metallic–roughness model (`common::metal_rough`): the base-colour texture and
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
 //! `KHR_materials_emissive_strength`, a transmitting material's absorbing inside with
@@ -22,7 +23,7 @@
 use crate::Imported;
 use crate::common::{self, Warnings};
 use alhazen_geom::TriangleMesh;
-use alhazen_math::{Bounds3, Mat4, Transform, Vec2, Vec3};
+use alhazen_math::{Bounds3, Mat4, Quat, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Ior, MetalRoughness};
 use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
@@ -55,6 +56,7 @@ const KNOWN: &[&str] = &[
     "KHR_materials_anisotropy",
     "EXT_texture_webp",
     "KHR_materials_dispersion",
+    "EXT_mesh_gpu_instancing",
 ];
 
 /// Reads a glTF 2.0 file.
@@ -100,6 +102,7 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
         path,
         worlds: HashMap::new(),
         textures: document.textures().collect(),
+        accessors: document.accessors().collect(),
         bytes,
         buffers,
         base,
@@ -144,8 +147,10 @@ struct Importer<'a> {
     path: &'a Path,
     /// Every node's transform to the world (a skin's joints are placed by theirs).
     worlds: HashMap<usize, Mat4>,
-    /// The file's textures, for those named by extensions the reader does not know.
+    /// The file's textures and accessors, for those named by extensions the reader does not
+    /// know.
     textures: Vec<gltf::Texture<'a>>,
+    accessors: Vec<gltf::Accessor<'a>>,
     bytes: &'a [u8],
     buffers: Vec<gltf::buffer::Data>,
     base: &'a Path,
@@ -212,12 +217,24 @@ impl Importer<'_> {
             // A skinned mesh is placed by its joints alone (glTF ignores its node's transform).
             let skin = node.skin().map(|skin| self.joint_matrices(&skin)).transpose()?;
             let placed = if skin.is_some() { Mat4::IDENTITY } else { world };
-            match Transform::from_matrix(placed) {
-                Ok(t) if skin.is_some() || weights.iter().any(|w| *w != 0.0) => {
-                    self.posed_mesh(&mesh, t, &weights, skin.as_deref())?
+            let posed = skin.is_some() || weights.iter().any(|w| *w != 0.0);
+            let instances = match node.extension_value("EXT_mesh_gpu_instancing") {
+                Some(_) if posed => {
+                    self.warn(format!(
+                        "node {}: instances of a posed mesh are not supported; one is drawn",
+                        node.index()
+                    ));
+                    vec![placed]
                 }
-                Ok(t) => self.mesh(&mesh, t)?,
-                Err(e) => self.warn(format!("node {} is left out: its transform {e}", node.index())),
+                Some(ext) => self.instances(ext, placed, node.index())?,
+                None => vec![placed],
+            };
+            for placed in instances {
+                match Transform::from_matrix(placed) {
+                    Ok(t) if posed => self.posed_mesh(&mesh, t, &weights, skin.as_deref())?,
+                    Ok(t) => self.mesh(&mesh, t)?,
+                    Err(e) => self.warn(format!("node {} is left out: its transform {e}", node.index())),
+                }
             }
         }
         if let Some(camera) = node.camera()
@@ -272,6 +289,56 @@ impl Importer<'_> {
             mesh_materials: vec![],
         });
         Ok(())
+    }
+
+    /// `EXT_mesh_gpu_instancing`'s instances of a node placed by `world`: each
+    /// `world · T · R · S` of its `TRANSLATION`, `ROTATION` (a unit quaternion) and `SCALE`
+    /// (any of them absent: none).
+    fn instances(&mut self, ext: &serde_json::Value, world: Mat4, node: usize) -> R<Vec<Mat4>> {
+        let name = format!("node {node}");
+        let attributes = ext.get("attributes");
+        let accessor = |key: &str| -> R<Option<gltf::Accessor<'_>>> {
+            match attributes.and_then(|a| a.get(key)) {
+                None => Ok(None),
+                Some(i) => {
+                    i.as_u64().and_then(|i| self.accessors.get(i as usize)).cloned().map(Some).ok_or_else(|| {
+                        self.err(format!(
+                            "{name}: EXT_mesh_gpu_instancing's {key} must name one of the file's accessors"
+                        ))
+                    })
+                }
+            }
+        };
+        let (t, r, sc) = (accessor("TRANSLATION")?, accessor("ROTATION")?, accessor("SCALE")?);
+        let translations = t.map(|a| self.integers::<3>(&a, &name, "TRANSLATION")).transpose()?;
+        let rotations = r.map(|a| self.integers::<4>(&a, &name, "ROTATION")).transpose()?;
+        let scales = sc.map(|a| self.integers::<3>(&a, &name, "SCALE")).transpose()?;
+        let counts: Vec<usize> =
+            [translations.as_ref().map(Vec::len), rotations.as_ref().map(Vec::len), scales.as_ref().map(Vec::len)]
+                .into_iter()
+                .flatten()
+                .collect();
+        let Some(&n) = counts.first() else {
+            return Err(self.err(format!("{name}: EXT_mesh_gpu_instancing has no TRANSLATION, ROTATION or SCALE")));
+        };
+        if counts.iter().any(|&c| c != n) {
+            return Err(
+                self.err(format!("{name}: EXT_mesh_gpu_instancing's attributes must have as many elements each"))
+            );
+        }
+        (0..n)
+            .map(|i| {
+                let t = translations.as_ref().map_or(Vec3::ZERO, |v| Vec3::from_array(v[i]));
+                let q = rotations.as_ref().map_or(Quat::IDENTITY, |v| Quat::from_array(v[i]));
+                let s = scales.as_ref().map_or(Vec3::ONE, |v| Vec3::from_array(v[i]));
+                if !(t.is_finite() && s.is_finite() && q.is_finite() && (q.length() - 1.0).abs() < 1e-3) {
+                    return Err(self.err(format!(
+                        "{name}: instance {i} has a non-finite place or a rotation that is not a unit quaternion"
+                    )));
+                }
+                Ok(world * Mat4::from_scale_rotation_translation(s, q.normalize(), t))
+            })
+            .collect()
     }
 
     /// A mesh as its node shows it: each primitive's vertices moved by its morph targets

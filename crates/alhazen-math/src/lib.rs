@@ -35,7 +35,7 @@ pub mod transform;
 pub mod viewing;
 
 pub use bounds::Bounds3;
-pub use glam::{DMat3 as Mat3, DMat4 as Mat4, DVec2 as Vec2, DVec3 as Vec3, DVec4 as Vec4};
+pub use glam::{DMat3 as Mat3, DMat4 as Mat4, DQuat as Quat, DVec2 as Vec2, DVec3 as Vec3, DVec4 as Vec4};
 pub use ray::Ray;
 pub use transform::{Transform, TransformError};
 
