@@ -11,10 +11,11 @@
 //! through the metallic–roughness model (`common::metal_rough`): the base-colour texture and
 //! factor exactly, `KHR_materials_transmission` and `_ior`, emission with
 //! `KHR_materials_emissive_strength`, a transmitting material's absorbing inside with
-//! `KHR_materials_volume`, a clear coat with `KHR_materials_clearcoat`, brushed facets with
-//! `KHR_materials_anisotropy`; a metallic–roughness texture, a textured metal's colour and
-//! stretched facets are read per point (`BsdfDesc::MetallicRoughness`, the model at each point), by
-//! their means under transmission; so is an emission texture (its factor and strength
+//! `KHR_materials_volume` (and its index by wavelength with `KHR_materials_dispersion`), a
+//! clear coat with `KHR_materials_clearcoat`, cloth's sheen with `KHR_materials_sheen`, brushed
+//! facets with `KHR_materials_anisotropy`; a metallic–roughness texture, a textured metal's
+//! colour and stretched facets are read per point (`BsdfDesc::MetallicRoughness`, the model at
+//! each point), by their means under transmission; so is an emission texture (its factor and strength
 //! multiplied in).
 //! `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the 683 lm/W
 //! that Blender's exporter uses. The first camera met is the camera; without one the
@@ -57,6 +58,7 @@ const KNOWN: &[&str] = &[
     "EXT_texture_webp",
     "KHR_materials_dispersion",
     "EXT_mesh_gpu_instancing",
+    "KHR_materials_sheen",
 ];
 
 /// Reads a glTF 2.0 file.
@@ -706,7 +708,7 @@ impl Importer<'_> {
             _ => (Vec2::ONE, Vec2::ZERO, 0.0),
         };
         let alpha = self.cut_out(&material, c[3] as f64, placement)?;
-        for ext in ["KHR_materials_sheen", "KHR_materials_iridescence"] {
+        for ext in ["KHR_materials_iridescence"] {
             if material.extension_value(ext).is_some() {
                 self.warn(format!("{name}: {ext} is not supported; ignored"));
             }
@@ -745,6 +747,7 @@ impl Importer<'_> {
                 None => bsdf,
             }
         };
+        let bsdf = self.sheen(&material, bsdf, &name)?;
         let bsdf = self.clearcoat(&material, bsdf, &name)?;
         let refracts = bsdf.refracts();
         let mut m = alhazen_scene::Material::from_bsdf(&name, bsdf);
@@ -838,6 +841,34 @@ impl Importer<'_> {
         let k = (ior - 1.0) * dispersion / 20.0;
         // Cauchy's `A + B/λ²` with λ in micrometres.
         Ok(Some(Ior::Cauchy { a: ior - 1.5168 * k, b: 0.523655 * k }))
+    }
+
+    /// `bsdf` under `KHR_materials_sheen`'s fibres: of colour `sheenColorFactor`, roughness
+    /// `sheenRoughnessFactor` (`α = r²`); none where the colour is black. Its textures are left
+    /// out (warning: the factors are used).
+    fn sheen(&mut self, material: &gltf::Material, bsdf: BsdfDesc, name: &str) -> R<BsdfDesc> {
+        let Some(e) = material.extension_value("KHR_materials_sheen") else { return Ok(bsdf) };
+        let unit = |x: &serde_json::Value| x.as_f64().filter(|x| (0.0..=1.0).contains(x));
+        let color = match e.get("sheenColorFactor") {
+            None => Some([0.0; 3]),
+            Some(c) => c.as_array().filter(|c| c.len() == 3).and_then(|c| {
+                let k: Option<Vec<f64>> = c.iter().map(unit).collect();
+                k.map(|k| [k[0], k[1], k[2]])
+            }),
+        };
+        let roughness = e.get("sheenRoughnessFactor").map_or(Some(0.0), unit);
+        let (Some(color), Some(roughness)) = (color, roughness) else {
+            return Err(self.err(format!(
+                "{name}: KHR_materials_sheen needs a sheenColorFactor of three numbers and a sheenRoughnessFactor, within [0, 1]"
+            )));
+        };
+        if ["sheenColorTexture", "sheenRoughnessTexture"].iter().any(|k| e.get(*k).is_some()) {
+            self.warn(format!("{name}: KHR_materials_sheen's textures are not supported; its factors are used"));
+        }
+        if color == [0.0; 3] {
+            return Ok(bsdf);
+        }
+        Ok(BsdfDesc::Sheened { base: Box::new(bsdf), color: Vec3::from_array(color), roughness })
     }
 
     /// `bsdf` under `KHR_materials_clearcoat`'s coat: of weight `clearcoatFactor`, GGX facets

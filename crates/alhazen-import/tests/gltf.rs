@@ -1000,6 +1000,47 @@ fn dispersion_spreads_the_glass_index_by_wavelength() {
     assert!(e.contains("dispersion must be a number ≥ 0"), "{e}");
 }
 
+/// `KHR_materials_sheen`: the fibres' colour and roughness over the material (under a clear
+/// coat where there is one); a black sheen is none; its textures are warned about; bad factors
+/// refused.
+#[test]
+fn sheen_factors_make_the_fibres() {
+    let read = |ext: &str| {
+        let json = embedded().replace(
+            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
+            &format!(r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "extensions": {{ {ext} }}"#),
+        );
+        let s = write_and_import(&[("s.gltf", json.into_bytes())])?;
+        let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+        Ok::<_, String>((s.scene.materials[s.scene.objects[0].material as usize].bsdf.clone().unwrap(), said))
+    };
+    let (bsdf, said) =
+        read(r#""KHR_materials_sheen": { "sheenColorFactor": [1, 0.5, 0.25], "sheenRoughnessFactor": 0.3 }"#).unwrap();
+    assert!(said.is_empty(), "{said:?}");
+    let BsdfDesc::Sheened { base, color, roughness } = bsdf else { panic!("{bsdf:?}") };
+    assert_eq!((color, roughness), (Vec3::new(1.0, 0.5, 0.25), 0.3));
+    assert!(matches!(*base, BsdfDesc::CookTorrance { .. }), "{base:?}");
+    let (bsdf, _) = read(
+        r#""KHR_materials_sheen": { "sheenColorFactor": [1, 1, 1] }, "KHR_materials_clearcoat": { "clearcoatFactor": 1 }"#,
+    )
+    .unwrap();
+    let BsdfDesc::Coated { base, .. } = bsdf else { panic!("{bsdf:?}") };
+    assert!(matches!(*base, BsdfDesc::Sheened { roughness: 0.0, .. }), "{base:?}");
+    let (bsdf, _) = read(r#""KHR_materials_sheen": { "sheenRoughnessFactor": 0.5 }"#).unwrap();
+    assert!(matches!(bsdf, BsdfDesc::CookTorrance { .. }), "{bsdf:?}");
+    let (_, said) =
+        read(r#""KHR_materials_sheen": { "sheenColorFactor": [1, 1, 1], "sheenColorTexture": { "index": 0 } }"#)
+            .unwrap();
+    assert!(said.iter().any(|w| w.contains("KHR_materials_sheen's textures are not supported")), "{said:?}");
+    for bad in [
+        r#""KHR_materials_sheen": { "sheenColorFactor": [2, 0, 0] }"#,
+        r#""KHR_materials_sheen": { "sheenRoughnessFactor": "soft" }"#,
+    ] {
+        let e = read(bad).unwrap_err();
+        assert!(e.contains("KHR_materials_sheen needs a sheenColorFactor"), "{bad}: {e}");
+    }
+}
+
 /// Gold spheres of roughness 0.3, 0.6 and 0.9 under a white sky (`bench/blender/
 /// multiscatter_vs_cycles.py`), Cycles' default Multiscatter GGX: alhazen's metals from a glTF
 /// give back the light of several facets, within 3 % of Cycles over the spheres (measured:

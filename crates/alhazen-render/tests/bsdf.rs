@@ -156,6 +156,19 @@ fn catalogue() -> Vec<(String, Bsdf)> {
             0.5,
         ))),
     ));
+    // Sheen: velvet over Lambert, a faint rough sheen over rough plastic.
+    list.push((
+        "sheened lambert, sheen α=0.3".into(),
+        Bsdf::Sheened(Box::new(Sheened::new(Bsdf::Lambert(Lambert { albedo }), Vec3::new(1.0, 0.8, 0.6), 0.3))),
+    ));
+    list.push((
+        "sheened rough plastic, sheen α=0.8".into(),
+        Bsdf::Sheened(Box::new(Sheened::new(
+            Bsdf::Plastic(Plastic::new(albedo, 1.49, Some(ggx(0.2)), false)),
+            Vec3::splat(0.3),
+            0.8,
+        ))),
+    ));
     list
 }
 
@@ -403,7 +416,7 @@ fn reciprocal_brdfs_satisfy_helmholtz() {
         if name.starts_with("rough dielectric") {
             continue; // dielectrics obey the η² law below
         }
-        if name.starts_with("coated") {
+        if name.starts_with("coated") || name.starts_with("sheened") {
             continue; // the base under a coat is weighed by what the coat lets through towards the viewer only (glTF's and Cycles' layering)
         }
         for _ in 0..200 {

@@ -238,6 +238,17 @@ pub enum BsdfDesc {
         /// The coat's index of refraction (1.5 in glTF).
         ior: f64,
     },
+    /// Sheen over `base` (velvet, satin; glTF's `KHR_materials_sheen`): Estevez and Kulla's
+    /// "Charlie" fibres of colour `color` reflecting `color·ρ_s`, the base below weighted by one
+    /// minus the sheen's albedo towards the viewer.
+    Sheened {
+        /// What lies under the sheen.
+        base: Box<BsdfDesc>,
+        /// The sheen's colour (0: none).
+        color: Rgb,
+        /// The fibres' roughness `r ∈ [0, 1]` (`α = r²`, at least 10⁻³).
+        roughness: f64,
+    },
     /// `weight · a + (1 − weight) · b`.
     Mix {
         /// First BSDF.
@@ -332,7 +343,7 @@ impl crate::model::Material {
                 }
             }
             BsdfDesc::Mix { a, .. } => self.follow(a),
-            BsdfDesc::Coated { base, .. } => self.follow(base),
+            BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => self.follow(base),
         }
     }
 }
@@ -459,7 +470,7 @@ impl BsdfDesc {
             | BsdfDesc::CookTorrance { albedo, .. }
             | BsdfDesc::Plastic { albedo, .. } => t(albedo),
             BsdfDesc::Mix { a, b, weight_map, .. } => a.is_textured() || b.is_textured() || weight_map.is_some(),
-            BsdfDesc::Coated { base, .. } => base.is_textured(),
+            BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => base.is_textured(),
             BsdfDesc::MetallicRoughness { base, map, anisotropy_map, .. } => {
                 t(base) || map.is_some() || anisotropy_map.is_some()
             }
@@ -494,6 +505,7 @@ impl BsdfDesc {
             BsdfDesc::Conductor { facets: Some(f), .. } | BsdfDesc::Dielectric { facets: Some(f), .. } => two(f),
             BsdfDesc::Mix { a, b, .. } => a.is_anisotropic() || b.is_anisotropic(),
             BsdfDesc::Coated { base, facets, .. } => base.is_anisotropic() || two(facets),
+            BsdfDesc::Sheened { base, .. } => base.is_anisotropic(),
             BsdfDesc::MetallicRoughness { anisotropy, .. } => anisotropy.is_anisotropic(),
             _ => false,
         }
@@ -505,7 +517,7 @@ impl BsdfDesc {
         match self {
             BsdfDesc::Dielectric { .. } => true,
             BsdfDesc::Mix { a, b, .. } => a.refracts() || b.refracts(),
-            BsdfDesc::Coated { base, .. } => base.refracts(),
+            BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => base.refracts(),
             _ => false,
         }
     }
@@ -515,7 +527,7 @@ impl BsdfDesc {
         match self {
             BsdfDesc::Dielectric { ior, .. } => ior.is_dispersive(),
             BsdfDesc::Mix { a, b, .. } => a.is_dispersive() || b.is_dispersive(),
-            BsdfDesc::Coated { base, .. } => base.is_dispersive(),
+            BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => base.is_dispersive(),
             _ => false,
         }
     }

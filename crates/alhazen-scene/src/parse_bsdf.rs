@@ -51,6 +51,7 @@ impl Parser<'_> {
             "mix",
             "metallic-roughness",
             "coated",
+            "sheen",
         ])?;
         let keys: Vec<&str> = match kind {
             "lambert" => vec!["color"],
@@ -66,6 +67,7 @@ impl Parser<'_> {
             }
             "thin-dielectric" => vec!["ior"],
             "coated" => [&["base", "weight", "ior"][..], MICROFACET_KEYS].concat(),
+            "sheen" => vec!["base", "sheen_color", "roughness"],
             _ => vec!["a", "b", "weight", "weight_map"],
         };
         t.check_keys(&[&["type"][..], &keys].concat())?;
@@ -178,6 +180,11 @@ impl Parser<'_> {
                     ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
                 }
             }
+            "sheen" => BsdfDesc::Sheened {
+                base: Box::new(self.bsdf(&t.req("base")?, &albedo)?),
+                color: t.opt_rgb("sheen_color", Vec3::ONE)?,
+                roughness: t.get("roughness").map_or(Ok(0.5), |n| n.in_range(0.0, 1.0))?,
+            },
             _ => BsdfDesc::Mix {
                 a: Box::new(self.bsdf(&t.req("a")?, &albedo)?),
                 b: Box::new(self.bsdf(&t.req("b")?, &albedo)?),

@@ -519,6 +519,12 @@ impl Writer<'_> {
                     num(*weight)
                 )
             }
+            BsdfDesc::Sheened { base, color, roughness } => format!(
+                "{{ type = \"sheen\", base = {}, sheen_color = {}, roughness = {} }}",
+                self.bsdf(base),
+                vec3(*color),
+                num(*roughness)
+            ),
             BsdfDesc::Coated { base, weight, facets: f, ior } => format!(
                 "{{ type = \"coated\", base = {}, weight = {}, ior = {}, {} }}",
                 self.bsdf(base),

@@ -312,6 +312,37 @@ fn anisotropy_stretches_the_roughness() {
     assert_eq!((flat.strength, flat.rotation), (0.8, 0.0));
 }
 
+/// Sheen over a base: its colour (white by default) and roughness (0.5), the base's albedo the
+/// material's colour; the same after writing the scene back out.
+#[test]
+fn sheen_reads_and_writes_back() {
+    use alhazen_scene::bsdf::BsdfDesc;
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"
+[materials.velvet]
+color = [0.3, 0.02, 0.05]
+bsdf = { type = "sheen", base = { type = "lambert" }, sheen_color = [1, 0.9, 0.9], roughness = 0.4 }
+[materials.plain]
+bsdf = { type = "sheen", base = { type = "lambert" } }
+"#;
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let mat = |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().bsdf.clone();
+    let Some(BsdfDesc::Sheened { base, color, roughness }) = mat(&s, "velvet") else { panic!() };
+    assert_eq!((color, roughness), (alhazen_math::Vec3::new(1.0, 0.9, 0.9), 0.4));
+    assert!(
+        matches!(*base, BsdfDesc::Lambert { albedo: Texture::Solid(c) } if c == alhazen_math::Vec3::new(0.3, 0.02, 0.05))
+    );
+    assert!(matches!(mat(&s, "plain"), Some(BsdfDesc::Sheened { roughness: 0.5, .. })));
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&again_path).unwrap();
+    for name in ["velvet", "plain"] {
+        assert_eq!(mat(&s, name), mat(&again, name));
+    }
+}
+
 /// Plastic: smooth by default (Mitsuba's polypropylene coat), rough with a roughness, and the
 /// same after writing the scene back out.
 #[test]

@@ -21,6 +21,7 @@ mod multiscatter;
 mod oren_nayar;
 mod phong;
 mod plastic;
+mod sheen;
 
 pub use blinn_phong::{BlinnPhong, BlinnPhongLobe};
 pub use build::{ColorMode, bsdf_at, is_anisotropic, tangent_at};
@@ -36,6 +37,7 @@ pub use multiscatter::SeveralFacets;
 pub use oren_nayar::OrenNayar;
 pub use phong::{Phong, PhongLobe};
 pub use plastic::{Coat, Plastic};
+pub use sheen::Sheened;
 
 use alhazen_math::{Vec2, Vec3};
 use std::f64::consts::PI;
@@ -80,6 +82,8 @@ pub enum Bsdf {
     Mix(Box<Mix>),
     /// A base under a clear coat.
     Coated(Box<Coated>),
+    /// A base under a sheen.
+    Sheened(Box<Sheened>),
 }
 
 macro_rules! dispatch {
@@ -95,6 +99,7 @@ macro_rules! dispatch {
             Bsdf::Dielectric($b) => $e,
             Bsdf::Mix($b) => $e,
             Bsdf::Coated($b) => $e,
+            Bsdf::Sheened($b) => $e,
         }
     };
 }
@@ -120,6 +125,7 @@ impl Bsdf {
             Bsdf::CookTorrance(c) => c.rough_eval_pdf(&c.lobe.facets, v, l),
             Bsdf::Mix(m) => m.eval_pdf(v, l),
             Bsdf::Coated(c) => c.eval_pdf(v, l),
+            Bsdf::Sheened(c) => c.eval_pdf(v, l),
             _ => (self.eval(v, l), self.pdf(v, l)),
         }
     }
@@ -161,6 +167,7 @@ impl Bsdf {
             Bsdf::Dielectric(d) => d.facets.is_none(),
             Bsdf::Mix(m) => m.a.has_delta_lobe() || m.b.has_delta_lobe(),
             Bsdf::Coated(c) => c.base.has_delta_lobe(),
+            Bsdf::Sheened(c) => c.base.has_delta_lobe(),
             _ => false,
         }
     }
@@ -172,6 +179,7 @@ impl Bsdf {
             Bsdf::Conductor(c) if c.facets.is_none() => c.fresnel(cos),
             Bsdf::Mix(m) => m.a.mirror_reflectance(cos) * m.weight + m.b.mirror_reflectance(cos) * (1.0 - m.weight),
             Bsdf::Coated(c) => c.base.mirror_reflectance(cos) * (1.0 - c.coat_albedo(cos)),
+            Bsdf::Sheened(c) => c.base.mirror_reflectance(cos) * (1.0 - c.sheen_albedo(cos)),
             _ => Vec3::ZERO,
         }
     }
@@ -182,6 +190,7 @@ impl Bsdf {
             Bsdf::Dielectric(_) => true,
             Bsdf::Mix(m) => m.a.transmits() || m.b.transmits(),
             Bsdf::Coated(c) => c.base.transmits(),
+            Bsdf::Sheened(c) => c.base.transmits(),
             _ => false,
         }
     }
