@@ -1146,16 +1146,15 @@ impl Importer<'_> {
             Kind::Spot { inner_cone_angle, outer_cone_angle } => {
                 let (inner, outer) =
                     (inner_cone_angle as f64, (outer_cone_angle as f64).clamp(1e-4, std::f64::consts::FRAC_PI_2));
+                // glTF's fade between its cones: the square of one linear in the cosine.
                 let fades = outer - inner > 1e-6;
-                if fades {
-                    self.warn("a spot light's fade between its cones (quadratic in the cosine) is approximated by a fade linear in angle");
-                }
+                let fade = alhazen_scene::SpotFade::SquaredCosine;
                 Light::Spot {
                     position,
                     direction,
                     cos_cutoff: outer.cos(),
                     falloff: 0.0,
-                    cos_beam: fades.then(|| inner.max(0.0).cos()),
+                    beam: fades.then(|| alhazen_scene::SpotBeam { cos: inner.max(0.0).cos(), fade }),
                     intensity: power,
                     attenuation: [1.0, 0.0, 0.0],
                 }

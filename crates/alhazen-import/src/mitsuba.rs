@@ -1761,7 +1761,10 @@ impl Importer {
                     // Mitsuba's fade: full intensity within `beam_width`, linear in angle to
                     // nothing at `cutoff_angle`.
                     falloff: 0.0,
-                    cos_beam: (beam < cutoff).then(|| beam.to_radians().cos()),
+                    beam: (beam < cutoff).then(|| alhazen_scene::SpotBeam {
+                        cos: beam.to_radians().cos(),
+                        fade: alhazen_scene::SpotFade::LinearAngle,
+                    }),
                     intensity,
                     attenuation: [1.0, 0.0, 0.0],
                 }

@@ -1247,16 +1247,15 @@ impl Importer {
                 if dir == Vec3::ZERO || !(cone > 0.0 && cone < 180.0) {
                     return Err(ctx.err(at.clone(), "a spot light needs from ≠ to and coneangle in (0, 180)"));
                 }
+                // pbrt's fade over conedelta: smooth in the cosine.
                 let beam = (cone - delta).max(0.0);
-                if beam < cone {
-                    self.warn(ctx, at, "a spot light's fade over conedelta (smooth in the cosine) is approximated by a fade linear in angle");
-                }
+                let fade = alhazen_scene::SpotFade::SmoothCosine;
                 Light::Spot {
                     position: m.transform_point3(from),
                     direction: dir,
                     cos_cutoff: cone.to_radians().cos(),
                     falloff: 0.0,
-                    cos_beam: (beam < cone).then(|| beam.to_radians().cos()),
+                    beam: (beam < cone).then(|| alhazen_scene::SpotBeam { cos: beam.to_radians().cos(), fade }),
                     intensity,
                     attenuation: [1.0, 0.0, 0.0],
                 }

@@ -181,11 +181,11 @@ fn emission_lights_the_render_and_what_is_left_out_is_said() {
     )
     .replace(
         r#""extensionsUsed": ["KHR_lights_punctual"]"#,
-        r#""extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_sheen", "KHR_texture_transform"]"#,
+        r#""extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_iridescence", "KHR_texture_transform"]"#,
     );
     let s = write_and_import(&[("e.gltf", json.into_bytes())]).unwrap();
     let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
-    assert!(said.iter().any(|w| w.contains("KHR_materials_sheen is not supported")), "{said:?}");
+    assert!(said.iter().any(|w| w.contains("KHR_materials_iridescence is not supported")), "{said:?}");
     assert!(said.iter().all(|w| !w.contains("KHR_texture_transform")), "{said:?}");
     let mut sc = s.scene;
     let m = &sc.materials[sc.objects[0].material as usize];
@@ -1039,6 +1039,24 @@ fn sheen_factors_make_the_fibres() {
         let e = read(bad).unwrap_err();
         assert!(e.contains("KHR_materials_sheen needs a sheenColorFactor"), "{bad}: {e}");
     }
+}
+
+/// A `KHR_lights_punctual` spot fades between its cones as glTF says (the square of a fade
+/// linear in the cosine), without a warning.
+#[test]
+fn gltf_spots_fade_as_gltf_says() {
+    let json = embedded().replace(
+        r#"{ "type": "point", "intensity": 683, "color": [1, 0.5, 0.25] }"#,
+        r#"{ "type": "spot", "intensity": 683, "spot": { "innerConeAngle": 0.3, "outerConeAngle": 0.5 } }"#,
+    );
+    let s = write_and_import(&[("spot.gltf", json.into_bytes())]).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let Light::Spot { cos_cutoff, beam: Some(beam), .. } = s.scene.lights[0] else { panic!("{:?}", s.scene.lights) };
+    assert!(
+        (cos_cutoff - 0.5f64.cos()).abs() < 1e-7 && (beam.cos - 0.3f64.cos()).abs() < 1e-7,
+        "{cos_cutoff} {beam:?}"
+    );
+    assert_eq!(beam.fade, alhazen_scene::SpotFade::SquaredCosine);
 }
 
 /// Gold spheres of roughness 0.3, 0.6 and 0.9 under a white sky (`bench/blender/

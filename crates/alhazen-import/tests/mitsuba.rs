@@ -998,10 +998,14 @@ fn spot_lights_keep_their_beam() {
            <emitter type="spot"/>"#,
     );
     let s = import(&[("s.xml", &xml)]).unwrap().scene;
-    let Light::Spot { cos_cutoff, falloff, cos_beam, .. } = s.lights[0] else { panic!("not a spot") };
-    assert_eq!((cos_cutoff, falloff, cos_beam), (30f64.to_radians().cos(), 0.0, Some(20f64.to_radians().cos())));
-    let Light::Spot { cos_cutoff, cos_beam, .. } = s.lights[1] else { panic!("not a spot") };
-    assert_eq!((cos_cutoff, cos_beam), (20f64.to_radians().cos(), Some(15f64.to_radians().cos())));
+    let Light::Spot { cos_cutoff, falloff, beam, .. } = s.lights[0] else { panic!("not a spot") };
+    assert_eq!(
+        (cos_cutoff, falloff, beam.map(|b| b.cos)),
+        (30f64.to_radians().cos(), 0.0, Some(20f64.to_radians().cos()))
+    );
+    let Light::Spot { cos_cutoff, beam, .. } = s.lights[1] else { panic!("not a spot") };
+    assert_eq!((cos_cutoff, beam.map(|b| b.cos)), (20f64.to_radians().cos(), Some(15f64.to_radians().cos())));
+    assert_eq!(beam.map(|b| b.fade), Some(alhazen_scene::SpotFade::LinearAngle));
 }
 
 /// A long chain of references to later elements reads without exhausting the stack: a BSDF

@@ -95,7 +95,8 @@ Translate -1 0.5 0
 ObjectInstance "ball"
 "#;
     let lights = r#"LightSource "point" "point3 from" [0 4 0] "rgb I" [2 2 2]
-LightSource "distant" "point3 from" [0 1 0] "point3 to" [0 0 0] "blackbody L" 5500"#;
+LightSource "distant" "point3 from" [0 1 0] "point3 to" [0 0 0] "blackbody L" 5500
+LightSource "spot" "point3 from" [0 3 0] "point3 to" [0 0 0] "float coneangle" 30 "float conedelta" 10"#;
     let s = import(&[("main.pbrt", main), ("lights.pbrt", lights)]).unwrap();
     let sc = &s.scene;
     assert_eq!((sc.render.width, sc.render.height), (32, 16));
@@ -119,6 +120,10 @@ LightSource "distant" "point3 from" [0 1 0] "point3 to" [0 0 0] "blackbody L" 55
         Light::Point { position: Vec3::new(-0.0, 4.0, 0.0), intensity: Vec3::splat(2.0), attenuation: [1.0, 0.0, 0.0] }
     );
     assert!(matches!(sc.lights[1], Light::Directional { direction, .. } if direction == -Vec3::Y));
+    // pbrt's spot fades smoothly in the cosine over conedelta.
+    let Light::Spot { cos_cutoff, beam: Some(beam), .. } = sc.lights[2] else { panic!("{:?}", sc.lights[2]) };
+    assert_eq!((cos_cutoff, beam.cos), (30f64.to_radians().cos(), 20f64.to_radians().cos()));
+    assert_eq!(beam.fade, alhazen_scene::SpotFade::SmoothCosine);
     let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
     assert!(said.iter().any(|w| w.contains("lights.pbrt:2: a blackbody spectrum")), "{said:?}");
     assert!(said.iter().any(|w| w.contains("main.pbrt:9: bilinear patches")), "{said:?}");

@@ -97,13 +97,13 @@ impl<'a> Emitter<'a> {
                 let (dir, pdf) = self.direction(*position, rng)?;
                 Emission { origin: *position, dir, power: *intensity / pdf }
             }
-            PathLight::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity } => {
+            PathLight::Spot { position, direction, cos_cutoff, falloff, beam, intensity } => {
                 let (dir, pdf) = self.direction(*position, rng)?;
                 let c = dir.dot(*direction);
                 if c < *cos_cutoff {
                     return None;
                 }
-                let shaped = alhazen_scene::spot_profile(c, *cos_cutoff, *falloff, *cos_beam);
+                let shaped = alhazen_scene::spot_profile(c, *cos_cutoff, *falloff, *beam);
                 Emission { origin: *position, dir, power: *intensity * shaped / pdf }
             }
             PathLight::Area { .. } => {

@@ -363,7 +363,7 @@ enum Source {
     Patch { poly: Polygon, centre: Vec3, normal: Vec3, radiosity: Vec3, aims: Vec<Vec3>, area: f64 },
     /// A point or spot light: intensity, and a spot's (axis, cosine of the cut-off, exponent,
     /// cosine of its beam).
-    Point { position: Vec3, intensity: Vec3, spot: Option<(Vec3, f64, f64, Option<f64>)> },
+    Point { position: Vec3, intensity: Vec3, spot: Option<(Vec3, f64, f64, Option<alhazen_scene::SpotBeam>)> },
     /// Parallel light from direction `towards` (unit, towards the light).
     Directional { towards: Vec3, irradiance: Vec3 },
     /// The background or environment map.
@@ -376,8 +376,8 @@ fn sources(scene: &Scene) -> Vec<Source> {
         .iter()
         .filter_map(|l| match *l {
             Light::Point { position, intensity, .. } => Some(Source::Point { position, intensity, spot: None }),
-            Light::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity, .. } => {
-                Some(Source::Point { position, intensity, spot: Some((direction, cos_cutoff, falloff, cos_beam)) })
+            Light::Spot { position, direction, cos_cutoff, falloff, beam, intensity, .. } => {
+                Some(Source::Point { position, intensity, spot: Some((direction, cos_cutoff, falloff, beam)) })
             }
             Light::Directional { direction, intensity } => {
                 Some(Source::Directional { towards: -direction.normalize(), irradiance: intensity })

@@ -94,7 +94,7 @@ pub enum PathLight {
         /// Falloff exponent.
         falloff: f64,
         /// Cosine of the beam of full intensity ([`alhazen_scene::spot_profile`]).
-        cos_beam: Option<f64>,
+        beam: Option<alhazen_scene::SpotBeam>,
         /// Intensity on the axis.
         intensity: Vec3,
     },
@@ -316,8 +316,8 @@ impl Lights {
         for l in &scene.lights {
             lights.push(match *l {
                 Light::Point { position, intensity, .. } => PathLight::Point { position, intensity },
-                Light::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity, .. } => {
-                    PathLight::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity }
+                Light::Spot { position, direction, cos_cutoff, falloff, beam, intensity, .. } => {
+                    PathLight::Spot { position, direction, cos_cutoff, falloff, beam, intensity }
                 }
                 Light::Directional { direction, intensity } => {
                     PathLight::Directional { direction, irradiance: intensity }
@@ -569,13 +569,13 @@ impl Lights {
         };
         match light {
             PathLight::Point { position, intensity } => delta(*position - p, *intensity),
-            PathLight::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity } => {
+            PathLight::Spot { position, direction, cos_cutoff, falloff, beam, intensity } => {
                 let to = *position - p;
                 let cos = -to.normalize_or_zero().dot(*direction);
                 if cos < *cos_cutoff {
                     return None;
                 }
-                delta(to, *intensity * alhazen_scene::spot_profile(cos, *cos_cutoff, *falloff, *cos_beam))
+                delta(to, *intensity * alhazen_scene::spot_profile(cos, *cos_cutoff, *falloff, *beam))
             }
             PathLight::Directional { direction, irradiance } => Some(LightSample {
                 dir: -*direction,

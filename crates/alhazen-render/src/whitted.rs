@@ -95,9 +95,9 @@ fn intensity_through(light: &Light, path: &MirrorPath) -> Option<Vec3> {
     };
     match light {
         Light::Point { intensity, attenuation, .. } => Some(*intensity * (path.geometry * unfolded(attenuation))),
-        Light::Spot { direction, cos_cutoff, falloff, cos_beam, intensity, attenuation, .. } => {
+        Light::Spot { direction, cos_cutoff, falloff, beam, intensity, attenuation, .. } => {
             let cos = -path.to_source.dot(*direction);
-            let shaped = alhazen_scene::spot_profile(cos, *cos_cutoff, *falloff, *cos_beam);
+            let shaped = alhazen_scene::spot_profile(cos, *cos_cutoff, *falloff, *beam);
             (cos >= *cos_cutoff).then(|| *intensity * (shaped * path.geometry * unfolded(attenuation)))
         }
         Light::Directional { intensity, .. } => Some(*intensity * path.geometry),

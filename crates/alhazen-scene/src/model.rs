@@ -519,9 +519,9 @@ pub enum Light {
         cos_cutoff: f64,
         /// Exponent of the cosine falloff.
         falloff: f64,
-        /// Cosine of the half-angle of a beam of full intensity, from whose edge the light
-        /// fades linearly in angle to nothing at the cone's (Mitsuba's spot); `None`: no fade.
-        cos_beam: Option<f64>,
+        /// A beam of full intensity, from whose edge the light fades to nothing at the cone's;
+        /// `None`: no fade.
+        beam: Option<SpotBeam>,
         /// Emitted intensity.
         intensity: Rgb,
         /// `[a, b, c]`.
@@ -555,12 +555,12 @@ impl Light {
                 (d > 0.0).then(|| (to / d, d, *intensity / falloff(attenuation, d)))
             }
             Light::Directional { direction, intensity } => Some((-*direction, f64::INFINITY, *intensity)),
-            Light::Spot { position, direction, cos_cutoff, falloff: e, cos_beam, intensity, attenuation } => {
+            Light::Spot { position, direction, cos_cutoff, falloff: e, beam, intensity, attenuation } => {
                 let to = *position - p;
                 let d = to.length();
                 let l = to / d;
                 let cos = -l.dot(*direction);
-                let shaped = spot_profile(cos, *cos_cutoff, *e, *cos_beam);
+                let shaped = spot_profile(cos, *cos_cutoff, *e, *beam);
                 (d > 0.0 && cos >= *cos_cutoff).then(|| (l, d, *intensity * shaped / falloff(attenuation, d)))
             }
             Light::Environment { .. } => None,
@@ -570,21 +570,56 @@ impl Light {
 
 /// The share of a spot light's axial intensity it sends at cosine `cos` from its axis: 0
 /// outside its cone (`cos < cos_cutoff`), `cos^falloff` inside, fading where it has a beam
-/// (`cos_beam`) linearly in angle from 1 at the beam's edge to 0 at the cone's.
+/// (`beam`) linearly in angle from 1 at the beam's edge to 0 at the cone's.
 #[inline]
-pub fn spot_profile(cos: f64, cos_cutoff: f64, falloff: f64, cos_beam: Option<f64>) -> f64 {
+pub fn spot_profile(cos: f64, cos_cutoff: f64, falloff: f64, beam: Option<SpotBeam>) -> f64 {
     let inside = cos >= cos_cutoff;
     if !inside {
         return 0.0;
     }
     // pow(x, 1) is x: the cosine spots that stand for emitters skip libm.
     let shaped = if falloff == 1.0 { cos } else { cos.powf(falloff) };
-    match cos_beam {
-        Some(beam) if cos < beam => {
-            let (theta, cutoff, inner) = (cos.clamp(-1.0, 1.0).acos(), cos_cutoff.acos(), beam.min(1.0).acos());
-            shaped * ((cutoff - theta) / (cutoff - inner)).clamp(0.0, 1.0)
-        }
+    match beam {
+        Some(SpotBeam { cos: inner, fade }) if cos < inner => shaped * fade.at(cos, cos_cutoff, inner.min(1.0)),
         _ => shaped,
+    }
+}
+
+/// A spot's beam of full intensity: the cosine of its half-angle and how the light fades from
+/// its edge to the cone's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotBeam {
+    /// Cosine of the beam's half-angle.
+    pub cos: f64,
+    /// The fade between the beam's edge and the cone's.
+    pub fade: SpotFade,
+}
+
+/// How a spot fades between its beam and its cone: each renderer's own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SpotFade {
+    /// Linear in angle (Mitsuba's spot; alhazen's TOML).
+    #[default]
+    LinearAngle,
+    /// Smooth in the cosine, `t²(3 − 2t)` with `t` linear in the cosine (pbrt-v4's spotlight).
+    SmoothCosine,
+    /// The square of a fade linear in the cosine (glTF's `KHR_lights_punctual`).
+    SquaredCosine,
+}
+
+impl SpotFade {
+    /// The share of the light at cosine `cos` between the cone's `cos_cutoff` and the beam's
+    /// `cos_beam`.
+    pub fn at(self, cos: f64, cos_cutoff: f64, cos_beam: f64) -> f64 {
+        let linear = |x: f64, edge: f64, inner: f64| ((x - edge) / (inner - edge)).clamp(0.0, 1.0);
+        match self {
+            SpotFade::LinearAngle => linear(cos.clamp(-1.0, 1.0).acos(), cos_cutoff.acos(), cos_beam.acos()),
+            SpotFade::SmoothCosine => {
+                let t = linear(cos, cos_cutoff, cos_beam);
+                t * t * (3.0 - 2.0 * t)
+            }
+            SpotFade::SquaredCosine => linear(cos, cos_cutoff, cos_beam).powi(2),
+        }
     }
 }
 
@@ -1154,14 +1189,15 @@ impl PixelCodes {
 
 #[cfg(test)]
 mod tests {
-    use super::spot_profile;
+    use super::{SpotBeam, SpotFade, spot_profile};
 
     /// Mitsuba's spot: full intensity within the beam, a fade linear in angle to nothing at
     /// the cone's edge; without a beam, `cos^e` inside the cone.
     #[test]
     fn spot_profiles_fade_linearly_in_angle_from_the_beam_to_the_cone() {
         let (cone, beam) = (30f64.to_radians(), 20f64.to_radians());
-        let at = |deg: f64| spot_profile(deg.to_radians().cos(), cone.cos(), 0.0, Some(beam.cos()));
+        let linear = SpotBeam { cos: beam.cos(), fade: SpotFade::LinearAngle };
+        let at = |deg: f64| spot_profile(deg.to_radians().cos(), cone.cos(), 0.0, Some(linear));
         assert_eq!((at(0.0), at(19.9), at(30.1)), (1.0, 1.0, 0.0));
         for (deg, want) in [(22.5, 0.75), (25.0, 0.5), (29.0, 0.1)] {
             assert!((at(deg) - want).abs() < 1e-9, "{deg}°: {}", at(deg));
@@ -1170,5 +1206,23 @@ mod tests {
         assert_eq!(spot_profile(c, cone.cos(), 1.0, None), c);
         assert_eq!(spot_profile(c, cone.cos(), 3.0, None), c.powf(3.0));
         assert_eq!(spot_profile(f64::NAN, cone.cos(), 1.0, None), 0.0);
+    }
+
+    /// pbrt's fade is smooth in the cosine, glTF's the square of a fade linear in it: both 1
+    /// at the beam's edge, 0 at the cone's, in between by their formulas.
+    #[test]
+    fn spot_fades_are_each_renderers_own() {
+        let (cone, beam) = (30f64.to_radians().cos(), 20f64.to_radians().cos());
+        let mid = 0.5 * (cone + beam);
+        for fade in [SpotFade::SmoothCosine, SpotFade::SquaredCosine, SpotFade::LinearAngle] {
+            let at = |cos: f64| spot_profile(cos, cone, 0.0, Some(SpotBeam { cos: beam, fade }));
+            assert_eq!((at(beam), at(1.0), at(cone - 1e-9)), (1.0, 1.0, 0.0), "{fade:?}");
+        }
+        let at = |cos: f64, fade| spot_profile(cos, cone, 0.0, Some(SpotBeam { cos: beam, fade }));
+        assert!((at(mid, SpotFade::SmoothCosine) - 0.5).abs() < 1e-12);
+        assert!((at(mid, SpotFade::SquaredCosine) - 0.25).abs() < 1e-12);
+        let quarter = cone + 0.25 * (beam - cone);
+        assert!((at(quarter, SpotFade::SmoothCosine) - 0.15625).abs() < 1e-12);
+        assert!((at(quarter, SpotFade::SquaredCosine) - 0.0625).abs() < 1e-12);
     }
 }

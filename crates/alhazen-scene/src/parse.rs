@@ -948,10 +948,23 @@ fn light(n: &Node) -> R<Light> {
     let keys: &[&str] = match kind {
         "point" => &["type", "position", "intensity", "attenuation"],
         "directional" => &["type", "direction", "intensity"],
-        _ => &["type", "position", "direction", "angle", "beam", "falloff", "intensity", "attenuation"],
+        _ => &["type", "position", "direction", "angle", "beam", "fade", "falloff", "intensity", "attenuation"],
     };
     t.check_keys(keys)?;
     let intensity = t.opt_rgb("intensity", Vec3::ONE)?;
+    // How a spot fades from its beam to its cone: "angle" (linear in angle), "smooth" (smooth in
+    // the cosine, pbrt's), "squared" (glTF's).
+    let fade = match t.get("fade") {
+        Some(f) => Some(match f.choice(&["angle", "smooth", "squared"])? {
+            "angle" => crate::SpotFade::LinearAngle,
+            "smooth" => crate::SpotFade::SmoothCosine,
+            _ => crate::SpotFade::SquaredCosine,
+        }),
+        None => None,
+    };
+    if let (Some(f), None) = (t.get("fade"), t.get("beam")) {
+        return Err(f.err("a spot's `fade` runs from its `beam` to its `angle`: give a `beam`"));
+    }
     Ok(match kind {
         "point" => Light::Point { position: t.req("position")?.vec3()?, intensity, attenuation: attenuation(&t)? },
         "directional" => Light::Directional { direction: t.req("direction")?.unit_vec3()?, intensity },
@@ -960,7 +973,11 @@ fn light(n: &Node) -> R<Light> {
             direction: t.req("direction")?.unit_vec3()?,
             cos_cutoff: t.get("angle").map_or(Ok(30.0), |n| n.in_range(0.0, 180.0))?.to_radians().cos(),
             falloff: t.get("falloff").map_or(Ok(1.0), |n| n.non_negative())?,
-            cos_beam: t.get("beam").map(|n| n.in_range(0.0, 180.0).map(|b| b.to_radians().cos())).transpose()?,
+            beam: t
+                .get("beam")
+                .map(|n| n.in_range(0.0, 180.0).map(|b| b.to_radians().cos()))
+                .transpose()?
+                .map(|cos| crate::SpotBeam { cos, fade: fade.unwrap_or_default() }),
             intensity,
             attenuation: attenuation(&t)?,
         },

@@ -272,13 +272,19 @@ impl Writer<'_> {
                 self.line("direction", vec3(*direction));
                 self.line("intensity", vec3(*intensity));
             }
-            Light::Spot { position, direction, cos_cutoff, falloff, cos_beam, intensity, attenuation } => {
+            Light::Spot { position, direction, cos_cutoff, falloff, beam, intensity, attenuation } => {
                 self.line("type", string("spot"));
                 self.line("position", vec3(*position));
                 self.line("direction", vec3(*direction));
                 self.line("angle", num(degrees(cos_cutoff.acos(), f64::cos)));
-                if let Some(beam) = cos_beam {
-                    self.line("beam", num(degrees(beam.acos(), f64::cos)));
+                if let Some(beam) = beam {
+                    self.line("beam", num(degrees(beam.cos.acos(), f64::cos)));
+                    let fade = match beam.fade {
+                        crate::SpotFade::LinearAngle => "angle",
+                        crate::SpotFade::SmoothCosine => "smooth",
+                        crate::SpotFade::SquaredCosine => "squared",
+                    };
+                    self.line("fade", string(fade));
                 }
                 self.line("falloff", num(*falloff));
                 self.line("intensity", vec3(*intensity));

@@ -529,6 +529,36 @@ emission = { hsv = [0, 0, 0.5] }
     assert!(e.contains("overflow single precision") && e.contains("e.toml:2:"), "{e}");
 }
 
+/// A spot's `fade` from its beam to its cone: linear in angle by default, smooth in the
+/// cosine (pbrt's) or the square of linear in the cosine (glTF's); the same after writing the
+/// scene back out.
+#[test]
+fn spot_fades_read_and_write_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.toml");
+    let spot = |fade: &str| {
+        format!(
+            "[[light]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\nangle = 30\nbeam = 20\n{fade}"
+        )
+    };
+    let text = [spot(""), spot("fade = \"smooth\"\n"), spot("fade = \"squared\"\n")].concat();
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let fades: Vec<_> = s
+        .lights
+        .iter()
+        .map(|l| match l {
+            alhazen_scene::Light::Spot { beam: Some(b), .. } => b.fade,
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    use alhazen_scene::SpotFade::*;
+    assert_eq!(fades, [LinearAngle, SmoothCosine, SquaredCosine]);
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    assert_eq!(load_scene(&again_path).unwrap().lights, s.lights);
+}
+
 /// This session's new keys refuse what they cannot mean, pointing at the value: a spot's
 /// `beam` outside 0–180° or NaN, an environment's `up` of no length or not finite, a thin
 /// sheet's `ior` below 1, a blend's `weight_map` that is not a texture.
@@ -542,6 +572,11 @@ fn beams_up_axes_thin_sheets_and_weight_maps_refuse_nonsense() {
     for beam in ["200", "-1", "nan"] {
         assert!(spot(beam).contains("s.toml:6"), "beam {beam}: {}", spot(beam));
     }
+    // A fade needs a beam to fade from, and is one of three.
+    let e = err("[[light]]\ntype = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\nfade = \"smooth\"\n");
+    assert!(e.contains("s.toml:5") && e.contains("give a `beam`"), "{e}");
+    let e = spot("20\nfade = \"cubic\"");
+    assert!(e.contains("s.toml:7") && e.contains("\"squared\""), "{e}");
     let sky = |up: &str| err(&format!("[[light]]\ntype = \"environment\"\nfile = \"none.exr\"\nup = {up}\n"));
     for up in ["[0, 0, 0]", "[nan, 1, 0]", "[1, 2]"] {
         let e = sky(up);

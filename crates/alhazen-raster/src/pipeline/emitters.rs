@@ -94,7 +94,7 @@ fn area_shares(tris: &[&Triangle], radiance: Vec3, shares: usize) -> Vec<Light> 
                     direction: n,
                     cos_cutoff: 0.0,
                     falloff: 1.0,
-                    cos_beam: None,
+                    beam: None,
                     intensity: radiance * (a / PI),
                     attenuation: [1.0, 0.0, 0.0],
                 },

@@ -369,12 +369,12 @@ impl PathTracer<'_> {
         let g = path.geometry;
         let (le, weight) = match (&self.lights.all()[light], area_point) {
             (PathLight::Point { intensity, .. }, _) => (*intensity * g, 1.0),
-            (PathLight::Spot { direction, cos_cutoff, falloff, cos_beam, intensity, .. }, _) => {
+            (PathLight::Spot { direction, cos_cutoff, falloff, beam, intensity, .. }, _) => {
                 let cos = -path.to_source.dot(*direction);
                 if cos < *cos_cutoff {
                     return Vec3::ZERO;
                 }
-                (*intensity * (alhazen_scene::spot_profile(cos, *cos_cutoff, *falloff, *cos_beam) * g), 1.0)
+                (*intensity * (alhazen_scene::spot_profile(cos, *cos_cutoff, *falloff, *beam) * g), 1.0)
             }
             (PathLight::Directional { irradiance, .. }, _) => (*irradiance * g, 1.0),
             (PathLight::Area { .. }, Some(AreaPoint { n: n_y, pdf_area, radiance, .. })) => {
