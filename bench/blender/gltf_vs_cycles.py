@@ -177,14 +177,15 @@ def export_and_render_emission(scene, out, stem, size, spp, pixel_filter=("BOX",
     export_and_render(scene, out, stem, size, spp, bounces=0, pixel_filter=pixel_filter)
 
 
-def export_and_render(scene, out, stem, size, spp, bounces, pixel_filter=("BOX", 1.0), glb=True):
-    """Writes OUT/STEM.glb (Blender's glTF exporter, with cameras and lights; left out when
-    not `glb`) and OUT/STEM-cycles.exr: Cycles with `bounces`, 32-bit, through `pixel_filter`."""
+def export_and_render(scene, out, stem, size, spp, bounces, pixel_filter=("BOX", 1.0), glb=True, **export_options):
+    """Writes OUT/STEM.glb (Blender's glTF exporter, with cameras and lights and any other
+    `export_options`; left out when not `glb`) and OUT/STEM-cycles.exr: Cycles with `bounces`,
+    32-bit, through `pixel_filter`."""
     os.makedirs(out, exist_ok=True)
     scene.render.resolution_x, scene.render.resolution_y = size
     if glb:
         bpy.ops.export_scene.gltf(filepath=os.path.join(out, f"{stem}.glb"), export_format="GLB",
-                                  export_cameras=True, export_lights=True, export_yup=True)
+                                  export_cameras=True, export_lights=True, export_yup=True, **export_options)
     seconds = render(scene, os.path.join(out, f"{stem}-cycles.exr"), spp, size, bounces=bounces, transparent=0,
                      depth="32", pixel_filter=pixel_filter)
     print(f"Cycles: {spp} spp at {size[0]}x{size[1]} on 2 threads in {seconds:.2f} s", file=sys.stderr)

@@ -15,7 +15,7 @@ import argparse, math, os, sys
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import black_world, material, render, sun  # noqa: E402
+from gltf_vs_cycles import black_world, export_and_render, material, sun  # noqa: E402
 
 
 def bent_cylinder():
@@ -76,15 +76,7 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=1024)
     a = ap.parse_args()
-    out = os.path.abspath(a.out)
-    os.makedirs(out, exist_ok=True)
-    scene = build()
-    scene.render.resolution_x, scene.render.resolution_y = 96, 64
-    bpy.ops.export_scene.gltf(filepath=os.path.join(out, "posed.glb"), export_format="GLB", export_cameras=True,
-                              export_lights=True, export_rest_position_armature=False)
-    seconds = render(scene, os.path.join(out, "posed-cycles.exr"), a.spp, (96, 64), bounces=4, transparent=0,
-                     depth="32")
-    print(f"Cycles: {a.spp} spp at 96x64 on 2 threads in {seconds:.2f} s", file=sys.stderr)
+    export_and_render(build(), os.path.abspath(a.out), "posed", (96, 64), a.spp, bounces=4, export_rest_position_armature=False)
 
 
 if __name__ == "__main__":

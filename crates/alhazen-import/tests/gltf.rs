@@ -1262,6 +1262,31 @@ fn skins_move_vertices_with_their_joints() {
     assert!(e.contains("joint 3 is not one of its skin's 1"), "{e}");
 }
 
+/// A Blender export (`bytes`, as read or changed) imported without warnings, to be rendered at
+/// `spp` by the path tracer at its camera's size.
+fn blender_export(name: &str, bytes: Vec<u8>, spp: u32) -> alhazen_scene::Scene {
+    let imported = write_and_import(&[(name, bytes)]).unwrap();
+    assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
+    let mut s = imported.scene;
+    s.render.spp = spp;
+    s.render.integrator = alhazen_scene::IntegratorKind::Path;
+    s
+}
+
+/// `Σ|ours − Cycles| / Σ Cycles` over alhazen's image of `s` at the size of Cycles' `cycles`.
+fn difference_from_cycles(s: &alhazen_scene::Scene, cycles: &alhazen_scene::ImageData) -> f64 {
+    let mut s = s.clone();
+    (s.render.width, s.render.height) = (cycles.width, cycles.height);
+    let img = alhazen_render::render(&s, &|_, _| {});
+    let (mut diff, mut sum) = (0.0, 0.0);
+    for (i, c) in cycles.texels().enumerate() {
+        let c = Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+        diff += (img.get(i as u32 % cycles.width, i as u32 / cycles.width) - c).abs().element_sum();
+        sum += c.element_sum();
+    }
+    diff / sum
+}
+
 /// A `.glb`'s JSON changed by `change`, its binary chunk kept.
 fn glb_with_json(bytes: &[u8], change: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
     let n = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
@@ -1283,23 +1308,8 @@ fn blender_posed_meshes_agree_with_cycles() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender");
     let bytes = std::fs::read(dir.join("posed.glb")).unwrap();
     let cycles = alhazen_scene::import::load_hdr_image(&dir.join("posed-cycles.exr")).unwrap();
-    let import = |bytes: Vec<u8>| {
-        let imported = write_and_import(&[("posed.glb", bytes)]).unwrap();
-        assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
-        let mut s = imported.scene;
-        (s.render.width, s.render.height, s.render.spp) = (96, 64, 256);
-        s
-    };
-    let error = |s: &alhazen_scene::Scene| {
-        let img = alhazen_render::render(s, &|_, _| {});
-        let (mut diff, mut sum) = (0.0, 0.0);
-        for (i, c) in cycles.texels().enumerate() {
-            let c = Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-            diff += (img.get(i as u32 % 96, i as u32 / 96) - c).abs().element_sum();
-            sum += c.element_sum();
-        }
-        diff / sum
-    };
+    let import = |bytes: Vec<u8>| blender_export("posed.glb", bytes, 256);
+    let error = |s: &alhazen_scene::Scene| difference_from_cycles(s, &cycles);
     let posed = import(bytes.clone());
     let bounds = |name: &str| {
         let o = posed.objects.iter().find(|o| o.name.as_deref() == Some(name)).unwrap();
@@ -1331,23 +1341,8 @@ fn blender_gpu_instances_agree_with_cycles() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender");
     let bytes = std::fs::read(dir.join("instances.glb")).unwrap();
     let cycles = alhazen_scene::import::load_hdr_image(&dir.join("instances-cycles.exr")).unwrap();
-    let import = |bytes: Vec<u8>| {
-        let imported = write_and_import(&[("instances.glb", bytes)]).unwrap();
-        assert!(imported.warnings.is_empty(), "{:?}", imported.warnings);
-        let mut s = imported.scene;
-        (s.render.width, s.render.height, s.render.spp) = (96, 64, 256);
-        s
-    };
-    let error = |s: &alhazen_scene::Scene| {
-        let img = alhazen_render::render(s, &|_, _| {});
-        let (mut diff, mut sum) = (0.0, 0.0);
-        for (i, c) in cycles.texels().enumerate() {
-            let c = Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-            diff += (img.get(i as u32 % 96, i as u32 / 96) - c).abs().element_sum();
-            sum += c.element_sum();
-        }
-        diff / sum
-    };
+    let import = |bytes: Vec<u8>| blender_export("instances.glb", bytes, 256);
+    let error = |s: &alhazen_scene::Scene| difference_from_cycles(s, &cycles);
     let s = import(bytes.clone());
     let cones: Vec<usize> = s
         .objects

@@ -80,18 +80,32 @@ impl Coated {
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let albedo = self.coat_albedo(v.z);
         let q = self.coat_choice(albedo);
-        let l = if uc < q {
-            self.coat.sample(v, u)?
-        } else {
-            let mut s = self.base.sample(v, ((uc - q) / (1.0 - q)).min(1.0 - 1e-16), u)?;
-            if s.delta {
-                s.f *= 1.0 - albedo;
-                s.pdf *= 1.0 - q;
-                return Some(s);
-            }
-            s.l
-        };
-        let (f, pdf) = self.eval_pdf(v, l);
-        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+        sample_under_layer(&self.base, (v, uc, u), (q, albedo), || self.coat.sample(v, u), |l| self.eval_pdf(v, l))
     }
+}
+
+/// A sample of a layer over `base` (a coat, a sheen): the layer's own direction (`top`) where
+/// `uc` falls below its share `q`, else the base's sample (`uc` rescaled for it) — a delta
+/// sample of the base keeping its own weight times what the layer of albedo `albedo` lets
+/// through —, a direction not a delta valued by the whole (`eval_pdf`).
+pub(crate) fn sample_under_layer(
+    base: &Bsdf,
+    (v, uc, u): (Vec3, f64, Vec2),
+    (q, albedo): (f64, f64),
+    top: impl FnOnce() -> Option<Vec3>,
+    eval_pdf: impl Fn(Vec3) -> (Vec3, f64),
+) -> Option<BsdfSample> {
+    let l = if uc < q {
+        top()?
+    } else {
+        let mut s = base.sample(v, ((uc - q) / (1.0 - q)).min(1.0 - 1e-16), u)?;
+        if s.delta {
+            s.f *= 1.0 - albedo;
+            s.pdf *= 1.0 - q;
+            return Some(s);
+        }
+        s.l
+    };
+    let (f, pdf) = eval_pdf(l);
+    (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
 }

@@ -79,19 +79,8 @@ impl Sheened {
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let albedo = self.sheen_albedo(v.z);
         let q = self.sheen_choice(albedo);
-        let l = if uc < q {
-            cosine_hemisphere(u, v)
-        } else {
-            let mut s = self.base.sample(v, ((uc - q) / (1.0 - q)).min(1.0 - 1e-16), u)?;
-            if s.delta {
-                s.f *= 1.0 - albedo;
-                s.pdf *= 1.0 - q;
-                return Some(s);
-            }
-            s.l
-        };
-        let (f, pdf) = self.eval_pdf(v, l);
-        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+        let top = || Some(cosine_hemisphere(u, v));
+        super::coated::sample_under_layer(&self.base, (v, uc, u), (q, albedo), top, |l| self.eval_pdf(v, l))
     }
 }
 
