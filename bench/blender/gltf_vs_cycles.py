@@ -226,6 +226,29 @@ def mapped(m, tex):
     links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
 
 
+def floor_under_sun(scene, eye, tilt_degrees, fov_degrees):
+    """A grey floor (10 × 10 at z = 0), a camera at `eye` looking along +y tilted down to
+    `tilt_degrees` from the vertical with `fov_degrees` across, a sun of 3 W/m² from the side
+    and above, and a black world."""
+    bpy.ops.mesh.primitive_plane_add(size=10, location=(0, 0, 0))
+    bpy.context.object.data.materials.append(material("floor", (0.6, 0.6, 0.6), 0.0, 0.8))
+    bpy.ops.object.camera_add(location=eye, rotation=(math.radians(tilt_degrees), 0, 0))
+    scene.camera = bpy.context.object
+    scene.camera.data.angle = math.radians(fov_degrees)
+    sun((40, 10, 30), energy=3.0)
+    black_world(scene)
+
+
+def main_of(stem, build, **export_options):
+    """The command line of a comparison script: OUT_DIR [--spp 1024], `build()`'s scene
+    written as OUT_DIR/STEM.glb and rendered by Cycles at 96 × 64 with four bounces."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("out")
+    ap.add_argument("--spp", type=int, default=1024)
+    a = ap.parse_args()
+    export_and_render(build(), os.path.abspath(a.out), stem, (96, 64), a.spp, bounces=4, **export_options)
+
+
 def black_world(scene):
     """No light from the world: what a glTF file, which has no world, holds."""
     world = bpy.data.worlds.new("black")

@@ -9,12 +9,12 @@ test `blender_gpu_instances_agree_with_cycles` (crates/alhazen-import/tests/gltf
 Writes OUT_DIR/instances.glb and OUT_DIR/instances-cycles.exr (96 × 64, CPU, 2 threads, box
 filter of one pixel, four bounces). Needs `pip install bpy`.
 """
-import argparse, math, os, sys
+import math, os, sys
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import black_world, export_and_render, material, sun  # noqa: E402
+from gltf_vs_cycles import floor_under_sun, main_of, material  # noqa: E402
 
 
 def build():
@@ -33,23 +33,9 @@ def build():
         copy.rotation_euler = (math.radians(10 * (k % 2)), 0, math.radians(25 * k))
         copy.scale = (0.6 + 0.15 * k,) * 3
         copy.parent = grove
-    bpy.ops.mesh.primitive_plane_add(size=10, location=(0, 0, 0))
-    bpy.context.object.data.materials.append(material("floor", (0.6, 0.6, 0.6), 0.0, 0.8))
-    bpy.ops.object.camera_add(location=(0, -6, 2.0), rotation=(math.radians(78), 0, 0))
-    scene.camera = bpy.context.object
-    scene.camera.data.angle = math.radians(45)
-    sun((40, 10, 30), energy=3.0)
-    black_world(scene)
+    floor_under_sun(scene, (0, -6, 2.0), 78, 45)
     return scene
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("out")
-    ap.add_argument("--spp", type=int, default=1024)
-    a = ap.parse_args()
-    export_and_render(build(), os.path.abspath(a.out), "instances", (96, 64), a.spp, bounces=4, export_gpu_instances=True)
-
-
 if __name__ == "__main__":
-    main()
+    main_of("instances", build, export_gpu_instances=True)

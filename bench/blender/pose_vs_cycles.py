@@ -10,12 +10,12 @@ Cycles, for the test `blender_posed_meshes_agree_with_cycles` (crates/alhazen-im
 Writes OUT_DIR/posed.glb and OUT_DIR/posed-cycles.exr (96 × 64, CPU, 2 threads, box filter of
 one pixel, four bounces). Needs `pip install bpy`.
 """
-import argparse, math, os, sys
+import math, os, sys
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import black_world, export_and_render, material, sun  # noqa: E402
+from gltf_vs_cycles import floor_under_sun, main_of, material  # noqa: E402
 
 
 def bent_cylinder():
@@ -61,23 +61,9 @@ def build():
     scene = bpy.context.scene
     bent_cylinder()
     tall_cube()
-    bpy.ops.mesh.primitive_plane_add(size=10, location=(0, 0, 0))
-    bpy.context.object.data.materials.append(material("floor", (0.6, 0.6, 0.6), 0.0, 0.8))
-    bpy.ops.object.camera_add(location=(0.5, -6, 1.5), rotation=(math.radians(85), 0, 0))
-    scene.camera = bpy.context.object
-    scene.camera.data.angle = math.radians(40)
-    sun((40, 10, 30), energy=3.0)
-    black_world(scene)
+    floor_under_sun(scene, (0.5, -6, 1.5), 85, 40)
     return scene
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("out")
-    ap.add_argument("--spp", type=int, default=1024)
-    a = ap.parse_args()
-    export_and_render(build(), os.path.abspath(a.out), "posed", (96, 64), a.spp, bounces=4, export_rest_position_armature=False)
-
-
 if __name__ == "__main__":
-    main()
+    main_of("posed", build, export_rest_position_armature=False)
