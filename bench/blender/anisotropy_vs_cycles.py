@@ -16,12 +16,12 @@ reads it and also as Cycles does (alhazen's `AnisotropyModel::Disney`, which Mit
 Writes OUT_DIR/anisotropy.glb and OUT_DIR/anisotropy-cycles.exr (96 × 32, CPU, 2 threads, box
 filter of one pixel, four bounces). Needs `pip install bpy`.
 """
-import argparse, os, sys
+import os, sys
 
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gltf_vs_cycles import export_and_render, front_camera, material, sun  # noqa: E402
+from gltf_vs_cycles import front_camera, main_of, material, sun  # noqa: E402
 
 ROUGHNESS, ANISOTROPIC = 0.4, 0.9
 ROTATIONS = [0.0, 0.125, 0.25]
@@ -56,15 +56,5 @@ def build():
     return scene
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("out")
-    ap.add_argument("--spp", type=int, default=1024)
-    a = ap.parse_args()
-    out = os.path.abspath(a.out)
-    os.makedirs(out, exist_ok=True)
-    export_and_render(build(), out, "anisotropy", (96, 32), a.spp, bounces=4)
-
-
 if __name__ == "__main__":
-    main()
+    main_of("anisotropy", build, size=(96, 32))

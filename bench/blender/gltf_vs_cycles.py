@@ -239,14 +239,14 @@ def floor_under_sun(scene, eye, tilt_degrees, fov_degrees):
     black_world(scene)
 
 
-def main_of(stem, build, **export_options):
+def main_of(stem, build, size=(96, 64), **export_options):
     """The command line of a comparison script: OUT_DIR [--spp 1024], `build()`'s scene
-    written as OUT_DIR/STEM.glb and rendered by Cycles at 96 × 64 with four bounces."""
+    written as OUT_DIR/STEM.glb and rendered by Cycles at `size` with four bounces."""
     ap = argparse.ArgumentParser()
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=1024)
     a = ap.parse_args()
-    export_and_render(build(), os.path.abspath(a.out), stem, (96, 64), a.spp, bounces=4, **export_options)
+    export_and_render(build(), os.path.abspath(a.out), stem, size, a.spp, bounces=4, **export_options)
 
 
 def black_world(scene):

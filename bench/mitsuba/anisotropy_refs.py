@@ -14,9 +14,8 @@ reference, for crates/alhazen-import/tests/mitsuba.rs:
 Writes brushed-principled.xml and brushed-principled-mitsuba.exr into
 crates/alhazen-import/tests/data/mitsuba/.
 """
-import argparse, os
-import mitsuba as mi
-from texture_refs import OUT, head
+import argparse
+from texture_refs import head, write_reference
 
 
 def sphere(x, anisotropic, turned=False):
@@ -41,14 +40,7 @@ SCENE = head("Brushed metal: principled spheres with anisotropic facets", 4, 40,
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=8192)
-    args = ap.parse_args()
-    mi.set_variant("scalar_rgb")
-    path = os.path.join(OUT, "brushed-principled.xml")
-    with open(path, "w") as f:
-        f.write(SCENE)
-    img = mi.render(mi.load_file(path), spp=args.spp, seed=17)
-    mi.Bitmap(img).write(os.path.join(OUT, "brushed-principled-mitsuba.exr"))
-    print(f"wrote {path} and its reference ({args.spp} spp)")
+    write_reference("brushed-principled", SCENE, ap.parse_args().spp, seed=17)
 
 
 if __name__ == "__main__":

@@ -16,9 +16,8 @@ crates/alhazen-import/tests/mitsuba.rs:
 Writes absorbing-glass.xml and absorbing-glass-mitsuba.exr into
 crates/alhazen-import/tests/data/mitsuba/.
 """
-import argparse, os
-import mitsuba as mi
-from texture_refs import OUT, head
+import argparse
+from texture_refs import head, write_reference
 
 SCENE = head("Tinted glass: dielectrics filled with absorbing media", 16, 45, "0, 1.4, 4.2", "0, 0.35, 0",
              integrator="volpath", script="medium_refs.py") + """    <medium type="homogeneous" id="amber">
@@ -67,14 +66,7 @@ SCENE = head("Tinted glass: dielectrics filled with absorbing media", 16, 45, "0
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=16384)
-    args = ap.parse_args()
-    mi.set_variant("scalar_rgb")
-    path = os.path.join(OUT, "absorbing-glass.xml")
-    with open(path, "w") as f:
-        f.write(SCENE)
-    img = mi.render(mi.load_file(path), spp=args.spp, seed=13)
-    mi.Bitmap(img).write(os.path.join(OUT, "absorbing-glass-mitsuba.exr"))
-    print(f"wrote {path} and its reference ({args.spp} spp)")
+    write_reference("absorbing-glass", SCENE, ap.parse_args().spp, seed=13)
 
 
 if __name__ == "__main__":

@@ -35,6 +35,18 @@ OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "crat
                    "data", "mitsuba")
 
 
+def write_reference(name, scene, spp, seed):
+    """Writes OUT/NAME.xml (`scene`) and Mitsuba 3's image of it at `spp` (`scalar_rgb`, seed
+    `seed`) as OUT/NAME-mitsuba.exr."""
+    mi.set_variant("scalar_rgb")
+    path = os.path.join(OUT, f"{name}.xml")
+    with open(path, "w") as f:
+        f.write(scene)
+    img = mi.render(mi.load_file(path), spp=spp, seed=seed)
+    mi.Bitmap(img).write(os.path.join(OUT, f"{name}-mitsuba.exr"))
+    print(f"wrote {path} and its reference ({spp} spp)")
+
+
 def head(what, depth, fov, origin, target, size=(96, 72), integrator="path", script="texture_refs.py"):
     """A scene file's opening: its comment, the integrator, a camera of `size` pixels."""
     return f"""<?xml version="1.0" encoding="utf-8"?>
