@@ -787,15 +787,17 @@ impl Importer<'_> {
         let rotation = rotation - turn * (rotation / turn).round();
         let anisotropy = Anisotropy { strength, rotation, model: AnisotropyModel::Gltf };
         let map = match a.get("anisotropyTexture") {
-            Some(info) if strength > 0.0 => Some(self.texture_of_info(info, name, "anisotropyTexture")?),
+            Some(info) if strength > 0.0 => {
+                Some(self.texture_of_info(info, name, "anisotropyTexture", Decoding::Linear)?)
+            }
             _ => None,
         };
         Ok((anisotropy, map))
     }
 
-    /// The linear image texture a JSON `textureInfo` of an extension names (`index`,
-    /// `texCoord`, `KHR_texture_transform`), placed and wrapped as glTF says.
-    fn texture_of_info(&mut self, info: &serde_json::Value, name: &str, what: &str) -> R<Texture> {
+    /// The image texture a JSON `textureInfo` of an extension names (`index`, `texCoord`,
+    /// `KHR_texture_transform`), decoded as `decoding` says, placed and wrapped as glTF says.
+    fn texture_of_info(&mut self, info: &serde_json::Value, name: &str, what: &str, decoding: Decoding) -> R<Texture> {
         let index = info.get("index").and_then(|i| i.as_u64());
         let tex_coord = info.get("texCoord").map_or(Some(0), |t| t.as_u64());
         let (Some(texture), Some(tex_coord)) =
@@ -805,7 +807,7 @@ impl Importer<'_> {
         };
         let transform = info.get("extensions").and_then(|e| e.get("KHR_texture_transform")).map(json_transform);
         let (scale, offset, rotation) = self.placement(tex_coord, transform, name)?;
-        let image = wrapped(self.image(&texture, Decoding::Linear)?, &texture);
+        let image = wrapped(self.image(&texture, decoding)?, &texture);
         self.scene.images.push(image);
         Ok(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation })
     }
@@ -843,9 +845,9 @@ impl Importer<'_> {
         Ok(Some(Ior::Cauchy { a: ior - 1.5168 * k, b: 0.523655 * k }))
     }
 
-    /// `bsdf` under `KHR_materials_sheen`'s fibres: of colour `sheenColorFactor`, roughness
-    /// `sheenRoughnessFactor` (`α = r²`); none where the colour is black. Its textures are left
-    /// out (warning: the factors are used).
+    /// `bsdf` under `KHR_materials_sheen`'s fibres: of colour `sheenColorFactor` (times
+    /// `sheenColorTexture`, sRGB), roughness `sheenRoughnessFactor` (times
+    /// `sheenRoughnessTexture`'s alpha; `α = r²`); none where the colour factor is black.
     fn sheen(&mut self, material: &gltf::Material, bsdf: BsdfDesc, name: &str) -> R<BsdfDesc> {
         let Some(e) = material.extension_value("KHR_materials_sheen") else { return Ok(bsdf) };
         let unit = |x: &serde_json::Value| x.as_f64().filter(|x| (0.0..=1.0).contains(x));
@@ -862,13 +864,26 @@ impl Importer<'_> {
                 "{name}: KHR_materials_sheen needs a sheenColorFactor of three numbers and a sheenRoughnessFactor, within [0, 1]"
             )));
         };
-        if ["sheenColorTexture", "sheenRoughnessTexture"].iter().any(|k| e.get(*k).is_some()) {
-            self.warn(format!("{name}: KHR_materials_sheen's textures are not supported; its factors are used"));
-        }
         if color == [0.0; 3] {
             return Ok(bsdf);
         }
-        Ok(BsdfDesc::Sheened { base: Box::new(bsdf), color: Vec3::from_array(color), roughness })
+        // The colour texture is sRGB, times the factor; the roughness is the texture's alpha.
+        let color = match e.get("sheenColorTexture") {
+            None => Texture::Solid(Vec3::from_array(color)),
+            Some(info) => match self.texture_of_info(info, name, "sheenColorTexture", Decoding::Srgb)? {
+                Texture::Image { image, scale, offset, rotation } => {
+                    let factored = scaled(self.scene.images[image].clone(), Vec3::from_array(color));
+                    self.scene.images[image] = factored;
+                    Texture::Image { image, scale, offset, rotation }
+                }
+                other => other,
+            },
+        };
+        let roughness_map = match e.get("sheenRoughnessTexture") {
+            None => None,
+            Some(info) => Some(self.texture_of_info(info, name, "sheenRoughnessTexture", Decoding::Alpha)?),
+        };
+        Ok(BsdfDesc::Sheened { base: Box::new(bsdf), color, roughness, roughness_map })
     }
 
     /// `bsdf` under `KHR_materials_clearcoat`'s coat: of weight `clearcoatFactor`, GGX facets

@@ -1001,7 +1001,7 @@ fn dispersion_spreads_the_glass_index_by_wavelength() {
 }
 
 /// `KHR_materials_sheen`: the fibres' colour and roughness over the material (under a clear
-/// coat where there is one); a black sheen is none; its textures are warned about; bad factors
+/// coat where there is one), their textures read per point; a black sheen is none; bad factors
 /// refused.
 #[test]
 fn sheen_factors_make_the_fibres() {
@@ -1017,8 +1017,8 @@ fn sheen_factors_make_the_fibres() {
     let (bsdf, said) =
         read(r#""KHR_materials_sheen": { "sheenColorFactor": [1, 0.5, 0.25], "sheenRoughnessFactor": 0.3 }"#).unwrap();
     assert!(said.is_empty(), "{said:?}");
-    let BsdfDesc::Sheened { base, color, roughness } = bsdf else { panic!("{bsdf:?}") };
-    assert_eq!((color, roughness), (Vec3::new(1.0, 0.5, 0.25), 0.3));
+    let BsdfDesc::Sheened { base, color, roughness, roughness_map: None } = bsdf else { panic!("{bsdf:?}") };
+    assert_eq!((color, roughness), (Texture::Solid(Vec3::new(1.0, 0.5, 0.25)), 0.3));
     assert!(matches!(*base, BsdfDesc::CookTorrance { .. }), "{base:?}");
     let (bsdf, _) = read(
         r#""KHR_materials_sheen": { "sheenColorFactor": [1, 1, 1] }, "KHR_materials_clearcoat": { "clearcoatFactor": 1 }"#,
@@ -1028,10 +1028,25 @@ fn sheen_factors_make_the_fibres() {
     assert!(matches!(*base, BsdfDesc::Sheened { roughness: 0.0, .. }), "{base:?}");
     let (bsdf, _) = read(r#""KHR_materials_sheen": { "sheenRoughnessFactor": 0.5 }"#).unwrap();
     assert!(matches!(bsdf, BsdfDesc::CookTorrance { .. }), "{bsdf:?}");
-    let (_, said) =
-        read(r#""KHR_materials_sheen": { "sheenColorFactor": [1, 1, 1], "sheenColorTexture": { "index": 0 } }"#)
-            .unwrap();
-    assert!(said.iter().any(|w| w.contains("KHR_materials_sheen's textures are not supported")), "{said:?}");
+    // Textures: the colour's sRGB texels times the factor, the roughness the alpha (1 where the
+    // image has none) times its factor.
+    let (bsdf, said) = read(
+        r#""KHR_materials_sheen": { "sheenColorFactor": [1, 0.5, 1], "sheenColorTexture": { "index": 0 }, "sheenRoughnessFactor": 0.4, "sheenRoughnessTexture": { "index": 0 } }"#,
+    )
+    .unwrap();
+    assert!(said.is_empty(), "{said:?}");
+    assert!(
+        matches!(
+            bsdf,
+            BsdfDesc::Sheened {
+                color: Texture::Image { .. },
+                roughness: 0.4,
+                roughness_map: Some(Texture::Image { .. }),
+                ..
+            }
+        ),
+        "{bsdf:?}"
+    );
     for bad in [
         r#""KHR_materials_sheen": { "sheenColorFactor": [2, 0, 0] }"#,
         r#""KHR_materials_sheen": { "sheenRoughnessFactor": "soft" }"#,

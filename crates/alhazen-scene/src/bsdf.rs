@@ -244,10 +244,13 @@ pub enum BsdfDesc {
     Sheened {
         /// What lies under the sheen.
         base: Box<BsdfDesc>,
-        /// The sheen's colour (0: none).
-        color: Rgb,
+        /// The sheen's colour (0: none), a texture where it varies.
+        color: Texture,
         /// The fibres' roughness `r ∈ [0, 1]` (`α = r²`, at least 10⁻³).
         roughness: f64,
+        /// Where the roughness varies: `roughness` times the map's first channel (read
+        /// linearly; glTF's `sheenRoughnessTexture` is its alpha).
+        roughness_map: Option<Texture>,
     },
     /// `weight · a + (1 − weight) · b`.
     Mix {
@@ -470,7 +473,10 @@ impl BsdfDesc {
             | BsdfDesc::CookTorrance { albedo, .. }
             | BsdfDesc::Plastic { albedo, .. } => t(albedo),
             BsdfDesc::Mix { a, b, weight_map, .. } => a.is_textured() || b.is_textured() || weight_map.is_some(),
-            BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => base.is_textured(),
+            BsdfDesc::Coated { base, .. } => base.is_textured(),
+            BsdfDesc::Sheened { base, color, roughness_map, .. } => {
+                base.is_textured() || t(color) || roughness_map.is_some()
+            }
             BsdfDesc::MetallicRoughness { base, map, anisotropy_map, .. } => {
                 t(base) || map.is_some() || anisotropy_map.is_some()
             }

@@ -67,7 +67,7 @@ impl Parser<'_> {
             }
             "thin-dielectric" => vec!["ior"],
             "coated" => [&["base", "weight", "ior"][..], MICROFACET_KEYS].concat(),
-            "sheen" => vec!["base", "sheen_color", "roughness"],
+            "sheen" => vec!["base", "sheen_color", "roughness", "roughness_map"],
             _ => vec!["a", "b", "weight", "weight_map"],
         };
         t.check_keys(&[&["type"][..], &keys].concat())?;
@@ -182,8 +182,11 @@ impl Parser<'_> {
             }
             "sheen" => BsdfDesc::Sheened {
                 base: Box::new(self.bsdf(&t.req("base")?, &albedo)?),
-                color: t.opt_rgb("sheen_color", Vec3::ONE)?,
+                color: t
+                    .get("sheen_color")
+                    .map_or(Ok(crate::model::Texture::Solid(Vec3::ONE)), |c| self.texture(&c))?,
                 roughness: t.get("roughness").map_or(Ok(0.5), |n| n.in_range(0.0, 1.0))?,
+                roughness_map: t.get("roughness_map").map(|m| self.linear_placed_image(&m)).transpose()?,
             },
             _ => BsdfDesc::Mix {
                 a: Box::new(self.bsdf(&t.req("a")?, &albedo)?),

@@ -525,11 +525,12 @@ impl Writer<'_> {
                     num(*weight)
                 )
             }
-            BsdfDesc::Sheened { base, color, roughness } => format!(
-                "{{ type = \"sheen\", base = {}, sheen_color = {}, roughness = {} }}",
+            BsdfDesc::Sheened { base, color, roughness, roughness_map } => format!(
+                "{{ type = \"sheen\", base = {}, sheen_color = {}, roughness = {}{} }}",
                 self.bsdf(base),
-                vec3(*color),
-                num(*roughness)
+                self.texture(color),
+                num(*roughness),
+                roughness_map.as_ref().map_or(String::new(), |m| format!(", roughness_map = {}", self.map_image(m)))
             ),
             BsdfDesc::Coated { base, weight, facets: f, ior } => format!(
                 "{{ type = \"coated\", base = {}, weight = {}, ior = {}, {} }}",

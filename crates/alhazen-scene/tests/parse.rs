@@ -324,13 +324,16 @@ color = [0.3, 0.02, 0.05]
 bsdf = { type = "sheen", base = { type = "lambert" }, sheen_color = [1, 0.9, 0.9], roughness = 0.4 }
 [materials.plain]
 bsdf = { type = "sheen", base = { type = "lambert" } }
+[materials.mapped]
+bsdf = { type = "sheen", base = { type = "lambert" }, sheen_color = { image = { file = "fibres.png" } }, roughness_map = { file = "fibres.png", scale = 2 } }
 "#;
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50])).save(dir.path().join("fibres.png")).unwrap();
     let path = dir.path().join("s.toml");
     std::fs::write(&path, text).unwrap();
     let s = load_scene(&path).unwrap();
     let mat = |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().bsdf.clone();
-    let Some(BsdfDesc::Sheened { base, color, roughness }) = mat(&s, "velvet") else { panic!() };
-    assert_eq!((color, roughness), (alhazen_math::Vec3::new(1.0, 0.9, 0.9), 0.4));
+    let Some(BsdfDesc::Sheened { base, color, roughness, .. }) = mat(&s, "velvet") else { panic!() };
+    assert_eq!((color, roughness), (Texture::Solid(alhazen_math::Vec3::new(1.0, 0.9, 0.9)), 0.4));
     assert!(
         matches!(*base, BsdfDesc::Lambert { albedo: Texture::Solid(c) } if c == alhazen_math::Vec3::new(0.3, 0.02, 0.05))
     );
@@ -338,9 +341,18 @@ bsdf = { type = "sheen", base = { type = "lambert" } }
     let again_path = dir.path().join("again.toml");
     alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
     let again = load_scene(&again_path).unwrap();
+    let texel = |s: &alhazen_scene::Scene, t: &Texture| match t {
+        Texture::Image { image, .. } => s.images[*image].texel(0),
+        other => panic!("{other:?}"),
+    };
+    let Some(BsdfDesc::Sheened { color, roughness_map: Some(map), .. }) = mat(&s, "mapped") else { panic!() };
+    // The colour sRGB-decoded, the roughness map read linearly.
+    assert!((texel(&s, &color)[0] - 0.5776).abs() < 1e-3 && texel(&s, &map)[0] == 200.0 / 255.0);
     for name in ["velvet", "plain"] {
         assert_eq!(mat(&s, name), mat(&again, name));
     }
+    let Some(BsdfDesc::Sheened { color: c2, roughness_map: Some(m2), .. }) = mat(&again, "mapped") else { panic!() };
+    assert_eq!((texel(&s, &color), texel(&s, &map)), (texel(&again, &c2), texel(&again, &m2)));
 }
 
 /// Plastic: smooth by default (Mitsuba's polypropylene coat), rough with a roughness, and the

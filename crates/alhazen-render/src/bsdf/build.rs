@@ -137,11 +137,14 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             let weight = (weight * at).clamp(0.0, 1.0);
             Bsdf::Mix(Box::new(Mix { a: from_desc(a, lookups, mode), b: from_desc(b, lookups, mode), weight }))
         }
-        BsdfDesc::Sheened { base, color, roughness } => Bsdf::Sheened(Box::new(super::Sheened::new(
-            from_desc(base, lookups, mode),
-            mode.color(*color),
-            roughness * roughness,
-        ))),
+        BsdfDesc::Sheened { base, color, roughness, roughness_map } => {
+            let r = roughness * roughness_map.as_ref().map_or(1.0, |m| (lookups.rgb)(m).x);
+            Bsdf::Sheened(Box::new(super::Sheened::new(
+                from_desc(base, lookups, mode),
+                mode.color((lookups.rgb)(color)),
+                r * r,
+            )))
+        }
         BsdfDesc::Coated { base, weight, facets, ior } => Bsdf::Coated(Box::new(super::Coated::new(
             from_desc(base, lookups, mode),
             CookTorranceLobe { facets: Microfacet::new(facets), ior: *ior, schlick: false },
