@@ -708,10 +708,8 @@ impl Importer<'_> {
             _ => (Vec2::ONE, Vec2::ZERO, 0.0),
         };
         let alpha = self.cut_out(&material, c[3] as f64, placement)?;
-        for ext in ["KHR_materials_iridescence"] {
-            if material.extension_value(ext).is_some() {
-                self.warn(format!("{name}: {ext} is not supported; ignored"));
-            }
+        if material.extension_value("KHR_materials_iridescence").is_some() {
+            self.warn(format!("{name}: KHR_materials_iridescence is not supported; ignored"));
         }
         let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
         // Per point where the map or a textured metal's colour varies (glTF's metal takes each

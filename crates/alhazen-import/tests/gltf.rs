@@ -1275,6 +1275,13 @@ fn skins_move_vertices_with_their_joints() {
     assert_eq!((b.min, b.max), (Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
     let e = skinned_quad(3, 1.0).unwrap_err();
     assert!(e.contains("joint 3 is not one of its skin's 1"), "{e}");
+    let e = skinned_quad(0, -1.0).unwrap_err();
+    assert!(e.contains("skin weights must be finite and ≥ 0"), "{e}");
+    // Morph weights for targets the mesh does not have.
+    let json =
+        embedded().replace(r#""meshes": [{ "name": "quad","#, r#""meshes": [{ "name": "quad", "weights": [0.5],"#);
+    let e = write_and_import(&[("m.gltf", json.into_bytes())]).unwrap_err();
+    assert!(e.contains("1 morph weights for 0 targets"), "{e}");
 }
 
 /// A Blender export (`bytes`, as read or changed) imported without warnings, to be rendered at
@@ -1380,7 +1387,7 @@ fn blender_gpu_instances_agree_with_cycles() {
     for (key, value, says) in [
         ("ROTATION", serde_json::json!(999), "ROTATION must name one of the file's accessors"),
         ("SCALE", serde_json::json!(0), "attributes must have as many elements each"),
-        ("ROTATION", translation, "ROTATION accessor must have 4 components"),
+        ("ROTATION", translation.clone(), "ROTATION accessor must have 4 components"),
     ] {
         let bad = glb_with_json(&bytes, |json| {
             json["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"][key] = value.clone();
@@ -1388,6 +1395,17 @@ fn blender_gpu_instances_agree_with_cycles() {
         let e = write_and_import(&[("instances.glb", bad)]).unwrap_err();
         assert!(e.contains("instances.glb") && e.contains(says), "{key}: {e}");
     }
+    // Rotations that are not unit quaternions: the translations' bytes read as five of them.
+    let bad = glb_with_json(&bytes, |json| {
+        let view = json["accessors"][translation.as_u64().unwrap() as usize]["bufferView"].clone();
+        let accessors = json["accessors"].as_array_mut().unwrap();
+        accessors.push(serde_json::json!({ "bufferView": view, "componentType": 5126, "count": 5, "type": "VEC4" }));
+        let rotation = accessors.len() - 1;
+        json["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"] =
+            serde_json::json!({ "ROTATION": rotation });
+    });
+    let e = write_and_import(&[("instances.glb", bad)]).unwrap_err();
+    assert!(e.contains("a rotation that is not a unit quaternion"), "{e}");
 }
 
 /// Tinted glass through Blender's exporter (`bench/blender/volume_vs_cycles.py`): a glass cube
