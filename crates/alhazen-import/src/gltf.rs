@@ -4,7 +4,8 @@
 //! The default scene's node hierarchy is walked with each node's TRS or matrix composed onto
 //! its parent's (the course's scene graph); every mesh primitive becomes one shared mesh
 //! (positions, normals, first texture coordinates — `v` flipped, glTF's origin being the image's
-//! top — indices; strips and fans unrolled), instanced by every node that uses it — except
+//! top — indices; strips and fans unrolled; Draco-compressed ones decoded first, `draco`, as are meshopt-compressed buffer views, `meshopt`),
+//! instanced by every node that uses it — except
 //! where a node poses it (a skin, by linear blend skinning with its joints' world transforms;
 //! morph targets of non-zero weight): that node's mesh is its own, its vertices moved; a node's
 //! `EXT_mesh_gpu_instancing` instances are objects of its one mesh. Materials map
@@ -21,8 +22,8 @@
 //! that Blender's exporter uses. The first camera met is the camera; without one the
 //! scene's bounds are framed from `+z`.
 
-use crate::Imported;
 use crate::common::{self, Warnings};
+use crate::{Imported, draco, meshopt};
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Mat4, Quat, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Ior, MetalRoughness};
@@ -59,10 +60,14 @@ const KNOWN: &[&str] = &[
     "KHR_materials_dispersion",
     "EXT_mesh_gpu_instancing",
     "KHR_materials_sheen",
+    draco::EXTENSION,
+    meshopt::EXTENSIONS[0],
+    meshopt::EXTENSIONS[1],
 ];
 
-/// Reads a glTF 2.0 file.
-pub fn load(path: &Path) -> Result<Imported, SceneError> {
+/// Reads a glTF 2.0 file, refusing compressed meshes that would decode to more than
+/// `memory_budget` bytes before decoding them.
+pub fn load(path: &Path, memory_budget: u64) -> Result<Imported, SceneError> {
     let bytes = common::read_bytes(path)?;
     // The gltf crate's validation panics on some inconsistent files (an index out of bounds in
     // gltf-json 1.4, found by fuzzing): such a panic is caught, kept off the terminal, and
@@ -70,20 +75,19 @@ pub fn load(path: &Path) -> Result<Imported, SceneError> {
     // would be silent too, and still fail.)
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_bytes(path, &bytes)));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_bytes(path, &bytes, memory_budget)));
     std::panic::set_hook(hook);
     result.unwrap_or_else(|_| {
         Err(error(path, &bytes, "not a valid glTF 2.0 file: its parts are inconsistent (the glTF reader failed on it)"))
     })
 }
 
-fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
+fn load_bytes(path: &Path, bytes: &[u8], memory_budget: u64) -> Result<Imported, SceneError> {
     let invalid = |e: gltf::Error| error(path, bytes, format!("not a valid glTF 2.0 file: {e}"));
-    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+    let (mut json, blob) = parse(bytes).map_err(invalid)?;
     // A required extension alhazen cannot read is said before the reader's validation (which
     // would name the textures a required image format leaves without a source); the rest
     // alhazen reads, some without the reader's support, whose validation would refuse them.
-    let mut json = gltf.document.into_json();
     if let Some(e) = json.extensions_required.iter().find(|e| !KNOWN.contains(&e.as_str())) {
         return Err(error(path, bytes, format!("the file requires extension {e}, which alhazen cannot read")));
     }
@@ -96,10 +100,18 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
             texture.source = gltf::json::Index::new(i.min(u32::MAX as u64 - 1) as u32);
         }
     }
-    let document = gltf::Document::from_json(json).map_err(invalid)?;
+    // The buffers are read before validation: compressed buffer views and Draco-compressed
+    // primitives are decoded from them into views and accessors of their own, which the
+    // validation then sees.
+    meshopt::empty_placeholders(&mut json, blob.is_some());
     let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&document, Some(base), gltf.blob)
+    let unvalidated = gltf::Document::from_json_without_validation(json);
+    let mut buffers = gltf::import_buffers(&unvalidated, Some(base), blob)
         .map_err(|e| error(path, bytes, format!("cannot read its buffers: {e}")))?;
+    let mut json = unvalidated.into_json();
+    meshopt::decompress(&mut json, &mut buffers, memory_budget).map_err(|e| error(path, bytes, e))?;
+    draco::decompress(&mut json, &mut buffers, memory_budget).map_err(|e| error(path, bytes, e))?;
+    let document = gltf::Document::from_json(json).map_err(invalid)?;
     let mut imp = Importer {
         path,
         worlds: HashMap::new(),
@@ -127,6 +139,27 @@ fn load_bytes(path: &Path, bytes: &[u8]) -> Result<Imported, SceneError> {
         imp.node(&node, Mat4::IDENTITY, 0)?;
     }
     imp.finish()
+}
+
+/// The file's JSON (not validated) and its binary chunk. Animations are not read: a file whose
+/// animations the reader cannot parse (`KHR_animation_pointer`'s channels, which target no
+/// node) is read without them; any other fault is the reader's error.
+fn parse(bytes: &[u8]) -> Result<(gltf::json::Root, Option<Vec<u8>>), gltf::Error> {
+    let error = match gltf::Gltf::from_slice_without_validation(bytes) {
+        Ok(g) => return Ok((g.document.into_json(), g.blob)),
+        Err(e) => e,
+    };
+    let (json, blob) = if bytes.starts_with(b"glTF") {
+        let Ok(glb) = gltf::binary::Glb::from_slice(bytes) else { return Err(error) };
+        (glb.json.into_owned(), glb.bin.map(|b| b.into_owned()))
+    } else {
+        (bytes.to_vec(), None)
+    };
+    let Ok(mut value) = serde_json::from_slice::<serde_json::Value>(&json) else { return Err(error) };
+    if value.as_object_mut().and_then(|o| o.remove("animations")).is_none() {
+        return Err(error);
+    }
+    serde_json::from_value(value).map(|root| (root, blob)).map_err(|_| error)
 }
 
 /// An error in a glTF file: JSON files are located by the first line naming the problem when

@@ -22,7 +22,9 @@
 //! ```
 
 mod common;
+mod draco;
 pub mod gltf;
+mod meshopt;
 pub mod mitsuba;
 pub mod pbrt;
 mod serialized;
@@ -132,7 +134,7 @@ fn read(path: &Path, memory_budget: u64, parameters: &[(String, String)]) -> Res
                 warnings.into_iter().map(|message| Warning { file: path.to_path_buf(), line: 0, message }).collect();
             Ok(Imported { scene, warnings })
         }
-        SceneFormat::Gltf => gltf::load(path),
+        SceneFormat::Gltf => gltf::load(path, memory_budget),
         SceneFormat::Mitsuba => mitsuba::load_with_parameters(path, parameters),
         SceneFormat::Pbrt => pbrt::load(path),
     }
