@@ -243,14 +243,15 @@ enum Read {
     /// `scene.meshes[index]`, turned inside out when `flip` and its texture coordinates'
     /// `v` turned to `1 − v` when `flip_v`; of a Mitsuba `serialized` file, its mesh `part`.
     Mesh { index: usize, flip: bool, flip_v: bool, part: Option<usize> },
-    /// `scene.images[index]`: linear values (or sRGB decoded), upside down when `rows_reversed`.
-    Image { index: usize, linear: bool, rows_reversed: bool },
+    /// `scene.images[index]`: linear values (or sRGB decoded), upside down when `rows_reversed`,
+    /// each channel times `gain`.
+    Image { index: usize, linear: bool, rows_reversed: bool, gain: [f32; 3] },
 }
 
 /// A pending file as read, with where it goes.
 enum Loaded {
     Mesh { index: usize, flip: bool, flip_v: bool, mesh: Result<alhazen_scene::import::LoadedMesh, String> },
-    Image { index: usize, rows_reversed: bool, image: Result<alhazen_scene::ImageData, String> },
+    Image { index: usize, rows_reversed: bool, gain: [f32; 3], image: Result<alhazen_scene::ImageData, String> },
 }
 
 impl PendingFiles {
@@ -284,8 +285,38 @@ impl PendingFiles {
     ) -> usize {
         images.push(Arc::new(alhazen_scene::ImageData::new(1, 1, vec![[0.0; 3]])));
         let index = images.len() - 1;
-        self.push(path, Read::Image { index, linear, rows_reversed }, at, span);
+        self.push(path, Read::Image { index, linear, rows_reversed, gain: [1.0; 3] }, at, span);
         index
+    }
+
+    /// A copy of image `index` of `images` with each channel times `gain` (a texture scaled by a
+    /// constant), added to `images`: read from the same file once it is read, if it is
+    /// pending. Its place in `images` is returned.
+    pub fn scaled_image(
+        &mut self,
+        images: &mut Vec<Arc<alhazen_scene::ImageData>>,
+        index: usize,
+        gain: [f32; 3],
+    ) -> usize {
+        let pending = self.reads.iter().find(|r| matches!(r.what, Read::Image { index: i, .. } if i == index));
+        let copy = match pending {
+            Some(r) => {
+                let Read::Image { linear, rows_reversed, gain: g, .. } = r.what else { unreachable!("an image") };
+                let what =
+                    Read::Image { index: images.len(), linear, rows_reversed, gain: [0, 1, 2].map(|c| g[c] * gain[c]) };
+                Some(PendingRead { path: r.path.clone(), what, file: r.file, span: r.span.clone() })
+            }
+            None => None,
+        };
+        let placeholder = images[index].clone();
+        match copy {
+            Some(read) => {
+                self.reads.push(read);
+                images.push(placeholder);
+            }
+            None => images.push(Arc::new(placeholder.channels_scaled(gain))),
+        }
+        images.len() - 1
     }
 
     fn push(&mut self, path: &Path, what: Read, at: (&Path, &Arc<str>), span: Range<usize>) {
@@ -305,7 +336,7 @@ impl PendingFiles {
             return Ok(());
         };
         let r = self.reads.remove(at);
-        let Read::Image { linear, rows_reversed, .. } = r.what else { unreachable!("found as an image") };
+        let Read::Image { linear, rows_reversed, gain, .. } = r.what else { unreachable!("found as an image") };
         let image = if linear {
             alhazen_scene::import::load_hdr_image(&r.path)
         } else {
@@ -316,6 +347,7 @@ impl PendingFiles {
             located(path, text, r.span.clone(), e)
         })?;
         let image = if rows_reversed { image.rows_reversed() } else { image };
+        let image = if gain == [1.0; 3] { image } else { image.channels_scaled(gain) };
         // The placeholder holds the wrap the texture asked for.
         scene.images[index] = Arc::new(image.with_wrap(scene.images[index].wrap));
         Ok(())
@@ -348,13 +380,13 @@ impl PendingFiles {
                 };
                 Loaded::Mesh { index, flip, flip_v, mesh }
             }
-            Read::Image { index, linear, rows_reversed } => {
+            Read::Image { index, linear, rows_reversed, gain } => {
                 let image = if linear {
                     alhazen_scene::import::load_hdr_image(&r.path)
                 } else {
                     alhazen_scene::import::load_image(&r.path)
                 };
-                Loaded::Image { index, rows_reversed, image }
+                Loaded::Image { index, rows_reversed, gain, image }
             }
         };
         let loaded: Vec<_> = pending.par_iter().map(read).collect();
@@ -375,9 +407,10 @@ impl PendingFiles {
                     }
                     scene.meshes[index] = Arc::new(mesh);
                 }
-                Loaded::Image { index, rows_reversed, image } => {
+                Loaded::Image { index, rows_reversed, gain, image } => {
                     let image = image.map_err(at)?;
                     let image = if rows_reversed { image.rows_reversed() } else { image };
+                    let image = if gain == [1.0; 3] { image } else { image.channels_scaled(gain) };
                     scene.images[index] = Arc::new(image.with_wrap(scene.images[index].wrap));
                 }
             }

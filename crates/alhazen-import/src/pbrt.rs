@@ -1119,12 +1119,23 @@ impl Importer {
         })
     }
 
-    /// A conductor's `eta` (`which = 0`) or `k` (`which = 1`): numbers or a named metal
-    /// spectrum (`metal-Au-eta`, …); copper by default, as pbrt.
+    /// A conductor's `eta` (`which = 0`) or `k` (`which = 1`): numbers, a named metal spectrum
+    /// (`metal-Au-eta`, …), a spectrum file (`spds/Au.eta.spd`: pairs of wavelength in nm and
+    /// value) or the pairs themselves, a spectrum's RGB as pbrt-v3 made its metals' (the CIE
+    /// integrals over the spectrum without an illuminant, divided by ȳ's); copper by default,
+    /// as pbrt.
     fn metal_spectrum(&mut self, ctx: &Ctx, p: &mut Params, name: &str, which: usize) -> R<Vec3> {
         let named = |metal: &str| alhazen_scene::bsdf::metal(metal).map(|ek| if which == 0 { ek.0 } else { ek.1 });
         let Some(q) = self.find(p, name) else { return Ok(named("copper").expect("a listed metal")) };
+        let rgb = |pairs: &[f64]| {
+            let (wavelengths, values): (Vec<f64>, Vec<f64>) = pairs.chunks_exact(2).map(|p| (p[0], p[1])).unzip();
+            alhazen_math::cie::spectrum_to_linear_srgb(&wavelengths, &values, true, false)
+        };
         if let [Value::Str(s)] = &q.values[..] {
+            let file = common::relative_to(ctx.path, s);
+            if !s.starts_with("metal-") && file.is_file() {
+                return Ok(rgb(&spectrum_file(&file).map_err(|e| ctx.err(q.span.clone(), e))?));
+            }
             let metal = match s.split('-').nth(1) {
                 Some("Au") => "gold",
                 Some("Ag") => "silver",
@@ -1142,6 +1153,13 @@ impl Importer {
                 }
             };
             return Ok(named(metal).expect("a listed metal"));
+        }
+        if q.ty == "spectrum" && q.values.len() > 1 {
+            let pairs = self.nums(ctx, &q)?;
+            return match sampled(&pairs) {
+                Ok(()) => Ok(rgb(&pairs)),
+                Err(e) => Err(ctx.err(q.span.clone(), format!("\"{}\" {e}", q.name))),
+            };
         }
         self.color_of(ctx, &q)
     }
@@ -1201,12 +1219,12 @@ impl Importer {
                 match t {
                     Texture::Solid(c) => Texture::Solid(c * s),
                     Texture::Checker { even, odd, size } => Texture::Checker { even: even * s, odd: odd * s, size },
-                    img => {
-                        if s != Vec3::ONE {
-                            self.warn(ctx, at, "a scaled image texture is used unscaled");
-                        }
-                        img
+                    Texture::Image { image, scale, offset, rotation } if s != Vec3::ONE => {
+                        let gain = s.to_array().map(|x| x as f32);
+                        let image = self.pending.scaled_image(&mut self.scene.images, image, gain);
+                        Texture::Image { image, scale, offset, rotation }
                     }
+                    img => img,
                 }
             }
             other => {
@@ -1364,7 +1382,9 @@ impl Importer {
                     self.warn(ctx, at, "a disk's inner radius is not supported: the disk is full");
                 }
                 partial(self, p, ctx)?;
-                Shape::Disk { center: Vec3::new(0.0, 0.0, self.float(ctx, p, "height", 0.0)?), normal: Vec3::Z, radius }
+                // A reversed disk faces −z: an emitting one shines that way.
+                let normal = if reverse { -Vec3::Z } else { Vec3::Z };
+                Shape::Disk { center: Vec3::new(0.0, 0.0, self.float(ctx, p, "height", 0.0)?), normal, radius }
             }
             "cylinder" => {
                 let radius = self.float(ctx, p, "radius", 1.0)?;
@@ -1404,8 +1424,12 @@ impl Importer {
                 return Ok(());
             }
         };
-        if reverse && !matches!(shape, Shape::Mesh { .. }) {
-            self.warn(ctx, at, "ReverseOrientation applies to meshes only: this shape emits from its outside");
+        if reverse && matches!(shape, Shape::Sphere { .. } | Shape::Cylinder { .. }) {
+            self.warn(
+                ctx,
+                at,
+                "ReverseOrientation applies to meshes and disks only: this shape emits from its outside",
+            );
         }
         // pbrt's alpha: a coverage that lets a fraction of the rays through (no cutoff).
         let coverage = self.texture_param(ctx, p, "alpha", Vec3::ONE)?;
@@ -1678,6 +1702,31 @@ fn equal_area_sphere_to_square(d: Vec3) -> Vec2 {
         v = 1.0 - v;
     }
     Vec2::new(0.5 * (u.copysign(d.x) + 1.0), 0.5 * (v.copysign(d.y) + 1.0))
+}
+
+/// The pairs of wavelength (nm) and value of a spectrum file (pbrt's `.spd`: numbers separated
+/// by white space, `#` comments), or why they cannot be had.
+fn spectrum_file(path: &Path) -> Result<Vec<f64>, String> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| format!("cannot read spectrum file {}: {e}", path.display()))?;
+    let mut pairs = Vec::new();
+    for word in text.lines().flat_map(|l| l.split('#').next().unwrap_or("").split_whitespace()) {
+        let v =
+            word.parse::<f64>().map_err(|_| format!("spectrum file {}: \"{word}\" is not a number", path.display()))?;
+        pairs.push(v);
+    }
+    sampled(&pairs).map_err(|e| format!("spectrum file {} {e}", path.display()))?;
+    Ok(pairs)
+}
+
+/// Whether `pairs` is a sampled spectrum: two or more pairs of finite numbers, the wavelengths
+/// increasing.
+fn sampled(pairs: &[f64]) -> Result<(), String> {
+    let ok = pairs.len() >= 4
+        && pairs.len().is_multiple_of(2)
+        && pairs.iter().all(|x| x.is_finite())
+        && pairs.chunks_exact(2).zip(pairs.chunks_exact(2).skip(1)).all(|(a, b)| a[0] < b[0]);
+    if ok { Ok(()) } else { Err("must be two or more pairs of wavelength (nm, increasing) and value".into()) }
 }
 
 #[cfg(test)]

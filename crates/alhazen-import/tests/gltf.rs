@@ -285,10 +285,7 @@ fn malformed_files_are_errors() {
         (
             "a.gltf",
             embedded()
-                .replace(
-                    r#""extensionsUsed""#,
-                    r#""extensionsRequired": ["EXT_texture_avif"], "extensionsUsed""#,
-                )
+                .replace(r#""extensionsUsed""#, r#""extensionsRequired": ["EXT_texture_avif"], "extensionsUsed""#)
                 .into_bytes(),
             "a.gltf:1:1: the file requires extension EXT_texture_avif, which alhazen cannot read",
         ),
