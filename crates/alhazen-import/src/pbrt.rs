@@ -183,7 +183,12 @@ struct Importer {
     /// Named media: their absorption per unit length (`None`: a medium alhazen does not
     /// render, warned where it was made).
     media: HashMap<String, Option<Vec3>>,
-    textures: HashMap<String, Texture>,
+    /// Named textures, each with the gain a `scale` texture puts on its image (1 elsewhere):
+    /// the image is copied scaled where the texture is a colour, and read as it is, the gain
+    /// its height, where it is a displacement.
+    textures: HashMap<String, (Texture, Vec3)>,
+    /// The scaled copies of images made so far: (image, the gain's bits) → the copy.
+    scaled_copies: HashMap<(usize, [u64; 3]), usize>,
     objects: HashMap<String, Vec<Object>>,
     defining: Option<(String, Vec<Object>)>,
     meshes: HashMap<(PathBuf, bool), usize>,
@@ -238,6 +243,7 @@ impl Importer {
             named_coords: HashMap::new(),
             named_materials: HashMap::new(),
             textures: HashMap::new(),
+            scaled_copies: HashMap::new(),
             cut_materials: HashMap::new(),
             objects: HashMap::new(),
             defining: None,
@@ -793,7 +799,13 @@ impl Importer {
 
     /// A colour parameter or texture reference.
     fn texture_param(&mut self, ctx: &Ctx, p: &mut Params, name: &str, default: Vec3) -> R<Texture> {
-        let Some(q) = self.find(p, name) else { return Ok(Texture::Solid(default)) };
+        let (t, gain) = self.texture_ref(ctx, p, name, default)?;
+        Ok(self.gained(t, gain))
+    }
+
+    /// Parameter `name` as a texture and the gain on its image (see `textures`).
+    fn texture_ref(&mut self, ctx: &Ctx, p: &mut Params, name: &str, default: Vec3) -> R<(Texture, Vec3)> {
+        let Some(q) = self.find(p, name) else { return Ok((Texture::Solid(default), Vec3::ONE)) };
         if q.ty == "texture" {
             let [Value::Str(t)] = &q.values[..] else {
                 return Err(ctx.err(q.span, "a texture parameter names one texture"));
@@ -804,7 +816,25 @@ impl Importer {
                 .cloned()
                 .ok_or_else(|| ctx.err(q.span.clone(), format!("no texture named \"{t}\"")));
         }
-        self.color_of(ctx, &q).map(Texture::Solid)
+        self.color_of(ctx, &q).map(|c| (Texture::Solid(c), Vec3::ONE))
+    }
+
+    /// `t` with `gain` on its image: a scaled copy of the image (one per image and gain).
+    fn gained(&mut self, t: Texture, gain: Vec3) -> Texture {
+        let Texture::Image { image, scale, offset, rotation } = t else { return t };
+        if gain == Vec3::ONE {
+            return t;
+        }
+        let key = (image, gain.to_array().map(f64::to_bits));
+        let copy = match self.scaled_copies.get(&key) {
+            Some(&copy) => copy,
+            None => {
+                let copy = self.pending.scaled_image(&mut self.scene.images, image, gain.to_array().map(|x| x as f32));
+                self.scaled_copies.insert(key, copy);
+                copy
+            }
+        };
+        Texture::Image { image: copy, scale, offset, rotation }
     }
 
     fn color(&mut self, ctx: &Ctx, p: &mut Params, name: &str, default: Vec3) -> R<Vec3> {
@@ -971,11 +1001,38 @@ impl Importer {
         }
     }
 
+    /// A material's `displacement`, pbrt-v4's bump mapping (the shading normal that of the
+    /// surface moved along its normal by a float texture): a bump of an image map's luminance
+    /// (pbrt averages the channels: the same on grey maps), its height the gain a `scale`
+    /// texture puts on the image; a constant moves nothing. A normal map, which pbrt prefers,
+    /// replaces it (warning).
+    fn displacement(&mut self, ctx: &Ctx, at: &Range<usize>, p: &mut Params) -> R<Option<Bump>> {
+        let (t, gain) = self.texture_ref(ctx, p, "displacement", Vec3::ZERO)?;
+        let bump = match t {
+            Texture::Solid(_) => None,
+            Texture::Image { image, scale, offset, rotation } => {
+                if offset != Vec2::ZERO || rotation != 0.0 {
+                    self.warn(ctx, at, "a displacement map's udelta and vdelta are not supported; ignored");
+                }
+                // A float texture's gain is the same on every channel.
+                let height = if gain == Vec3::splat(gain.x) { gain.x } else { gain.element_sum() / 3.0 };
+                Some(Bump { height, pattern: BumpPattern::Image { image, scale } })
+            }
+            _ => {
+                self.warn(ctx, at, "only image maps (scaled or not) can displace; the displacement is ignored");
+                None
+            }
+        };
+        if bump.is_some() && p.list.iter().any(|q| q.name == "normalmap") {
+            self.warn(ctx, at, "a material with a normal map and a displacement takes the normal map, as pbrt");
+            return Ok(None);
+        }
+        Ok(bump)
+    }
+
     fn material(&mut self, ctx: &Ctx, kind: &str, at: &Range<usize>, p: &mut Params, name: &str) -> R<MaterialId> {
         let bsdf = self.bsdf(ctx, kind, at, p, 0)?;
-        if self.find(p, "displacement").is_some() {
-            self.warn(ctx, at, "displacement is not supported; ignored");
-        }
+        let displacement = self.displacement(ctx, at, p)?;
         let bump = match self.string(ctx, p, "normalmap")? {
             Some(file) => {
                 let path = common::relative_to(ctx.path, &file);
@@ -995,7 +1052,7 @@ impl Importer {
                     },
                 })
             }
-            None => None,
+            None => displacement,
         };
         self.unused(ctx, p, &format!("material \"{kind}\""));
         let mut m = alhazen_scene::Material::from_bsdf(name, bsdf);
@@ -1164,7 +1221,9 @@ impl Importer {
         self.color_of(ctx, &q)
     }
 
-    fn texture(&mut self, ctx: &Ctx, kind: &str, at: &Range<usize>, p: &mut Params) -> R<Texture> {
+    /// A `Texture` directive's texture, and the gain a `scale` texture puts on its image.
+    fn texture(&mut self, ctx: &Ctx, kind: &str, at: &Range<usize>, p: &mut Params) -> R<(Texture, Vec3)> {
+        let mut gain = Vec3::ONE;
         let t = match kind {
             "imagemap" => {
                 let name = self
@@ -1214,17 +1273,15 @@ impl Importer {
             }
             "constant" => Texture::Solid(self.color(ctx, p, "value", Vec3::ONE)?),
             "scale" => {
-                let t = self.texture_param(ctx, p, "tex", Vec3::ONE)?;
+                let (t, inner) = self.texture_ref(ctx, p, "tex", Vec3::ONE)?;
                 let s = self.color(ctx, p, "scale", Vec3::ONE)?;
                 match t {
                     Texture::Solid(c) => Texture::Solid(c * s),
                     Texture::Checker { even, odd, size } => Texture::Checker { even: even * s, odd: odd * s, size },
-                    Texture::Image { image, scale, offset, rotation } if s != Vec3::ONE => {
-                        let gain = s.to_array().map(|x| x as f32);
-                        let image = self.pending.scaled_image(&mut self.scene.images, image, gain);
-                        Texture::Image { image, scale, offset, rotation }
+                    img => {
+                        gain = inner * s;
+                        img
                     }
-                    img => img,
                 }
             }
             other => {
@@ -1234,7 +1291,7 @@ impl Importer {
             }
         };
         self.unused(ctx, p, &format!("texture \"{kind}\""));
-        Ok(t)
+        Ok((t, gain))
     }
 
     // ---- lights --------------------------------------------------------------------------

@@ -519,3 +519,34 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3] "point3 P" [-3 -3 0 3 -3 0 
     let (down, up) = (scene("ReverseOrientation"), scene(""));
     assert!(down > 100.0 * up.max(1e-3), "{down} {up}");
 }
+
+/// A material's `displacement` (pbrt-v4's bump mapping; its contemporary-bathroom floors: a
+/// `scale` of −0.05 over a float image map) bumps the shading normal by the image, the scale
+/// its height: no scaled copy of the image is made for it. Where the same scaled texture is a
+/// colour, one copy serves every material that uses it.
+#[test]
+fn displacement_maps_bump_and_scaled_textures_share_their_copy() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_fn(4, 4, |x, y| image::Rgb([(x * 60) as u8, (y * 60) as u8, 90]))
+        .save(dir.path().join("b.png"))
+        .unwrap();
+    let head = "Camera \"perspective\"\nWorldBegin\nTexture \"base\" \"float\" \"imagemap\" \"string filename\" \"b.png\" \"float uscale\" 2\n\
+                Texture \"bump\" \"float\" \"scale\" \"float scale\" -0.05 \"texture tex\" \"base\"\n";
+    let load = |body: &str| {
+        std::fs::write(dir.path().join("a.pbrt"), format!("{head}{body}")).unwrap();
+        alhazen_import::load(&dir.path().join("a.pbrt")).unwrap()
+    };
+    let bumped = load("Material \"diffuse\" \"texture displacement\" \"bump\"\nShape \"sphere\"");
+    assert!(bumped.warnings.is_empty(), "{:?}", bumped.warnings);
+    let s = &bumped.scene;
+    let bump = s.materials[s.objects[0].material as usize].bump.clone();
+    let pattern = alhazen_scene::BumpPattern::Image { image: 0, scale: alhazen_math::Vec2::new(2.0, 1.0) };
+    assert_eq!(bump, Some(alhazen_scene::Bump { height: -0.05, pattern }));
+    assert_eq!(s.images.len(), 1, "no scaled copy for a displacement");
+    let coloured = load(
+        "Material \"diffuse\" \"texture reflectance\" \"bump\"\nShape \"sphere\"\n\
+         Material \"coateddiffuse\" \"texture reflectance\" \"bump\"\nShape \"sphere\"",
+    );
+    assert_eq!(coloured.scene.images.len(), 2, "one copy for both materials");
+    assert_eq!(coloured.scene.images[1].texel(5), coloured.scene.images[0].texel(5).map(|c| -0.05 * c));
+}
