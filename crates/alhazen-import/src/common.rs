@@ -237,6 +237,43 @@ struct PendingRead {
     span: Range<usize>,
 }
 
+/// An affine change of an image's channels, `offset + gain·v`, then `max(0, ·)` where `floor`
+/// (pbrt's image maps' `scale` and `invert`, its `scale` and `mix` textures over one image).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexelMap {
+    /// Each channel's factor.
+    pub gain: [f64; 3],
+    /// Each channel's term.
+    pub offset: [f64; 3],
+    /// Whether negative values become 0.
+    pub floor: bool,
+}
+
+impl TexelMap {
+    /// No change.
+    pub const IDENTITY: Self = Self { gain: [1.0; 3], offset: [0.0; 3], floor: false };
+
+    /// This change, then `outer`.
+    pub fn then(self, outer: Self) -> Self {
+        Self {
+            gain: std::array::from_fn(|c| outer.gain[c] * self.gain[c]),
+            offset: std::array::from_fn(|c| outer.offset[c] + outer.gain[c] * self.offset[c]),
+            floor: self.floor || outer.floor,
+        }
+    }
+
+    /// `image` changed (itself where this is no change).
+    pub fn apply(&self, image: alhazen_scene::ImageData) -> alhazen_scene::ImageData {
+        if *self == Self::IDENTITY {
+            return image;
+        }
+        image.channels_mapped(|c, v| {
+            let x = (self.offset[c] + self.gain[c] * v as f64) as f32;
+            if self.floor { x.max(0.0) } else { x }
+        })
+    }
+}
+
 /// What a pending file becomes.
 #[derive(Clone, Copy)]
 enum Read {
@@ -244,14 +281,14 @@ enum Read {
     /// `v` turned to `1 − v` when `flip_v`; of a Mitsuba `serialized` file, its mesh `part`.
     Mesh { index: usize, flip: bool, flip_v: bool, part: Option<usize> },
     /// `scene.images[index]`: linear values (or sRGB decoded), upside down when `rows_reversed`,
-    /// each channel times `gain`.
-    Image { index: usize, linear: bool, rows_reversed: bool, gain: [f32; 3] },
+    /// its channels changed by `map`.
+    Image { index: usize, linear: bool, rows_reversed: bool, map: TexelMap },
 }
 
 /// A pending file as read, with where it goes.
 enum Loaded {
     Mesh { index: usize, flip: bool, flip_v: bool, mesh: Result<alhazen_scene::import::LoadedMesh, String> },
-    Image { index: usize, rows_reversed: bool, gain: [f32; 3], image: Result<alhazen_scene::ImageData, String> },
+    Image { index: usize, rows_reversed: bool, map: TexelMap, image: Result<alhazen_scene::ImageData, String> },
 }
 
 impl PendingFiles {
@@ -285,36 +322,32 @@ impl PendingFiles {
     ) -> usize {
         images.push(Arc::new(alhazen_scene::ImageData::new(1, 1, vec![[0.0; 3]])));
         let index = images.len() - 1;
-        self.push(path, Read::Image { index, linear, rows_reversed, gain: [1.0; 3] }, at, span);
+        self.push(path, Read::Image { index, linear, rows_reversed, map: TexelMap::IDENTITY }, at, span);
         index
     }
 
-    /// A copy of image `index` of `images` with each channel times `gain` (a texture scaled by a
-    /// constant), added to `images`: read from the same file once it is read, if it is
-    /// pending. Its place in `images` is returned.
-    pub fn scaled_image(
+    /// A copy of image `index` of `images` with its channels changed by `map` (a texture of
+    /// a scene file that changes an image), added to `images`: read from the same file once it
+    /// is read, if it is pending. Its place in `images` is returned.
+    pub fn mapped_image(
         &mut self,
         images: &mut Vec<Arc<alhazen_scene::ImageData>>,
         index: usize,
-        gain: [f32; 3],
+        map: TexelMap,
     ) -> usize {
         let pending = self.reads.iter().find(|r| matches!(r.what, Read::Image { index: i, .. } if i == index));
-        let copy = match pending {
-            Some(r) => {
-                let Read::Image { linear, rows_reversed, gain: g, .. } = r.what else { unreachable!("an image") };
-                let what =
-                    Read::Image { index: images.len(), linear, rows_reversed, gain: [0, 1, 2].map(|c| g[c] * gain[c]) };
-                Some(PendingRead { path: r.path.clone(), what, file: r.file, span: r.span.clone() })
-            }
-            None => None,
-        };
+        let copy = pending.map(|r| {
+            let Read::Image { linear, rows_reversed, map: first, .. } = r.what else { unreachable!("an image") };
+            let what = Read::Image { index: images.len(), linear, rows_reversed, map: first.then(map) };
+            PendingRead { path: r.path.clone(), what, file: r.file, span: r.span.clone() }
+        });
         let placeholder = images[index].clone();
         match copy {
             Some(read) => {
                 self.reads.push(read);
                 images.push(placeholder);
             }
-            None => images.push(Arc::new(placeholder.channels_scaled(gain))),
+            None => images.push(Arc::new(map.apply((*placeholder).clone()))),
         }
         images.len() - 1
     }
@@ -336,7 +369,7 @@ impl PendingFiles {
             return Ok(());
         };
         let r = self.reads.remove(at);
-        let Read::Image { linear, rows_reversed, gain, .. } = r.what else { unreachable!("found as an image") };
+        let Read::Image { linear, rows_reversed, map, .. } = r.what else { unreachable!("found as an image") };
         let image = if linear {
             alhazen_scene::import::load_hdr_image(&r.path)
         } else {
@@ -347,7 +380,7 @@ impl PendingFiles {
             located(path, text, r.span.clone(), e)
         })?;
         let image = if rows_reversed { image.rows_reversed() } else { image };
-        let image = if gain == [1.0; 3] { image } else { image.channels_scaled(gain) };
+        let image = map.apply(image);
         // The placeholder holds the wrap the texture asked for.
         scene.images[index] = Arc::new(image.with_wrap(scene.images[index].wrap));
         Ok(())
@@ -380,13 +413,13 @@ impl PendingFiles {
                 };
                 Loaded::Mesh { index, flip, flip_v, mesh }
             }
-            Read::Image { index, linear, rows_reversed, gain } => {
+            Read::Image { index, linear, rows_reversed, map } => {
                 let image = if linear {
                     alhazen_scene::import::load_hdr_image(&r.path)
                 } else {
                     alhazen_scene::import::load_image(&r.path)
                 };
-                Loaded::Image { index, rows_reversed, gain, image }
+                Loaded::Image { index, rows_reversed, map, image }
             }
         };
         let loaded: Vec<_> = pending.par_iter().map(read).collect();
@@ -407,10 +440,10 @@ impl PendingFiles {
                     }
                     scene.meshes[index] = Arc::new(mesh);
                 }
-                Loaded::Image { index, rows_reversed, gain, image } => {
+                Loaded::Image { index, rows_reversed, map, image } => {
                     let image = image.map_err(at)?;
                     let image = if rows_reversed { image.rows_reversed() } else { image };
-                    let image = if gain == [1.0; 3] { image } else { image.channels_scaled(gain) };
+                    let image = map.apply(image);
                     scene.images[index] = Arc::new(image.with_wrap(scene.images[index].wrap));
                 }
             }

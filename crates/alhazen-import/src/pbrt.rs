@@ -20,7 +20,7 @@
 //! write) are taken as they are.
 
 use crate::Imported;
-use crate::common::{self, PendingFiles, Warnings, flip_mesh, located};
+use crate::common::{self, PendingFiles, TexelMap, Warnings, flip_mesh, located};
 use alhazen_math::{Mat3, Mat4, Transform, Vec2, Vec3};
 use alhazen_scene::bsdf::{BsdfDesc, Ior};
 use alhazen_scene::{
@@ -183,12 +183,13 @@ struct Importer {
     /// Named media: their absorption per unit length (`None`: a medium alhazen does not
     /// render, warned where it was made).
     media: HashMap<String, Option<Vec3>>,
-    /// Named textures, each with the gain a `scale` texture puts on its image (1 elsewhere):
-    /// the image is copied scaled where the texture is a colour, and read as it is, the gain
-    /// its height, where it is a displacement.
-    textures: HashMap<String, (Texture, Vec3)>,
-    /// The scaled copies of images made so far: (image, the gain's bits) → the copy.
-    scaled_copies: HashMap<(usize, [u64; 3]), usize>,
+    /// Named textures, each with the change its image map's `scale` and `invert`, or a `scale`
+    /// or `mix` texture over it, makes to its image's values (none elsewhere): the image is
+    /// copied changed where the texture is a colour, and read as it is, the change's gain its
+    /// height, where it is a displacement.
+    textures: HashMap<String, (Texture, TexelMap)>,
+    /// The changed copies of images made so far: (image, the change's bits) → the copy.
+    mapped_copies: HashMap<(usize, [u64; 6], bool), usize>,
     objects: HashMap<String, Vec<Object>>,
     defining: Option<(String, Vec<Object>)>,
     meshes: HashMap<(PathBuf, bool), usize>,
@@ -243,7 +244,7 @@ impl Importer {
             named_coords: HashMap::new(),
             named_materials: HashMap::new(),
             textures: HashMap::new(),
-            scaled_copies: HashMap::new(),
+            mapped_copies: HashMap::new(),
             cut_materials: HashMap::new(),
             objects: HashMap::new(),
             defining: None,
@@ -799,13 +800,13 @@ impl Importer {
 
     /// A colour parameter or texture reference.
     fn texture_param(&mut self, ctx: &Ctx, p: &mut Params, name: &str, default: Vec3) -> R<Texture> {
-        let (t, gain) = self.texture_ref(ctx, p, name, default)?;
-        Ok(self.gained(t, gain))
+        let (t, map) = self.texture_ref(ctx, p, name, default)?;
+        Ok(self.mapped(t, map))
     }
 
-    /// Parameter `name` as a texture and the gain on its image (see `textures`).
-    fn texture_ref(&mut self, ctx: &Ctx, p: &mut Params, name: &str, default: Vec3) -> R<(Texture, Vec3)> {
-        let Some(q) = self.find(p, name) else { return Ok((Texture::Solid(default), Vec3::ONE)) };
+    /// Parameter `name` as a texture and the change to its image's values (see `textures`).
+    fn texture_ref(&mut self, ctx: &Ctx, p: &mut Params, name: &str, default: Vec3) -> R<(Texture, TexelMap)> {
+        let Some(q) = self.find(p, name) else { return Ok((Texture::Solid(default), TexelMap::IDENTITY)) };
         if q.ty == "texture" {
             let [Value::Str(t)] = &q.values[..] else {
                 return Err(ctx.err(q.span, "a texture parameter names one texture"));
@@ -816,21 +817,23 @@ impl Importer {
                 .cloned()
                 .ok_or_else(|| ctx.err(q.span.clone(), format!("no texture named \"{t}\"")));
         }
-        self.color_of(ctx, &q).map(|c| (Texture::Solid(c), Vec3::ONE))
+        self.color_of(ctx, &q).map(|c| (Texture::Solid(c), TexelMap::IDENTITY))
     }
 
-    /// `t` with `gain` on its image: a scaled copy of the image (one per image and gain).
-    fn gained(&mut self, t: Texture, gain: Vec3) -> Texture {
+    /// `t` with `map` changing its image: a changed copy of the image (one per image and
+    /// change).
+    fn mapped(&mut self, t: Texture, map: TexelMap) -> Texture {
         let Texture::Image { image, scale, offset, rotation } = t else { return t };
-        if gain == Vec3::ONE {
+        if map == TexelMap::IDENTITY {
             return t;
         }
-        let key = (image, gain.to_array().map(f64::to_bits));
-        let copy = match self.scaled_copies.get(&key) {
+        let bits: Vec<u64> = map.gain.iter().chain(&map.offset).map(|x| x.to_bits()).collect();
+        let key = (image, std::array::from_fn(|i| bits[i]), map.floor);
+        let copy = match self.mapped_copies.get(&key) {
             Some(&copy) => copy,
             None => {
-                let copy = self.pending.scaled_image(&mut self.scene.images, image, gain.to_array().map(|x| x as f32));
-                self.scaled_copies.insert(key, copy);
+                let copy = self.pending.mapped_image(&mut self.scene.images, image, map);
+                self.mapped_copies.insert(key, copy);
                 copy
             }
         };
@@ -1003,11 +1006,13 @@ impl Importer {
 
     /// A material's `displacement`, pbrt-v4's bump mapping (the shading normal that of the
     /// surface moved along its normal by a float texture): a bump of an image map's luminance
-    /// (pbrt averages the channels: the same on grey maps), its height the gain a `scale`
-    /// texture puts on the image; a constant moves nothing. A normal map, which pbrt prefers,
+    /// (pbrt averages the channels: the same on grey maps), its height the gain its `scale`,
+    /// a `scale` or `mix` texture puts on the image; a constant moves nothing. A normal map, which pbrt prefers,
     /// replaces it (warning).
     fn displacement(&mut self, ctx: &Ctx, at: &Range<usize>, p: &mut Params) -> R<Option<Bump>> {
-        let (t, gain) = self.texture_ref(ctx, p, "displacement", Vec3::ZERO)?;
+        let (t, map) = self.texture_ref(ctx, p, "displacement", Vec3::ZERO)?;
+        // A constant added to the height moves no normal.
+        let gain = Vec3::from_array(map.gain);
         let bump = match t {
             Texture::Solid(_) => None,
             Texture::Image { image, scale, offset, rotation } => {
@@ -1221,9 +1226,9 @@ impl Importer {
         self.color_of(ctx, &q)
     }
 
-    /// A `Texture` directive's texture, and the gain a `scale` texture puts on its image.
-    fn texture(&mut self, ctx: &Ctx, kind: &str, at: &Range<usize>, p: &mut Params) -> R<(Texture, Vec3)> {
-        let mut gain = Vec3::ONE;
+    /// A `Texture` directive's texture, and the change it makes to its image's values.
+    fn texture(&mut self, ctx: &Ctx, kind: &str, at: &Range<usize>, p: &mut Params) -> R<(Texture, TexelMap)> {
+        let mut map = TexelMap::IDENTITY;
         let t = match kind {
             "imagemap" => {
                 let name = self
@@ -1256,8 +1261,10 @@ impl Importer {
                 };
                 std::sync::Arc::make_mut(&mut self.scene.images[index]).wrap = [wrap; 2];
                 self.string(ctx, p, "filter")?;
+                // pbrt's `scale · texel`, then `max(0, 1 − ·)` where inverted.
+                map = affine(Vec3::splat(self.float(ctx, p, "scale", 1.0)?), Vec3::ZERO);
                 if self.boolean(ctx, p, "invert", false)? {
-                    self.warn(ctx, at, "invert is not supported; ignored");
+                    map = map.then(TexelMap { floor: true, ..affine(-Vec3::ONE, Vec3::ONE) });
                 }
                 Texture::Image { image: index, scale: Vec2::new(us, vs), offset, rotation: 0.0 }
             }
@@ -1279,10 +1286,15 @@ impl Importer {
                     Texture::Solid(c) => Texture::Solid(c * s),
                     Texture::Checker { even, odd, size } => Texture::Checker { even: even * s, odd: odd * s, size },
                     img => {
-                        gain = inner * s;
+                        map = inner.then(affine(s, Vec3::ZERO));
                         img
                     }
                 }
+            }
+            "mix" => {
+                let (t, m) = self.mix(ctx, at, p)?;
+                map = m;
+                t
             }
             other => {
                 self.warn(ctx, at, format!("texture \"{other}\" is not supported; approximated by grey 0.5"));
@@ -1291,7 +1303,33 @@ impl Importer {
             }
         };
         self.unused(ctx, p, &format!("texture \"{kind}\""));
-        Ok((t, gain))
+        Ok((t, map))
+    }
+
+    /// pbrt's `mix` texture, `(1 − amount)·tex1 + amount·tex2` (`tex1` 0, `tex2` 1 and
+    /// `amount` ½ by default): exact where at most one of the three is an image (a change of
+    /// its values), else the mix of their means (warning).
+    fn mix(&mut self, ctx: &Ctx, at: &Range<usize>, p: &mut Params) -> R<(Texture, TexelMap)> {
+        let (a, ma) = self.texture_ref(ctx, p, "amount", Vec3::splat(0.5))?;
+        let (t1, m1) = self.texture_ref(ctx, p, "tex1", Vec3::ZERO)?;
+        let (t2, m2) = self.texture_ref(ctx, p, "tex2", Vec3::ONE)?;
+        Ok(match (a, t1, t2) {
+            (Texture::Solid(a), Texture::Solid(c1), Texture::Solid(c2)) => {
+                (Texture::Solid((Vec3::ONE - a) * c1 + a * c2), TexelMap::IDENTITY)
+            }
+            (img, Texture::Solid(c1), Texture::Solid(c2)) => (img, ma.then(affine(c2 - c1, c1))),
+            (Texture::Solid(a), img, Texture::Solid(c2)) => (img, m1.then(affine(Vec3::ONE - a, a * c2))),
+            (Texture::Solid(a), Texture::Solid(c1), img) => (img, m2.then(affine(a, (Vec3::ONE - a) * c1))),
+            (a, t1, t2) => {
+                self.warn(ctx, at, "a mix of two or three textures is replaced by the mix of their means");
+                let mut mean = |t: Texture, m: TexelMap| {
+                    let t = self.mapped(t, m);
+                    self.pending.texture_mean(&t, &mut self.scene)
+                };
+                let (a, c1, c2) = (mean(a, ma)?, mean(t1, m1)?, mean(t2, m2)?);
+                (Texture::Solid((Vec3::ONE - a) * c1 + a * c2), TexelMap::IDENTITY)
+            }
+        })
     }
 
     // ---- lights --------------------------------------------------------------------------
@@ -1759,6 +1797,11 @@ fn equal_area_sphere_to_square(d: Vec3) -> Vec2 {
         v = 1.0 - v;
     }
     Vec2::new(0.5 * (u.copysign(d.x) + 1.0), 0.5 * (v.copysign(d.y) + 1.0))
+}
+
+/// The change `offset + gain·v` of an image's values.
+fn affine(gain: Vec3, offset: Vec3) -> TexelMap {
+    TexelMap { gain: gain.to_array(), offset: offset.to_array(), floor: false }
 }
 
 /// The pairs of wavelength (nm) and value of a spectrum file (pbrt's `.spd`: numbers separated

@@ -548,5 +548,53 @@ fn displacement_maps_bump_and_scaled_textures_share_their_copy() {
          Material \"coateddiffuse\" \"texture reflectance\" \"bump\"\nShape \"sphere\"",
     );
     assert_eq!(coloured.scene.images.len(), 2, "one copy for both materials");
-    assert_eq!(coloured.scene.images[1].texel(5), coloured.scene.images[0].texel(5).map(|c| -0.05 * c));
+    let (copy, image) = (coloured.scene.images[1].texel(5), coloured.scene.images[0].texel(5));
+    assert!((0..3).all(|c| (copy[c] - -0.05 * image[c]).abs() < 1e-8), "{copy:?} {image:?}");
+}
+
+/// An image map's own `scale` and `invert` (`max(0, 1 − scale·v)`), and `mix` textures over
+/// one image (pbrt-v4's kroken scene: an inverted float map mixing two colours, a wood image
+/// half mixed with grey) change a copy of the image's values as pbrt evaluates them; a mix of
+/// two images is the mix of their means (warning).
+#[test]
+fn image_map_scale_invert_and_mixes_change_the_image() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_fn(4, 1, |x, _| image::Rgb([(x * 80) as u8, 200, 30]))
+        .save(dir.path().join("m.png"))
+        .unwrap();
+    let body = r#"Camera "perspective"
+WorldBegin
+Texture "plain" "spectrum" "imagemap" "string filename" "m.png"
+Texture "bright" "spectrum" "imagemap" "string filename" "m.png" "float scale" 3
+Texture "inv" "float" "imagemap" "string filename" "m.png" "bool invert" true "float scale" 0.5
+Texture "blanket" "spectrum" "mix" "texture amount" "inv" "rgb tex2" [ .7 .7 .7 ] "rgb tex1" [ .85 .7 .6 ]
+Texture "wood" "spectrum" "imagemap" "string filename" "m.png" "float scale" 1.1
+Texture "wood-mixed" "spectrum" "mix" "texture tex1" "wood" "rgb tex2" [ .5 .5 .5 ] "float amount" .5
+Texture "both" "spectrum" "mix" "texture tex1" "wood" "texture tex2" "plain"
+"#;
+    let shapes = ["plain", "bright", "blanket", "wood-mixed", "both"]
+        .map(|t| format!("Material \"diffuse\" \"texture reflectance\" \"{t}\"\nShape \"sphere\"\n"))
+        .concat();
+    std::fs::write(dir.path().join("a.pbrt"), format!("{body}{shapes}")).unwrap();
+    let imported = alhazen_import::load(&dir.path().join("a.pbrt")).unwrap();
+    let said: Vec<String> = imported.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(said.len() == 1 && said[0].contains("a.pbrt:9") && said[0].contains("mix of their means"), "{said:?}");
+    let s = &imported.scene;
+    let albedo = |object: usize| match &s.materials[s.objects[object].material as usize].bsdf {
+        Some(BsdfDesc::Lambert { albedo }) => albedo.clone(),
+        other => panic!("{other:?}"),
+    };
+    let texels = |object: usize| match albedo(object) {
+        Texture::Image { image, .. } => (0..4).map(|i| s.images[image].texel(i).map(f64::from)).collect::<Vec<_>>(),
+        other => panic!("{other:?}"),
+    };
+    let plain = texels(0);
+    let near = |a: &[[f64; 3]], f: &dyn Fn(usize, f64) -> f64| {
+        a.iter().zip(&plain).all(|(a, p)| (0..3).all(|c| (a[c] - f(c, p[c])).abs() < 1e-6))
+    };
+    assert!(near(&texels(1), &|_, v| 3.0 * v), "{:?}", texels(1));
+    let (c1, c2) = ([0.85, 0.7, 0.6], [0.7, 0.7, 0.7]);
+    assert!(near(&texels(2), &|c, v| c1[c] + (c2[c] - c1[c]) * (1.0 - 0.5 * v).max(0.0)), "{:?}", texels(2));
+    assert!(near(&texels(3), &|_, v| 0.5 * 1.1 * v + 0.25), "{:?}", texels(3));
+    assert!(matches!(albedo(4), Texture::Solid(_)));
 }

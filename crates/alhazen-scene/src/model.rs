@@ -1106,13 +1106,19 @@ impl ImageData {
     /// The image with each pixel's channels multiplied by `factor`'s (`p[c] · factor[c]` in
     /// `f32`): an image that codes keeps its codes and scales its tables.
     pub fn channels_scaled(&self, factor: [f32; 3]) -> Self {
+        self.channels_mapped(|c, v| v * factor[c])
+    }
+
+    /// The image with each pixel's channel `c` of value `v` replaced by `f(c, v)`: an image
+    /// that codes keeps its codes and maps its tables.
+    pub fn channels_mapped(&self, f: impl Fn(usize, f32) -> f32) -> Self {
         let (width, height) = (self.width, self.height);
         match &self.texels {
             Texels::Floats(p) => {
-                Self::new(width, height, p.iter().map(|p| std::array::from_fn(|c| p[c] * factor[c])).collect())
+                Self::new(width, height, p.iter().map(|p| std::array::from_fn(|c| f(c, p[c]))).collect())
             }
             Texels::Codes(c) => {
-                let tables = Box::new(std::array::from_fn(|k| c.tables[k].map(|v| v * factor[k])));
+                let tables = Box::new(std::array::from_fn(|k| c.tables[k].map(|v| f(k, v))));
                 let texels = Texels::Codes(PixelCodes { tables, codes: c.codes.clone() });
                 Self { width, height, texels, wrap: self.wrap }
             }
