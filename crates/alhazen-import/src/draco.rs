@@ -42,16 +42,7 @@ pub fn decompress(json: &mut Root, buffers: &mut Vec<gltf::buffer::Data>, memory
                 .map_err(|e| format!("{name}: its {EXTENSION} data {e}"))?;
         }
     }
-    if !out.is_empty() {
-        json.buffers.push(buffer::Buffer {
-            byte_length: USize64(out.len() as u64),
-            name: Some("decoded Draco data".into()),
-            uri: None,
-            extensions: None,
-            extras: Default::default(),
-        });
-        buffers.push(gltf::buffer::Data(out));
-    }
+    crate::gltf::append_buffer(json, buffers, out, "decoded Draco data");
     Ok(())
 }
 

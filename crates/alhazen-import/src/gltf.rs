@@ -141,6 +141,27 @@ fn load_bytes(path: &Path, bytes: &[u8], memory_budget: u64) -> Result<Imported,
     imp.finish()
 }
 
+/// Appends decoded data `out` (if any) to the file as a buffer named `name`, its bytes the
+/// last of `buffers`.
+pub(crate) fn append_buffer(
+    json: &mut gltf::json::Root,
+    buffers: &mut Vec<gltf::buffer::Data>,
+    out: Vec<u8>,
+    name: &str,
+) {
+    if out.is_empty() {
+        return;
+    }
+    json.buffers.push(gltf::json::buffer::Buffer {
+        byte_length: gltf::json::validation::USize64(out.len() as u64),
+        name: Some(name.into()),
+        uri: None,
+        extensions: None,
+        extras: Default::default(),
+    });
+    buffers.push(gltf::buffer::Data(out));
+}
+
 /// The file's JSON (not validated) and its binary chunk. Animations are not read: a file whose
 /// animations the reader cannot parse (`KHR_animation_pointer`'s channels, which target no
 /// node) is read without them; any other fault is the reader's error.

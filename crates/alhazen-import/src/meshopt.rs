@@ -84,16 +84,7 @@ pub fn decompress(json: &mut Root, buffers: &mut Vec<gltf::buffer::Data>, memory
         view.buffer = Index::new(new_buffer as u32);
         view.byte_offset = Some(USize64(start as u64));
     }
-    if !out.is_empty() {
-        json.buffers.push(buffer::Buffer {
-            byte_length: USize64(out.len() as u64),
-            name: Some("decoded meshopt data".into()),
-            uri: None,
-            extensions: None,
-            extras: Default::default(),
-        });
-        buffers.push(gltf::buffer::Data(out));
-    }
+    crate::gltf::append_buffer(json, buffers, out, "decoded meshopt data");
     Ok(())
 }
 

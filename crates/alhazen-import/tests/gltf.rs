@@ -1771,26 +1771,37 @@ fn damaged_or_oversized_draco_streams_are_refused() {
     let view = &json["bufferViews"][0];
     let start = 28 + n + view["byteOffset"].as_u64().unwrap_or(0) as usize;
     let len = view["byteLength"].as_u64().unwrap() as usize;
+    damaged_everywhere(&bytes, start..start + len, |e| e.contains("mesh \"painted\" primitive 0: its "));
+    let err = within_budget(&bytes, 1000);
+    assert!(err.contains("cannot be decoded") && err.contains("ceiling"), "{err}");
+}
+
+/// Imports `bytes` (a `.glb`) with each byte of `range` XORed three ways: each is read, or
+/// refused with a message `refusal` accepts (never the reader's failure: a panic).
+fn damaged_everywhere(bytes: &[u8], range: std::ops::Range<usize>, refusal: impl Fn(&str) -> bool) {
     let (mut refused, mut read) = (0, 0);
-    for i in start..start + len {
+    for i in range {
         for flip in [0x01, 0x5a, 0xff] {
-            let mut damaged = bytes.clone();
+            let mut damaged = bytes.to_vec();
             damaged[i] ^= flip;
             match write_and_import(&[("a.glb", damaged)]) {
                 Ok(_) => read += 1,
                 Err(e) => {
-                    assert!(e.contains("mesh \"painted\" primitive 0: its "), "byte {i}: {e}");
+                    assert!(refusal(&e) && !e.contains("the glTF reader failed"), "byte {i}: {e}");
                     refused += 1;
                 }
             }
         }
     }
-    eprintln!("{refused} damaged streams refused, {read} read");
+    eprintln!("{refused} damaged files refused, {read} read");
     assert!(refused > 0);
+}
+
+/// The error importing `bytes` (a `.glb`) within a memory budget of `budget` bytes.
+fn within_budget(bytes: &[u8], budget: u64) -> String {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("a.glb"), &bytes).unwrap();
-    let err = alhazen_import::load_within(&dir.path().join("a.glb"), 1000).unwrap_err().to_string();
-    assert!(err.contains("cannot be decoded") && err.contains("ceiling"), "{err}");
+    std::fs::write(dir.path().join("a.glb"), bytes).unwrap();
+    alhazen_import::load_within(&dir.path().join("a.glb"), budget).unwrap_err().to_string()
 }
 
 /// Animations are not read, so a file whose animations the glTF reader cannot parse —
@@ -1891,32 +1902,30 @@ fn meshopt_views_decode_to_the_uncompressed_pack() {
 
 /// A damaged meshopt stream is an error naming its buffer view (or, where it decodes to
 /// impossible values, the mesh they make) — never a panic — whichever byte is wrong; views
-/// that would decode to more than the memory budget are refused before any is decoded.
+/// that would decode to more than the memory budget are refused before any is decoded, and
+/// parameters that are no codec's, or disagree with their view, are errors naming the view.
 #[test]
 fn damaged_or_oversized_meshopt_streams_are_refused() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gltfpack");
     for name in ["instances-ext.glb", "vertex-colors-khr.glb"] {
         let bytes = std::fs::read(dir.join(name)).unwrap();
         let n = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
-        let (mut refused, mut read) = (0, 0);
-        for i in 28 + n..bytes.len() {
-            for flip in [0x01, 0x5a, 0xff] {
-                let mut damaged = bytes.clone();
-                damaged[i] ^= flip;
-                match write_and_import(&[("a.glb", damaged)]) {
-                    Ok(_) => read += 1,
-                    Err(e) => {
-                        assert!(!e.contains("the glTF reader failed"), "{name}, byte {i}: {e}");
-                        refused += 1;
-                    }
-                }
-            }
-        }
-        eprintln!("{name}: {refused} damaged streams refused, {read} read");
-        assert!(refused > 0);
-        let tmp = tempfile::tempdir().unwrap();
-        std::fs::write(tmp.path().join("a.glb"), &bytes).unwrap();
-        let err = alhazen_import::load_within(&tmp.path().join("a.glb"), 100).unwrap_err().to_string();
-        assert!(err.contains("more than the memory budget of 100"), "{err}");
+        damaged_everywhere(&bytes, 28 + n..bytes.len(), |_| true);
+        let err = within_budget(&bytes, 100);
+        assert!(err.contains("more than the memory budget of 100"), "{name}: {err}");
+    }
+    // Parameters that are not one of the codecs', or that disagree with the view.
+    let bytes = std::fs::read(dir.join("vertex-colors-ext.glb")).unwrap();
+    let cases: [(&str, serde_json::Value, &str); 3] = [
+        ("mode", "FOO".into(), "has mode \"FOO\" and filter \"NONE\", which are not one of its codecs"),
+        ("byteStride", 6.into(), "ATTRIBUTES NONE cannot have a byteStride of 6"),
+        ("count", 170.into(), "decodes 170 elements of 8 bytes, not its 1352 bytes"),
+    ];
+    for (key, value, expected) in cases {
+        let changed = glb_with_json(&bytes, |j| {
+            j["bufferViews"][0]["extensions"]["EXT_meshopt_compression"][key] = value.clone()
+        });
+        let err = write_and_import(&[("a.glb", changed)]).unwrap_err();
+        assert!(err.contains("buffer view 0: its EXT_meshopt_compression") && err.contains(expected), "{key}: {err}");
     }
 }
