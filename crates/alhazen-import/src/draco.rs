@@ -2,7 +2,8 @@
 //! bitstream in a buffer view, decoded with the `draco-core` crate (Google's Draco format, as
 //! Blender's glTF exporter writes it under "Compression").
 //!
-//! The decoded attributes and triangles are written into one new buffer, each behind a buffer
+//! The file's streams are decoded on all threads; the decoded attributes and triangles are
+//! then written, in the file's order, into one new buffer, each behind a buffer
 //! view and accessor of its own (of the component type and width the primitive's accessor
 //! declares, so normalised integers stay normalised), and the primitive's attributes and
 //! indices are pointed at them before the glTF is validated: the rest of the importer reads a
@@ -17,50 +18,73 @@ use draco_core::mesh_decoder::MeshDecoder;
 use gltf::json::accessor::{ComponentType, GenericComponentType, Type};
 use gltf::json::validation::{Checked, USize64};
 use gltf::json::{Accessor, Index, Root, buffer};
+use rayon::prelude::*;
 
 /// The extension's name.
 pub const EXTENSION: &str = "KHR_draco_mesh_compression";
 
 /// Decompresses every Draco primitive of `json` into a buffer appended to `buffers` (whose
-/// entries are the file's buffers, by index), refusing streams that would decode to more than
-/// `memory_budget` bytes before decoding them. Errors name the mesh and primitive.
+/// entries are the file's buffers, by index): the streams decoded on all threads, each refused
+/// if it would decode to more than `memory_budget` bytes before it is decoded, and all of them
+/// if their data come to more. Errors name the mesh and primitive (the first in the file's
+/// order).
 pub fn decompress(json: &mut Root, buffers: &mut Vec<gltf::buffer::Data>, memory_budget: u64) -> Result<(), String> {
+    let mut jobs = Vec::new();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            if let Some(ext) = prim.extensions.as_ref().and_then(|e| e.others.get(EXTENSION)) {
+                jobs.push((m, p, ext.clone()));
+            }
+        }
+    }
+    let decoded: Vec<Result<Mesh, String>> =
+        jobs.par_iter().map(|(_, _, ext)| decode(json, buffers, ext, memory_budget)).collect();
     let mut out = Vec::new();
     let new_buffer = Index::new(json.buffers.len() as u32);
-    for m in 0..json.meshes.len() {
-        for p in 0..json.meshes[m].primitives.len() {
-            let Some(ext) =
-                json.meshes[m].primitives[p].extensions.as_ref().and_then(|e| e.others.get(EXTENSION)).cloned()
-            else {
-                continue;
-            };
-            let name = match &json.meshes[m].name {
-                Some(n) => format!("mesh \"{n}\" primitive {p}"),
-                None => format!("mesh {m} primitive {p}"),
-            };
-            decompress_primitive(json, buffers, (m, p), &ext, new_buffer, &mut out, memory_budget)
-                .map_err(|e| format!("{name}: its {EXTENSION} data {e}"))?;
+    for ((m, p, ext), mesh) in jobs.iter().zip(decoded) {
+        let name = match &json.meshes[*m].name {
+            Some(n) => format!("mesh \"{n}\" primitive {p}"),
+            None => format!("mesh {m} primitive {p}"),
+        };
+        let located = |e: String| format!("{name}: its {EXTENSION} data {e}");
+        let mesh = mesh.map_err(located)?;
+        decompress_primitive(json, (*m, *p), ext, &mesh, new_buffer, &mut out).map_err(located)?;
+        if out.len() as u64 > memory_budget {
+            return Err(located(format!(
+                "and the primitives before it decode to more than the memory budget of {memory_budget} bytes"
+            )));
         }
     }
     crate::gltf::append_buffer(json, buffers, out, "decoded Draco data");
     Ok(())
 }
 
-fn decompress_primitive(
-    json: &mut Root,
+/// The mesh of the Draco stream `ext` names, decoded within `memory_budget` bytes.
+fn decode(
+    json: &Root,
     buffers: &[gltf::buffer::Data],
-    (m, p): (usize, usize),
     ext: &serde_json::Value,
-    new_buffer: Index<buffer::Buffer>,
-    out: &mut Vec<u8>,
     memory_budget: u64,
-) -> Result<(), String> {
+) -> Result<Mesh, String> {
     let view = ext.get("bufferView").and_then(|v| v.as_u64()).ok_or("names no bufferView")?;
     let bytes = view_bytes(json, buffers, view)?;
     let limits = DecodeLimits::default().with_max_decoded_bytes(memory_budget);
     let mut stream = DecoderBuffer::new(bytes).with_limits(limits);
     let mut mesh = Mesh::new();
     MeshDecoder::new().decode(&mut stream, &mut mesh).map_err(|e| format!("cannot be decoded: {e}"))?;
+    Ok(mesh)
+}
+
+/// Writes `mesh`'s attributes and triangles, as extension object `ext` of primitive `p` of
+/// mesh `m` assigns them, into `out` (buffer `new_buffer`), and points the primitive at them.
+fn decompress_primitive(
+    json: &mut Root,
+    (m, p): (usize, usize),
+    ext: &serde_json::Value,
+    mesh: &Mesh,
+    new_buffer: Index<buffer::Buffer>,
+    out: &mut Vec<u8>,
+) -> Result<(), String> {
     let points = mesh.num_points();
     let attributes = ext.get("attributes").and_then(|a| a.as_object()).ok_or("names no attributes")?;
     for (semantic, id) in attributes {

@@ -1761,7 +1761,7 @@ fn blender_draco_meshes_agree_with_the_uncompressed_files_and_cycles() {
 /// A damaged Draco stream is an error naming its mesh, whichever byte is wrong — the stream's,
 /// or the values it decodes to — never a panic (which the importer would report as the reader
 /// failing); or, where the damage leaves a valid stream, a mesh. One that would decode to more
-/// than the memory budget is refused.
+/// than the memory budget is refused, and so are streams whose data come to more together.
 #[test]
 fn damaged_or_oversized_draco_streams_are_refused() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender");
@@ -1774,6 +1774,10 @@ fn damaged_or_oversized_draco_streams_are_refused() {
     damaged_everywhere(&bytes, start..start + len, |e| e.contains("mesh \"painted\" primitive 0: its "));
     let err = within_budget(&bytes, 1000);
     assert!(err.contains("cannot be decoded") && err.contains("ceiling"), "{err}");
+    // Each stream within the budget, their triangles and attributes together over it.
+    let materials = std::fs::read(dir.join("materials-draco.glb")).unwrap();
+    let err = within_budget(&materials, 200_000);
+    assert!(err.contains("decode to more than the memory budget of 200000 bytes"), "{err}");
 }
 
 /// Imports `bytes` (a `.glb`) with each byte of `range` XORed three ways: each is read, or
