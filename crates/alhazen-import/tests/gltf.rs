@@ -2,6 +2,9 @@
 //! embedded as data URIs, in a `.glb` and in external files, textures, cameras, lights, and
 //! malformed files.
 
+mod common;
+use common::difference_from_reference;
+
 use alhazen_import::Imported;
 use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::bsdf::BsdfDesc;
@@ -1292,20 +1295,6 @@ fn blender_export(name: &str, bytes: Vec<u8>, spp: u32) -> alhazen_scene::Scene 
     s
 }
 
-/// `Σ|ours − Cycles| / Σ Cycles` over alhazen's image of `s` at the size of Cycles' `cycles`.
-fn difference_from_cycles(s: &alhazen_scene::Scene, cycles: &alhazen_scene::ImageData) -> f64 {
-    let mut s = s.clone();
-    (s.render.width, s.render.height) = (cycles.width, cycles.height);
-    let img = alhazen_render::render(&s, &|_, _| {});
-    let (mut diff, mut sum) = (0.0, 0.0);
-    for (i, c) in cycles.texels().enumerate() {
-        let c = Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-        diff += (img.get(i as u32 % cycles.width, i as u32 / cycles.width) - c).abs().element_sum();
-        sum += c.element_sum();
-    }
-    diff / sum
-}
-
 /// A `.glb`'s JSON changed by `change`, its binary chunk kept.
 fn glb_with_json(bytes: &[u8], change: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
     let n = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
@@ -1328,7 +1317,7 @@ fn blender_posed_meshes_agree_with_cycles() {
     let bytes = std::fs::read(dir.join("posed.glb")).unwrap();
     let cycles = alhazen_scene::import::load_hdr_image(&dir.join("posed-cycles.exr")).unwrap();
     let import = |bytes: Vec<u8>| blender_export("posed.glb", bytes, 256);
-    let error = |s: &alhazen_scene::Scene| difference_from_cycles(s, &cycles);
+    let error = |s: &alhazen_scene::Scene| difference_from_reference(s, &cycles);
     let posed = import(bytes.clone());
     let bounds = |name: &str| {
         let o = posed.objects.iter().find(|o| o.name.as_deref() == Some(name)).unwrap();
@@ -1361,7 +1350,7 @@ fn blender_gpu_instances_agree_with_cycles() {
     let bytes = std::fs::read(dir.join("instances.glb")).unwrap();
     let cycles = alhazen_scene::import::load_hdr_image(&dir.join("instances-cycles.exr")).unwrap();
     let import = |bytes: Vec<u8>| blender_export("instances.glb", bytes, 256);
-    let error = |s: &alhazen_scene::Scene| difference_from_cycles(s, &cycles);
+    let error = |s: &alhazen_scene::Scene| difference_from_reference(s, &cycles);
     let s = import(bytes.clone());
     let cones: Vec<usize> = s
         .objects
@@ -1751,7 +1740,7 @@ fn blender_draco_meshes_agree_with_the_uncompressed_files_and_cycles() {
             }
         }
         let (from_plain, plain_off, draco_off) =
-            (diff / sum, difference_from_cycles(&plain, &cycles), difference_from_cycles(&draco, &cycles));
+            (diff / sum, difference_from_reference(&plain, &cycles), difference_from_reference(&draco, &cycles));
         eprintln!("{stem}: Draco against uncompressed {from_plain:.4}; against Cycles {draco_off:.4} ({plain_off:.4})");
         assert!(from_plain < 0.005, "{stem}: {from_plain}");
         assert!((draco_off - plain_off).abs() < 0.005, "{stem}: {draco_off} against {plain_off}");
@@ -1899,7 +1888,7 @@ fn meshopt_views_decode_to_the_uncompressed_pack() {
     let cycles = alhazen_scene::import::load_hdr_image(&dir.join("../blender/vertex-colors-cycles.exr")).unwrap();
     let mut s = load("vertex-colors-khr.glb".into());
     (s.render.spp, s.render.integrator) = (64, alhazen_scene::IntegratorKind::Path);
-    let off = difference_from_cycles(&s, &cycles);
+    let off = difference_from_reference(&s, &cycles);
     eprintln!("vertex-colors-khr against Cycles: {off:.4}");
     assert!(off < 0.01, "{off}");
 }

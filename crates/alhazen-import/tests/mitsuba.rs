@@ -1175,18 +1175,6 @@ fn reconstruction_filters_are_mitsubas() {
     assert!(e.contains("f.xml:2:") && e.contains("sigma must lie in"), "{e}");
 }
 
-/// `Σ|alhazen − reference| / Σ reference` over `s`'s image.
-fn relative_difference(s: &Scene, reference: &alhazen_scene::ImageData) -> f64 {
-    let img = alhazen_render::render(s, &|_, _| {});
-    let (mut diff, mut sum) = (0.0, 0.0);
-    for (i, r) in reference.texels().enumerate() {
-        let r = Vec3::new(r[0] as f64, r[1] as f64, r[2] as f64);
-        diff += (img.get(i as u32 % img.width, i as u32 / img.width) - r).abs().element_sum();
-        sum += r.element_sum();
-    }
-    diff / sum
-}
-
 /// A PLY panel's float vertex colours read by a diffuse BSDF's `mesh_attribute` `vertex_color`
 /// under a white sky (`bench/mitsuba/texture_refs.py --only vertex-colors`, Mitsuba 8192 spp):
 /// alhazen's image within 1 % of Mitsuba's on average (measured: 0.22 %); without the colours
@@ -1200,7 +1188,7 @@ fn vertex_colors_agree_with_mitsuba() {
     assert!(s.materials.iter().any(|m| m.vertex_colors) && s.meshes.iter().all(|m| m.colors.len() == 169));
     (s.render.spp, s.render.sampler) = (256, alhazen_scene::SamplerKind::Sobol);
     let reference = alhazen_scene::import::load_hdr_image(&dir.join("vertex-colors-mitsuba.exr")).unwrap();
-    let error = |s: &Scene| relative_difference(s, &reference);
+    let error = |s: &Scene| difference_from_reference(s, &reference);
     let colored = error(&s);
     for mesh in &mut s.meshes {
         std::sync::Arc::make_mut(mesh).colors.iter_mut().for_each(|c| *c = Vec3::splat(0.5));
@@ -1229,7 +1217,7 @@ fn a_turned_texture_agrees_with_mitsuba() {
     assert!((offset - alhazen_math::Vec2::new(0.15, 0.3)).length() < 1e-6 && (rotation - 30.0).abs() < 1e-6);
     s.render.spp = 256;
     let reference = alhazen_scene::import::load_hdr_image(&dir.join("turned-texture-mitsuba.exr")).unwrap();
-    let error = |s: &Scene| relative_difference(s, &reference);
+    let error = |s: &Scene| difference_from_reference(s, &reference);
     let turned = error(&s);
     for m in &mut s.materials {
         if let Some(Texture::Image { rotation, .. }) = &mut m.emission_texture {

@@ -40,3 +40,17 @@ pub fn mesh_triangle_counts(s: &alhazen_scene::Scene) -> Vec<usize> {
     };
     s.objects.iter().map(count).collect()
 }
+
+/// `Σ|alhazen − reference| / Σ reference` over alhazen's image of `s` at the reference's size.
+pub fn difference_from_reference(s: &alhazen_scene::Scene, reference: &alhazen_scene::ImageData) -> f64 {
+    let mut s = s.clone();
+    (s.render.width, s.render.height) = (reference.width, reference.height);
+    let img = alhazen_render::render(&s, &|_, _| {});
+    let (mut diff, mut sum) = (0.0, 0.0);
+    for (i, r) in reference.texels().enumerate() {
+        let r = alhazen_math::Vec3::new(r[0] as f64, r[1] as f64, r[2] as f64);
+        diff += (img.get(i as u32 % reference.width, i as u32 / reference.width) - r).abs().element_sum();
+        sum += r.element_sum();
+    }
+    diff / sum
+}
