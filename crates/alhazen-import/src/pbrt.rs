@@ -1807,8 +1807,7 @@ fn affine(gain: Vec3, offset: Vec3) -> TexelMap {
 /// The pairs of wavelength (nm) and value of a spectrum file (pbrt's `.spd`: numbers separated
 /// by white space, `#` comments), or why they cannot be had.
 fn spectrum_file(path: &Path) -> Result<Vec<f64>, String> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| format!("cannot read spectrum file {}: {e}", path.display()))?;
+    let text = common::read_text(path).map_err(|e| format!("cannot read spectrum file: {e}"))?;
     let mut pairs = Vec::new();
     for word in text.lines().flat_map(|l| l.split('#').next().unwrap_or("").split_whitespace()) {
         let v =

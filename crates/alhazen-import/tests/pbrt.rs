@@ -448,6 +448,7 @@ fn spectrum_files_give_conductors_their_colour() {
     std::fs::write(dir.path().join("spds/Au.eta.spd"), format!("# gold\n{}\n", eta.replace("  ", "\n"))).unwrap();
     std::fs::write(dir.path().join("spds/Au.k.spd"), k).unwrap();
     std::fs::write(dir.path().join("spds/bad.spd"), "400 1.0 500").unwrap();
+    std::fs::write(dir.path().join("spds/nan.spd"), "400 1.0 500 NaN").unwrap();
     let load = |material: &str| {
         let text = format!("Camera \"perspective\"\nWorldBegin\nMaterial \"conductor\" {material}\nShape \"sphere\"");
         std::fs::write(dir.path().join("a.pbrt"), text).unwrap();
@@ -465,6 +466,8 @@ fn spectrum_files_give_conductors_their_colour() {
         assert!(off(eta, METALS[0].1) < 0.03 && off(k, METALS[0].2) < 0.03, "{eta} {k}");
     }
     let err = load(r#""spectrum eta" "spds/bad.spd""#).unwrap_err();
+    assert!(err.contains("a.pbrt:3:") && err.contains("must be two or more pairs"), "{err}");
+    let err = load(r#""spectrum eta" "spds/nan.spd""#).unwrap_err();
     assert!(err.contains("a.pbrt:3:") && err.contains("must be two or more pairs"), "{err}");
     let err = load(r#""spectrum eta" [ 500 1 400 2 ]"#).unwrap_err();
     assert!(err.contains("a.pbrt:3:") && err.contains("increasing"), "{err}");
