@@ -14,8 +14,9 @@
 //! `KHR_materials_emissive_strength`, a transmitting material's absorbing inside with
 //! `KHR_materials_volume` (and its index by wavelength with `KHR_materials_dispersion`), a
 //! clear coat with `KHR_materials_clearcoat`, cloth's sheen with `KHR_materials_sheen`, brushed
-//! facets with `KHR_materials_anisotropy`; a metallic–roughness texture, a textured metal's
-//! colour and stretched facets are read per point (`BsdfDesc::MetallicRoughness`, the model at
+//! facets with `KHR_materials_anisotropy`, a thin film's interference colours with
+//! `KHR_materials_iridescence`; a metallic–roughness texture, a textured metal's
+//! colour, stretched facets and a thin film are read per point (`BsdfDesc::MetallicRoughness`, the model at
 //! each point), by their means under transmission; so is an emission texture (its factor and strength
 //! multiplied in).
 //! `KHR_lights_punctual` lights convert from photometric units (candela, lux) by the 683 lm/W
@@ -26,7 +27,7 @@ use crate::common::{self, Warnings};
 use crate::{Imported, draco, meshopt};
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Mat4, Quat, Transform, Vec2, Vec3};
-use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Ior, MetalRoughness};
+use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Ior, Iridescence, MetalRoughness};
 use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
     PerspectiveOpening, Scene, SceneError, Shape, Texture, Wrap,
@@ -60,6 +61,7 @@ const KNOWN: &[&str] = &[
     "KHR_materials_dispersion",
     "EXT_mesh_gpu_instancing",
     "KHR_materials_sheen",
+    "KHR_materials_iridescence",
     draco::EXTENSION,
     meshopt::EXTENSIONS[0],
     meshopt::EXTENSIONS[1],
@@ -762,9 +764,7 @@ impl Importer<'_> {
             _ => (Vec2::ONE, Vec2::ZERO, 0.0),
         };
         let alpha = self.cut_out(&material, c[3] as f64, placement)?;
-        if material.extension_value("KHR_materials_iridescence").is_some() {
-            self.warn(format!("{name}: KHR_materials_iridescence is not supported; ignored"));
-        }
+        let iridescence = self.iridescence(&material, transmission, &name)?;
         let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
         // Per point where the map or a textured metal's colour varies (glTF's metal takes each
         // texel's base colour), else the constant mix (and its glass under transmission).
@@ -777,7 +777,7 @@ impl Importer<'_> {
             (lobes.anisotropy, anisotropy_map) = (Anisotropy::default(), None);
         }
         // Stretched facets turn with the surface's tangent: read per point.
-        let per_point = map.is_some() || textured_metal || lobes.anisotropy.is_anisotropic();
+        let per_point = map.is_some() || textured_metal || lobes.anisotropy.is_anisotropic() || iridescence.is_some();
         let bsdf = if per_point {
             let MetalRoughness { ior, specular, multiscatter, anisotropy } = lobes;
             BsdfDesc::MetallicRoughness {
@@ -790,6 +790,7 @@ impl Importer<'_> {
                 multiscatter,
                 anisotropy,
                 anisotropy_map,
+                iridescence,
             }
         } else {
             let bsdf =
@@ -845,6 +846,49 @@ impl Importer<'_> {
             _ => None,
         };
         Ok((anisotropy, map))
+    }
+
+    /// `KHR_materials_iridescence`'s thin film: weight `iridescenceFactor` (times
+    /// `iridescenceTexture`'s red), index `iridescenceIOR`, thickness
+    /// `iridescenceThicknessMaximum` nm, or from the minimum to it by
+    /// `iridescenceThicknessTexture`'s green (both read linearly); under a clear coat the film's
+    /// outside is the coat's index, 1.5. None without it, at a factor of 0, and under
+    /// transmission (warning: not supported there).
+    fn iridescence(&mut self, material: &gltf::Material, transmission: f64, name: &str) -> R<Option<Box<Iridescence>>> {
+        let Some(e) = material.extension_value("KHR_materials_iridescence") else { return Ok(None) };
+        let number = |key: &str, default: f64, range: std::ops::RangeInclusive<f64>| match e.get(key) {
+            None => Some(default),
+            Some(x) => x.as_f64().filter(|x| range.contains(x)),
+        };
+        let (Some(factor), Some(ior), Some(thin), Some(thick)) = (
+            number("iridescenceFactor", 0.0, 0.0..=1.0),
+            number("iridescenceIOR", 1.3, 1.0..=10.0),
+            number("iridescenceThicknessMinimum", 100.0, 0.0..=1e5),
+            number("iridescenceThicknessMaximum", 400.0, 0.0..=1e5),
+        ) else {
+            return Err(self.err(format!(
+                "{name}: KHR_materials_iridescence needs an iridescenceFactor within [0, 1], an iridescenceIOR within [1, 10] and thicknesses within [0, 100000] nm"
+            )));
+        };
+        if factor == 0.0 {
+            return Ok(None);
+        }
+        if transmission > 0.0 {
+            self.warn(format!("{name}: KHR_materials_iridescence under transmission is not supported; ignored"));
+            return Ok(None);
+        }
+        let map = |s: &mut Self, key: &str| match e.get(key) {
+            Some(info) => s.texture_of_info(info, name, key, Decoding::Linear).map(Some),
+            None => Ok(None),
+        };
+        let factor_map = map(self, "iridescenceTexture")?;
+        let thickness_map = map(self, "iridescenceThicknessTexture")?;
+        let coated = material
+            .extension_value("KHR_materials_clearcoat")
+            .and_then(|c| c.get("clearcoatFactor").and_then(|f| f.as_f64()))
+            .is_some_and(|f| f > 0.0);
+        let outside = if coated { 1.5 } else { 1.0 };
+        Ok(Some(Box::new(Iridescence { factor, ior, thickness: [thin, thick], outside, factor_map, thickness_map })))
     }
 
     /// The image texture a JSON `textureInfo` of an extension names (`index`, `texCoord`,

@@ -1333,6 +1333,7 @@ impl Importer {
                 multiscatter: false,
                 anisotropy,
                 anisotropy_map: None,
+                iridescence: None,
             });
         }
         let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
@@ -1352,6 +1353,7 @@ impl Importer {
                 multiscatter: false,
                 anisotropy,
                 anisotropy_map: None,
+                iridescence: None,
             });
         }
         Ok(common::metal_rough(base, mean, metallic, roughness, (ior, common::plain_lobes(ior)), trans))

@@ -67,6 +67,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                         tint: Vec3::ONE,
                         schlick: false,
                         multiscatter: None,
+                        film: None,
                     }),
                 ));
                 // The light of several facets (GGX's; other facets take single scattering).
@@ -81,6 +82,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                                 tint: Vec3::ONE,
                                 schlick,
                                 multiscatter: None,
+                                film: None,
                             }
                             .with_several_facets(),
                         ),
@@ -108,6 +110,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
             tint: Vec3::ONE,
             schlick: true,
             multiscatter: None,
+            film: None,
         }),
     ));
     list.push(("rough plastic ggx m=0.2".into(), Bsdf::Plastic(Plastic::new(albedo, 1.49, Some(ggx(0.2)), false))));
@@ -131,6 +134,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 tint: Vec3::ONE,
                 schlick: false,
                 multiscatter: None,
+                film: None,
             }),
             weight: 0.4,
         })),
@@ -151,6 +155,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 tint: Vec3::ONE,
                 schlick: false,
                 multiscatter: None,
+                film: None,
             }),
             coat(0.3),
             0.5,
@@ -169,7 +174,46 @@ fn catalogue() -> Vec<(String, Bsdf)> {
             0.8,
         ))),
     ));
+    // Thin films (glTF's iridescence) over the metallic–roughness model's metal and coating.
+    for (metallic, multiscatter) in [(1.0, false), (1.0, true), (0.0, false), (0.4, false)] {
+        list.push((
+            format!("metallic-roughness {metallic} under a film, multiscatter {multiscatter}"),
+            filmed(metallic, multiscatter),
+        ));
+    }
     list
+}
+
+/// glTF's metallic–roughness surface of `metallic` under a thin film, as the path tracer builds it.
+fn filmed(metallic: f64, multiscatter: bool) -> Bsdf {
+    filmed_by(metallic, multiscatter, 0.8)
+}
+
+fn filmed_by(metallic: f64, multiscatter: bool, factor: f64) -> Bsdf {
+    use alhazen_scene::bsdf::{Anisotropy, BsdfDesc, Iridescence};
+    let desc = BsdfDesc::MetallicRoughness {
+        // (Pale enough that the model's coating, whose diffuse weight does not fall with the
+        // angle, keeps within the energy it receives at grazing angles.)
+        base: alhazen_scene::Texture::Solid(Vec3::new(0.6, 0.45, 0.3)),
+        metallic,
+        roughness: 0.4,
+        map: None,
+        ior: 1.5,
+        specular: 1.0,
+        multiscatter,
+        anisotropy: Anisotropy::default(),
+        anisotropy_map: None,
+        iridescence: Some(Box::new(Iridescence {
+            factor,
+            ior: 1.8,
+            thickness: [100.0, 450.0],
+            outside: 1.0,
+            factor_map: None,
+            thickness_map: None,
+        })),
+    };
+    let m = alhazen_scene::Material::from_bsdf("film", desc);
+    alhazen_render::bsdf::bsdf_at(&m, Vec2::ZERO, Vec3::ONE, &[], alhazen_render::bsdf::ColorMode::Rgb)
 }
 
 fn direction(theta_deg: f64, phi: f64) -> Vec3 {
@@ -484,6 +528,7 @@ fn conductor_fresnel_matches_known_values() {
         tint: Vec3::ONE,
         schlick: false,
         multiscatter: None,
+        film: None,
     };
     let f = c(1.5, 0.0).fresnel(1.0).x;
     assert!((f - 0.04).abs() < 1e-12);
@@ -540,6 +585,7 @@ fn several_facets_give_the_white_furnace_back_its_light() {
             tint: Vec3::ONE,
             schlick: false,
             multiscatter: None,
+            film: None,
         };
         Bsdf::Conductor(if multiscatter { c.with_several_facets() } else { c })
     };

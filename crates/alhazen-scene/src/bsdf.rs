@@ -224,6 +224,8 @@ pub enum BsdfDesc {
         /// tangent and bitangent (turned further by the rotation), its blue multiplying the
         /// strength.
         anisotropy_map: Option<Texture>,
+        /// A thin film over both lobes (glTF's `KHR_materials_iridescence`); none by default.
+        iridescence: Option<Box<Iridescence>>,
     },
     /// A clear coat over `base` (car paint, lacquer; glTF's `KHR_materials_clearcoat`): a
     /// dielectric microfacet layer of `weight` reflecting `weight·D G F/(4⟨l,n⟩⟨v,n⟩)`, the
@@ -431,6 +433,37 @@ impl Anisotropy {
     }
 }
 
+/// A thin dielectric film over a metallic–roughness surface (glTF's
+/// `KHR_materials_iridescence`, Belcour and Barla 2017): its interference colours blended into
+/// both lobes' Fresnel factors with weight `factor`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Iridescence {
+    /// The film's weight in `[0, 1]`, times `factor_map`'s red channel where there is one.
+    pub factor: f64,
+    /// The film's index of refraction.
+    pub ior: f64,
+    /// The film's thickness in nanometres where `thickness_map`'s green channel is 0 and where
+    /// it is 1 (glTF's minimum and maximum); the second without a map.
+    pub thickness: [f64; 2],
+    /// The index of refraction above the film (1; a clear coat's over it).
+    pub outside: f64,
+    /// Where the weight varies (read linearly).
+    pub factor_map: Option<Texture>,
+    /// Where the thickness varies (read linearly).
+    pub thickness_map: Option<Texture>,
+}
+
+impl Iridescence {
+    /// The film's weight and thickness (nm) at a point whose maps' texels are `factor_texel`
+    /// and `thickness_texel` (linear RGB; `None` where there is no map).
+    pub fn at(&self, factor_texel: Option<Vec3>, thickness_texel: Option<Vec3>) -> (f64, f64) {
+        let weight = self.factor * factor_texel.map_or(1.0, |t| t.x.clamp(0.0, 1.0));
+        let [thin, thick] = self.thickness;
+        let thickness = thickness_texel.map_or(thick, |t| thin + (thick - thin) * t.y.clamp(0.0, 1.0));
+        (weight.clamp(0.0, 1.0), thickness.max(0.0))
+    }
+}
+
 /// What shapes the metallic–roughness model's lobes besides its colour, metalness and
 /// roughness: the coating's index and specular strength, the metal's multiple scattering.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -477,8 +510,9 @@ impl BsdfDesc {
             BsdfDesc::Sheened { base, color, roughness_map, .. } => {
                 base.is_textured() || t(color) || roughness_map.is_some()
             }
-            BsdfDesc::MetallicRoughness { base, map, anisotropy_map, .. } => {
-                t(base) || map.is_some() || anisotropy_map.is_some()
+            BsdfDesc::MetallicRoughness { base, map, anisotropy_map, iridescence, .. } => {
+                let film = iridescence.as_ref().is_some_and(|i| i.factor_map.is_some() || i.thickness_map.is_some());
+                t(base) || map.is_some() || anisotropy_map.is_some() || film
             }
             BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } | BsdfDesc::ThinDielectric { .. } => false,
         }

@@ -35,6 +35,37 @@ impl Parser<'_> {
         Ok((anisotropy, t.get("map").map(|m| self.linear_placed_image(&m)).transpose()?))
     }
 
+    /// A metallic–roughness surface's `iridescence = { factor, ior, thickness, outside,
+    /// factor_map, thickness_map }`: `thickness` one number (nm) or the two the thickness map's
+    /// green channel runs between.
+    fn iridescence(&mut self, n: &Node) -> R<Iridescence> {
+        let t = n.table(&["factor", "ior", "thickness", "outside", "factor_map", "thickness_map"])?;
+        let thickness = match t.get("thickness") {
+            None => [100.0, 400.0],
+            Some(x) if x.is_array() => {
+                let ends = x.numbers::<2>()?;
+                if !ends.iter().all(|d| (0.0..=1e5).contains(d)) {
+                    return Err(x.err(
+                        "a film's `thickness` is [at the map's 0, at its 1] in nanometres, each within [0, 100000]",
+                    ));
+                }
+                ends
+            }
+            Some(x) => {
+                let d = x.in_range(0.0, 1e5)?;
+                [d, d]
+            }
+        };
+        Ok(Iridescence {
+            factor: t.get("factor").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
+            ior: t.get("ior").map_or(Ok(1.3), |n| n.in_range(1.0, 10.0))?,
+            thickness,
+            outside: t.get("outside").map_or(Ok(1.0), |n| n.in_range(1.0, 10.0))?,
+            factor_map: t.get("factor_map").map(|m| self.linear_placed_image(&m)).transpose()?,
+            thickness_map: t.get("thickness_map").map(|m| self.linear_placed_image(&m)).transpose()?,
+        })
+    }
+
     /// A `bsdf` table; `albedo` is the material's `color`, the default albedo.
     pub(crate) fn bsdf(&mut self, n: &Node, albedo: &Texture) -> R<BsdfDesc> {
         let t = n.table_any()?;
@@ -63,7 +94,17 @@ impl Parser<'_> {
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel", "multiscatter"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
             "metallic-roughness" => {
-                vec!["color", "metallic", "roughness", "map", "ior", "specular", "multiscatter", "anisotropy"]
+                vec![
+                    "color",
+                    "metallic",
+                    "roughness",
+                    "map",
+                    "ior",
+                    "specular",
+                    "multiscatter",
+                    "anisotropy",
+                    "iridescence",
+                ]
             }
             "thin-dielectric" => vec!["ior"],
             "coated" => [&["base", "weight", "ior"][..], MICROFACET_KEYS].concat(),
@@ -162,6 +203,7 @@ impl Parser<'_> {
                     multiscatter: t.opt_bool("multiscatter", false)?,
                     anisotropy,
                     anisotropy_map,
+                    iridescence: t.get("iridescence").map(|n| self.iridescence(&n).map(Box::new)).transpose()?,
                 }
             }
             "coated" => {

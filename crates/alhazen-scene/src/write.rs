@@ -7,7 +7,7 @@
 //! whose conversion gives back the same radians where one exists, so reading the file again
 //! gives the same scene (tested: `tests/write.rs`).
 
-use crate::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Distribution, Ior, Microfacets, Shadowing};
+use crate::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Distribution, Ior, Iridescence, Microfacets, Shadowing};
 use crate::model::*;
 use alhazen_math::{Vec2, Vec3};
 use std::collections::HashMap;
@@ -368,6 +368,22 @@ impl Writer<'_> {
         )
     }
 
+    fn iridescence_entry(&self, i: &Iridescence) -> String {
+        let map = |key: &str, m: &Option<Texture>| {
+            m.as_ref().map_or(String::new(), |m| format!(", {key} = {}", self.map_image(m)))
+        };
+        format!(
+            ", iridescence = {{ factor = {}, ior = {}, thickness = [{}, {}], outside = {}{}{} }}",
+            num(i.factor),
+            num(i.ior),
+            num(i.thickness[0]),
+            num(i.thickness[1]),
+            num(i.outside),
+            map("factor_map", &i.factor_map),
+            map("thickness_map", &i.thickness_map)
+        )
+    }
+
     fn map_image(&self, map: &Texture) -> String {
         match map {
             Texture::Image { image, scale, offset, rotation } => self.placed_image(*image, *scale, *offset, *rotation),
@@ -549,9 +565,10 @@ impl Writer<'_> {
                 multiscatter,
                 anisotropy,
                 anisotropy_map,
+                iridescence,
             } => {
                 format!(
-                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{} }}",
+                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{}{} }}",
                     self.texture(base),
                     num(*metallic),
                     num(*roughness),
@@ -559,7 +576,8 @@ impl Writer<'_> {
                     if *specular == 1.0 { String::new() } else { format!(", specular = {}", num(*specular)) },
                     if *multiscatter { ", multiscatter = true" } else { "" },
                     map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m))),
-                    self.anisotropy_entry(anisotropy, anisotropy_map.as_ref())
+                    self.anisotropy_entry(anisotropy, anisotropy_map.as_ref()),
+                    iridescence.as_ref().map_or(String::new(), |i| self.iridescence_entry(i))
                 )
             }
         }

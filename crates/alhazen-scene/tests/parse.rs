@@ -289,6 +289,67 @@ bsdf = { type = "metallic-roughness", metallic = 1, anisotropy = { strength = 0.
     }
 }
 
+/// A metallic–roughness surface's `iridescence` (a thin film): its defaults, one thickness or
+/// the two a map runs between, maps read linearly; the same after writing the scene back out;
+/// mistakes located.
+#[test]
+fn metallic_roughness_iridescence_reads_and_writes_back() {
+    use alhazen_scene::bsdf::{BsdfDesc, Iridescence};
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"
+[materials.soap]
+bsdf = { type = "metallic-roughness", roughness = 0.1, iridescence = {} }
+[materials.oil]
+bsdf = { type = "metallic-roughness", metallic = 1, iridescence = { factor = 0.7, ior = 1.5, thickness = 550, outside = 1.5 } }
+[materials.mapped]
+bsdf = { type = "metallic-roughness", iridescence = { thickness = [800, 200], factor_map = { file = "f.png" }, thickness_map = { file = "f.png", scale = 3 } } }
+"#;
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 200])).save(dir.path().join("f.png")).unwrap();
+    let path = dir.path().join("i.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let film = |s: &alhazen_scene::Scene, name: &str| match &s.materials.iter().find(|m| m.name == name).unwrap().bsdf {
+        Some(BsdfDesc::MetallicRoughness { iridescence: Some(i), .. }) => (**i).clone(),
+        other => panic!("{other:?}"),
+    };
+    let plain = |factor, ior, thickness, outside| Iridescence {
+        factor,
+        ior,
+        thickness,
+        outside,
+        factor_map: None,
+        thickness_map: None,
+    };
+    assert_eq!(film(&s, "soap"), plain(1.0, 1.3, [100.0, 400.0], 1.0));
+    assert_eq!(film(&s, "oil"), plain(0.7, 1.5, [550.0, 550.0], 1.5));
+    let mapped = film(&s, "mapped");
+    assert_eq!(mapped.thickness, [800.0, 200.0]);
+    let Some(Texture::Image { image, .. }) = mapped.thickness_map else { panic!("{mapped:?}") };
+    // Read linearly: 128/255, not its sRGB decoding; green 0.5 is halfway from 800 to 200 nm.
+    assert_eq!(s.images[image].texel(0), [1.0, 128.0 / 255.0, 200.0 / 255.0]);
+    assert_eq!(mapped.at(None, Some(alhazen_math::Vec3::new(0.0, 0.5, 0.0))), (1.0, 500.0));
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&again_path).unwrap();
+    for name in ["soap", "oil"] {
+        assert_eq!(film(&s, name), film(&again, name));
+    }
+    let m = film(&again, "mapped");
+    assert_eq!((m.thickness, m.factor_map.is_some(), m.thickness_map.is_some()), ([800.0, 200.0], true, true));
+    for (bad, says) in [
+        ("iridescence = { factor = 2 }", "2"),
+        ("iridescence = { thickness = [100, -1] }", "each within [0, 100000]"),
+        ("iridescence = { thickness = [100] }", "2"),
+        ("iridescence = { ior = 0.5 }", "0.5"),
+        ("iridescence = { colour = 1 }", "colour"),
+    ] {
+        let text = format!("[materials.m]\nbsdf = {{ type = \"metallic-roughness\", {bad} }}\n");
+        std::fs::write(&path, &text).unwrap();
+        let e = load_scene(&path).unwrap_err().to_string();
+        assert!(e.contains("i.toml:2:") && e.contains(says), "{bad}: {e}");
+    }
+}
+
 /// glTF's stretch `α_t = α + (1 − α)s²`, `α_b = α`; Disney's `α/a`, `α·a` with
 /// `a = √(1 − 0.9s)`; none at strength 0.
 #[test]

@@ -72,6 +72,7 @@ fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec
         tint: mode.color(m.mirror / w),
         schlick: false,
         multiscatter: None,
+        film: None,
     });
     Bsdf::Mix(Box::new(Mix { a: mirror, b: lambert, weight: w }))
 }
@@ -119,6 +120,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                 tint: mode.color(*tint * lookups.tint),
                 schlick: *fresnel == FresnelMode::Schlick,
                 multiscatter: None,
+                film: None,
             };
             Bsdf::Conductor(if *multiscatter { c.with_several_facets() } else { c })
         }
@@ -160,6 +162,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             multiscatter,
             anisotropy,
             anisotropy_map,
+            iridescence,
         } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
@@ -176,9 +179,74 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                 },
             );
             let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
-            Bsdf::Mix(Box::new(Mix { a, b, weight }))
+            match iridescence {
+                // (The general kernel shades filmed surfaces, whatever their lobes: all metal or
+                // none is one lobe, the film's Fresnel factor not found for the other.)
+                Some(i) if weight >= 1.0 => filmed_metal(a, thin_film(i, lookups, mode)),
+                Some(i) if weight <= 0.0 => filmed_coating(b, thin_film(i, lookups, mode)),
+                Some(i) => {
+                    let film = thin_film(i, lookups, mode);
+                    let (a, b) = (filmed_metal(a, film), filmed_coating(b, film));
+                    Bsdf::Mix(Box::new(Mix { a, b, weight }))
+                }
+                None => Bsdf::Mix(Box::new(Mix { a, b, weight })),
+            }
         }
     }
+}
+
+/// The film of `i` at a point: its weight and thickness from its maps there.
+fn thin_film(i: &alhazen_scene::bsdf::Iridescence, lookups: &Lookups, mode: ColorMode) -> ThinFilm {
+    let texel = |m: &Option<alhazen_scene::Texture>| m.as_ref().map(|m| (lookups.rgb)(m));
+    let (weight, thickness) = i.at(texel(&i.factor_map), texel(&i.thickness_map));
+    let wavelengths = match mode {
+        ColorMode::Rgb => None,
+        ColorMode::Spectral(l) => Some(l.map(|x| x as f32)),
+    };
+    ThinFilm {
+        weight: weight as f32,
+        ior: i.ior as f32,
+        thickness: thickness as f32,
+        outside: i.outside as f32,
+        wavelengths,
+    }
+}
+
+/// The metallic–roughness model's metal under `film`: its Fresnel factor blended with the
+/// film's (its light of several facets found again with it).
+fn filmed_metal(metal: Bsdf, film: ThinFilm) -> Bsdf {
+    match metal {
+        Bsdf::Conductor(c) => {
+            let several = c.multiscatter.is_some();
+            let c = Conductor { film: Some(film), multiscatter: None, ..c };
+            Bsdf::Conductor(if several { c.with_several_facets() } else { c })
+        }
+        other => other,
+    }
+}
+
+/// The metallic–roughness model's coating under `film`: its specular lobe split into `1 − w` of
+/// itself and `w` of the film's (glTF's `mix(F, F_film, w)`), the latter a lobe of the same
+/// facets whose factor is the film's over the coating's index: `ρ_d + k_s(1 − w)ρ_s +
+/// k_s·w·ρ_film`, written as a mix that samples the film's lobe with probability `k_s·w/2`.
+fn filmed_coating(coating: Bsdf, film: ThinFilm) -> Bsdf {
+    let (Bsdf::CookTorrance(ct), w) = (&coating, f64::from(film.weight)) else { return coating };
+    if w <= 0.0 {
+        return coating;
+    }
+    let film_share = ct.ks * w / 2.0;
+    let keep = 1.0 - film_share;
+    let own = CookTorrance { diffuse: ct.diffuse / keep, ks: ct.ks * (1.0 - w) / keep, lobe: ct.lobe };
+    let lobe = Conductor {
+        facets: Some(ct.lobe.facets),
+        eta: Vec3::splat(ct.lobe.ior),
+        k: Vec3::ZERO,
+        tint: Vec3::splat(ct.ks * w / film_share),
+        schlick: true,
+        multiscatter: None,
+        film: Some(ThinFilm { weight: 1.0, ..film }),
+    };
+    Bsdf::Mix(Box::new(Mix { a: Bsdf::CookTorrance(own), b: Bsdf::Conductor(lobe), weight: keep }))
 }
 
 /// The world-space tangent that anisotropic lobes align with at `hit`: Blinn–Phong's

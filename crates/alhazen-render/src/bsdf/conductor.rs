@@ -7,7 +7,7 @@
 //! `tint` (a multiplier, 1 is physical), Fresnel mode. `η = κ = 0` is an ideal mirror (`F = tint`).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, MicrofacetLobes, reflect, same_side};
+use super::{BsdfSample, MicrofacetLobes, ThinFilm, reflect, same_side};
 use alhazen_math::{Vec2, Vec3};
 
 /// A conductor.
@@ -28,6 +28,8 @@ pub struct Conductor {
     /// terms that do not depend on the directions ([`Self::with_several_facets`]); `None`:
     /// single scattering.
     pub multiscatter: Option<super::SeveralFacets>,
+    /// A thin film over the metal ([`ThinFilm`]): its interference blended into `F`.
+    pub film: Option<ThinFilm>,
 }
 
 /// Unpolarised reflectance of a conductor `η + iκ` at incidence cosine `cos_i`:
@@ -85,12 +87,19 @@ impl Conductor {
         let f = if self.schlick {
             let f0 = normal_reflectance_channels(channels(self.eta), channels(self.k));
             let f = |i: usize| f0[i] + (1.0 - f0[i]) * (1.0 - cos.abs().min(1.0)).powi(5);
-            Vec3::new(f(0), f(1), f(2)) * self.tint
+            Vec3::new(f(0), f(1), f(2))
         } else {
             let f = fresnel_conductor_channels(cos, channels(self.eta), channels(self.k));
-            Vec3::new(f[0], f[1], f[2]) * self.tint
+            Vec3::new(f[0], f[1], f[2])
         };
-        if mirror { self.tint } else { f }
+        let f = match &self.film {
+            Some(film) => {
+                let f0 = normal_reflectance_channels(channels(self.eta), channels(self.k));
+                film.blend(f, cos, Vec3::new(f0[0], f0[1], f0[2]))
+            }
+            None => f,
+        };
+        if mirror { self.tint } else { f * self.tint }
     }
 
     /// `D G F / (4⟨l,n⟩⟨v,n⟩)` (plus the light of several facets with
@@ -182,7 +191,7 @@ impl Conductor {
         if self.eta == Vec3::ZERO && self.k == Vec3::ZERO {
             return self.tint;
         }
-        if self.schlick {
+        if self.schlick && self.film.is_none() {
             let channels = |v: Vec3| [v.x, v.y, v.z, 0.0];
             let f0 = normal_reflectance_channels(channels(self.eta), channels(self.k));
             let avg = |i: usize| f0[i] + (1.0 - f0[i]) / 21.0;

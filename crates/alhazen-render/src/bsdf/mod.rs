@@ -22,6 +22,7 @@ mod oren_nayar;
 mod phong;
 mod plastic;
 mod sheen;
+mod thin_film;
 
 pub use blinn_phong::{BlinnPhong, BlinnPhongLobe};
 pub use build::{ColorMode, bsdf_at, is_anisotropic, tangent_at};
@@ -38,6 +39,7 @@ pub use oren_nayar::OrenNayar;
 pub use phong::{Phong, PhongLobe};
 pub use plastic::{Coat, Plastic};
 pub use sheen::Sheened;
+pub use thin_film::ThinFilm;
 
 use alhazen_math::{Vec2, Vec3};
 use std::f64::consts::PI;

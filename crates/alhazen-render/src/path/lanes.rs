@@ -491,7 +491,7 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
     match bsdf {
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
         // The light of several facets is the general kernel's.
-        Bsdf::Conductor(c) if c.multiple_scattering(Vec3::Z).is_some() => Kernel::General,
+        Bsdf::Conductor(c) if c.multiple_scattering(Vec3::Z).is_some() || c.film.is_some() => Kernel::General,
         Bsdf::Conductor(c) => match (c.facets.map(|_| conductor_facets(c)), c.schlick) {
             (None, false) => Kernel::SmoothConductor,
             (None, true) => Kernel::SmoothSchlickConductor,
@@ -538,7 +538,9 @@ fn conductor_facets(c: &Conductor) -> Option<bool> {
 /// conductor, exact Fresnel term) mixed with Lambert.
 fn lambert_mirror(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &crate::bsdf::Lambert, f64)> {
     match (&mix.a, &mix.b) {
-        (Bsdf::Conductor(c), Bsdf::Lambert(l)) if c.facets.is_none() && !c.schlick => Some((c, l, mix.weight)),
+        (Bsdf::Conductor(c), Bsdf::Lambert(l)) if c.facets.is_none() && !c.schlick && c.film.is_none() => {
+            Some((c, l, mix.weight))
+        }
         _ => None,
     }
 }
@@ -551,6 +553,7 @@ fn metallic_roughness(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &CookTorran
         (Bsdf::Conductor(c), Bsdf::CookTorrance(base))
             if c.schlick
                 && c.multiscatter.is_none()
+                && c.film.is_none()
                 && conductor_facets(c) == Some(false)
                 && c.facets.is_some_and(|f| f.alpha_u == f.alpha_v)
                 && cook_torrance_facets(base) == Some(false) =>
@@ -1157,7 +1160,7 @@ impl RoughBsdf for Conductor {
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        Conductor { facets: Some(facets), eta, k, tint, schlick: false, multiscatter: None }
+        Conductor { facets: Some(facets), eta, k, tint, schlick: false, multiscatter: None, film: None }
     }
 }
 
@@ -1180,7 +1183,15 @@ impl RoughBsdf for SchlickConductor {
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        SchlickConductor(Conductor { facets: Some(facets), eta, k, tint, schlick: true, multiscatter: None })
+        SchlickConductor(Conductor {
+            facets: Some(facets),
+            eta,
+            k,
+            tint,
+            schlick: true,
+            multiscatter: None,
+            film: None,
+        })
     }
 }
 
@@ -1262,7 +1273,11 @@ impl<const SCHLICK: bool> LaneBsdf for SmoothConductor<SCHLICK> {
     #[inline(always)]
     fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        (true, Conductor { facets: None, eta, k, tint, schlick: SCHLICK, multiscatter: None }.smooth_sample(wv))
+        (
+            true,
+            Conductor { facets: None, eta, k, tint, schlick: SCHLICK, multiscatter: None, film: None }
+                .smooth_sample(wv),
+        )
     }
 }
 
@@ -1310,7 +1325,7 @@ impl LambertMirror {
     #[inline(always)]
     fn at(v: &Vertices, i: usize) -> (Conductor, crate::bsdf::Lambert, f64) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        let mirror = Conductor { facets: None, eta, k, tint, schlick: false, multiscatter: None };
+        let mirror = Conductor { facets: None, eta, k, tint, schlick: false, multiscatter: None, film: None };
         (mirror, crate::bsdf::Lambert { albedo: get(&v.albedo, i) }, v.mix_weight[i])
     }
 }
@@ -1352,7 +1367,8 @@ impl MetallicRoughness {
     fn at(v: &Vertices, i: usize) -> ((Conductor, Microfacet), (CookTorrance, Microfacet), f64) {
         let metal_facets = Microfacet::smith::<false>(v.alpha[0][i], v.alpha[0][i]);
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
-        let metal = Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true, multiscatter: None };
+        let metal =
+            Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true, multiscatter: None, film: None };
         let base_facets = Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]);
         let lobe = CookTorranceLobe { facets: base_facets, ior: v.ior[i], schlick: false };
         let base = CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe };
