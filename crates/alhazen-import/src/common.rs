@@ -111,14 +111,17 @@ pub(crate) fn absorbing(scene: &mut Scene, base: MaterialId, absorption: Rgb) ->
 /// `coateddiffuse` reduced to it): a metal whose normal-incidence reflectance is the base
 /// colour (Schlick), mixed by `metallic` with a dielectric coating over a Lambertian base (the
 /// coating's index and strength and the metal's multiple scattering: `lobes`), both with GGX roughness `α = roughness²`; `transmission` mixes in rough glass of index
-/// `ior`.
+/// `ior`, times the map's luminance at each point where there is one (glTF's
+/// `transmissionTexture`, whose red channel the importer gives all three), the light it lets
+/// through keeping `glass_tint` at each crossing (Disney's, Cycles' and Mitsuba's `√base`, so
+/// that a closed object passes its base colour).
 pub(crate) fn metal_rough(
     base: Texture,
     base_mean: Rgb,
     metallic: f64,
     roughness: f64,
     (ior, lobes): (f64, MetalRoughness),
-    transmission: f64,
+    (transmission, transmission_map, glass_tint): (f64, Option<Texture>, Texture),
 ) -> BsdfDesc {
     // The model at a point of colour `base_mean`, its coating given the texture itself, its
     // metal smooth where the roughness is below the facets' least `α` (a material with a
@@ -133,8 +136,20 @@ pub(crate) fn metal_rough(
         *albedo = base;
     }
     let opaque = mix(metal, plastic, metallic);
-    let glass = BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact };
-    mix(glass, opaque, transmission * (1.0 - metallic))
+    let glass = BsdfDesc::Dielectric {
+        facets,
+        ior: Ior::Constant(ior),
+        fresnel: FresnelMode::Exact,
+        transmittance: glass_tint,
+    };
+    let weight = transmission * (1.0 - metallic);
+    match transmission_map {
+        // Glass only where the map says: the mix kept even at full weight.
+        Some(map) if weight > 0.0 => {
+            BsdfDesc::Mix { a: Box::new(glass), b: Box::new(opaque), weight, weight_map: Some(map) }
+        }
+        _ => mix(glass, opaque, weight),
+    }
 }
 
 /// The plain lobes of the metallic–roughness model: a coating of index `ior` at full

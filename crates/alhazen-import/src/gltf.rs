@@ -718,16 +718,31 @@ impl Importer<'_> {
             self.scene.images.push(img);
             emission_texture = Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation });
         }
-        let transmission = material.transmission().map_or(0.0, |t| {
-            if t.transmission_texture().is_some() {
-                self.warnings.add(
-                    self.path,
-                    0,
-                    format!("{name}: the transmission texture is ignored (its factor is used)"),
-                );
+        let transmission = material.transmission().map_or(0.0, |t| t.transmission_factor() as f64);
+        // Where the glass is: the factor times the texture's red channel, per point.
+        let transmission_map = match material.transmission().and_then(|t| t.transmission_texture()) {
+            Some(info) if transmission > 0.0 => {
+                let (scale, offset, rotation) = self.texture_placement(&info, &name)?;
+                let image = wrapped(self.image(&info.texture(), Decoding::Red)?, &info.texture());
+                self.scene.images.push(image);
+                Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation })
             }
-            t.transmission_factor() as f64
-        });
+            _ => None,
+        };
+        // What the glass keeps at each crossing: the base colour's square root (Cycles', Disney's).
+        let glass_tint = match &base {
+            Texture::Image { image, scale, offset, rotation } if transmission > 0.0 => {
+                let root = self.scene.images[*image].channels_mapped(|_, v| v.max(0.0).sqrt());
+                self.scene.images.push(Arc::new(root));
+                Texture::Image {
+                    image: self.scene.images.len() - 1,
+                    scale: *scale,
+                    offset: *offset,
+                    rotation: *rotation,
+                }
+            }
+            _ => Texture::Solid(base_mean.max(Vec3::ZERO).powf(0.5)),
+        };
         let ior = material.ior().unwrap_or(1.5) as f64;
         let (mut metallic, mut roughness) = (pbr.metallic_factor() as f64, pbr.roughness_factor() as f64);
         // The metallic-roughness texture is read per point (roughness in green, metalness in
@@ -793,8 +808,14 @@ impl Importer<'_> {
                 iridescence,
             }
         } else {
-            let bsdf =
-                common::metal_rough(base, base_mean, metallic, roughness, (ior, lobes), transmission.clamp(0.0, 1.0));
+            let bsdf = common::metal_rough(
+                base,
+                base_mean,
+                metallic,
+                roughness,
+                (ior, lobes),
+                (transmission.clamp(0.0, 1.0), transmission_map, glass_tint),
+            );
             match self.dispersion(&material, ior, &name)? {
                 Some(cauchy) => glass_of_index(bsdf, cauchy),
                 None => bsdf,
@@ -1198,6 +1219,8 @@ impl Importer<'_> {
                 wanted.extend(srgb.iter().flatten().map(|t| (t.source().index(), Decoding::Srgb)));
                 wanted.extend(linear.iter().flatten().map(|t| (t.source().index(), Decoding::Linear)));
                 wanted.extend(alpha.map(|t| (t.texture().source().index(), Decoding::Alpha)));
+                let transmission = material.transmission().and_then(|t| t.transmission_texture());
+                wanted.extend(transmission.map(|t| (t.texture().source().index(), Decoding::Red)));
             }
             todo.extend(node.children().map(|c| (c, depth + 1)));
         }
@@ -1347,7 +1370,9 @@ fn node_worlds(scene: &gltf::Scene) -> HashMap<usize, Mat4> {
 /// `bsdf` with its glass (the dielectric that transmission mixes in) of index `ior`.
 fn glass_of_index(bsdf: BsdfDesc, ior: Ior) -> BsdfDesc {
     match bsdf {
-        BsdfDesc::Dielectric { facets, fresnel, .. } => BsdfDesc::Dielectric { facets, ior, fresnel },
+        BsdfDesc::Dielectric { facets, fresnel, transmittance, .. } => {
+            BsdfDesc::Dielectric { facets, ior, fresnel, transmittance }
+        }
         BsdfDesc::Mix { a, b, weight, weight_map } => BsdfDesc::Mix {
             a: Box::new(glass_of_index(*a, ior)),
             b: Box::new(glass_of_index(*b, ior)),
@@ -1440,6 +1465,8 @@ enum Decoding {
     Linear,
     /// The alpha channel, as it is, in all three (1 where the image has none).
     Alpha,
+    /// The red channel, as it is, in all three (the first of a grey image).
+    Red,
 }
 
 /// Decoded glTF image data as linear RGB.
@@ -1466,6 +1493,7 @@ fn decode(data: &gltf::image::Data, decoding: Decoding) -> Option<ImageData> {
     let has_alpha = channels % 2 == 0;
     let channel = |i: usize| match decoding {
         Decoding::Alpha if has_alpha => channels - 1,
+        Decoding::Red => 0,
         _ if channels < 3 => 0,
         _ => i,
     };

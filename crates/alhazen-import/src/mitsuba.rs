@@ -1028,13 +1028,15 @@ impl Importer {
             }
             "dielectric" | "roughdielectric" | "thindielectric" => {
                 let ior = self.ior(ctx, &p, 1.5046)?;
-                for key in ["specular_reflectance", "specular_transmittance"] {
+                // A dielectric's transmission may be tinted; its reflection, and a thin one's, not.
+                let unread: &[&str] = if kind == "thindielectric" {
+                    &["specular_reflectance", "specular_transmittance"]
+                } else {
+                    &["specular_reflectance"]
+                };
+                for key in unread {
                     if let Some(n) = self.prop(&p, key) {
-                        self.warn(
-                            ctx,
-                            n,
-                            format!("`{key}` of a dielectric is not supported: alhazen's glass is clear"),
-                        );
+                        self.warn(ctx, n, format!("`{key}` of a {kind} is not supported: taken as 1"));
                     }
                 }
                 if kind == "thindielectric" {
@@ -1048,7 +1050,8 @@ impl Importer {
                     BsdfDesc::ThinDielectric { ior: ior.max(1.0) }
                 } else {
                     let facets = self.facets(ctx, &p, kind == "roughdielectric")?;
-                    BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact }
+                    let transmittance = self.color(ctx, &p, "specular_transmittance", Vec3::ONE)?;
+                    BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact, transmittance }
                 }
             }
             "plastic" | "roughplastic" => {
@@ -1356,7 +1359,14 @@ impl Importer {
                 iridescence: None,
             });
         }
-        Ok(common::metal_rough(base, mean, metallic, roughness, (ior, common::plain_lobes(ior)), trans))
+        Ok(common::metal_rough(
+            base,
+            mean,
+            metallic,
+            roughness,
+            (ior, common::plain_lobes(ior)),
+            (trans, None, Texture::Solid(mean.powf(0.5))),
+        ))
     }
 
     /// `v`, or the mean luminance of its texture (parameter `name`), with a warning.

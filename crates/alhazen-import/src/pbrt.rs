@@ -1112,6 +1112,7 @@ impl Importer {
                     facets: facets(rough),
                     ior: Ior::Constant(self.eta(ctx, p)?),
                     fresnel: FresnelMode::Exact,
+                    transmittance: Texture::Solid(Vec3::ONE),
                 }
             }
             "thindielectric" => {
@@ -1167,7 +1168,12 @@ impl Importer {
             }
             "interface" => {
                 self.warn(ctx, at, "an interface material (a medium boundary) is rendered as clear glass of index 1");
-                BsdfDesc::Dielectric { facets: None, ior: Ior::Constant(1.0), fresnel: FresnelMode::Exact }
+                BsdfDesc::Dielectric {
+                    facets: None,
+                    ior: Ior::Constant(1.0),
+                    fresnel: FresnelMode::Exact,
+                    transmittance: Texture::Solid(Vec3::ONE),
+                }
             }
             other => {
                 self.warn(

@@ -96,6 +96,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                         schlick: false,
                         dispersive: false,
                         thin: false,
+                        tint: Vec3::ONE,
                     }),
                 ));
             }
@@ -366,6 +367,7 @@ fn rough_dielectric_sampling_from_inside_matches_its_density() {
         schlick: false,
         dispersive: false,
         thin: false,
+        tint: Vec3::ONE,
     });
     for theta in [20.0, 60.0] {
         let v = -direction(theta, 1.1);
@@ -412,7 +414,14 @@ fn lambert_with_albedo_one_conserves_energy_exactly() {
 fn smooth_dielectric_splits_energy_without_loss() {
     // Importance transport: reflected F plus transmitted (1 − F) once the η² of radiance is undone.
     for eta in [1.33, 1.5, 2.4] {
-        let b = Bsdf::Dielectric(Dielectric { facets: None, eta, schlick: false, dispersive: false, thin: false });
+        let b = Bsdf::Dielectric(Dielectric {
+            facets: None,
+            eta,
+            schlick: false,
+            dispersive: false,
+            thin: false,
+            tint: Vec3::ONE,
+        });
         for v in [direction(0.0, 0.0), direction(50.0, 1.0), -direction(30.0, 2.0), -direction(70.0, 2.0)] {
             let (mut total, n) = (0.0, 20_000);
             let mut rng = Rng::for_sample(1, 1, 1, 1);
@@ -488,8 +497,14 @@ fn the_course_phong_is_not_reciprocal_but_the_normalised_one_is() {
 fn refraction_obeys_the_course_eta_squared_law() {
     // η₁² ρ(l, v) = η₂² ρ(v, l), η₁ on the light's side, η₂ on the viewer's.
     let eta = 1.5;
-    let b =
-        Bsdf::Dielectric(Dielectric { facets: Some(ggx(0.35)), eta, schlick: false, dispersive: false, thin: false });
+    let b = Bsdf::Dielectric(Dielectric {
+        facets: Some(ggx(0.35)),
+        eta,
+        schlick: false,
+        dispersive: false,
+        thin: false,
+        tint: Vec3::ONE,
+    });
     let mut rng = Rng::for_sample(3, 3, 3, 3);
     let mut checked = 0;
     for _ in 0..500 {
@@ -547,7 +562,7 @@ fn conductor_fresnel_matches_known_values() {
 /// nothing (every sample's weight is 1).
 #[test]
 fn a_thin_sheet_reflects_both_faces_and_passes_the_rest_straight() {
-    let sheet = Dielectric { facets: None, eta: 1.5, schlick: false, dispersive: false, thin: true };
+    let sheet = Dielectric { facets: None, eta: 1.5, schlick: false, dispersive: false, thin: true, tint: Vec3::ONE };
     for (theta, side) in [(0.0, 1.0), (40.0, 1.0), (75.0, -1.0), (89.0, -1.0)] {
         let v = direction(theta, 0.7) * Vec3::new(1.0, 1.0, side);
         let cos = v.z.abs();

@@ -186,6 +186,9 @@ pub enum BsdfDesc {
         ior: Ior,
         /// Exact or Schlick.
         fresnel: FresnelMode,
+        /// What refracted light keeps at each crossing, per channel (white: clear glass; glTF's
+        /// transmission is tinted by the base colour, Mitsuba's by `specular_transmittance`).
+        transmittance: Texture,
     },
     /// A thin sheet of glass (a window pane): light passes straight through it, or is
     /// reflected by its two faces and every bounce between them, `R' = 2R/(1 + R)` of it for a
@@ -514,7 +517,8 @@ impl BsdfDesc {
                 let film = iridescence.as_ref().is_some_and(|i| i.factor_map.is_some() || i.thickness_map.is_some());
                 t(base) || map.is_some() || anisotropy_map.is_some() || film
             }
-            BsdfDesc::Conductor { .. } | BsdfDesc::Dielectric { .. } | BsdfDesc::ThinDielectric { .. } => false,
+            BsdfDesc::Dielectric { transmittance, .. } => t(transmittance),
+            BsdfDesc::Conductor { .. } | BsdfDesc::ThinDielectric { .. } => false,
         }
     }
 

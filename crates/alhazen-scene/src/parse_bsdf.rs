@@ -92,7 +92,9 @@ impl Parser<'_> {
             "cook-torrance" => [&["color", "kd", "ks", "ior", "fresnel"][..], MICROFACET_KEYS].concat(),
             "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel", "multiscatter"][..], MICROFACET_KEYS].concat(),
-            "dielectric" => [&["ior", "cauchy", "sellmeier", "glass", "fresnel"][..], MICROFACET_KEYS].concat(),
+            "dielectric" => {
+                [&["ior", "cauchy", "sellmeier", "glass", "fresnel", "transmittance"][..], MICROFACET_KEYS].concat()
+            }
             "metallic-roughness" => {
                 vec![
                     "color",
@@ -183,7 +185,22 @@ impl Parser<'_> {
                     nonlinear: t.opt_bool("nonlinear", false)?,
                 }
             }
-            "dielectric" => BsdfDesc::Dielectric { facets: microfacets(&t)?, ior: ior(&t)?, fresnel: fresnel(&t)? },
+            "dielectric" => BsdfDesc::Dielectric {
+                facets: microfacets(&t)?,
+                ior: ior(&t)?,
+                fresnel: fresnel(&t)?,
+                transmittance: match t.get("transmittance") {
+                    Some(c) => match self.texture(&c)? {
+                        Texture::Solid(k) if !(k.min_element() >= 0.0 && k.max_element() <= 1.0) => {
+                            return Err(
+                                c.err("a dielectric's `transmittance` is a colour within [0, 1]: what light keeps")
+                            );
+                        }
+                        tint => tint,
+                    },
+                    None => Texture::Solid(Vec3::ONE),
+                },
+            },
             "thin-dielectric" => {
                 BsdfDesc::ThinDielectric { ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))? }
             }

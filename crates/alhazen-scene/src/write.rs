@@ -516,7 +516,7 @@ impl Writer<'_> {
                 if *multiscatter { ", multiscatter = true" } else { "" }
             ),
             BsdfDesc::ThinDielectric { ior } => format!("{{ type = \"thin-dielectric\", ior = {} }}", num(*ior)),
-            BsdfDesc::Dielectric { facets: f, ior, fresnel: fr } => {
+            BsdfDesc::Dielectric { facets: f, ior, fresnel: fr, transmittance } => {
                 let ior = match ior {
                     Ior::Constant(x) => format!("ior = {}", num(*x)),
                     Ior::Cauchy { a, b } => format!("cauchy = [{}, {}]", num(*a), num(*b)),
@@ -530,7 +530,11 @@ impl Writer<'_> {
                         num(c[2])
                     ),
                 };
-                format!("{{ type = \"dielectric\", {ior}, fresnel = \"{}\", {} }}", fresnel(*fr), facets(f))
+                let tint = match transmittance {
+                    Texture::Solid(c) if *c == Vec3::ONE => String::new(),
+                    other => format!(", transmittance = {}", self.texture(other)),
+                };
+                format!("{{ type = \"dielectric\", {ior}, fresnel = \"{}\", {}{tint} }}", fresnel(*fr), facets(f))
             }
             BsdfDesc::Mix { a, b, weight, weight_map } => {
                 let map = weight_map.as_ref().map_or(String::new(), |t| format!(", weight_map = {}", self.texture(t)));

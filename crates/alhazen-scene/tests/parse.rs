@@ -289,6 +289,43 @@ bsdf = { type = "metallic-roughness", metallic = 1, anisotropy = { strength = 0.
     }
 }
 
+/// A dielectric's `transmittance` (what refracted light keeps at each crossing): white by
+/// default, a colour or an image; the same after writing the scene back out.
+#[test]
+fn dielectric_transmittance_reads_and_writes_back() {
+    use alhazen_scene::bsdf::BsdfDesc;
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"
+[materials.clear]
+bsdf = { type = "dielectric", ior = 1.5 }
+[materials.amber]
+bsdf = { type = "dielectric", ior = 1.5, roughness = 0.1, transmittance = [0.9, 0.6, 0.2] }
+[materials.mapped]
+bsdf = { type = "dielectric", transmittance = { image = { file = "t.png" } } }
+"#;
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 0])).save(dir.path().join("t.png")).unwrap();
+    let path = dir.path().join("d.toml");
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let tint = |s: &alhazen_scene::Scene, name: &str| match &s.materials.iter().find(|m| m.name == name).unwrap().bsdf {
+        Some(BsdfDesc::Dielectric { transmittance, .. }) => transmittance.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(tint(&s, "clear"), Texture::Solid(alhazen_math::Vec3::ONE));
+    assert_eq!(tint(&s, "amber"), Texture::Solid(alhazen_math::Vec3::new(0.9, 0.6, 0.2)));
+    assert!(matches!(tint(&s, "mapped"), Texture::Image { .. }));
+    let again_path = dir.path().join("again.toml");
+    alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
+    let again = load_scene(&again_path).unwrap();
+    for name in ["clear", "amber"] {
+        assert_eq!(tint(&s, name), tint(&again, name));
+    }
+    assert!(matches!(tint(&again, "mapped"), Texture::Image { .. }));
+    std::fs::write(&path, "[materials.m]\nbsdf = { type = \"dielectric\", transmittance = [2, 0, 0] }\n").unwrap();
+    let e = load_scene(&path).unwrap_err().to_string();
+    assert!(e.contains("d.toml:2:") && e.contains("within [0, 1]"), "{e}");
+}
+
 /// A metallic–roughness surface's `iridescence` (a thin film): its defaults, one thickness or
 /// the two a map runs between, maps read linearly; the same after writing the scene back out;
 /// mistakes located.

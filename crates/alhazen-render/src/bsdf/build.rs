@@ -58,6 +58,7 @@ fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec
             schlick: m.fresnel == FresnelMode::Schlick,
             dispersive: false,
             thin: false,
+            tint: Vec3::ONE,
         });
     }
     let lambert = Bsdf::Lambert(Lambert { albedo: tex(&m.color) * m.diffuse });
@@ -124,16 +125,26 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             };
             Bsdf::Conductor(if *multiscatter { c.with_several_facets() } else { c })
         }
-        BsdfDesc::Dielectric { facets, ior, fresnel } => Bsdf::Dielectric(Dielectric {
+        BsdfDesc::Dielectric { facets, ior, fresnel, transmittance } => Bsdf::Dielectric(Dielectric {
             facets: facets.as_ref().map(Microfacet::new),
             eta: mode.ior(ior),
             schlick: *fresnel == FresnelMode::Schlick,
             dispersive: ior.is_dispersive() && matches!(mode, ColorMode::Spectral(_)),
             thin: false,
+            // Clear glass stays exactly clear (in every colour mode).
+            tint: match transmittance {
+                alhazen_scene::Texture::Solid(c) if *c == Vec3::ONE && lookups.tint == Vec3::ONE => Vec3::ONE,
+                t => tex(t),
+            },
         }),
-        BsdfDesc::ThinDielectric { ior } => {
-            Bsdf::Dielectric(Dielectric { facets: None, eta: *ior, schlick: false, dispersive: false, thin: true })
-        }
+        BsdfDesc::ThinDielectric { ior } => Bsdf::Dielectric(Dielectric {
+            facets: None,
+            eta: *ior,
+            schlick: false,
+            dispersive: false,
+            thin: true,
+            tint: Vec3::ONE,
+        }),
         BsdfDesc::Mix { a, b, weight, weight_map } => {
             let at = weight_map.as_ref().map_or(1.0, |t| alhazen_math::color::luminance((lookups.rgb)(t)));
             let weight = (weight * at).clamp(0.0, 1.0);

@@ -32,6 +32,9 @@ pub struct Dielectric {
     /// A thin sheet (smooth): light passes straight through, or is reflected by both faces
     /// and the bounces between them ([`Self::thin_sample`]).
     pub thin: bool,
+    /// What the refracted (or passing) light keeps, per channel (1: clear; glTF tints
+    /// transmission by the base colour, Mitsuba by `specular_transmittance`).
+    pub tint: Vec3,
 }
 
 impl Dielectric {
@@ -79,7 +82,7 @@ impl Dielectric {
             let denom = (l.dot(h) + v.dot(h) / etap).powi(2) * (l.z * v.z).abs();
             dg * (1.0 - fr) * (l.dot(h) * v.dot(h)).abs() / denom / (etap * etap)
         };
-        Vec3::splat(value)
+        Vec3::splat(value) * if etap == 1.0 { Vec3::ONE } else { self.tint }
     }
 
     /// Density of `sample`: facet density times the reflect/refract Jacobian and choice.
@@ -125,8 +128,12 @@ impl Dielectric {
         }
         let r = self.fresnel(v.z.abs());
         let reflectance = 2.0 * r / (1.0 + r);
-        let (l, p) = if uc < reflectance { (reflect(v, Vec3::Z), reflectance) } else { (-v, 1.0 - reflectance) };
-        Some(BsdfSample { l, f: Vec3::splat(p / l.z.abs()), pdf: p, delta: true, eta: 1.0, dispersive: false })
+        let (l, p, tint) = if uc < reflectance {
+            (reflect(v, Vec3::Z), reflectance, Vec3::ONE)
+        } else {
+            (-v, 1.0 - reflectance, self.tint)
+        };
+        Some(BsdfSample { l, f: Vec3::splat(p / l.z.abs()) * tint, pdf: p, delta: true, eta: 1.0, dispersive: false })
     }
 
     /// The smooth boundary's mirror direction (with probability `F`, when `uc < F`) or
@@ -145,7 +152,7 @@ impl Dielectric {
             let (l, f) = (mirrored, Vec3::splat(fr / mirrored.z.abs()));
             BsdfSample { l, f, pdf: fr, delta: true, eta: 1.0, dispersive: false }
         } else {
-            let (l, f) = (refracted, Vec3::splat((1.0 - fr) / refracted.z.abs() / (etap * etap)));
+            let (l, f) = (refracted, Vec3::splat((1.0 - fr) / refracted.z.abs() / (etap * etap)) * self.tint);
             BsdfSample { l, f, pdf: 1.0 - fr, delta: true, eta: etap, dispersive: self.dispersive }
         };
         let side_ok = if reflects {
@@ -170,7 +177,7 @@ impl MicrofacetLobes for Dielectric {
         let denom = (l.dot(h) + v.dot(h) / etap).powi(2) * (l.z * v.z).abs();
         let value = dg * (1.0 - fr) * (l.dot(h) * v.dot(h)).abs() / denom / (etap * etap);
         let jacobian = l.dot(h).abs() / (l.dot(h) + v.dot(h) / etap).powi(2);
-        let refracted = (Vec3::splat(value), pdf_h * jacobian * (1.0 - fr));
+        let refracted = (Vec3::splat(value) * self.tint, pdf_h * jacobian * (1.0 - fr));
         let (value, pdf) = if etap == 1.0 { reflected } else { refracted };
         if valid { (value, pdf) } else { (Vec3::ZERO, 0.0) }
     }

@@ -501,7 +501,7 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             (Some(Some(true)), true) => Kernel::BeckmannSchlickConductor,
             (Some(None), _) => Kernel::General,
         },
-        Bsdf::Dielectric(d) if d.thin => Kernel::General,
+        Bsdf::Dielectric(d) if d.thin || d.tint != Vec3::ONE => Kernel::General,
         Bsdf::Dielectric(d) if d.facets.is_none() && !d.schlick && !d.dispersive => Kernel::SmoothDielectric,
         Bsdf::Dielectric(d) => match dielectric_facets(d) {
             Some(false) => Kernel::RoughDielectric,
@@ -1200,7 +1200,14 @@ impl RoughBsdf for Dielectric {
 
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
-        Dielectric { facets: Some(facets), eta: v.ior[i], schlick: false, dispersive: false, thin: false }
+        Dielectric {
+            facets: Some(facets),
+            eta: v.ior[i],
+            schlick: false,
+            dispersive: false,
+            thin: false,
+            tint: Vec3::ONE,
+        }
     }
 }
 
@@ -1289,7 +1296,8 @@ impl LaneBsdf for SmoothDielectric {
 
     #[inline(always)]
     fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
-        Dielectric { facets: None, eta: v.ior[i], schlick: false, dispersive: false, thin: false }.smooth_sample(wv, uc)
+        Dielectric { facets: None, eta: v.ior[i], schlick: false, dispersive: false, thin: false, tint: Vec3::ONE }
+            .smooth_sample(wv, uc)
     }
 }
 
