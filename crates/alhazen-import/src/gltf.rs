@@ -1005,8 +1005,9 @@ impl Importer<'_> {
 
     /// `bsdf` under `KHR_materials_clearcoat`'s coat: of weight `clearcoatFactor`, GGX facets
     /// of `α = clearcoatRoughnessFactor²` (at least 0.01, a clear coat), index 1.5 (glTF's);
-    /// none where the factor is 0. Its textures and normal map are left out (warning: the
-    /// factors are used).
+    /// none where the factor is 0. `clearcoatTexture`'s red channel multiplies the weight and
+    /// `clearcoatRoughnessTexture`'s green the roughness, per point (read linearly); its normal
+    /// map is left out (warning).
     fn clearcoat(&mut self, material: &gltf::Material, bsdf: BsdfDesc, name: &str) -> R<BsdfDesc> {
         let Some(c) = material.extension_value("KHR_materials_clearcoat") else { return Ok(bsdf) };
         let number = |key: &str| match c.get(key) {
@@ -1018,17 +1019,23 @@ impl Importer<'_> {
                 "{name}: KHR_materials_clearcoat's clearcoatFactor and clearcoatRoughnessFactor must be numbers within [0, 1]"
             )));
         };
-        if ["clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"]
-            .iter()
-            .any(|k| c.get(*k).is_some())
-        {
-            self.warn(format!("{name}: KHR_materials_clearcoat's textures are not supported; its factors are used"));
+        if c.get("clearcoatNormalTexture").is_some() {
+            self.warn(format!(
+                "{name}: KHR_materials_clearcoat's normal texture is not supported; the surface's normal is used"
+            ));
         }
         if weight == 0.0 {
             return Ok(bsdf);
         }
+        let mut map = |key: &str| match c.get(key) {
+            Some(info) => self.texture_of_info(info, name, key, Decoding::Linear).map(Some),
+            None => Ok(None),
+        };
+        let weight_map = map("clearcoatTexture")?;
+        let roughness_map = map("clearcoatRoughnessTexture")?;
         let alpha = (roughness * roughness).max(0.01);
-        Ok(BsdfDesc::Coated { base: Box::new(bsdf), weight, facets: alhazen_scene::bsdf::ggx(alpha, alpha), ior: 1.5 })
+        let facets = alhazen_scene::bsdf::ggx(alpha, alpha);
+        Ok(BsdfDesc::Coated { base: Box::new(bsdf), weight, facets, ior: 1.5, weight_map, roughness_map })
     }
 
     /// The absorption per unit length of a transmitting material's inside under

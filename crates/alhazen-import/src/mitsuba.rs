@@ -1095,7 +1095,14 @@ impl Importer {
                 if clearcoat > 0.0 {
                     let alpha = (0.1 + (0.001 - 0.1) * gloss.clamp(0.0, 1.0)).max(0.01);
                     let (weight, facets) = ((0.25 * clearcoat).min(1.0), common::ggx(alpha, alpha));
-                    BsdfDesc::Coated { base: Box::new(bsdf), weight, facets, ior: 1.5 }
+                    BsdfDesc::Coated {
+                        base: Box::new(bsdf),
+                        weight,
+                        facets,
+                        ior: 1.5,
+                        weight_map: None,
+                        roughness_map: None,
+                    }
                 } else {
                     bsdf
                 }

@@ -1104,6 +1104,8 @@ impl Importer {
                     weight: 1.0,
                     facets: common::ggx(u.max(0.01), v.max(0.01)),
                     ior,
+                    weight_map: None,
+                    roughness_map: None,
                 }
             }
             "dielectric" => {

@@ -420,7 +420,7 @@ Shape "sphere""#,
     .unwrap();
     let s = &imported.scene;
     let bsdf = s.materials[s.objects[0].material as usize].bsdf.clone().unwrap();
-    let BsdfDesc::Coated { base, weight, facets, ior } = bsdf else { panic!("{bsdf:?}") };
+    let BsdfDesc::Coated { base, weight, facets, ior, .. } = bsdf else { panic!("{bsdf:?}") };
     assert_eq!((weight, facets.alpha_u, ior), (1.0, 0.01, 1.6));
     let BsdfDesc::Conductor { facets: Some(metal), eta, .. } = *base else { panic!("{base:?}") };
     assert!((metal.alpha_u - 0.2).abs() < 1e-12 && eta == Vec3::from_array(METALS[0].1), "{metal:?} {eta}");

@@ -242,6 +242,12 @@ pub enum BsdfDesc {
         facets: Microfacets,
         /// The coat's index of refraction (1.5 in glTF).
         ior: f64,
+        /// Where the weight varies: `weight` times the map's red channel (read linearly; glTF's
+        /// `clearcoatTexture`).
+        weight_map: Option<Texture>,
+        /// Where the roughness varies: the facets' roughness `√α` times the map's green channel
+        /// (read linearly, `α` at least 0.01; glTF's `clearcoatRoughnessTexture`).
+        roughness_map: Option<Texture>,
     },
     /// Sheen over `base` (velvet, satin; glTF's `KHR_materials_sheen`): Estevez and Kulla's
     /// "Charlie" fibres of colour `color` reflecting `color·ρ_s`, the base below weighted by one
@@ -509,7 +515,9 @@ impl BsdfDesc {
             | BsdfDesc::CookTorrance { albedo, .. }
             | BsdfDesc::Plastic { albedo, .. } => t(albedo),
             BsdfDesc::Mix { a, b, weight_map, .. } => a.is_textured() || b.is_textured() || weight_map.is_some(),
-            BsdfDesc::Coated { base, .. } => base.is_textured(),
+            BsdfDesc::Coated { base, weight_map, roughness_map, .. } => {
+                base.is_textured() || weight_map.is_some() || roughness_map.is_some()
+            }
             BsdfDesc::Sheened { base, color, roughness_map, .. } => {
                 base.is_textured() || t(color) || roughness_map.is_some()
             }

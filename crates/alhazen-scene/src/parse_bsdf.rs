@@ -109,7 +109,7 @@ impl Parser<'_> {
                 ]
             }
             "thin-dielectric" => vec!["ior"],
-            "coated" => [&["base", "weight", "ior"][..], MICROFACET_KEYS].concat(),
+            "coated" => [&["base", "weight", "ior", "weight_map", "roughness_map"][..], MICROFACET_KEYS].concat(),
             "sheen" => vec!["base", "sheen_color", "roughness", "roughness_map"],
             _ => vec!["a", "b", "weight", "weight_map"],
         };
@@ -237,6 +237,8 @@ impl Parser<'_> {
                     weight: t.get("weight").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?,
                     facets,
                     ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))?,
+                    weight_map: t.get("weight_map").map(|m| self.linear_placed_image(&m)).transpose()?,
+                    roughness_map: t.get("roughness_map").map(|m| self.linear_placed_image(&m)).transpose()?,
                 }
             }
             "sheen" => BsdfDesc::Sheened {

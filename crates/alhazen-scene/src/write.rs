@@ -552,13 +552,20 @@ impl Writer<'_> {
                 num(*roughness),
                 roughness_map.as_ref().map_or(String::new(), |m| format!(", roughness_map = {}", self.map_image(m)))
             ),
-            BsdfDesc::Coated { base, weight, facets: f, ior } => format!(
-                "{{ type = \"coated\", base = {}, weight = {}, ior = {}, {} }}",
-                self.bsdf(base),
-                num(*weight),
-                num(*ior),
-                facets(&Some(*f))
-            ),
+            BsdfDesc::Coated { base, weight, facets: f, ior, weight_map, roughness_map } => {
+                let map = |key: &str, m: &Option<Texture>| {
+                    m.as_ref().map_or(String::new(), |m| format!(", {key} = {}", self.map_image(m)))
+                };
+                format!(
+                    "{{ type = \"coated\", base = {}, weight = {}, ior = {}, {}{}{} }}",
+                    self.bsdf(base),
+                    num(*weight),
+                    num(*ior),
+                    facets(&Some(*f)),
+                    map("weight_map", weight_map),
+                    map("roughness_map", roughness_map)
+                )
+            }
             BsdfDesc::MetallicRoughness {
                 base,
                 metallic,

@@ -1010,12 +1010,28 @@ fn coats_read_write_back_and_refuse_nonsense() {
     let coat = |s: &alhazen_scene::Scene| s.materials.iter().find(|m| m.name == "paint").unwrap().bsdf.clone().unwrap();
     let s = load_scene(&path).unwrap();
     let read = coat(&s);
-    let BsdfDesc::Coated { base, weight, facets, ior } = &read else { panic!("{read:?}") };
+    let BsdfDesc::Coated { base, weight, facets, ior, .. } = &read else { panic!("{read:?}") };
     assert!(matches!(**base, BsdfDesc::Lambert { .. }), "{base:?}");
     assert_eq!((*weight, facets.alpha_u, *ior), (1.0, 0.05, 1.5));
     let again = dir.path().join("again.toml");
     alhazen_scene::write::write_scene(&s, &again, &dir.path().join("assets"), "").unwrap();
     assert_eq!(coat(&load_scene(&again).unwrap()), read);
+    // The weight and roughness read per point from maps, written back as maps.
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 0])).save(dir.path().join("coat.png")).unwrap();
+    let text = "[materials.paint]\nbsdf = { type = \"coated\", base = { type = \"lambert\" }, roughness = 0.3, weight_map = { file = \"coat.png\" }, roughness_map = { file = \"coat.png\", scale = 2 } }\n";
+    std::fs::write(&path, text).unwrap();
+    let s = load_scene(&path).unwrap();
+    let mapped = |s: &alhazen_scene::Scene| match coat(s) {
+        BsdfDesc::Coated {
+            weight_map: Some(Texture::Image { image: w, .. }),
+            roughness_map: Some(Texture::Image { image: r, scale, .. }),
+            ..
+        } => (s.images[w].texel(0), s.images[r].texel(0), scale),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(mapped(&s), ([1.0, 128.0 / 255.0, 0.0], [1.0, 128.0 / 255.0, 0.0], alhazen_math::Vec2::splat(2.0)));
+    alhazen_scene::write::write_scene(&s, &again, &dir.path().join("assets"), "").unwrap();
+    assert_eq!(mapped(&load_scene(&again).unwrap()), mapped(&s));
     let material = |bsdf: &str| {
         err(&format!("[materials.m]\nbsdf = {bsdf}\n[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"m\"\n"))
     };

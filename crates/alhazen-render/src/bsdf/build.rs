@@ -158,11 +158,21 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                 r * r,
             )))
         }
-        BsdfDesc::Coated { base, weight, facets, ior } => Bsdf::Coated(Box::new(super::Coated::new(
-            from_desc(base, lookups, mode),
-            CookTorranceLobe { facets: Microfacet::new(facets), ior: *ior, schlick: false },
-            *weight,
-        ))),
+        BsdfDesc::Coated { base, weight, facets, ior, weight_map, roughness_map } => {
+            // glTF's maps: the weight in the red channel, the roughness in the green.
+            let weight = weight * weight_map.as_ref().map_or(1.0, |m| (lookups.rgb)(m).x.clamp(0.0, 1.0));
+            let mut facets = *facets;
+            if let Some(m) = roughness_map {
+                let g = (lookups.rgb)(m).y.clamp(0.0, 1.0);
+                facets.alpha_u = (facets.alpha_u * g * g).max(0.01);
+                facets.alpha_v = (facets.alpha_v * g * g).max(0.01);
+            }
+            Bsdf::Coated(Box::new(super::Coated::new(
+                from_desc(base, lookups, mode),
+                CookTorranceLobe { facets: Microfacet::new(&facets), ior: *ior, schlick: false },
+                weight,
+            )))
+        }
         BsdfDesc::MetallicRoughness {
             base,
             metallic,
