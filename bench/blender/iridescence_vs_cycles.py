@@ -16,12 +16,13 @@ equations at both interfaces; glTF's, which alhazen renders, uses Schlick's appr
 both and the metal's index found from its colour: the hues are expected to match, their
 strengths only roughly.
 
-    python3 bench/blender/iridescence_vs_cycles.py OUT_DIR [--spp 1024]
+    python3 bench/blender/iridescence_vs_cycles.py OUT_DIR [--spp 1024] [--glass]
 
 Writes OUT_DIR/iridescence.glb and OUT_DIR/iridescence-cycles.exr (96 × 32, CPU, 2 threads, box
-filter of one pixel, four bounces). Needs `pip install bpy`.
+filter of one pixel, four bounces). `--glass` gives clear glass spheres the films instead, before
+a dark backdrop (files iridescence-glass, eight bounces). Needs `pip install bpy`.
 """
-import argparse, json, os, struct, sys
+import argparse, json, math, os, struct, sys
 
 import bpy
 
@@ -36,19 +37,34 @@ SPHERES = [
 ]
 
 
-def build():
+# Soap bubbles and coated lenses (`--glass`): clear glass spheres (IOR 1.5, smooth) under
+# films of 300 nm of 1.33, 500 nm of 1.33 and 400 nm of 1.8, before a dark backdrop.
+GLASS = [
+    ("bubble 300", (1.0, 1.0, 1.0), 0.0, 0.0, 300.0, 1.33),
+    ("bubble 500", (1.0, 1.0, 1.0), 0.0, 0.0, 500.0, 1.33),
+    ("lens 400", (1.0, 1.0, 1.0), 0.0, 0.0, 400.0, 1.8),
+]
+
+
+def build(glass=False):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.world = bpy.data.worlds.new("white")
     scene.world.use_nodes = True
-    for k, (name, color, metallic, rough, thickness, ior) in enumerate(SPHERES):
+    for k, (name, color, metallic, rough, thickness, ior) in enumerate(GLASS if glass else SPHERES):
         m = material(name, color, metallic, rough)
         p = m.node_tree.nodes["Principled BSDF"]
         p.inputs["Thin Film Thickness"].default_value = thickness
         p.inputs["Thin Film IOR"].default_value = ior
+        if glass:
+            p.inputs["Transmission Weight"].default_value = 1.0
+            p.inputs["IOR"].default_value = 1.5
         bpy.ops.mesh.primitive_uv_sphere_add(radius=0.45, segments=48, ring_count=24, location=(k - 1.0, 0.0, 0.0))
         bpy.ops.object.shade_smooth()
         bpy.context.object.data.materials.append(m)
+    if glass:
+        bpy.ops.mesh.primitive_plane_add(size=8, location=(0.0, 2.0, 0.0), rotation=(math.radians(90), 0, 0))
+        bpy.context.object.data.materials.append(material("backdrop", (0.05, 0.05, 0.05), 0.0, 1.0))
     front_camera(scene, 40)
     white_world(scene)
     return scene
@@ -64,8 +80,10 @@ def add_films(path):
     assert json_type == b"JSON"
     doc = json.loads(data[20:20 + json_len])
     rest = data[20 + json_len:]
-    films = {name: (thickness, ior) for name, _, _, _, thickness, ior in SPHERES}
+    films = {name: (thickness, ior) for name, _, _, _, thickness, ior in SPHERES + GLASS}
     for m in doc["materials"]:
+        if m["name"] not in films:
+            continue
         thickness, ior = films[m["name"]]
         m.setdefault("extensions", {})["KHR_materials_iridescence"] = {
             "iridescenceFactor": 1.0,
@@ -87,7 +105,9 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("out")
     ap.add_argument("--spp", type=int, default=1024)
+    ap.add_argument("--glass", action="store_true", help="films on clear glass spheres (iridescence-glass)")
     a = ap.parse_args()
     out = os.path.abspath(a.out)
-    export_and_render(build(), out, "iridescence", (96, 32), a.spp, bounces=4)
-    add_films(os.path.join(out, "iridescence.glb"))
+    stem = "iridescence-glass" if a.glass else "iridescence"
+    export_and_render(build(a.glass), out, stem, (96, 32), a.spp, bounces=8 if a.glass else 4)
+    add_films(os.path.join(out, f"{stem}.glb"))

@@ -121,8 +121,9 @@ pub(crate) fn metal_rough(
     metallic: f64,
     roughness: f64,
     (ior, lobes): (f64, MetalRoughness),
-    (transmission, transmission_map, glass_tint): (f64, Option<Texture>, Texture),
+    glass: Glass,
 ) -> BsdfDesc {
+    let Glass { weight: transmission, map: transmission_map, tint: glass_tint, film } = glass;
     // The model at a point of colour `base_mean`, its coating given the texture itself, its
     // metal smooth where the roughness is below the facets' least `α` (a material with a
     // single value need not keep the same lobes everywhere).
@@ -141,6 +142,7 @@ pub(crate) fn metal_rough(
         ior: Ior::Constant(ior),
         fresnel: FresnelMode::Exact,
         transmittance: glass_tint,
+        film,
     };
     let weight = transmission * (1.0 - metallic);
     match transmission_map {
@@ -149,6 +151,25 @@ pub(crate) fn metal_rough(
             BsdfDesc::Mix { a: Box::new(glass), b: Box::new(opaque), weight, weight_map: Some(map) }
         }
         _ => mix(glass, opaque, weight),
+    }
+}
+
+/// The glass a metallic–roughness material mixes in ([`metal_rough`]).
+pub(crate) struct Glass {
+    /// Its weight (glTF's `transmissionFactor`).
+    pub weight: f64,
+    /// Where it is: the weight times the map's luminance, per point.
+    pub map: Option<Texture>,
+    /// What the light it lets through keeps at each crossing.
+    pub tint: Texture,
+    /// A thin film on its outside face.
+    pub film: Option<Box<alhazen_scene::bsdf::Iridescence>>,
+}
+
+impl Glass {
+    /// Clear glass of weight `weight` everywhere.
+    pub fn clear(weight: f64, tint: Texture) -> Self {
+        Glass { weight, map: None, tint, film: None }
     }
 }
 

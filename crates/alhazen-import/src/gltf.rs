@@ -779,7 +779,14 @@ impl Importer<'_> {
             _ => (Vec2::ONE, Vec2::ZERO, 0.0),
         };
         let alpha = self.cut_out(&material, c[3] as f64, placement)?;
-        let iridescence = self.iridescence(&material, transmission, &name)?;
+        let iridescence = self.iridescence(&material, &name)?;
+        // Under transmission the film is the glass's (on its outside face).
+        let (iridescence, glass_film) = if transmission > 0.0 { (None, iridescence) } else { (iridescence, None) };
+        if glass_film.is_some() && transmission < 1.0 {
+            self.warn(format!(
+                "{name}: KHR_materials_iridescence under partial transmission is rendered on the glass only"
+            ));
+        }
         let (metallic, roughness) = (metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
         // Per point where the map or a textured metal's colour varies (glTF's metal takes each
         // texel's base colour), else the constant mix (and its glass under transmission).
@@ -792,7 +799,12 @@ impl Importer<'_> {
             (lobes.anisotropy, anisotropy_map) = (Anisotropy::default(), None);
         }
         // Stretched facets turn with the surface's tangent: read per point.
-        let per_point = map.is_some() || textured_metal || lobes.anisotropy.is_anisotropic() || iridescence.is_some();
+        let specular_map = self.specular_map(&material, transmission, &name)?;
+        let per_point = map.is_some()
+            || textured_metal
+            || lobes.anisotropy.is_anisotropic()
+            || iridescence.is_some()
+            || specular_map.is_some();
         let bsdf = if per_point {
             let MetalRoughness { ior, specular, multiscatter, anisotropy } = lobes;
             BsdfDesc::MetallicRoughness {
@@ -806,6 +818,7 @@ impl Importer<'_> {
                 anisotropy,
                 anisotropy_map,
                 iridescence,
+                specular_map,
             }
         } else {
             let bsdf = common::metal_rough(
@@ -814,7 +827,12 @@ impl Importer<'_> {
                 metallic,
                 roughness,
                 (ior, lobes),
-                (transmission.clamp(0.0, 1.0), transmission_map, glass_tint),
+                common::Glass {
+                    weight: transmission.clamp(0.0, 1.0),
+                    map: transmission_map,
+                    tint: glass_tint,
+                    film: glass_film,
+                },
             );
             match self.dispersion(&material, ior, &name)? {
                 Some(cauchy) => glass_of_index(bsdf, cauchy),
@@ -873,9 +891,8 @@ impl Importer<'_> {
     /// `iridescenceTexture`'s red), index `iridescenceIOR`, thickness
     /// `iridescenceThicknessMaximum` nm, or from the minimum to it by
     /// `iridescenceThicknessTexture`'s green (both read linearly); under a clear coat the film's
-    /// outside is the coat's index, 1.5. None without it, at a factor of 0, and under
-    /// transmission (warning: not supported there).
-    fn iridescence(&mut self, material: &gltf::Material, transmission: f64, name: &str) -> R<Option<Box<Iridescence>>> {
+    /// outside is the coat's index, 1.5. None without it and at a factor of 0.
+    fn iridescence(&mut self, material: &gltf::Material, name: &str) -> R<Option<Box<Iridescence>>> {
         let Some(e) = material.extension_value("KHR_materials_iridescence") else { return Ok(None) };
         let number = |key: &str, default: f64, range: std::ops::RangeInclusive<f64>| match e.get(key) {
             None => Some(default),
@@ -892,10 +909,6 @@ impl Importer<'_> {
             )));
         };
         if factor == 0.0 {
-            return Ok(None);
-        }
-        if transmission > 0.0 {
-            self.warn(format!("{name}: KHR_materials_iridescence under transmission is not supported; ignored"));
             return Ok(None);
         }
         let map = |s: &mut Self, key: &str| match e.get(key) {
@@ -1082,8 +1095,8 @@ impl Importer<'_> {
     fn lobes(&mut self, material: &gltf::Material, ior: f64, name: &str) -> MetalRoughness {
         let plain = MetalRoughness { multiscatter: true, ..common::plain_lobes(ior) };
         let Some(s) = material.specular() else { return plain };
-        if s.specular_texture().is_some() || s.specular_color_texture().is_some() {
-            self.warn(format!("{name}: KHR_materials_specular's textures are not supported; its factors are used"));
+        if s.specular_color_texture().is_some() {
+            self.warn(format!("{name}: KHR_materials_specular's colour texture is not supported; its factor is used"));
         }
         let color = s.specular_color_factor().map(f64::from);
         if color.iter().any(|&c| (c - color[0]).abs() > 1e-6) {
@@ -1093,6 +1106,23 @@ impl Importer<'_> {
         let f0 = (((ior - 1.0) / (ior + 1.0)).powi(2) * scale).clamp(0.0, 0.99);
         let ior = if scale == 1.0 { ior } else { (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()) };
         MetalRoughness { ior: ior.max(1.0), specular: (s.specular_factor() as f64).clamp(0.0, 1.0), ..plain }
+    }
+
+    /// `KHR_materials_specular`'s `specularTexture`: the coating's specular strength per point,
+    /// its factor times the texture's alpha (in all three channels). None without it, and
+    /// under transmission (warning: its factor is used there).
+    fn specular_map(&mut self, material: &gltf::Material, transmission: f64, name: &str) -> R<Option<Texture>> {
+        let Some(info) = material.specular().and_then(|s| s.specular_texture()) else { return Ok(None) };
+        if transmission > 0.0 {
+            self.warn(format!(
+                "{name}: KHR_materials_specular's texture under transmission is not supported; its factor is used"
+            ));
+            return Ok(None);
+        }
+        let (scale, offset, rotation) = self.texture_placement(&info, name)?;
+        let image = wrapped(self.image(&info.texture(), Decoding::Alpha)?, &info.texture());
+        self.scene.images.push(image);
+        Ok(Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation }))
     }
 
     /// `KHR_texture_transform`'s scale, offset and rotation in alhazen's texture coordinates, and
@@ -1377,8 +1407,8 @@ fn node_worlds(scene: &gltf::Scene) -> HashMap<usize, Mat4> {
 /// `bsdf` with its glass (the dielectric that transmission mixes in) of index `ior`.
 fn glass_of_index(bsdf: BsdfDesc, ior: Ior) -> BsdfDesc {
     match bsdf {
-        BsdfDesc::Dielectric { facets, fresnel, transmittance, .. } => {
-            BsdfDesc::Dielectric { facets, ior, fresnel, transmittance }
+        BsdfDesc::Dielectric { facets, fresnel, transmittance, film, .. } => {
+            BsdfDesc::Dielectric { facets, ior, fresnel, transmittance, film }
         }
         BsdfDesc::Mix { a, b, weight, weight_map } => BsdfDesc::Mix {
             a: Box::new(glass_of_index(*a, ior)),

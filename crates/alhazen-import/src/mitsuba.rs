@@ -1051,7 +1051,13 @@ impl Importer {
                 } else {
                     let facets = self.facets(ctx, &p, kind == "roughdielectric")?;
                     let transmittance = self.color(ctx, &p, "specular_transmittance", Vec3::ONE)?;
-                    BsdfDesc::Dielectric { facets, ior: Ior::Constant(ior), fresnel: FresnelMode::Exact, transmittance }
+                    BsdfDesc::Dielectric {
+                        facets,
+                        ior: Ior::Constant(ior),
+                        fresnel: FresnelMode::Exact,
+                        transmittance,
+                        film: None,
+                    }
                 }
             }
             "plastic" | "roughplastic" => {
@@ -1344,6 +1350,7 @@ impl Importer {
                 anisotropy,
                 anisotropy_map: None,
                 iridescence: None,
+                specular_map: None,
             });
         }
         let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
@@ -1364,6 +1371,7 @@ impl Importer {
                 anisotropy,
                 anisotropy_map: None,
                 iridescence: None,
+                specular_map: None,
             });
         }
         Ok(common::metal_rough(
@@ -1372,7 +1380,7 @@ impl Importer {
             metallic,
             roughness,
             (ior, common::plain_lobes(ior)),
-            (trans, None, Texture::Solid(mean.powf(0.5))),
+            common::Glass::clear(trans, Texture::Solid(mean.powf(0.5))),
         ))
     }
 

@@ -1115,6 +1115,7 @@ impl Importer {
                     ior: Ior::Constant(self.eta(ctx, p)?),
                     fresnel: FresnelMode::Exact,
                     transmittance: Texture::Solid(Vec3::ONE),
+                    film: None,
                 }
             }
             "thindielectric" => {
@@ -1175,6 +1176,7 @@ impl Importer {
                     ior: Ior::Constant(1.0),
                     fresnel: FresnelMode::Exact,
                     transmittance: Texture::Solid(Vec3::ONE),
+                    film: None,
                 }
             }
             other => {

@@ -97,6 +97,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                         dispersive: false,
                         thin: false,
                         tint: Vec3::ONE,
+                        film: None,
                     }),
                 ));
             }
@@ -175,6 +176,21 @@ fn catalogue() -> Vec<(String, Bsdf)> {
             0.8,
         ))),
     ));
+    // Tinted glass under a thin film on its outside face (glTF's iridescence under transmission).
+    let film =
+        alhazen_render::bsdf::ThinFilm { weight: 0.9, ior: 1.33, thickness: 350.0, outside: 1.0, wavelengths: None };
+    list.push((
+        "rough dielectric tinted, under a film".into(),
+        Bsdf::Dielectric(Dielectric {
+            facets: Some(ggx(0.3)),
+            eta: 1.5,
+            schlick: false,
+            dispersive: false,
+            thin: false,
+            tint: Vec3::new(0.9, 0.7, 0.5),
+            film: Some(film),
+        }),
+    ));
     // Thin films (glTF's iridescence) over the metallic–roughness model's metal and coating.
     for (metallic, multiscatter) in [(1.0, false), (1.0, true), (0.0, false), (0.4, false)] {
         list.push((
@@ -212,6 +228,7 @@ fn filmed_by(metallic: f64, multiscatter: bool, factor: f64) -> Bsdf {
             factor_map: None,
             thickness_map: None,
         })),
+        specular_map: None,
     };
     let m = alhazen_scene::Material::from_bsdf("film", desc);
     alhazen_render::bsdf::bsdf_at(&m, Vec2::ZERO, Vec3::ONE, &[], alhazen_render::bsdf::ColorMode::Rgb)
@@ -368,6 +385,7 @@ fn rough_dielectric_sampling_from_inside_matches_its_density() {
         dispersive: false,
         thin: false,
         tint: Vec3::ONE,
+        film: None,
     });
     for theta in [20.0, 60.0] {
         let v = -direction(theta, 1.1);
@@ -421,6 +439,7 @@ fn smooth_dielectric_splits_energy_without_loss() {
             dispersive: false,
             thin: false,
             tint: Vec3::ONE,
+            film: None,
         });
         for v in [direction(0.0, 0.0), direction(50.0, 1.0), -direction(30.0, 2.0), -direction(70.0, 2.0)] {
             let (mut total, n) = (0.0, 20_000);
@@ -504,6 +523,7 @@ fn refraction_obeys_the_course_eta_squared_law() {
         dispersive: false,
         thin: false,
         tint: Vec3::ONE,
+        film: None,
     });
     let mut rng = Rng::for_sample(3, 3, 3, 3);
     let mut checked = 0;
@@ -562,7 +582,15 @@ fn conductor_fresnel_matches_known_values() {
 /// nothing (every sample's weight is 1).
 #[test]
 fn a_thin_sheet_reflects_both_faces_and_passes_the_rest_straight() {
-    let sheet = Dielectric { facets: None, eta: 1.5, schlick: false, dispersive: false, thin: true, tint: Vec3::ONE };
+    let sheet = Dielectric {
+        facets: None,
+        eta: 1.5,
+        schlick: false,
+        dispersive: false,
+        thin: true,
+        tint: Vec3::ONE,
+        film: None,
+    };
     for (theta, side) in [(0.0, 1.0), (40.0, 1.0), (75.0, -1.0), (89.0, -1.0)] {
         let v = direction(theta, 0.7) * Vec3::new(1.0, 1.0, side);
         let cos = v.z.abs();
@@ -629,4 +657,45 @@ fn several_facets_give_the_white_furnace_back_its_light() {
     }
     let v = direction(40.0, 0.3);
     assert!(albedo(&white(1.0, false), v) < 0.75, "the roughest single scattering loses light");
+}
+
+/// A metallic–roughness coating's specular map (glTF's `specularTexture`) scales its specular
+/// strength per point: `k_s = specular · texel`, the diffuse weighted by `1 − k_s·F(0)`.
+#[test]
+fn a_specular_map_scales_the_coating_per_point() {
+    use alhazen_scene::bsdf::{Anisotropy, BsdfDesc};
+    let texel = std::sync::Arc::new(alhazen_scene::ImageData::new(1, 1, vec![[0.25; 3]]));
+    let map = alhazen_scene::Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 };
+    let desc = |specular_map| BsdfDesc::MetallicRoughness {
+        base: alhazen_scene::Texture::Solid(Vec3::splat(0.5)),
+        metallic: 0.0,
+        roughness: 0.4,
+        map: None,
+        ior: 1.5,
+        specular: 0.8,
+        multiscatter: false,
+        anisotropy: Anisotropy::default(),
+        anisotropy_map: None,
+        iridescence: None,
+        specular_map,
+    };
+    let coating = |specular_map| {
+        let m = alhazen_scene::Material::from_bsdf("m", desc(specular_map));
+        match alhazen_render::bsdf::bsdf_at(
+            &m,
+            Vec2::ZERO,
+            Vec3::ONE,
+            std::slice::from_ref(&texel),
+            alhazen_render::bsdf::ColorMode::Rgb,
+        ) {
+            Bsdf::Mix(mix) => match mix.b {
+                Bsdf::CookTorrance(c) => (c.ks, c.diffuse.x),
+                other => panic!("{other:?}"),
+            },
+            other => panic!("{other:?}"),
+        }
+    };
+    assert_eq!(coating(None), (0.8, 0.5 * (1.0 - 0.8 * 0.04)));
+    let (ks, kd) = coating(Some(map));
+    assert!((ks - 0.2).abs() < 1e-12 && (kd - 0.5 * (1.0 - 0.2 * 0.04)).abs() < 1e-12, "{ks} {kd}");
 }

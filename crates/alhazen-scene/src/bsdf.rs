@@ -189,6 +189,9 @@ pub enum BsdfDesc {
         /// What refracted light keeps at each crossing, per channel (white: clear glass; glTF's
         /// transmission is tinted by the base colour, Mitsuba's by `specular_transmittance`).
         transmittance: Texture,
+        /// A thin film on its outside face (glTF's iridescence over transmission); none by
+        /// default.
+        film: Option<Box<Iridescence>>,
     },
     /// A thin sheet of glass (a window pane): light passes straight through it, or is
     /// reflected by its two faces and every bounce between them, `R' = 2R/(1 + R)` of it for a
@@ -229,6 +232,9 @@ pub enum BsdfDesc {
         anisotropy_map: Option<Texture>,
         /// A thin film over both lobes (glTF's `KHR_materials_iridescence`); none by default.
         iridescence: Option<Box<Iridescence>>,
+        /// Where the coating's specular strength varies: `specular` times the map's first
+        /// channel (read linearly; glTF's `specularTexture` is its alpha).
+        specular_map: Option<Texture>,
     },
     /// A clear coat over `base` (car paint, lacquer; glTF's `KHR_materials_clearcoat`): a
     /// dielectric microfacet layer of `weight` reflecting `weight·D G F/(4⟨l,n⟩⟨v,n⟩)`, the
@@ -521,9 +527,9 @@ impl BsdfDesc {
             BsdfDesc::Sheened { base, color, roughness_map, .. } => {
                 base.is_textured() || t(color) || roughness_map.is_some()
             }
-            BsdfDesc::MetallicRoughness { base, map, anisotropy_map, iridescence, .. } => {
+            BsdfDesc::MetallicRoughness { base, map, anisotropy_map, iridescence, specular_map, .. } => {
                 let film = iridescence.as_ref().is_some_and(|i| i.factor_map.is_some() || i.thickness_map.is_some());
-                t(base) || map.is_some() || anisotropy_map.is_some() || film
+                t(base) || map.is_some() || anisotropy_map.is_some() || film || specular_map.is_some()
             }
             BsdfDesc::Dielectric { transmittance, .. } => t(transmittance),
             BsdfDesc::Conductor { .. } | BsdfDesc::ThinDielectric { .. } => false,

@@ -92,9 +92,11 @@ impl Parser<'_> {
             "cook-torrance" => [&["color", "kd", "ks", "ior", "fresnel"][..], MICROFACET_KEYS].concat(),
             "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel", "multiscatter"][..], MICROFACET_KEYS].concat(),
-            "dielectric" => {
-                [&["ior", "cauchy", "sellmeier", "glass", "fresnel", "transmittance"][..], MICROFACET_KEYS].concat()
-            }
+            "dielectric" => [
+                &["ior", "cauchy", "sellmeier", "glass", "fresnel", "transmittance", "iridescence"][..],
+                MICROFACET_KEYS,
+            ]
+            .concat(),
             "metallic-roughness" => {
                 vec![
                     "color",
@@ -106,6 +108,7 @@ impl Parser<'_> {
                     "multiscatter",
                     "anisotropy",
                     "iridescence",
+                    "specular_map",
                 ]
             }
             "thin-dielectric" => vec!["ior"],
@@ -200,6 +203,7 @@ impl Parser<'_> {
                     },
                     None => Texture::Solid(Vec3::ONE),
                 },
+                film: t.get("iridescence").map(|n| self.iridescence(&n).map(Box::new)).transpose()?,
             },
             "thin-dielectric" => {
                 BsdfDesc::ThinDielectric { ior: t.get("ior").map_or(Ok(1.5), |n| n.in_range(1.0, 10.0))? }
@@ -221,6 +225,7 @@ impl Parser<'_> {
                     anisotropy,
                     anisotropy_map,
                     iridescence: t.get("iridescence").map(|n| self.iridescence(&n).map(Box::new)).transpose()?,
+                    specular_map: t.get("specular_map").map(|m| self.linear_placed_image(&m)).transpose()?,
                 }
             }
             "coated" => {

@@ -516,7 +516,7 @@ impl Writer<'_> {
                 if *multiscatter { ", multiscatter = true" } else { "" }
             ),
             BsdfDesc::ThinDielectric { ior } => format!("{{ type = \"thin-dielectric\", ior = {} }}", num(*ior)),
-            BsdfDesc::Dielectric { facets: f, ior, fresnel: fr, transmittance } => {
+            BsdfDesc::Dielectric { facets: f, ior, fresnel: fr, transmittance, film } => {
                 let ior = match ior {
                     Ior::Constant(x) => format!("ior = {}", num(*x)),
                     Ior::Cauchy { a, b } => format!("cauchy = [{}, {}]", num(*a), num(*b)),
@@ -534,7 +534,8 @@ impl Writer<'_> {
                     Texture::Solid(c) if *c == Vec3::ONE => String::new(),
                     other => format!(", transmittance = {}", self.texture(other)),
                 };
-                format!("{{ type = \"dielectric\", {ior}, fresnel = \"{}\", {}{tint} }}", fresnel(*fr), facets(f))
+                let film = film.as_ref().map_or(String::new(), |i| self.iridescence_entry(i));
+                format!("{{ type = \"dielectric\", {ior}, fresnel = \"{}\", {}{tint}{film} }}", fresnel(*fr), facets(f))
             }
             BsdfDesc::Mix { a, b, weight, weight_map } => {
                 let map = weight_map.as_ref().map_or(String::new(), |t| format!(", weight_map = {}", self.texture(t)));
@@ -577,9 +578,10 @@ impl Writer<'_> {
                 anisotropy,
                 anisotropy_map,
                 iridescence,
+                specular_map,
             } => {
                 format!(
-                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{}{} }}",
+                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{}{}{} }}",
                     self.texture(base),
                     num(*metallic),
                     num(*roughness),
@@ -588,7 +590,8 @@ impl Writer<'_> {
                     if *multiscatter { ", multiscatter = true" } else { "" },
                     map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m))),
                     self.anisotropy_entry(anisotropy, anisotropy_map.as_ref()),
-                    iridescence.as_ref().map_or(String::new(), |i| self.iridescence_entry(i))
+                    iridescence.as_ref().map_or(String::new(), |i| self.iridescence_entry(i)),
+                    specular_map.as_ref().map_or(String::new(), |m| format!(", specular_map = {}", self.map_image(m)))
                 )
             }
         }

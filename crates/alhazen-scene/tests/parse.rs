@@ -302,6 +302,8 @@ bsdf = { type = "dielectric", ior = 1.5 }
 bsdf = { type = "dielectric", ior = 1.5, roughness = 0.1, transmittance = [0.9, 0.6, 0.2] }
 [materials.mapped]
 bsdf = { type = "dielectric", transmittance = { image = { file = "t.png" } } }
+[materials.bubble]
+bsdf = { type = "dielectric", iridescence = { ior = 1.33, thickness = 300 } }
 "#;
     image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 0])).save(dir.path().join("t.png")).unwrap();
     let path = dir.path().join("d.toml");
@@ -321,14 +323,21 @@ bsdf = { type = "dielectric", transmittance = { image = { file = "t.png" } } }
         assert_eq!(tint(&s, name), tint(&again, name));
     }
     assert!(matches!(tint(&again, "mapped"), Texture::Image { .. }));
+    // A film on the outside face, written back.
+    let film = |s: &alhazen_scene::Scene| match &s.materials.iter().find(|m| m.name == "bubble").unwrap().bsdf {
+        Some(BsdfDesc::Dielectric { film: Some(i), .. }) => (i.ior, i.thickness),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(film(&s), (1.33, [300.0, 300.0]));
+    assert_eq!(film(&again), film(&s));
     std::fs::write(&path, "[materials.m]\nbsdf = { type = \"dielectric\", transmittance = [2, 0, 0] }\n").unwrap();
     let e = load_scene(&path).unwrap_err().to_string();
     assert!(e.contains("d.toml:2:") && e.contains("within [0, 1]"), "{e}");
 }
 
 /// A metallic–roughness surface's `iridescence` (a thin film): its defaults, one thickness or
-/// the two a map runs between, maps read linearly; the same after writing the scene back out;
-/// mistakes located.
+/// the two a map runs between, maps read linearly; the same after writing the scene back out
+/// (and its `specular_map`); mistakes located.
 #[test]
 fn metallic_roughness_iridescence_reads_and_writes_back() {
     use alhazen_scene::bsdf::{BsdfDesc, Iridescence};
@@ -339,7 +348,7 @@ bsdf = { type = "metallic-roughness", roughness = 0.1, iridescence = {} }
 [materials.oil]
 bsdf = { type = "metallic-roughness", metallic = 1, iridescence = { factor = 0.7, ior = 1.5, thickness = 550, outside = 1.5 } }
 [materials.mapped]
-bsdf = { type = "metallic-roughness", iridescence = { thickness = [800, 200], factor_map = { file = "f.png" }, thickness_map = { file = "f.png", scale = 3 } } }
+bsdf = { type = "metallic-roughness", specular_map = { file = "f.png" }, iridescence = { thickness = [800, 200], factor_map = { file = "f.png" }, thickness_map = { file = "f.png", scale = 3 } } }
 "#;
     image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 200])).save(dir.path().join("f.png")).unwrap();
     let path = dir.path().join("i.toml");
@@ -371,6 +380,13 @@ bsdf = { type = "metallic-roughness", iridescence = { thickness = [800, 200], fa
     for name in ["soap", "oil"] {
         assert_eq!(film(&s, name), film(&again, name));
     }
+    let specular_map = |s: &alhazen_scene::Scene| match &s.materials.iter().find(|m| m.name == "mapped").unwrap().bsdf {
+        Some(BsdfDesc::MetallicRoughness { specular_map: Some(Texture::Image { image, .. }), .. }) => {
+            s.images[*image].texel(0)
+        }
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(specular_map(&s), specular_map(&again));
     let m = film(&again, "mapped");
     assert_eq!((m.thickness, m.factor_map.is_some(), m.thickness_map.is_some()), ([800.0, 200.0], true, true));
     for (bad, says) in [

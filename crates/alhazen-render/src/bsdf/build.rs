@@ -59,6 +59,7 @@ fn whitted_equivalent(m: &Material, tex: &dyn Fn(&alhazen_scene::Texture) -> Vec
             dispersive: false,
             thin: false,
             tint: Vec3::ONE,
+            film: None,
         });
     }
     let lambert = Bsdf::Lambert(Lambert { albedo: tex(&m.color) * m.diffuse });
@@ -125,7 +126,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             };
             Bsdf::Conductor(if *multiscatter { c.with_several_facets() } else { c })
         }
-        BsdfDesc::Dielectric { facets, ior, fresnel, transmittance } => Bsdf::Dielectric(Dielectric {
+        BsdfDesc::Dielectric { facets, ior, fresnel, transmittance, film } => Bsdf::Dielectric(Dielectric {
             facets: facets.as_ref().map(Microfacet::new),
             eta: mode.ior(ior),
             schlick: *fresnel == FresnelMode::Schlick,
@@ -136,6 +137,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                 alhazen_scene::Texture::Solid(c) if *c == Vec3::ONE && lookups.tint == Vec3::ONE => Vec3::ONE,
                 t => tex(t),
             },
+            film: film.as_ref().map(|i| thin_film(i, lookups, mode)),
         }),
         BsdfDesc::ThinDielectric { ior } => Bsdf::Dielectric(Dielectric {
             facets: None,
@@ -144,6 +146,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             dispersive: false,
             thin: true,
             tint: Vec3::ONE,
+            film: None,
         }),
         BsdfDesc::Mix { a, b, weight, weight_map } => {
             let at = weight_map.as_ref().map_or(1.0, |t| alhazen_math::color::luminance((lookups.rgb)(t)));
@@ -184,6 +187,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             anisotropy,
             anisotropy_map,
             iridescence,
+            specular_map,
         } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
@@ -194,7 +198,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                 roughness * texel.y,
                 alhazen_scene::bsdf::MetalRoughness {
                     ior: *ior,
-                    specular: *specular,
+                    specular: specular * specular_map.as_ref().map_or(1.0, |m| (lookups.rgb)(m).x.clamp(0.0, 1.0)),
                     multiscatter: *multiscatter,
                     anisotropy,
                 },

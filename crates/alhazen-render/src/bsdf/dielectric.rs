@@ -14,7 +14,7 @@
 //! dispersive), optional microfacets, Fresnel mode, `dispersive` (marks refracted samples).
 
 use super::microfacet::Microfacet;
-use super::{BsdfSample, MicrofacetLobes, reflect, refract_whole};
+use super::{BsdfSample, MicrofacetLobes, ThinFilm, reflect, refract_whole};
 use crate::optics::{fresnel_dielectric, fresnel_schlick};
 use alhazen_math::{Vec2, Vec3};
 
@@ -35,6 +35,9 @@ pub struct Dielectric {
     /// What the refracted (or passing) light keeps, per channel (1: clear; glTF tints
     /// transmission by the base colour, Mitsuba by `specular_transmittance`).
     pub tint: Vec3,
+    /// A thin film on the outside face ([`ThinFilm`]): light arriving from outside is
+    /// reflected by `(1 − w)F + w·F_film` per channel and transmitted by one minus that.
+    pub film: Option<ThinFilm>,
 }
 
 impl Dielectric {
@@ -43,6 +46,19 @@ impl Dielectric {
     fn fresnel(&self, cos_v: f64) -> f64 {
         let eta = if cos_v >= 0.0 { self.eta } else { 1.0 / self.eta };
         if self.schlick { fresnel_schlick(cos_v, eta) } else { fresnel_dielectric(cos_v, eta) }
+    }
+
+    /// With a film, what the reflected and the refracted light at cosine `cos_v` are scaled by
+    /// beyond the boundary's own `F` and `1 − F` (`fr`): the film's factors over them. The
+    /// reflection is still chosen with probability `F`, so the samples keep their densities.
+    /// `None` without a film, or from inside (the film is on the outside face).
+    #[inline(always)]
+    fn film_scales(&self, cos_v: f64, fr: f64) -> Option<(Vec3, Vec3)> {
+        let film = self.film.as_ref().filter(|_| cos_v > 0.0)?;
+        let f0 = ((self.eta - 1.0) / (self.eta + 1.0)).powi(2);
+        let f = film.blend(Vec3::splat(fr), cos_v, Vec3::splat(f0)).clamp(Vec3::ZERO, Vec3::ONE);
+        let over = |x: Vec3, by: f64| if by > 0.0 { x / by } else { Vec3::ZERO };
+        Some((over(f, fr), over(Vec3::ONE - f, 1.0 - fr)))
     }
 
     /// The generalised half vector of `v, l` facing `+z`, and `η' = η_l/η_v`.
@@ -82,7 +98,11 @@ impl Dielectric {
             let denom = (l.dot(h) + v.dot(h) / etap).powi(2) * (l.z * v.z).abs();
             dg * (1.0 - fr) * (l.dot(h) * v.dot(h)).abs() / denom / (etap * etap)
         };
-        Vec3::splat(value) * if etap == 1.0 { Vec3::ONE } else { self.tint }
+        let value = Vec3::splat(value) * if etap == 1.0 { Vec3::ONE } else { self.tint };
+        match self.film_scales(v.dot(h), fr) {
+            Some((r, t)) => value * if etap == 1.0 { r } else { t },
+            None => value,
+        }
     }
 
     /// Density of `sample`: facet density times the reflect/refract Jacobian and choice.
@@ -148,13 +168,16 @@ impl Dielectric {
         let reflects = uc < fr;
         let mirrored = reflect(v, h);
         let (refracts, refracted, etap) = refract_whole(v, h, self.eta);
-        let sample = if reflects {
+        let mut sample = if reflects {
             let (l, f) = (mirrored, Vec3::splat(fr / mirrored.z.abs()));
             BsdfSample { l, f, pdf: fr, delta: true, eta: 1.0, dispersive: false }
         } else {
             let (l, f) = (refracted, Vec3::splat((1.0 - fr) / refracted.z.abs() / (etap * etap)) * self.tint);
             BsdfSample { l, f, pdf: 1.0 - fr, delta: true, eta: etap, dispersive: self.dispersive }
         };
+        if let Some((r, t)) = self.film_scales(v.dot(h), fr) {
+            sample.f *= if reflects { r } else { t };
+        }
         let side_ok = if reflects {
             mirrored.z * v.z > 0.0 || (mirrored.z * v.z).is_nan()
         } else {
@@ -179,6 +202,10 @@ impl MicrofacetLobes for Dielectric {
         let jacobian = l.dot(h).abs() / (l.dot(h) + v.dot(h) / etap).powi(2);
         let refracted = (Vec3::splat(value) * self.tint, pdf_h * jacobian * (1.0 - fr));
         let (value, pdf) = if etap == 1.0 { reflected } else { refracted };
+        let value = match self.film_scales(v.dot(h), fr) {
+            Some((r, t)) => value * if etap == 1.0 { r } else { t },
+            None => value,
+        };
         if valid { (value, pdf) } else { (Vec3::ZERO, 0.0) }
     }
 

@@ -501,7 +501,7 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             (Some(Some(true)), true) => Kernel::BeckmannSchlickConductor,
             (Some(None), _) => Kernel::General,
         },
-        Bsdf::Dielectric(d) if d.thin || d.tint != Vec3::ONE => Kernel::General,
+        Bsdf::Dielectric(d) if d.thin || d.tint != Vec3::ONE || d.film.is_some() => Kernel::General,
         Bsdf::Dielectric(d) if d.facets.is_none() && !d.schlick && !d.dispersive => Kernel::SmoothDielectric,
         Bsdf::Dielectric(d) => match dielectric_facets(d) {
             Some(false) => Kernel::RoughDielectric,
@@ -1207,6 +1207,7 @@ impl RoughBsdf for Dielectric {
             dispersive: false,
             thin: false,
             tint: Vec3::ONE,
+            film: None,
         }
     }
 }
@@ -1296,8 +1297,16 @@ impl LaneBsdf for SmoothDielectric {
 
     #[inline(always)]
     fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
-        Dielectric { facets: None, eta: v.ior[i], schlick: false, dispersive: false, thin: false, tint: Vec3::ONE }
-            .smooth_sample(wv, uc)
+        Dielectric {
+            facets: None,
+            eta: v.ior[i],
+            schlick: false,
+            dispersive: false,
+            thin: false,
+            tint: Vec3::ONE,
+            film: None,
+        }
+        .smooth_sample(wv, uc)
     }
 }
 
