@@ -1183,11 +1183,10 @@ fn films_against_cycles(stem: &str) -> ([f64; 3], [f64; 3]) {
     };
     let filmed = errors(&s);
     for m in &mut s.materials {
-        match &mut m.bsdf {
-            Some(BsdfDesc::MetallicRoughness { iridescence: film, .. } | BsdfDesc::Dielectric { film, .. }) => {
-                *film = None
-            }
-            _ => {}
+        if let Some(BsdfDesc::MetallicRoughness { iridescence: film, .. } | BsdfDesc::Dielectric { film, .. }) =
+            &mut m.bsdf
+        {
+            *film = None;
         }
     }
     let plain = errors(&s);
