@@ -22,13 +22,8 @@ Writes NAME.xml and NAME-mitsuba.exr into crates/alhazen-import/tests/data/mitsu
 import argparse
 from texture_refs import head, write_reference
 
-SCENE = head("Tinted glass: dielectrics filled with absorbing media", 16, 45, "0, 1.4, 4.2", "0, 0.35, 0",
-             integrator="volpath", script="medium_refs.py") + """    <medium type="homogeneous" id="amber">
-        <volume name="sigma_t" type="constvolume"><rgb name="value" value="0.4, 1.2, 3.0"/></volume>
-        <float name="scale" value="1.5"/>
-        <float name="albedo" value="0"/>
-    </medium>
-    <shape type="rectangle">
+# The room both scenes stand in: a small light above, a grey sky, a diffuse floor.
+ROOM = """    <shape type="rectangle">
         <transform name="to_world">
             <scale x="0.6" y="0.6" z="1"/>
             <rotate x="1" angle="90"/>
@@ -44,7 +39,15 @@ SCENE = head("Tinted glass: dielectrics filled with absorbing media", 16, 45, "0
         </transform>
         <bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.7, 0.7"/></bsdf>
     </shape>
-    <shape type="sphere">
+"""
+
+SCENE = head("Tinted glass: dielectrics filled with absorbing media", 16, 45, "0, 1.4, 4.2", "0, 0.35, 0",
+             integrator="volpath", script="medium_refs.py") + """    <medium type="homogeneous" id="amber">
+        <volume name="sigma_t" type="constvolume"><rgb name="value" value="0.4, 1.2, 3.0"/></volume>
+        <float name="scale" value="1.5"/>
+        <float name="albedo" value="0"/>
+    </medium>
+""" + ROOM + """    <shape type="sphere">
         <point name="center" value="-0.6, 0.55, 0"/>
         <float name="radius" value="0.55"/>
         <bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf>
@@ -69,23 +72,7 @@ SCENE = head("Tinted glass: dielectrics filled with absorbing media", 16, 45, "0
 # The same room with glass that tints what it lets through at each crossing instead
 # (`specular_transmittance`): a smooth sphere and a rough cube, no media.
 TRANSMITTANCE = head("Tinted glass: dielectrics whose specular_transmittance is a colour", 16, 45, "0, 1.4, 4.2",
-                     "0, 0.35, 0", script="medium_refs.py") + """    <shape type="rectangle">
-        <transform name="to_world">
-            <scale x="0.6" y="0.6" z="1"/>
-            <rotate x="1" angle="90"/>
-            <translate x="0.3" y="2.8" z="0.8"/>
-        </transform>
-        <emitter type="area"><rgb name="radiance" value="14, 13, 12"/></emitter>
-    </shape>
-    <emitter type="constant"><rgb name="radiance" value="0.5, 0.55, 0.6"/></emitter>
-    <shape type="rectangle">
-        <transform name="to_world">
-            <scale value="3"/>
-            <rotate x="1" angle="-90"/>
-        </transform>
-        <bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.7, 0.7"/></bsdf>
-    </shape>
-    <shape type="sphere">
+                     "0, 0.35, 0", script="medium_refs.py") + """""" + ROOM + """    <shape type="sphere">
         <point name="center" value="-0.6, 0.55, 0"/>
         <float name="radius" value="0.55"/>
         <bsdf type="dielectric">

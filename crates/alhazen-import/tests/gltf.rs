@@ -1075,15 +1075,7 @@ fn dispersion_spreads_the_glass_index_by_wavelength() {
 /// refused.
 #[test]
 fn sheen_factors_make_the_fibres() {
-    let read = |ext: &str| {
-        let json = embedded().replace(
-            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
-            &format!(r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "extensions": {{ {ext} }}"#),
-        );
-        let s = write_and_import(&[("s.gltf", json.into_bytes())])?;
-        let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
-        Ok::<_, String>((s.scene.materials[s.scene.objects[0].material as usize].bsdf.clone().unwrap(), said))
-    };
+    let read = material_with_extensions;
     let (bsdf, said) =
         read(r#""KHR_materials_sheen": { "sheenColorFactor": [1, 0.5, 0.25], "sheenRoughnessFactor": 0.3 }"#).unwrap();
     assert!(said.is_empty(), "{said:?}");
@@ -1199,15 +1191,7 @@ fn films_against_cycles(stem: &str) -> ([f64; 3], [f64; 3]) {
 /// none at a factor of 0; the glass's under transmission; bad factors refused.
 #[test]
 fn iridescence_makes_a_thin_film() {
-    let read = |ext: &str| {
-        let json = embedded().replace(
-            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
-            &format!(r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "extensions": {{ {ext} }}"#),
-        );
-        let s = write_and_import(&[("i.gltf", json.into_bytes())])?;
-        let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
-        Ok::<_, String>((s.scene.materials[s.scene.objects[0].material as usize].bsdf.clone().unwrap(), said))
-    };
+    let read = material_with_extensions;
     let film = |bsdf: &BsdfDesc| match bsdf {
         BsdfDesc::MetallicRoughness { iridescence: Some(i), .. } => Some((**i).clone()),
         BsdfDesc::Coated { base, .. } => match &**base {
@@ -1661,6 +1645,18 @@ fn panel_against_cycles(stem: &str, mut change: impl FnMut(&mut alhazen_scene::S
     (as_imported, changed)
 }
 
+/// The BSDF of the embedded quad's material with `ext` (the members of its `extensions`) and the
+/// import's warnings, or the import's error.
+fn material_with_extensions(ext: &str) -> Result<(BsdfDesc, Vec<String>), String> {
+    let json = embedded().replace(
+        r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
+        &format!(r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "extensions": {{ {ext} }}"#),
+    );
+    let s = write_and_import(&[("m.gltf", json.into_bytes())])?;
+    let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    Ok((s.scene.materials[s.scene.objects[0].material as usize].bsdf.clone().unwrap(), said))
+}
+
 /// A 2×1 lossless WebP: green on the left, white on the right.
 fn webp() -> Vec<u8> {
     let mut out = vec![];
@@ -1812,17 +1808,7 @@ fn quantized_meshes_read_as_their_floats() {
 /// multiplies the strength per point; its colour texture is warned about.
 #[test]
 fn specular_factors_shape_the_coating() {
-    let import = |ext: &str| {
-        let json = embedded().replace(
-            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
-            &format!(
-                r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "extensions": {{ "KHR_materials_specular": {ext} }}"#
-            ),
-        );
-        let s = write_and_import(&[("s.gltf", json.into_bytes())]).unwrap();
-        let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
-        (s.scene.materials[s.scene.objects[0].material as usize].bsdf.clone().unwrap(), said)
-    };
+    let import = |ext: &str| material_with_extensions(&format!(r#""KHR_materials_specular": {ext}"#)).unwrap();
     let coat = |ext: &str| match import(ext) {
         (BsdfDesc::CookTorrance { kd, ks, ior, .. }, said) => ((kd, ks, ior), said),
         other => panic!("{other:?}"),
