@@ -205,8 +205,9 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             );
             let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
             match iridescence {
-                // (The general kernel shades filmed surfaces, whatever their lobes: all metal or
-                // none is one lobe, the film's Fresnel factor not found for the other.)
+                // (The general kernel shades filmed surfaces, whatever their lobes — a filmed
+                // conductor is never a lane kernel's —: all metal or none is one lobe, the
+                // film's Fresnel factor not found for the other.)
                 Some(i) if weight >= 1.0 => filmed_metal(a, thin_film(i, lookups, mode)),
                 Some(i) if weight <= 0.0 => filmed_coating(b, thin_film(i, lookups, mode)),
                 Some(i) => {
@@ -254,11 +255,11 @@ fn filmed_metal(metal: Bsdf, film: ThinFilm) -> Bsdf {
 /// itself and `w` of the film's (glTF's `mix(F, F_film, w)`), the latter a lobe of the same
 /// facets whose factor is the film's over the coating's index: `ρ_d + k_s(1 − w)ρ_s +
 /// k_s·w·ρ_film`, written as a mix that samples the film's lobe with probability `k_s·w/2`.
+/// The mix is kept where the film or the specular lobe is nothing (its film lobe then of weight
+/// 0), so that every point of a filmed surface has the same kind of BSDF.
 fn filmed_coating(coating: Bsdf, film: ThinFilm) -> Bsdf {
-    let (Bsdf::CookTorrance(ct), w) = (&coating, f64::from(film.weight)) else { return coating };
-    if w <= 0.0 {
-        return coating;
-    }
+    let Bsdf::CookTorrance(ct) = &coating else { return coating };
+    let w = f64::from(film.weight).clamp(0.0, 1.0);
     let film_share = ct.ks * w / 2.0;
     let keep = 1.0 - film_share;
     let own = CookTorrance { diffuse: ct.diffuse / keep, ks: ct.ks * (1.0 - w) / keep, lobe: ct.lobe };
@@ -266,7 +267,8 @@ fn filmed_coating(coating: Bsdf, film: ThinFilm) -> Bsdf {
         facets: Some(ct.lobe.facets),
         eta: Vec3::splat(ct.lobe.ior),
         k: Vec3::ZERO,
-        tint: Vec3::splat(ct.ks * w / film_share),
+        // `k_s·w / (k_s·w/2)`, where the film lobe is sampled at all.
+        tint: Vec3::splat(if film_share > 0.0 { 2.0 } else { 0.0 }),
         schlick: true,
         multiscatter: None,
         film: Some(ThinFilm { weight: 1.0, ..film }),

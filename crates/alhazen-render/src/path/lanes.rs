@@ -1934,6 +1934,43 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         }
     }
 
+    /// A film whose map gives it no weight anywhere, over a metallic–roughness map whose
+    /// metalness runs from 0 to 1: every point takes the general kernel (a filmed surface's
+    /// kind of BSDF is the same everywhere), and its BSDF is finite.
+    #[test]
+    fn a_filmed_surface_takes_the_general_kernel_everywhere() {
+        let mut scene = mixed_scene();
+        let material = mapped_material(&scene);
+        let image = scene.images.len() - 1;
+        let map = alhazen_scene::Texture::Image {
+            image,
+            scale: alhazen_math::Vec2::ONE,
+            offset: alhazen_math::Vec2::ZERO,
+            rotation: 0.0,
+        };
+        let bsdf = scene.materials[material].bsdf.as_mut();
+        let Some(alhazen_scene::bsdf::BsdfDesc::MetallicRoughness { iridescence, .. }) = bsdf else {
+            panic!("{bsdf:?}")
+        };
+        *iridescence = Some(Box::new(alhazen_scene::bsdf::Iridescence {
+            factor: 1.0,
+            ior: 1.4,
+            thickness: [100.0, 600.0],
+            outside: 1.0,
+            factor_map: Some(map.clone()),
+            thickness_map: Some(map),
+        }));
+        let m = &scene.materials[material];
+        let (v, l) = (Vec3::new(0.3, 0.1, 0.95).normalize(), Vec3::new(-0.2, 0.4, 0.89).normalize());
+        for i in 0..64 {
+            let uv = Vec2::new((i % 8 + 1) as f64 / 8.0, (i / 8 + 1) as f64 / 8.0);
+            let bsdf = crate::bsdf::bsdf_at(m, uv, Vec3::ONE, &scene.images, ColorMode::Rgb);
+            assert_eq!(kernel_of(&bsdf, m), Kernel::General, "{uv}: {bsdf:?}");
+            let (f, pdf) = bsdf.eval_pdf(v, l);
+            assert!(f.is_finite() && f.min_element() >= 0.0 && pdf.is_finite() && pdf > 0.0, "{uv}: {f} {pdf}");
+        }
+    }
+
     /// A metallic–roughness map varies the BSDF from point to point — its metal's weight and
     /// both lobes' roughness — and every point, the map's zeros and ones included, takes the
     /// metallic–roughness kernel.
