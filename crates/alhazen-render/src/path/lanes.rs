@@ -489,6 +489,9 @@ pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<Kernel> {
 /// The kernel of `bsdf`, material `m`'s at some point.
 fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
     match bsdf {
+        // Glass that may be tinted somewhere is tinted nowhere at some points (a white texel):
+        // the general kernel's everywhere.
+        _ if tints_glass(m) => Kernel::General,
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
         // The light of several facets is the general kernel's.
         Bsdf::Conductor(c) if c.multiple_scattering(Vec3::Z).is_some() || c.film.is_some() => Kernel::General,
@@ -525,6 +528,23 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
         }
         _ => Kernel::General,
     }
+}
+
+/// True where `m`'s glass may be tinted at some point: a transmittance that is not plain white,
+/// or vertex colours over glass (the kernels' glass is clear).
+fn tints_glass(m: &alhazen_scene::Material) -> bool {
+    use alhazen_scene::bsdf::BsdfDesc;
+    fn walk(d: &BsdfDesc, vertex: bool) -> bool {
+        match d {
+            BsdfDesc::Dielectric { transmittance, .. } => {
+                vertex || *transmittance != alhazen_scene::Texture::Solid(Vec3::ONE)
+            }
+            BsdfDesc::Mix { a, b, .. } => walk(a, vertex) || walk(b, vertex),
+            BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => walk(base, vertex),
+            _ => false,
+        }
+    }
+    m.bsdf.as_ref().is_some_and(|d| walk(d, m.vertex_colors))
 }
 
 /// For a conductor a rough kernel evaluates — Trowbridge–Reitz or Beckmann facets with Smith's
@@ -1932,6 +1952,37 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         for k in MATERIAL_KERNELS {
             assert!(kernels.contains(&k), "{k:?}");
         }
+    }
+
+    /// Glass whose transmittance is an image, white at one texel: every point, that one
+    /// included, takes the general kernel (the kernels' glass is clear), and so does clear glass
+    /// under vertex colours; plain clear glass keeps its own kernel.
+    #[test]
+    fn glass_that_may_be_tinted_takes_the_general_kernel_everywhere() {
+        use alhazen_scene::bsdf::{BsdfDesc, Ior};
+        let images = [std::sync::Arc::new(alhazen_scene::ImageData::new(2, 1, vec![[1.0; 3], [0.9, 0.5, 0.2]]))];
+        let map = alhazen_scene::Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 };
+        let glass = |transmittance| BsdfDesc::Dielectric {
+            facets: None,
+            ior: Ior::Constant(1.5),
+            fresnel: alhazen_scene::FresnelMode::Exact,
+            transmittance,
+            film: None,
+        };
+        let kernels = |m: &alhazen_scene::Material| -> Vec<Kernel> {
+            [0.25, 0.75]
+                .map(|u| {
+                    let bsdf = crate::bsdf::bsdf_at(m, Vec2::new(u, 0.5), Vec3::ONE, &images, ColorMode::Rgb);
+                    kernel_of(&bsdf, m)
+                })
+                .to_vec()
+        };
+        let tinted = alhazen_scene::Material::from_bsdf("tinted", glass(map));
+        assert_eq!(kernels(&tinted), [Kernel::General, Kernel::General]);
+        let clear = alhazen_scene::Material::from_bsdf("clear", glass(alhazen_scene::Texture::Solid(Vec3::ONE)));
+        assert_eq!(kernels(&clear), [Kernel::SmoothDielectric, Kernel::SmoothDielectric]);
+        let painted = alhazen_scene::Material { vertex_colors: true, ..clear };
+        assert_eq!(kernels(&painted), [Kernel::General, Kernel::General]);
     }
 
     /// A film whose map gives it no weight anywhere, over a metallic–roughness map whose
