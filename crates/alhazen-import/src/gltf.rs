@@ -799,12 +799,13 @@ impl Importer<'_> {
             (lobes.anisotropy, anisotropy_map) = (Anisotropy::default(), None);
         }
         // Stretched facets turn with the surface's tangent: read per point.
-        let specular_map = self.specular_map(&material, transmission, &name)?;
+        let (specular_map, specular_color_map) = self.specular_maps(&material, transmission, &name)?;
         let per_point = map.is_some()
             || textured_metal
             || lobes.anisotropy.is_anisotropic()
             || iridescence.is_some()
-            || specular_map.is_some();
+            || specular_map.is_some()
+            || specular_color_map.is_some();
         let bsdf = if per_point {
             let MetalRoughness { ior, specular, multiscatter, anisotropy } = lobes;
             BsdfDesc::MetallicRoughness {
@@ -819,6 +820,7 @@ impl Importer<'_> {
                 anisotropy_map,
                 iridescence,
                 specular_map,
+                specular_color_map,
             }
         } else {
             let bsdf = common::metal_rough(
@@ -1095,34 +1097,41 @@ impl Importer<'_> {
     fn lobes(&mut self, material: &gltf::Material, ior: f64, name: &str) -> MetalRoughness {
         let plain = MetalRoughness { multiscatter: true, ..common::plain_lobes(ior) };
         let Some(s) = material.specular() else { return plain };
-        if s.specular_color_texture().is_some() {
-            self.warn(format!("{name}: KHR_materials_specular's colour texture is not supported; its factor is used"));
-        }
         let color = s.specular_color_factor().map(f64::from);
         if color.iter().any(|&c| (c - color[0]).abs() > 1e-6) {
             self.warn(format!("{name}: a coloured specularColorFactor is read as its mean"));
         }
-        let scale = color.iter().sum::<f64>() / 3.0;
-        let f0 = (((ior - 1.0) / (ior + 1.0)).powi(2) * scale).clamp(0.0, 0.99);
-        let ior = if scale == 1.0 { ior } else { (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()) };
+        let ior = alhazen_scene::bsdf::ior_scaled(ior, color.iter().sum::<f64>() / 3.0);
         MetalRoughness { ior: ior.max(1.0), specular: (s.specular_factor() as f64).clamp(0.0, 1.0), ..plain }
     }
 
-    /// `KHR_materials_specular`'s `specularTexture`: the coating's specular strength per point,
-    /// its factor times the texture's alpha (in all three channels). None without it, and
-    /// under transmission (warning: its factor is used there).
-    fn specular_map(&mut self, material: &gltf::Material, transmission: f64, name: &str) -> R<Option<Texture>> {
-        let Some(info) = material.specular().and_then(|s| s.specular_texture()) else { return Ok(None) };
-        if transmission > 0.0 {
+    /// `KHR_materials_specular`'s textures, per point: `specularTexture` the coating's specular
+    /// strength (its factor times the texture's alpha, in all three channels),
+    /// `specularColorTexture` its normal-incidence reflectance (times the texture's mean colour,
+    /// sRGB decoded). None without them, and under transmission (warning: the factors are used
+    /// there).
+    fn specular_maps(
+        &mut self,
+        material: &gltf::Material,
+        transmission: f64,
+        name: &str,
+    ) -> R<(Option<Texture>, Option<Texture>)> {
+        let Some(s) = material.specular() else { return Ok((None, None)) };
+        let (strength, color) = (s.specular_texture(), s.specular_color_texture());
+        if transmission > 0.0 && (strength.is_some() || color.is_some()) {
             self.warn(format!(
-                "{name}: KHR_materials_specular's texture under transmission is not supported; its factor is used"
+                "{name}: KHR_materials_specular's textures under transmission are not supported; its factors are used"
             ));
-            return Ok(None);
+            return Ok((None, None));
         }
-        let (scale, offset, rotation) = self.texture_placement(&info, name)?;
-        let image = wrapped(self.image(&info.texture(), Decoding::Alpha)?, &info.texture());
-        self.scene.images.push(image);
-        Ok(Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation }))
+        let mut read = |info: Option<gltf::texture::Info>, decoding| -> R<Option<Texture>> {
+            let Some(info) = info else { return Ok(None) };
+            let (scale, offset, rotation) = self.texture_placement(&info, name)?;
+            let image = wrapped(self.image(&info.texture(), decoding)?, &info.texture());
+            self.scene.images.push(image);
+            Ok(Some(Texture::Image { image: self.scene.images.len() - 1, scale, offset, rotation }))
+        };
+        Ok((read(strength, Decoding::Alpha)?, read(color, Decoding::Srgb)?))
     }
 
     /// `KHR_texture_transform`'s scale, offset and rotation in alhazen's texture coordinates, and

@@ -1351,6 +1351,7 @@ impl Importer {
                 anisotropy_map: None,
                 iridescence: None,
                 specular_map: None,
+                specular_color_map: None,
             });
         }
         let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
@@ -1372,6 +1373,7 @@ impl Importer {
                 anisotropy_map: None,
                 iridescence: None,
                 specular_map: None,
+                specular_color_map: None,
             });
         }
         Ok(common::metal_rough(

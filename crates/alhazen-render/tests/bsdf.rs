@@ -229,6 +229,7 @@ fn filmed_by(metallic: f64, multiscatter: bool, factor: f64) -> Bsdf {
             thickness_map: None,
         })),
         specular_map: None,
+        specular_color_map: None,
     };
     let m = alhazen_scene::Material::from_bsdf("film", desc);
     alhazen_render::bsdf::bsdf_at(&m, Vec2::ZERO, Vec3::ONE, &[], alhazen_render::bsdf::ColorMode::Rgb)
@@ -659,14 +660,16 @@ fn several_facets_give_the_white_furnace_back_its_light() {
     assert!(albedo(&white(1.0, false), v) < 0.75, "the roughest single scattering loses light");
 }
 
-/// A metallic–roughness coating's specular map (glTF's `specularTexture`) scales its specular
-/// strength per point: `k_s = specular · texel`, the diffuse weighted by `1 − k_s·F(0)`.
+/// A metallic–roughness coating's specular maps (glTF's `specularTexture` and
+/// `specularColorTexture`) act per point: the first scales its specular strength (`k_s =
+/// specular · texel`, the diffuse weighted by `1 − k_s·F(0)`), the second its normal-incidence
+/// reflectance (`F(0)` times the texel's mean, through the index with that reflectance).
 #[test]
-fn a_specular_map_scales_the_coating_per_point() {
+fn specular_maps_shape_the_coating_per_point() {
     use alhazen_scene::bsdf::{Anisotropy, BsdfDesc};
     let texel = std::sync::Arc::new(alhazen_scene::ImageData::new(1, 1, vec![[0.25; 3]]));
     let map = alhazen_scene::Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 };
-    let desc = |specular_map| BsdfDesc::MetallicRoughness {
+    let desc = |specular_map, specular_color_map| BsdfDesc::MetallicRoughness {
         base: alhazen_scene::Texture::Solid(Vec3::splat(0.5)),
         metallic: 0.0,
         roughness: 0.4,
@@ -678,24 +681,26 @@ fn a_specular_map_scales_the_coating_per_point() {
         anisotropy_map: None,
         iridescence: None,
         specular_map,
+        specular_color_map,
     };
-    let coating = |specular_map| {
-        let m = alhazen_scene::Material::from_bsdf("m", desc(specular_map));
-        match alhazen_render::bsdf::bsdf_at(
-            &m,
-            Vec2::ZERO,
-            Vec3::ONE,
-            std::slice::from_ref(&texel),
-            alhazen_render::bsdf::ColorMode::Rgb,
-        ) {
+    let coating = |specular_map, specular_color_map| {
+        let m = alhazen_scene::Material::from_bsdf("m", desc(specular_map, specular_color_map));
+        let images = std::slice::from_ref(&texel);
+        match alhazen_render::bsdf::bsdf_at(&m, Vec2::ZERO, Vec3::ONE, images, alhazen_render::bsdf::ColorMode::Rgb) {
             Bsdf::Mix(mix) => match mix.b {
-                Bsdf::CookTorrance(c) => (c.ks, c.diffuse.x),
+                Bsdf::CookTorrance(c) => (c.ks, c.diffuse.x, c.lobe.ior),
                 other => panic!("{other:?}"),
             },
             other => panic!("{other:?}"),
         }
     };
-    assert_eq!(coating(None), (0.8, 0.5 * (1.0 - 0.8 * 0.04)));
-    let (ks, kd) = coating(Some(map));
+    assert_eq!(coating(None, None), (0.8, 0.5 * (1.0 - 0.8 * 0.04), 1.5));
+    let (ks, kd, _) = coating(Some(map.clone()), None);
     assert!((ks - 0.2).abs() < 1e-12 && (kd - 0.5 * (1.0 - 0.2 * 0.04)).abs() < 1e-12, "{ks} {kd}");
+    // F(0) of 1.5 is 0.04; a quarter of it is 0.01, the reflectance of an index of 11/9.
+    let (ks, kd, ior) = coating(None, Some(map));
+    assert!(
+        (ior - 11.0 / 9.0).abs() < 1e-12 && ks == 0.8 && (kd - 0.5 * (1.0 - 0.8 * 0.01)).abs() < 1e-12,
+        "{ior} {kd}"
+    );
 }

@@ -89,6 +89,9 @@ impl Ior {
 }
 
 /// A scattering function.
+// A description, made once per material and read where a BSDF is built (the tracers' own
+// `Bsdf` is what hot loops copy): the metallic–roughness variant's maps kept inline.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub enum BsdfDesc {
     /// `ρ = albedo/π`.
@@ -235,6 +238,9 @@ pub enum BsdfDesc {
         /// Where the coating's specular strength varies: `specular` times the map's first
         /// channel (read linearly; glTF's `specularTexture` is its alpha).
         specular_map: Option<Texture>,
+        /// Where the coating's normal-incidence reflectance varies: `F(0)` of `ior` times the
+        /// map's mean colour, the coating's index found from that (glTF's `specularColorTexture`).
+        specular_color_map: Option<Texture>,
     },
     /// A clear coat over `base` (car paint, lacquer; glTF's `KHR_materials_clearcoat`): a
     /// dielectric microfacet layer of `weight` reflecting `weight·D G F/(4⟨l,n⟩⟨v,n⟩)`, the
@@ -504,6 +510,16 @@ pub fn ggx(alpha_u: f64, alpha_v: f64) -> Microfacets {
     }
 }
 
+/// The index whose normal-incidence reflectance is `scale` times that of `ior` (at most 0.99;
+/// glTF's `specularColorFactor` and texture, by their mean): `ior` itself at a scale of 1.
+pub fn ior_scaled(ior: f64, scale: f64) -> f64 {
+    if scale == 1.0 {
+        return ior;
+    }
+    let f0 = (((ior - 1.0) / (ior + 1.0)).powi(2) * scale).clamp(0.0, 0.99);
+    ((1.0 + f0.sqrt()) / (1.0 - f0.sqrt())).max(1.0)
+}
+
 /// The real index `η` (with `κ = 0`) whose normal-incidence reflectance is `f0`.
 pub fn eta_from_f0(f0: Rgb) -> Rgb {
     let r = f0.clamp(Vec3::ZERO, Vec3::splat(0.999)).powf(0.5);
@@ -527,9 +543,18 @@ impl BsdfDesc {
             BsdfDesc::Sheened { base, color, roughness_map, .. } => {
                 base.is_textured() || t(color) || roughness_map.is_some()
             }
-            BsdfDesc::MetallicRoughness { base, map, anisotropy_map, iridescence, specular_map, .. } => {
+            BsdfDesc::MetallicRoughness {
+                base,
+                map,
+                anisotropy_map,
+                iridescence,
+                specular_map,
+                specular_color_map,
+                ..
+            } => {
                 let film = iridescence.as_ref().is_some_and(|i| i.factor_map.is_some() || i.thickness_map.is_some());
-                t(base) || map.is_some() || anisotropy_map.is_some() || film || specular_map.is_some()
+                let specular = specular_map.is_some() || specular_color_map.is_some();
+                t(base) || map.is_some() || anisotropy_map.is_some() || film || specular
             }
             BsdfDesc::Dielectric { transmittance, .. } => t(transmittance),
             BsdfDesc::Conductor { .. } | BsdfDesc::ThinDielectric { .. } => false,

@@ -109,6 +109,7 @@ impl Parser<'_> {
                     "anisotropy",
                     "iridescence",
                     "specular_map",
+                    "specular_color_map",
                 ]
             }
             "thin-dielectric" => vec!["ior"],
@@ -226,6 +227,7 @@ impl Parser<'_> {
                     anisotropy_map,
                     iridescence: t.get("iridescence").map(|n| self.iridescence(&n).map(Box::new)).transpose()?,
                     specular_map: t.get("specular_map").map(|m| self.linear_placed_image(&m)).transpose()?,
+                    specular_color_map: t.get("specular_color_map").map(|m| self.texture(&m)).transpose()?,
                 }
             }
             "coated" => {

@@ -579,9 +579,10 @@ impl Writer<'_> {
                 anisotropy_map,
                 iridescence,
                 specular_map,
+                specular_color_map,
             } => {
                 format!(
-                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{}{}{} }}",
+                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{}{}{}{} }}",
                     self.texture(base),
                     num(*metallic),
                     num(*roughness),
@@ -591,7 +592,10 @@ impl Writer<'_> {
                     map.as_ref().map_or(String::new(), |m| format!(", map = {}", self.map_image(m))),
                     self.anisotropy_entry(anisotropy, anisotropy_map.as_ref()),
                     iridescence.as_ref().map_or(String::new(), |i| self.iridescence_entry(i)),
-                    specular_map.as_ref().map_or(String::new(), |m| format!(", specular_map = {}", self.map_image(m)))
+                    specular_map.as_ref().map_or(String::new(), |m| format!(", specular_map = {}", self.map_image(m))),
+                    specular_color_map
+                        .as_ref()
+                        .map_or(String::new(), |m| format!(", specular_color_map = {}", self.texture(m)))
                 )
             }
         }

@@ -337,7 +337,7 @@ bsdf = { type = "dielectric", iridescence = { ior = 1.33, thickness = 300 } }
 
 /// A metallic–roughness surface's `iridescence` (a thin film): its defaults, one thickness or
 /// the two a map runs between, maps read linearly; the same after writing the scene back out
-/// (and its `specular_map`); mistakes located.
+/// (and its `specular_map` and `specular_color_map`); mistakes located.
 #[test]
 fn metallic_roughness_iridescence_reads_and_writes_back() {
     use alhazen_scene::bsdf::{BsdfDesc, Iridescence};
@@ -348,7 +348,7 @@ bsdf = { type = "metallic-roughness", roughness = 0.1, iridescence = {} }
 [materials.oil]
 bsdf = { type = "metallic-roughness", metallic = 1, iridescence = { factor = 0.7, ior = 1.5, thickness = 550, outside = 1.5 } }
 [materials.mapped]
-bsdf = { type = "metallic-roughness", specular_map = { file = "f.png" }, iridescence = { thickness = [800, 200], factor_map = { file = "f.png" }, thickness_map = { file = "f.png", scale = 3 } } }
+bsdf = { type = "metallic-roughness", specular_map = { file = "f.png" }, specular_color_map = { image = { file = "f.png" } }, iridescence = { thickness = [800, 200], factor_map = { file = "f.png" }, thickness_map = { file = "f.png", scale = 3 } } }
 "#;
     image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 200])).save(dir.path().join("f.png")).unwrap();
     let path = dir.path().join("i.toml");
@@ -387,6 +387,13 @@ bsdf = { type = "metallic-roughness", specular_map = { file = "f.png" }, iridesc
         other => panic!("{other:?}"),
     };
     assert_eq!(specular_map(&s), specular_map(&again));
+    let colour_map = |s: &alhazen_scene::Scene| match &s.materials.iter().find(|m| m.name == "mapped").unwrap().bsdf {
+        Some(BsdfDesc::MetallicRoughness { specular_color_map: Some(Texture::Image { image, .. }), .. }) => {
+            s.images[*image].texel(0)
+        }
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(colour_map(&s), colour_map(&again));
     let m = film(&again, "mapped");
     assert_eq!((m.thickness, m.factor_map.is_some(), m.thickness_map.is_some()), ([800.0, 200.0], true, true));
     for (bad, says) in [

@@ -188,6 +188,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             anisotropy_map,
             iridescence,
             specular_map,
+            specular_color_map,
         } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
@@ -197,7 +198,10 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                 metallic * texel.z,
                 roughness * texel.y,
                 alhazen_scene::bsdf::MetalRoughness {
-                    ior: *ior,
+                    ior: specular_color_map.as_ref().map_or(*ior, |m| {
+                        let c = (lookups.rgb)(m);
+                        alhazen_scene::bsdf::ior_scaled(*ior, (c.x + c.y + c.z) / 3.0)
+                    }),
                     specular: specular * specular_map.as_ref().map_or(1.0, |m| (lookups.rgb)(m).x.clamp(0.0, 1.0)),
                     multiscatter: *multiscatter,
                     anisotropy,
