@@ -880,15 +880,7 @@ fn blender_clearcoat_maps_agree_with_cycles() {
 /// the material; a factor of 0 is no coat; its textures are warned about; bad factors refused.
 #[test]
 fn clearcoat_factors_make_the_coat() {
-    let coat = |ext: &str| {
-        let json = embedded().replace(
-            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
-            &format!(r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "extensions": {{ "KHR_materials_clearcoat": {ext} }}"#),
-        );
-        let s = write_and_import(&[("s.gltf", json.into_bytes())])?;
-        let said: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
-        Ok::<_, String>((s.scene.materials[s.scene.objects[0].material as usize].bsdf.clone().unwrap(), said))
-    };
+    let coat = |ext: &str| material_with_extensions(&format!(r#""KHR_materials_clearcoat": {ext}"#));
     let (bsdf, said) = coat(r#"{ "clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.5 }"#).unwrap();
     assert!(said.is_empty(), "{said:?}");
     let BsdfDesc::Coated { base, weight, facets, ior, weight_map: None, roughness_map: None } = bsdf else {

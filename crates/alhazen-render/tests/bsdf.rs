@@ -90,15 +90,7 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 }
                 list.push((
                     format!("rough dielectric {name} m={a}"),
-                    Bsdf::Dielectric(Dielectric {
-                        facets: Some(facets(d, a, a, Shadowing::Smith)),
-                        eta: 1.5,
-                        schlick: false,
-                        dispersive: false,
-                        thin: false,
-                        tint: Vec3::ONE,
-                        film: None,
-                    }),
+                    Bsdf::Dielectric(Dielectric::clear(Some(facets(d, a, a, Shadowing::Smith)), 1.5)),
                 ));
             }
         }
@@ -379,15 +371,7 @@ fn sampling_matches_the_density_of_every_bsdf_chi2() {
 
 #[test]
 fn rough_dielectric_sampling_from_inside_matches_its_density() {
-    let b = Bsdf::Dielectric(Dielectric {
-        facets: Some(ggx(0.4)),
-        eta: 1.5,
-        schlick: false,
-        dispersive: false,
-        thin: false,
-        tint: Vec3::ONE,
-        film: None,
-    });
+    let b = Bsdf::Dielectric(Dielectric::clear(Some(ggx(0.4)), 1.5));
     for theta in [20.0, 60.0] {
         let v = -direction(theta, 1.1);
         let p = chi2_p_value(&b, v, 400_000, 98);
@@ -433,15 +417,7 @@ fn lambert_with_albedo_one_conserves_energy_exactly() {
 fn smooth_dielectric_splits_energy_without_loss() {
     // Importance transport: reflected F plus transmitted (1 − F) once the η² of radiance is undone.
     for eta in [1.33, 1.5, 2.4] {
-        let b = Bsdf::Dielectric(Dielectric {
-            facets: None,
-            eta,
-            schlick: false,
-            dispersive: false,
-            thin: false,
-            tint: Vec3::ONE,
-            film: None,
-        });
+        let b = Bsdf::Dielectric(Dielectric::clear(None, eta));
         for v in [direction(0.0, 0.0), direction(50.0, 1.0), -direction(30.0, 2.0), -direction(70.0, 2.0)] {
             let (mut total, n) = (0.0, 20_000);
             let mut rng = Rng::for_sample(1, 1, 1, 1);
@@ -517,15 +493,7 @@ fn the_course_phong_is_not_reciprocal_but_the_normalised_one_is() {
 fn refraction_obeys_the_course_eta_squared_law() {
     // η₁² ρ(l, v) = η₂² ρ(v, l), η₁ on the light's side, η₂ on the viewer's.
     let eta = 1.5;
-    let b = Bsdf::Dielectric(Dielectric {
-        facets: Some(ggx(0.35)),
-        eta,
-        schlick: false,
-        dispersive: false,
-        thin: false,
-        tint: Vec3::ONE,
-        film: None,
-    });
+    let b = Bsdf::Dielectric(Dielectric::clear(Some(ggx(0.35)), eta));
     let mut rng = Rng::for_sample(3, 3, 3, 3);
     let mut checked = 0;
     for _ in 0..500 {

@@ -41,6 +41,13 @@ pub struct Dielectric {
 }
 
 impl Dielectric {
+    /// Clear glass of relative index `eta`, smooth when `facets` is `None`: exact Fresnel
+    /// factor, one index for every colour, no tint, no film.
+    #[inline(always)]
+    pub fn clear(facets: Option<Microfacet>, eta: f64) -> Self {
+        Dielectric { facets, eta, schlick: false, dispersive: false, thin: false, tint: Vec3::ONE, film: None }
+    }
+
     /// Reflectance for the cosine between `v` and the (micro)normal; `v` inside when negative.
     #[inline(always)]
     fn fresnel(&self, cos_v: f64) -> f64 {

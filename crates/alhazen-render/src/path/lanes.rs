@@ -1220,15 +1220,7 @@ impl RoughBsdf for Dielectric {
 
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
-        Dielectric {
-            facets: Some(facets),
-            eta: v.ior[i],
-            schlick: false,
-            dispersive: false,
-            thin: false,
-            tint: Vec3::ONE,
-            film: None,
-        }
+        Dielectric::clear(Some(facets), v.ior[i])
     }
 }
 
@@ -1317,16 +1309,7 @@ impl LaneBsdf for SmoothDielectric {
 
     #[inline(always)]
     fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
-        Dielectric {
-            facets: None,
-            eta: v.ior[i],
-            schlick: false,
-            dispersive: false,
-            thin: false,
-            tint: Vec3::ONE,
-            film: None,
-        }
-        .smooth_sample(wv, uc)
+        Dielectric::clear(None, v.ior[i]).smooth_sample(wv, uc)
     }
 }
 
