@@ -330,9 +330,12 @@ bsdf = { type = "dielectric", iridescence = { ior = 1.33, thickness = 300 } }
     };
     assert_eq!(film(&s), (1.33, [300.0, 300.0]));
     assert_eq!(film(&again), film(&s));
-    std::fs::write(&path, "[materials.m]\nbsdf = { type = \"dielectric\", transmittance = [2, 0, 0] }\n").unwrap();
-    let e = load_scene(&path).unwrap_err().to_string();
-    assert!(e.contains("d.toml:2:") && e.contains("within [0, 1]"), "{e}");
+    for (bad, says) in [("[2, 0, 0]", "within [0, 1]"), ("[nan, 0, 0]", "finite"), ("[-1, 0, 0]", "must be ≥ 0")] {
+        std::fs::write(&path, format!("[materials.m]\nbsdf = {{ type = \"dielectric\", transmittance = {bad} }}\n"))
+            .unwrap();
+        let e = load_scene(&path).unwrap_err().to_string();
+        assert!(e.contains("d.toml:2:") && e.contains(says), "{bad}: {e}");
+    }
 }
 
 /// A metallic–roughness surface's `iridescence` (a thin film): its defaults, one thickness or
@@ -402,6 +405,9 @@ bsdf = { type = "metallic-roughness", specular_map = { file = "f.png" }, specula
         ("iridescence = { thickness = [100] }", "2"),
         ("iridescence = { ior = 0.5 }", "0.5"),
         ("iridescence = { colour = 1 }", "colour"),
+        ("iridescence = { ior = nan }", "finite"),
+        ("iridescence = { thickness = [nan, 100] }", "finite"),
+        ("iridescence = { thickness = inf }", "finite"),
     ] {
         let text = format!("[materials.m]\nbsdf = {{ type = \"metallic-roughness\", {bad} }}\n");
         std::fs::write(&path, &text).unwrap();
