@@ -67,6 +67,22 @@ pub struct Bvh {
     order: Vec<u32>,
 }
 
+/// What a traversal does at a leaf: `visit(labels, t_max)` returns a closer hit distance, or
+/// `Some(0.0)` to stop ([`Bvh::traverse_leaves`]). Any closure of that shape is one; a type of
+/// its own can promise to be inlined into the traversal (`#[inline(always)]`), which a closure
+/// cannot — and a leaf test in vector registers must be, to be compiled for them.
+pub trait LeafVisit {
+    /// Visits the leaf of `labels` with the closest hit so far at `t_max`.
+    fn visit(&mut self, labels: std::ops::Range<usize>, t_max: f64) -> Option<f64>;
+}
+
+impl<F: FnMut(std::ops::Range<usize>, f64) -> Option<f64>> LeafVisit for F {
+    #[inline(always)]
+    fn visit(&mut self, labels: std::ops::Range<usize>, t_max: f64) -> Option<f64> {
+        self(labels, t_max)
+    }
+}
+
 impl Tree {
     /// An empty tree with room for one over `items` primitives (at most `2·items − 1` nodes;
     /// pages reserved and never written cost no memory).
@@ -377,21 +393,22 @@ impl Bvh {
         ray: &Ray,
         mut t_max: f64,
         prefetch: impl Fn(std::ops::Range<usize>),
-        mut visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
+        mut visit: impl LeafVisit,
     ) -> f64 {
         let Some(mut at) = self.start else { return t_max };
         if at.is_leaf() {
             // A lone leaf is tested whole: its box test would only cost a division.
-            return visit(at.labels(), t_max).map_or(t_max, |t| t_max.min(t.max(0.0)));
+            return visit.visit(at.labels(), t_max).map_or(t_max, |t| t_max.min(t.max(0.0)));
         }
-        let slab = Slab::new(ray, self.reach);
+        // SAFETY: the caller's contract.
+        let slab = unsafe { Slab::of::<AVX2>(ray, self.reach) };
         let mut limit = wide::up(t_max);
         // Not zeroed: a traversal of a small tree would spend longer clearing it than using it.
         let mut stack = [const { std::mem::MaybeUninit::<Entry>::uninit() }; STACK];
         let mut sp = 0;
         loop {
             if at.is_leaf() {
-                if let Some(t) = visit(at.labels(), t_max) {
+                if let Some(t) = visit.visit(at.labels(), t_max) {
                     if t <= 0.0 {
                         return 0.0;
                     }
@@ -428,31 +445,23 @@ impl Bvh {
                 }
                 if hits != 0 {
                     // The children met, nearest first (ties in slot order); the rest wait.
-                    let mut met = [(0.0f32, 0usize); WIDTH];
-                    let mut n = 0;
-                    for k in (0..WIDTH).filter(|k| hits >> k & 1 == 1) {
-                        let mut i = n;
-                        while i > 0 && met[i - 1].0 > near[k] {
-                            met[i] = met[i - 1];
-                            i -= 1;
-                        }
-                        met[i] = (near[k], k);
-                        n += 1;
-                    }
-                    for &(t, k) in met[1..n].iter().rev() {
-                        stack[sp].write(Slab::child(node, k, t));
+                    let (met, n) = wide::nearest_first(hits, &near);
+                    for &key in met[1..n].iter().rev() {
+                        let k = wide::slot_of(key);
+                        stack[sp].write(Slab::child(node, k, near[k]));
                         sp += 1;
                     }
                     // Load the nodes met while the nearest is descended into.
-                    for &(_, k) in &met[..n] {
-                        let child = Slab::child(node, k, 0.0);
+                    for &key in &met[..n] {
+                        let child = Slab::child(node, wide::slot_of(key), 0.0);
                         if child.is_leaf() {
                             prefetch(child.labels());
                         } else {
                             Slab::prefetch(&self.wide[child.offset as usize]);
                         }
                     }
-                    at = Slab::child(node, met[0].1, met[0].0);
+                    let k = wide::slot_of(met[0]);
+                    at = Slab::child(node, k, near[k]);
                     continue;
                 }
             }

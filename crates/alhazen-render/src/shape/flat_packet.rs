@@ -441,6 +441,56 @@ impl<L: Copy + Default> PackedFlats<L> {
     }
 }
 
+#[cfg(target_arch = "x86_64")]
+pub(crate) use simd::RayLanes;
+
+/// `ray` prepared for [`PackedFlats::nearest_in_lanes`] and [`PackedFlats::any_in_lanes`]:
+/// rounded to `f32` and broadcast, once per traversal.
+///
+/// # Safety
+/// Only on a processor with AVX2; fast only inlined into a function compiled for it.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(crate) unsafe fn ray_in_lanes(ray: &Ray) -> RayLanes {
+    // SAFETY: the caller's contract.
+    unsafe { simd::lanes_of(ray) }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<L: Copy + Default> PackedFlats<L> {
+    /// [`Self::nearest`] by the AVX2 kernel for a ray in lanes ([`ray_in_lanes`]): the same
+    /// hit, inlined into a caller compiled for AVX2 (a mesh's traversal).
+    ///
+    /// # Safety
+    /// As [`ray_in_lanes`].
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(crate) unsafe fn nearest_in_lanes(
+        &self,
+        range: std::ops::Range<usize>,
+        r: &RayLanes,
+        t_max: f64,
+    ) -> Option<(L, LaneHit)> {
+        let first = range.start;
+        // SAFETY: the caller's contract.
+        let (k, h) = unsafe { simd::nearest_in(&self.packets[range], r, t_max as f32) }?;
+        Some((self.lanes[first + k][h.lane], h))
+    }
+
+    /// [`FlatPacket::any_of`] on packets `range` by the AVX2 kernel for a ray in lanes, as
+    /// [`Self::nearest_in_lanes`].
+    ///
+    /// # Safety
+    /// As [`ray_in_lanes`].
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(crate) unsafe fn any_in_lanes(&self, range: std::ops::Range<usize>, r: &RayLanes, t_max: f64) -> bool {
+        // SAFETY: the caller's contract.
+        unsafe { simd::any_in(&self.packets[range], r, t_max as f32) }
+    }
+}
+
 /// Which of the packet kernels runs: all give the same bits. A value can only come from
 /// [`VectorUnit::detect`], [`VectorUnit::available`] or [`VectorUnit::PORTABLE`], so it never
 /// names an instruction set this processor lacks (the kernels rely on that).
@@ -565,7 +615,7 @@ mod simd {
     }
 
     /// A ray per lane (eight rays, or one in all lanes).
-    struct RayLanes {
+    pub(crate) struct RayLanes {
         origin: [__m256; 3],
         dir: [__m256; 3],
     }
@@ -694,6 +744,73 @@ mod simd {
         pub b2: [f32; LANES],
     }
 
+    /// [`FlatPacket::nearest_of`]'s kernel for a ray already in lanes: each lane keeps the
+    /// nearest hit it has seen, and the lanes are compared once at the end (on a tie, the first
+    /// flat). Inlined where the caller is compiled for AVX2 (a mesh's traversal, which prepares
+    /// its ray once for all the leaves it visits): a leaf then costs no call and no registers
+    /// saved around one.
+    ///
+    /// # Safety
+    /// Only on a processor with AVX2, and fast only inlined into a function compiled for it.
+    #[inline(always)]
+    pub(crate) unsafe fn nearest_in(
+        packets: &[FlatPacket],
+        r: &RayLanes,
+        t_max: f32,
+    ) -> Option<(usize, super::LaneHit)> {
+        // SAFETY: the caller's contract: every call below is to an AVX2 function.
+        unsafe {
+            let limit = _mm256_set1_ps(t_max);
+            let mut best = Nearest::new(limit);
+            let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+            for (k, p) in packets.iter().enumerate() {
+                let at = _mm256_add_epi32(_mm256_set1_epi32((k * LANES) as i32), lane);
+                best.update(hits(&packet_lanes(p), r, limit), at);
+            }
+            // Most leaves a ray visits it misses, and most it hits it hits in one lane: neither
+            // needs the lanes stored and compared (a loop whose branches follow random hits).
+            let hit = _mm256_movemask_ps(best.hit) as u32;
+            if hit == 0 {
+                return None;
+            }
+            let h = best.store();
+            let nearest = if hit & (hit - 1) == 0 {
+                hit.trailing_zeros() as usize
+            } else {
+                (0..LANES)
+                    .filter(|&l| h.hit & (1 << l) != 0)
+                    .min_by(|&a, &b| h.t[a].total_cmp(&h.t[b]).then(h.at[a].cmp(&h.at[b])))?
+            };
+            let at = h.at[nearest] as usize;
+            Some((at / LANES, super::LaneHit::new(at % LANES, (h.t[nearest], h.b1[nearest], h.b2[nearest]))))
+        }
+    }
+
+    /// [`FlatPacket::any_of`]'s kernel for a ray already in lanes, as [`nearest_in`]: stops at
+    /// the first packet with a lane hit.
+    ///
+    /// # Safety
+    /// As [`nearest_in`].
+    #[inline(always)]
+    pub(crate) unsafe fn any_in(packets: &[FlatPacket], r: &RayLanes, t_max: f32) -> bool {
+        // SAFETY: the caller's contract: every call below is to an AVX2 function.
+        unsafe {
+            let limit = _mm256_set1_ps(t_max);
+            packets.iter().any(|p| _mm256_movemask_ps(hits(&packet_lanes(p), r, limit).3) != 0)
+        }
+    }
+
+    /// `ray` rounded to `f32` as [`Ray32::new`] rounds it, in every lane: prepared once for all
+    /// the leaves one traversal visits.
+    ///
+    /// # Safety
+    /// As [`nearest_in`].
+    #[inline(always)]
+    pub(crate) unsafe fn lanes_of(ray: &alhazen_math::Ray) -> RayLanes {
+        // SAFETY: the caller's contract.
+        unsafe { ray_lanes(&Ray32::new(ray)) }
+    }
+
     /// Defines each kernel twice from one body: for AVX2 processors (16 vector registers) and,
     /// named `…_avx512`, for AVX-512 ones, where the same AVX2 instructions (the same
     /// arithmetic, the same bits) get 32 registers: the rays, the flats and the nearest hits
@@ -716,36 +833,14 @@ mod simd {
         /// [`FlatPacket::nearest_of`]: each lane keeps the nearest hit it has seen, and the
         /// lanes are compared once at the end (on a tie, the first flat).
         fn nearest / nearest_avx512(packets: &[FlatPacket], r: &Ray32, t_max: f32) -> Option<(usize, super::LaneHit)> {
-            let r = ray_lanes(r);
-            let limit = _mm256_set1_ps(t_max);
-            let mut best = Nearest::new(limit);
-            let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-            for (k, p) in packets.iter().enumerate() {
-                let at = _mm256_add_epi32(_mm256_set1_epi32((k * LANES) as i32), lane);
-                best.update(hits(&packet_lanes(p), &r, limit), at);
-            }
-            // Most leaves a ray visits it misses, and most it hits it hits in one lane: neither
-            // needs the lanes stored and compared (a loop whose branches follow random hits).
-            let hit = _mm256_movemask_ps(best.hit) as u32;
-            if hit == 0 {
-                return None;
-            }
-            let h = best.store();
-            let nearest = if hit & (hit - 1) == 0 {
-                hit.trailing_zeros() as usize
-            } else {
-                (0..LANES)
-                    .filter(|&l| h.hit & (1 << l) != 0)
-                    .min_by(|&a, &b| h.t[a].total_cmp(&h.t[b]).then(h.at[a].cmp(&h.at[b])))?
-            };
-            let at = h.at[nearest] as usize;
-            Some((at / LANES, super::LaneHit::new(at % LANES, (h.t[nearest], h.b1[nearest], h.b2[nearest]))))
+            // SAFETY: this kernel runs only where AVX2 is.
+            unsafe { nearest_in(packets, &ray_lanes(r), t_max) }
         }
 
         /// [`FlatPacket::any_of`]: stops at the first packet with a lane hit.
         fn any / any_avx512(packets: &[FlatPacket], r: &Ray32, t_max: f32) -> bool {
-            let (r, limit) = (ray_lanes(r), _mm256_set1_ps(t_max));
-            packets.iter().any(|p| _mm256_movemask_ps(hits(&packet_lanes(p), &r, limit).3) != 0)
+            // SAFETY: this kernel runs only where AVX2 is.
+            unsafe { any_in(packets, &ray_lanes(r), t_max) }
         }
 
         /// Eight rays' nearest hits, ray by lane.

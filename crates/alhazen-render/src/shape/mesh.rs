@@ -199,12 +199,7 @@ impl MeshShape {
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn traverse<const AVX2: bool>(
-        &self,
-        ray: &Ray,
-        t_max: f64,
-        visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
-    ) {
+    unsafe fn traverse<const AVX2: bool>(&self, ray: &Ray, t_max: f64, visit: impl crate::bvh::LeafVisit) {
         let a = &*self.accel;
         let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
         // SAFETY: the caller's contract.
@@ -218,32 +213,62 @@ impl MeshShape {
         if self.accel.vectors.is_simd() {
             // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes it) only where the
             // processor has it.
-            return unsafe { self.hit_avx2(ray, t_max) };
+            return unsafe {
+                if self.accel.vectors.is_avx512() { self.hit_avx512(ray, t_max) } else { self.hit_avx2(ray, t_max) }
+            };
         }
-        // SAFETY: without AVX2.
-        unsafe { self.hit_with::<false>(ray, t_max) }
+        self.hit_portable(ray, t_max)
     }
 
-    /// [`Self::hit`] compiled for AVX2, its nodes tested in AVX2 registers.
+    /// [`Self::hit`] compiled for AVX2: its nodes tested in AVX2 registers, its leaves by the
+    /// packets' AVX2 kernel inlined.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[allow(unsafe_code)]
     fn hit_avx2(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         // SAFETY: this function runs only where AVX2 is.
-        unsafe { self.hit_with::<true>(ray, t_max) }
+        unsafe { self.hit_in_lanes(ray, t_max) }
     }
 
-    /// [`Self::hit`] with the tree's node test of `AVX2`.
+    /// [`Self::hit_avx2`] compiled for AVX-512 processors: the same instructions, the same
+    /// bits, with 32 vector registers, so the ray's lanes stay in registers across the leaves.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    #[allow(unsafe_code)]
+    fn hit_avx512(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        // SAFETY: this function runs only where AVX-512 (and so AVX2) is.
+        unsafe { self.hit_in_lanes(ray, t_max) }
+    }
+
+    /// [`Self::hit`] with AVX2: the ray prepared in lanes once, each leaf's packets tested by
+    /// the AVX2 kernel (the bits of [`FlatPacket::nearest_of`]).
     ///
     /// # Safety
-    /// `AVX2` only on a processor with AVX2.
+    /// Only on a processor with AVX2.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn hit_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+    unsafe fn hit_in_lanes(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
         let a = &*self.accel;
         if let Some(alpha) = &self.alpha {
             // SAFETY: the caller's contract.
-            return unsafe { self.hit_kept::<AVX2>(ray, t_max, alpha) };
+            return unsafe { self.hit_kept::<true>(ray, t_max, alpha) };
+        }
+        // SAFETY: the caller's contract.
+        let mut visit =
+            NearestInLanes { packets: &a.packets, ray: unsafe { super::flat_packet::ray_in_lanes(ray) }, best: None };
+        // SAFETY: the caller's contract.
+        unsafe { self.traverse::<true>(ray, t_max, &mut visit) };
+        visit.best.map(|(lane, h)| lane.candidate(h.t, h.b1, h.b2))
+    }
+
+    /// [`Self::hit`] without AVX2: nodes in SSE halves, leaves by the portable kernel.
+    #[allow(unsafe_code)]
+    fn hit_portable(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
+        let a = &*self.accel;
+        if let Some(alpha) = &self.alpha {
+            // SAFETY: without AVX2.
+            return unsafe { self.hit_kept::<false>(ray, t_max, alpha) };
         }
         let mut best = None;
         let visit = |packets, t_max| {
@@ -251,12 +276,12 @@ impl MeshShape {
             best = Some((lane, h));
             Some(h.t)
         };
-        // SAFETY: the caller's contract.
-        unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
+        // SAFETY: without AVX2.
+        unsafe { self.traverse::<false>(ray, t_max, visit) };
         best.map(|(lane, h)| lane.candidate(h.t, h.b1, h.b2))
     }
 
-    /// [`Self::hit_with`] on a mesh with cut-outs: the nearest hit where `alpha` says the
+    /// [`Self::hit`] on a mesh with cut-outs: the nearest hit where `alpha` says the
     /// surface is.
     ///
     /// # Safety
@@ -291,44 +316,75 @@ impl MeshShape {
         #[cfg(target_arch = "x86_64")]
         if self.accel.vectors.is_simd() {
             // SAFETY: as in `hit`.
-            return unsafe { self.blocks_avx2(ray, t_max) };
+            return unsafe {
+                if self.accel.vectors.is_avx512() {
+                    self.blocks_avx512(ray, t_max)
+                } else {
+                    self.blocks_avx2(ray, t_max)
+                }
+            };
         }
-        // SAFETY: without AVX2.
-        unsafe { self.blocks_with::<false>(ray, t_max) }
+        self.blocks_portable(ray, t_max)
     }
 
-    /// [`Self::blocks`] compiled for AVX2.
+    /// [`Self::blocks`] compiled for AVX2, as [`Self::hit_avx2`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[allow(unsafe_code)]
     fn blocks_avx2(&self, ray: &Ray, t_max: f64) -> bool {
         // SAFETY: this function runs only where AVX2 is.
-        unsafe { self.blocks_with::<true>(ray, t_max) }
+        unsafe { self.blocks_in_lanes(ray, t_max) }
     }
 
-    /// [`Self::blocks`] with the tree's node test of `AVX2`.
+    /// [`Self::blocks`] compiled for AVX-512 processors, as [`Self::hit_avx512`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    #[allow(unsafe_code)]
+    fn blocks_avx512(&self, ray: &Ray, t_max: f64) -> bool {
+        // SAFETY: this function runs only where AVX-512 (and so AVX2) is.
+        unsafe { self.blocks_in_lanes(ray, t_max) }
+    }
+
+    /// [`Self::blocks`] with AVX2, the ray prepared in lanes once, as [`Self::hit_in_lanes`].
     ///
     /// # Safety
-    /// `AVX2` only on a processor with AVX2.
+    /// Only on a processor with AVX2.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn blocks_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> bool {
+    unsafe fn blocks_in_lanes(&self, ray: &Ray, t_max: f64) -> bool {
         let a = &*self.accel;
         if let Some(alpha) = &self.alpha {
             // SAFETY: the caller's contract.
-            return unsafe { self.blocks_kept::<AVX2>(ray, t_max, alpha) };
+            return unsafe { self.blocks_kept::<true>(ray, t_max, alpha) };
+        }
+        // SAFETY: the caller's contract.
+        let mut visit =
+            AnyInLanes { packets: &a.packets, ray: unsafe { super::flat_packet::ray_in_lanes(ray) }, blocked: false };
+        // SAFETY: the caller's contract.
+        unsafe { self.traverse::<true>(ray, t_max, &mut visit) };
+        visit.blocked
+    }
+
+    /// [`Self::blocks`] without AVX2, as [`Self::hit_portable`].
+    #[allow(unsafe_code)]
+    fn blocks_portable(&self, ray: &Ray, t_max: f64) -> bool {
+        let a = &*self.accel;
+        if let Some(alpha) = &self.alpha {
+            // SAFETY: without AVX2.
+            return unsafe { self.blocks_kept::<false>(ray, t_max, alpha) };
         }
         let mut blocked = false;
         let visit = |packets: std::ops::Range<usize>, t_max| {
             blocked = FlatPacket::any_of(&a.packets.packets[packets], ray, t_max, a.vectors);
             blocked.then_some(0.0)
         };
-        // SAFETY: the caller's contract.
-        unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
+        // SAFETY: without AVX2.
+        unsafe { self.traverse::<false>(ray, t_max, visit) };
         blocked
     }
 
-    /// [`Self::blocks_with`] on a mesh with cut-outs: some hit in `(0, t_max)` where `alpha`
+    /// [`Self::blocks`] on a mesh with cut-outs: some hit in `(0, t_max)` where `alpha`
     /// says the surface is.
     ///
     /// # Safety
@@ -380,5 +436,47 @@ impl MeshShape {
     /// Bounding box.
     pub fn bounds(&self) -> Bounds3 {
         self.accel.bvh.bounds()
+    }
+}
+
+/// A leaf visit of [`MeshShape::hit_in_lanes`]: the nearest hit in the leaf's packets by the AVX2
+/// kernel, inlined into the traversal. Made only where AVX2 is (its ray comes from the `unsafe`
+/// [`super::flat_packet::ray_in_lanes`]).
+#[cfg(target_arch = "x86_64")]
+struct NearestInLanes<'a> {
+    packets: &'a PackedFlats<FlatLane>,
+    ray: super::flat_packet::RayLanes,
+    best: Option<(FlatLane, LaneHit)>,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl crate::bvh::LeafVisit for &mut NearestInLanes<'_> {
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn visit(&mut self, packets: std::ops::Range<usize>, t_max: f64) -> Option<f64> {
+        // SAFETY: a visit is made only where AVX2 is (see the type).
+        let (lane, h) = unsafe { self.packets.nearest_in_lanes(packets, &self.ray, t_max) }?;
+        self.best = Some((lane, h));
+        Some(h.t)
+    }
+}
+
+/// A leaf visit of [`MeshShape::blocks_in_lanes`]: whether the leaf's packets hold a hit, as
+/// [`NearestInLanes`].
+#[cfg(target_arch = "x86_64")]
+struct AnyInLanes<'a> {
+    packets: &'a PackedFlats<FlatLane>,
+    ray: super::flat_packet::RayLanes,
+    blocked: bool,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl crate::bvh::LeafVisit for &mut AnyInLanes<'_> {
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn visit(&mut self, packets: std::ops::Range<usize>, t_max: f64) -> Option<f64> {
+        // SAFETY: a visit is made only where AVX2 is (see the type).
+        self.blocked = unsafe { self.packets.any_in_lanes(packets, &self.ray, t_max) };
+        self.blocked.then_some(0.0)
     }
 }
