@@ -560,56 +560,95 @@ impl World {
         if self.vectors.is_simd() && !self.bvh.is_one_leaf() {
             // SAFETY: a `VectorUnit` says AVX2 or AVX-512 (which includes it) only where the
             // processor has it.
-            return unsafe { self.nearest_avx2(ray, t_max) };
+            return unsafe {
+                if self.vectors.is_avx512() { self.nearest_avx512(ray, t_max) } else { self.nearest_avx2(ray, t_max) }
+            };
         }
-        // SAFETY: without AVX2.
-        unsafe { self.nearest_with::<false>(ray, t_max) }
+        self.nearest_portable(ray, t_max)
     }
 
-    /// [`Self::nearest`] compiled for AVX2, the tree's nodes tested in AVX2 registers.
+    /// [`Self::nearest`] compiled for AVX2: the tree's nodes tested in AVX2 registers, the
+    /// leaves' flats by the packets' AVX2 kernel inlined (as a mesh's, `MeshShape::hit`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[allow(unsafe_code)]
     fn nearest_avx2(&self, ray: &Ray, t_max: f64) -> Option<Nearest> {
         // SAFETY: this function runs only where AVX2 is.
-        unsafe { self.nearest_with::<true>(ray, t_max) }
+        unsafe { self.nearest_in_lanes(ray, t_max) }
     }
 
-    /// [`Self::nearest`] with the tree's node test of `AVX2` ([`Bvh::traverse_leaves_prefetching_with`]).
+    /// [`Self::nearest_avx2`] compiled for AVX-512 processors: the same bits, 32 registers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    #[allow(unsafe_code)]
+    fn nearest_avx512(&self, ray: &Ray, t_max: f64) -> Option<Nearest> {
+        // SAFETY: this function runs only where AVX-512 (and so AVX2) is.
+        unsafe { self.nearest_in_lanes(ray, t_max) }
+    }
+
+    /// [`Self::nearest`] with AVX2, the ray prepared in lanes once for every leaf's flats.
     ///
     /// # Safety
-    /// `AVX2` only on a processor with AVX2.
+    /// Only on a processor with AVX2.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn nearest_with<const AVX2: bool>(&self, ray: &Ray, t_max: f64) -> Option<Nearest> {
+    unsafe fn nearest_in_lanes(&self, ray: &Ray, t_max: f64) -> Option<Nearest> {
+        let best = self.nearest_unbounded(ray, t_max);
+        let t_best = best.map_or(t_max, |(c, _)| c.t);
+        // SAFETY: the caller's contract.
+        let lanes = unsafe { crate::shape::ray_in_lanes(ray) };
+        let mut visit = NearestInLanes { world: self, ray, lanes, best, best_flat: None };
+        // SAFETY: the caller's contract.
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<true>(ray, t_best, |_| {}, &mut visit) };
+        visit.best_flat.map(|(k, h)| Nearest::Flat(k, h)).or(visit.best.map(|(c, i)| Nearest::Other(c, i)))
+    }
+
+    /// [`Self::nearest`] without AVX2 ([`Bvh::traverse_leaves_prefetching_with`]).
+    #[allow(unsafe_code)]
+    fn nearest_portable(&self, ray: &Ray, t_max: f64) -> Option<Nearest> {
         let mut best = self.nearest_unbounded(ray, t_max);
         let t_best = best.map_or(t_max, |(c, _)| c.t);
         // The nearest flat's packet and lane; made a candidate once, after the traversal.
         let mut best_flat: Option<(usize, LaneHit)> = None;
         let visit = |range: std::ops::Range<usize>, t_max| {
             let leaf = &self.leaves[range.start];
-            let mut closer = None;
-            let mut t_max = t_max;
             // Leaves of spheres and other objects only skip the flat kernel's call, as leaves
             // without spheres skip the sphere kernel's.
-            let flats = if leaf.packets.is_empty() {
-                None
-            } else {
-                self.flats.nearest_packet(leaf.packets.clone(), ray, t_max, self.vectors)
+            let flats = match leaf.packets.is_empty() {
+                true => None,
+                false => self.flats.nearest_packet(leaf.packets.clone(), ray, t_max, self.vectors),
             };
-            if let Some((k, h)) = flats {
-                best_flat = Some((k, h));
-                (t_max, closer) = (h.t, Some(h.t));
-            }
-            if let Some((c, i)) = self.nearest_solid(leaf, ray, t_max) {
-                (best, best_flat) = (Some((c, i)), None);
-                closer = Some(c.t);
-            }
-            closer
+            self.nearest_in_leaf(leaf, ray, t_max, flats, &mut best, &mut best_flat)
         };
-        // SAFETY: the caller's contract.
-        unsafe { self.bvh.traverse_leaves_prefetching_with::<AVX2>(ray, t_best, |_| {}, visit) };
+        // SAFETY: without AVX2.
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<false>(ray, t_best, |_| {}, visit) };
         best_flat.map(|(k, h)| Nearest::Flat(k, h)).or(best.map(|(c, i)| Nearest::Other(c, i)))
+    }
+
+    /// A leaf's part of [`Self::nearest`] once its flats' nearest hit `flats` is known: that
+    /// hit, unless one of its spheres or other objects is nearer; returns the closer hit
+    /// distance if the leaf holds one.
+    #[inline(always)]
+    fn nearest_in_leaf(
+        &self,
+        leaf: &Leaf,
+        ray: &Ray,
+        mut t_max: f64,
+        flats: Option<(usize, LaneHit)>,
+        best: &mut Option<(Candidate, u32)>,
+        best_flat: &mut Option<(usize, LaneHit)>,
+    ) -> Option<f64> {
+        let mut closer = None;
+        if let Some((k, h)) = flats {
+            *best_flat = Some((k, h));
+            (t_max, closer) = (h.t, Some(h.t));
+        }
+        if let Some((c, i)) = self.nearest_solid(leaf, ray, t_max) {
+            (*best, *best_flat) = (Some((c, i)), None);
+            closer = Some(c.t);
+        }
+        closer
     }
 
     /// The nearest hit on an unbounded object (a plane) before `t_max`: the first of equally
@@ -895,28 +934,58 @@ impl World {
         #[cfg(target_arch = "x86_64")]
         if self.vectors.is_simd() && !self.bvh.is_one_leaf() {
             // SAFETY: as in `nearest`.
-            return unsafe { self.unoccluded_avx2(origin, dir, dist) };
+            return unsafe {
+                if self.vectors.is_avx512() {
+                    self.unoccluded_avx512(origin, dir, dist)
+                } else {
+                    self.unoccluded_avx2(origin, dir, dist)
+                }
+            };
         }
-        // SAFETY: without AVX2.
-        unsafe { self.unoccluded_with::<false>(origin, dir, dist) }
+        self.unoccluded_portable(origin, dir, dist)
     }
 
-    /// [`Self::unoccluded`] compiled for AVX2.
+    /// [`Self::unoccluded`] compiled for AVX2, the leaves' flats by the AVX2 kernel inlined.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[allow(unsafe_code)]
     fn unoccluded_avx2(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
         // SAFETY: this function runs only where AVX2 is.
-        unsafe { self.unoccluded_with::<true>(origin, dir, dist) }
+        unsafe { self.unoccluded_in_lanes(origin, dir, dist) }
     }
 
-    /// [`Self::unoccluded`] with the tree's node test of `AVX2`.
+    /// [`Self::unoccluded_avx2`] compiled for AVX-512 processors: the same bits, 32 registers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    #[allow(unsafe_code)]
+    fn unoccluded_avx512(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
+        // SAFETY: this function runs only where AVX-512 (and so AVX2) is.
+        unsafe { self.unoccluded_in_lanes(origin, dir, dist) }
+    }
+
+    /// [`Self::unoccluded`] with AVX2, the ray prepared in lanes once for every leaf's flats.
     ///
     /// # Safety
-    /// `AVX2` only on a processor with AVX2.
+    /// Only on a processor with AVX2.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn unoccluded_with<const AVX2: bool>(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
+    unsafe fn unoccluded_in_lanes(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
+        let ray = Ray::new(origin, dir);
+        if self.unbounded_blocks(&ray, dist) {
+            return false;
+        }
+        // SAFETY: the caller's contract.
+        let lanes = unsafe { crate::shape::ray_in_lanes(&ray) };
+        let mut visit = AnyInLanes { world: self, ray: &ray, lanes, blocked: false };
+        // SAFETY: the caller's contract.
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<true>(&ray, dist, |_| {}, &mut visit) };
+        !visit.blocked
+    }
+
+    /// [`Self::unoccluded`] without AVX2.
+    #[allow(unsafe_code)]
+    fn unoccluded_portable(&self, origin: Vec3, dir: Vec3, dist: f64) -> bool {
         let ray = Ray::new(origin, dir);
         if self.unbounded_blocks(&ray, dist) {
             return false;
@@ -929,8 +998,8 @@ impl World {
                 || self.solid_blocks(leaf, &ray, t_max);
             blocked.then_some(0.0)
         };
-        // SAFETY: the caller's contract.
-        unsafe { self.bvh.traverse_leaves_prefetching_with::<AVX2>(&ray, dist, |_| {}, visit) };
+        // SAFETY: without AVX2.
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<false>(&ray, dist, |_| {}, visit) };
         !blocked
     }
 
@@ -944,6 +1013,57 @@ impl World {
             }
         }
         best
+    }
+}
+
+/// A leaf visit of [`World::nearest_in_lanes`]: the leaf's flats by the AVX2 kernel for a ray in
+/// lanes, inlined into the traversal (a type, not a closure, so that it is), then its other
+/// objects. Made only where AVX2 is (its lanes come from the `unsafe` `ray_in_lanes`).
+#[cfg(target_arch = "x86_64")]
+struct NearestInLanes<'a> {
+    world: &'a World,
+    ray: &'a Ray,
+    lanes: crate::shape::RayLanes,
+    best: Option<(Candidate, u32)>,
+    best_flat: Option<(usize, LaneHit)>,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl crate::bvh::LeafVisit for &mut NearestInLanes<'_> {
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn visit(&mut self, range: std::ops::Range<usize>, t_max: f64) -> Option<f64> {
+        let leaf = &self.world.leaves[range.start];
+        let flats = match leaf.packets.is_empty() {
+            true => None,
+            // SAFETY: a visit is made only where AVX2 is (see the type).
+            false => unsafe { self.world.flats.nearest_packet_in_lanes(leaf.packets.clone(), &self.lanes, t_max) },
+        };
+        self.world.nearest_in_leaf(leaf, self.ray, t_max, flats, &mut self.best, &mut self.best_flat)
+    }
+}
+
+/// A leaf visit of [`World::unoccluded_in_lanes`]: whether the leaf's flats (by the AVX2 kernel
+/// for a ray in lanes) or other objects block the segment, as [`NearestInLanes`].
+#[cfg(target_arch = "x86_64")]
+struct AnyInLanes<'a> {
+    world: &'a World,
+    ray: &'a Ray,
+    lanes: crate::shape::RayLanes,
+    blocked: bool,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl crate::bvh::LeafVisit for &mut AnyInLanes<'_> {
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    fn visit(&mut self, range: std::ops::Range<usize>, t_max: f64) -> Option<f64> {
+        let (world, leaf) = (self.world, &self.world.leaves[range.start]);
+        // SAFETY: a visit is made only where AVX2 is (see the type).
+        self.blocked = !leaf.packets.is_empty()
+            && unsafe { world.flats.any_in_lanes(leaf.packets.clone(), &self.lanes, t_max) }
+            || world.solid_blocks(leaf, self.ray, t_max);
+        self.blocked.then_some(0.0)
     }
 }
 

@@ -472,10 +472,28 @@ impl<L: Copy + Default> PackedFlats<L> {
         r: &RayLanes,
         t_max: f64,
     ) -> Option<(L, LaneHit)> {
+        // SAFETY: the caller's contract.
+        let (k, h) = unsafe { self.nearest_packet_in_lanes(range, r, t_max) }?;
+        Some((self.lanes[k][h.lane], h))
+    }
+
+    /// [`Self::nearest_in_lanes`] naming the packet (its index among all), as
+    /// [`Self::nearest_packet`] does.
+    ///
+    /// # Safety
+    /// As [`ray_in_lanes`].
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub(crate) unsafe fn nearest_packet_in_lanes(
+        &self,
+        range: std::ops::Range<usize>,
+        r: &RayLanes,
+        t_max: f64,
+    ) -> Option<(usize, LaneHit)> {
         let first = range.start;
         // SAFETY: the caller's contract.
         let (k, h) = unsafe { simd::nearest_in(&self.packets[range], r, t_max as f32) }?;
-        Some((self.lanes[first + k][h.lane], h))
+        Some((first + k, h))
     }
 
     /// [`FlatPacket::any_of`] on packets `range` by the AVX2 kernel for a ray in lanes, as

@@ -24,6 +24,8 @@ pub use csg::Csg;
 pub use cylinder::{Cone, Cylinder};
 pub use flat::{Flat, FlatLane, flat_primitives, parallelogram_of, parallelogram_to_triangle};
 pub use flat_packet::{FlatPacket, LANES as FLAT_LANES, LaneHit, PackedFlats, RayPacket, VectorUnit, ray_epsilon};
+#[cfg(target_arch = "x86_64")]
+pub(crate) use flat_packet::{RayLanes, ray_in_lanes};
 pub use mesh::{MeshAccel, MeshShape, on_triangle, triangle_hit};
 pub use plane::{Disk, Plane};
 pub use sphere::Sphere;
