@@ -5,7 +5,7 @@
 //!   Lambert's edge sum), the course's hemicube with its delta form factors, the textbook
 //!   patch-to-patch closed forms;
 //! * [`mesh`] — the surfaces as quadtrees of triangular elements below shooting patches;
-//! * [`solve`] — progressive refinement: the brightest unshot patch shoots, receivers refine
+//! * [`solve`](mod@solve) — progressive refinement: the brightest unshot patch shoots, receivers refine
 //!   where the light changes, point lights and the sky shoot first;
 //! * [`display`] — vertex averaging for display and the final image by ray casting;
 //! * [`ply`] — the solution as a PLY mesh with per-vertex values, read back by the preview.

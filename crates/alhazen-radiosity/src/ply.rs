@@ -167,7 +167,7 @@ pub fn write(
     out.write_all(&buf)
 }
 
-/// Reads a solution written by [`write`]; errors say what is wrong.
+/// Reads a solution written by [`write()`]; errors say what is wrong.
 pub fn read(bytes: &[u8]) -> Result<LitMesh, String> {
     let end = b"end_header\n";
     let at = bytes.windows(end.len()).position(|w| w == end).ok_or("not a PLY file (no end_header)")?;

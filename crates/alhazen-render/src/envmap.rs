@@ -192,7 +192,7 @@ impl EnvMap {
     }
 
     /// The first step of [`Self::sample`]: the row `u` falls in, its `v` and index, and the
-    /// row's guide entries for `u.x` asked of memory ([`prefetch`]), so that paths sampling
+    /// row's guide entries for `u.x` asked of memory (`prefetch`), so that paths sampling
     /// side by side wait for their rows together rather than one after another.
     pub fn sample_row(&self, u: Vec2) -> (f64, usize) {
         let (v, y) = self.rows.sample_point(u.y);

@@ -22,7 +22,7 @@
 //! are then off (the estimate holds their paths too), and so are the lanes' material kernels.
 //!
 //! Where the world tests eight rays at once faster than one by one (`World::traces_rays_together`),
-//! samples are traced side by side in groups of eight (`lanes`), each with the same arithmetic ([`PathTracer::vertex`]),
+//! samples are traced side by side in groups of eight (`lanes`), each with the same arithmetic (`PathTracer::vertex`),
 //! so the same samples, whatever the materials.
 
 use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_at};
@@ -102,7 +102,7 @@ fn offset(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
 
 /// The shadow segment from `p` (geometric normal `ng`) to a light point `dist` away along unit
 /// `dir` (`dist` infinite: a direction): its origin, direction and length. The origin moves off
-/// the surface ([`offset`]); toward a point, the segment is aimed from there at the point (not
+/// the surface (`offset`); toward a point, the segment is aimed from there at the point (not
 /// along `dir`, which seen from the moved origin would cut the light's own surface short of the
 /// point where the light is met at a grazing angle) and stops short of it by more than the
 /// origin moved (`4·ray_epsilon(scale)`), so that the light does not shadow itself. Written

@@ -6,7 +6,7 @@
 //!   `docs/scene-format.md`; every error is a [`Diagnostic`] with `file:line:col`, a caret
 //!   under the offending text, what was expected and, for typos, a "did you mean";
 //! * [`import`] — OBJ/MTL and PLY meshes, PNG textures;
-//! * [`write`] — a scene written back as TOML (with its meshes as PLY, images as EXR).
+//! * [`write`](mod@write) — a scene written back as TOML (with its meshes as PLY, images as EXR).
 //!
 //! ```
 //! let text = "[[object]]\nshape = \"sphere\"\nradius = 1.0\n";

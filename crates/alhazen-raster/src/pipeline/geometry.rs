@@ -186,7 +186,7 @@ fn object_triangles(scene: &Scene, shape: &Shape) -> Option<Vec<[Vertex; 3]>> {
     })
 }
 
-/// How many triangles [`object_triangles`] makes of `shape`, without making them (for the
+/// How many triangles `object_triangles` makes of `shape`, without making them (for the
 /// memory estimate).
 pub fn triangle_count(scene: &Scene, shape: &Shape) -> u64 {
     let round = SEGMENTS as u64;

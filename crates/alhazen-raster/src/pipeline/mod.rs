@@ -426,7 +426,7 @@ impl Projection {
     }
 
     /// The eye ray through NDC `(x, y)`: from the near plane, along the line through the
-    /// depth-0 point (both stay finite under the infinite far plane, unlike [`Self::ray_dir`]'s).
+    /// depth-0 point (both stay finite under the infinite far plane, unlike `Self::ray_dir`'s).
     pub fn near_ray(&self, x: f64, y: f64) -> alhazen_math::Ray {
         let at = |z: f64| {
             let q = self.clip_to_world * Vec4::new(x, y, z, 1.0);

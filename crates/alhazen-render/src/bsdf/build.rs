@@ -283,7 +283,7 @@ fn filmed_coating(coating: Bsdf, film: ThinFilm) -> Bsdf {
 /// The world-space tangent that anisotropic lobes align with at `hit`: Blinn–Phong's
 /// scratches, else `∂p/∂u` for anisotropic microfacets (as pbrt and Mitsuba orient them),
 /// turned about the normal by a metallic–roughness surface's rotation and its map's direction
-/// there ([`turned_tangent`], [`alhazen_scene::bsdf::Anisotropy::at_texel`]); `None` for
+/// there (`turned_tangent`, [`alhazen_scene::bsdf::Anisotropy::at_texel`]); `None` for
 /// isotropic BSDFs, whose frame may turn freely about the normal, and where `∂p/∂u` is
 /// unknown (zero).
 pub fn tangent_at(m: &Material, hit: &crate::shape::SurfaceHit, images: &[Arc<ImageData>]) -> Option<Vec3> {

@@ -24,7 +24,7 @@ pub struct Conductor {
     /// Schlick instead of the exact formula.
     pub schlick: bool,
     /// A rough conductor adds the light that meets several facets (Kulla and Conty's lobe,
-    /// [`super::multiscatter`]), as Cycles' multiple-scattering GGX gives it back: the lobe's
+    /// `super::multiscatter`), as Cycles' multiple-scattering GGX gives it back: the lobe's
     /// terms that do not depend on the directions ([`Self::with_several_facets`]); `None`:
     /// single scattering.
     pub multiscatter: Option<super::SeveralFacets>,

@@ -30,7 +30,7 @@ pub struct Dielectric {
     /// The index depends on wavelength.
     pub dispersive: bool,
     /// A thin sheet (smooth): light passes straight through, or is reflected by both faces
-    /// and the bounces between them ([`Self::thin_sample`]).
+    /// and the bounces between them (`Self::thin_sample`).
     pub thin: bool,
     /// What the refracted (or passing) light keeps, per channel (1: clear; glTF tints
     /// transmission by the base colour, Mitsuba by `specular_transmittance`).

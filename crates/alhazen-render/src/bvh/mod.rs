@@ -258,7 +258,7 @@ impl Bvh {
         Self::build_packed(bounds, |_| false)
     }
 
-    /// A mesh's tree ([`Leaves::MESH`]) by `method`, over `count` primitives whose bounds
+    /// A mesh's tree (`Leaves::MESH`) by `method`, over `count` primitives whose bounds
     /// `bounds(i)` gives: no vector of them is made (a million-triangle mesh's would be 48 MB
     /// of fresh memory).
     pub fn build_with(
@@ -272,7 +272,7 @@ impl Bvh {
 
     /// [`Self::build`] for primitives some of which (`packed(i)`) are tested eight at a time
     /// in a leaf: the surface area heuristic charges a leaf one test per started group of
-    /// them plus one per other primitive ([`Leaves::WORLD`]), so leaves of such primitives grow
+    /// them plus one per other primitive (`Leaves::WORLD`), so leaves of such primitives grow
     /// large.
     pub fn build_packed(bounds: &[Bounds3], packed: impl Fn(usize) -> bool + Sync) -> Self {
         Self::build_packed_within(bounds, packed, 0)

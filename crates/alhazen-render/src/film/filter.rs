@@ -6,7 +6,7 @@
 //! pixel (the film's exact sums and its parts are unchanged), and the filter costs a table
 //! lookup a sample.
 //!
-//! Each axis's profile is tabulated as a staircase of [`STEPS`] steps, each holding the same
+//! Each axis's profile is tabulated as a staircase of `STEPS` steps, each holding the same
 //! share of `∫|f|` (narrow where the filter is high, wide in its tails), each as high as the
 //! profile's mean magnitude over it: the offset is drawn from the staircase exactly — step
 //! `⌊u · STEPS⌋`, uniformly within it, no search — so the filter applied is the staircase, which
