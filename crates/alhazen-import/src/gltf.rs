@@ -15,7 +15,8 @@
 //! `KHR_materials_volume` (and its index by wavelength with `KHR_materials_dispersion`), a
 //! clear coat with `KHR_materials_clearcoat`, cloth's sheen with `KHR_materials_sheen`, brushed
 //! facets with `KHR_materials_anisotropy`, a thin film's interference colours with
-//! `KHR_materials_iridescence`; a metallic–roughness texture, a textured metal's
+//! `KHR_materials_iridescence`; an unlit material (`KHR_materials_unlit`) is a black emitter
+//! of its base colour; a metallic–roughness texture, a textured metal's
 //! colour, stretched facets and a thin film are read per point (`BsdfDesc::MetallicRoughness`, the model at
 //! each point), by their means under transmission; so is an emission texture (its factor and strength
 //! multiplied in).
@@ -62,6 +63,7 @@ const KNOWN: &[&str] = &[
     "EXT_mesh_gpu_instancing",
     "KHR_materials_sheen",
     "KHR_materials_iridescence",
+    "KHR_materials_unlit",
     draco::EXTENSION,
     meshopt::EXTENSIONS[0],
     meshopt::EXTENSIONS[1],
@@ -130,6 +132,7 @@ fn load_bytes(path: &Path, bytes: &[u8], memory_budget: u64) -> Result<Imported,
         decoded: HashMap::new(),
         camera: None,
         bounds: Bounds3::EMPTY,
+        unlit: Default::default(),
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.extensions(&document);
@@ -222,6 +225,9 @@ struct Importer<'a> {
     decoded: HashMap<(usize, Decoding), Result<ImageData, String>>,
     camera: Option<CameraDesc>,
     bounds: Bounds3,
+    /// The materials made of `KHR_materials_unlit` ones, whose emission vertex colours do not
+    /// tint.
+    unlit: std::collections::HashSet<MaterialId>,
 }
 
 impl Importer<'_> {
@@ -337,6 +343,12 @@ impl Importer<'_> {
         // glTF multiplies every base colour by COLOR_0 where a primitive has it.
         if !self.scene.meshes[index].colors.is_empty() {
             self.scene.materials[material as usize].vertex_colors = true;
+            if self.unlit.contains(&material) {
+                let name = &self.scene.materials[material as usize].name;
+                let message =
+                    format!("{name}: the vertex colours (COLOR_0) of an unlit material are not supported; ignored");
+                self.warn(message);
+            }
         }
         self.bounds = self.bounds.union(t.bounds(&self.scene.meshes[index].bounds()));
         self.scene.objects.push(Object {
@@ -702,6 +714,9 @@ impl Importer<'_> {
             }
             None => (Texture::Solid(factor), factor),
         };
+        if material.extension_value("KHR_materials_unlit").is_some() {
+            return self.unlit(&material, &name, base, base_mean, c[3] as f64);
+        }
         // The emissive texture is read per point, its factor and strength multiplied in.
         let strength = material.emissive_strength().unwrap_or(1.0) as f64;
         let mut emission = rgb(material.emissive_factor()) * strength;
@@ -853,6 +868,31 @@ impl Importer<'_> {
         m.alpha = alpha;
         let id = common::add_material(&mut self.scene, m);
         self.materials.insert(material.index(), id);
+        Ok(id)
+    }
+
+    /// `KHR_materials_unlit`: the base colour shown as it is. A path tracer has no surface
+    /// that lighting leaves alone, so the material is an emitter of radiance equal to its base
+    /// colour (factor times texture, read per point) that reflects nothing: a camera ray that
+    /// meets it sees exactly the base colour, as glTF's unlit shading says, and a scene of unlit
+    /// materials (baked lighting) renders as it was baked. Blender's importer makes the same
+    /// emitter visible to camera rays only; here it also lights its neighbours and casts shadows.
+    /// Its other properties are ignored, as the extension says; its alpha cuts out as any
+    /// material's.
+    fn unlit(&mut self, material: &gltf::Material, name: &str, base: Texture, mean: Vec3, alpha: f64) -> R<MaterialId> {
+        let placement = match base {
+            Texture::Image { scale, offset, rotation, .. } => (scale, offset, rotation),
+            _ => (Vec2::ONE, Vec2::ZERO, 0.0),
+        };
+        let alpha = self.cut_out(material, alpha, placement)?;
+        let black = BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::ZERO) };
+        let mut m = alhazen_scene::Material::from_bsdf(name, black);
+        m.emission = mean;
+        m.emission_texture = matches!(base, Texture::Image { .. }).then_some(base);
+        m.alpha = alpha;
+        let id = common::add_material(&mut self.scene, m);
+        self.materials.insert(material.index(), id);
+        self.unlit.insert(id);
         Ok(id)
     }
 

@@ -2131,3 +2131,47 @@ fn damaged_or_oversized_meshopt_streams_are_refused() {
         assert!(err.contains("buffer view 0: its EXT_meshopt_compression") && err.contains(expected), "{key}: {err}");
     }
 }
+
+/// `KHR_materials_unlit`: the base colour shown as it is — a black emitter of the base colour
+/// (factor times texture, per point), read without a warning, whatever lights the scene has:
+/// the quad's centre pixel is the texture's mean times the factor, though a point light shines
+/// on it. Its vertex colours, which the emission does not take, are warned about.
+#[test]
+fn an_unlit_material_shows_its_base_colour() {
+    let doc = embedded().replace(
+        r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
+        r#""metallicFactor": 0, "roughnessFactor": 0.5 }, "extensions": { "KHR_materials_unlit": {} }"#,
+    );
+    let doc = doc.replace(
+        r#""extensionsUsed": ["KHR_lights_punctual"]"#,
+        r#""extensionsUsed": ["KHR_lights_punctual", "KHR_materials_unlit"]"#,
+    );
+    let unlit_doc = doc.clone();
+    let s = write_and_import(&[("unlit.gltf", doc.into_bytes())]).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let m = &s.scene.materials[s.scene.objects[0].material as usize];
+    assert_eq!(m.bsdf, Some(BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::ZERO) }));
+    let Some(Texture::Image { image, .. }) = &m.emission_texture else { panic!("{:?}", m.emission_texture) };
+    let mean = alhazen_scene::texture::image_mean(&s.scene.images[*image]);
+    assert_eq!(m.emission, mean);
+    let texels: Vec<[f32; 3]> = s.scene.images[*image].texels().collect();
+    assert_eq!(texels, vec![[0.5, 0.0, 0.0], [0.0, 0.0, 1.0]], "red and blue, times the factor (0.5, 1, 1)");
+    // The quad spans x ∈ [1, 3], y ∈ [0, 2] at z = 0 before the camera at z = 5 (yfov 0.8):
+    // its middle falls near pixel (47, 12) of 64 × 32, between the texture's red and blue
+    // texels. Its colour is their blend, `r/0.5 + b = 1` and no green — not the orange point
+    // light's reflection.
+    let mut scene = s.scene;
+    (scene.render.width, scene.render.height, scene.render.spp) = (64, 32, 4);
+    let img = alhazen_render::render(&scene, &|_, _| {});
+    let c = img.get(47, 12);
+    assert!(c.y == 0.0 && c.x > 0.1 && c.z > 0.1 && (c.x / 0.5 + c.z - 1.0).abs() < 1e-4, "{c}");
+    // Vertex colours (the quad's normals read as colours) would tint a lit base colour; an
+    // unlit one's emission does not take them, and says so.
+    let painted = unlit_doc.replace(r#""TEXCOORD_0": 2 }"#, r#""TEXCOORD_0": 2, "COLOR_0": 1 }"#);
+    let s = write_and_import(&[("painted.gltf", painted.into_bytes())]).unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.to_string().contains("vertex colours (COLOR_0) of an unlit material")),
+        "{:?}",
+        s.warnings
+    );
+}
