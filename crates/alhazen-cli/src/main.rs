@@ -143,7 +143,8 @@ struct ConvertArgs {
 #[derive(Args, Default)]
 pub(crate) struct SceneParameters {
     /// A Mitsuba scene's parameter: `-D spp=64` gives `$spp` that value, over the scene's
-    /// `<default>` (repeat for more).
+    /// `<default>` (repeat for more); for a glTF file, `-D variant=NAME` picks a material
+    /// variant (`KHR_materials_variants`).
     #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define)]
     pub(crate) defines: Vec<(String, String)>,
 }
@@ -266,9 +267,10 @@ fn main() -> ExitCode {
 /// what the import approximated; every problem with it is bad input (exit code 2).
 pub(crate) fn load(path: &Path, parameters: &SceneParameters) -> Result<Scene, Failure> {
     let format = alhazen_import::SceneFormat::from_path(path);
-    if !parameters.defines.is_empty() && format != alhazen_import::SceneFormat::Mitsuba {
+    let takes_parameters = matches!(format, alhazen_import::SceneFormat::Mitsuba | alhazen_import::SceneFormat::Gltf);
+    if !parameters.defines.is_empty() && !takes_parameters {
         return Err(Failure::input(format!(
-            "-D gives values to a Mitsuba scene's $parameters; {} is a {} file",
+            "-D gives values to a Mitsuba scene's $parameters, or a glTF file's material variant; {} is a {} file",
             path.display(),
             format.name()
         )));

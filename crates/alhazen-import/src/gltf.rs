@@ -16,7 +16,8 @@
 //! clear coat with `KHR_materials_clearcoat`, cloth's sheen with `KHR_materials_sheen`, brushed
 //! facets with `KHR_materials_anisotropy`, a thin film's interference colours with
 //! `KHR_materials_iridescence`; an unlit material (`KHR_materials_unlit`) is a black emitter
-//! of its base colour; a metallic–roughness texture, a textured metal's
+//! of its base colour; a `KHR_materials_variants` variant is chosen by the `variant` parameter
+//! (`-D variant=NAME`); a metallic–roughness texture, a textured metal's
 //! colour, stretched facets and a thin film are read per point (`BsdfDesc::MetallicRoughness`, the model at
 //! each point), by their means under transmission; so is an emission texture (its factor and strength
 //! multiplied in).
@@ -64,6 +65,7 @@ const KNOWN: &[&str] = &[
     "KHR_materials_sheen",
     "KHR_materials_iridescence",
     "KHR_materials_unlit",
+    "KHR_materials_variants",
     draco::EXTENSION,
     meshopt::EXTENSIONS[0],
     meshopt::EXTENSIONS[1],
@@ -71,7 +73,7 @@ const KNOWN: &[&str] = &[
 
 /// Reads a glTF 2.0 file, refusing compressed meshes that would decode to more than
 /// `memory_budget` bytes before decoding them.
-pub fn load(path: &Path, memory_budget: u64) -> Result<Imported, SceneError> {
+pub fn load(path: &Path, memory_budget: u64, parameters: &[(String, String)]) -> Result<Imported, SceneError> {
     let bytes = common::read_bytes(path)?;
     // The gltf crate's validation panics on some inconsistent files (an index out of bounds in
     // gltf-json 1.4, found by fuzzing): such a panic is caught, kept off the terminal, and
@@ -79,14 +81,20 @@ pub fn load(path: &Path, memory_budget: u64) -> Result<Imported, SceneError> {
     // would be silent too, and still fail.)
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_bytes(path, &bytes, memory_budget)));
+    let result =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_bytes(path, &bytes, memory_budget, parameters)));
     std::panic::set_hook(hook);
     result.unwrap_or_else(|_| {
         Err(error(path, &bytes, "not a valid glTF 2.0 file: its parts are inconsistent (the glTF reader failed on it)"))
     })
 }
 
-fn load_bytes(path: &Path, bytes: &[u8], memory_budget: u64) -> Result<Imported, SceneError> {
+fn load_bytes(
+    path: &Path,
+    bytes: &[u8],
+    memory_budget: u64,
+    parameters: &[(String, String)],
+) -> Result<Imported, SceneError> {
     let invalid = |e: gltf::Error| error(path, bytes, format!("not a valid glTF 2.0 file: {e}"));
     let (mut json, blob) = parse(bytes).map_err(invalid)?;
     // A required extension alhazen cannot read is said before the reader's validation (which
@@ -133,9 +141,12 @@ fn load_bytes(path: &Path, bytes: &[u8], memory_budget: u64) -> Result<Imported,
         camera: None,
         bounds: Bounds3::EMPTY,
         unlit: Default::default(),
+        all_materials: document.materials().collect(),
+        variant: None,
     };
     imp.scene.render.integrator = IntegratorKind::Path;
     imp.extensions(&document);
+    imp.variant = imp.chosen_variant(&document, parameters)?;
     let scene = document.default_scene().or_else(|| document.scenes().next());
     let Some(scene) = scene else { return Err(error(path, bytes, "the file has no scene")) };
     imp.worlds = node_worlds(&scene);
@@ -228,9 +239,13 @@ struct Importer<'a> {
     /// The materials made of `KHR_materials_unlit` ones, whose emission vertex colours do not
     /// tint.
     unlit: std::collections::HashSet<MaterialId>,
+    /// The file's materials, for `KHR_materials_variants`' mappings, which name them by index.
+    all_materials: Vec<gltf::Material<'a>>,
+    /// The `KHR_materials_variants` variant chosen (`-D variant=NAME`), by index.
+    variant: Option<usize>,
 }
 
-impl Importer<'_> {
+impl<'a> Importer<'a> {
     fn warn(&mut self, message: impl Into<String>) {
         self.warnings.add(self.path, 0, message);
     }
@@ -247,6 +262,60 @@ impl Importer<'_> {
                 self.warn(format!("extension {e} is not supported; ignored"));
             }
         }
+    }
+
+    /// The `KHR_materials_variants` variant `-D variant=NAME` names (its index), or none; any
+    /// other parameter, or a name the file does not have, is an error that lists the names.
+    /// A file with variants rendered without one says which it has.
+    fn chosen_variant(&mut self, doc: &gltf::Document, parameters: &[(String, String)]) -> R<Option<usize>> {
+        let names: Vec<String> = doc
+            .extension_value("KHR_materials_variants")
+            .and_then(|v| v.get("variants"))
+            .and_then(|v| v.as_array())
+            .map(|all| {
+                let name = |(i, v): (usize, &serde_json::Value)| match v.get("name").and_then(|n| n.as_str()) {
+                    Some(n) => n.to_string(),
+                    None => format!("variant {i}"),
+                };
+                all.iter().enumerate().map(name).collect()
+            })
+            .unwrap_or_default();
+        let listed = || match names.is_empty() {
+            true => "the file has no material variants".to_string(),
+            false => format!(
+                "its material variants are {}",
+                names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+            ),
+        };
+        let mut chosen = None;
+        for (key, value) in parameters {
+            if key != "variant" {
+                return Err(self.err(format!(
+                    "-D {key}=…: a glTF file takes one parameter, -D variant=NAME (KHR_materials_variants); {}",
+                    listed()
+                )));
+            }
+            let Some(i) = names.iter().position(|n| n == value) else {
+                return Err(self.err(format!("-D variant={value}: no such material variant; {}", listed())));
+            };
+            chosen = Some(i);
+        }
+        if chosen.is_none() && !names.is_empty() {
+            self.warn(format!("{}: its default materials are used (-D variant=NAME picks one)", listed()));
+        }
+        Ok(chosen)
+    }
+
+    /// The material the chosen variant maps `prim` to, if it maps it.
+    fn variant_material(&self, prim: &gltf::Primitive) -> Option<gltf::Material<'a>> {
+        let variant = self.variant?;
+        let mappings = prim.extension_value("KHR_materials_variants")?.get("mappings")?.as_array()?;
+        let maps_it = |m: &&serde_json::Value| {
+            let variants = m.get("variants").and_then(|v| v.as_array());
+            variants.is_some_and(|v| v.iter().any(|x| x.as_u64() == Some(variant as u64)))
+        };
+        let material = mappings.iter().find(maps_it)?.get("material")?.as_u64()?;
+        self.all_materials.get(usize::try_from(material).ok()?).cloned()
     }
 
     fn finish(mut self) -> R<Imported> {
@@ -339,7 +408,10 @@ impl Importer<'_> {
 
     /// An object of scene mesh `index` (the primitive's) with its material, placed by `t`.
     fn place_mesh(&mut self, mesh: &gltf::Mesh, prim: &gltf::Primitive, index: usize, t: Transform) -> R<()> {
-        let material = self.material(prim.material())?;
+        let material = match self.variant_material(prim) {
+            Some(m) => self.material(m)?,
+            None => self.material(prim.material())?,
+        };
         // glTF multiplies every base colour by COLOR_0 where a primitive has it.
         if !self.scene.meshes[index].colors.is_empty() {
             self.scene.materials[material as usize].vertex_colors = true;

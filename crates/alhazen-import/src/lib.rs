@@ -110,7 +110,9 @@ pub fn load_within(path: &Path, memory_budget: u64) -> Result<Imported, SceneErr
 }
 
 /// [`load_within`], a Mitsuba scene's `$name` parameters given `parameters`' values over its
-/// `<default>`s (Mitsuba's `-D name=value`; other formats have no parameters and ignore them).
+/// `<default>`s (Mitsuba's `-D name=value`), or a glTF file's material variant chosen by
+/// `variant` (`KHR_materials_variants`; another name is an error); the other formats have no
+/// parameters and ignore them.
 pub fn load_with_parameters(
     path: &Path,
     memory_budget: u64,
@@ -134,7 +136,7 @@ fn read(path: &Path, memory_budget: u64, parameters: &[(String, String)]) -> Res
                 warnings.into_iter().map(|message| Warning { file: path.to_path_buf(), line: 0, message }).collect();
             Ok(Imported { scene, warnings })
         }
-        SceneFormat::Gltf => gltf::load(path, memory_budget),
+        SceneFormat::Gltf => gltf::load(path, memory_budget, parameters),
         SceneFormat::Mitsuba => mitsuba::load_with_parameters(path, parameters),
         SceneFormat::Pbrt => pbrt::load(path),
     }

@@ -2175,3 +2175,56 @@ fn an_unlit_material_shows_its_base_colour() {
         s.warnings
     );
 }
+
+/// `KHR_materials_variants`: `-D variant=NAME` (the `variant` parameter) gives each primitive
+/// the material the variant maps it to, others keep their default; without one the file's
+/// variants are named in a warning; a name the file lacks, or another parameter, is an error
+/// that lists the names.
+#[test]
+fn material_variants_are_chosen_by_name() {
+    let doc = embedded()
+        .replace(
+            r#""material": 0 }]"#,
+            r#""material": 0, "extensions": { "KHR_materials_variants": { "mappings": [{ "material": 1, "variants": [1] }] } } }]"#,
+        )
+        .replace(
+            r#""roughnessFactor": 0.5 }  }],"#,
+            r#""roughnessFactor": 0.5 } }, { "name": "red", "pbrMetallicRoughness": { "baseColorFactor": [1, 0, 0, 1], "metallicFactor": 0 } }],"#,
+        )
+        .replace(
+            r#""extensions": { "KHR_lights_punctual""#,
+            r#""extensions": { "KHR_materials_variants": { "variants": [{ "name": "plain" }, { "name": "red" }] }, "KHR_lights_punctual""#,
+        )
+        .replace(r#""extensionsUsed": ["KHR_lights_punctual"]"#, r#""extensionsUsed": ["KHR_lights_punctual", "KHR_materials_variants"]"#);
+    assert!(doc.contains(r#""name": "red", "pbr"#) && doc.contains("mappings") && doc.contains(r#""name": "plain""#));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("variants.gltf");
+    std::fs::write(&path, doc).unwrap();
+    let load = |params: &[(&str, &str)]| {
+        let params: Vec<(String, String)> = params.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+        alhazen_import::load_with_parameters(&path, alhazen_scene::DEFAULT_MEMORY_BUDGET, &params)
+    };
+    let material = |s: &Imported| s.scene.materials[s.scene.objects[0].material as usize].name.clone();
+    let default = load(&[]).unwrap();
+    assert_eq!(material(&default), "tex");
+    let said: Vec<String> = default.warnings.iter().map(|w| w.to_string()).collect();
+    assert!(said.iter().any(|w| w.contains("`plain`, `red`") && w.contains("-D variant=NAME")), "{said:?}");
+    let red = load(&[("variant", "red")]).unwrap();
+    assert_eq!(material(&red), "red");
+    assert!(red.warnings.is_empty(), "{:?}", red.warnings);
+    assert_eq!(
+        material(&load(&[("variant", "plain")]).unwrap()),
+        "tex",
+        "a variant that maps nothing keeps the default"
+    );
+    let err = load(&[("variant", "blue")]).unwrap_err().to_string();
+    assert!(err.contains("no such material variant") && err.contains("`plain`, `red`"), "{err}");
+    let err = load(&[("spp", "4")]).unwrap_err().to_string();
+    assert!(err.contains("-D variant=NAME"), "{err}");
+    // A file without variants says so when one is asked for.
+    let plain = dir.path().join("plain.gltf");
+    std::fs::write(&plain, embedded()).unwrap();
+    let params = [("variant".to_string(), "red".to_string())];
+    let err = alhazen_import::load_with_parameters(&plain, alhazen_scene::DEFAULT_MEMORY_BUDGET, &params).unwrap_err();
+    assert!(err.to_string().contains("the file has no material variants"), "{err}");
+}
