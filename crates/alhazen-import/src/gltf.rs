@@ -306,16 +306,25 @@ impl<'a> Importer<'a> {
         Ok(chosen)
     }
 
-    /// The material the chosen variant maps `prim` to, if it maps it.
-    fn variant_material(&self, prim: &gltf::Primitive) -> Option<gltf::Material<'a>> {
+    /// The material the chosen variant maps `prim` to, if it maps it; a mapping that names no
+    /// material of the file is warned about and the default kept.
+    fn variant_material(&mut self, prim: &gltf::Primitive) -> Option<gltf::Material<'a>> {
         let variant = self.variant?;
         let mappings = prim.extension_value("KHR_materials_variants")?.get("mappings")?.as_array()?;
         let maps_it = |m: &&serde_json::Value| {
             let variants = m.get("variants").and_then(|v| v.as_array());
             variants.is_some_and(|v| v.iter().any(|x| x.as_u64() == Some(variant as u64)))
         };
-        let material = mappings.iter().find(maps_it)?.get("material")?.as_u64()?;
-        self.all_materials.get(usize::try_from(material).ok()?).cloned()
+        let named = mappings.iter().find(maps_it)?.get("material");
+        let found =
+            named.and_then(|m| m.as_u64()).and_then(|m| self.all_materials.get(usize::try_from(m).ok()?)).cloned();
+        if found.is_none() {
+            let named = named.map_or("nothing".to_string(), |m| m.to_string());
+            self.warn(format!(
+                "a KHR_materials_variants mapping names material {named}, which the file does not have: the default material is kept"
+            ));
+        }
+        found
     }
 
     fn finish(mut self) -> R<Imported> {

@@ -2221,6 +2221,17 @@ fn material_variants_are_chosen_by_name() {
     assert!(err.contains("no such material variant") && err.contains("`plain`, `red`"), "{err}");
     let err = load(&[("spp", "4")]).unwrap_err().to_string();
     assert!(err.contains("-D variant=NAME"), "{err}");
+    // A mapping to a material the file lacks keeps the default, with a warning.
+    let broken = dir.path().join("broken.gltf");
+    std::fs::write(
+        &broken,
+        std::fs::read_to_string(&path).unwrap().replace(r#""material": 1, "variants""#, r#""material": 7, "variants""#),
+    )
+    .unwrap();
+    let params = [("variant".to_string(), "red".to_string())];
+    let s = alhazen_import::load_with_parameters(&broken, alhazen_scene::DEFAULT_MEMORY_BUDGET, &params).unwrap();
+    assert_eq!(material(&s), "tex");
+    assert!(s.warnings.iter().any(|w| w.to_string().contains("names material 7")), "{:?}", s.warnings);
     // A file without variants says so when one is asked for.
     let plain = dir.path().join("plain.gltf");
     std::fs::write(&plain, embedded()).unwrap();
