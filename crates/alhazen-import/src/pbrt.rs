@@ -1141,6 +1141,7 @@ impl Importer {
                     facets: common::ggx(rough.0, rough.1),
                     ior,
                     fresnel: FresnelMode::Exact,
+                    layered: false,
                 }
             }
             "diffusetransmission" => {

@@ -54,9 +54,20 @@ fn catalogue() -> Vec<(String, Bsdf)> {
                 Bsdf::CookTorrance(CookTorrance {
                     diffuse: albedo * 0.4,
                     ks: 0.6,
-                    lobe: CookTorranceLobe { facets: facets(d, a, a, g), ior: 1.5, schlick: false },
+                    lobe: CookTorranceLobe { facets: facets(d, a, a, g), ior: 1.5, schlick: false, layer: 0.0 },
                 }),
             ));
+            if d != Distribution::Gaussian {
+                // A white base layered under the lobe: everything it receives comes back.
+                list.push((
+                    format!("layered cook-torrance {name} m={a}, white"),
+                    Bsdf::CookTorrance(CookTorrance {
+                        diffuse: Vec3::ONE,
+                        ks: 1.0,
+                        lobe: CookTorranceLobe { facets: facets(d, a, a, g), ior: 1.5, schlick: false, layer: 1.0 },
+                    }),
+                ));
+            }
             if d != Distribution::Gaussian {
                 list.push((
                     format!("rough conductor {name} m={a}"),
@@ -134,7 +145,12 @@ fn catalogue() -> Vec<(String, Bsdf)> {
         })),
     ));
     // Clear coats: a glossy one over Lambert, a rougher one of half weight over a rough metal.
-    let coat = |alpha: f64| alhazen_render::bsdf::CookTorranceLobe { facets: ggx(alpha), ior: 1.5, schlick: false };
+    let coat = |alpha: f64| alhazen_render::bsdf::CookTorranceLobe {
+        facets: ggx(alpha),
+        ior: 1.5,
+        schlick: false,
+        layer: 0.0,
+    };
     list.push((
         "coated lambert, coat ggx m=0.05".into(),
         Bsdf::Coated(Box::new(Coated::new(Bsdf::Lambert(Lambert { albedo }), coat(0.05), 1.0))),
@@ -201,8 +217,8 @@ fn filmed(metallic: f64, multiscatter: bool) -> Bsdf {
 fn filmed_by(metallic: f64, multiscatter: bool, factor: f64) -> Bsdf {
     use alhazen_scene::bsdf::{Anisotropy, BsdfDesc, Iridescence};
     let desc = BsdfDesc::MetallicRoughness {
-        // (Pale enough that the model's coating, whose diffuse weight does not fall with the
-        // angle, keeps within the energy it receives at grazing angles.)
+        // (Pale: the coating's diffuse term is layered under its own lobe, but the film's lobe
+        // that replaces part of it may reflect more than the lobe would.)
         base: alhazen_scene::Texture::Solid(Vec3::new(0.6, 0.45, 0.3)),
         metallic,
         roughness: 0.4,
@@ -458,6 +474,19 @@ fn white_smooth_plastic_reflects_all_it_receives() {
     }
 }
 
+/// A white base layered under a Cook–Torrance lobe (glTF's dielectric, as Cycles layers it)
+/// gives back what it receives at every angle, within the lobe's tabulated albedo; with the
+/// constant weight `1 − F(0)` it gave back 9 % more at 85°.
+#[test]
+fn white_layered_cook_torrance_reflects_all_it_receives() {
+    for (name, b) in catalogue().into_iter().filter(|(name, _)| name.starts_with("layered")) {
+        for theta in [0.0, 40.0, 75.0, 85.0] {
+            let (a, err) = albedo(&b, direction(theta, 0.2), 200_000);
+            assert!((a.x - 1.0).abs() < 4.0 * err + 5e-3, "{name} at {theta}°: {a} ± {err}");
+        }
+    }
+}
+
 #[test]
 fn reciprocal_brdfs_satisfy_helmholtz() {
     let mut rng = Rng::for_sample(2, 2, 2, 2);
@@ -465,7 +494,11 @@ fn reciprocal_brdfs_satisfy_helmholtz() {
         if name.starts_with("rough dielectric") {
             continue; // dielectrics obey the η² law below
         }
-        if name.starts_with("coated") || name.starts_with("sheened") {
+        if name.starts_with("coated")
+            || name.starts_with("sheened")
+            || name.starts_with("layered")
+            || name.contains("metallic-roughness 0")
+        {
             continue; // the base under a coat is weighed by what the coat lets through towards the viewer only (glTF's and Cycles' layering)
         }
         for _ in 0..200 {
@@ -630,7 +663,7 @@ fn several_facets_give_the_white_furnace_back_its_light() {
 
 /// A metallic–roughness coating's specular maps (glTF's `specularTexture` and
 /// `specularColorTexture`) act per point: the first scales its specular strength (`k_s =
-/// specular · texel`, the diffuse weighted by `1 − k_s·F(0)`), the second its normal-incidence
+/// specular · texel`, the diffuse layered under it), the second its normal-incidence
 /// reflectance (`F(0)` times the texel's mean, through the index with that reflectance).
 #[test]
 fn specular_maps_shape_the_coating_per_point() {
@@ -656,19 +689,19 @@ fn specular_maps_shape_the_coating_per_point() {
         let images = std::slice::from_ref(&texel);
         match alhazen_render::bsdf::bsdf_at(&m, Vec2::ZERO, Vec3::ONE, images, alhazen_render::bsdf::ColorMode::Rgb) {
             Bsdf::Mix(mix) => match mix.b {
-                Bsdf::CookTorrance(c) => (c.ks, c.diffuse.x, c.lobe.ior),
+                Bsdf::CookTorrance(c) => {
+                    assert_eq!(c.lobe.layer, c.ks, "the diffuse layered under the lobe");
+                    (c.ks, c.diffuse.x, c.lobe.ior)
+                }
                 other => panic!("{other:?}"),
             },
             other => panic!("{other:?}"),
         }
     };
-    assert_eq!(coating(None, None), (0.8, 0.5 * (1.0 - 0.8 * 0.04), 1.5));
-    let (ks, kd, _) = coating(Some(map.clone()), None);
-    assert!((ks - 0.2).abs() < 1e-12 && (kd - 0.5 * (1.0 - 0.2 * 0.04)).abs() < 1e-12, "{ks} {kd}");
+    assert_eq!(coating(None, None), (0.8, 0.5, 1.5));
+    let (ks, diffuse, _) = coating(Some(map.clone()), None);
+    assert!((ks - 0.2).abs() < 1e-12 && diffuse == 0.5, "{ks} {diffuse}");
     // F(0) of 1.5 is 0.04; a quarter of it is 0.01, the reflectance of an index of 11/9.
-    let (ks, kd, ior) = coating(None, Some(map));
-    assert!(
-        (ior - 11.0 / 9.0).abs() < 1e-12 && ks == 0.8 && (kd - 0.5 * (1.0 - 0.8 * 0.01)).abs() < 1e-12,
-        "{ior} {kd}"
-    );
+    let (ks, diffuse, ior) = coating(None, Some(map));
+    assert!((ior - 11.0 / 9.0).abs() < 1e-12 && ks == 0.8 && diffuse == 0.5, "{ior} {diffuse}");
 }

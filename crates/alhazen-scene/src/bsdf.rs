@@ -149,6 +149,11 @@ pub enum BsdfDesc {
         ior: f64,
         /// Exact or Schlick.
         fresnel: FresnelMode,
+        /// The diffuse term weighed by what the specular lobe leaves towards the viewer,
+        /// `k_d·(1 − k_s·E(μ_o))` with `E` the lobe's directional albedo (Cycles' Principled
+        /// BSDF's albedo scaling, what a glTF dielectric is layered as): energy is kept at every
+        /// angle, where a constant `k_d` sends back more than arrives at grazing angles.
+        layered: bool,
     },
     /// Plastic: a diffuse base under a dielectric coat of index `ior`, smooth when `facets` is
     /// `None`, the light bouncing between base and coat summed in closed form (Mitsuba 3's
@@ -220,8 +225,8 @@ pub enum BsdfDesc {
         /// The coating's index of refraction.
         ior: f64,
         /// The strength of the coating's specular lobe (glTF's `KHR_materials_specular`
-        /// `specularFactor`, 1 without it): Cook–Torrance's `ks`, the diffuse weighted by
-        /// `1 − specular·F(0)`.
+        /// `specularFactor`, 1 without it): Cook–Torrance's `ks`, the diffuse layered under it
+        /// (weighted by `1 − specular·E(μ_o)`).
         specular: f64,
         /// The metal's light of several facets ([`BsdfDesc::Conductor`]'s `multiscatter`).
         multiscatter: bool,
@@ -305,7 +310,12 @@ impl crate::model::Material {
     fn follow(&mut self, bsdf: &BsdfDesc) {
         match bsdf {
             BsdfDesc::Lambert { albedo } | BsdfDesc::OrenNayar { albedo, .. } => self.color = albedo.clone(),
-            BsdfDesc::CookTorrance { albedo, kd, .. } => (self.color, self.diffuse) = (albedo.clone(), *kd),
+            BsdfDesc::CookTorrance { albedo, kd, ks, ior, layered, .. } => {
+                // A layered surface's diffuse weight as seen head-on.
+                let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+                let kd = if *layered { kd * (1.0 - ks * f0) } else { *kd };
+                (self.color, self.diffuse) = (albedo.clone(), kd);
+            }
             BsdfDesc::Plastic { albedo, ior, facets, .. } => {
                 // The diffuse base as colour, the coat's normal-incidence reflectance as a
                 // highlight (as sharp as its roughness) or a faint mirror.
@@ -387,14 +397,14 @@ fn metallic_roughness_lobes(base: Rgb, roughness: f64, lobes: MetalRoughness) ->
         fresnel: FresnelMode::Schlick,
         multiscatter,
     };
-    let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
     let coating = BsdfDesc::CookTorrance {
         albedo: Texture::Solid(base),
-        kd: 1.0 - specular * f0,
+        kd: 1.0,
         ks: specular,
         facets: ggx(along.max(0.01), across.max(0.01)),
         ior,
         fresnel: FresnelMode::Exact,
+        layered: true,
     };
     (metal, coating)
 }

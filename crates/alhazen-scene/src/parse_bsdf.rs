@@ -89,7 +89,7 @@ impl Parser<'_> {
             "oren-nayar" => vec!["color", "sigma", "interreflection"],
             "phong" => vec!["color", "kd", "ks", "exponent"],
             "blinn-phong" => vec!["color", "kd", "ks", "exponent", "anisotropy", "scratches"],
-            "cook-torrance" => [&["color", "kd", "ks", "ior", "fresnel"][..], MICROFACET_KEYS].concat(),
+            "cook-torrance" => [&["color", "kd", "ks", "ior", "fresnel", "layered"][..], MICROFACET_KEYS].concat(),
             "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel", "multiscatter"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [
@@ -146,7 +146,8 @@ impl Parser<'_> {
                 }
             }
             "cook-torrance" => {
-                let (kd, ks) = fresnel_weights(&t, 0.5)?;
+                let layered = t.opt_bool("layered", false)?;
+                let (kd, ks) = if layered { layered_weights(&t, 0.5)? } else { fresnel_weights(&t, 0.5)? };
                 let facets = microfacets(&t)?.unwrap_or(default_facets(0.3));
                 BsdfDesc::CookTorrance {
                     albedo,
@@ -155,6 +156,7 @@ impl Parser<'_> {
                     facets,
                     ior: t.opt_positive("ior", 1.5)?,
                     fresnel: fresnel(&t)?,
+                    layered,
                 }
             }
             "conductor" => {
@@ -294,6 +296,14 @@ fn fresnel_weights(t: &Table, default_ks: f64) -> R<(f64, f64)> {
         let node = t.get("kd").or(t.get("ks")).expect("one was given");
         return Err(node.err(format!("kd + ks·F(0) = {} exceeds 1: the surface would create energy", kd + ks * f0)));
     }
+    Ok((kd, ks))
+}
+
+/// `kd` (1) and `ks` of a layered surface, whose diffuse weight `k_d(1 − k_s·E)` keeps energy
+/// whatever they are in `[0, 1]`.
+fn layered_weights(t: &Table, default_ks: f64) -> R<(f64, f64)> {
+    let ks = t.get("ks").map_or(Ok(default_ks), |n| n.in_range(0.0, 1.0))?;
+    let kd = t.get("kd").map_or(Ok(1.0), |n| n.in_range(0.0, 1.0))?;
     Ok((kd, ks))
 }
 

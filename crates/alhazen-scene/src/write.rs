@@ -491,8 +491,8 @@ impl Writer<'_> {
                 num(*anisotropy),
                 vec3(*scratches)
             ),
-            BsdfDesc::CookTorrance { albedo, kd, ks, facets: f, ior, fresnel: fr } => format!(
-                "{{ type = \"cook-torrance\", color = {}, kd = {}, ks = {}, ior = {}, fresnel = \"{}\", {} }}",
+            BsdfDesc::CookTorrance { albedo, kd, ks, facets: f, ior, fresnel: fr, layered } => format!(
+                "{{ type = \"cook-torrance\", color = {}, kd = {}, ks = {}, ior = {}, fresnel = \"{}\", layered = {layered}, {} }}",
                 self.texture(albedo),
                 num(*kd),
                 num(*ks),

@@ -102,13 +102,14 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             ks: *ks,
             lobe: BlinnPhongLobe { exponent: *exponent, anisotropy: *anisotropy },
         }),
-        BsdfDesc::CookTorrance { albedo, kd, ks, facets, ior, fresnel } => Bsdf::CookTorrance(CookTorrance {
+        BsdfDesc::CookTorrance { albedo, kd, ks, facets, ior, fresnel, layered } => Bsdf::CookTorrance(CookTorrance {
             diffuse: tex(albedo) * *kd,
             ks: *ks,
             lobe: CookTorranceLobe {
                 facets: Microfacet::new(facets),
                 ior: *ior,
                 schlick: *fresnel == FresnelMode::Schlick,
+                layer: if *layered { *ks } else { 0.0 },
             },
         }),
         BsdfDesc::Plastic { albedo, ior, facets, nonlinear } => {
@@ -172,7 +173,7 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             }
             Bsdf::Coated(Box::new(super::Coated::new(
                 from_desc(base, lookups, mode),
-                CookTorranceLobe { facets: Microfacet::new(&facets), ior: *ior, schlick: false },
+                CookTorranceLobe { facets: Microfacet::new(&facets), ior: *ior, schlick: false, layer: 0.0 },
                 weight,
             )))
         }

@@ -22,6 +22,9 @@ pub struct CookTorranceLobe {
     pub ior: f64,
     /// Use Schlick's `F`.
     pub schlick: bool,
+    /// The specular weight the diffuse term is layered under (`k_d(1 − layer·E(μ_o))`,
+    /// [`super::layering`]); 0 for a diffuse weight that does not vary.
+    pub layer: f64,
 }
 
 /// Cook–Torrance.
@@ -50,6 +53,12 @@ impl SpecularLobe for CookTorranceLobe {
         self.value_pdf(v, l).0
     }
 
+    /// `1 − layer·E(μ_o)`: exactly 1 where the lobe is not layered.
+    #[inline(always)]
+    fn diffuse_weight(&self, mu: f64) -> f64 {
+        if self.layer == 0.0 { 1.0 } else { 1.0 - self.layer * super::layering::albedo(&self.facets, mu, self.ior) }
+    }
+
     /// The facet's density over `4⟨h,v⟩`.
     fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
         self.value_pdf(v, l).1
@@ -62,28 +71,44 @@ impl SpecularLobe for CookTorranceLobe {
     }
 }
 
+impl CookTorrance {
+    /// [`MicrofacetLobes::rough_eval_pdf`] with the diffuse term weighed by `weight`, the
+    /// lobe's [`SpecularLobe::diffuse_weight`] seen from `v` (the path tracer's lanes find it
+    /// before their vector loop: its table lookup would keep the loop scalar).
+    #[inline(always)]
+    pub(crate) fn eval_pdf_weighted(&self, weight: f64, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (value, lobe_pdf) = self.lobe.value_pdf(v, l);
+        let pd = self.p_diffuse();
+        let f = self.diffuse * (FRAC_1_PI * weight) + Vec3::splat(self.ks * value);
+        let pdf = pd * cosine_pdf(v, l) + (1.0 - pd) * lobe_pdf;
+        if same_side(v, l) { (f, pdf) } else { (Vec3::ZERO, 0.0) }
+    }
+
+    /// [`MicrofacetLobes::rough_sample`] with the diffuse term weighed by `weight`.
+    #[inline(always)]
+    pub(crate) fn sample_weighted(&self, weight: f64, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let diffuse = uc < self.p_diffuse();
+        let h = self.lobe.facets.sample_h_from(v, u);
+        let mirrored = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
+        let l = if diffuse { cosine_hemisphere(u, v) } else { mirrored };
+        let (f, pdf) = self.eval_pdf_weighted(weight, v, l);
+        ((diffuse || h.is_some()) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+}
+
 impl MicrofacetLobes for CookTorrance {
     /// `(eval, pdf)` of [`DiffuseSpecular`] on this lobe, computed whole and then chosen: the
     /// per-path tracer's ([`super::Bsdf::eval_pdf`]) and the lanes'. `facets` are the lobe's
     /// own (the lanes build it with them).
     #[inline(always)]
     fn rough_eval_pdf(&self, _: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
-        let (value, lobe_pdf) = self.lobe.value_pdf(v, l);
-        let pd = self.p_diffuse();
-        let f = self.diffuse * FRAC_1_PI + Vec3::splat(self.ks * value);
-        let pdf = pd * cosine_pdf(v, l) + (1.0 - pd) * lobe_pdf;
-        if same_side(v, l) { (f, pdf) } else { (Vec3::ZERO, 0.0) }
+        self.eval_pdf_weighted(self.lobe.diffuse_weight(v.z), v, l)
     }
 
     /// [`DiffuseSpecular::sample`] on this lobe, computed whole and then chosen: whether there
     /// is a sample (a facet where the lobe is chosen, a positive density) and the sample.
     #[inline(always)]
-    fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        let diffuse = uc < self.p_diffuse();
-        let h = self.lobe.facets.sample_h_from(v, u);
-        let mirrored = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
-        let l = if diffuse { cosine_hemisphere(u, v) } else { mirrored };
-        let (f, pdf) = self.rough_eval_pdf(facets, v, l);
-        ((diffuse || h.is_some()) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+    fn rough_sample(&self, _: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        self.sample_weighted(self.lobe.diffuse_weight(v.z), v, uc, u)
     }
 }

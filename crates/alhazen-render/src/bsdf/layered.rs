@@ -15,6 +15,11 @@ pub trait SpecularLobe {
     fn pdf(&self, v: Vec3, l: Vec3) -> f64;
     /// A direction `l` from `u ∈ [0, 1)²`.
     fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3>;
+    /// What the diffuse term is weighed by, seen at cosine `mu`: 1 unless the lobe layers it
+    /// ([`super::layering`]).
+    fn diffuse_weight(&self, _mu: f64) -> f64 {
+        1.0
+    }
 }
 
 /// `k_d·albedo/π + k_s·ρ_s`.
@@ -38,7 +43,7 @@ impl<S: SpecularLobe> DiffuseSpecular<S> {
         if !same_side(v, l) {
             return Vec3::ZERO;
         }
-        self.diffuse * FRAC_1_PI + Vec3::splat(self.ks * self.lobe.value(v, l))
+        self.diffuse * (FRAC_1_PI * self.lobe.diffuse_weight(v.z)) + Vec3::splat(self.ks * self.lobe.value(v, l))
     }
 
     /// The mixture of the cosine density and the lobe's.

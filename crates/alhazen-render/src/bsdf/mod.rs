@@ -15,6 +15,7 @@ mod cook_torrance;
 mod dielectric;
 mod lambert;
 pub mod layered;
+mod layering;
 pub mod microfacet;
 mod mix;
 mod multiscatter;

@@ -40,6 +40,7 @@
 //! `lanes_match_the_per_path_tracer`).
 
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic, shadow_segment};
+use crate::bsdf::layered::SpecularLobe;
 use crate::bsdf::{
     Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe, Dielectric, Frame, Microfacet,
     MicrofacetLobes, Plastic, cosine_hemisphere, cosine_pdf, same_side,
@@ -111,6 +112,11 @@ struct Vertices {
     /// (times `k_d`) and its `k_s`.
     albedo: Lanes3,
     ks: Lanes,
+    /// A Cook–Torrance surface's specular weight its diffuse term is layered under (0 for
+    /// none: [`CookTorranceLobe::layer`]), and the weight of that term seen from the viewer
+    /// ([`weigh_layers`]).
+    layer: Lanes,
+    diffuse_weight: Lanes,
     /// A mix's weight of its first component ([`crate::bsdf::Mix`]).
     mix_weight: Lanes,
     /// A rough dielectric's relative index `η_inside/η_outside`, or a plastic coat's.
@@ -734,6 +740,7 @@ impl PathTracer<'_> {
                     let v = &mut b.vertices;
                     self.lights.sample_lanes(&b.lights.asks, |i, sample| set_light(v, i, sample));
                 }
+                weigh_layers(b.kernel, &mut b.vertices, b.len);
                 shade_with(b.kernel, &b.vertices, b.coat.unwrap_or(&Coat::NONE), &mut b.shaded, b.len, unit);
             }
             for (p, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
@@ -842,7 +849,7 @@ impl PathTracer<'_> {
             }
             Bsdf::CookTorrance(c) => {
                 set(&mut v.albedo, i, c.diffuse);
-                (v.ks[i], v.ior[i]) = (c.ks, c.lobe.ior);
+                (v.ks[i], v.ior[i], v.layer[i]) = (c.ks, c.lobe.ior, c.lobe.layer);
                 set_facets(v, i, &c.lobe.facets, None);
             }
             Bsdf::Mix(mix) if let Some((c, lambert, weight)) = lambert_mirror(mix) => {
@@ -859,7 +866,7 @@ impl PathTracer<'_> {
                 let metal_alpha = metal.facets.map_or(0.0, |f| f.alpha_u);
                 (v.alpha[0][i], v.alpha[1][i]) = (metal_alpha, base.lobe.facets.alpha_u);
                 set(&mut v.albedo, i, base.diffuse);
-                (v.ks[i], v.ior[i]) = (base.ks, base.lobe.ior);
+                (v.ks[i], v.ior[i], v.layer[i]) = (base.ks, base.lobe.ior, base.lobe.layer);
                 v.mix_weight[i] = weight;
             }
             Bsdf::Plastic(p) => {
@@ -1224,14 +1231,30 @@ impl RoughBsdf for Dielectric {
     }
 }
 
-impl RoughBsdf for CookTorrance {
+/// Cook–Torrance in the lanes: its diffuse weight found before the kernel's loop
+/// ([`weigh_layers`]), the same number the per-path tracer's BSDF finds from the viewer.
+struct LaneCookTorrance(CookTorrance, f64);
+
+impl MicrofacetLobes for LaneCookTorrance {
+    #[inline(always)]
+    fn rough_eval_pdf(&self, _: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        self.0.eval_pdf_weighted(self.1, v, l)
+    }
+
+    #[inline(always)]
+    fn rough_sample(&self, _: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        self.0.sample_weighted(self.1, v, uc, u)
+    }
+}
+
+impl RoughBsdf for LaneCookTorrance {
     /// Isotropic facets only ([`cook_torrance_facets`]).
     const TANGENT: bool = false;
 
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
-        let lobe = CookTorranceLobe { facets, ior: v.ior[i], schlick: false };
-        CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe }
+        let lobe = CookTorranceLobe { facets, ior: v.ior[i], schlick: false, layer: v.layer[i] };
+        LaneCookTorrance(CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe }, v.diffuse_weight[i])
     }
 }
 
@@ -1381,27 +1404,26 @@ impl LaneBsdf for LambertMirror {
 struct MetallicRoughness;
 
 impl MetallicRoughness {
-    /// Lane `i`'s metal and its facets, its Cook–Torrance base and its facets, and the metal's
-    /// weight.
+    /// Lane `i`'s metal and its facets, its Cook–Torrance base, and the metal's weight.
     #[inline(always)]
-    fn at(v: &Vertices, i: usize) -> ((Conductor, Microfacet), (CookTorrance, Microfacet), f64) {
+    fn at(v: &Vertices, i: usize) -> ((Conductor, Microfacet), CookTorrance, f64) {
         let metal_facets = Microfacet::smith::<false>(v.alpha[0][i], v.alpha[0][i]);
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         let metal =
             Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true, multiscatter: None, film: None };
         let base_facets = Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]);
-        let lobe = CookTorranceLobe { facets: base_facets, ior: v.ior[i], schlick: false };
+        let lobe = CookTorranceLobe { facets: base_facets, ior: v.ior[i], schlick: false, layer: v.layer[i] };
         let base = CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe };
-        ((metal, metal_facets), (base, base_facets), v.mix_weight[i])
+        ((metal, metal_facets), base, v.mix_weight[i])
     }
 }
 
 impl LaneBsdf for MetallicRoughness {
     #[inline(always)]
     fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        let ((metal, metal_facets), (base, base_facets), w) = Self::at(v, i);
+        let ((metal, metal_facets), base, w) = Self::at(v, i);
         let (fa, pa) = metal.rough_eval_pdf(&metal_facets, wv, l);
-        let (fb, pb) = base.rough_eval_pdf(&base_facets, wv, l);
+        let (fb, pb) = base.eval_pdf_weighted(v.diffuse_weight[i], wv, l);
         (crate::bsdf::blend(w, fa, fb), crate::bsdf::blend_density(w, pa, pb))
     }
 
@@ -1409,10 +1431,10 @@ impl LaneBsdf for MetallicRoughness {
     /// `Bsdf::sample` draws it: the metal's without its lobe number), valued as the whole mix.
     #[inline(always)]
     fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        let ((metal, metal_facets), (base, base_facets), w) = Self::at(v, i);
+        let ((metal, metal_facets), base, w) = Self::at(v, i);
         let (first, uc) = crate::bsdf::Mix::component_choice(w, uc);
         let (metal_ok, metal_sample) = metal.rough_sample(&metal_facets, wv, 0.0, u);
-        let (base_ok, base_sample) = base.rough_sample(&base_facets, wv, uc, u);
+        let (base_ok, base_sample) = base.sample_weighted(v.diffuse_weight[i], wv, uc, u);
         let (sampled, l) = if first { (metal_ok, metal_sample.l) } else { (base_ok, base_sample.l) };
         let (f, pdf) = Self::eval_pdf(v, coat, i, wv, l);
         (sampled && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
@@ -1430,8 +1452,8 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
         Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, coat, out, len, unit),
         Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, coat, out, len, unit),
         Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, coat, out, len, unit),
-        Kernel::CookTorrance => shade::<Rough<CookTorrance, false>>(v, coat, out, len, unit),
-        Kernel::BeckmannCookTorrance => shade::<Rough<CookTorrance, true>>(v, coat, out, len, unit),
+        Kernel::CookTorrance => shade::<Rough<LaneCookTorrance, false>>(v, coat, out, len, unit),
+        Kernel::BeckmannCookTorrance => shade::<Rough<LaneCookTorrance, true>>(v, coat, out, len, unit),
         Kernel::SmoothConductor => shade::<SmoothConductor<false>>(v, coat, out, len, unit),
         Kernel::RoughSchlickConductor => shade::<Rough<SchlickConductor, false>>(v, coat, out, len, unit),
         Kernel::BeckmannSchlickConductor => shade::<Rough<SchlickConductor, true>>(v, coat, out, len, unit),
@@ -1527,21 +1549,12 @@ fn shade_lanes<M: LaneBsdf, const BUMPS: bool, const FROM: usize, const TO: usiz
 /// inlined into the all-lane loop.
 #[inline(always)]
 fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat, out: &mut Shaded, i: usize) {
-    let (wo, p) = (get(&v.wo, i), get(&v.p, i));
-    // The shading frame (`PathTracer::shading_frame`).
-    let (mut ng, mut ns, mut n0) = (get(&v.ng, i), get(&v.ns, i), get(&v.n0, i));
-    if !M::TRANSMITS && ng.dot(wo) < 0.0 {
-        (ng, ns, n0) = (-ng, -ns, -n0);
-    }
-    if ns.dot(wo) * ng.dot(wo) <= 0.0 {
-        ns = ng;
-    }
+    let p = get(&v.p, i);
+    let View { ng, ns, n0, frame, wv } = view::<M>(v, i);
     // The bump terminator's shadowing (`Terminator::shadowing`), chosen without branches.
     let (bent, terminator) = Terminator::bent(n0, ns);
     let bent = BUMPS && v.bumped.at(i) && bent;
     let shadowing = |dir: Vec3| if bent { terminator.factor(dir) } else { 1.0 };
-    let frame = M::frame(v, i, ns);
-    let wv = frame.to_local(wo);
     // Next event (`PathTracer::next_event`).
     let dir = get(&v.light_dir, i);
     let l = frame.to_local(dir);
@@ -1578,6 +1591,62 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat,
     set(&mut out.beta, i, beta);
     set(&mut out.dir, i, dir);
     set(&mut out.origin, i, offset(p, ng, dir));
+}
+
+/// Lane `i`'s shading frame as `M` turns it (`PathTracer::shading_frame`): its geometric,
+/// shading and unbent normals turned towards the viewer (unless `M` transmits), the frame, and
+/// the viewer in it.
+struct View {
+    ng: Vec3,
+    ns: Vec3,
+    n0: Vec3,
+    frame: Frame,
+    wv: Vec3,
+}
+
+#[inline(always)]
+fn view<M: LaneBsdf>(v: &Vertices, i: usize) -> View {
+    let wo = get(&v.wo, i);
+    let (mut ng, mut ns, mut n0) = (get(&v.ng, i), get(&v.ns, i), get(&v.n0, i));
+    if !M::TRANSMITS && ng.dot(wo) < 0.0 {
+        (ng, ns, n0) = (-ng, -ns, -n0);
+    }
+    if ns.dot(wo) * ng.dot(wo) <= 0.0 {
+        ns = ng;
+    }
+    let frame = M::frame(v, i, ns);
+    View { ng, ns, n0, frame, wv: frame.to_local(wo) }
+}
+
+/// Each Cook–Torrance vertex's diffuse weight seen from its viewer
+/// ([`CookTorranceLobe::diffuse_weight`], 1 where it is not layered), for the kernels that have
+/// one, found one lane after another before the kernel's vector loop: a table lookup inside it
+/// would keep the loop scalar.
+fn weigh_layers(kernel: Kernel, v: &mut Vertices, len: usize) {
+    match kernel {
+        Kernel::CookTorrance => weigh_layers_of::<Rough<LaneCookTorrance, false>>(v, len, |v, i| {
+            Microfacet::smith::<false>(v.alpha[0][i], v.alpha[1][i])
+        }),
+        Kernel::BeckmannCookTorrance => weigh_layers_of::<Rough<LaneCookTorrance, true>>(v, len, |v, i| {
+            Microfacet::smith::<true>(v.alpha[0][i], v.alpha[1][i])
+        }),
+        Kernel::MetallicRoughness => weigh_layers_of::<MetallicRoughness>(v, len, |v, i| {
+            Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i])
+        }),
+        _ => {}
+    }
+}
+
+/// [`weigh_layers`] for kernel `M`, whose Cook–Torrance lobe has the facets `facets` gives.
+fn weigh_layers_of<M: LaneBsdf>(v: &mut Vertices, len: usize, facets: impl Fn(&Vertices, usize) -> Microfacet) {
+    for i in 0..len {
+        v.diffuse_weight[i] = if v.layer[i] == 0.0 {
+            1.0
+        } else {
+            let lobe = CookTorranceLobe { facets: facets(v, i), ior: v.ior[i], schlick: false, layer: v.layer[i] };
+            lobe.diffuse_weight(view::<M>(v, i).wv.z)
+        };
+    }
 }
 
 /// `!(x <= 0)`, as the per-path tracer's rejections read (NaN passes).
@@ -1704,7 +1773,7 @@ material = { bsdf = { type = "cook-torrance", roughness = 0.1, distribution = "b
 shape = "sphere"
 center = [-1.3, 0.3, 2.9]
 radius = 0.3
-material = { bsdf = { type = "cook-torrance", roughness = 0.2, distribution = "ggx", color = { checker = { even = [0.8, 0.3, 0.1], odd = [0.1, 0.2, 0.7], size = 0.1 } }, kd = 0.96, ks = 1.0 } }
+material = { bsdf = { type = "cook-torrance", roughness = 0.2, distribution = "ggx", color = { checker = { even = [0.8, 0.3, 0.1], odd = [0.1, 0.2, 0.7], size = 0.1 } }, ks = 1.0, layered = true } }
 [[object]]
 shape = "box"
 min = [-2.5, 0, -2]
