@@ -107,8 +107,7 @@ pub(crate) fn absorbing(scene: &mut Scene, base: MaterialId, absorption: Rgb) ->
     add_material(scene, m)
 }
 
-/// The glTF 2.0 metallic–roughness model (also Mitsuba's `principled` and pbrt's
-/// `coateddiffuse` reduced to it): a metal whose normal-incidence reflectance is the base
+/// The glTF 2.0 metallic–roughness model (also Mitsuba's `principled` reduced to it): a metal whose normal-incidence reflectance is the base
 /// colour (Schlick), mixed by `metallic` with a dielectric coating over a Lambertian base (the
 /// coating's index and strength and the metal's multiple scattering: `lobes`), both with GGX roughness `α = roughness²`; `transmission` mixes in rough glass of index
 /// `ior`, times the map's luminance at each point where there is one (glTF's

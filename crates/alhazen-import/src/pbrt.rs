@@ -961,6 +961,47 @@ impl Importer {
 
     /// pbrt's roughness (`roughness` or `uroughness`/`vroughness`), remapped to α as pbrt
     /// does unless `remaproughness` is false; `None` when smooth.
+    /// pbrt's `coateddiffuse`: a diffuse base under a dielectric interface, the light that enters
+    /// bouncing between them — what alhazen's plastic sums in closed form (`nonlinear`: each
+    /// bounce coloured by the base), but for pbrt's thin absorbing layer (`thickness`; its
+    /// `albedo` 0 by default), left out. Stretched facets, which a plastic's coat cannot take, or
+    /// an index of at most 1 give Cook–Torrance with its diffuse term layered under the lobe.
+    fn coated_diffuse(
+        &mut self,
+        ctx: &Ctx,
+        at: &Range<usize>,
+        albedo: Texture,
+        rough: Option<(f64, f64)>,
+        ior: f64,
+    ) -> BsdfDesc {
+        match rough {
+            Some((u, v)) if u != v || ior <= 1.0 => {
+                self.warn(ctx, at, "coateddiffuse with stretched facets or an index of at most 1 is approximated by Cook–Torrance over Lambert, the diffuse term weighed by what the coat reflects");
+                BsdfDesc::CookTorrance {
+                    albedo,
+                    kd: 1.0,
+                    ks: 1.0,
+                    facets: common::ggx(u, v),
+                    ior,
+                    fresnel: FresnelMode::Exact,
+                    layered: true,
+                }
+            }
+            None if ior <= 1.0 => {
+                self.warn(ctx, at, "coateddiffuse with an index of at most 1 is read as its diffuse base");
+                BsdfDesc::Lambert { albedo }
+            }
+            _ => {
+                self.warn(
+                    ctx,
+                    at,
+                    "coateddiffuse is read as a plastic: its thin absorbing layer (thickness, albedo) is left out",
+                );
+                BsdfDesc::Plastic { albedo, ior, facets: rough.map(|(u, v)| common::ggx(u, v)), nonlinear: true }
+            }
+        }
+    }
+
     fn roughness(&mut self, ctx: &Ctx, p: &mut Params) -> R<Option<(f64, f64)>> {
         self.roughness_of(ctx, p, "")
     }
@@ -1127,22 +1168,12 @@ impl Importer {
             }
             "coateddiffuse" => {
                 let albedo = self.texture_param(ctx, p, "reflectance", Vec3::splat(0.5))?;
-                let rough = self.roughness(ctx, p)?.unwrap_or((0.01, 0.01));
+                let rough = self.roughness(ctx, p)?;
                 let ior = self.eta(ctx, p)?;
                 for k in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
                     self.find(p, k);
                 }
-                self.warn(ctx, at, "coateddiffuse is approximated by Cook–Torrance: Lambert weighted by 1 − F(0) under a microfacet coat");
-                let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
-                BsdfDesc::CookTorrance {
-                    albedo,
-                    kd: 1.0 - f0,
-                    ks: 1.0,
-                    facets: common::ggx(rough.0, rough.1),
-                    ior,
-                    fresnel: FresnelMode::Exact,
-                    layered: false,
-                }
+                self.coated_diffuse(ctx, at, albedo, rough, ior)
             }
             "diffusetransmission" => {
                 let r = self.color(ctx, p, "reflectance", Vec3::splat(0.25))?;
