@@ -985,6 +985,7 @@ impl Importer {
                     ior,
                     fresnel: FresnelMode::Exact,
                     layered: true,
+                    transmittance: Texture::Solid(Vec3::ZERO),
                 }
             }
             None if ior <= 1.0 => {
@@ -1176,14 +1177,33 @@ impl Importer {
                 self.coated_diffuse(ctx, at, albedo, rough, ior)
             }
             "diffusetransmission" => {
-                let r = self.color(ctx, p, "reflectance", Vec3::splat(0.25))?;
-                let t = self.color(ctx, p, "transmittance", Vec3::splat(0.25))?;
-                self.warn(
-                    ctx,
-                    at,
-                    "diffusetransmission is approximated by Lambertian reflection of reflectance + transmittance",
-                );
-                BsdfDesc::Lambert { albedo: Texture::Solid((r + t).min(Vec3::ONE)) }
+                let scale = self.float(ctx, p, "scale", 1.0)?.max(0.0);
+                let mut part = |name: &str| -> R<Texture> {
+                    Ok(match self.texture_param(ctx, p, name, Vec3::splat(0.25))? {
+                        Texture::Solid(c) => Texture::Solid(c * scale),
+                        image if scale == 1.0 => image,
+                        image => {
+                            self.warn(
+                                ctx,
+                                at,
+                                format!("diffusetransmission's scale {scale} is left out of its {name} image"),
+                            );
+                            image
+                        }
+                    })
+                };
+                let (albedo, transmittance) = (part("reflectance")?, part("transmittance")?);
+                // Lambert on both sides: Cook–Torrance without its specular lobe.
+                BsdfDesc::CookTorrance {
+                    albedo,
+                    kd: 1.0,
+                    ks: 0.0,
+                    facets: common::ggx(1.0, 1.0),
+                    ior: 1.5,
+                    fresnel: FresnelMode::Exact,
+                    layered: false,
+                    transmittance,
+                }
             }
             "mix" => {
                 let q = self

@@ -626,3 +626,29 @@ fn coated_diffuse_is_a_plastic() {
     assert!(matches!(stretched, BsdfDesc::CookTorrance { layered: true, .. }), "{stretched:?}");
     assert!(said.iter().any(|w| w.contains("stretched facets")), "{said:?}");
 }
+
+/// pbrt's `diffusetransmission` (leaves, paper): Lambert on the lit side and on the other, each
+/// of its colour times `scale` — a sheet lit from behind shows its transmittance, where it was
+/// read as Lambert reflection of the two summed and showed black.
+#[test]
+fn diffuse_transmission_passes_light_through() {
+    let text = "LookAt 0 0 -3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 20\n\
+                Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\n\
+                WorldBegin\nLightSource \"distant\" \"point3 from\" [0 0 5] \"point3 to\" [0 0 0] \"blackbody L\" 6500\n\
+                Material \"diffusetransmission\" \"rgb reflectance\" [0.2 0.2 0.2] \"rgb transmittance\" [0.3 0.6 0.2] \"float scale\" 0.5\n\
+                Shape \"bilinearmesh\" \"point3 P\" [-2 -2 0  2 -2 0  -2 2 0  2 2 0]";
+    let s = import(&[("leaf.pbrt", text)]).unwrap();
+    let Some(BsdfDesc::CookTorrance { albedo, ks, transmittance, .. }) =
+        &s.scene.materials[s.scene.objects[0].material as usize].bsdf
+    else {
+        panic!()
+    };
+    assert_eq!((albedo, *ks), (&Texture::Solid(Vec3::splat(0.1)), 0.0));
+    assert_eq!(transmittance, &Texture::Solid(Vec3::new(0.15, 0.3, 0.1)));
+    // Lit from behind (the light at +z, the camera at −z): the sheet glows green.
+    let mut scene = s.scene;
+    scene.render.integrator = alhazen_scene::IntegratorKind::Path;
+    let img = small(scene, 16);
+    let c = img.get(8, 8);
+    assert!(c.y > 0.05 && c.y > 1.5 * c.x && c.y > 2.0 * c.z, "{c}");
+}

@@ -154,6 +154,11 @@ pub enum BsdfDesc {
         /// BSDF's albedo scaling, what a glTF dielectric is layered as): energy is kept at every
         /// angle, where a constant `k_d` sends back more than arrives at grazing angles.
         layered: bool,
+        /// What passes through diffusely to the other side, `transmittance/π` there (black for
+        /// none): a thin translucent sheet — a leaf, paper, a lampshade (pbrt's
+        /// `diffusetransmission`, glTF's `KHR_materials_diffuse_transmission`). Weighed as the
+        /// diffuse term is when layered, not by `kd`.
+        transmittance: Texture,
     },
     /// Plastic: a diffuse base under a dielectric coat of index `ior`, smooth when `facets` is
     /// `None`, the light bouncing between base and coat summed in closed form (Mitsuba 3's
@@ -405,6 +410,7 @@ fn metallic_roughness_lobes(base: Rgb, roughness: f64, lobes: MetalRoughness) ->
         ior,
         fresnel: FresnelMode::Exact,
         layered: true,
+        transmittance: Texture::Solid(Vec3::ZERO),
     };
     (metal, coating)
 }

@@ -35,6 +35,22 @@ impl Parser<'_> {
         Ok((anisotropy, t.get("map").map(|m| self.linear_placed_image(&m)).transpose()?))
     }
 
+    /// A Cook–Torrance surface's `transmittance` (black when absent): a colour or texture; a
+    /// colour within `[0, 1]` that with the diffuse weight `kd` sends on at most what arrives.
+    fn diffuse_transmittance(&mut self, t: &Table, kd: f64) -> R<Texture> {
+        let Some(c) = t.get("transmittance") else { return Ok(Texture::Solid(Vec3::ZERO)) };
+        match self.texture(&c)? {
+            Texture::Solid(k) if !(k.min_element() >= 0.0 && k.max_element() <= 1.0) => {
+                Err(c.err("`transmittance` is a colour within [0, 1]: what passes through"))
+            }
+            Texture::Solid(k) if kd + k.max_element() > 1.0 + 1e-9 => Err(c.err(format!(
+                "kd + transmittance = {} exceeds 1: the surface would create energy",
+                kd + k.max_element()
+            ))),
+            texture => Ok(texture),
+        }
+    }
+
     /// A metallic–roughness surface's `iridescence = { factor, ior, thickness, outside,
     /// factor_map, thickness_map }`: `thickness` one number (nm) or the two the thickness map's
     /// green channel runs between.
@@ -89,7 +105,9 @@ impl Parser<'_> {
             "oren-nayar" => vec!["color", "sigma", "interreflection"],
             "phong" => vec!["color", "kd", "ks", "exponent"],
             "blinn-phong" => vec!["color", "kd", "ks", "exponent", "anisotropy", "scratches"],
-            "cook-torrance" => [&["color", "kd", "ks", "ior", "fresnel", "layered"][..], MICROFACET_KEYS].concat(),
+            "cook-torrance" => {
+                [&["color", "kd", "ks", "ior", "fresnel", "layered", "transmittance"][..], MICROFACET_KEYS].concat()
+            }
             "plastic" => [&["color", "ior", "nonlinear"][..], MICROFACET_KEYS].concat(),
             "conductor" => [&["metal", "eta", "k", "tint", "fresnel", "multiscatter"][..], MICROFACET_KEYS].concat(),
             "dielectric" => [
@@ -157,6 +175,7 @@ impl Parser<'_> {
                     ior: t.opt_positive("ior", 1.5)?,
                     fresnel: fresnel(&t)?,
                     layered,
+                    transmittance: self.diffuse_transmittance(&t, kd)?,
                 }
             }
             "conductor" => {

@@ -491,15 +491,21 @@ impl Writer<'_> {
                 num(*anisotropy),
                 vec3(*scratches)
             ),
-            BsdfDesc::CookTorrance { albedo, kd, ks, facets: f, ior, fresnel: fr, layered } => format!(
-                "{{ type = \"cook-torrance\", color = {}, kd = {}, ks = {}, ior = {}, fresnel = \"{}\", layered = {layered}, {} }}",
-                self.texture(albedo),
-                num(*kd),
-                num(*ks),
-                num(*ior),
-                fresnel(*fr),
-                facets(&Some(*f))
-            ),
+            BsdfDesc::CookTorrance { albedo, kd, ks, facets: f, ior, fresnel: fr, layered, transmittance } => {
+                let through = match transmittance {
+                    Texture::Solid(c) if *c == Vec3::ZERO => String::new(),
+                    other => format!(", transmittance = {}", self.texture(other)),
+                };
+                format!(
+                    "{{ type = \"cook-torrance\", color = {}, kd = {}, ks = {}, ior = {}, fresnel = \"{}\", layered = {layered}, {}{through} }}",
+                    self.texture(albedo),
+                    num(*kd),
+                    num(*ks),
+                    num(*ior),
+                    fresnel(*fr),
+                    facets(&Some(*f))
+                )
+            }
             BsdfDesc::Plastic { albedo, ior, facets: f, nonlinear } => format!(
                 "{{ type = \"plastic\", color = {}, ior = {}, nonlinear = {nonlinear}, {} }}",
                 self.texture(albedo),

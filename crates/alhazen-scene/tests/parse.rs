@@ -509,17 +509,21 @@ bsdf = { type = "plastic", color = [0.1, 0.3, 0.6], ior = 1.6, roughness = 0.15,
 }
 
 /// A layered Cook–Torrance surface: `kd` 1 unless given, any `ks` in [0, 1] (its diffuse weight
-/// `kd(1 − ks·E)` keeps energy), and the same after writing the scene back out.
+/// `kd(1 − ks·E)` keeps energy), a translucent sheet's `transmittance`, and the same after
+/// writing the scene back out.
 #[test]
 fn layered_cook_torrance_reads_and_writes_back() {
     use alhazen_scene::bsdf::BsdfDesc;
-    let text = "[materials.glaze]\nbsdf = { type = \"cook-torrance\", color = [0.8, 0.2, 0.1], ks = 1, layered = true, roughness = 0.2 }\n\
+    let text = "[materials.glaze]\nbsdf = { type = \"cook-torrance\", color = [0.8, 0.2, 0.1], ks = 1, layered = true, roughness = 0.2, kd = 0.7, transmittance = [0.3, 0.2, 0.1] }\n\
                 [materials.plain]\nbsdf = { type = \"cook-torrance\", color = [0.8, 0.2, 0.1] }\n\
                 [[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"glaze\"\n[[object]]\nshape = \"sphere\"\nradius = 1\nmaterial = \"plain\"\n";
     let s = alhazen_scene::parse_scene("s.toml".as_ref(), text).unwrap();
     let bsdf = |s: &alhazen_scene::Scene, name: &str| s.materials.iter().find(|m| m.name == name).unwrap().bsdf.clone();
-    let Some(BsdfDesc::CookTorrance { kd, ks, layered: true, .. }) = bsdf(&s, "glaze") else { panic!() };
-    assert_eq!((kd, ks), (1.0, 1.0));
+    let Some(BsdfDesc::CookTorrance { kd, ks, layered: true, transmittance, .. }) = bsdf(&s, "glaze") else { panic!() };
+    assert_eq!(
+        (kd, ks, transmittance),
+        (0.7, 1.0, alhazen_scene::Texture::Solid(alhazen_math::Vec3::new(0.3, 0.2, 0.1)))
+    );
     assert!(matches!(bsdf(&s, "plain"), Some(BsdfDesc::CookTorrance { kd: 0.5, layered: false, .. })));
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("again.toml");
@@ -538,6 +542,10 @@ fn physically_based_mistakes_are_explained() {
     assert!(m(r#"{ type = "cook-torrance", kd = 1, ks = 1 }"#).contains("kd + ks·F(0) = 1.04 exceeds 1"));
     assert!(m(r#"{ type = "cook-torrance", layered = "yes" }"#).contains("layered"));
     assert!(m(r#"{ type = "cook-torrance", layered = true, kd = 1.2 }"#).contains("kd"));
+    assert!(
+        m(r#"{ type = "cook-torrance", ks = 0, kd = 0.7, transmittance = 0.5 }"#).contains("kd + transmittance = 1.2")
+    );
+    assert!(m(r#"{ type = "cook-torrance", transmittance = [0.2, 1.5, 0] }"#).contains("within [0, 1]"));
     assert!(
         m(r#"{ type = "conductor", roughness = 0.2, distribution = "gaussian", shadowing = "smith" }"#)
             .contains("Smith shadowing has no closed form")

@@ -94,24 +94,31 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
         BsdfDesc::OrenNayar { albedo, sigma, interreflection } => {
             Bsdf::OrenNayar(OrenNayar { albedo: tex(albedo), sigma: *sigma, interreflection: *interreflection })
         }
-        BsdfDesc::Phong { albedo, kd, ks, exponent } => {
-            Bsdf::Phong(Phong { diffuse: tex(albedo) * *kd, ks: *ks, lobe: PhongLobe { exponent: *exponent } })
-        }
+        BsdfDesc::Phong { albedo, kd, ks, exponent } => Bsdf::Phong(Phong {
+            diffuse: tex(albedo) * *kd,
+            ks: *ks,
+            lobe: PhongLobe { exponent: *exponent },
+            transmittance: Vec3::ZERO,
+        }),
         BsdfDesc::BlinnPhong { albedo, kd, ks, exponent, anisotropy, .. } => Bsdf::BlinnPhong(BlinnPhong {
             diffuse: tex(albedo) * *kd,
             ks: *ks,
             lobe: BlinnPhongLobe { exponent: *exponent, anisotropy: *anisotropy },
+            transmittance: Vec3::ZERO,
         }),
-        BsdfDesc::CookTorrance { albedo, kd, ks, facets, ior, fresnel, layered } => Bsdf::CookTorrance(CookTorrance {
-            diffuse: tex(albedo) * *kd,
-            ks: *ks,
-            lobe: CookTorranceLobe {
-                facets: Microfacet::new(facets),
-                ior: *ior,
-                schlick: *fresnel == FresnelMode::Schlick,
-                layer: if *layered { *ks } else { 0.0 },
-            },
-        }),
+        BsdfDesc::CookTorrance { albedo, kd, ks, facets, ior, fresnel, layered, transmittance } => {
+            Bsdf::CookTorrance(CookTorrance {
+                diffuse: tex(albedo) * *kd,
+                ks: *ks,
+                lobe: CookTorranceLobe {
+                    facets: Microfacet::new(facets),
+                    ior: *ior,
+                    schlick: *fresnel == FresnelMode::Schlick,
+                    layer: if *layered { *ks } else { 0.0 },
+                },
+                transmittance: tex(transmittance),
+            })
+        }
         BsdfDesc::Plastic { albedo, ior, facets, nonlinear } => {
             Bsdf::Plastic(Plastic::new(tex(albedo), *ior, facets.as_ref().map(Microfacet::new), *nonlinear))
         }
@@ -267,7 +274,12 @@ fn filmed_coating(coating: Bsdf, film: ThinFilm) -> Bsdf {
     let w = f64::from(film.weight).clamp(0.0, 1.0);
     let film_share = ct.ks * w / 2.0;
     let keep = 1.0 - film_share;
-    let own = CookTorrance { diffuse: ct.diffuse / keep, ks: ct.ks * (1.0 - w) / keep, lobe: ct.lobe };
+    let own = CookTorrance {
+        diffuse: ct.diffuse / keep,
+        ks: ct.ks * (1.0 - w) / keep,
+        lobe: ct.lobe,
+        transmittance: ct.transmittance / keep,
+    };
     let lobe = Conductor {
         facets: Some(ct.lobe.facets),
         eta: Vec3::splat(ct.lobe.ior),

@@ -78,19 +78,31 @@ impl CookTorrance {
     #[inline(always)]
     pub(crate) fn eval_pdf_weighted(&self, weight: f64, v: Vec3, l: Vec3) -> (Vec3, f64) {
         let (value, lobe_pdf) = self.lobe.value_pdf(v, l);
-        let pd = self.p_diffuse();
-        let f = self.diffuse * (FRAC_1_PI * weight) + Vec3::splat(self.ks * value);
-        let pdf = pd * cosine_pdf(v, l) + (1.0 - pd) * lobe_pdf;
-        if same_side(v, l) { (f, pdf) } else { (Vec3::ZERO, 0.0) }
+        let (pd, reflected) = (self.p_diffuse(), self.p_reflected());
+        let diffuse = FRAC_1_PI * weight;
+        let f = self.diffuse * diffuse + Vec3::splat(self.ks * value);
+        let pdf = pd * reflected * cosine_pdf(v, l) + (1.0 - pd) * lobe_pdf;
+        // Through to the other side: the diffuse transmission alone, sampled by it and by the
+        // specular lobe's facets that send the viewer below the surface.
+        let lobe_through = if self.transmittance != Vec3::ZERO { (1.0 - pd) * lobe_pdf } else { 0.0 };
+        let through = (self.transmittance * diffuse, pd * (1.0 - reflected) * (l.z.abs() * FRAC_1_PI) + lobe_through);
+        if same_side(v, l) { (f, pdf) } else { through }
     }
 
     /// [`MicrofacetLobes::rough_sample`] with the diffuse term weighed by `weight`.
     #[inline(always)]
     pub(crate) fn sample_weighted(&self, weight: f64, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        let diffuse = uc < self.p_diffuse();
+        let pd = self.p_diffuse();
+        let (diffuse, reflected) = (uc < pd, uc < pd * self.p_reflected());
         let h = self.lobe.facets.sample_h_from(v, u);
         let mirrored = reflect(v, h.unwrap_or(Vec3::Z) * v.z.signum());
-        let l = if diffuse { cosine_hemisphere(u, v) } else { mirrored };
+        let l = if reflected {
+            cosine_hemisphere(u, v)
+        } else if diffuse {
+            cosine_hemisphere(u, -v)
+        } else {
+            mirrored
+        };
         let (f, pdf) = self.eval_pdf_weighted(weight, v, l);
         ((diffuse || h.is_some()) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }

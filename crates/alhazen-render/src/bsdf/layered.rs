@@ -22,7 +22,8 @@ pub trait SpecularLobe {
     }
 }
 
-/// `k_d·albedo/π + k_s·ρ_s`.
+/// `k_d·albedo/π + k_s·ρ_s`, and `transmittance/π` on the other side (a thin translucent
+/// sheet; black for none).
 #[derive(Clone, Copy, Debug)]
 pub struct DiffuseSpecular<S> {
     /// Diffuse colour times `k_d`.
@@ -31,33 +32,55 @@ pub struct DiffuseSpecular<S> {
     pub ks: f64,
     /// `ρ_s`.
     pub lobe: S,
+    /// What passes diffusely through to the other side.
+    pub transmittance: Vec3,
 }
 
 impl<S: SpecularLobe> DiffuseSpecular<S> {
+    /// The probability of sampling a diffuse lobe (reflected or passed through) rather than
+    /// the specular one.
     pub(super) fn p_diffuse(&self) -> f64 {
-        lobe_probability(luminance(self.diffuse), self.ks)
+        lobe_probability(luminance(self.diffuse) + luminance(self.transmittance), self.ks)
+    }
+
+    /// Of a diffuse lobe, the probability that it is the reflected one (exactly 1 without
+    /// transmittance).
+    pub(super) fn p_reflected(&self) -> f64 {
+        let through = luminance(self.transmittance);
+        if through > 0.0 { luminance(self.diffuse) / (luminance(self.diffuse) + through) } else { 1.0 }
     }
 
     /// `ρ`.
     pub fn eval(&self, v: Vec3, l: Vec3) -> Vec3 {
+        let diffuse = FRAC_1_PI * self.lobe.diffuse_weight(v.z);
         if !same_side(v, l) {
-            return Vec3::ZERO;
+            return self.transmittance * diffuse;
         }
-        self.diffuse * (FRAC_1_PI * self.lobe.diffuse_weight(v.z)) + Vec3::splat(self.ks * self.lobe.value(v, l))
+        self.diffuse * diffuse + Vec3::splat(self.ks * self.lobe.value(v, l))
     }
 
-    /// The mixture of the cosine density and the lobe's.
+    /// The mixture of the cosine densities, reflected and passed through, and the lobe's.
     pub fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        if !same_side(v, l) {
-            return 0.0;
-        }
         let pd = self.p_diffuse();
-        pd * cosine_pdf(v, l) + (1.0 - pd) * self.lobe.pdf(v, l)
+        if !same_side(v, l) {
+            // The specular lobe's facets send some of its samples through too.
+            let lobe = if self.transmittance != Vec3::ZERO { (1.0 - pd) * self.lobe.pdf(v, l) } else { 0.0 };
+            return pd * (1.0 - self.p_reflected()) * (l.z.abs() * FRAC_1_PI) + lobe;
+        }
+        pd * self.p_reflected() * cosine_pdf(v, l) + (1.0 - pd) * self.lobe.pdf(v, l)
     }
 
-    /// The diffuse or the specular lobe by `uc`, then a direction from it.
+    /// The diffuse reflection, the diffuse transmission or the specular lobe by `uc`, then a
+    /// direction from it.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
-        let l = if uc < self.p_diffuse() { cosine_hemisphere(u, v) } else { self.lobe.sample(v, u)? };
+        let pd = self.p_diffuse();
+        let l = if uc < pd * self.p_reflected() {
+            cosine_hemisphere(u, v)
+        } else if uc < pd {
+            cosine_hemisphere(u, -v)
+        } else {
+            self.lobe.sample(v, u)?
+        };
         let pdf = self.pdf(v, l);
         (pdf > 0.0).then(|| BsdfSample { l, f: self.eval(v, l), pdf, delta: false, eta: 1.0, dispersive: false })
     }

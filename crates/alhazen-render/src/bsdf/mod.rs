@@ -191,6 +191,7 @@ impl Bsdf {
     pub fn transmits(&self) -> bool {
         match self {
             Bsdf::Dielectric(_) => true,
+            Bsdf::CookTorrance(c) => c.transmittance != Vec3::ZERO,
             Bsdf::Mix(m) => m.a.transmits() || m.b.transmits(),
             Bsdf::Coated(c) => c.base.transmits(),
             Bsdf::Sheened(c) => c.base.transmits(),

@@ -498,6 +498,8 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
         // Glass that may be tinted somewhere is tinted nowhere at some points (a white texel):
         // the general kernel's everywhere.
         _ if tints_glass(m) => Kernel::General,
+        // So is a translucent sheet's (the kernels shade reflection only).
+        _ if translucent(m) => Kernel::General,
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
         // The light of several facets is the general kernel's.
         Bsdf::Conductor(c) if c.multiple_scattering(Vec3::Z).is_some() || c.film.is_some() => Kernel::General,
@@ -551,6 +553,21 @@ fn tints_glass(m: &alhazen_scene::Material) -> bool {
         }
     }
     m.bsdf.as_ref().is_some_and(|d| walk(d, m.vertex_colors))
+}
+
+/// True where `m` passes light diffusely through somewhere (a Cook–Torrance `transmittance`
+/// that is not black).
+fn translucent(m: &alhazen_scene::Material) -> bool {
+    use alhazen_scene::bsdf::BsdfDesc;
+    fn walk(d: &BsdfDesc) -> bool {
+        match d {
+            BsdfDesc::CookTorrance { transmittance, .. } => *transmittance != alhazen_scene::Texture::Solid(Vec3::ZERO),
+            BsdfDesc::Mix { a, b, .. } => walk(a) || walk(b),
+            BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => walk(base),
+            _ => false,
+        }
+    }
+    m.bsdf.as_ref().is_some_and(walk)
 }
 
 /// For a conductor a rough kernel evaluates — Trowbridge–Reitz or Beckmann facets with Smith's
@@ -1254,7 +1271,11 @@ impl RoughBsdf for LaneCookTorrance {
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
         let lobe = CookTorranceLobe { facets, ior: v.ior[i], schlick: false, layer: v.layer[i] };
-        LaneCookTorrance(CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe }, v.diffuse_weight[i])
+        let transmittance = Vec3::ZERO;
+        LaneCookTorrance(
+            CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe, transmittance },
+            v.diffuse_weight[i],
+        )
     }
 }
 
@@ -1413,7 +1434,7 @@ impl MetallicRoughness {
             Conductor { facets: Some(metal_facets), eta, k, tint, schlick: true, multiscatter: None, film: None };
         let base_facets = Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]);
         let lobe = CookTorranceLobe { facets: base_facets, ior: v.ior[i], schlick: false, layer: v.layer[i] };
-        let base = CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe };
+        let base = CookTorrance { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe, transmittance: Vec3::ZERO };
         ((metal, metal_facets), base, v.mix_weight[i])
     }
 }
