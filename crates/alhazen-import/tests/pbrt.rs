@@ -310,21 +310,24 @@ fn image_maps_load_after_the_walk_and_an_unreadable_one_is_located() {
     assert!(err.contains("a.pbrt:2:") && err.contains("cannot load image"), "{err}");
 }
 
-/// A texture the model holds constant is replaced by the mean of its image's pixels, read
-/// before the walk ends (not the placeholder that waits for the file, which is black).
+/// A texture the model holds constant (a checkerboard's squares) is replaced by the mean of its
+/// image's pixels, read before the walk ends (not the placeholder that waits for the file,
+/// which is black).
 #[test]
 fn a_texture_replaced_by_its_mean_is_read_first() {
     let dir = tempfile::tempdir().unwrap();
     let png = image::RgbImage::from_fn(2, 1, |x, _| image::Rgb(if x == 0 { [255, 0, 0] } else { [255, 255, 0] }));
     png.save(dir.path().join("rg.png")).unwrap();
     let body = "WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"rg.png\"\n\
-                Material \"diffusetransmission\" \"texture reflectance\" \"t\" \"rgb transmittance\" [0 0 0]\n\
+                Texture \"c\" \"spectrum\" \"checkerboard\" \"texture tex1\" \"t\" \"rgb tex2\" [0 0 0]\n\
+                Material \"diffuse\" \"texture reflectance\" \"c\"\n\
                 Shape \"sphere\"";
     std::fs::write(dir.path().join("a.pbrt"), body).unwrap();
     let imported = alhazen_import::load(&dir.path().join("a.pbrt")).unwrap();
     let s = &imported.scene;
     let m = &s.materials[s.objects[0].material as usize];
-    assert_eq!(m.bsdf, Some(BsdfDesc::Lambert { albedo: Texture::Solid(Vec3::new(1.0, 0.5, 0.0)) }));
+    let Some(BsdfDesc::Lambert { albedo: Texture::Checker { even, odd, .. } }) = m.bsdf else { panic!("{:?}", m.bsdf) };
+    assert_eq!((even, odd), (Vec3::new(1.0, 0.5, 0.0), Vec3::ZERO));
     assert!(imported.warnings.iter().any(|w| w.to_string().contains("replaced by its mean")));
 }
 
