@@ -175,7 +175,13 @@ impl Glass {
 /// The plain lobes of the metallic–roughness model: a coating of index `ior` at full
 /// strength, a metal of single scattering (as Mitsuba's and pbrt's).
 pub(crate) fn plain_lobes(ior: f64) -> MetalRoughness {
-    MetalRoughness { ior, specular: 1.0, multiscatter: false, anisotropy: Default::default() }
+    MetalRoughness {
+        ior,
+        specular: 1.0,
+        multiscatter: false,
+        anisotropy: Default::default(),
+        translucency: Default::default(),
+    }
 }
 
 /// `w·a + (1 − w)·b`, or the one that has all the weight.

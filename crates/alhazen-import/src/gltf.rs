@@ -15,7 +15,8 @@
 //! `KHR_materials_volume` (and its index by wavelength with `KHR_materials_dispersion`), a
 //! clear coat with `KHR_materials_clearcoat`, cloth's sheen with `KHR_materials_sheen`, brushed
 //! facets with `KHR_materials_anisotropy`, a thin film's interference colours with
-//! `KHR_materials_iridescence`; an unlit material (`KHR_materials_unlit`) is a black emitter
+//! `KHR_materials_iridescence`, a thin sheet's light passed through diffusely (leaves, paper)
+//! with `KHR_materials_diffuse_transmission`; an unlit material (`KHR_materials_unlit`) is a black emitter
 //! of its base colour; a `KHR_materials_variants` variant is chosen by the `variant` parameter
 //! (`-D variant=NAME`); a metallic–roughness texture, a textured metal's
 //! colour, stretched facets and a thin film are read per point (`BsdfDesc::MetallicRoughness`, the model at
@@ -29,7 +30,7 @@ use crate::common::{self, Warnings};
 use crate::{Imported, draco, meshopt};
 use alhazen_geom::TriangleMesh;
 use alhazen_math::{Bounds3, Mat4, Quat, Transform, Vec2, Vec3};
-use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Ior, Iridescence, MetalRoughness};
+use alhazen_scene::bsdf::{Anisotropy, AnisotropyModel, BsdfDesc, Ior, Iridescence, MetalRoughness, Translucency};
 use alhazen_scene::{
     Bump, BumpPattern, CameraDesc, Diagnostic, ImageData, IntegratorKind, Light, LookAt, MaterialId, Object,
     PerspectiveOpening, Scene, SceneError, Shape, Texture, Wrap,
@@ -66,6 +67,7 @@ const KNOWN: &[&str] = &[
     "KHR_materials_iridescence",
     "KHR_materials_unlit",
     "KHR_materials_variants",
+    "KHR_materials_diffuse_transmission",
     draco::EXTENSION,
     meshopt::EXTENSIONS[0],
     meshopt::EXTENSIONS[1],
@@ -888,6 +890,7 @@ impl<'a> Importer<'a> {
         // texel's base colour), else the constant mix (and its glass under transmission).
         let textured_metal = metallic > 0.0 && transmission <= 0.0 && !matches!(base, Texture::Solid(_));
         let mut lobes = self.lobes(&material, ior, &name);
+        lobes.translucency = self.translucency(&material, &name)?;
         let mut anisotropy_map;
         (lobes.anisotropy, anisotropy_map) = self.anisotropy(&material, &name)?;
         if lobes.anisotropy.is_anisotropic() && transmission > 0.0 {
@@ -903,7 +906,7 @@ impl<'a> Importer<'a> {
             || specular_map.is_some()
             || specular_color_map.is_some();
         let bsdf = if per_point {
-            let MetalRoughness { ior, specular, multiscatter, anisotropy } = lobes;
+            let MetalRoughness { ior, specular, multiscatter, anisotropy, translucency } = lobes;
             BsdfDesc::MetallicRoughness {
                 base,
                 metallic,
@@ -917,6 +920,7 @@ impl<'a> Importer<'a> {
                 iridescence,
                 specular_map,
                 specular_color_map,
+                translucency,
             }
         } else {
             let bsdf = common::metal_rough(
@@ -1224,6 +1228,47 @@ impl<'a> Importer<'a> {
         }
         let ior = alhazen_scene::bsdf::ior_scaled(ior, color.iter().sum::<f64>() / 3.0);
         MetalRoughness { ior: ior.max(1.0), specular: (s.specular_factor() as f64).clamp(0.0, 1.0), ..plain }
+    }
+
+    /// `KHR_materials_diffuse_transmission`: the share of the coating's diffuse light that passes
+    /// through to the other side (`diffuseTransmissionFactor`, 0 without it) and its colour
+    /// (`diffuseTransmissionColorFactor`, white): `(1 − share)·base` reflected, `share·colour`
+    /// transmitted. Their textures (the share's alpha, the colour's sRGB) are read by their
+    /// means, with a warning.
+    fn translucency(&mut self, material: &gltf::Material, name: &str) -> R<Translucency> {
+        let Some(e) = material.extension_value("KHR_materials_diffuse_transmission") else {
+            return Ok(Translucency::default());
+        };
+        let unit = |x: &serde_json::Value| x.as_f64().filter(|x| (0.0..=1.0).contains(x));
+        let factor = e.get("diffuseTransmissionFactor").map_or(Some(0.0), unit);
+        let color = match e.get("diffuseTransmissionColorFactor") {
+            None => Some(Vec3::ONE),
+            Some(c) => c.as_array().filter(|c| c.len() == 3).and_then(|c| {
+                let k: Option<Vec<f64>> = c.iter().map(unit).collect();
+                k.map(|k| Vec3::new(k[0], k[1], k[2]))
+            }),
+        };
+        let (Some(mut factor), Some(mut color)) = (factor, color) else {
+            return Err(self.err(format!(
+                "{name}: KHR_materials_diffuse_transmission needs a diffuseTransmissionFactor and a diffuseTransmissionColorFactor of three numbers, within [0, 1]"
+            )));
+        };
+        for (key, decoding) in
+            [("diffuseTransmissionTexture", Decoding::Alpha), ("diffuseTransmissionColorTexture", Decoding::Srgb)]
+        {
+            let Some(info) = e.get(key) else { continue };
+            let texture = self.texture_of_info(info, name, key, decoding)?;
+            let mean = alhazen_scene::texture::mean(&texture, &self.scene.images);
+            if matches!(texture, Texture::Image { image, .. } if image + 1 == self.scene.images.len()) {
+                self.scene.images.pop();
+            }
+            self.warn(format!("{name}: KHR_materials_diffuse_transmission's {key} is read by its mean"));
+            match decoding {
+                Decoding::Alpha => factor *= mean.x,
+                _ => color *= mean,
+            }
+        }
+        Ok(Translucency { factor: factor.clamp(0.0, 1.0), color: color.clamp(Vec3::ZERO, Vec3::ONE) })
     }
 
     /// `KHR_materials_specular`'s textures, per point: `specularTexture` the coating's specular

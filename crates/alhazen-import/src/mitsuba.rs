@@ -1352,6 +1352,7 @@ impl Importer {
                 iridescence: None,
                 specular_map: None,
                 specular_color_map: None,
+                translucency: Default::default(),
             });
         }
         let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
@@ -1374,6 +1375,7 @@ impl Importer {
                 iridescence: None,
                 specular_map: None,
                 specular_color_map: None,
+                translucency: Default::default(),
             });
         }
         Ok(common::metal_rough(

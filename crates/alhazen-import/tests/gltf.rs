@@ -814,6 +814,45 @@ fn blender_specular_level_agrees_with_cycles() {
     }
 }
 
+/// `KHR_materials_diffuse_transmission` (leaves, paper): the coating's diffuse light split into
+/// `(1 − share)·base` reflected and `share·colour` passed through to the other side. The quad
+/// lit from behind by a directional light shows the colour passed through (red here), black
+/// without the extension; its textures are read by their means (warning); factors out of
+/// range are refused.
+#[test]
+fn diffuse_transmission_passes_light_through_a_leaf() {
+    let ext = r#""KHR_materials_diffuse_transmission": { "diffuseTransmissionFactor": 0.4, "diffuseTransmissionColorFactor": [1, 0, 0] }"#;
+    let (bsdf, said) = material_with_extensions(ext).unwrap();
+    assert!(said.is_empty(), "{said:?}");
+    let BsdfDesc::CookTorrance { kd, transmittance, layered: true, .. } = &bsdf else { panic!("{bsdf:?}") };
+    assert_eq!((*kd, transmittance), (0.6, &Texture::Solid(Vec3::new(0.4, 0.0, 0.0))));
+    let lit_from_behind = |ext: &str| {
+        let json = embedded().replace(
+            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
+            &format!(
+                r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "doubleSided": true, "extensions": {{ {ext} }}"#
+            ),
+        );
+        let mut s = write_and_import(&[("m.gltf", json.into_bytes())]).unwrap().scene;
+        s.lights = vec![alhazen_scene::Light::Directional { direction: Vec3::Z, intensity: Vec3::splat(3.0) }];
+        s.background = alhazen_scene::Background::Solid(Vec3::ZERO);
+        (s.render.width, s.render.height, s.render.spp) = (32, 16, 16);
+        s.render.integrator = alhazen_scene::IntegratorKind::Path;
+        let img = alhazen_render::render(&s, &|_, _| {});
+        (0..32).flat_map(|x| (0..16).map(move |y| (x, y))).map(|(x, y)| img.get(x, y)).sum::<Vec3>()
+    };
+    let (through, opaque) = (lit_from_behind(ext), lit_from_behind(r#""KHR_materials_ior": { "ior": 1.5 }"#));
+    assert!(through.x > 1.0 && through.y.max(through.z) < 1e-9 && opaque.max_element() < 1e-9, "{through} {opaque}");
+    let (_, said) = material_with_extensions(
+        r#""KHR_materials_diffuse_transmission": { "diffuseTransmissionFactor": 1, "diffuseTransmissionTexture": { "index": 0 } }"#,
+    )
+    .unwrap();
+    assert!(said.iter().any(|w| w.contains("diffuseTransmissionTexture is read by its mean")), "{said:?}");
+    let e = material_with_extensions(r#""KHR_materials_diffuse_transmission": { "diffuseTransmissionFactor": 1.5 }"#)
+        .unwrap_err();
+    assert!(e.contains("diffuseTransmissionFactor"), "{e}");
+}
+
 /// A white furnace: a sphere of a white Principled dielectric (roughness 0.15) alone under a
 /// uniform white world (`bench/blender/furnace_vs_cycles.py`, Cycles 4096 spp). Cycles layers
 /// the base under the specular lobe by what the lobe leaves (`1 − E(μ_o)`), so the sphere is

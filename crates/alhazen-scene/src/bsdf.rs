@@ -251,6 +251,9 @@ pub enum BsdfDesc {
         /// Where the coating's normal-incidence reflectance varies: `F(0)` of `ior` times the
         /// map's mean colour, the coating's index found from that (glTF's `specularColorTexture`).
         specular_color_map: Option<Texture>,
+        /// The share of the coating's diffuse light that passes through (glTF's
+        /// `KHR_materials_diffuse_transmission`).
+        translucency: Translucency,
     },
     /// A clear coat over `base` (car paint, lacquer; glTF's `KHR_materials_clearcoat`): a
     /// dielectric microfacet layer of `weight` reflecting `weight·D G F/(4⟨l,n⟩⟨v,n⟩)`, the
@@ -374,6 +377,7 @@ impl crate::model::Material {
                     specular: *specular,
                     multiscatter: *multiscatter,
                     anisotropy: *anisotropy,
+                    translucency: Translucency::default(),
                 };
                 let (metal, coating) = metallic_roughness_lobes(Vec3::ONE, *roughness, lobes);
                 if *metallic > 0.0 {
@@ -391,7 +395,7 @@ impl crate::model::Material {
 
 /// The metal and the coating of [`BsdfDesc::metallic_roughness_at`].
 fn metallic_roughness_lobes(base: Rgb, roughness: f64, lobes: MetalRoughness) -> (BsdfDesc, BsdfDesc) {
-    let MetalRoughness { ior, specular, multiscatter, anisotropy } = lobes;
+    let MetalRoughness { ior, specular, multiscatter, anisotropy, translucency } = lobes;
     let alpha = (roughness * roughness).clamp(0.0, 1.0);
     let (along, across) = anisotropy.alphas(alpha);
     let metal = BsdfDesc::Conductor {
@@ -404,13 +408,13 @@ fn metallic_roughness_lobes(base: Rgb, roughness: f64, lobes: MetalRoughness) ->
     };
     let coating = BsdfDesc::CookTorrance {
         albedo: Texture::Solid(base),
-        kd: 1.0,
+        kd: 1.0 - translucency.factor,
         ks: specular,
         facets: ggx(along.max(0.01), across.max(0.01)),
         ior,
         fresnel: FresnelMode::Exact,
         layered: true,
-        transmittance: Texture::Solid(Vec3::ZERO),
+        transmittance: Texture::Solid(translucency.color * translucency.factor),
     };
     (metal, coating)
 }
@@ -513,6 +517,25 @@ pub struct MetalRoughness {
     pub multiscatter: bool,
     /// Its facets' stretch.
     pub anisotropy: Anisotropy,
+    /// The coating's diffuse transmission.
+    pub translucency: Translucency,
+}
+
+/// A thin sheet's diffuse transmission (glTF's `KHR_materials_diffuse_transmission`): the
+/// `factor` of the diffuse light that passes through to the other side rather than being
+/// reflected, coloured `color` (`(1 − factor)·base` reflected, `factor·color` transmitted).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Translucency {
+    /// In `[0, 1]`; 0 for an opaque surface.
+    pub factor: f64,
+    /// What the passing light keeps, per channel in `[0, 1]`.
+    pub color: Rgb,
+}
+
+impl Default for Translucency {
+    fn default() -> Self {
+        Translucency { factor: 0.0, color: Vec3::ONE }
+    }
 }
 
 /// GGX microfacets with Smith shadowing, `α` clamped away from 0 (where the distribution

@@ -128,6 +128,7 @@ impl Parser<'_> {
                     "iridescence",
                     "specular_map",
                     "specular_color_map",
+                    "diffuse_transmission",
                 ]
             }
             "thin-dielectric" => vec!["ior"],
@@ -249,6 +250,11 @@ impl Parser<'_> {
                     iridescence: t.get("iridescence").map(|n| self.iridescence(&n).map(Box::new)).transpose()?,
                     specular_map: t.get("specular_map").map(|m| self.linear_placed_image(&m)).transpose()?,
                     specular_color_map: t.get("specular_color_map").map(|m| self.texture(&m)).transpose()?,
+                    translucency: t
+                        .get("diffuse_transmission")
+                        .map(|n| translucency(&n))
+                        .transpose()?
+                        .unwrap_or_default(),
                 }
             }
             "coated" => {
@@ -316,6 +322,19 @@ fn fresnel_weights(t: &Table, default_ks: f64) -> R<(f64, f64)> {
         return Err(node.err(format!("kd + ks·F(0) = {} exceeds 1: the surface would create energy", kd + ks * f0)));
     }
     Ok((kd, ks))
+}
+
+/// A metallic–roughness surface's `diffuse_transmission = { factor, color }` (0 and white when
+/// absent).
+fn translucency(n: &Node) -> R<Translucency> {
+    let t = n.table(&["factor", "color"])?;
+    let factor = t.get("factor").map_or(Ok(0.0), |f| f.in_range(0.0, 1.0))?;
+    let color = t.opt_rgb("color", Vec3::ONE)?;
+    if !(color.min_element() >= 0.0 && color.max_element() <= 1.0) {
+        let node = t.get("color").expect("a colour out of range was given");
+        return Err(node.err("`color` is what passing light keeps: a colour within [0, 1]"));
+    }
+    Ok(Translucency { factor, color })
 }
 
 /// `kd` (1) and `ks` of a layered surface, whose diffuse weight `k_d(1 − k_s·E)` keeps energy

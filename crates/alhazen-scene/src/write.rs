@@ -586,9 +586,19 @@ impl Writer<'_> {
                 iridescence,
                 specular_map,
                 specular_color_map,
+                translucency,
             } => {
+                let through = if translucency.factor == 0.0 {
+                    String::new()
+                } else {
+                    format!(
+                        ", diffuse_transmission = {{ factor = {}, color = {} }}",
+                        num(translucency.factor),
+                        vec3(translucency.color)
+                    )
+                };
                 format!(
-                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{}{}{}{} }}",
+                    "{{ type = \"metallic-roughness\", color = {}, metallic = {}, roughness = {}, ior = {}{}{}{}{}{}{}{}{through} }}",
                     self.texture(base),
                     num(*metallic),
                     num(*roughness),

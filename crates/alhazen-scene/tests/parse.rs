@@ -209,6 +209,8 @@ fn metallic_roughness_reads_and_writes_back() {
 bsdf = { type = "metallic-roughness" }
 [materials.worn]
 bsdf = { type = "metallic-roughness", color = [0.9, 0.6, 0.2], metallic = 1, roughness = 0.7, ior = 1.4, map = { file = "mr.png", scale = 2 } }
+[materials.leaf]
+bsdf = { type = "metallic-roughness", color = [0.2, 0.6, 0.1], diffuse_transmission = { factor = 0.4, color = [1, 0.5, 0] } }
 "#;
     let path = dir.path().join("mr.toml");
     std::fs::write(&path, text).unwrap();
@@ -227,10 +229,13 @@ bsdf = { type = "metallic-roughness", color = [0.9, 0.6, 0.2], metallic = 1, rou
     assert_eq!((metallic, roughness, scale), (1.0, 0.7, alhazen_math::Vec2::splat(2.0)));
     // Read linearly: 200/255, not its sRGB decoding.
     assert_eq!(s.images[image].texel(1), [0.0, 200.0 / 255.0, 0.0]);
+    let Some(BsdfDesc::MetallicRoughness { translucency, .. }) = mat(&s, "leaf") else { panic!() };
+    let color = alhazen_math::Vec3::new(1.0, 0.5, 0.0);
+    assert_eq!(translucency, alhazen_scene::bsdf::Translucency { factor: 0.4, color });
     let again_path = dir.path().join("again.toml");
     alhazen_scene::write::write_scene(&s, &again_path, &dir.path().join("assets"), "").unwrap();
     let again = load_scene(&again_path).unwrap();
-    for name in ["plain", "worn"] {
+    for name in ["plain", "worn", "leaf"] {
         assert_eq!(mat(&s, name), mat(&again, name));
     }
 }
@@ -558,6 +563,10 @@ fn physically_based_mistakes_are_explained() {
     assert!(m(r#"{ type = "plastic", nonlinear = 1 }"#).contains("nonlinear"));
     assert!(m(r#"{ type = "dielectric", glass = "bk8" }"#).contains("did you mean \"bk7\"?"));
     assert!(m(r#"{ type = "metallic-roughness", metallic = 1.5 }"#).contains("s.toml:2:"));
+    assert!(m(r#"{ type = "metallic-roughness", diffuse_transmission = { factor = 2 } }"#).contains("factor"));
+    assert!(
+        m(r#"{ type = "metallic-roughness", diffuse_transmission = { color = [2, 0, 0] } }"#).contains("within [0, 1]")
+    );
     assert!(m(r#"{ type = "metallic-roughness", roughness = -0.1 }"#).contains("roughness"));
     assert!(m(r#"{ type = "metallic-roughness", metallic = nan }"#).contains("expected a finite number"));
     assert!(m(r#"{ type = "metallic-roughness", roughness = 1e300 }"#).contains("roughness"));
