@@ -14,14 +14,11 @@
 
 use super::microfacet::Microfacet;
 use crate::optics::fresnel_dielectric;
-use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::bsdf::Distribution;
 use std::sync::OnceLock;
 
 /// Table size along `μ` and along `r = √α`.
 const N: usize = 32;
-/// Stratified facet normals per table cell (`STRATA²`).
-const STRATA: usize = 16;
 /// Slices along `t`, `t_k = k·T_STEP` up to 0.9 (an index of 19).
 const SLICES: usize = 19;
 const T_STEP: f64 = 0.05;
@@ -59,29 +56,10 @@ fn compute(beckmann: bool, eta: f64) -> Slice {
     rows
 }
 
-/// `E(μ)` of the lobe of `facets` and index `eta`, by the facets' visible-normal sampling over a
-/// stratified grid (a fixed set of numbers: the table is the same every run).
+/// `E(μ)` of the lobe of `facets` and index `eta` (the quadrature of [`super::multiscatter`]'s
+/// table, with the Fresnel factor).
 pub(super) fn directional_albedo(facets: &Microfacet, mu: f64, eta: f64) -> f64 {
-    let mu = mu.max(1e-3);
-    let v = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-    let mut sum = 0.0;
-    for a in 0..STRATA {
-        for b in 0..STRATA {
-            let u = Vec2::new((a as f64 + 0.5) / STRATA as f64, (b as f64 + 0.5) / STRATA as f64);
-            let Some(h) = facets.sample_h_from(v, u) else { continue };
-            let l = 2.0 * v.dot(h) * h - v;
-            if l.z <= 0.0 {
-                continue;
-            }
-            let d = facets.d(h);
-            let pdf = facets.pdf_h_from(v, h, d) / (4.0 * h.dot(v));
-            if pdf > 0.0 {
-                let f = fresnel_dielectric(h.dot(l), eta);
-                sum += d * facets.g(v, l, h) * f / (4.0 * v.z * l.z) * l.z / pdf;
-            }
-        }
-    }
-    (sum / (STRATA * STRATA) as f64).clamp(0.0, 1.0)
+    super::multiscatter::stratified_albedo(facets, mu, |cos| fresnel_dielectric(cos, eta))
 }
 
 /// `E(μ)` of a dielectric lobe of index `eta` on `facets` (Beckmann's or, for every other

@@ -54,11 +54,16 @@ fn alpha_at(i: usize) -> f64 {
     (r * r).max(1e-3)
 }
 
-/// `∫ D G / (4 μ_v μ_l) μ_l dω_l` for `F = 1` at `μ_v = mu`, by the facets' visible-normal
-/// sampling over a stratified grid (a fixed set of numbers: the table is the same every run).
+/// `∫ D G / (4 μ_v μ_l) μ_l dω_l` for `F = 1` at `μ_v = mu`.
 fn single_scattering_albedo(mu: f64, alpha: f64) -> f64 {
+    stratified_albedo(&Microfacet::smith::<false>(alpha, alpha), mu, |_| 1.0)
+}
+
+/// `∫ D G F / (4 μ_v μ_l) μ_l dω_l` at `μ_v = mu`, `F` of the cosine between facet and light
+/// given by `fresnel`, by the facets' visible-normal sampling over a stratified grid (a fixed
+/// set of numbers: a table of it is the same every run).
+pub(super) fn stratified_albedo(facets: &Microfacet, mu: f64, fresnel: impl Fn(f64) -> f64) -> f64 {
     let mu = mu.max(1e-3);
-    let facets = Microfacet::smith::<false>(alpha, alpha);
     let v = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let mut sum = 0.0;
     for a in 0..STRATA {
@@ -72,7 +77,7 @@ fn single_scattering_albedo(mu: f64, alpha: f64) -> f64 {
             let d = facets.d(h);
             let pdf = facets.pdf_h_from(v, h, d) / (4.0 * h.dot(v));
             if pdf > 0.0 {
-                sum += d * facets.g(v, l, h) / (4.0 * v.z * l.z) * l.z / pdf;
+                sum += d * facets.g(v, l, h) * fresnel(h.dot(l)) / (4.0 * v.z * l.z) * l.z / pdf;
             }
         }
     }
