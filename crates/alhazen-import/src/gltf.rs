@@ -1107,29 +1107,22 @@ impl<'a> Importer<'a> {
     /// `sheenRoughnessTexture`'s alpha; `α = r²`); none where the colour factor is black.
     fn sheen(&mut self, material: &gltf::Material, bsdf: BsdfDesc, name: &str) -> R<BsdfDesc> {
         let Some(e) = material.extension_value("KHR_materials_sheen") else { return Ok(bsdf) };
-        let unit = |x: &serde_json::Value| x.as_f64().filter(|x| (0.0..=1.0).contains(x));
-        let color = match e.get("sheenColorFactor") {
-            None => Some([0.0; 3]),
-            Some(c) => c.as_array().filter(|c| c.len() == 3).and_then(|c| {
-                let k: Option<Vec<f64>> = c.iter().map(unit).collect();
-                k.map(|k| [k[0], k[1], k[2]])
-            }),
-        };
+        let color = unit_rgb(e.get("sheenColorFactor"), Vec3::ZERO);
         let roughness = e.get("sheenRoughnessFactor").map_or(Some(0.0), unit);
         let (Some(color), Some(roughness)) = (color, roughness) else {
             return Err(self.err(format!(
                 "{name}: KHR_materials_sheen needs a sheenColorFactor of three numbers and a sheenRoughnessFactor, within [0, 1]"
             )));
         };
-        if color == [0.0; 3] {
+        if color == Vec3::ZERO {
             return Ok(bsdf);
         }
         // The colour texture is sRGB, times the factor; the roughness is the texture's alpha.
         let color = match e.get("sheenColorTexture") {
-            None => Texture::Solid(Vec3::from_array(color)),
+            None => Texture::Solid(color),
             Some(info) => match self.texture_of_info(info, name, "sheenColorTexture", Decoding::Srgb)? {
                 Texture::Image { image, scale, offset, rotation } => {
-                    let factored = scaled(self.scene.images[image].clone(), Vec3::from_array(color));
+                    let factored = scaled(self.scene.images[image].clone(), color);
                     self.scene.images[image] = factored;
                     Texture::Image { image, scale, offset, rotation }
                 }
@@ -1239,15 +1232,8 @@ impl<'a> Importer<'a> {
         let Some(e) = material.extension_value("KHR_materials_diffuse_transmission") else {
             return Ok(Translucency::default());
         };
-        let unit = |x: &serde_json::Value| x.as_f64().filter(|x| (0.0..=1.0).contains(x));
         let factor = e.get("diffuseTransmissionFactor").map_or(Some(0.0), unit);
-        let color = match e.get("diffuseTransmissionColorFactor") {
-            None => Some(Vec3::ONE),
-            Some(c) => c.as_array().filter(|c| c.len() == 3).and_then(|c| {
-                let k: Option<Vec<f64>> = c.iter().map(unit).collect();
-                k.map(|k| Vec3::new(k[0], k[1], k[2]))
-            }),
-        };
+        let color = unit_rgb(e.get("diffuseTransmissionColorFactor"), Vec3::ONE);
         let (Some(mut factor), Some(mut color)) = (factor, color) else {
             return Err(self.err(format!(
                 "{name}: KHR_materials_diffuse_transmission needs a diffuseTransmissionFactor and a diffuseTransmissionColorFactor of three numbers, within [0, 1]"
@@ -1666,6 +1652,19 @@ fn decode_webp(bytes: &[u8]) -> Result<gltf::image::Data, String> {
         (img.into_rgb8().into_raw(), gltf::image::Format::R8G8B8)
     };
     Ok(gltf::image::Data { pixels, format, width, height })
+}
+
+/// A JSON number within `[0, 1]`, as extensions' factors are.
+fn unit(x: &serde_json::Value) -> Option<f64> {
+    x.as_f64().filter(|x| (0.0..=1.0).contains(x))
+}
+
+/// A JSON colour factor of three numbers within `[0, 1]`, `default` where it is absent; `None`
+/// where it is malformed.
+fn unit_rgb(value: Option<&serde_json::Value>, default: Vec3) -> Option<Vec3> {
+    let Some(c) = value else { return Some(default) };
+    let k: Vec<f64> = c.as_array().filter(|c| c.len() == 3)?.iter().map(unit).collect::<Option<_>>()?;
+    Some(Vec3::new(k[0], k[1], k[2]))
 }
 
 /// How an image's channels are read.
