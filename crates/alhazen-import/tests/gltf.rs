@@ -848,9 +848,17 @@ fn diffuse_transmission_passes_light_through_a_leaf() {
     )
     .unwrap();
     assert!(said.iter().any(|w| w.contains("diffuseTransmissionTexture is read by its mean")), "{said:?}");
-    let e = material_with_extensions(r#""KHR_materials_diffuse_transmission": { "diffuseTransmissionFactor": 1.5 }"#)
-        .unwrap_err();
-    assert!(e.contains("diffuseTransmissionFactor"), "{e}");
+    for bad in [
+        r#"{ "diffuseTransmissionFactor": 1.5 }"#,
+        r#"{ "diffuseTransmissionFactor": -0.1 }"#,
+        r#"{ "diffuseTransmissionFactor": "half" }"#,
+        r#"{ "diffuseTransmissionColorFactor": [1, 2, 0] }"#,
+        r#"{ "diffuseTransmissionColorFactor": [1, 0] }"#,
+        r#"{ "diffuseTransmissionTexture": { "index": 99 } }"#,
+    ] {
+        let e = material_with_extensions(&format!(r#""KHR_materials_diffuse_transmission": {bad}"#)).unwrap_err();
+        assert!(e.contains("diffuseTransmission"), "{bad}: {e}");
+    }
 }
 
 /// A thin panel lit from behind (and, weaker, from the front) against Cycles' mix of a Diffuse

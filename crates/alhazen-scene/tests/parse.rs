@@ -551,6 +551,8 @@ fn physically_based_mistakes_are_explained() {
         m(r#"{ type = "cook-torrance", ks = 0, kd = 0.7, transmittance = 0.5 }"#).contains("kd + transmittance = 1.2")
     );
     assert!(m(r#"{ type = "cook-torrance", transmittance = [0.2, 1.5, 0] }"#).contains("within [0, 1]"));
+    assert!(m(r#"{ type = "cook-torrance", transmittance = nan }"#).contains("expected a finite number"));
+    assert!(m(r#"{ type = "cook-torrance", transmittance = 1e300 }"#).contains("beyond ±1e100"));
     assert!(
         m(r#"{ type = "conductor", roughness = 0.2, distribution = "gaussian", shadowing = "smith" }"#)
             .contains("Smith shadowing has no closed form")
@@ -567,6 +569,8 @@ fn physically_based_mistakes_are_explained() {
     assert!(
         m(r#"{ type = "metallic-roughness", diffuse_transmission = { color = [2, 0, 0] } }"#).contains("within [0, 1]")
     );
+    assert!(m(r#"{ type = "metallic-roughness", diffuse_transmission = { factor = nan } }"#).contains("finite"));
+    assert!(m(r#"{ type = "metallic-roughness", diffuse_transmission = { colour = [1, 0, 0] } }"#).contains("colour"));
     assert!(m(r#"{ type = "metallic-roughness", roughness = -0.1 }"#).contains("roughness"));
     assert!(m(r#"{ type = "metallic-roughness", metallic = nan }"#).contains("expected a finite number"));
     assert!(m(r#"{ type = "metallic-roughness", roughness = 1e300 }"#).contains("roughness"));
