@@ -1821,7 +1821,7 @@ impl Importer {
                 let name =
                     self.string(ctx, &p, "filename")?.ok_or_else(|| ctx.err(node, "envmap needs a `filename`"))?;
                 let path = self.resolve(ctx, &name, false);
-                let img = alhazen_scene::import::load_hdr_image(&path).map_err(|e| ctx.err(node, e))?;
+                let img = alhazen_scene::import::load_radiance_image(&path).map_err(|e| ctx.err(node, e))?;
                 let scale = self.float(ctx, &p, "scale", 1.0)?;
                 let (rotation, up) = self.map_orientation(ctx, node, l);
                 self.scene.images.push(Arc::new(img));

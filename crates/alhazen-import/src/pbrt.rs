@@ -1447,7 +1447,7 @@ impl Importer {
             "infinite" => {
                 if let Some(name) = self.string(ctx, p, "filename")? {
                     let path = common::relative_to(ctx.path, &name);
-                    let img = alhazen_scene::import::load_hdr_image(&path).map_err(|e| ctx.err(at.clone(), e))?;
+                    let img = alhazen_scene::import::load_radiance_image(&path).map_err(|e| ctx.err(at.clone(), e))?;
                     if img.width != img.height {
                         return Err(ctx.err(
                             at.clone(),

@@ -884,6 +884,19 @@ fn environment_maps_keep_any_rotation() {
     assert!(checked > 190, "{checked}");
 }
 
+/// An 8-bit map's codes are sRGB, as Mitsuba reads them: a map of code 128 lights a scene
+/// by 0.2159 (Mitsuba 3 renders a camera inside it 0.21586), not 128/255.
+#[test]
+fn an_eight_bit_environment_map_is_decoded_from_srgb() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(8, 4, image::Rgb([128, 128, 128])).save(dir.path().join("grey.png")).unwrap();
+    let xml = scene(r#"<emitter type="envmap"><string name="filename" value="grey.png"/></emitter>"#);
+    std::fs::write(dir.path().join("s.xml"), xml).unwrap();
+    let s = alhazen_import::load(&dir.path().join("s.xml")).unwrap().scene;
+    let sky = s.sky(Vec3::new(0.3, 0.2, -0.9).normalize());
+    assert!((sky - Vec3::splat(0.21586)).abs().max_element() < 1e-4, "{sky}");
+}
+
 /// Sampled spectra become the colours Mitsuba's RGB modes make of them
 /// (`mi.spectrum_list_to_srgb`, Mitsuba 3.9.1): a reflectance weighed by the CIE matching
 /// functions under D65, an emitter's radiance without it; a single value emitted is that much

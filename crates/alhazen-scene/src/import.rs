@@ -496,12 +496,32 @@ fn has_pixels(path: &Path, w: u32, h: u32) -> Result<(), String> {
     Ok(())
 }
 
+/// Loads an environment map's radiance: a floating-point image (Radiance `.hdr`, OpenEXR) as
+/// its values, an image of integers (8- or 16-bit PNG, JPEG) decoded from sRGB, as Blender,
+/// Mitsuba and pbrt read such a map.
+pub fn load_radiance_image(path: &Path) -> Result<ImageData, String> {
+    let img = open_image(path)?;
+    let srgb = !matches!(img.color(), image::ColorType::Rgb32F | image::ColorType::Rgba32F);
+    linear_pixels(path, img, srgb)
+}
+
 /// Loads a high-dynamic-range image (Radiance `.hdr` or OpenEXR), whose values are linear
-/// radiance already.
+/// radiance already, or any image's values read linearly (normal maps).
 pub fn load_hdr_image(path: &Path) -> Result<ImageData, String> {
-    let img = image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))?.to_rgb32f();
+    linear_pixels(path, open_image(path)?, false)
+}
+
+fn open_image(path: &Path) -> Result<image::DynamicImage, String> {
+    image::open(path).map_err(|e| format!("cannot load image {}: {e}", path.display()))
+}
+
+/// An image's values as floats, decoded from sRGB when `srgb`; refused when some are negative,
+/// infinite or NaN.
+fn linear_pixels(path: &Path, img: image::DynamicImage, srgb: bool) -> Result<ImageData, String> {
+    let img = img.to_rgb32f();
     has_pixels(path, img.width(), img.height())?;
-    let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
+    let decode = |c: f32| if srgb { srgb_to_linear(c as f64) as f32 } else { c };
+    let pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0.map(decode)).collect();
     if pixels.iter().flatten().any(|v| !v.is_finite() || *v < 0.0) {
         return Err(format!("{}: the image has negative, infinite or NaN values", path.display()));
     }

@@ -302,7 +302,7 @@ impl Parser<'_> {
         let rotation = t.opt_f64("rotate_y", 0.0)?.to_radians();
         let up = t.get("up").map_or(Ok(Vec3::Y), |n| n.unit_vec3())?;
         let path = self.dir.join(file.str()?);
-        let data = import::load_hdr_image(&path).map_err(|e| file.err(e))?;
+        let data = import::load_radiance_image(&path).map_err(|e| file.err(e))?;
         self.scene.images.push(Arc::new(data));
         Ok(Light::Environment { image: self.scene.images.len() - 1, scale, rotation, up })
     }
