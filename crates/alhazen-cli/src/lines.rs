@@ -159,7 +159,7 @@ pub fn run(a: &LinesArgs) -> Result<(), Failure> {
     let (drawing, summary) = match (a.graph, &a.scene) {
         (Some(g), _) => graph_drawing(g, a),
         (None, Some(path)) => {
-            let scene = load(path, &a.parameters)?;
+            let scene = load(path, &a.parameters, &crate::EnvironmentArgs::default())?;
             let opts = Options {
                 width_mm: a.width_mm,
                 feature_angle_deg: a.feature_angle,

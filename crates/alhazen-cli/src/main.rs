@@ -134,6 +134,8 @@ struct ConvertArgs {
     scene: PathBuf,
     #[command(flatten)]
     parameters: SceneParameters,
+    #[command(flatten)]
+    environment: EnvironmentArgs,
     /// The TOML file to write (its meshes and images go to a folder beside it, named after it).
     #[arg(short, long)]
     output: PathBuf,
@@ -158,6 +160,65 @@ fn parse_define(s: &str) -> Result<(String, String), String> {
     Ok((name.to_string(), value.to_string()))
 }
 
+/// An environment map to light a scene by, in place of its own (a glTF file has none: a
+/// Blender export carries no world).
+#[derive(Args, Default)]
+pub(crate) struct EnvironmentArgs {
+    /// Light the scene by this equirectangular map (Radiance .hdr or OpenEXR, linear radiance)
+    /// instead of its own environment or sky: e.g. the HDRI a Blender scene exported to glTF
+    /// was lit by (turned by --environment-rotate 90, it is where Blender shows it).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) environment: Option<PathBuf>,
+    /// The --environment map's values times this.
+    #[arg(long, value_name = "SCALE", default_value_t = 1.0, allow_negative_numbers = true, value_parser = parse_environment_scale, requires = "environment")]
+    pub(crate) environment_scale: f64,
+    /// The --environment map turned about its up axis by this many degrees: its centre seen
+    /// towards +z at 0, towards +x at 90 (as Blender's world behind the glTF files it writes).
+    #[arg(long, value_name = "DEGREES", default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_degrees, requires = "environment")]
+    pub(crate) environment_rotate: f64,
+    /// The --environment map's up axis: y (glTF's, alhazen's) or z (a z-up scene's, as many
+    /// pbrt and Mitsuba scenes are).
+    #[arg(long, value_enum, default_value = "y", requires = "environment")]
+    pub(crate) environment_up: UpAxis,
+}
+
+#[derive(Clone, Copy, Default, ValueEnum)]
+pub(crate) enum UpAxis {
+    #[default]
+    Y,
+    Z,
+}
+
+impl EnvironmentArgs {
+    /// The map, read; `None` without `--environment`. A file that cannot be read as one is
+    /// bad input.
+    fn read(&self) -> Result<Option<alhazen_scene::OutsideEnvironment>, Failure> {
+        let Some(file) = &self.environment else { return Ok(None) };
+        let image = alhazen_scene::import::load_radiance_image(file)
+            .map_err(|e| Failure::input(format!("--environment: {e}")))?;
+        let up = match self.environment_up {
+            UpAxis::Y => alhazen_math::Vec3::Y,
+            UpAxis::Z => alhazen_math::Vec3::Z,
+        };
+        let rotation = self.environment_rotate.to_radians();
+        Ok(Some(alhazen_scene::OutsideEnvironment { image: image.into(), scale: self.environment_scale, rotation, up }))
+    }
+}
+
+fn parse_environment_scale(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("a scale is a number of at least 0, not {s:?}")),
+    }
+}
+
+fn parse_degrees(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x.abs() <= 1e6 => Ok(x),
+        _ => Err(format!("an angle is a number of degrees from -1000000 to 1000000, not {s:?}")),
+    }
+}
+
 /// What every image-producing command takes: the scene, the output and its size.
 #[derive(Args)]
 pub(crate) struct ImageArgs {
@@ -165,6 +226,8 @@ pub(crate) struct ImageArgs {
     pub(crate) scene: PathBuf,
     #[command(flatten)]
     pub(crate) parameters: SceneParameters,
+    #[command(flatten)]
+    pub(crate) environment: EnvironmentArgs,
     /// Output image: .png (8-bit sRGB), .exr or .pfm (linear floats).
     #[arg(short, long)]
     pub(crate) output: PathBuf,
@@ -265,7 +328,7 @@ fn main() -> ExitCode {
 
 /// Reads a scene file in any format alhazen imports (TOML, glTF, Mitsuba XML, pbrt), printing
 /// what the import approximated; every problem with it is bad input (exit code 2).
-pub(crate) fn load(path: &Path, parameters: &SceneParameters) -> Result<Scene, Failure> {
+pub(crate) fn load(path: &Path, parameters: &SceneParameters, environment: &EnvironmentArgs) -> Result<Scene, Failure> {
     let format = alhazen_import::SceneFormat::from_path(path);
     let takes_parameters = matches!(format, alhazen_import::SceneFormat::Mitsuba | alhazen_import::SceneFormat::Gltf);
     if !parameters.defines.is_empty() && !takes_parameters {
@@ -275,11 +338,16 @@ pub(crate) fn load(path: &Path, parameters: &SceneParameters) -> Result<Scene, F
             format.name()
         )));
     }
-    let imported =
-        alhazen_import::load_with_parameters(path, memory_budget(), &parameters.defines).map_err(|e| match e {
-            SceneError::Io { .. } => Failure::input(e.to_string()),
-            SceneError::Syntax(d) => Failure::input(d.to_string()),
-        })?;
+    let environment = environment.read()?;
+    let options = alhazen_import::LoadOptions {
+        memory_budget: memory_budget(),
+        parameters: &parameters.defines,
+        environment: environment.as_ref(),
+    };
+    let imported = alhazen_import::load_with(path, &options).map_err(|e| match e {
+        SceneError::Io { .. } => Failure::input(e.to_string()),
+        SceneError::Syntax(d) => Failure::input(d.to_string()),
+    })?;
     for w in &imported.warnings {
         eprintln!("warning: {w}");
     }
@@ -288,7 +356,7 @@ pub(crate) fn load(path: &Path, parameters: &SceneParameters) -> Result<Scene, F
 
 /// Reads the scene and applies `--width`/`--height`, refusing sizes that cannot be allocated.
 pub(crate) fn load_sized(a: &ImageArgs) -> Result<Scene, Failure> {
-    let mut scene = load(&a.scene, &a.parameters)?;
+    let mut scene = load(&a.scene, &a.parameters, &a.environment)?;
     let r = &mut scene.render;
     r.width = a.width.unwrap_or(r.width);
     r.height = a.height.unwrap_or(r.height);
@@ -334,7 +402,7 @@ fn run_convert(a: &ConvertArgs) -> Result<(), Failure> {
         return Err(Failure::input(format!("{}: the output of convert is a .toml file", a.output.display())));
     }
     check_output_dir(&a.output)?;
-    let scene = load(&a.scene, &a.parameters)?;
+    let scene = load(&a.scene, &a.parameters, &a.environment)?;
     let stem = a.output.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
     let assets = a.output.with_file_name(format!("{stem}-assets"));
     let header = format!(

@@ -25,6 +25,8 @@ pub(crate) struct ViewArgs {
     scene: PathBuf,
     #[command(flatten)]
     parameters: crate::SceneParameters,
+    #[command(flatten)]
+    environment: crate::EnvironmentArgs,
     /// Window width (overrides the scene's image width).
     #[arg(long, value_parser = clap::value_parser!(u32).range(16..=8192))]
     width: Option<u32>,
@@ -123,7 +125,7 @@ pub(crate) fn run(a: &ViewArgs) -> Result<(), Failure> {
     if let Some(s) = &a.screenshot {
         check_output(s, false)?;
     }
-    let mut scene = load(&a.scene, &a.parameters)?;
+    let mut scene = load(&a.scene, &a.parameters, &a.environment)?;
     scene.render.width = a.width.unwrap_or(scene.render.width).clamp(16, 8192);
     scene.render.height = a.height.unwrap_or(scene.render.height).clamp(16, 8192);
     let (w, h) = (scene.render.width as usize, scene.render.height as usize);

@@ -818,6 +818,52 @@ fn convert_writes_toml_that_renders_and_refuses_other_outputs() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("is a .toml file"));
 }
 
+/// `--environment` lights any scene by a map in place of its own sky (a glTF file has none):
+/// rays that leave see the map, not the scene's background, in the path tracer and Whitted's;
+/// `convert` writes it into the TOML. Its options without a map, and maps that cannot be read
+/// or numbers that mean nothing, are refused with exit code 2.
+#[test]
+fn an_environment_map_given_on_the_command_line_lights_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    // The map: a render of a uniform sky of (0.2, 0.4, 0.6), written as OpenEXR.
+    std::fs::write(p("sky.toml"), "background = [0.2, 0.4, 0.6]\n[render]\nwidth = 8\nheight = 4\n").unwrap();
+    let o = alhazen(&["render", &p("sky.toml"), "-o", &p("sky.exr"), "-q"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let scene = scene_file(dir.path(), &format!("background = [1, 0, 0]\n{OK}"));
+    let corner = |extra: &[&str]| {
+        let out = p("o.pfm");
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o", &out, "-q"];
+        args.extend_from_slice(extra);
+        let o = alhazen(&args);
+        assert_eq!(o.status.code(), Some(0), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        let bytes = std::fs::read(p("o.pfm")).unwrap();
+        let floats = &bytes[bytes.len() - 16 * 12 * 12..];
+        std::array::from_fn::<f32, 3, _>(|c| f32::from_le_bytes(floats[4 * c..4 * c + 4].try_into().unwrap()))
+    };
+    assert_eq!(corner(&[]), [1.0, 0.0, 0.0]);
+    for integrator in ["whitted", "path"] {
+        let seen = corner(&["--integrator", integrator, "--environment", &p("sky.exr"), "--environment-scale", "2"]);
+        assert!(seen.iter().zip([0.4, 0.8, 1.2]).all(|(a, b)| (a - b).abs() < 1e-5), "{integrator}: {seen:?}");
+    }
+    let o = alhazen(&["convert", scene.to_str().unwrap(), "-o", &p("lit.toml"), "--environment", &p("sky.exr")]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read_to_string(p("lit.toml")).unwrap().contains("type = \"environment\""));
+    for (extra, says) in [
+        (&["--environment-scale", "2"][..], "--environment <FILE>"),
+        (&["--environment", "missing.hdr"], "--environment: cannot load image missing.hdr"),
+        (&["--environment", scene.to_str().unwrap()], "--environment: cannot load image"),
+        (&["--environment", &p("sky.exr"), "--environment-scale", "-1"], "a scale is a number of at least 0"),
+        (&["--environment", &p("sky.exr"), "--environment-rotate", "nan"], "an angle is a number of degrees"),
+        (&["--environment", &p("sky.exr"), "--environment-up", "x"], "possible values: y, z"),
+    ] {
+        let (code, err, exists) = render(OK, extra);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains(says), "{extra:?}: {err}");
+        assert!(!exists);
+    }
+}
+
 /// What the fuzz test (tests/fuzz.rs) found: each used to panic.
 #[test]
 fn inputs_found_by_fuzzing_are_refused_or_rendered() {

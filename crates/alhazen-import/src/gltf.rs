@@ -342,10 +342,6 @@ impl<'a> Importer<'a> {
                     .unwrap_or(self.scene.camera.clone())
             }
         };
-        if self.scene.lights.is_empty() && self.scene.materials.iter().all(|m| m.emission == Vec3::ZERO) {
-            self.warn("the scene has no lights: a uniform white sky lights it");
-            self.scene.background = alhazen_scene::Background::Solid(Vec3::ONE);
-        }
         Ok(Imported { scene: self.scene, warnings: self.warnings.into_vec() })
     }
 

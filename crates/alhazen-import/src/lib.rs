@@ -29,7 +29,7 @@ pub mod mitsuba;
 pub mod pbrt;
 mod serialized;
 
-use alhazen_scene::{Scene, SceneError};
+use alhazen_scene::{OutsideEnvironment, Scene, SceneError};
 use std::path::{Path, PathBuf};
 
 pub use common::MAX_SCENE_FILE_BYTES;
@@ -118,13 +118,40 @@ pub fn load_with_parameters(
     memory_budget: u64,
     parameters: &[(String, String)],
 ) -> Result<Imported, SceneError> {
-    let mut imported = read(path, memory_budget, parameters)?;
+    load_with(path, &LoadOptions { memory_budget, parameters, environment: None })
+}
+
+/// How to read a scene file: [`load_with`]'s options.
+#[derive(Clone, Copy, Debug)]
+pub struct LoadOptions<'a> {
+    /// The most bytes the geometry the scene generates may take ([`load_within`]).
+    pub memory_budget: u64,
+    /// Values of its parameters ([`load_with_parameters`]).
+    pub parameters: &'a [(String, String)],
+    /// An environment map to light it by in place of its own
+    /// ([`alhazen_scene::Scene::light_by`]).
+    pub environment: Option<&'a OutsideEnvironment>,
+}
+
+/// Reads a scene file as `options` say. A glTF file, which has no sky of its own, is lit by
+/// a uniform white sky (with a warning) when it has no light and no environment is given.
+pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Imported, SceneError> {
+    let mut imported = read(path, options.memory_budget, options.parameters)?;
+    let scene = &mut imported.scene;
+    let warn = |message: &str| Warning { file: path.to_path_buf(), line: 0, message: message.to_string() };
+    match options.environment {
+        Some(env) => scene.light_by(env),
+        None if SceneFormat::from_path(path) == SceneFormat::Gltf
+            && scene.lights.is_empty()
+            && scene.materials.iter().all(|m| m.emission == alhazen_scene::Rgb::ZERO) =>
+        {
+            imported.warnings.push(warn("the scene has no lights: a uniform white sky lights it"));
+            scene.background = alhazen_scene::Background::Solid(alhazen_scene::Rgb::ONE);
+        }
+        None => {}
+    }
     let cut_outs = imported.scene.opaque_cut_outs();
-    imported.warnings.extend(cut_outs.into_iter().map(|message| Warning {
-        file: path.to_path_buf(),
-        line: 0,
-        message,
-    }));
+    imported.warnings.extend(cut_outs.iter().map(|message| warn(message)));
     Ok(imported)
 }
 

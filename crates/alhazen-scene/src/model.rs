@@ -623,7 +623,30 @@ impl SpotFade {
     }
 }
 
+/// An environment map given apart from the scene file (`alhazen render --environment`), as a
+/// [`Light::Environment`] gives one: it lights the scene in place of the file's own.
+#[derive(Clone, Debug)]
+pub struct OutsideEnvironment {
+    /// The equirectangular map (linear radiance).
+    pub image: Arc<ImageData>,
+    /// Multiplier of the map's values.
+    pub scale: f64,
+    /// Rotation of the map about its up axis, radians.
+    pub rotation: f64,
+    /// The map's up axis (unit).
+    pub up: Vec3,
+}
+
 impl Scene {
+    /// Lights the scene by `env` instead of its own environment map (its image is kept: it
+    /// was read already); rays that leave the scene then see `env`, not the background.
+    pub fn light_by(&mut self, env: &OutsideEnvironment) {
+        self.lights.retain(|l| !matches!(l, Light::Environment { .. }));
+        self.images.push(env.image.clone());
+        let image = self.images.len() - 1;
+        self.lights.push(Light::Environment { image, scale: env.scale, rotation: env.rotation, up: env.up });
+    }
+
     /// What a ray leaving the scene in direction `dir` sees: the environment map if the scene
     /// has one (nearest texel), else the background.
     pub fn sky(&self, dir: Vec3) -> Rgb {
