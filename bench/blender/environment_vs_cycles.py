@@ -8,7 +8,7 @@ over a brown ground, with four coloured lamps around the horizon — red towards
 map's centre), white towards +y, blue towards −x, green towards −y — and a small bright warm sun
 high towards +x. A mirror ball, a white diffuse ball and a grey rough metal ball stand in it,
 seen from the front (−y, as `front_camera`), with the map behind them. Cycles reads the map
-nearest-texel (Closest), as alhazen reads an environment map.
+with its default interpolation (Linear: bilinear between texel centres), as alhazen does.
 
     python3 bench/blender/environment_vs_cycles.py OUT_DIR [--spp 1024]
 
@@ -73,7 +73,7 @@ def build(sky_path):
     env = nodes.new("ShaderNodeTexEnvironment")
     env.image = sky(sky_path)
     env.image.colorspace_settings.name = "Linear Rec.709"
-    env.interpolation = "Closest"
+    env.interpolation = "Linear"
     links.new(env.outputs["Color"], nodes["Background"].inputs["Color"])
     nodes["Background"].inputs["Strength"].default_value = 1.0
     scene.world = world

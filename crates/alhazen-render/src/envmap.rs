@@ -3,8 +3,13 @@
 //! marginal distribution, then a texel by the row's conditional one.
 //!
 //! Mapping: `u = φ/2π` with `φ` the azimuth from `−z` towards `+x` (plus the map's rotation),
-//! `v = ϑ/π` from straight up (`+y`) to straight down; texels are constant (nearest lookup), so
-//! the sampling density matches the radiance exactly.
+//! `v = ϑ/π` from straight up (`+y`) to straight down. The radiance is interpolated bilinearly
+//! between texel centres, as Mitsuba and Cycles read a map (a map of 1024 texels round, seen
+//! behind a picture 50° wide, would otherwise show blocks 13 pixels across); the sampling
+//! density is constant over each texel, in proportion to the mean of the interpolated radiance
+//! over it (a 1-6-1 stencil across and down, over 64), which is positive wherever the radiance
+//! is, so next-event estimates stay unbiased and a lit texel's dark neighbours, which its light
+//! spills into, are sampled too.
 //!
 //! Layout: the caches, not the arithmetic, bound the map's cost (a 512 × 256 map in double
 //! precision with guide tables is 3.5 MB, past what a core of this machine keeps close). Each
@@ -66,23 +71,31 @@ impl EnvMap {
         let (width, height) = (image.width as usize, image.height as usize);
         let mut texels = Vec::with_capacity(width * height);
         let mut row_power = Vec::with_capacity(height);
+        // Three rows' luminance at a time: an image kept as codes is never expanded whole.
+        let luminances = |y: usize| -> Vec<f64> {
+            let lum = |p: [f32; 3]| luminance(Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+            (0..width)
+                .map(|x| lum(image.texel(y * width + x)))
+                .map(|l| if l.is_finite() { l.max(0.0) } else { 0.0 })
+                .collect()
+        };
+        let (mut above, mut here) = (luminances(0), luminances(0));
         for y in 0..height {
-            // One row at a time: an image kept as codes is never expanded whole.
-            let row: Vec<[f32; 3]> = (0..width).map(|x| image.texel(y * width + x)).collect();
+            let below = luminances((y + 1).min(height - 1));
             let sin = (PI * (y as f64 + 0.5) / height as f64).sin();
-            let power = |p: &[f32; 3]| {
-                let w = luminance(Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)) * sin;
-                if w.is_finite() { w.max(0.0) } else { 0.0 }
-            };
-            let powers: Vec<f64> = row.iter().map(power).collect();
+            // The mean over the texel of the interpolated luminance (1-6-1 across and down).
+            let across = |r: &[f64], x: usize| r[(x + width - 1) % width] + 6.0 * r[x] + r[(x + 1) % width];
+            let power = |x: usize| (across(&above, x) + 6.0 * across(&here, x) + across(&below, x)) / 64.0 * sin;
+            let powers: Vec<f64> = (0..width).map(power).collect();
             let total: f64 = powers.iter().sum();
             let mut before = 0.0;
-            for (x, (p, w)) in row.iter().zip(&powers).enumerate() {
+            for (x, w) in powers.iter().enumerate() {
                 let cdf = if total > 0.0 { before / total } else { x as f64 / width as f64 };
-                texels.push(Texel { radiance: *p, cdf: cdf as f32 });
+                texels.push(Texel { radiance: image.texel(y * width + x), cdf: cdf as f32 });
                 before += w;
             }
             row_power.push(total);
+            (above, here) = (here, below);
         }
         let guided = (GUIDED_FROM..u16::MAX as usize).contains(&width);
         let mut m = Self {
@@ -134,10 +147,14 @@ impl EnvMap {
         (x, y)
     }
 
-    /// The radiance of texel `(x, y)`.
-    fn radiance_of(&self, (x, y): (usize, usize)) -> Vec3 {
-        let p = self.texels[y * self.width + x].radiance;
-        Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64) * self.scale
+    /// The radiance at `uv`, interpolated bilinearly between the texel centres around it.
+    fn radiance_at(&self, uv: Vec2) -> Vec3 {
+        let taps = alhazen_scene::texture::equirect_taps(uv, self.width, self.height);
+        let sum = taps.iter().fold(Vec3::ZERO, |sum, &(i, w)| {
+            let p = self.texels[i].radiance;
+            sum + Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64) * w
+        });
+        sum * self.scale
     }
 
     /// The density of sampling a point of texel `(x, y)` in the unit square of `uv`.
@@ -183,7 +200,7 @@ impl EnvMap {
 
     /// Radiance arriving from direction `dir` (unit, pointing away from the scene).
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
-        self.radiance_of(self.texel_at(self.to_uv(dir)))
+        self.radiance_at(self.to_uv(dir))
     }
 
     /// A direction with density ∝ power, its radiance and solid-angle density.
@@ -202,18 +219,24 @@ impl EnvMap {
         (v, y)
     }
 
-    /// The second step: the texels the search of row `y` for `u.x` will read, asked of memory
-    /// (their slice's guide entries read, which [`Self::sample_row`] asked for).
-    pub fn touch_texels(&self, (_, y): (f64, usize), u: Vec2) {
-        let (w, row) = (self.width, &self.texels[y * self.width..(y + 1) * self.width]);
+    /// The second step: the texels the search of row `y` for `u.x` will read, and those of the
+    /// row the radiance is interpolated from with them, asked of memory (their slice's guide
+    /// entries read, which [`Self::sample_row`] asked for).
+    pub fn touch_texels(&self, (v, y): (f64, usize), u: Vec2) {
+        let w = self.width;
         let (lo, hi) = if self.guides.is_empty() {
             (0, w)
         } else {
             let (j, guides) = (self.slice(u.x), &self.guides[y * (w + 1)..]);
             (guides[j] as usize, guides[j + 1] as usize)
         };
-        prefetch(&row[lo.saturating_sub(1).min(w - 1)]);
-        prefetch(&row[hi.min(w) - 1]);
+        let other =
+            if v * (self.height as f64) < y as f64 + 0.5 { y.saturating_sub(1) } else { (y + 1).min(self.height - 1) };
+        for row in [y, other] {
+            let row = &self.texels[row * w..(row + 1) * w];
+            prefetch(&row[lo.saturating_sub(1).min(w - 1)]);
+            prefetch(&row[hi.min(w) - 1]);
+        }
     }
 
     /// [`Self::sample`] in row `row` ([`Self::sample_row`]`(u)`).
@@ -226,7 +249,7 @@ impl EnvMap {
         if density <= 0.0 || sin <= 0.0 {
             return None;
         }
-        Some((dir, self.radiance_of((x, y)), density / (2.0 * PI * PI * sin)))
+        Some((dir, self.radiance_at(Vec2::new(u, v)), density / (2.0 * PI * PI * sin)))
     }
 
     /// Solid-angle density of [`Self::sample`] choosing `dir`.
@@ -236,13 +259,14 @@ impl EnvMap {
 
     /// [`Self::radiance`] and [`Self::pdf`] of `dir`, mapped to the image once.
     pub fn radiance_and_pdf(&self, dir: Vec3) -> (Vec3, f64) {
-        self.radiance_and_pdf_at(dir, self.texel_at(self.to_uv(dir)))
+        self.radiance_and_pdf_at(dir, self.to_uv(dir))
     }
 
     /// The first half of [`Self::radiance_and_pdf`] for many directions (`None` where a lane
-    /// has none): every lane's texel, found in one loop of arithmetic (vectorised) and asked of
-    /// memory. [`Self::radiance_and_pdf_at`] reads them later, when they have arrived.
-    pub fn texels_ahead<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [(usize, usize); N] {
+    /// has none): every lane's place in the map, found in one loop of arithmetic (vectorised),
+    /// and the texels around it asked of memory. [`Self::radiance_and_pdf_at`] reads them
+    /// later, when they have arrived.
+    pub fn texels_ahead<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [Vec2; N] {
         // The directions given, side by side, [`AHEAD`] at a time: lanes without one (often
         // half of them) cost no inverse trigonometry.
         let (mut dense, mut from, mut n) = ([Vec3::Y; N], [0; N], 0);
@@ -252,63 +276,66 @@ impl EnvMap {
                 n += 1;
             }
         }
-        let mut texels = [(0, 0); N];
+        let mut uvs = [Vec2::ZERO; N];
         for start in (0..n).step_by(AHEAD) {
             let mut some = [Vec3::Y; AHEAD];
             let len = AHEAD.min(n - start);
             some[..len].copy_from_slice(&dense[start..start + len]);
-            for (k, &(x, y)) in self.texels_in_lanes(&some, unit)[..len].iter().enumerate() {
-                texels[from[start + k]] = (x, y);
-                prefetch(&self.texels[y * self.width + x]);
+            for (k, &uv) in self.uvs_in_lanes(&some, unit)[..len].iter().enumerate() {
+                uvs[from[start + k]] = uv;
+                // The two rows the interpolation reads (a row's pair is one line or two).
+                let taps = alhazen_scene::texture::equirect_taps(uv, self.width, self.height);
+                prefetch(&self.texels[taps[0].0]);
+                prefetch(&self.texels[taps[3].0]);
             }
         }
-        texels
+        uvs
     }
 
-    /// [`Self::radiance_and_pdf`] of `dir` in its texel, `texel` ([`Self::texels_ahead`]).
-    pub fn radiance_and_pdf_at(&self, dir: Vec3, texel: (usize, usize)) -> (Vec3, f64) {
-        (self.radiance_of(texel), self.solid_angle_density(texel, polar_sine(self.in_map_axes(dir))))
+    /// [`Self::radiance_and_pdf`] of `dir`, at its place `uv` in the map ([`Self::texels_ahead`]).
+    pub fn radiance_and_pdf_at(&self, dir: Vec3, uv: Vec2) -> (Vec3, f64) {
+        (self.radiance_at(uv), self.solid_angle_density(self.texel_at(uv), polar_sine(self.in_map_axes(dir))))
     }
 
-    /// The texels of many directions, in AVX-512 or AVX2 where `unit` has them.
+    /// The places in the map of many directions, in AVX-512 or AVX2 where `unit` has them.
     #[allow(unsafe_code)]
-    fn texels_in_lanes<const N: usize>(&self, dirs: &[Vec3; N], unit: VectorUnit) -> [(usize, usize); N] {
+    fn uvs_in_lanes<const N: usize>(&self, dirs: &[Vec3; N], unit: VectorUnit) -> [Vec2; N] {
         #[cfg(target_arch = "x86_64")]
         if unit.is_avx512() {
             // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-            return unsafe { self.texels_avx512(dirs) };
+            return unsafe { self.uvs_avx512(dirs) };
         }
         #[cfg(target_arch = "x86_64")]
         if unit.is_avx2() {
             // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-            return unsafe { self.texels_avx2(dirs) };
+            return unsafe { self.uvs_avx2(dirs) };
         }
         let _ = unit;
-        self.texels_of(dirs)
+        self.uvs_of(dirs)
     }
 
-    /// [`Self::texels_in_lanes`]'s loop, inlined into each vector unit's function.
+    /// [`Self::uvs_in_lanes`]'s loop, inlined into each vector unit's function.
     #[inline(always)]
-    fn texels_of<const N: usize>(&self, dirs: &[Vec3; N]) -> [(usize, usize); N] {
-        let mut texels = [(0, 0); N];
-        for (texel, &dir) in texels.iter_mut().zip(dirs) {
-            *texel = self.texel_at(self.to_uv(dir));
+    fn uvs_of<const N: usize>(&self, dirs: &[Vec3; N]) -> [Vec2; N] {
+        let mut uvs = [Vec2::ZERO; N];
+        for (uv, &dir) in uvs.iter_mut().zip(dirs) {
+            *uv = self.to_uv(dir);
         }
-        texels
+        uvs
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
     #[allow(unsafe_code)]
-    unsafe fn texels_avx512<const N: usize>(&self, dirs: &[Vec3; N]) -> [(usize, usize); N] {
-        self.texels_of(dirs)
+    unsafe fn uvs_avx512<const N: usize>(&self, dirs: &[Vec3; N]) -> [Vec2; N] {
+        self.uvs_of(dirs)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[allow(unsafe_code)]
-    unsafe fn texels_avx2<const N: usize>(&self, dirs: &[Vec3; N]) -> [(usize, usize); N] {
-        self.texels_of(dirs)
+    unsafe fn uvs_avx2<const N: usize>(&self, dirs: &[Vec3; N]) -> [Vec2; N] {
+        self.uvs_of(dirs)
     }
 
     /// The density of a direction in `texel` whose polar angle has sine `sin`.
@@ -368,13 +395,70 @@ mod tests {
             let u = Vec2::new((k as f64 * 0.618).fract(), (k as f64 * 0.377 + 0.1).fract());
             let (d, l, pdf) = m.sample(u).unwrap();
             assert!((m.pdf(d) - pdf).abs() < 1e-9 * pdf.max(1.0), "{k}");
-            assert_eq!(m.radiance(d), l);
-            assert_eq!(m.radiance_and_pdf(d), (l, m.pdf(d)));
+            // Looked up again from the direction, the place in the map moves by rounding.
+            assert!((m.radiance(d) - l).abs().max_element() < 1e-6 * l.max_element().max(1.0), "{k}");
+            assert_eq!(m.radiance_and_pdf(d), (m.radiance(d), m.pdf(d)));
         }
     }
 
-    /// A single lit texel among black rows (whose CDFs fall back to uniform) takes every
-    /// sample, with the density its lookups report; narrow maps (searched without guide
+    /// Between texel centres the radiance is interpolated bilinearly: a texel's own value at
+    /// its centre, the mean of two at the edge between them, round the seam in `u`, held at
+    /// the first and last rows' centres towards the poles.
+    #[test]
+    fn radiance_is_interpolated_between_texel_centres() {
+        let (w, h) = (8usize, 4usize);
+        let value = |x: usize, y: usize| (x + 10 * y) as f32;
+        let pixels = (0..w * h).map(|i| [value(i % w, i / w), 1.0, 0.0]).collect();
+        let m = EnvMap::new(&ImageData::new(w as u32, h as u32, pixels), 2.0, (0.0, Vec3::Y));
+        let at = |x: f64, y: f64| m.radiance_at(Vec2::new(x / w as f64, y / h as f64)).x / 2.0;
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(at(3.5, 1.5), 13.0) && close(at(4.0, 1.5), 13.5) && close(at(3.5, 2.0), 18.0));
+        assert!(close(at(4.0, 2.0), 18.5));
+        // Round the seam: between the last column and the first.
+        assert!(close(at(0.0, 1.5), 13.5) && close(at(7.75, 1.5), 0.25 * 10.0 + 0.75 * 17.0));
+        // Towards the poles, the first and last rows' values.
+        assert!(close(at(2.5, 0.1), 2.0) && close(at(2.5, 3.9), 32.0));
+        assert!((m.radiance_at(Vec2::new(0.3, 0.6)).y - 2.0).abs() < 1e-12);
+    }
+
+    /// Next-event estimates of the light a map sends through a window of directions are
+    /// unbiased: the mean of radiance over density of its samples that fall inside equals the
+    /// integral of the interpolated radiance over the window (a fine midpoint sum), for a map
+    /// with one lit texel among black ones (whose light spills into its neighbours) and a
+    /// smooth one.
+    #[test]
+    fn light_sampling_integrates_the_interpolated_radiance() {
+        let (w, h) = (16u32, 8u32);
+        let one_lit = (0..w * h).map(|i| if i == 3 * w + 5 { [40.0, 30.0, 20.0] } else { [0.0; 3] }).collect();
+        let smooth = (0..w * h).map(|i| [(i % w) as f32 * 0.3 + 0.1, (i / w) as f32, 1.0]).collect();
+        for pixels in [one_lit, smooth] {
+            let m = EnvMap::new(&ImageData::new(w, h, pixels), 1.0, (0.4, Vec3::Y));
+            let inside = |d: Vec3| d.x > 0.2 && d.y > -0.3;
+            let n = 1usize << 20;
+            let mut estimate = Vec3::ZERO;
+            for k in 0..n {
+                let u = Vec2::new((k as f64 * 0.618_033_988_749_895).fract(), (k as f64 + 0.5) / n as f64);
+                if let Some((_, l, pdf)) = m.sample(u).filter(|s| inside(s.0)) {
+                    estimate += l / pdf;
+                }
+            }
+            estimate /= n as f64;
+            let (cells, mut integral) = (1024usize, Vec3::ZERO);
+            for j in 0..cells {
+                for i in 0..2 * cells {
+                    let uv = Vec2::new((i as f64 + 0.5) / (2 * cells) as f64, (j as f64 + 0.5) / cells as f64);
+                    let (d, sin) = m.to_dir(uv);
+                    if inside(d) {
+                        integral += m.radiance_at(uv) * sin * 2.0 * PI * PI / (2 * cells * cells) as f64;
+                    }
+                }
+            }
+            assert!((estimate - integral).abs().max_element() < 2e-3 * integral.max_element(), "{estimate} {integral}");
+        }
+    }
+
+    /// A single lit texel and the neighbours its light spills into, among black rows (whose
+    /// CDFs fall back to uniform), take every sample, with the density their lookups report; narrow maps (searched without guide
     /// tables) and black maps give finite densities.
     #[test]
     fn one_lit_texel_takes_every_sample() {
@@ -385,7 +469,11 @@ mod tests {
             for k in 0..100 {
                 let u = Vec2::new((k as f64 * 0.618).fract(), (k as f64 * 0.377 + 0.1).fract());
                 let (d, l, pdf) = m.sample(u).unwrap();
-                assert_eq!(l, Vec3::new(5.0, 4.0, 3.0), "{w}×{h} sample {k}");
+                // Within a texel of the lit one's centre, where its light spills.
+                let uv = m.to_uv(d);
+                let (dx, dy) = (uv.x * w as f64 - (w / 4) as f64 - 0.5, uv.y * h as f64 - (h / 3) as f64 - 0.5);
+                assert!(dx.abs() <= 1.5 && dy.abs() <= 1.5, "{w}×{h} sample {k}: {dx}, {dy}");
+                assert!(l.x >= 0.0 && (l - Vec3::new(5.0, 4.0, 3.0) * (l.x / 5.0)).length() < 1e-12);
                 assert!((m.pdf(d) - pdf).abs() < 1e-9 * pdf, "{w}×{h} sample {k}");
             }
             let black = EnvMap::new(&ImageData::new(w, h, vec![[0.0; 3]; (w * h) as usize]), 1.0, (0.0, Vec3::Y));

@@ -407,18 +407,18 @@ impl Lights {
     /// The first half of [`Self::sky`] for many directions (`None` where a lane has none): an
     /// environment map's texels found for all lanes at once and asked of memory;
     /// [`Self::sky_at`] reads them, as late as the caller can wait.
-    pub fn sky_ahead<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [(usize, usize); N] {
+    pub fn sky_ahead<const N: usize>(&self, dirs: &[Option<Vec3>; N], unit: VectorUnit) -> [Vec2; N] {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => m.texels_ahead(dirs, unit),
-            _ => [(0, 0); N],
+            _ => [Vec2::ZERO; N],
         }
     }
 
-    /// [`Self::sky`] of `dir`, whose texel [`Self::sky_ahead`] found.
-    pub fn sky_at(&self, dir: Vec3, texel: (usize, usize)) -> (Vec3, f64) {
+    /// [`Self::sky`] of `dir`, whose place in the map [`Self::sky_ahead`] found.
+    pub fn sky_at(&self, dir: Vec3, uv: Vec2) -> (Vec3, f64) {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => {
-                let (radiance, pdf) = m.radiance_and_pdf_at(dir, texel);
+                let (radiance, pdf) = m.radiance_and_pdf_at(dir, uv);
                 (radiance, pdf * self.choice_pdf())
             }
             _ => self.sky(dir),

@@ -648,12 +648,12 @@ impl Scene {
     }
 
     /// What a ray leaving the scene in direction `dir` sees: the environment map if the scene
-    /// has one (nearest texel), else the background.
+    /// has one (interpolated bilinearly), else the background.
     pub fn sky(&self, dir: Vec3) -> Rgb {
         for l in &self.lights {
             if let Light::Environment { image, scale, rotation, up } = *l {
                 let dir = crate::texture::into_map(crate::texture::up_frame(up), dir);
-                return crate::texture::equirect_texel(&self.images[image], dir, rotation) * scale;
+                return crate::texture::equirect_radiance(&self.images[image], dir, rotation) * scale;
             }
         }
         self.background.radiance(dir)

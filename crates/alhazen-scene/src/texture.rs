@@ -77,17 +77,37 @@ pub fn into_map(frame: Option<Mat3>, dir: Vec3) -> Vec3 {
     frame.map_or(dir, |f| f.transpose() * dir)
 }
 
-/// The texel of an equirectangular image seen in direction `dir` (nearest lookup).
-pub fn equirect_texel(img: &ImageData, dir: Vec3, rotation: f64) -> Vec3 {
-    equirect_texel_at(img, equirect_uv(dir, rotation))
+/// The radiance of an equirectangular image seen in direction `dir`: interpolated bilinearly
+/// between the centres of the four texels around it ([`equirect_taps`]), as Mitsuba and Cycles
+/// read a map.
+pub fn equirect_radiance(img: &ImageData, dir: Vec3, rotation: f64) -> Vec3 {
+    let taps = equirect_taps(equirect_uv(dir, rotation), img.width as usize, img.height as usize);
+    taps.iter().fold(Vec3::ZERO, |sum, &(i, w)| {
+        let p = img.texel(i);
+        sum + Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64) * w
+    })
 }
 
-/// The texel of an equirectangular image at `uv` ([`equirect_uv`]'s coordinates).
-pub fn equirect_texel_at(img: &ImageData, uv: Vec2) -> Vec3 {
-    let (w, h) = (img.width as usize, img.height as usize);
-    let (x, y) = (((uv.x * w as f64) as usize).min(w - 1), ((uv.y * h as f64) as usize).min(h - 1));
-    let p = img.texel(y * w + x);
-    Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+/// The four texels (indices into a `width × height` image, rows from the top) whose centres
+/// surround `uv` ([`equirect_uv`]'s coordinates) and their bilinear weights: wrapping round in
+/// `u`, the first and last rows' centres standing for the poles. The weights sum to 1.
+#[inline(always)]
+pub fn equirect_taps(uv: Vec2, width: usize, height: usize) -> [(usize, f64); 4] {
+    let x = uv.x * width as f64 - 0.5;
+    let y = (uv.y * height as f64 - 0.5).clamp(0.0, (height - 1) as f64);
+    // `x` lies in [−½, width − ½): its floor is −1 at least.
+    let left = if x < 0.0 { width - 1 } else { (x as usize).min(width - 1) };
+    let fx = if x < 0.0 { x + 1.0 } else { x - left as f64 };
+    let right = if left + 1 == width { 0 } else { left + 1 };
+    let top = (y as usize).min(height - 1);
+    let fy = y - top as f64;
+    let bottom = (top + 1).min(height - 1);
+    [
+        (top * width + left, (1.0 - fx) * (1.0 - fy)),
+        (top * width + right, fx * (1.0 - fy)),
+        (bottom * width + left, (1.0 - fx) * fy),
+        (bottom * width + right, fx * fy),
+    ]
 }
 
 /// `x.rem_euclid(1.0)`, bit for bit, without the call to `fmod` it makes where `x` lies in
