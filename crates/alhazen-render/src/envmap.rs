@@ -84,7 +84,10 @@ impl EnvMap {
             let below = luminances((y + 1).min(height - 1));
             let sin = (PI * (y as f64 + 0.5) / height as f64).sin();
             // The mean over the texel of the interpolated luminance (1-6-1 across and down).
-            let across = |r: &[f64], x: usize| r[(x + width - 1) % width] + 6.0 * r[x] + r[(x + 1) % width];
+            let across = |r: &[f64], x: usize| {
+                let (left, right) = (if x == 0 { width - 1 } else { x - 1 }, if x + 1 == width { 0 } else { x + 1 });
+                r[left] + 6.0 * r[x] + r[right]
+            };
             let power = |x: usize| (across(&above, x) + 6.0 * across(&here, x) + across(&below, x)) / 64.0 * sin;
             let powers: Vec<f64> = (0..width).map(power).collect();
             let total: f64 = powers.iter().sum();
@@ -219,24 +222,18 @@ impl EnvMap {
         (v, y)
     }
 
-    /// The second step: the texels the search of row `y` for `u.x` will read, and those of the
-    /// row the radiance is interpolated from with them, asked of memory (their slice's guide
-    /// entries read, which [`Self::sample_row`] asked for).
-    pub fn touch_texels(&self, (v, y): (f64, usize), u: Vec2) {
-        let w = self.width;
+    /// The second step: the texels the search of row `y` for `u.x` will read, asked of memory
+    /// (their slice's guide entries read, which [`Self::sample_row`] asked for).
+    pub fn touch_texels(&self, (_, y): (f64, usize), u: Vec2) {
+        let (w, row) = (self.width, &self.texels[y * self.width..(y + 1) * self.width]);
         let (lo, hi) = if self.guides.is_empty() {
             (0, w)
         } else {
             let (j, guides) = (self.slice(u.x), &self.guides[y * (w + 1)..]);
             (guides[j] as usize, guides[j + 1] as usize)
         };
-        let other =
-            if v * (self.height as f64) < y as f64 + 0.5 { y.saturating_sub(1) } else { (y + 1).min(self.height - 1) };
-        for row in [y, other] {
-            let row = &self.texels[row * w..(row + 1) * w];
-            prefetch(&row[lo.saturating_sub(1).min(w - 1)]);
-            prefetch(&row[hi.min(w) - 1]);
-        }
+        prefetch(&row[lo.saturating_sub(1).min(w - 1)]);
+        prefetch(&row[hi.min(w) - 1]);
     }
 
     /// [`Self::sample`] in row `row` ([`Self::sample_row`]`(u)`).
