@@ -933,14 +933,7 @@ fn blender_environment_agrees_with_cycles() {
         let mut s = imported.scene;
         (s.render.width, s.render.height, s.render.spp) = (96, 64, 256);
         s.render.integrator = alhazen_scene::IntegratorKind::Path;
-        let img = alhazen_render::render(&s, &|_, _| {});
-        let (mut diff, mut sum) = (0.0, 0.0);
-        for (i, c) in cycles.texels().enumerate() {
-            let c = Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-            diff += (img.get(i as u32 % 96, i as u32 / 96) - c).abs().element_sum();
-            sum += c.element_sum();
-        }
-        diff / sum
+        relative_difference(&alhazen_render::render(&s, &|_, _| {}), &cycles)
     };
     let (as_blender, turned_back) = (error(90.0), error(-90.0));
     eprintln!("environment: relative difference {as_blender:.4} (turned the other way {turned_back:.4})");
@@ -1756,21 +1749,23 @@ fn panel_against_cycles(stem: &str, mut change: impl FnMut(&mut alhazen_scene::S
     s.render.integrator = alhazen_scene::IntegratorKind::Path;
     let cycles = alhazen_scene::import::load_hdr_image(&dir.join(format!("{stem}-cycles.exr"))).unwrap();
     assert_eq!((cycles.width, cycles.height), (64, 64));
-    let error = |s: &alhazen_scene::Scene| {
-        let img = alhazen_render::render(s, &|_, _| {});
-        let (mut diff, mut sum) = (0.0, 0.0);
-        for (i, c) in cycles.texels().enumerate() {
-            let c = Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-            diff += (img.get(i as u32 % 64, i as u32 / 64) - c).abs().element_sum();
-            sum += c.element_sum();
-        }
-        diff / sum
-    };
+    let error = |s: &alhazen_scene::Scene| relative_difference(&alhazen_render::render(s, &|_, _| {}), &cycles);
     let as_imported = error(&s);
     change(&mut s);
     let changed = error(&s);
     eprintln!("{stem}: relative difference {as_imported:.4} (changed: {changed:.4})");
     (as_imported, changed)
+}
+
+/// `Σ|ours − Cycles| / Σ Cycles` over every pixel and channel of two images of one size.
+fn relative_difference(ours: &alhazen_render::Image, cycles: &alhazen_scene::ImageData) -> f64 {
+    let (mut diff, mut sum) = (0.0, 0.0);
+    for (i, c) in cycles.texels().enumerate() {
+        let c = Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+        diff += (ours.get(i as u32 % cycles.width, i as u32 / cycles.width) - c).abs().element_sum();
+        sum += c.element_sum();
+    }
+    diff / sum
 }
 
 /// The BSDF of the embedded quad's material with `ext` (the members of its `extensions`) and the
