@@ -886,7 +886,9 @@ impl<'a> Importer<'a> {
         // texel's base colour), else the constant mix (and its glass under transmission).
         let textured_metal = metallic > 0.0 && transmission <= 0.0 && !matches!(base, Texture::Solid(_));
         let mut lobes = self.lobes(&material, ior, &name);
-        lobes.translucency = self.translucency(&material, &name)?;
+        let translucency_map;
+        let translucency_color_map;
+        (lobes.translucency, translucency_map, translucency_color_map) = self.translucency(&material, &name)?;
         let mut anisotropy_map;
         (lobes.anisotropy, anisotropy_map) = self.anisotropy(&material, &name)?;
         if lobes.anisotropy.is_anisotropic() && transmission > 0.0 {
@@ -900,7 +902,9 @@ impl<'a> Importer<'a> {
             || lobes.anisotropy.is_anisotropic()
             || iridescence.is_some()
             || specular_map.is_some()
-            || specular_color_map.is_some();
+            || specular_color_map.is_some()
+            || translucency_map.is_some()
+            || translucency_color_map.is_some();
         let bsdf = if per_point {
             let MetalRoughness { ior, specular, multiscatter, anisotropy, translucency } = lobes;
             BsdfDesc::MetallicRoughness {
@@ -917,6 +921,8 @@ impl<'a> Importer<'a> {
                 specular_map,
                 specular_color_map,
                 translucency,
+                translucency_map,
+                translucency_color_map,
             }
         } else {
             let bsdf = common::metal_rough(
@@ -1222,35 +1228,30 @@ impl<'a> Importer<'a> {
     /// `KHR_materials_diffuse_transmission`: the share of the coating's diffuse light that passes
     /// through to the other side (`diffuseTransmissionFactor`, 0 without it) and its colour
     /// (`diffuseTransmissionColorFactor`, white): `(1 − share)·base` reflected, `share·colour`
-    /// transmitted. Their textures (the share's alpha, the colour's sRGB) are read by their
-    /// means, with a warning.
-    fn translucency(&mut self, material: &gltf::Material, name: &str) -> R<Translucency> {
+    /// transmitted; and their textures, read per point (the share's alpha, the colour's sRGB).
+    fn translucency(
+        &mut self,
+        material: &gltf::Material,
+        name: &str,
+    ) -> R<(Translucency, Option<Texture>, Option<Texture>)> {
         let Some(e) = material.extension_value("KHR_materials_diffuse_transmission") else {
-            return Ok(Translucency::default());
+            return Ok((Translucency::default(), None, None));
         };
         let factor = e.get("diffuseTransmissionFactor").map_or(Some(0.0), unit);
         let color = unit_rgb(e.get("diffuseTransmissionColorFactor"), Vec3::ONE);
-        let (Some(mut factor), Some(mut color)) = (factor, color) else {
+        let (Some(factor), Some(color)) = (factor, color) else {
             return Err(self.err(format!(
                 "{name}: KHR_materials_diffuse_transmission needs a diffuseTransmissionFactor and a diffuseTransmissionColorFactor of three numbers, within [0, 1]"
             )));
         };
-        for (key, decoding) in
-            [("diffuseTransmissionTexture", Decoding::Alpha), ("diffuseTransmissionColorTexture", Decoding::Srgb)]
-        {
-            let Some(info) = e.get(key) else { continue };
-            let texture = self.texture_of_info(info, name, key, decoding)?;
-            let mean = alhazen_scene::texture::mean(&texture, &self.scene.images);
-            if matches!(texture, Texture::Image { image, .. } if image + 1 == self.scene.images.len()) {
-                self.scene.images.pop();
-            }
-            self.warn(format!("{name}: KHR_materials_diffuse_transmission's {key} is read by its mean"));
-            match decoding {
-                Decoding::Alpha => factor *= mean.x,
-                _ => color *= mean,
-            }
-        }
-        Ok(Translucency { factor: factor.clamp(0.0, 1.0), color: color.clamp(Vec3::ZERO, Vec3::ONE) })
+        let mut map = |key: &str, decoding| match e.get(key) {
+            Some(info) => self.texture_of_info(info, name, key, decoding).map(Some),
+            None => Ok(None),
+        };
+        let factor_map = map("diffuseTransmissionTexture", Decoding::Alpha)?;
+        let color_map = map("diffuseTransmissionColorTexture", Decoding::Srgb)?;
+        let translucency = Translucency { factor: factor.clamp(0.0, 1.0), color: color.clamp(Vec3::ZERO, Vec3::ONE) };
+        Ok((translucency, factor_map, color_map))
     }
 
     /// `KHR_materials_specular`'s textures, per point: `specularTexture` the coating's specular

@@ -1353,6 +1353,8 @@ impl Importer {
                 specular_map: None,
                 specular_color_map: None,
                 translucency: Default::default(),
+                translucency_map: None,
+                translucency_color_map: None,
             });
         }
         let metallic = self.textured_mean(ctx, p, "metallic", metallic)?;
@@ -1376,6 +1378,8 @@ impl Importer {
                 specular_map: None,
                 specular_color_map: None,
                 translucency: Default::default(),
+                translucency_map: None,
+                translucency_color_map: None,
             });
         }
         Ok(common::metal_rough(

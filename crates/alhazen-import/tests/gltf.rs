@@ -818,8 +818,7 @@ fn blender_specular_level_agrees_with_cycles() {
 /// `KHR_materials_diffuse_transmission` (leaves, paper): the coating's diffuse light split into
 /// `(1 − share)·base` reflected and `share·colour` passed through to the other side. The quad
 /// lit from behind by a directional light shows the colour passed through (red here), black
-/// without the extension; its textures are read by their means (warning); factors out of
-/// range are refused.
+/// without the extension; its textures are read per point; factors out of range are refused.
 #[test]
 fn diffuse_transmission_passes_light_through_a_leaf() {
     let ext = r#""KHR_materials_diffuse_transmission": { "diffuseTransmissionFactor": 0.4, "diffuseTransmissionColorFactor": [1, 0, 0] }"#;
@@ -844,11 +843,44 @@ fn diffuse_transmission_passes_light_through_a_leaf() {
     };
     let (through, opaque) = (lit_from_behind(ext), lit_from_behind(r#""KHR_materials_ior": { "ior": 1.5 }"#));
     assert!(through.x > 1.0 && through.y.max(through.z) < 1e-9 && opaque.max_element() < 1e-9, "{through} {opaque}");
-    let (_, said) = material_with_extensions(
+    // The share's texture, read per point: a map of alpha 1 then 0 along u passes light on one
+    // side of the leaf only (its light's centre moved that way), and says nothing.
+    let (bsdf, said) = material_with_extensions(
         r#""KHR_materials_diffuse_transmission": { "diffuseTransmissionFactor": 1, "diffuseTransmissionTexture": { "index": 0 } }"#,
     )
     .unwrap();
-    assert!(said.iter().any(|w| w.contains("diffuseTransmissionTexture is read by its mean")), "{said:?}");
+    assert!(said.is_empty(), "{said:?}");
+    assert!(matches!(bsdf, BsdfDesc::MetallicRoughness { translucency_map: Some(_), .. }), "{bsdf:?}");
+    let centre = |ext: &str| {
+        let json = embedded().replace(&base64(&png()), &base64(&png_with_alpha())).replace(
+            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
+            &format!(
+                r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "doubleSided": true, "extensions": {{ {ext} }}"#
+            ),
+        );
+        let mut s = write_and_import(&[("m.gltf", json.into_bytes())]).unwrap().scene;
+        s.lights = vec![alhazen_scene::Light::Directional { direction: Vec3::Z, intensity: Vec3::splat(3.0) }];
+        s.background = alhazen_scene::Background::Solid(Vec3::ZERO);
+        (s.render.width, s.render.height, s.render.spp) = (32, 16, 16);
+        s.render.integrator = alhazen_scene::IntegratorKind::Path;
+        let img = alhazen_render::render(&s, &|_, _| {});
+        let pixels = || (0..32u32).flat_map(|x| (0..16u32).map(move |y| (x, y)));
+        let sum: f64 = pixels().map(|(x, y)| img.get(x, y).x).sum();
+        (pixels().map(|(x, y)| x as f64 * img.get(x, y).x).sum::<f64>() / sum, sum)
+    };
+    let through = r#""KHR_materials_diffuse_transmission": { "diffuseTransmissionFactor": 1, "diffuseTransmissionColorFactor": [1, 0, 0]"#;
+    let (mapped, uniform) = (
+        centre(&format!(r#"{through}, "diffuseTransmissionTexture": {{ "index": 0 }} }}"#)),
+        centre(&format!("{through} }}")),
+    );
+    eprintln!(
+        "light through the leaf: centre {:.2} with the map, {:.2} without; {:.1} against {:.1}",
+        mapped.0, uniform.0, mapped.1, uniform.1
+    );
+    assert!(
+        mapped.0 < uniform.0 - 0.5 && mapped.1 < 0.75 * uniform.1 && mapped.1 > 0.25 * uniform.1,
+        "{mapped:?} {uniform:?}"
+    );
     for bad in [
         r#"{ "diffuseTransmissionFactor": 1.5 }"#,
         r#"{ "diffuseTransmissionFactor": -0.1 }"#,

@@ -267,6 +267,8 @@ fn filmed_by(metallic: f64, multiscatter: bool, factor: f64) -> Bsdf {
         specular_map: None,
         specular_color_map: None,
         translucency: Default::default(),
+        translucency_map: None,
+        translucency_color_map: None,
     };
     let m = alhazen_scene::Material::from_bsdf("film", desc);
     alhazen_render::bsdf::bsdf_at(&m, Vec2::ZERO, Vec3::ONE, &[], alhazen_render::bsdf::ColorMode::Rgb)
@@ -721,6 +723,8 @@ fn specular_maps_shape_the_coating_per_point() {
         specular_map,
         specular_color_map,
         translucency: Default::default(),
+        translucency_map: None,
+        translucency_color_map: None,
     };
     let coating = |specular_map, specular_color_map| {
         let m = alhazen_scene::Material::from_bsdf("m", desc(specular_map, specular_color_map));

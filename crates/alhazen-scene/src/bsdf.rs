@@ -254,6 +254,11 @@ pub enum BsdfDesc {
         /// The share of the coating's diffuse light that passes through (glTF's
         /// `KHR_materials_diffuse_transmission`).
         translucency: Translucency,
+        /// Where that share varies: its `factor` times the map's first channel (read linearly;
+        /// glTF's `diffuseTransmissionTexture` is its alpha).
+        translucency_map: Option<Texture>,
+        /// Where the colour of the passing light varies: its `color` times the map's.
+        translucency_color_map: Option<Texture>,
     },
     /// A clear coat over `base` (car paint, lacquer; glTF's `KHR_materials_clearcoat`): a
     /// dielectric microfacet layer of `weight` reflecting `weight·D G F/(4⟨l,n⟩⟨v,n⟩)`, the
@@ -589,11 +594,14 @@ impl BsdfDesc {
                 iridescence,
                 specular_map,
                 specular_color_map,
+                translucency_map,
+                translucency_color_map,
                 ..
             } => {
                 let film = iridescence.as_ref().is_some_and(|i| i.factor_map.is_some() || i.thickness_map.is_some());
                 let specular = specular_map.is_some() || specular_color_map.is_some();
-                t(base) || map.is_some() || anisotropy_map.is_some() || film || specular
+                let through = translucency_map.is_some() || translucency_color_map.is_some();
+                t(base) || map.is_some() || anisotropy_map.is_some() || film || specular || through
             }
             BsdfDesc::Dielectric { transmittance, .. } => t(transmittance),
             BsdfDesc::Conductor { .. } | BsdfDesc::ThinDielectric { .. } => false,

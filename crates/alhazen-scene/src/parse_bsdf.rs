@@ -236,6 +236,10 @@ impl Parser<'_> {
                     Some(n) => self.anisotropy(&n)?,
                     None => (Anisotropy::default(), None),
                 };
+                let (translucency, translucency_map, translucency_color_map) = match t.get("diffuse_transmission") {
+                    Some(n) => self.translucency(&n)?,
+                    None => (Translucency::default(), None, None),
+                };
                 BsdfDesc::MetallicRoughness {
                     base: albedo,
                     metallic: t.get("metallic").map_or(Ok(0.0), |n| n.in_range(0.0, 1.0))?,
@@ -250,11 +254,9 @@ impl Parser<'_> {
                     iridescence: t.get("iridescence").map(|n| self.iridescence(&n).map(Box::new)).transpose()?,
                     specular_map: t.get("specular_map").map(|m| self.linear_placed_image(&m)).transpose()?,
                     specular_color_map: t.get("specular_color_map").map(|m| self.texture(&m)).transpose()?,
-                    translucency: t
-                        .get("diffuse_transmission")
-                        .map(|n| translucency(&n))
-                        .transpose()?
-                        .unwrap_or_default(),
+                    translucency,
+                    translucency_map,
+                    translucency_color_map,
                 }
             }
             "coated" => {
@@ -306,6 +308,22 @@ impl Parser<'_> {
         self.scene.images.push(Arc::new(data));
         Ok(Light::Environment { image: self.scene.images.len() - 1, scale, rotation, up })
     }
+
+    /// A metallic–roughness surface's `diffuse_transmission = { factor, color, factor_map,
+    /// color_map }` (0 and white when absent; the factor's map read linearly, its first
+    /// channel the share's multiplier; the colour's map a texture).
+    fn translucency(&mut self, n: &Node) -> R<(Translucency, Option<Texture>, Option<Texture>)> {
+        let t = n.table(&["factor", "color", "factor_map", "color_map"])?;
+        let factor = t.get("factor").map_or(Ok(0.0), |f| f.in_range(0.0, 1.0))?;
+        let color = t.opt_rgb("color", Vec3::ONE)?;
+        if !(color.min_element() >= 0.0 && color.max_element() <= 1.0) {
+            let node = t.get("color").expect("a colour out of range was given");
+            return Err(node.err("`color` is what passing light keeps: a colour within [0, 1]"));
+        }
+        let factor_map = t.get("factor_map").map(|m| self.linear_placed_image(&m)).transpose()?;
+        let color_map = t.get("color_map").map(|m| self.texture(&m)).transpose()?;
+        Ok((Translucency { factor, color }, factor_map, color_map))
+    }
 }
 
 /// Cook–Torrance's `kd` and `ks`: its specular term carries the Fresnel factor, so energy is
@@ -322,19 +340,6 @@ fn fresnel_weights(t: &Table, default_ks: f64) -> R<(f64, f64)> {
         return Err(node.err(format!("kd + ks·F(0) = {} exceeds 1: the surface would create energy", kd + ks * f0)));
     }
     Ok((kd, ks))
-}
-
-/// A metallic–roughness surface's `diffuse_transmission = { factor, color }` (0 and white when
-/// absent).
-fn translucency(n: &Node) -> R<Translucency> {
-    let t = n.table(&["factor", "color"])?;
-    let factor = t.get("factor").map_or(Ok(0.0), |f| f.in_range(0.0, 1.0))?;
-    let color = t.opt_rgb("color", Vec3::ONE)?;
-    if !(color.min_element() >= 0.0 && color.max_element() <= 1.0) {
-        let node = t.get("color").expect("a colour out of range was given");
-        return Err(node.err("`color` is what passing light keeps: a colour within [0, 1]"));
-    }
-    Ok(Translucency { factor, color })
 }
 
 /// `kd` (1) and `ks` of a layered surface, whose diffuse weight `k_d(1 − k_s·E)` keeps energy

@@ -587,14 +587,22 @@ impl Writer<'_> {
                 specular_map,
                 specular_color_map,
                 translucency,
+                translucency_map,
+                translucency_color_map,
             } => {
                 let through = if translucency.factor == 0.0 {
                     String::new()
                 } else {
                     format!(
-                        ", diffuse_transmission = {{ factor = {}, color = {} }}",
+                        ", diffuse_transmission = {{ factor = {}, color = {}{}{} }}",
                         num(translucency.factor),
-                        vec3(translucency.color)
+                        vec3(translucency.color),
+                        translucency_map
+                            .as_ref()
+                            .map_or(String::new(), |m| format!(", factor_map = {}", self.map_image(m))),
+                        translucency_color_map
+                            .as_ref()
+                            .map_or(String::new(), |m| format!(", color_map = {}", self.texture(m)))
                     )
                 };
                 format!(

@@ -211,6 +211,8 @@ bsdf = { type = "metallic-roughness" }
 bsdf = { type = "metallic-roughness", color = [0.9, 0.6, 0.2], metallic = 1, roughness = 0.7, ior = 1.4, map = { file = "mr.png", scale = 2 } }
 [materials.leaf]
 bsdf = { type = "metallic-roughness", color = [0.2, 0.6, 0.1], diffuse_transmission = { factor = 0.4, color = [1, 0.5, 0] } }
+[materials.veined]
+bsdf = { type = "metallic-roughness", diffuse_transmission = { factor = 1, factor_map = { file = "mr.png" }, color_map = { image = { file = "mr.png" } } } }
 "#;
     let path = dir.path().join("mr.toml");
     std::fs::write(&path, text).unwrap();
@@ -238,6 +240,20 @@ bsdf = { type = "metallic-roughness", color = [0.2, 0.6, 0.1], diffuse_transmiss
     for name in ["plain", "worn", "leaf"] {
         assert_eq!(mat(&s, name), mat(&again, name));
     }
+    // A leaf's share and colour read per point: the share's map linearly (200/255 in green),
+    // the colour's decoded from sRGB; written back, the same texels.
+    let maps = |s: &alhazen_scene::Scene| match mat(s, "veined") {
+        Some(BsdfDesc::MetallicRoughness {
+            translucency_map: Some(Texture::Image { image: a, .. }),
+            translucency_color_map: Some(Texture::Image { image: b, .. }),
+            ..
+        }) => (s.images[a].texel(1), s.images[b].texel(1)),
+        other => panic!("{other:?}"),
+    };
+    let (share, colour) = maps(&s);
+    assert_eq!(share, [0.0, 200.0 / 255.0, 0.0]);
+    assert!((colour[1] - 0.578).abs() < 1e-3, "{colour:?}");
+    assert_eq!(maps(&again), (share, colour));
 }
 
 /// A metallic–roughness surface's `anisotropy`: a strength (glTF's stretch, no turn) or a
@@ -571,6 +587,14 @@ fn physically_based_mistakes_are_explained() {
     );
     assert!(m(r#"{ type = "metallic-roughness", diffuse_transmission = { factor = nan } }"#).contains("finite"));
     assert!(m(r#"{ type = "metallic-roughness", diffuse_transmission = { colour = [1, 0, 0] } }"#).contains("colour"));
+    assert!(
+        m(r#"{ type = "metallic-roughness", diffuse_transmission = { factor_map = { file = "nowhere.png" } } }"#)
+            .contains("nowhere.png")
+    );
+    assert!(
+        m(r#"{ type = "metallic-roughness", diffuse_transmission = { color_map = "leaf.png" } }"#)
+            .contains("color_map")
+    );
     assert!(m(r#"{ type = "metallic-roughness", roughness = -0.1 }"#).contains("roughness"));
     assert!(m(r#"{ type = "metallic-roughness", metallic = nan }"#).contains("expected a finite number"));
     assert!(m(r#"{ type = "metallic-roughness", roughness = 1e300 }"#).contains("roughness"));

@@ -198,6 +198,8 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
             specular_map,
             specular_color_map,
             translucency,
+            translucency_map,
+            translucency_color_map,
         } => {
             // glTF's map: roughness in its green channel, metalness in its blue.
             let texel = map.as_ref().map_or(Vec3::ONE, |m| (lookups.rgb)(m));
@@ -214,7 +216,14 @@ fn from_desc(desc: &BsdfDesc, lookups: &Lookups, mode: ColorMode) -> Bsdf {
                     specular: specular * specular_map.as_ref().map_or(1.0, |m| (lookups.rgb)(m).x.clamp(0.0, 1.0)),
                     multiscatter: *multiscatter,
                     anisotropy,
-                    translucency: *translucency,
+                    translucency: alhazen_scene::bsdf::Translucency {
+                        factor: translucency.factor
+                            * translucency_map.as_ref().map_or(1.0, |m| (lookups.rgb)(m).x.clamp(0.0, 1.0)),
+                        color: translucency.color
+                            * translucency_color_map
+                                .as_ref()
+                                .map_or(Vec3::ONE, |m| (lookups.rgb)(m).clamp(Vec3::ZERO, Vec3::ONE)),
+                    },
                 },
             );
             let (a, b) = (from_desc(&metal, lookups, mode), from_desc(&coating, lookups, mode));
