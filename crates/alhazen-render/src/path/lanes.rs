@@ -556,12 +556,13 @@ fn tints_glass(m: &alhazen_scene::Material) -> bool {
 }
 
 /// True where `m` passes light diffusely through somewhere (a Cook–Torrance `transmittance`
-/// that is not black).
+/// that is not black, a metallic–roughness coating's diffuse transmission).
 fn translucent(m: &alhazen_scene::Material) -> bool {
     use alhazen_scene::bsdf::BsdfDesc;
     fn walk(d: &BsdfDesc) -> bool {
         match d {
             BsdfDesc::CookTorrance { transmittance, .. } => *transmittance != alhazen_scene::Texture::Solid(Vec3::ZERO),
+            BsdfDesc::MetallicRoughness { translucency, .. } => translucency.factor > 0.0,
             BsdfDesc::Mix { a, b, .. } => walk(a) || walk(b),
             BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => walk(base),
             _ => false,
@@ -1979,7 +1980,20 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         // Through a filter of negative lobes: the samples placed beyond their pixels, weighed ±.
         let mut filtered = small("cornell-box", (16, 16, 9));
         filtered.render.filter = alhazen_scene::PixelFilter::Mitchell { b: 0.0, c: 0.5, radius: [2.0, 1.5] };
+        // Thin sheets lit from behind, metallic–roughness with a diffuse transmission, one of
+        // them mapped (each point's share read from a checker): the general kernel's.
+        let sheets = alhazen_scene::parse_scene(
+            "sheets.toml".as_ref(),
+            "[render]\nwidth = 16\nheight = 12\nspp = 9\nintegrator = \"path\"\n[camera]\neye = [0, 0, 4]\n\
+             [[light]]\ntype = \"directional\"\ndirection = [0.2, 0, 1]\nintensity = 3\n\
+             [materials.leaf]\nbsdf = { type = \"metallic-roughness\", color = [0.3, 0.6, 0.2], diffuse_transmission = { factor = 0.8, color = [1, 0.5, 0.2], color_map = { checker = { even = [1, 1, 1], odd = [0.2, 0.2, 0.2], size = 0.5 } } } }\n\
+             [materials.paper]\nbsdf = { type = \"metallic-roughness\", metallic = 0.3, diffuse_transmission = { factor = 0.5 } }\n\
+             [[object]]\nshape = \"rectangle\"\nmaterial = \"leaf\"\ntransform = [{ scale = [0.7, 1, 1] }, { translate = [-0.8, 0, 0] }]\n\
+             [[object]]\nshape = \"rectangle\"\nmaterial = \"paper\"\ntransform = [{ scale = [0.7, 1, 1] }, { translate = [0.8, 0, 0] }]\n",
+        )
+        .unwrap();
         let scenes = [
+            ("thin sheets lit from behind", sheets),
             ("cornell-box through a Catmull–Rom filter", filtered),
             ("cornell-box through a lens", through_lens),
             ("cornell-box, cut out", cut),
