@@ -109,10 +109,22 @@ fn parse_plane(s: &str) -> Result<alhazen_math::Vec4, String> {
     Ok(alhazen_math::Vec4::new(a, b, c, d))
 }
 
+/// True when an environment map is the scene's only light (no lamps, no emitters): the
+/// preview's objects are then dark without image-based lighting.
+fn lit_by_environment_only(scene: &alhazen_scene::Scene) -> bool {
+    use alhazen_scene::Light;
+    let map = scene.lights.iter().any(|l| matches!(l, Light::Environment { .. }));
+    let others = scene.lights.iter().any(|l| !matches!(l, Light::Environment { .. }));
+    map && !others && scene.materials.iter().all(|m| m.emission == alhazen_math::Vec3::ZERO)
+}
+
 pub(crate) fn run(a: &RasterArgs) -> Result<(), Failure> {
     let format = check_output(&a.image.output, a.image.half)?;
     let output = crate::open_output(&a.image.output)?;
     let scene = load_sized(&a.image)?;
+    if !a.ibl && lit_by_environment_only(&scene) {
+        eprintln!("warning: the scene is lit by its environment map alone: --ibl lights the preview by it");
+    }
     if a.anaglyph && !matches!(scene.camera, alhazen_scene::CameraDesc::Stereo { .. }) {
         return Err(Failure::input(format!(
             "{}: --anaglyph needs a stereo camera (`type = \"stereo\"`)",

@@ -819,7 +819,8 @@ fn convert_writes_toml_that_renders_and_refuses_other_outputs() {
 }
 
 /// `--environment` lights any scene by a map in place of its own sky (a glTF file has none):
-/// rays that leave see the map, not the scene's background, in the path tracer and Whitted's;
+/// rays that leave see the map, not the scene's background, in the path tracer, Whitted's and
+/// the preview;
 /// `convert` writes it into the TOML. Its options without a map, and maps that cannot be read
 /// or numbers that mean nothing, are refused with exit code 2.
 #[test]
@@ -846,6 +847,55 @@ fn an_environment_map_given_on_the_command_line_lights_the_scene() {
         let seen = corner(&["--integrator", integrator, "--environment", &p("sky.exr"), "--environment-scale", "2"]);
         assert!(seen.iter().zip([0.4, 0.8, 1.2]).all(|(a, b)| (a - b).abs() < 1e-5), "{integrator}: {seen:?}");
     }
+    // The preview shows the map behind its objects too, and says what lights it; a glTF
+    // camera without a far plane (Blender's export) sees it as well.
+    let glb = Path::new(env!("CARGO_MANIFEST_DIR")).join("../alhazen-import/tests/data/blender/environment.glb");
+    for file in [scene.to_str().unwrap(), glb.to_str().unwrap()] {
+        let o = alhazen(&[
+            "raster",
+            file,
+            "-o",
+            &p("r.pfm"),
+            "--environment",
+            &p("sky.exr"),
+            "--width",
+            "16",
+            "--height",
+            "12",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        // (The TOML scene has a lamp; the glTF file no light but the map.)
+        assert_eq!(
+            String::from_utf8_lossy(&o.stderr).contains("--ibl lights the preview"),
+            file == glb.to_str().unwrap()
+        );
+        let bytes = std::fs::read(p("r.pfm")).unwrap();
+        let floats = &bytes[bytes.len() - 16 * 12 * 12..];
+        let seen: [f32; 3] = std::array::from_fn(|c| f32::from_le_bytes(floats[4 * c..4 * c + 4].try_into().unwrap()));
+        assert!(seen.iter().zip([0.2, 0.4, 0.6]).all(|(a, b)| (a - b).abs() < 1e-5), "{file}: {seen:?}");
+    }
+    // Under a map that varies, the preview's sky above the balls is Whitted's (but for where in
+    // each pixel it is looked up: the sky changes fast towards the pole).
+    let map = glb.with_file_name("environment-sky.exr");
+    let top_row = |command: &str| {
+        let (out, map) = (p("t.pfm"), map.to_str().unwrap());
+        let mut args = vec![command, glb.to_str().unwrap(), "-o", &out, "--width", "16", "--height", "12", "-q"];
+        args.extend(["--environment", map, "--environment-rotate", "90"]);
+        if command == "render" {
+            args.extend(["--integrator", "whitted"]);
+        }
+        let o = alhazen(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        let bytes = std::fs::read(p("t.pfm")).unwrap();
+        let floats: Vec<f32> =
+            bytes[bytes.len() - 16 * 12 * 12..].chunks(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect();
+        // PFM rows run bottom to top: the image's top row is the last.
+        let top = &floats[11 * 16 * 3..];
+        [0, 1, 2].map(|c| top.iter().skip(c).step_by(3).sum::<f32>() / 16.0)
+    };
+    let (preview, whitted) = (top_row("raster"), top_row("render"));
+    assert!(preview.iter().zip(whitted).all(|(a, b)| (a - b).abs() < 0.1 * b), "{preview:?} {whitted:?}");
+    assert!(preview[2] > 1.2 * preview[0], "a blue sky: {preview:?}");
     let o = alhazen(&["convert", scene.to_str().unwrap(), "-o", &p("lit.toml"), "--environment", &p("sky.exr")]);
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(std::fs::read_to_string(p("lit.toml")).unwrap().contains("type = \"environment\""));

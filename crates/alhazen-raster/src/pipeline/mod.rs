@@ -436,13 +436,12 @@ impl Projection {
         alhazen_math::Ray::new(origin, (at(0.0) - origin).normalize_or_zero())
     }
 
-    /// The world direction of the ray through NDC `(x, y)`.
+    /// The world direction of the ray through NDC `(x, y)` ([`Self::near_ray`]'s: from the
+    /// near plane to the depth halfway in NDC, which a projection without a far plane — a
+    /// glTF camera's without `zfar` — maps to a finite point where the far plane's is at
+    /// infinity).
     fn ray_dir(&self, x: f64, y: f64) -> Vec3 {
-        let h = |z: f64| {
-            let q = self.clip_to_world * Vec4::new(x, y, z, 1.0);
-            q.truncate() / q.w
-        };
-        (h(1.0) - h(-1.0)).normalize_or_zero()
+        self.near_ray(x, y).dir
     }
 }
 
@@ -887,7 +886,7 @@ fn render_view_in(
                     let shadows = &shade::Lighting { blocked: blocked[k], reflected, behind, ..*shadows };
                     let c = if *src == u32::MAX {
                         let (x, y) = ((k as u32 % w) as f64 + 0.5, (y0 + k as u32 / w) as f64 + 0.5);
-                        scene.background.radiance(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
+                        scene.sky(proj.ray_dir(2.0 * x / w as f64 - 1.0, 1.0 - 2.0 * y / h as f64))
                     } else {
                         match prelit {
                             Some(lit) => lit_color(scene, &tris[*src as usize], &lit[*src as usize], b),

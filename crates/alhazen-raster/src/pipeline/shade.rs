@@ -70,9 +70,9 @@ pub fn lighting(scene: &Scene, m: &Material, p: Vec3, n: Vec3, v: Vec3, extra: &
 }
 
 /// Radiance towards the viewer from the light factors of [`lighting`] at texture coordinates
-/// `uv`: `a·diffuse + specular`, plus emission; for mirrors what they show (or the background in
-/// the reflected direction); for glass a Fresnel-weighted blend of what lies behind it
-/// (unrefracted) and the reflected background.
+/// `uv`: `a·diffuse + specular`, plus emission; for mirrors what they show (or the sky — the
+/// environment map, else the background — in the reflected direction); for glass a
+/// Fresnel-weighted blend of what lies behind it (unrefracted) and the reflected sky.
 pub fn combine(
     scene: &Scene,
     m: &Material,
@@ -93,13 +93,13 @@ pub fn combine(
         c += m.specular * ibl.filtered(r, rough) * ibl.split_factor(v.dot(n), 0.04);
     }
     if m.mirror != Vec3::ZERO {
-        c += m.mirror * extra.reflected.unwrap_or_else(|| scene.background.radiance(2.0 * v.dot(n) * n - v));
+        c += m.mirror * extra.reflected.unwrap_or_else(|| scene.sky(2.0 * v.dot(n) * n - v));
     }
     if m.transparency != Vec3::ZERO {
         // A Fresnel-weighted blend of what lies behind (not refracted) and the reflected sky.
         let f = alhazen_render::optics::fresnel_dielectric(v.dot(n), m.ior);
-        let behind = extra.behind.unwrap_or_else(|| scene.background.radiance(-v));
-        let mirrored = scene.background.radiance(2.0 * v.dot(n) * n - v);
+        let behind = extra.behind.unwrap_or_else(|| scene.sky(-v));
+        let mirrored = scene.sky(2.0 * v.dot(n) * n - v);
         c += m.transparency * (behind * (1.0 - f) + mirrored * f);
     }
     c
