@@ -815,6 +815,21 @@ fn blender_specular_level_agrees_with_cycles() {
     }
 }
 
+/// The embedded quad, its image `png`, its material given `ext` (the members of its
+/// `extensions`) and made two-sided, lit from behind by a directional light: 32 × 16, 16 spp.
+fn leaf_lit_from_behind(png: &[u8], ext: &str) -> alhazen_render::Image {
+    let json = embedded().replace(&base64(&self::png()), &base64(png)).replace(
+        r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
+        &format!(r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "doubleSided": true, "extensions": {{ {ext} }}"#),
+    );
+    let mut s = write_and_import(&[("m.gltf", json.into_bytes())]).unwrap().scene;
+    s.lights = vec![alhazen_scene::Light::Directional { direction: Vec3::Z, intensity: Vec3::splat(3.0) }];
+    s.background = alhazen_scene::Background::Solid(Vec3::ZERO);
+    (s.render.width, s.render.height, s.render.spp) = (32, 16, 16);
+    s.render.integrator = alhazen_scene::IntegratorKind::Path;
+    alhazen_render::render(&s, &|_, _| {})
+}
+
 /// `KHR_materials_diffuse_transmission` (leaves, paper): the coating's diffuse light split into
 /// `(1 − share)·base` reflected and `share·colour` passed through to the other side. The quad
 /// lit from behind by a directional light shows the colour passed through (red here), black
@@ -827,18 +842,7 @@ fn diffuse_transmission_passes_light_through_a_leaf() {
     let BsdfDesc::CookTorrance { kd, transmittance, layered: true, .. } = &bsdf else { panic!("{bsdf:?}") };
     assert_eq!((*kd, transmittance), (0.6, &Texture::Solid(Vec3::new(0.4, 0.0, 0.0))));
     let lit_from_behind = |ext: &str| {
-        let json = embedded().replace(
-            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
-            &format!(
-                r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "doubleSided": true, "extensions": {{ {ext} }}"#
-            ),
-        );
-        let mut s = write_and_import(&[("m.gltf", json.into_bytes())]).unwrap().scene;
-        s.lights = vec![alhazen_scene::Light::Directional { direction: Vec3::Z, intensity: Vec3::splat(3.0) }];
-        s.background = alhazen_scene::Background::Solid(Vec3::ZERO);
-        (s.render.width, s.render.height, s.render.spp) = (32, 16, 16);
-        s.render.integrator = alhazen_scene::IntegratorKind::Path;
-        let img = alhazen_render::render(&s, &|_, _| {});
+        let img = leaf_lit_from_behind(&png(), ext);
         (0..32).flat_map(|x| (0..16).map(move |y| (x, y))).map(|(x, y)| img.get(x, y)).sum::<Vec3>()
     };
     let (through, opaque) = (lit_from_behind(ext), lit_from_behind(r#""KHR_materials_ior": { "ior": 1.5 }"#));
@@ -852,18 +856,7 @@ fn diffuse_transmission_passes_light_through_a_leaf() {
     assert!(said.is_empty(), "{said:?}");
     assert!(matches!(bsdf, BsdfDesc::MetallicRoughness { translucency_map: Some(_), .. }), "{bsdf:?}");
     let centre = |ext: &str| {
-        let json = embedded().replace(&base64(&png()), &base64(&png_with_alpha())).replace(
-            r#""metallicFactor": 0, "roughnessFactor": 0.5 }"#,
-            &format!(
-                r#""metallicFactor": 0, "roughnessFactor": 0.5 }}, "doubleSided": true, "extensions": {{ {ext} }}"#
-            ),
-        );
-        let mut s = write_and_import(&[("m.gltf", json.into_bytes())]).unwrap().scene;
-        s.lights = vec![alhazen_scene::Light::Directional { direction: Vec3::Z, intensity: Vec3::splat(3.0) }];
-        s.background = alhazen_scene::Background::Solid(Vec3::ZERO);
-        (s.render.width, s.render.height, s.render.spp) = (32, 16, 16);
-        s.render.integrator = alhazen_scene::IntegratorKind::Path;
-        let img = alhazen_render::render(&s, &|_, _| {});
+        let img = leaf_lit_from_behind(&png_with_alpha(), ext);
         let pixels = || (0..32u32).flat_map(|x| (0..16u32).map(move |y| (x, y)));
         let sum: f64 = pixels().map(|(x, y)| img.get(x, y).x).sum();
         (pixels().map(|(x, y)| x as f64 * img.get(x, y).x).sum::<f64>() / sum, sum)
