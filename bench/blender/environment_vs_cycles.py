@@ -12,6 +12,9 @@ with its default interpolation (Linear: bilinear between texel centres), as alha
 
     python3 bench/blender/environment_vs_cycles.py OUT_DIR [--spp 1024]
 
+Blender saves the float map sRGB-encoded (a texel of 0.25 is stored as 0.537); Cycles reads the
+file back as linear, as alhazen does, so both render the same stored values.
+
 Writes OUT_DIR/environment.glb, OUT_DIR/environment-sky.exr and OUT_DIR/environment-cycles.exr
 (96 × 64, CPU, 2 threads, box filter of one pixel, eight bounces), for the test
 `blender_environment_agrees_with_cycles`. Needs `pip install bpy`.
