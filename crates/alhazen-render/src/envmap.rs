@@ -19,7 +19,7 @@
 //! CDF apart from the radiance was no faster). Densities come from the same single-precision
 //! CDF as the sampling, so samples and lookups agree exactly. Paths traced side by side take
 //! their samples and lookups in steps ([`EnvMap::sample_row`], [`EnvMap::touch_texels`],
-//! [`EnvMap::sample_in`]; [`EnvMap::texels_ahead`], [`EnvMap::radiance_and_pdf_at`]), each
+//! [`EnvMap::sample_texel`], [`EnvMap::sample_at`]; [`EnvMap::texels_ahead`], [`EnvMap::radiance_and_pdf_at`]), each
 //! asking memory for what the next will read, so that the paths' cache misses overlap.
 
 use crate::distribution::{Distribution1D, Slices, guide_table, search_cdf};
@@ -44,6 +44,13 @@ struct Texel {
 
 /// Directions [`EnvMap::texels_ahead`] maps to texels in one vector loop.
 const AHEAD: usize = 8;
+
+/// A point of the map [`EnvMap::sample_texel`] chose: its place and its texel.
+#[derive(Clone, Copy, Debug)]
+pub struct TexelSample {
+    uv: Vec2,
+    texel: (usize, usize),
+}
 
 /// An environment map ready for lookup and sampling.
 #[derive(Clone, Debug)]
@@ -237,16 +244,32 @@ impl EnvMap {
     }
 
     /// [`Self::sample`] in row `row` ([`Self::sample_row`]`(u)`).
-    pub fn sample_in(&self, (v, y): (f64, usize), u: Vec2) -> Option<(Vec3, Vec3, f64)> {
+    pub fn sample_in(&self, row: (f64, usize), u: Vec2) -> Option<(Vec3, Vec3, f64)> {
+        self.sample_at(self.sample_texel(row, u))
+    }
+
+    /// The third step: the point in row `row` (its texel searched for, whose records
+    /// [`Self::touch_texels`] asked for), and the texels its radiance is interpolated from
+    /// asked of memory — in the row above or below too, which no earlier step could know.
+    pub fn sample_texel(&self, (v, y): (f64, usize), u: Vec2) -> TexelSample {
         let (u, x) = self.sample_in_row(y, u.x);
-        let (dir, sin) = self.to_dir(Vec2::new(u, v));
+        let taps = alhazen_scene::texture::equirect_taps(Vec2::new(u, v), self.width, self.height);
+        prefetch(&self.texels[taps[0].0]);
+        prefetch(&self.texels[taps[3].0]);
+        TexelSample { uv: Vec2::new(u, v), texel: (x, y) }
+    }
+
+    /// The last step: the direction of a point [`Self::sample_texel`] found, its radiance and
+    /// solid-angle density.
+    pub fn sample_at(&self, TexelSample { uv, texel }: TexelSample) -> Option<(Vec3, Vec3, f64)> {
+        let (dir, sin) = self.to_dir(uv);
         // The texel sampled (not looked up again from the direction: the same texel but for
         // rounding on its edges, without the inverse trigonometry).
-        let density = self.density_uv((x, y));
+        let density = self.density_uv(texel);
         if density <= 0.0 || sin <= 0.0 {
             return None;
         }
-        Some((dir, self.radiance_at(Vec2::new(u, v)), density / (2.0 * PI * PI * sin)))
+        Some((dir, self.radiance_at(uv), density / (2.0 * PI * PI * sin)))
     }
 
     /// Solid-angle density of [`Self::sample`] choosing `dir`.

@@ -7,7 +7,7 @@
 //! coordinates of the point a light sample lands on and of the point a ray hits alike.
 
 use crate::distribution::Distribution1D;
-use crate::envmap::EnvMap;
+use crate::envmap::{EnvMap, TexelSample};
 use crate::shape::VectorUnit;
 use alhazen_math::{Vec2, Vec3, orthonormal_basis};
 use alhazen_scene::{Background, ImageData, Light, Scene, Shape, Texture};
@@ -526,8 +526,9 @@ impl Lights {
 
     /// [`Self::sample`] for paths side by side, each lane's [`LightAsk`] or `None`, handing
     /// lane `i`'s sample to `found(i, sample)`: the same samples, but an environment map's
-    /// texels are asked of memory for every lane before any lane reads them, so that the
-    /// lanes' cache misses overlap.
+    /// texels are asked of memory for every lane before any lane reads them (those its search
+    /// reads, then those its radiance is interpolated from), so that the lanes' cache misses
+    /// overlap.
     #[inline]
     pub fn sample_lanes<const N: usize>(
         &self,
@@ -543,14 +544,18 @@ impl Lights {
                 m.touch_texels(row, ask.u);
             }
         }
+        let texels: [Option<TexelSample>; N] = std::array::from_fn(|i| {
+            let ask = asks[i].as_ref()?;
+            map(ask).map(|(m, row)| m.sample_texel(row, ask.u))
+        });
         for (i, ask) in asks.iter().enumerate() {
             let Some(ask) = ask else { continue };
-            let sample = match map(ask) {
-                Some((m, row)) => env_sample(m.sample_in(row, ask.u)).map(|mut s| {
+            let sample = match (map(ask), texels[i]) {
+                (Some((m, _)), Some(texel)) => env_sample(m.sample_at(texel)).map(|mut s| {
                     s.pdf *= self.choice_pdf();
                     s
                 }),
-                None => self.sample(ask.p, ask.u_choice, ask.u),
+                _ => self.sample(ask.p, ask.u_choice, ask.u),
             };
             found(i, sample);
         }
