@@ -73,40 +73,43 @@ pub struct EnvMap {
 }
 
 impl EnvMap {
-    /// From a linear radiance image, turned by `rotation` (radians) about its up axis `up`.
-    pub fn new(image: &ImageData, scale: f64, (rotation, up): (f64, Vec3)) -> Self {
+    /// From a linear radiance image, turned by `rotation` (radians) about its up axis `up`,
+    /// sampled in proportion to its power everywhere.
+    pub fn new(image: &ImageData, scale: f64, turn: (f64, Vec3)) -> Self {
+        Self::sampled(image, scale, turn, MapSampling::Whole)
+    }
+
+    /// [`Self::new`] with its samples drawn as `sampling` says.
+    pub fn sampled(image: &ImageData, scale: f64, (rotation, up): (f64, Vec3), sampling: MapSampling) -> Self {
         let (width, height) = (image.width as usize, image.height as usize);
-        let mut texels = Vec::with_capacity(width * height);
-        let mut row_power = Vec::with_capacity(height);
-        // Three rows' luminance at a time: an image kept as codes is never expanded whole.
-        let luminances = |y: usize| -> Vec<f64> {
-            let lum = |p: [f32; 3]| luminance(Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-            (0..width)
-                .map(|x| lum(image.texel(y * width + x)))
-                .map(|l| if l.is_finite() { l.max(0.0) } else { 0.0 })
-                .collect()
-        };
-        let (mut above, mut here) = (luminances(0), luminances(0));
-        for y in 0..height {
-            let below = luminances((y + 1).min(height - 1));
-            let sin = (PI * (y as f64 + 0.5) / height as f64).sin();
-            // The mean over the texel of the interpolated luminance (1-6-1 across and down).
-            let across = |r: &[f64], x: usize| {
-                let (left, right) = (if x == 0 { width - 1 } else { x - 1 }, if x + 1 == width { 0 } else { x + 1 });
-                r[left] + 6.0 * r[x] + r[right]
-            };
-            let power = |x: usize| (across(&above, x) + 6.0 * across(&here, x) + across(&below, x)) / 64.0 * sin;
-            let powers: Vec<f64> = (0..width).map(power).collect();
-            let total: f64 = powers.iter().sum();
-            let mut before = 0.0;
-            for (x, w) in powers.iter().enumerate() {
-                let cdf = if total > 0.0 { before / total } else { x as f64 / width as f64 };
-                texels.push(Texel { radiance: image.texel(y * width + x), cdf: cdf as f32 });
-                before += w;
+        // The records over `floor`, and the greatest texel mean.
+        let records = |floor: f64| {
+            let (mut texels, mut row_power) = (Vec::with_capacity(width * height), Vec::with_capacity(height));
+            let mut greatest = 0.0f64;
+            for (y, means) in texel_means(image) {
+                greatest = means.iter().fold(greatest, |g, &l| g.max(l));
+                let sin = (PI * (y as f64 + 0.5) / height as f64).sin();
+                let powers: Vec<f64> = means.iter().map(|&l| (l - floor).max(0.0) * sin).collect();
+                let total: f64 = powers.iter().sum();
+                let mut before = 0.0;
+                for (x, w) in powers.iter().enumerate() {
+                    let cdf = if total > 0.0 { before / total } else { x as f64 / width as f64 };
+                    texels.push(Texel { radiance: image.texel(y * width + x), cdf: cdf as f32 });
+                    before += w;
+                }
+                row_power.push(total);
             }
-            row_power.push(total);
-            (above, here) = (here, below);
-        }
+            (texels, row_power, greatest)
+        };
+        let (texels, row_power, _) = match sampling {
+            MapSampling::Whole => records(0.0),
+            MapSampling::AboveMean => {
+                let mean = mean_luminance(image);
+                let above = records(mean);
+                // Nothing above the mean but by rounding (a map of one colour): sampled whole.
+                if above.2 > mean * (1.0 + 1e-6) { above } else { records(0.0) }
+            }
+        };
         let guided = (GUIDED_FROM..u16::MAX as usize).contains(&width);
         let mut m = Self {
             width,
@@ -364,6 +367,61 @@ impl EnvMap {
     }
 }
 
+/// How an environment map's light samples are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapSampling {
+    /// In proportion to the interpolated radiance's luminance over each texel: every direction
+    /// the map lights can be drawn (what an estimate by light samples alone needs).
+    Whole,
+    /// In proportion to how far that luminance exceeds its mean over the sphere, nothing below
+    /// it (Karlík et al. 2019, "MIS compensation"): for estimates that weigh light samples
+    /// against BSDF samples, which cover the rest — the light samples go to the map's bright
+    /// parts (a sun), where the BSDF samples are weak. Sampled whole where no texel exceeds
+    /// the mean (a map of one colour). The mean is of the texels' own values, the excess of
+    /// their interpolated means over it: any floor gives unbiased estimates, as long as the
+    /// densities come from the same tables as the samples (they do).
+    AboveMean,
+}
+
+/// Row by row, each texel's mean of the interpolated luminance over it (1-6-1 across and down,
+/// over 64; three rows' luminance at a time: an image kept as codes is never expanded whole).
+fn texel_means(image: &ImageData) -> impl Iterator<Item = (usize, Vec<f64>)> + '_ {
+    let (width, height) = (image.width as usize, image.height as usize);
+    let luminances =
+        move |y: usize| -> Vec<f64> { (0..width).map(|x| texel_luminance(image.texel(y * width + x))).collect() };
+    let mut rows = (luminances(0), luminances(0));
+    (0..height).map(move |y| {
+        let below = luminances((y + 1).min(height - 1));
+        let across = |r: &[f64], x: usize| {
+            let (left, right) = (if x == 0 { width - 1 } else { x - 1 }, if x + 1 == width { 0 } else { x + 1 });
+            r[left] + 6.0 * r[x] + r[right]
+        };
+        let (above, here) = &rows;
+        let means = (0..width).map(|x| (across(above, x) + 6.0 * across(here, x) + across(&below, x)) / 64.0).collect();
+        rows = (std::mem::take(&mut rows.1), below);
+        (y, means)
+    })
+}
+
+/// The mean luminance of the map over the sphere (each texel weighed by its solid angle; the
+/// texels' own values, which the interpolation averages to the same within rounding).
+fn mean_luminance(image: &ImageData) -> f64 {
+    let (width, height) = (image.width as usize, image.height as usize);
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for y in 0..height {
+        let sin = (PI * (y as f64 + 0.5) / height as f64).sin();
+        let row: f64 = (0..width).map(|x| texel_luminance(image.texel(y * width + x))).sum();
+        (sum, weight) = (sum + row * sin, weight + width as f64 * sin);
+    }
+    if weight > 0.0 { sum / weight } else { 0.0 }
+}
+
+/// A texel's luminance, zero where it is not a finite positive number.
+fn texel_luminance(p: [f32; 3]) -> f64 {
+    let l = luminance(Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+    if l.is_finite() { l.max(0.0) } else { 0.0 }
+}
+
 /// The sine of unit direction `dir`'s angle from +y, without trigonometry.
 fn polar_sine(dir: Vec3) -> f64 {
     (dir.x * dir.x + dir.z * dir.z).sqrt()
@@ -373,12 +431,57 @@ fn polar_sine(dir: Vec3) -> f64 {
 mod tests {
     use super::*;
 
-    /// Upright, tilted towards `+z` (a z-up world's map) and upside down.
-    fn test_maps() -> [EnvMap; 3] {
+    /// Upright, tilted towards `+z` (a z-up world's map) and upside down; sampled whole and
+    /// above its mean.
+    fn test_maps() -> Vec<EnvMap> {
         let (w, h) = (16u32, 8u32);
         let pixels: Vec<_> = (0..w * h).map(|i| [(i % 7) as f32 + 0.5, 1.0, (i % 3) as f32]).collect();
-        [Vec3::Y, Vec3::new(0.0, 0.6, 0.8), -Vec3::Y]
-            .map(|up| EnvMap::new(&ImageData::new(w, h, pixels.clone()), 2.0, (0.4, up)))
+        let image = ImageData::new(w, h, pixels);
+        let ups = [Vec3::Y, Vec3::new(0.0, 0.6, 0.8), -Vec3::Y];
+        let samplings = [MapSampling::Whole, MapSampling::AboveMean];
+        samplings.iter().flat_map(|&s| ups.map(|up| EnvMap::sampled(&image, 2.0, (0.4, up), s))).collect()
+    }
+
+    /// Sampled above its mean, a map draws no direction where its interpolated luminance is
+    /// below the mean (its density there is zero), and all where it is above; a map of one
+    /// colour is sampled whole.
+    #[test]
+    fn above_its_mean_a_map_samples_its_bright_parts_only() {
+        let (w, h) = (32u32, 16u32);
+        // A dim sky brightening upwards and a bright patch.
+        let pixels: Vec<_> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let sky = 1.0 + (h - y) as f32 / h as f32;
+                if (10..13).contains(&x) && (4..6).contains(&y) { [90.0, 80.0, 70.0] } else { [sky; 3] }
+            })
+            .collect();
+        let image = ImageData::new(w, h, pixels);
+        let m = EnvMap::sampled(&image, 1.0, (0.0, Vec3::Y), MapSampling::AboveMean);
+        let mean = mean_luminance(&image);
+        let means: Vec<f64> = texel_means(&image).flat_map(|(_, row)| row).collect();
+        for k in 0..300 {
+            let u = Vec2::new((k as f64 * 0.618).fract(), (k as f64 * 0.377 + 0.1).fract());
+            let (d, _, pdf) = m.sample(u).unwrap();
+            let (x, y) = m.texel_at(m.to_uv(d));
+            assert!(means[y * w as usize + x] > mean, "sample {k} in texel {x}, {y}");
+            assert!((m.pdf(d) - pdf).abs() < 1e-9 * pdf);
+        }
+        // The dim sky far from the patch: no density; the patch: more than sampled whole.
+        let whole = EnvMap::new(&image, 1.0, (0.0, Vec3::Y));
+        let (dim, patch) = (whole.to_dir(Vec2::new(0.8, 0.9)).0, whole.to_dir(Vec2::new(11.5 / 32.0, 5.0 / 16.0)).0);
+        assert_eq!(m.pdf(dim), 0.0);
+        assert!(whole.pdf(dim) > 0.0 && m.pdf(patch) > whole.pdf(patch));
+        // One colour: sampled whole (uniformly over the sphere, but for the rows' sines).
+        let grey = ImageData::new(w, h, vec![[0.7; 3]; (w * h) as usize]);
+        let (a, b) = (
+            EnvMap::sampled(&grey, 1.0, (0.0, Vec3::Y), MapSampling::AboveMean),
+            EnvMap::new(&grey, 1.0, (0.0, Vec3::Y)),
+        );
+        for dir in [Vec3::new(0.0, 0.8, 0.6), Vec3::new(0.6, 0.0, 0.8), Vec3::new(0.0, -0.8, 0.6)] {
+            assert_eq!(a.pdf(dir), b.pdf(dir));
+            assert!((a.pdf(dir) * 4.0 * PI - 1.0).abs() < 0.1, "{dir}: {}", a.pdf(dir));
+        }
     }
 
     #[test]

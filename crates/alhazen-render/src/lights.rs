@@ -7,7 +7,7 @@
 //! coordinates of the point a light sample lands on and of the point a ray hits alike.
 
 use crate::distribution::Distribution1D;
-use crate::envmap::{EnvMap, TexelSample};
+use crate::envmap::{EnvMap, MapSampling, TexelSample};
 use crate::shape::VectorUnit;
 use alhazen_math::{Vec2, Vec3, orthonormal_basis};
 use alhazen_scene::{Background, ImageData, Light, Scene, Shape, Texture};
@@ -215,6 +215,25 @@ pub struct Lights {
     sky: Option<u32>,
     /// Some light is an environment map.
     has_environment: bool,
+    /// The lights a sample chooses among: the first `choices` of `lights` (all but a sky of
+    /// one colour or a gradient, last, under [`LightSampling::AgainstBsdf`]).
+    choices: usize,
+}
+
+/// What a scene's light samples are for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightSampling {
+    /// Estimates by light samples alone (Whitted's soft shadows, photon emission): every
+    /// light is sampled wherever it shines.
+    Whole,
+    /// The path tracer's, each light sample weighed against a BSDF sample by multiple
+    /// importance sampling: the BSDF samples cover every direction, so the lights sample only
+    /// where the BSDF's do poorly (Karlík et al. 2019, "MIS compensation"; pbrt-v4's
+    /// `allowIncompletePDF`). An environment map draws its samples where it exceeds its mean
+    /// ([`MapSampling::AboveMean`]): a sun's, not the dim sky's. A sky of one colour or a
+    /// gradient is left to the BSDF samples alone (sampled uniformly, it would only add noise
+    /// and shadow rays), and the choice among the other lights.
+    AgainstBsdf,
 }
 
 /// The world-space triangles of an emitting mesh object whose radiance is `texture`, cut out by
@@ -311,6 +330,11 @@ pub(crate) fn uniform_sphere(u: Vec2) -> Vec3 {
 impl Lights {
     /// The lights of `scene`: its light list, then one area light per emitting object.
     pub fn build(scene: &Scene) -> Self {
+        Self::build_for(scene, LightSampling::Whole)
+    }
+
+    /// [`Self::build`] for estimates of the kind `use_` says.
+    pub fn build_for(scene: &Scene, use_: LightSampling) -> Self {
         let mut lights = Vec::new();
         let mut sky = None;
         for l in &scene.lights {
@@ -324,7 +348,16 @@ impl Lights {
                 }
                 Light::Environment { image, scale, rotation, up } => {
                     sky = Some(lights.len() as u32);
-                    PathLight::Environment(Box::new(EnvMap::new(&scene.images[image], scale, (rotation, up))))
+                    let sampling = match use_ {
+                        LightSampling::Whole => MapSampling::Whole,
+                        LightSampling::AgainstBsdf => MapSampling::AboveMean,
+                    };
+                    PathLight::Environment(Box::new(EnvMap::sampled(
+                        &scene.images[image],
+                        scale,
+                        (rotation, up),
+                        sampling,
+                    )))
                 }
             });
         }
@@ -357,8 +390,21 @@ impl Lights {
                 lights.push(light);
             }
         }
+        let mut choices = lights.len();
+        if let (LightSampling::AgainstBsdf, Some(i)) = (use_, sky)
+            && matches!(lights[i as usize], PathLight::Background(_))
+        {
+            // The sky last, out of the choice.
+            let background = lights.remove(i as usize);
+            for light in by_object.iter_mut().flatten().filter(|l| **l > i) {
+                *light -= 1;
+            }
+            sky = Some(lights.len() as u32);
+            lights.push(background);
+            choices -= 1;
+        }
         let has_environment = lights.iter().any(|l| matches!(l, PathLight::Environment(_)));
-        Self { lights, by_object, sky, has_environment }
+        Self { lights, by_object, sky, has_environment, choices }
     }
 
     /// Number of lights.
@@ -366,23 +412,34 @@ impl Lights {
         self.lights.len()
     }
 
-    /// True when there is nothing to sample.
+    /// True when there is no light.
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
     }
 
-    /// Probability of choosing any one light.
-    pub fn choice_pdf(&self) -> f64 {
-        1.0 / self.lights.len() as f64
+    /// Number of lights a sample chooses among ([`Self::choose`]; all of them but a sky left to
+    /// BSDF samples, [`LightSampling::AgainstBsdf`]).
+    pub fn choices(&self) -> usize {
+        self.choices
     }
 
-    /// The light `u_choice` chooses (uniformly); there must be one.
+    /// Probability of choosing any one light.
+    pub fn choice_pdf(&self) -> f64 {
+        1.0 / self.choices as f64
+    }
+
+    /// The light `u_choice` chooses (uniformly); there must be one ([`Self::choices`]).
     #[inline]
     pub fn choose(&self, u_choice: f64) -> usize {
         // In `u32`: x86-64 converts between `f64` and 32-bit integers in one instruction each,
         // and `usize` (unsigned 64-bit) in several; the light is the same (far fewer than 2³²).
-        let n = u32::try_from(self.lights.len()).unwrap_or(u32::MAX);
+        let n = u32::try_from(self.choices).unwrap_or(u32::MAX);
         ((u_choice * f64::from(n)) as u32).min(n - 1) as usize
+    }
+
+    /// The sky is a light that samples choose ([`Self::choices`]).
+    fn sky_sampled(&self) -> bool {
+        self.sky.is_some_and(|i| (i as usize) < self.choices)
     }
 
     /// Radiance arriving from the sky along `-dir` (`dir` pointing away from the scene) and the
@@ -394,7 +451,9 @@ impl Lights {
                 let (radiance, pdf) = m.radiance_and_pdf(dir);
                 (radiance, pdf * self.choice_pdf())
             }
-            Some(PathLight::Background(b)) => (b.radiance(dir), self.choice_pdf() / (4.0 * PI)),
+            Some(PathLight::Background(b)) => {
+                (b.radiance(dir), if self.sky_sampled() { self.choice_pdf() / (4.0 * PI) } else { 0.0 })
+            }
             _ => (Vec3::ZERO, 0.0),
         }
     }
@@ -496,7 +555,7 @@ impl Lights {
     /// Chooses a light by `u_choice` and a point on it by `u`, as seen from `p`.
     #[inline]
     pub fn sample(&self, p: Vec3, u_choice: f64, u: Vec2) -> Option<LightSample> {
-        if self.lights.is_empty() {
+        if self.choices == 0 {
             return None;
         }
         let mut s = self.sample_one(&self.lights[self.choose(u_choice)], p, u)?;
@@ -516,7 +575,7 @@ impl Lights {
     /// asked of memory, while the other paths are busy.
     #[inline]
     pub fn ask(&self, p: Vec3, u_choice: f64, u: Vec2) -> LightAsk {
-        let chosen = (!self.lights.is_empty()).then(|| &self.lights[self.choose(u_choice)]);
+        let chosen = (self.choices > 0).then(|| &self.lights[self.choose(u_choice)]);
         let row = match chosen {
             Some(PathLight::Environment(m)) => Some(m.sample_row(u)),
             _ => None,
@@ -535,8 +594,9 @@ impl Lights {
         asks: &[Option<LightAsk>; N],
         mut found: impl FnMut(usize, Option<LightSample>),
     ) {
-        let map = |ask: &LightAsk| match (&self.lights[self.choose(ask.u_choice)], ask.row) {
-            (PathLight::Environment(m), Some(row)) => Some((m.as_ref(), row)),
+        // (A lane has a row only when a light was chosen: an environment map.)
+        let map = |ask: &LightAsk| match (ask.row, ask.row.map(|_| &self.lights[self.choose(ask.u_choice)])) {
+            (Some(row), Some(PathLight::Environment(m))) => Some((m.as_ref(), row)),
             _ => None,
         };
         for ask in asks.iter().flatten() {

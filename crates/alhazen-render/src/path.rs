@@ -5,6 +5,10 @@
 //! sampling, power heuristic), next-event estimation towards one light chosen uniformly (weighted
 //! against BSDF sampling), then a BSDF-sampled continuation; Russian roulette from depth 5 on.
 //! Delta lights and delta BSDF lobes skip the heuristic (their densities are not comparable).
+//! As every light sample is weighed against a BSDF sample, which reaches every direction, the
+//! lights sample only where BSDF samples do poorly (MIS compensation, Karlík et al. 2019;
+//! [`LightSampling::AgainstBsdf`]): an environment map where it exceeds its mean, a sky of one
+//! colour or a gradient not at all.
 //!
 //! Depth follows Mitsuba's `max_depth`: a path of `k` segments from the camera contributes when
 //! `k ≤ max_depth` (1 = emitters seen directly, 2 = direct lighting). Emitters shine from the
@@ -28,7 +32,7 @@
 use crate::bsdf::{Bsdf, ColorMode, Frame, bsdf_at, tangent_at};
 use crate::camera::Camera;
 use crate::film::PixelEstimator;
-use crate::lights::Lights;
+use crate::lights::{LightSampling, Lights};
 use crate::sampler::{PixelSeeds, SampleStream, Sequence};
 use crate::shape::ray_epsilon;
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
@@ -39,6 +43,8 @@ use std::borrow::Cow;
 
 mod lanes;
 mod mirrors;
+#[cfg(test)]
+mod tests;
 
 /// Depth from which Russian roulette may end paths (Mitsuba's `rr_depth`).
 const RR_DEPTH: u32 = 5;
@@ -212,8 +218,20 @@ struct Vertex {
 }
 
 impl<'a> PathTracer<'a> {
-    /// Prepares the lights of `scene`.
+    /// Prepares the lights of `scene`, each light sample weighed against a BSDF sample
+    /// ([`LightSampling::AgainstBsdf`]).
     pub fn new(scene: &'a Scene, world: &'a World, camera: &'a Camera) -> Self {
+        Self::with_light_sampling(scene, world, camera, LightSampling::AgainstBsdf)
+    }
+
+    /// [`Self::new`] with the lights sampled as `sampling` says (either gives every image the
+    /// same expectation; [`LightSampling::Whole`] is there to show it).
+    pub fn with_light_sampling(
+        scene: &'a Scene,
+        world: &'a World,
+        camera: &'a Camera,
+        sampling: LightSampling,
+    ) -> Self {
         let spectral = scene.materials.iter().any(|m| m.bsdf.as_ref().is_some_and(|b| b.is_dispersive()));
         let sequence = match scene.render.sampler {
             SamplerKind::Sobol => Sequence::Sobol,
@@ -229,7 +247,7 @@ impl<'a> PathTracer<'a> {
                 untextured.then(|| bsdf_at(m, Vec2::ZERO, Vec3::ONE, &scene.images, ColorMode::Rgb))
             })
             .collect();
-        let lights = Lights::build(scene);
+        let lights = Lights::build_for(scene, sampling);
         let mirrors = scene
             .render
             .mirror_connections
@@ -339,7 +357,7 @@ impl<'a> PathTracer<'a> {
         let v = frame.to_local(wo);
         // One pair picks the light and the BSDF lobe, drawn only when there is a choice;
         // one pair each places the points.
-        let choices = if self.lights.len() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
+        let choices = if self.lights.choices() > 1 || bsdf.chooses_lobe() { s.next_2d() } else { Vec2::ZERO };
         if !bsdf.is_delta() {
             let (light, shadow) = self.next_event(&bsdf, &frame, terminator, wh.hit.p, ng, v, mode, choices.x, s);
             (out.light, out.shadow) = (Some(light), shadow);

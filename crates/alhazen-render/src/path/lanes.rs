@@ -190,7 +190,7 @@ pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
         PathLight::Background(Background::Solid(radiance)) => Some(LaneLight { radiance, sky: true, ..none }),
         _ => None,
     };
-    lights.all().iter().map(lane).collect::<Option<Vec<_>>>().filter(|all| !all.is_empty())
+    lights.all()[..lights.choices()].iter().map(lane).collect::<Option<Vec<_>>>().filter(|all| !all.is_empty())
 }
 
 /// Where the lanes sample parallelogram and point lights: each lane's light and its two
@@ -938,7 +938,7 @@ impl PathTracer<'_> {
         let path = &lane.path;
         // One pair picks the light and the lobe, drawn only when there is a choice; a delta
         // BSDF samples no light and draws no number for it.
-        let chooses = self.lights.len() > 1 || kernel.chooses_lobe();
+        let chooses = self.lights.choices() > 1 || kernel.chooses_lobe();
         let (choice, u_lobe) = if chooses { s.next_2d().into() } else { (0.0, 0.0) };
         v.u_lobe[i] = u_lobe;
         let u_light = if kernel.is_delta() { Vec2::ZERO } else { s.next_2d() };
