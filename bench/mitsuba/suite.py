@@ -6,6 +6,7 @@ Mitsuba XML file that both renderers read as it is (so the twins are one file).
     python3 bench/mitsuba/suite.py reference [NAME…]   # Mitsuba's converged images (committed)
     python3 bench/mitsuba/suite.py run [--runs 3] [NAME…]
     python3 bench/mitsuba/suite.py depths [--runs 3] [NAME…]
+    python3 bench/mitsuba/suite.py errors [--spp 64] [--seeds 3] [NAME…]
 
 `run`, per scene, 256×256, 64 spp, max depth 8, on all cores:
 1. Equal samples: median wall time of the whole `alhazen render` process (parse, build, render,
@@ -24,6 +25,10 @@ Mitsuba XML file that both renderers read as it is (so the twins are one file).
 build, against `mi.render` in llvm) with the path depth capped at 1, 2, 3 and the scene's own:
 where the time goes — a depth of 1 is the camera rays, their hits and the emitters seen, each
 further depth one bounce with its light sample — and so which part of a sample to speed up.
+
+`errors`, per scene: alhazen's RMSE, mean relative error and image mean against the reference
+at `--spp` samples, averaged over seeds 1 to `--seeds` (no timing): a change to the estimator's
+noise seen apart from its speed.
 
 Needs `pip install mitsuba numpy`, `apt-get install libllvm19`.
 """
@@ -184,13 +189,29 @@ def depths(name, runs, spp, tmp):
     print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
 
 
+def seed_errors(name, spp, seeds, tmp):
+    """alhazen's error at `spp` samples against the reference, over `seeds` seeds (no timing):
+    what a change of the estimator does to the noise, apart from speed."""
+    ref = load(os.path.join(SUITE, "ref", f"{name}.exr"))
+    rmse, rel, bias = [], [], []
+    for seed in range(1, seeds + 1):
+        out = f"{tmp}/ours.exr"
+        subprocess.run([EXE, "render", SCENES[name], "-o", out, "--spp", str(spp), "--sampler", SAMPLER,
+                        "--seed", str(seed), "--quiet"], check=True)
+        img = load(out)
+        e = errors(img, ref)
+        rmse.append(e[0]), rel.append(e[1]), bias.append(img.mean() / ref.mean() - 1)
+    print(f"| {name} | {np.mean(rmse):.4f} | {np.mean(rel):.4f} | {np.mean(bias) * 100:+.2f} % |", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("mode", choices=["reference", "run", "depths"])
+    ap.add_argument("mode", choices=["reference", "run", "depths", "errors"])
     ap.add_argument("names", nargs="*")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--ref-spp", type=int, default=4096)
+    ap.add_argument("--seeds", type=int, default=3)
     a = ap.parse_args()
     names = a.names or list(SCENES)
     if a.mode == "reference":
@@ -200,6 +221,13 @@ def main():
     if "ALHAZEN" not in os.environ:
         subprocess.run(["cargo", "build", "--release", "-q", "-p", "alhazen-cli"], cwd=ROOT, check=True)
     tmp = tempfile.mkdtemp()
+    if a.mode == "errors":
+        print(f"alhazen at {a.spp} spp against the references, means over seeds 1-{a.seeds}")
+        print("| scene | RMSE | mean rel. | image mean vs ref. |")
+        print("|---|---|---|---|")
+        for n in names:
+            seed_errors(n, a.spp, a.seeds, tmp)
+        return
     if a.mode == "depths":
         print(f"{os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}; render alone, alhazen / Mitsuba llvm")
         print("| scene | depth 1 | depth 2 | depth 3 | the scene's depth |")
