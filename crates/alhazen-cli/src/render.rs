@@ -157,10 +157,9 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
 /// Whitted lights with emitting spheres, disks, boxes and meshes; says which others it only
 /// shows.
 fn warn_unsampled_emitters(scene: &Scene) {
-    let lights = alhazen_render::lights::Lights::build(scene);
     let emits = |o: &alhazen_scene::Object| scene.materials[o.material as usize].emission != alhazen_math::Vec3::ZERO;
-    let unsampled =
-        scene.objects.iter().enumerate().filter(|(i, o)| emits(o) && lights.of_object(*i as u32).is_none()).count();
+    let sampled = |i: usize| alhazen_render::lights::Lights::samples_object(scene, i);
+    let unsampled = scene.objects.iter().enumerate().filter(|(i, o)| emits(o) && !sampled(*i)).count();
     if unsampled > 0 {
         eprintln!(
             "warning: {unsampled} emitting object(s) light nothing under Whitted ray tracing (only spheres, disks, rectangles, boxes and meshes do; not cylinders, cones, patches, CSG or distorted spheres): they are shown, not sampled; use --integrator path"

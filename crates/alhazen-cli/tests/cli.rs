@@ -1320,3 +1320,21 @@ fn scene_parameters_are_refused_when_malformed_or_misplaced() {
     let (code, err, written) = render(OK, &["-D", "spp=4"]);
     assert!(code == 2 && !written && err.contains("Mitsuba"), "{err}");
 }
+
+/// Under Whitted an emitting cylinder is shown, not sampled, and the render says so; an
+/// emitting sphere is sampled and adds nothing to the count (the environment map beside them
+/// is not built for the warning).
+#[test]
+fn whitted_says_which_emitters_it_only_shows() {
+    let dir = tempfile::tempdir().unwrap();
+    let sky: Vec<u8> =
+        "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n".bytes().chain([128, 128, 128, 129].repeat(2)).collect();
+    std::fs::write(dir.path().join("sky.hdr"), sky).unwrap();
+    let text = "[render]\nwidth = 16\nheight = 12\nspp = 1\n[camera]\neye = [0, 0, 5]\n[[light]]\ntype = \"environment\"\nfile = \"sky.hdr\"\n[[object]]\nshape = \"sphere\"\nradius = 0.5\nmaterial = { emission = [2, 2, 2] }\n[[object]]\nshape = \"cylinder\"\nradius = 0.2\nmaterial = { emission = [2, 2, 2] }\n";
+    let scene = scene_file(dir.path(), text);
+    let out = dir.path().join("out.png");
+    let o = alhazen(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("warning: 1 emitting object(s) light nothing under Whitted"), "{err}");
+}

@@ -236,6 +236,27 @@ pub enum LightSampling {
     AgainstBsdf,
 }
 
+/// The area light of scene object `o`: where it emits and is a shape lights sample.
+fn area_light_of(scene: &Scene, o: &alhazen_scene::Object) -> Option<PathLight> {
+    let m = &scene.materials[o.material as usize];
+    let radiance = m.emission;
+    if radiance == Vec3::ZERO {
+        return None;
+    }
+    // Read per point where the emission varies or a cut-out takes parts of it away.
+    let textured = match (&m.emission_texture, &m.alpha) {
+        (None, None) => None,
+        (texture, cut_out) => {
+            let texture = texture.clone().unwrap_or(Texture::Solid(radiance));
+            textured_emitter_of(scene, o, &texture, cut_out.as_ref())
+        }
+    };
+    match textured {
+        Some((emitter, t)) => Some(PathLight::Area { emitter, radiance, texture: Some(Box::new(t)) }),
+        None => emitter_of(scene, o).map(|emitter| PathLight::Area { emitter, radiance, texture: None }),
+    }
+}
+
 /// The world-space triangles of an emitting mesh object whose radiance is `texture`, cut out by
 /// `cut_out`, with their texture coordinates (never a parallelogram: its two triangles'
 /// coordinates may differ).
@@ -368,24 +389,7 @@ impl Lights {
         }
         let mut by_object = vec![None; scene.objects.len()];
         for (i, o) in scene.objects.iter().enumerate() {
-            let m = &scene.materials[o.material as usize];
-            let radiance = m.emission;
-            if radiance == Vec3::ZERO {
-                continue;
-            }
-            // Read per point where the emission varies or a cut-out takes parts of it away.
-            let textured = match (&m.emission_texture, &m.alpha) {
-                (None, None) => None,
-                (texture, cut_out) => {
-                    let texture = texture.clone().unwrap_or(Texture::Solid(radiance));
-                    textured_emitter_of(scene, o, &texture, cut_out.as_ref())
-                }
-            };
-            let light = match textured {
-                Some((emitter, t)) => Some(PathLight::Area { emitter, radiance, texture: Some(Box::new(t)) }),
-                None => emitter_of(scene, o).map(|emitter| PathLight::Area { emitter, radiance, texture: None }),
-            };
-            if let Some(light) = light {
+            if let Some(light) = area_light_of(scene, o) {
                 by_object[i] = Some(lights.len() as u32);
                 lights.push(light);
             }
@@ -405,6 +409,12 @@ impl Lights {
         }
         let has_environment = lights.iter().any(|l| matches!(l, PathLight::Environment(_)));
         Self { lights, by_object, sky, has_environment, choices }
+    }
+
+    /// Whether scene object `object` emits and is sampled as an area light ([`Self::of_object`]
+    /// of the lights [`Self::build`] makes, without building the others: environment maps).
+    pub fn samples_object(scene: &Scene, object: usize) -> bool {
+        scene.objects.get(object).and_then(|o| area_light_of(scene, o)).is_some()
     }
 
     /// Number of lights.
