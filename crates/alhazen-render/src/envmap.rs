@@ -19,8 +19,13 @@
 //! CDF apart from the radiance was no faster). Densities come from the same single-precision
 //! CDF as the sampling, so samples and lookups agree exactly. Paths traced side by side take
 //! their samples and lookups in steps ([`EnvMap::sample_row`], [`EnvMap::touch_texels`],
-//! [`EnvMap::sample_texel`], [`EnvMap::sample_at`]; [`EnvMap::texels_ahead`], [`EnvMap::radiance_and_pdf_at`]), each
-//! asking memory for what the next will read, so that the paths' cache misses overlap.
+//! [`EnvMap::sample_texel`], [`EnvMap::sample_at`]; [`EnvMap::texels_ahead`],
+//! [`EnvMap::radiance_and_pdf_at`]), each asking memory for what the next will read, so that
+//! the paths' cache misses overlap.
+//!
+//! Where every light sample is weighed against a BSDF sample (the path tracer), the map is
+//! sampled by each texel's excess over its mean instead ([`MapSampling::AboveMean`], MIS
+//! compensation: Karlík et al. 2019): the BSDF samples find the dim sky well.
 
 use crate::distribution::{Distribution1D, Slices, guide_table, search_cdf};
 use crate::prefetch::prefetch;

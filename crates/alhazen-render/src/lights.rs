@@ -3,6 +3,9 @@
 //! meshes, boxes — and disks by area), the environment map and a coloured background
 //! (uniformly over the sphere). Lights are chosen uniformly; every density here includes that
 //! choice. Emitters of other shapes still shine when paths hit them, without light sampling.
+//! For the path tracer, whose light samples are weighed against BSDF samples, the sky is
+//! sampled only where BSDF samples do poorly ([`LightSampling::AgainstBsdf`], MIS
+//! compensation: Karlík et al. 2019).
 //! A textured emission ([`AreaTexture`]) is read per point on meshes, by the texture
 //! coordinates of the point a light sample lands on and of the point a ray hits alike.
 
@@ -354,8 +357,8 @@ impl Lights {
         Self::build_for(scene, LightSampling::Whole)
     }
 
-    /// [`Self::build`] for estimates of the kind `use_` says.
-    pub fn build_for(scene: &Scene, use_: LightSampling) -> Self {
+    /// [`Self::build`] for estimates of the kind `purpose` says.
+    pub fn build_for(scene: &Scene, purpose: LightSampling) -> Self {
         let mut lights = Vec::new();
         let mut sky = None;
         for l in &scene.lights {
@@ -369,7 +372,7 @@ impl Lights {
                 }
                 Light::Environment { image, scale, rotation, up } => {
                     sky = Some(lights.len() as u32);
-                    let sampling = match use_ {
+                    let sampling = match purpose {
                         LightSampling::Whole => MapSampling::Whole,
                         LightSampling::AgainstBsdf => MapSampling::AboveMean,
                     };
@@ -395,7 +398,7 @@ impl Lights {
             }
         }
         let mut choices = lights.len();
-        if let (LightSampling::AgainstBsdf, Some(i)) = (use_, sky)
+        if let (LightSampling::AgainstBsdf, Some(i)) = (purpose, sky)
             && matches!(lights[i as usize], PathLight::Background(_))
         {
             // The sky last, out of the choice.
