@@ -51,7 +51,6 @@ use crate::shape::{RayPacket, VectorUnit};
 use crate::spectrum::{sample_wavelengths, spectrum_to_rgb};
 use crate::world::{HitPoint, WorldHit};
 use alhazen_math::{Ray, Vec2, Vec3};
-use alhazen_scene::Background;
 use std::f64::consts::FRAC_1_PI;
 
 /// Paths traced side by side: one AVX-512 register of `f64` (two AVX2 ones).
@@ -149,9 +148,8 @@ struct Vertices {
     u_roulette: Lanes,
 }
 
-/// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`), a point
-/// light (`point`: at `corner`, `radiance` its intensity, as `Lights::sample` takes it) or a
-/// sky of one colour (`sky`: sampled uniformly over the sphere, as `Lights::sample` does).
+/// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`) or a point
+/// light (`point`: at `corner`, `radiance` its intensity, as `Lights::sample` takes it).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct LaneLight {
     corner: Vec3,
@@ -161,12 +159,12 @@ pub(super) struct LaneLight {
     /// `1 / area`.
     pdf_area: f64,
     radiance: Vec3,
-    sky: bool,
     point: bool,
 }
 
-/// The lights in lane form when every one is a parallelogram, a point or a sky of one colour
-/// (the lanes then sample them too).
+/// The lights samples choose among in lane form when every one is a parallelogram or a point
+/// (the lanes then sample them too; a sky of one colour is not among them for the path tracer,
+/// [`crate::lights::LightSampling::AgainstBsdf`], and where it is, `Lights::sample` samples it).
 pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
     let none = LaneLight {
         corner: Vec3::ZERO,
@@ -175,7 +173,6 @@ pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
         normal: Vec3::ZERO,
         pdf_area: 0.0,
         radiance: Vec3::ZERO,
-        sky: false,
         point: false,
     };
     let lane = |light: &PathLight| match *light {
@@ -187,7 +184,6 @@ pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
         PathLight::Point { position, intensity } => {
             Some(LaneLight { corner: position, radiance: intensity, point: true, ..none })
         }
-        PathLight::Background(Background::Solid(radiance)) => Some(LaneLight { radiance, sky: true, ..none }),
         _ => None,
     };
     lights.all()[..lights.choices()].iter().map(lane).collect::<Option<Vec<_>>>().filter(|all| !all.is_empty())
@@ -203,9 +199,6 @@ struct LightLanes {
     normal: Lanes3,
     pdf_area: Lanes,
     u: [Lanes; 2],
-    /// The lane samples the sky of one colour; `any_sky`: some light is that sky.
-    sky: [bool; LANES],
-    any_sky: bool,
     /// The lane samples a point light; `any_point`: some light is a point.
     point: [bool; LANES],
     any_point: bool,
@@ -265,16 +258,14 @@ struct Batches {
     all: Vec<Batch>,
     used: usize,
     open: [Option<usize>; MATERIAL_KERNELS.len()],
-    /// Whether some light is a sky of one colour or a point (see [`LightLanes::any_sky`],
-    /// [`LightLanes::any_point`]).
-    any_sky: bool,
+    /// Whether some light is a point (see [`LightLanes::any_point`]).
     any_point: bool,
 }
 
 impl Batches {
     /// Batches in the storage `all` (a thread's, kept from its last call: see [`SPARE_BATCHES`]).
-    fn reusing(all: Vec<Batch>, any_sky: bool, any_point: bool) -> Self {
-        Batches { all, used: 0, open: [None; MATERIAL_KERNELS.len()], any_sky, any_point }
+    fn reusing(all: Vec<Batch>, any_point: bool) -> Self {
+        Batches { all, used: 0, open: [None; MATERIAL_KERNELS.len()], any_point }
     }
 
     /// Empties every batch for the next bounce (their storage kept).
@@ -297,7 +288,7 @@ impl Batches {
             return (b, self.all[b].len - 1);
         }
         if self.used == self.all.len() {
-            let lights = LightLanes { any_sky: self.any_sky, any_point: self.any_point, ..LightLanes::default() };
+            let lights = LightLanes { any_point: self.any_point, ..LightLanes::default() };
             let (vertices, shaded) = (Vertices::default(), Shaded::default());
             self.all.push(Batch { kernel, coat, len: 0, vertices, lights, shaded });
         }
@@ -306,7 +297,7 @@ impl Batches {
         self.open[k] = Some(b);
         let batch = &mut self.all[b];
         (batch.kernel, batch.coat, batch.len) = (kernel, coat, 1);
-        (batch.lights.any_sky, batch.lights.any_point) = (self.any_sky, self.any_point);
+        batch.lights.any_point = self.any_point;
         // What a slot is not sure to overwrite: a stale bent normal would only cost the bump
         // kernel's work, a stale ask a light sample.
         batch.vertices.bumped = Flags::default();
@@ -636,7 +627,7 @@ impl PathTracer<'_> {
     /// turn, sample `first + i` of pixel `p` at `out[p × n + i]` (`n` samples per pixel).
     pub(super) fn pixels_in_lanes(&self, pixels: &[(u32, u32)], first: u32, out: &mut [Vec3]) {
         let any = |kind: fn(&LaneLight) -> bool| self.lane_lights.as_ref().is_some_and(|all| all.iter().any(kind));
-        let mut batches = Batches::reusing(SPARE_BATCHES.take(), any(|k| k.sky), any(|k| k.point));
+        let mut batches = Batches::reusing(SPARE_BATCHES.take(), any(|k| k.point));
         self.trace_in_lanes(pixels, first, out, &mut batches);
         SPARE_BATCHES.set(batches.all);
     }
@@ -957,7 +948,7 @@ impl PathTracer<'_> {
                 set(&mut lights.e2, i, k.e2);
                 set(&mut lights.normal, i, k.normal);
                 lights.pdf_area[i] = k.pdf_area;
-                (lights.sky[i], lights.point[i]) = (k.sky, k.point);
+                lights.point[i] = k.point;
                 (lights.u[0][i], lights.u[1][i]) = (u_light.x, u_light.y);
                 set(&mut v.light_radiance, i, k.radiance);
                 v.light.put(i, k.radiance != Vec3::ZERO);
@@ -1065,59 +1056,51 @@ fn finish_kernel(lane: &mut LanePath, mirrors: &KernelMirrors, s: &Shaded, clear
     s.alive.at(i)
 }
 
-/// Every lane's point on its parallelogram light, its point light's position or its direction
-/// to the sky, as `Lights::sample` computes them.
+/// Every lane's point on its parallelogram light or its point light's position, as
+/// `Lights::sample` computes them.
 fn sample_lights(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
-    match (k.any_sky, k.any_point) {
-        (false, false) => sample_lights_in::<false, false>(k, v, choice_pdf, unit),
-        (true, false) => sample_lights_in::<true, false>(k, v, choice_pdf, unit),
-        (false, true) => sample_lights_in::<false, true>(k, v, choice_pdf, unit),
-        (true, true) => sample_lights_in::<true, true>(k, v, choice_pdf, unit),
+    match k.any_point {
+        false => sample_lights_in::<false>(k, v, choice_pdf, unit),
+        true => sample_lights_in::<true>(k, v, choice_pdf, unit),
     }
 }
 
 #[allow(unsafe_code)]
-fn sample_lights_in<const SKY: bool, const POINT: bool>(
-    k: &LightLanes,
-    v: &mut Vertices,
-    choice_pdf: f64,
-    unit: VectorUnit,
-) {
+fn sample_lights_in<const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { sample_lights_avx512::<SKY, POINT>(k, v, choice_pdf) };
+        return unsafe { sample_lights_avx512::<POINT>(k, v, choice_pdf) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { sample_lights_avx2::<SKY, POINT>(k, v, choice_pdf) };
+        return unsafe { sample_lights_avx2::<POINT>(k, v, choice_pdf) };
     }
     let _ = unit;
-    (0..LANES).for_each(|i| sample_light::<SKY, POINT>(k, v, choice_pdf, i));
+    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, choice_pdf, i));
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn sample_lights_avx512<const SKY: bool, const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
-    (0..LANES).for_each(|i| sample_light::<SKY, POINT>(k, v, choice_pdf, i));
+unsafe fn sample_lights_avx512<const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
+    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, choice_pdf, i));
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn sample_lights_avx2<const SKY: bool, const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
-    (0..LANES).for_each(|i| sample_light::<SKY, POINT>(k, v, choice_pdf, i));
+unsafe fn sample_lights_avx2<const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
+    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, choice_pdf, i));
 }
 
-/// Lane `i`'s point on its parallelogram, as `lights::sample_area` computes it, or (`SKY`:
-/// some light is the sky, and this lane's is) its direction uniform over the sphere, or
-/// (`POINT`: some light is a point, and this lane's is) the point with its intensity over the
-/// squared distance, as `Lights::sample` draws them. All are computed and one kept, so the
-/// lanes do not branch.
+/// Lane `i`'s point on its parallelogram, as `lights::sample_area` computes it, or (`POINT`:
+/// some light is a point, and this lane's is) the point with its intensity over the squared
+/// distance, as `Lights::sample` draws them. Both are computed and one kept, so the lanes do
+/// not branch.
 #[inline(always)]
-fn sample_light<const SKY: bool, const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
+fn sample_light<const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
     let corner = get(&k.corner, i);
     let on_area = corner + get(&k.e1, i) * k.u[0][i] + get(&k.e2, i) * k.u[1][i];
     let q = if POINT && k.point[i] { corner } else { on_area };
@@ -1128,12 +1111,7 @@ fn sample_light<const SKY: bool, const POINT: bool>(k: &LightLanes, v: &mut Vert
     let cos = -get(&k.normal, i).dot(dir);
     let pdf = k.pdf_area[i] * d2 / cos * choice_pdf;
     let area_ok = dist != 0.0 && not_at_most_zero(cos) && not_at_most_zero(pdf);
-    if SKY && k.sky[i] {
-        let sky_pdf = 1.0 / (4.0 * std::f64::consts::PI) * choice_pdf;
-        v.light.put(i, v.light.at(i) && not_at_most_zero(sky_pdf));
-        set(&mut v.light_dir, i, crate::lights::uniform_sphere(Vec2::new(k.u[0][i], k.u[1][i])));
-        (v.light_dist[i], v.light_pdf[i]) = (f64::INFINITY, sky_pdf);
-    } else if POINT && k.point[i] {
+    if POINT && k.point[i] {
         // `Lights::sample`'s point: `dist` is `to.length()`, the radiance its intensity over
         // `dist · dist`, the density the choice's alone.
         let (radiance, pdf) = (get(&v.light_radiance, i) / (dist * dist), 1.0 * choice_pdf);
@@ -1872,9 +1850,18 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
     /// Every sample of every pixel, `(in lanes, per path)`, in full precision, with `unit`'s
     /// kernels.
     fn samples(scene: &alhazen_scene::Scene, unit: VectorUnit) -> (Vec<Vec3>, Vec<Vec3>) {
+        samples_with(scene, unit, crate::lights::LightSampling::AgainstBsdf)
+    }
+
+    /// [`samples`] with the lights sampled as `sampling` says.
+    fn samples_with(
+        scene: &alhazen_scene::Scene,
+        unit: VectorUnit,
+        sampling: crate::lights::LightSampling,
+    ) -> (Vec<Vec3>, Vec<Vec3>) {
         let world = World::build_with(scene, unit);
         let camera = Camera::new(&scene.camera, scene.render.width, scene.render.height);
-        let mut tracer = PathTracer::new(scene, &world, &camera);
+        let mut tracer = PathTracer::with_light_sampling(scene, &world, &camera, sampling);
         let mut all = [vec![], vec![]];
         for (in_lanes, out) in [true, false].into_iter().zip(&mut all) {
             tracer.in_lanes = in_lanes;
@@ -1949,7 +1936,8 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
                 *ior = alhazen_scene::bsdf::Ior::Constant(1.52);
             }
         }
-        // A sky of one colour beside parallelogram lights: the lanes sample it too.
+        // A sky of one colour beside parallelogram lights: left to BSDF samples (and, below,
+        // sampled among the lights, which the lanes leave to `Lights::sample`).
         let sky = alhazen_scene::Background::Solid(Vec3::new(0.3, 0.4, 0.5));
         let mut two_lights_and_sky = two_lights.clone();
         two_lights_and_sky.background = sky;
@@ -1998,7 +1986,7 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
             ("cornell-box through a lens", through_lens),
             ("cornell-box, cut out", cut),
             ("point lights, a parallelogram and a sky", points),
-            ("two lights and a sky", two_lights_and_sky),
+            ("two lights and a sky", two_lights_and_sky.clone()),
             ("cornell-rough and a sky", rough_under_sky),
             ("cornell-box", small("cornell-box", (20, 20, 11))),
             ("cornell-rough, glass of index 1.52", glass),
@@ -2025,6 +2013,15 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
                     }
                 }
             }
+        }
+        for unit in VectorUnit::available() {
+            let whole = crate::lights::LightSampling::Whole;
+            let (lanes, per_path) = samples_with(&two_lights_and_sky, unit, whole);
+            let same = lanes
+                .iter()
+                .zip(&per_path)
+                .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits));
+            assert!(same, "two lights and a sky sampled among them, {}: the lanes' samples differ", unit.name());
         }
     }
 
@@ -2155,7 +2152,7 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
             let plastic = |k: Kernel| matches!(k, Kernel::RoughPlastic | Kernel::BeckmannPlastic | Kernel::SmoothPlastic);
             let coat_of = |(k, c): (usize, usize)| plastic(MATERIAL_KERNELS[k]).then_some(coats[c]);
             let key = |(k, c): (usize, usize)| (k, if plastic(MATERIAL_KERNELS[k]) { c } else { 0 });
-            let mut batches = Batches::reusing(vec![], false, false);
+            let mut batches = Batches::reusing(vec![], false);
             for round in 0..2 {
                 batches.clear();
                 let mut taken = std::collections::HashSet::new();
