@@ -110,9 +110,9 @@ impl EnvMap {
             MapSampling::Whole => records(0.0),
             MapSampling::AboveMean => {
                 let mean = mean_luminance(image);
-                let above = records(mean);
+                let (texels, row_power, greatest) = records(mean);
                 // Nothing above the mean but by rounding (a map of one colour): sampled whole.
-                if above.2 > mean * (1.0 + 1e-6) { above } else { records(0.0) }
+                if greatest > mean * (1.0 + 1e-6) { (texels, row_power, greatest) } else { records(0.0) }
             }
         };
         let guided = (GUIDED_FROM..u16::MAX as usize).contains(&width);
@@ -448,8 +448,8 @@ mod tests {
     }
 
     /// Sampled above its mean, a map draws no direction where its interpolated luminance is
-    /// below the mean (its density there is zero), and all where it is above; a map of one
-    /// colour is sampled whole.
+    /// below the mean (its density there is zero), and its bright patch more often than sampled
+    /// whole; a map of one colour is sampled whole.
     #[test]
     fn above_its_mean_a_map_samples_its_bright_parts_only() {
         let (w, h) = (32u32, 16u32);

@@ -344,7 +344,7 @@ fn parallelogram(indices: &[[u32; 3]], corners: &[[Vec3; 3]]) -> Option<Emitter>
 
 /// The direction `u` picks uniformly on the unit sphere (a sky's light sample).
 #[inline(always)]
-pub(crate) fn uniform_sphere(u: Vec2) -> Vec3 {
+fn uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
     let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
@@ -607,28 +607,30 @@ impl Lights {
         asks: &[Option<LightAsk>; N],
         mut found: impl FnMut(usize, Option<LightSample>),
     ) {
-        // (A lane has a row only when a light was chosen: an environment map.)
-        let map = |ask: &LightAsk| match (ask.row, ask.row.map(|_| &self.lights[self.choose(ask.u_choice)])) {
-            (Some(row), Some(PathLight::Environment(m))) => Some((m.as_ref(), row)),
-            _ => None,
-        };
-        for ask in asks.iter().flatten() {
-            if let Some((m, row)) = map(ask) {
-                m.touch_texels(row, ask.u);
+        // (A lane has a row only where an environment map was chosen.)
+        let map = |ask: &LightAsk| {
+            let row = ask.row?;
+            match &self.lights[self.choose(ask.u_choice)] {
+                PathLight::Environment(m) => Some((m.as_ref(), row)),
+                _ => None,
             }
+        };
+        let maps: [Option<(&EnvMap, (f64, usize))>; N] = std::array::from_fn(|i| asks[i].as_ref().and_then(map));
+        for (ask, (m, row)) in asks.iter().zip(&maps).filter_map(|(a, m)| Some((a.as_ref()?, (*m)?))) {
+            m.touch_texels(row, ask.u);
         }
-        let texels: [Option<TexelSample>; N] = std::array::from_fn(|i| {
-            let ask = asks[i].as_ref()?;
-            map(ask).map(|(m, row)| m.sample_texel(row, ask.u))
+        let texels: [Option<(&EnvMap, TexelSample)>; N] = std::array::from_fn(|i| {
+            let ((m, row), ask) = (maps[i]?, asks[i].as_ref()?);
+            Some((m, m.sample_texel(row, ask.u)))
         });
         for (i, ask) in asks.iter().enumerate() {
             let Some(ask) = ask else { continue };
-            let sample = match (map(ask), texels[i]) {
-                (Some((m, _)), Some(texel)) => env_sample(m.sample_at(texel)).map(|mut s| {
+            let sample = match texels[i] {
+                Some((m, texel)) => env_sample(m.sample_at(texel)).map(|mut s| {
                     s.pdf *= self.choice_pdf();
                     s
                 }),
-                _ => self.sample(ask.p, ask.u_choice, ask.u),
+                None => self.sample(ask.p, ask.u_choice, ask.u),
             };
             found(i, sample);
         }

@@ -1853,6 +1853,12 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         samples_with(scene, unit, crate::lights::LightSampling::AgainstBsdf)
     }
 
+    /// Every sample the same, bit for bit.
+    fn same_bits(a: &[Vec3], b: &[Vec3]) -> bool {
+        a.len() == b.len()
+            && a.iter().zip(b).all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits))
+    }
+
     /// [`samples`] with the lights sampled as `sampling` says.
     fn samples_with(
         scene: &alhazen_scene::Scene,
@@ -2003,11 +2009,11 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
                 scene.render.max_depth = depth;
                 for unit in VectorUnit::available() {
                     let (lanes, per_path) = samples(&scene, unit);
-                    let same = lanes
-                        .iter()
-                        .zip(&per_path)
-                        .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits));
-                    assert!(same, "{name}, max_depth {depth}, {}: the lanes' samples differ", unit.name());
+                    assert!(
+                        same_bits(&lanes, &per_path),
+                        "{name}, max_depth {depth}, {}: the lanes' samples differ",
+                        unit.name()
+                    );
                     if depth > 2 {
                         assert!(lanes.iter().filter(|c| c.x > 0.0).count() > lanes.len() / 4, "{name}: lit");
                     }
@@ -2017,11 +2023,11 @@ material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0
         for unit in VectorUnit::available() {
             let whole = crate::lights::LightSampling::Whole;
             let (lanes, per_path) = samples_with(&two_lights_and_sky, unit, whole);
-            let same = lanes
-                .iter()
-                .zip(&per_path)
-                .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits));
-            assert!(same, "two lights and a sky sampled among them, {}: the lanes' samples differ", unit.name());
+            assert!(
+                same_bits(&lanes, &per_path),
+                "two lights and a sky sampled among them, {}: the lanes' samples differ",
+                unit.name()
+            );
         }
     }
 
