@@ -41,6 +41,11 @@ pub(crate) struct RenderArgs {
     /// The path tracer's sampler (overrides the scene).
     #[arg(long, value_enum)]
     sampler: Option<SamplerArg>,
+    /// How the path tracer's light samples choose among several lights (overrides the scene):
+    /// by the direct light a pilot pass measures each sending to what the camera sees, by
+    /// power, or uniformly. Every choice converges to the same image.
+    #[arg(long, value_enum)]
+    light_choice: Option<LightChoiceArg>,
     /// The pixel reconstruction filter, with its default parameters (overrides the scene's,
     /// e.g. the Gaussian an imported Mitsuba or pbrt scene gets when it names none): `box` is
     /// each sample anywhere in its own pixel.
@@ -127,6 +132,17 @@ enum SamplerArg {
     Independent,
 }
 
+/// `--light-choice`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum LightChoiceArg {
+    /// By the direct light each sends to what the camera sees (a pilot pass; the default).
+    Measured,
+    /// By power.
+    Power,
+    /// Every light equally often.
+    Uniform,
+}
+
 fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
     let r = &mut scene.render;
     r.spp = a.spp.unwrap_or(r.spp);
@@ -150,6 +166,13 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) {
         r.sampler = match s {
             SamplerArg::Sobol => alhazen_scene::SamplerKind::Sobol,
             SamplerArg::Independent => alhazen_scene::SamplerKind::Independent,
+        };
+    }
+    if let Some(c) = a.light_choice {
+        r.light_choice = match c {
+            LightChoiceArg::Measured => alhazen_scene::LightChoice::Measured,
+            LightChoiceArg::Power => alhazen_scene::LightChoice::Power,
+            LightChoiceArg::Uniform => alhazen_scene::LightChoice::Uniform,
         };
     }
 }

@@ -600,6 +600,19 @@ impl Importer {
                 let mut p = self.params(ctx, tokens, i)?;
                 let depth = self.float(ctx, &mut p, "maxdepth", 5.0)?;
                 self.scene.render.max_depth = (depth.max(0.0) as u32).saturating_add(1).min(1000);
+                // pbrt's light tree chooses lights by what they may send to each point; the
+                // measured choice is alhazen's nearest.
+                self.scene.render.light_choice = match self.string(ctx, &mut p, "lightsampler")?.as_deref() {
+                    None | Some("bvh") => alhazen_scene::LightChoice::Measured,
+                    Some("power") => alhazen_scene::LightChoice::Power,
+                    Some("uniform") => alhazen_scene::LightChoice::Uniform,
+                    Some(other) => {
+                        return Err(ctx.err(
+                            at,
+                            format!("unknown \"lightsampler\" \"{other}\": expected \"bvh\", \"power\" or \"uniform\""),
+                        ));
+                    }
+                };
                 if !matches!(kind.as_str(), "path" | "volpath") {
                     self.warn(ctx, &at, format!("integrator \"{kind}\" is rendered by alhazen's path tracer"));
                 }

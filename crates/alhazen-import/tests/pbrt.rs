@@ -251,10 +251,28 @@ fn malformed_files_are_located_errors() {
         ("Film \"rgb\" \"integer xresolution\" 100000", "xresolution must be"),
         ("WorldBegin\n\"oops\"", "a.pbrt:2:1: expected a directive"),
         ("WorldBegin\nShape \"sphere\" \"float radius\" 1e999", "not a finite number"),
+        ("Integrator \"path\" \"string lightsampler\" \"tree\"", "a.pbrt:1:1: unknown \"lightsampler\" \"tree\""),
     ];
     for (text, expected) in cases {
         let err = import(&[("a.pbrt", text)]).expect_err(expected);
         assert!(err.contains(expected), "expected {expected:?} in:\n{err}");
+    }
+}
+
+/// pbrt's light samplers: its light tree (the default) as alhazen's measured choice, power and
+/// uniform as they are.
+#[test]
+fn light_samplers_choose_lights_as_pbrt_names_them() {
+    use alhazen_scene::LightChoice;
+    for (sampler, choice) in [
+        ("", LightChoice::Measured),
+        (" \"string lightsampler\" \"bvh\"", LightChoice::Measured),
+        (" \"string lightsampler\" \"power\"", LightChoice::Power),
+        (" \"string lightsampler\" \"uniform\"", LightChoice::Uniform),
+    ] {
+        let s = import(&[("a.pbrt", &format!("Integrator \"path\"{sampler}\nWorldBegin\nShape \"sphere\""))]).unwrap();
+        assert_eq!(s.scene.render.light_choice, choice, "{sampler}");
+        assert!(!s.warnings.iter().any(|w| w.to_string().contains("lightsampler")), "{:?}", s.warnings);
     }
 }
 

@@ -37,6 +37,7 @@ pub mod connect;
 pub mod distribution;
 pub mod envmap;
 pub mod film;
+pub mod light_choice;
 pub mod lights;
 pub mod optics;
 pub mod output;

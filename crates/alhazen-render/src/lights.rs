@@ -1,8 +1,8 @@
 //! The path tracer's light sources: point, spot and directional lights (delta), area lights
 //! (any object whose material emits: spheres sampled by solid angle, rectangles, triangles —
 //! meshes, boxes — and disks by area), the environment map and a coloured background
-//! (uniformly over the sphere). Lights are chosen uniformly; every density here includes that
-//! choice. Emitters of other shapes still shine when paths hit them, without light sampling.
+//! (uniformly over the sphere). Lights are chosen by their power or uniformly
+//! ([`alhazen_scene::LightChoice`]); every density here includes that choice. Emitters of other shapes still shine when paths hit them, without light sampling.
 //! For the path tracer, whose light samples are weighed against BSDF samples, the sky is
 //! sampled only where BSDF samples do poorly ([`LightSampling::AgainstBsdf`], MIS
 //! compensation: Karlík et al. 2019).
@@ -13,7 +13,7 @@ use crate::distribution::Distribution1D;
 use crate::envmap::{EnvMap, MapSampling, TexelSample};
 use crate::shape::VectorUnit;
 use alhazen_math::{Vec2, Vec3, orthonormal_basis};
-use alhazen_scene::{Background, ImageData, Light, Scene, Shape, Texture};
+use alhazen_scene::{Background, ImageData, Light, LightChoice, Scene, Shape, Texture};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -221,6 +221,58 @@ pub struct Lights {
     /// The lights a sample chooses among: the first `choices` of `lights` (all but a sky of
     /// one colour or a gradient, last, under [`LightSampling::AgainstBsdf`]).
     choices: usize,
+    /// The probability of choosing each of the first `choices` lights and its running sum
+    /// (the last 1); both empty where every light is chosen equally often.
+    choice_pmf: Vec<f64>,
+    choice_cdf: Vec<f64>,
+}
+
+/// The share of the choice among lights in the scene that goes to them uniformly whatever
+/// their power (a defensive mixture: a dim lamp that lights what the camera sees still gets a
+/// tenth of its uniform share of samples beside a bright one that lights little of it).
+const UNIFORM_SHARE: f64 = 0.1;
+
+/// How often each of `lights` is chosen under [`LightChoice::Power`] (`None` for the other
+/// choices, and where that is equally often): lights in the scene by their power mixed with a uniform share ([`UNIFORM_SHARE`]); each
+/// light at infinity (directional, environment, sky), whose power grows with the scene's size,
+/// as often as all lights in the scene together (pbrt-v4's `BVHLightSampler` places them so).
+/// `area_density(i)` is light `i`'s density per unit area.
+fn choice_pmf(lights: &[PathLight], area_density: impl Fn(usize) -> f64, choice: LightChoice) -> Option<Vec<f64>> {
+    let powers: Vec<Option<f64>> = lights.iter().enumerate().map(|(i, l)| power(l, area_density(i))).collect();
+    let local = powers.iter().flatten().count();
+    let total: f64 = powers.iter().flatten().sum();
+    if choice != LightChoice::Power || local == 0 || !(total > 0.0 && total.is_finite()) {
+        return None;
+    }
+    let group = 1.0 / (lights.len() - local + 1) as f64;
+    let pmf: Vec<f64> = powers
+        .iter()
+        .map(|p| match p {
+            Some(p) => group * ((1.0 - UNIFORM_SHARE) * p / total + UNIFORM_SHARE / local as f64),
+            None => group,
+        })
+        .collect();
+    unless_uniform(pmf)
+}
+
+/// `pmf`, or `None` where it chooses every light equally often (so that the choice keeps its
+/// uniform arithmetic and its images their bits).
+pub(crate) fn unless_uniform(pmf: Vec<f64>) -> Option<Vec<f64>> {
+    let uniform = 1.0 / pmf.len() as f64;
+    (!pmf.iter().all(|p| (p - uniform).abs() <= 1e-12 * uniform)).then_some(pmf)
+}
+
+/// A light's power, its channels' mean (the flux it emits), for the choice among lights;
+/// `None` for a light at infinity. `area_density` is an area light's density per unit area.
+fn power(light: &PathLight, area_density: f64) -> Option<f64> {
+    let mean = |c: Vec3| c.element_sum().max(0.0) / 3.0;
+    match light {
+        PathLight::Point { intensity, .. } => Some(4.0 * PI * mean(*intensity)),
+        // Its cone's solid angle: an upper bound on a profile that falls off inside it.
+        PathLight::Spot { cos_cutoff, intensity, .. } => Some(2.0 * PI * (1.0 - cos_cutoff) * mean(*intensity)),
+        PathLight::Area { radiance, .. } => Some(PI * mean(*radiance) / area_density),
+        PathLight::Directional { .. } | PathLight::Environment(_) | PathLight::Background(_) => None,
+    }
 }
 
 /// What a scene's light samples are for.
@@ -411,7 +463,26 @@ impl Lights {
             choices -= 1;
         }
         let has_environment = lights.iter().any(|l| matches!(l, PathLight::Environment(_)));
-        Self { lights, by_object, sky, has_environment, choices }
+        let density = |i: usize| area_density(&lights[i]);
+        let pmf = choice_pmf(&lights[..choices], density, scene.render.light_choice);
+        let mut built = Self { lights, by_object, sky, has_environment, choices, ..Self::default() };
+        built.choose_by(pmf);
+        built
+    }
+
+    /// Chooses light `i` with probability `pmf[i]` (one for each of [`Self::choices`], summing
+    /// to 1), or every light equally often (`None`).
+    pub fn choose_by(&mut self, pmf: Option<Vec<f64>>) {
+        let pmf = pmf.unwrap_or_default();
+        assert!(pmf.is_empty() || pmf.len() == self.choices, "one probability per light chosen among");
+        self.choice_cdf = pmf
+            .iter()
+            .scan(0.0, |sum, p| {
+                *sum += p;
+                Some(*sum)
+            })
+            .collect();
+        self.choice_pmf = pmf;
     }
 
     /// Whether scene object `object` emits and is sampled as an area light ([`Self::of_object`]
@@ -436,23 +507,42 @@ impl Lights {
         self.choices
     }
 
-    /// Probability of choosing any one light.
-    pub fn choice_pdf(&self) -> f64 {
-        1.0 / self.choices as f64
+    /// Probability of choosing light `light` (one of the first [`Self::choices`]).
+    #[inline]
+    pub fn choice_pdf(&self, light: usize) -> f64 {
+        match self.choice_pmf.get(light) {
+            Some(p) => *p,
+            None => 1.0 / self.choices as f64,
+        }
     }
 
-    /// The light `u_choice` chooses (uniformly); there must be one ([`Self::choices`]).
+    /// The light `u_choice` chooses (by [`Self::choice_pdf`]); there must be one
+    /// ([`Self::choices`]).
     #[inline]
     pub fn choose(&self, u_choice: f64) -> usize {
         // In `u32`: x86-64 converts between `f64` and 32-bit integers in one instruction each,
         // and `usize` (unsigned 64-bit) in several; the light is the same (far fewer than 2³²).
         let n = u32::try_from(self.choices).unwrap_or(u32::MAX);
-        ((u_choice * f64::from(n)) as u32).min(n - 1) as usize
+        if self.choice_cdf.is_empty() {
+            return ((u_choice * f64::from(n)) as u32).min(n - 1) as usize;
+        }
+        self.choice_cdf.partition_point(|&c| c <= u_choice).min(n as usize - 1)
     }
 
-    /// The sky is a light that samples choose ([`Self::choices`]).
-    fn sky_sampled(&self) -> bool {
-        self.sky.is_some_and(|i| (i as usize) < self.choices)
+    /// The chosen light `u_choice` picks and the probability of that choice.
+    #[inline]
+    fn chosen(&self, u_choice: f64) -> (&PathLight, f64) {
+        let i = self.choose(u_choice);
+        (&self.lights[i], self.choice_pdf(i))
+    }
+
+    /// The probability that a light sample chooses the sky (0 where it is left out of the
+    /// choice, [`Self::choices`]).
+    fn sky_choice_pdf(&self) -> f64 {
+        match self.sky {
+            Some(i) if (i as usize) < self.choices => self.choice_pdf(i as usize),
+            _ => 0.0,
+        }
     }
 
     /// Radiance arriving from the sky along `-dir` (`dir` pointing away from the scene) and the
@@ -462,11 +552,9 @@ impl Lights {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => {
                 let (radiance, pdf) = m.radiance_and_pdf(dir);
-                (radiance, pdf * self.choice_pdf())
+                (radiance, pdf * self.sky_choice_pdf())
             }
-            Some(PathLight::Background(b)) => {
-                (b.radiance(dir), if self.sky_sampled() { self.choice_pdf() / (4.0 * PI) } else { 0.0 })
-            }
+            Some(PathLight::Background(b)) => (b.radiance(dir), self.sky_choice_pdf() / (4.0 * PI)),
             _ => (Vec3::ZERO, 0.0),
         }
     }
@@ -491,7 +579,7 @@ impl Lights {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => {
                 let (radiance, pdf) = m.radiance_and_pdf_at(dir, uv);
-                (radiance, pdf * self.choice_pdf())
+                (radiance, pdf * self.sky_choice_pdf())
             }
             _ => self.sky(dir),
         }
@@ -515,7 +603,7 @@ impl Lights {
             Emitter::Parallelogram { area, .. } => area_to_solid(1.0 / area),
             Emitter::Disk { radius, .. } => area_to_solid(1.0 / (PI * radius * radius)),
         };
-        pdf * self.choice_pdf()
+        pdf * self.choice_pdf(*i as usize)
     }
 
     /// Every light, in the order of their indices.
@@ -555,14 +643,7 @@ impl Lights {
 
     /// The area density of [`Self::point_by_area`] for area light `light`.
     pub fn area_density(&self, light: usize) -> f64 {
-        match &self.lights[light] {
-            PathLight::Area { emitter, .. } => match emitter {
-                Emitter::Sphere { radius, .. } => 1.0 / (4.0 * PI * radius * radius),
-                Emitter::Triangles { area, .. } | Emitter::Parallelogram { area, .. } => 1.0 / area,
-                Emitter::Disk { radius, .. } => 1.0 / (PI * radius * radius),
-            },
-            _ => 0.0,
-        }
+        area_density(&self.lights[light])
     }
 
     /// Chooses a light by `u_choice` and a point on it by `u`, as seen from `p`.
@@ -571,8 +652,9 @@ impl Lights {
         if self.choices == 0 {
             return None;
         }
-        let mut s = self.sample_one(&self.lights[self.choose(u_choice)], p, u)?;
-        s.pdf *= self.choice_pdf();
+        let (light, choice_pdf) = self.chosen(u_choice);
+        let mut s = self.sample_one(light, p, u)?;
+        s.pdf *= choice_pdf;
         Some(s)
     }
 
@@ -588,7 +670,7 @@ impl Lights {
     /// asked of memory, while the other paths are busy.
     #[inline]
     pub fn ask(&self, p: Vec3, u_choice: f64, u: Vec2) -> LightAsk {
-        let chosen = (self.choices > 0).then(|| &self.lights[self.choose(u_choice)]);
+        let chosen = (self.choices > 0).then(|| self.chosen(u_choice).0);
         let row = match chosen {
             Some(PathLight::Environment(m)) => Some(m.sample_row(u)),
             _ => None,
@@ -610,24 +692,26 @@ impl Lights {
         // (A lane has a row only where an environment map was chosen.)
         let map = |ask: &LightAsk| {
             let row = ask.row?;
-            match &self.lights[self.choose(ask.u_choice)] {
-                PathLight::Environment(m) => Some((m.as_ref(), row)),
+            match self.chosen(ask.u_choice) {
+                (PathLight::Environment(m), choice_pdf) => Some((m.as_ref(), row, choice_pdf)),
                 _ => None,
             }
         };
-        let maps: [Option<(&EnvMap, (f64, usize))>; N] = std::array::from_fn(|i| asks[i].as_ref().and_then(map));
-        for (ask, (m, row)) in asks.iter().zip(&maps).filter_map(|(a, m)| Some((a.as_ref()?, (*m)?))) {
+        // Each lane's map, the row its search found, and the map's choice probability.
+        type Chosen<'a> = Option<(&'a EnvMap, (f64, usize), f64)>;
+        let maps: [Chosen; N] = std::array::from_fn(|i| asks[i].as_ref().and_then(map));
+        for (ask, (m, row, _)) in asks.iter().zip(&maps).filter_map(|(a, m)| Some((a.as_ref()?, (*m)?))) {
             m.touch_texels(row, ask.u);
         }
-        let texels: [Option<(&EnvMap, TexelSample)>; N] = std::array::from_fn(|i| {
-            let ((m, row), ask) = (maps[i]?, asks[i].as_ref()?);
-            Some((m, m.sample_texel(row, ask.u)))
+        let texels: [Option<(&EnvMap, TexelSample, f64)>; N] = std::array::from_fn(|i| {
+            let ((m, row, choice_pdf), ask) = (maps[i]?, asks[i].as_ref()?);
+            Some((m, m.sample_texel(row, ask.u), choice_pdf))
         });
         for (i, ask) in asks.iter().enumerate() {
             let Some(ask) = ask else { continue };
             let sample = match texels[i] {
-                Some((m, texel)) => env_sample(m.sample_at(texel)).map(|mut s| {
-                    s.pdf *= self.choice_pdf();
+                Some((m, texel, choice_pdf)) => env_sample(m.sample_at(texel)).map(|mut s| {
+                    s.pdf *= choice_pdf;
                     s
                 }),
                 None => self.sample(ask.p, ask.u_choice, ask.u),
@@ -672,6 +756,19 @@ impl Lights {
             }
             PathLight::Area { emitter, radiance, texture } => sample_area(emitter, *radiance, texture.as_deref(), p, u),
         }
+    }
+}
+
+/// An area light's density per unit area when its points are drawn by area (0 for other
+/// lights).
+fn area_density(light: &PathLight) -> f64 {
+    match light {
+        PathLight::Area { emitter, .. } => match emitter {
+            Emitter::Sphere { radius, .. } => 1.0 / (4.0 * PI * radius * radius),
+            Emitter::Triangles { area, .. } | Emitter::Parallelogram { area, .. } => 1.0 / area,
+            Emitter::Disk { radius, .. } => 1.0 / (PI * radius * radius),
+        },
+        _ => 0.0,
     }
 }
 

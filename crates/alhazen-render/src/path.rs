@@ -247,7 +247,10 @@ impl<'a> PathTracer<'a> {
                 untextured.then(|| bsdf_at(m, Vec2::ZERO, Vec3::ONE, &scene.images, ColorMode::Rgb))
             })
             .collect();
-        let lights = Lights::build_for(scene, sampling);
+        let mut lights = Lights::build_for(scene, sampling);
+        if scene.render.light_choice == alhazen_scene::LightChoice::Measured {
+            lights.choose_by(crate::light_choice::measured_pmf(scene, world, camera, &lights));
+        }
         let mirrors = scene
             .render
             .mirror_connections

@@ -59,6 +59,22 @@ pub enum SamplerKind {
     Sobol,
 }
 
+/// How the path tracer's light samples choose among the scene's lights (pbrt-v4's
+/// `lightsampler`). Any choice gives every image the same expectation; they differ in noise.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightChoice {
+    /// Every light equally often (Mitsuba 3's choice without sampling weights).
+    Uniform,
+    /// Lights in the scene by their power, mixed with a uniform share; lights at infinity
+    /// (directional, environment, a sampled sky) each as often as all the others together,
+    /// as pbrt-v4 places them beside its light tree.
+    Power,
+    /// Lights by the direct light a pilot pass measures each sending to the surfaces the
+    /// camera sees (shadows included: a lamp behind a wall is seldom chosen), mixed with a
+    /// uniform share.
+    Measured,
+}
+
 /// Image size and sampling.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -76,6 +92,8 @@ pub struct RenderSettings {
     pub integrator: IntegratorKind,
     /// The path tracer's sampler.
     pub sampler: SamplerKind,
+    /// How the path tracer's light samples choose a light.
+    pub light_choice: LightChoice,
     /// Join lights to non-specular points through sphere, cylinder and plane mirrors exactly
     /// (specular connections, both ray tracers).
     pub mirror_connections: bool,
@@ -93,6 +111,7 @@ impl Default for RenderSettings {
             seed: 0,
             integrator: IntegratorKind::Whitted,
             sampler: SamplerKind::Sobol,
+            light_choice: LightChoice::Measured,
             mirror_connections: true,
             filter: PixelFilter::PIXEL,
         }

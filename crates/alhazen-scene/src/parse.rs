@@ -736,6 +736,7 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
         "seed",
         "integrator",
         "sampler",
+        "light_choice",
         "mirror_connections",
         "filter",
     ])?;
@@ -761,6 +762,14 @@ fn render_settings(n: &Node) -> R<RenderSettings> {
                 _ => SamplerKind::Independent,
             },
             None => d.sampler,
+        },
+        light_choice: match t.get("light_choice") {
+            Some(i) => match i.choice(&["measured", "power", "uniform"])? {
+                "uniform" => LightChoice::Uniform,
+                "power" => LightChoice::Power,
+                _ => LightChoice::Measured,
+            },
+            None => d.light_choice,
         },
         mirror_connections: t.opt_bool("mirror_connections", d.mirror_connections)?,
         filter: t.get("filter").map_or(Ok(d.filter), |n| pixel_filter(&n))?,

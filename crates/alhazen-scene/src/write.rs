@@ -182,6 +182,11 @@ impl Writer<'_> {
             SamplerKind::Independent => "independent",
         };
         self.line("sampler", string(sampler));
+        match r.light_choice {
+            LightChoice::Measured => {}
+            LightChoice::Power => self.line("light_choice", string("power")),
+            LightChoice::Uniform => self.line("light_choice", string("uniform")),
+        }
         if !r.mirror_connections {
             self.line("mirror_connections", "false".to_string());
         }

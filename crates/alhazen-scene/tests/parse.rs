@@ -88,6 +88,7 @@ fn mistakes_are_located_and_explained() {
     );
     assert!(err("[[object]]\nshape = \"curve\"\npoints = [[0, 0, 0]]\n").contains("at least 2 control points"));
     assert!(err("[[object]]\nshape = \"subdivision\"\nbase = \"cuboid\"\n").contains("did you mean \"cube\"?"));
+    assert!(err("[render]\nlight_choice = \"measure\"\n").contains("did you mean \"measured\"?"));
     assert!(
         err("[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 9\n")
             .contains("`levels` must be an integer in 0..=6")
@@ -163,6 +164,7 @@ fn physically_based_materials_are_read() {
 [render]
 integrator = "path"
 sampler = "independent"
+light_choice = "power"
 [materials.gold]
 bsdf = { type = "conductor", metal = "gold", roughness = [0.1, 0.3], distribution = "beckmann" }
 [materials.prism]
@@ -178,6 +180,7 @@ material = "lamp"
     let s = parse_scene("pbr.toml".as_ref(), text).unwrap();
     assert_eq!(s.render.integrator, alhazen_scene::IntegratorKind::Path);
     assert_eq!(s.render.sampler, alhazen_scene::SamplerKind::Independent);
+    assert_eq!(s.render.light_choice, alhazen_scene::LightChoice::Power);
     let mat = |name: &str| s.materials.iter().find(|m| m.name == name).unwrap();
     let Some(BsdfDesc::Conductor { facets: Some(f), .. }) = &mat("gold").bsdf else { panic!() };
     assert_eq!(

@@ -198,6 +198,8 @@ struct LightLanes {
     e2: Lanes3,
     normal: Lanes3,
     pdf_area: Lanes,
+    /// The probability of the lane's light's choice among the lights.
+    choice_pdf: Lanes,
     u: [Lanes; 2],
     /// The lane samples a point light; `any_point`: some light is a point.
     point: [bool; LANES],
@@ -744,7 +746,7 @@ impl PathTracer<'_> {
             // Each material kernel's batches: their lights sampled, their vertices shaded.
             for b in &mut batches.all[..batches.used] {
                 if self.lane_lights.is_some() {
-                    sample_lights(&b.lights, &mut b.vertices, self.lights.choice_pdf(), unit);
+                    sample_lights(&b.lights, &mut b.vertices, unit);
                 } else if self.lights.has_environment() {
                     let v = &mut b.vertices;
                     self.lights.sample_lanes(&b.lights.asks, |i, sample| set_light(v, i, sample));
@@ -942,7 +944,9 @@ impl PathTracer<'_> {
         match &self.lane_lights {
             _ if kernel.is_delta() => v.light.put(i, false),
             Some(all) => {
-                let k = &all[self.lights.choose(choice)];
+                let chosen = self.lights.choose(choice);
+                let k = &all[chosen];
+                lights.choice_pdf[i] = self.lights.choice_pdf(chosen);
                 set(&mut lights.corner, i, k.corner);
                 set(&mut lights.e1, i, k.e1);
                 set(&mut lights.e2, i, k.e2);
@@ -1058,41 +1062,41 @@ fn finish_kernel(lane: &mut LanePath, mirrors: &KernelMirrors, s: &Shaded, clear
 
 /// Every lane's point on its parallelogram light or its point light's position, as
 /// `Lights::sample` computes them.
-fn sample_lights(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
+fn sample_lights(k: &LightLanes, v: &mut Vertices, unit: VectorUnit) {
     match k.any_point {
-        false => sample_lights_in::<false>(k, v, choice_pdf, unit),
-        true => sample_lights_in::<true>(k, v, choice_pdf, unit),
+        false => sample_lights_in::<false>(k, v, unit),
+        true => sample_lights_in::<true>(k, v, unit),
     }
 }
 
 #[allow(unsafe_code)]
-fn sample_lights_in<const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, unit: VectorUnit) {
+fn sample_lights_in<const POINT: bool>(k: &LightLanes, v: &mut Vertices, unit: VectorUnit) {
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { sample_lights_avx512::<POINT>(k, v, choice_pdf) };
+        return unsafe { sample_lights_avx512::<POINT>(k, v) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { sample_lights_avx2::<POINT>(k, v, choice_pdf) };
+        return unsafe { sample_lights_avx2::<POINT>(k, v) };
     }
     let _ = unit;
-    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, choice_pdf, i));
+    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, i));
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn sample_lights_avx512<const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
-    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, choice_pdf, i));
+unsafe fn sample_lights_avx512<const POINT: bool>(k: &LightLanes, v: &mut Vertices) {
+    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, i));
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn sample_lights_avx2<const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64) {
-    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, choice_pdf, i));
+unsafe fn sample_lights_avx2<const POINT: bool>(k: &LightLanes, v: &mut Vertices) {
+    (0..LANES).for_each(|i| sample_light::<POINT>(k, v, i));
 }
 
 /// Lane `i`'s point on its parallelogram, as `lights::sample_area` computes it, or (`POINT`:
@@ -1100,7 +1104,8 @@ unsafe fn sample_lights_avx2<const POINT: bool>(k: &LightLanes, v: &mut Vertices
 /// distance, as `Lights::sample` draws them. Both are computed and one kept, so the lanes do
 /// not branch.
 #[inline(always)]
-fn sample_light<const POINT: bool>(k: &LightLanes, v: &mut Vertices, choice_pdf: f64, i: usize) {
+fn sample_light<const POINT: bool>(k: &LightLanes, v: &mut Vertices, i: usize) {
+    let choice_pdf = k.choice_pdf[i];
     let corner = get(&k.corner, i);
     let on_area = corner + get(&k.e1, i) * k.u[0][i] + get(&k.e2, i) * k.u[1][i];
     let q = if POINT && k.point[i] { corner } else { on_area };

@@ -1,12 +1,13 @@
 //! Light samples left to BSDF samples where those do well ([`LightSampling::AgainstBsdf`]) give
 //! every image the expectation light samples everywhere ([`LightSampling::Whole`]) give: every
 //! kind of BSDF, under a gradient sky (left to BSDF samples alone) and under an environment map
-//! with a sun (sampled only above its mean), beside a lamp (and a point light).
+//! with a sun (sampled only above its mean), beside a lamp (and a point light). So does every
+//! choice among several lights ([`LightChoice`]).
 
 use super::{LightSampling, PathTracer};
 use crate::{Camera, World};
 use alhazen_math::Vec3;
-use alhazen_scene::{ImageData, Light, Scene};
+use alhazen_scene::{ImageData, Light, LightChoice, Scene};
 
 /// Twelve spheres in a 4 × 3 grid, one per kind of BSDF, on a grey ground, and a lamp.
 const SPHERES: &str = r#"
@@ -172,5 +173,47 @@ fn against_bsdf_samples_a_gradient_sky_is_not_chosen() {
     assert!(matches!(against.all()[lamp], PathLight::Area { .. }) && lamp < against.choices());
     for u in [0.0, 0.5, 0.999] {
         assert_eq!(against.choose(u), lamp);
+    }
+}
+
+/// Lights chosen uniformly, by power and as a pilot pass measures them light every BSDF alike:
+/// beside the lamp and a sun map, a bright point light, a spot, a directional light, and a
+/// strong point light under the ground, which lights nothing the camera sees.
+#[test]
+fn every_light_choice_lights_every_bsdf_alike() {
+    let mut scene = alhazen_scene::parse_scene("spheres.toml".as_ref(), SPHERES).unwrap();
+    scene.images.push(sun_map().into());
+    let image = scene.images.len() - 1;
+    let point = |position: Vec3, intensity: f64| Light::Point {
+        position,
+        intensity: Vec3::splat(intensity),
+        attenuation: [1.0, 0.0, 0.0],
+    };
+    scene.lights.extend([
+        Light::Environment { image, scale: 0.2, rotation: 0.3, up: Vec3::Y },
+        point(Vec3::new(2.0, 4.0, 3.0), 3.0),
+        point(Vec3::new(0.0, -3.0, 0.0), 3000.0),
+        Light::Spot {
+            position: Vec3::new(-3.0, 4.0, 2.0),
+            direction: Vec3::new(0.5, -0.6, -0.6).normalize(),
+            cos_cutoff: 0.9,
+            falloff: 1.0,
+            beam: None,
+            intensity: Vec3::splat(5.0),
+            attenuation: [1.0, 0.0, 0.0],
+        },
+        Light::Directional { direction: Vec3::new(0.3, -1.0, -0.4).normalize(), intensity: Vec3::splat(0.2) },
+    ]);
+    let means = |choice| {
+        let mut scene = scene.clone();
+        scene.render.light_choice = choice;
+        block_means(&scene, LightSampling::AgainstBsdf)
+    };
+    let uniform = means(LightChoice::Uniform);
+    for choice in [LightChoice::Power, LightChoice::Measured] {
+        for (i, (a, b)) in uniform.iter().zip(&means(choice)).enumerate() {
+            let difference = (*a - *b).abs().max_element() / a.max_element().max(1e-3);
+            assert!(difference < 0.03, "{choice:?}, block {i}: uniform {a}, {b} ({:.2} %)", 100.0 * difference);
+        }
     }
 }

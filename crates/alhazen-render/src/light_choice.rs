@@ -1,0 +1,281 @@
+//! How often the path tracer's light samples choose each light, measured
+//! ([`alhazen_scene::LightChoice::Measured`]): a pilot pass follows camera rays through a grid
+//! over the film to the surfaces they meet and there draws one point of every light, shadow ray
+//! and all, so each light's share of the direct light on what the camera sees is known before
+//! the first sample. Lights are then chosen in proportion to it, mixed with a uniform share —
+//! choosing lights by an estimate of their contribution is Shirley, Wang and Zimmerman's
+//! (1996, "Monte Carlo techniques for direct lighting calculations", §4); the uniform share is
+//! Hesterberg's defensive mixture, so a light the pilot saw little of (one that lights only
+//! what mirrors or later bounces show) keeps samples; with thousands of lights the pilot's
+//! points per light are fewer and that share grows. A lamp behind a wall, which power alone
+//! would choose most, is chosen least.
+//!
+//! The pass is a pure function of the scene and camera (its own fixed numbers, not the
+//! render's seed): every band, pass and checkpoint of one image chooses alike.
+
+use crate::bsdf::{ColorMode, bsdf_at};
+use crate::camera::Camera;
+use crate::lights::{Lights, unless_uniform};
+use crate::path::shadow_segment;
+use crate::sampler::Rng;
+use crate::world::World;
+use alhazen_math::{Vec2, Vec3};
+use alhazen_scene::Scene;
+use rayon::prelude::*;
+
+/// The share of the choice that goes to every light equally, whatever the pilot measured…
+const UNIFORM_SHARE: f64 = 0.1;
+/// …where the pilot has at least this many points; with fewer (thousands of lights), each
+/// light's measure is noisier and the uniform share grows in proportion, to all at none.
+const TRUSTED_POINTS: u32 = 256;
+/// The pilot's grid is at most this many points along each side of the film…
+const GRID: u32 = 64;
+/// …and its shadow rays at most this many in all (fewer points for many lights).
+const SHADOW_RAYS: u64 = 1 << 18;
+/// The pilot's numbers (any fixed seed).
+const PILOT_SEED: u64 = 0x6c69_6768_7473;
+
+/// How often to choose each of `lights`' [`Lights::choices`], by the direct light each sends to
+/// the surfaces `camera` sees in `world` (of `scene`); `None` where that is equally often,
+/// where there is no choice to make, or where the pilot saw no light at all.
+pub fn measured_pmf(scene: &Scene, world: &World, camera: &Camera, lights: &Lights) -> Option<Vec<f64>> {
+    let n = lights.choices();
+    if n < 2 {
+        return None;
+    }
+    let (columns, rows) = grid(camera, n);
+    // Light reaches a surface that lets it through (glass, a translucent sheet) from either side.
+    let through: Vec<bool> = (scene.materials.iter())
+        .map(|m| bsdf_at(m, Vec2::ZERO, Vec3::ONE, &scene.images, ColorMode::Rgb).transmits())
+        .collect();
+    let pilot = Pilot { world, camera, lights, through: &through, grid: (columns, rows) };
+    let per_row: Vec<Vec<f64>> = (0..rows).into_par_iter().map(|y| pilot.row(y)).collect();
+    let mut sent = vec![0.0; n];
+    for row in &per_row {
+        sent.iter_mut().zip(row).for_each(|(s, r)| *s += r);
+    }
+    let total: f64 = sent.iter().sum();
+    if !(total > 0.0 && total.is_finite()) {
+        return None;
+    }
+    let trust = (1.0 - UNIFORM_SHARE) * (columns * rows).min(TRUSTED_POINTS) as f64 / TRUSTED_POINTS as f64;
+    unless_uniform(sent.iter().map(|s| trust * s / total + (1.0 - trust) / n as f64).collect())
+}
+
+/// The pilot grid's columns and rows for `lights` lights: at most [`GRID`] a side, no more
+/// than the film's pixels, and within [`SHADOW_RAYS`].
+fn grid(camera: &Camera, lights: usize) -> (u32, u32) {
+    let points = (SHADOW_RAYS / lights as u64).clamp(16, (GRID * GRID) as u64);
+    let side = (points as f64).sqrt() as u32;
+    (side.min(camera.film_width).max(1), side.min(camera.film_height).max(1))
+}
+
+/// The pilot pass over `grid` (columns, rows) of the film; `through[m]`: material `m` lets
+/// light through.
+struct Pilot<'a> {
+    world: &'a World,
+    camera: &'a Camera,
+    lights: &'a Lights,
+    through: &'a [bool],
+    grid: (u32, u32),
+}
+
+impl Pilot<'_> {
+    /// Row `y` of the grid: what each light sends to the points its cells' camera rays meet
+    /// (irradiance on the side the camera sees — either side where the surface lets light
+    /// through —, shadowed), summed.
+    fn row(&self, y: u32) -> Vec<f64> {
+        let Pilot { world, camera, lights, through, grid: (columns, rows) } = *self;
+        let mut sent = vec![0.0; lights.choices()];
+        let (w, h) = (camera.film_width as f64, camera.film_height as f64);
+        for x in 0..columns {
+            let mut rng = Rng::for_sample(PILOT_SEED, x, y, 0);
+            let fx = (x as f64 + rng.uniform()) * w / columns as f64;
+            let fy = (y as f64 + rng.uniform()) * h / rows as f64;
+            let column = (fx as u32).min(camera.film_width - 1);
+            let ray = camera.pixel_ray(column, fx, fy);
+            let Some(hit) = world.intersect(&ray, f64::INFINITY) else { continue };
+            let (p, n) = (hit.hit.p, hit.hit.n);
+            let seen = if n.dot(ray.dir) < 0.0 { n } else { -n };
+            let both_sides = through[hit.material as usize];
+            for (light, s) in sent.iter_mut().enumerate() {
+                let u = Vec2::new(rng.uniform(), rng.uniform());
+                let Some(ls) = lights.sample_light(light, p, u) else { continue };
+                let cos = if both_sides { seen.dot(ls.dir).abs() } else { seen.dot(ls.dir) };
+                let irradiance = ls.radiance.element_sum() / 3.0 * cos / ls.pdf;
+                if !(cos > 0.0 && irradiance > 0.0 && irradiance.is_finite()) {
+                    continue;
+                }
+                let (origin, dir, dist) = shadow_segment(p, seen, ls.dir, ls.dist, p);
+                if world.unoccluded(origin, dir, dist) {
+                    *s += irradiance;
+                }
+            }
+        }
+        sent
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alhazen_scene::{LightChoice, parse_scene};
+
+    /// A floor seen from the front, a wall behind it, and `lights` (TOML): a lamp above the
+    /// floor and whatever else.
+    fn room(lights: &str) -> alhazen_scene::Scene {
+        room_seen_from("eye = [0, 1.5, 5]\ntarget = [0, 0.5, 0]", lights)
+    }
+
+    /// [`room`] seen by the camera `camera` (TOML).
+    fn room_seen_from(camera: &str, lights: &str) -> alhazen_scene::Scene {
+        let text = format!(
+            r#"
+[render]
+width = 64
+height = 48
+integrator = "path"
+[camera]
+{camera}
+fov = 50
+[[object]]
+shape = "plane"
+normal = [0, 1, 0]
+material = {{ color = 0.5 }}
+[[object]]
+shape = "box"
+min = [-50, -1, -2]
+max = [50, 20, -1.5]
+material = {{ color = 0.5 }}
+[[object]]
+shape = "rectangle"
+transform = [{{ scale = [0.5, 0.5, 1] }}, {{ rotate_x = 90 }}, {{ translate = [0, 2.5, 0] }}]
+material = {{ color = 0, emission = [4, 4, 4] }}
+{lights}
+"#
+        );
+        parse_scene("room.toml".as_ref(), &text).unwrap()
+    }
+
+    fn measured(scene: &alhazen_scene::Scene) -> (Lights, Option<Vec<f64>>) {
+        let world = World::build(scene);
+        let camera = Camera::new(&scene.camera, scene.render.width, scene.render.height);
+        let lights = Lights::build_for(scene, crate::lights::LightSampling::AgainstBsdf);
+        let pmf = measured_pmf(scene, &world, &camera, &lights);
+        (lights, pmf)
+    }
+
+    /// A point light a thousand times the lamp's power behind the wall gets the uniform share
+    /// alone; the lamp, which lights the floor, the rest. Choosing by power, the hidden light
+    /// takes nearly every sample.
+    #[test]
+    fn a_light_behind_a_wall_gets_the_uniform_share_alone() {
+        let mut scene = room("[[light]]\ntype = \"point\"\nposition = [0, 3, -4]\nintensity = 4000");
+        let (lights, pmf) = measured(&scene);
+        let pmf = pmf.unwrap();
+        let (lamp, hidden) = (lights.of_object(2).unwrap(), 0);
+        assert_eq!(lights.choices(), 2);
+        assert!((pmf[hidden] - UNIFORM_SHARE / 2.0).abs() < 1e-15, "{pmf:?}");
+        assert!((pmf[lamp] - (1.0 - UNIFORM_SHARE / 2.0)).abs() < 1e-15, "{pmf:?}");
+        scene.render.light_choice = LightChoice::Power;
+        let by_power = Lights::build_for(&scene, crate::lights::LightSampling::AgainstBsdf);
+        assert!(by_power.choice_pdf(hidden) > 0.9, "{}", by_power.choice_pdf(hidden));
+    }
+
+    /// Two lights lighting the floor alike share the choice alike; a weaker one gets less.
+    #[test]
+    fn lights_are_chosen_as_often_as_they_light_what_the_camera_sees() {
+        let point = |x: f64, i: f64| format!("[[light]]\ntype = \"point\"\nposition = [{x}, 2, 1]\nintensity = {i}\n");
+        let (lights, pmf) = measured(&room(&(point(-1.0, 3.0) + &point(1.0, 3.0) + &point(0.0, 0.3))));
+        let pmf = pmf.unwrap();
+        assert_eq!(lights.choices(), 4);
+        assert!((pmf[0] - pmf[1]).abs() < 0.1 * pmf[0], "{pmf:?}");
+        assert!(pmf[2] < 0.3 * pmf[0], "{pmf:?}");
+        assert!((pmf.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+
+    /// With thousands of lights the pilot has fewer points, each light's measure is noisier,
+    /// and more of the choice is shared equally: half the lights, behind the wall, still get
+    /// more than half their uniform share.
+    #[test]
+    fn with_many_lights_the_uniform_share_grows() {
+        let light = |k: usize| {
+            let z = if k.is_multiple_of(2) { -4.0 } else { 1.0 };
+            format!("[[light]]\ntype = \"point\"\nposition = [{}, 2, {z}]\nintensity = 0.01\n", k as f64 * 0.001)
+        };
+        let (lights, pmf) = measured(&room(&(0..2000).map(light).collect::<String>()));
+        let (pmf, n) = (pmf.unwrap(), lights.choices() as f64);
+        assert_eq!(n, 2001.0);
+        let least = pmf.iter().cloned().fold(f64::INFINITY, f64::min);
+        assert!(least * n > 0.5 && least * n < 0.7, "{}", least * n);
+    }
+
+    /// Nothing to choose: one light, or none seen (the camera looks at the sky).
+    #[test]
+    fn without_a_choice_or_a_light_seen_every_light_is_chosen_alike() {
+        assert_eq!(measured(&room("")).1, None);
+        let up = "eye = [0, 30, 0]\ntarget = [0, 60, 0]\nup = [0, 0, 1]";
+        assert_eq!(measured(&room_seen_from(up, "[[light]]\ntype = \"point\"\nposition = [0, 3, -4]")).1, None);
+    }
+
+    proptest::proptest! {
+        /// Where a light sample lands, a ray meeting that light reckons the density the sample
+        /// was drawn with — the light's choice included — (the MIS weights' invariant), for
+        /// lights chosen by power: two lamps and a lit sphere of different powers, a point light
+        /// and a sky.
+        #[test]
+        fn a_light_sample_and_a_ray_reaching_it_agree_on_its_density(
+            u_choice in 0.0..1.0f64, u in (0.0..1.0f64, 0.0..1.0f64), (x, z) in (-2.0..2.0f64, -1.0..2.0f64),
+        ) {
+            let mut scene = room(
+                "[[object]]\nshape = \"rectangle\"\ntransform = [{ scale = [2, 1, 1] }, { rotate_x = 60 }, { translate = [1, 3, 1] }]\n\
+                 material = { color = 0, emission = [0.3, 0.3, 0.3] }\n\
+                 [[object]]\nshape = \"sphere\"\ncenter = [-1.5, 1.5, 0]\nradius = 0.2\nmaterial = { color = 0, emission = [40, 30, 20] }\n\
+                 [[light]]\ntype = \"point\"\nposition = [0, 2, 1]\nintensity = 2\n",
+            );
+            scene.background = alhazen_scene::Background::Solid(alhazen_math::Vec3::splat(0.2));
+            scene.render.light_choice = LightChoice::Power;
+            let lights = Lights::build(&scene);
+            proptest::prop_assert_eq!(lights.choices(), 5);
+            proptest::prop_assert!((0..5).map(|i| lights.choice_pdf(i)).any(|p| (p - 0.2).abs() > 0.01));
+            let p = alhazen_math::Vec3::new(x, 0.0, z);
+            let ls = lights.sample(p, u_choice, alhazen_math::Vec2::new(u.0, u.1));
+            proptest::prop_assume!(ls.is_some());
+            let ls = ls.unwrap();
+            let light = lights.choose(u_choice);
+            let objects = lights.objects();
+            let reckoned = match (objects[light], &lights.all()[light]) {
+                (Some(object), crate::lights::PathLight::Area { emitter, .. }) => {
+                    let n = match emitter {
+                        crate::lights::Emitter::Parallelogram { normal, .. } => *normal,
+                        _ => (p + ls.dir * ls.dist - emitter.centre()).normalize(),
+                    };
+                    lights.area_pdf(object, p, p + ls.dir * ls.dist, n)
+                }
+                (_, crate::lights::PathLight::Background(_)) => lights.sky(ls.dir).1,
+                _ => lights.choice_pdf(light),
+            };
+            proptest::prop_assert!((reckoned - ls.pdf).abs() <= 1e-9 * ls.pdf, "light {light}: sampled {}, reckoned {reckoned}", ls.pdf);
+        }
+
+        /// A light is chosen as often as its probability says: over `n` evenly spread numbers,
+        /// each light within one of `n · p` times.
+        #[test]
+        fn lights_are_chosen_by_their_probabilities(weights in proptest::collection::vec(0.01..10.0f64, 2..12)) {
+            let scene = room(&"[[light]]\ntype = \"point\"\nposition = [0, 2, 1]\n".repeat(weights.len() - 1));
+            let mut lights = Lights::build(&scene);
+            let total: f64 = weights.iter().sum();
+            let pmf: Vec<f64> = weights.iter().map(|w| w / total).collect();
+            lights.choose_by(Some(pmf.clone()));
+            let n = 10_000;
+            let mut counts = vec![0usize; pmf.len()];
+            for k in 0..n {
+                counts[lights.choose((k as f64 + 0.5) / n as f64)] += 1;
+            }
+            for (i, (c, p)) in counts.iter().zip(&pmf).enumerate() {
+                proptest::prop_assert!((*c as f64 - n as f64 * p).abs() <= 1.0, "light {i}: {c} of {n}, p {p}");
+                proptest::prop_assert_eq!(lights.choice_pdf(i), *p);
+            }
+        }
+    }
+}
