@@ -15,7 +15,7 @@
 
 use crate::bsdf::{ColorMode, bsdf_at};
 use crate::camera::Camera;
-use crate::lights::{Lights, unless_uniform};
+use crate::lights::{Lights, UNIFORM_SHARE, unless_uniform};
 use crate::path::shadow_segment;
 use crate::sampler::Rng;
 use crate::world::World;
@@ -23,10 +23,9 @@ use alhazen_math::{Vec2, Vec3};
 use alhazen_scene::Scene;
 use rayon::prelude::*;
 
-/// The share of the choice that goes to every light equally, whatever the pilot measured…
-const UNIFORM_SHARE: f64 = 0.1;
-/// …where the pilot has at least this many points; with fewer (thousands of lights), each
-/// light's measure is noisier and the uniform share grows in proportion, to all at none.
+/// The pilot's measures weigh all the choice but [`UNIFORM_SHARE`] where it has at least this
+/// many points; with fewer (thousands of lights), each light's measure is noisier and their
+/// weight shrinks in proportion, to none at none.
 const TRUSTED_POINTS: u32 = 256;
 /// The pilot's grid is at most this many points along each side of the film…
 const GRID: u32 = 64;

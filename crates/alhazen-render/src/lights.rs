@@ -1,8 +1,10 @@
 //! The path tracer's light sources: point, spot and directional lights (delta), area lights
 //! (any object whose material emits: spheres sampled by solid angle, rectangles, triangles —
 //! meshes, boxes — and disks by area), the environment map and a coloured background
-//! (uniformly over the sphere). Lights are chosen by their power or uniformly
-//! ([`alhazen_scene::LightChoice`]); every density here includes that choice. Emitters of other shapes still shine when paths hit them, without light sampling.
+//! (uniformly over the sphere). Lights are chosen uniformly, by their power, or as a pilot pass
+//! measures them ([`alhazen_scene::LightChoice`], [`crate::light_choice`]); every density here
+//! includes that choice. Emitters of other shapes still shine when paths hit them, without
+//! light sampling.
 //! For the path tracer, whose light samples are weighed against BSDF samples, the sky is
 //! sampled only where BSDF samples do poorly ([`LightSampling::AgainstBsdf`], MIS
 //! compensation: Karlík et al. 2019).
@@ -227,14 +229,14 @@ pub struct Lights {
     choice_cdf: Vec<f64>,
 }
 
-/// The share of the choice among lights in the scene that goes to them uniformly whatever
-/// their power (a defensive mixture: a dim lamp that lights what the camera sees still gets a
+/// The share of a choice among lights by power or by measure that goes to every light
+/// equally (a defensive mixture: a dim lamp that lights what the camera sees still gets a
 /// tenth of its uniform share of samples beside a bright one that lights little of it).
-const UNIFORM_SHARE: f64 = 0.1;
+pub(crate) const UNIFORM_SHARE: f64 = 0.1;
 
 /// How often each of `lights` is chosen under [`LightChoice::Power`] (`None` for the other
-/// choices, and where that is equally often): lights in the scene by their power mixed with a uniform share ([`UNIFORM_SHARE`]); each
-/// light at infinity (directional, environment, sky), whose power grows with the scene's size,
+/// choices, and where that is equally often): lights in the scene by their power mixed with a
+/// uniform share ([`UNIFORM_SHARE`]); each light at infinity (directional, environment, sky), whose power grows with the scene's size,
 /// as often as all lights in the scene together (pbrt-v4's `BVHLightSampler` places them so).
 /// `area_density(i)` is light `i`'s density per unit area.
 fn choice_pmf(lights: &[PathLight], area_density: impl Fn(usize) -> f64, choice: LightChoice) -> Option<Vec<f64>> {
