@@ -15,7 +15,7 @@ exe=${ALHAZEN:-target/release/alhazen}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 if [ $# = 0 ]; then
-    set -- scenes/*.toml scenes/mitsuba/*.xml scenes/pbrt/*.pbrt bench/mitsuba/suite/*.xml \
+    set -- scenes/*.toml scenes/mitsuba/*.xml scenes/pbrt/*.pbrt bench/mitsuba/suite/*.xml bench/lights/*.xml \
         crates/alhazen-import/tests/data/blender/*.glb
 fi
 n=0 different=0

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Issue 18's benchmark suite: alhazen's path tracer against Mitsuba 3 on eight scenes (the six of the issue, and two of several lights), each a
+"""Issue 18's benchmark suite: alhazen's path tracer against Mitsuba 3 on nine scenes (the six of the issue, and three of several lights), each a
 Mitsuba XML file that both renderers read as it is (so the twins are one file).
 
     python3 bench/mitsuba/suite/make_data.py           # textures, sky, meshes (once)
@@ -49,9 +49,10 @@ SCENES = {
     "envmap": os.path.join(SUITE, "envmap.xml"),
     "million": os.path.join(SUITE, "million.xml"),
     # Several lights (session 57): powers a thousandfold apart, the strongest lighting what is
-    # seen, or behind a wall.
+    # seen, or behind a wall; six equal lamps along a corridor, each lighting its own stretch.
     "five-lamps": os.path.join(ROOT, "bench/lights/five-lamps.xml"),
     "hidden-lamp": os.path.join(ROOT, "bench/lights/hidden-lamp.xml"),
+    "corridor": os.path.join(ROOT, "bench/lights/corridor.xml"),
 }
 EXE = os.environ.get("ALHAZEN", os.path.join(ROOT, "target/release/alhazen"))
 # Each renderer with its default sampler: alhazen's Sobol points (the files ask for Mitsuba's

@@ -223,10 +223,87 @@ pub struct Lights {
     /// The lights a sample chooses among: the first `choices` of `lights` (all but a sky of
     /// one colour or a gradient, last, under [`LightSampling::AgainstBsdf`]).
     choices: usize,
-    /// The probability of choosing each of the first `choices` lights and its running sum
-    /// (the last 1); both empty where every light is chosen equally often.
-    choice_pmf: Vec<f64>,
-    choice_cdf: Vec<f64>,
+    /// How often each of the first `choices` lights is chosen, where that is not equally
+    /// often.
+    choice: Option<ChoiceTable>,
+}
+
+/// How often a light sample chooses each of `n` lights: everywhere alike, or cell by cell of a
+/// grid over the scene, by the cell of the point the light is sampled from (a light that
+/// lights one corner of a room is chosen there). Any such table gives every image the same
+/// expectation, as long as the choice at a point and its density there are read from the same
+/// cell.
+#[derive(Clone, Debug)]
+pub struct ChoiceTable {
+    /// The probabilities, `n` for each cell in turn, and their running sums within each cell.
+    pmf: Vec<f64>,
+    cdf: Vec<f64>,
+    n: usize,
+    cells: Cells,
+}
+
+/// A grid of boxes: its lower corner, its cells per unit length along each axis and its cells
+/// along each axis; a point beyond the grid (or NaN) takes the nearest cell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cells {
+    /// Lower corner.
+    pub min: Vec3,
+    /// Cells per unit length along each axis.
+    pub scale: Vec3,
+    /// Cells along each axis (at least one).
+    pub res: [u32; 3],
+}
+
+impl Cells {
+    /// One cell holding everything.
+    pub const ONE: Cells = Cells { min: Vec3::ZERO, scale: Vec3::ZERO, res: [1, 1, 1] };
+
+    /// How many cells.
+    pub fn count(&self) -> usize {
+        self.res.iter().map(|&r| r as usize).product()
+    }
+
+    /// The cell of point `at` (`x` fastest).
+    #[inline]
+    pub fn index(&self, at: Vec3) -> usize {
+        if self.res == [1, 1, 1] {
+            return 0;
+        }
+        let f = (at - self.min) * self.scale;
+        // `max` takes NaN to 0; the conversion saturates.
+        let c = |x: f64, r: u32| (x.max(0.0) as u32).min(r - 1) as usize;
+        let [rx, ry, _] = self.res.map(|r| r as usize);
+        (c(f.z, self.res[2]) * ry + c(f.y, self.res[1])) * rx + c(f.x, self.res[0])
+    }
+}
+
+impl ChoiceTable {
+    /// `pmf` (summing to 1) everywhere.
+    pub fn everywhere(pmf: Vec<f64>) -> Self {
+        Self::in_cells(pmf, Cells::ONE)
+    }
+
+    /// `pmfs`, one probability per light for each of `cells` in turn (each summing to 1).
+    pub fn in_cells(pmfs: Vec<f64>, cells: Cells) -> Self {
+        assert!(pmfs.len().is_multiple_of(cells.count()), "one probability per light in each cell");
+        let n = pmfs.len() / cells.count();
+        let cdf = pmfs
+            .chunks(n)
+            .flat_map(|cell| {
+                cell.iter().scan(0.0, |sum, p| {
+                    *sum += p;
+                    Some(*sum)
+                })
+            })
+            .collect();
+        Self { pmf: pmfs, cdf, n, cells }
+    }
+
+    /// The first of the `n` entries of the cell of point `at`.
+    #[inline]
+    fn cell(&self, at: Vec3) -> usize {
+        self.cells.index(at) * self.n
+    }
 }
 
 /// The share of a choice among lights by power or by measure that goes to every light
@@ -466,25 +543,15 @@ impl Lights {
         }
         let has_environment = lights.iter().any(|l| matches!(l, PathLight::Environment(_)));
         let density = |i: usize| area_density(&lights[i]);
-        let pmf = choice_pmf(&lights[..choices], density, scene.render.light_choice);
-        let mut built = Self { lights, by_object, sky, has_environment, choices, ..Self::default() };
-        built.choose_by(pmf);
-        built
+        let choice = choice_pmf(&lights[..choices], density, scene.render.light_choice).map(ChoiceTable::everywhere);
+        Self { lights, by_object, sky, has_environment, choices, choice }
     }
 
-    /// Chooses light `i` with probability `pmf[i]` (one for each of [`Self::choices`], summing
-    /// to 1), or every light equally often (`None`).
-    pub fn choose_by(&mut self, pmf: Option<Vec<f64>>) {
-        let pmf = pmf.unwrap_or_default();
-        assert!(pmf.is_empty() || pmf.len() == self.choices, "one probability per light chosen among");
-        self.choice_cdf = pmf
-            .iter()
-            .scan(0.0, |sum, p| {
-                *sum += p;
-                Some(*sum)
-            })
-            .collect();
-        self.choice_pmf = pmf;
+    /// Chooses lights as `table` says (one probability per light of [`Self::choices`] in each
+    /// of its cells), or every light equally often (`None`).
+    pub fn choose_by(&mut self, table: Option<ChoiceTable>) {
+        assert!(table.as_ref().is_none_or(|t| t.n == self.choices), "one probability per light chosen among");
+        self.choice = table;
     }
 
     /// Whether scene object `object` emits and is sampled as an area light ([`Self::of_object`]
@@ -509,54 +576,58 @@ impl Lights {
         self.choices
     }
 
-    /// Probability of choosing light `light` (one of the first [`Self::choices`]).
+    /// Probability of choosing light `light` (one of the first [`Self::choices`]) for a
+    /// sample drawn from point `at`.
     #[inline]
-    pub fn choice_pdf(&self, light: usize) -> f64 {
-        match self.choice_pmf.get(light) {
-            Some(p) => *p,
+    pub fn choice_pdf(&self, light: usize, at: Vec3) -> f64 {
+        match &self.choice {
+            Some(t) => t.pmf[t.cell(at) + light],
             None => 1.0 / self.choices as f64,
         }
     }
 
-    /// The light `u_choice` chooses (by [`Self::choice_pdf`]); there must be one
-    /// ([`Self::choices`]).
+    /// The light `u_choice` chooses (by [`Self::choice_pdf`]) for a sample drawn from point
+    /// `at`; there must be one ([`Self::choices`]).
     #[inline]
-    pub fn choose(&self, u_choice: f64) -> usize {
+    pub fn choose(&self, u_choice: f64, at: Vec3) -> usize {
         // In `u32`: x86-64 converts between `f64` and 32-bit integers in one instruction each,
         // and `usize` (unsigned 64-bit) in several; the light is the same (far fewer than 2³²).
         let n = u32::try_from(self.choices).unwrap_or(u32::MAX);
-        if self.choice_cdf.is_empty() {
-            return ((u_choice * f64::from(n)) as u32).min(n - 1) as usize;
+        match &self.choice {
+            None => ((u_choice * f64::from(n)) as u32).min(n - 1) as usize,
+            Some(t) => {
+                let cell = t.cell(at);
+                t.cdf[cell..cell + t.n].partition_point(|&c| c <= u_choice).min(t.n - 1)
+            }
         }
-        self.choice_cdf.partition_point(|&c| c <= u_choice).min(n as usize - 1)
     }
 
-    /// The chosen light `u_choice` picks and the probability of that choice.
+    /// The light `u_choice` picks from `at` and the probability of that choice.
     #[inline]
-    fn chosen(&self, u_choice: f64) -> (&PathLight, f64) {
-        let i = self.choose(u_choice);
-        (&self.lights[i], self.choice_pdf(i))
+    fn chosen(&self, u_choice: f64, at: Vec3) -> (&PathLight, f64) {
+        let i = self.choose(u_choice, at);
+        (&self.lights[i], self.choice_pdf(i, at))
     }
 
-    /// The probability that a light sample chooses the sky (0 where it is left out of the
-    /// choice, [`Self::choices`]).
-    fn sky_choice_pdf(&self) -> f64 {
+    /// The probability that a light sample drawn from `at` chooses the sky (0 where it is left
+    /// out of the choice, [`Self::choices`]).
+    fn sky_choice_pdf(&self, at: Vec3) -> f64 {
         match self.sky {
-            Some(i) if (i as usize) < self.choices => self.choice_pdf(i as usize),
+            Some(i) if (i as usize) < self.choices => self.choice_pdf(i as usize, at),
             _ => 0.0,
         }
     }
 
     /// Radiance arriving from the sky along `-dir` (`dir` pointing away from the scene) and the
-    /// density of sampling `dir` among the lights (an environment map's direction is mapped to
-    /// its image once).
-    pub fn sky(&self, dir: Vec3) -> (Vec3, f64) {
+    /// density of sampling `dir` among the lights from point `from` (an environment map's
+    /// direction is mapped to its image once).
+    pub fn sky(&self, dir: Vec3, from: Vec3) -> (Vec3, f64) {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => {
                 let (radiance, pdf) = m.radiance_and_pdf(dir);
-                (radiance, pdf * self.sky_choice_pdf())
+                (radiance, pdf * self.sky_choice_pdf(from))
             }
-            Some(PathLight::Background(b)) => (b.radiance(dir), self.sky_choice_pdf() / (4.0 * PI)),
+            Some(PathLight::Background(b)) => (b.radiance(dir), self.sky_choice_pdf(from) / (4.0 * PI)),
             _ => (Vec3::ZERO, 0.0),
         }
     }
@@ -577,13 +648,13 @@ impl Lights {
     }
 
     /// [`Self::sky`] of `dir`, whose place in the map [`Self::sky_ahead`] found.
-    pub fn sky_at(&self, dir: Vec3, uv: Vec2) -> (Vec3, f64) {
+    pub fn sky_at(&self, dir: Vec3, uv: Vec2, from: Vec3) -> (Vec3, f64) {
         match self.sky.map(|i| &self.lights[i as usize]) {
             Some(PathLight::Environment(m)) => {
                 let (radiance, pdf) = m.radiance_and_pdf_at(dir, uv);
-                (radiance, pdf * self.sky_choice_pdf())
+                (radiance, pdf * self.sky_choice_pdf(from))
             }
-            _ => self.sky(dir),
+            _ => self.sky(dir, from),
         }
     }
 
@@ -605,7 +676,7 @@ impl Lights {
             Emitter::Parallelogram { area, .. } => area_to_solid(1.0 / area),
             Emitter::Disk { radius, .. } => area_to_solid(1.0 / (PI * radius * radius)),
         };
-        pdf * self.choice_pdf(*i as usize)
+        pdf * self.choice_pdf(*i as usize, p)
     }
 
     /// Every light, in the order of their indices.
@@ -654,7 +725,7 @@ impl Lights {
         if self.choices == 0 {
             return None;
         }
-        let (light, choice_pdf) = self.chosen(u_choice);
+        let (light, choice_pdf) = self.chosen(u_choice, p);
         let mut s = self.sample_one(light, p, u)?;
         s.pdf *= choice_pdf;
         Some(s)
@@ -672,7 +743,7 @@ impl Lights {
     /// asked of memory, while the other paths are busy.
     #[inline]
     pub fn ask(&self, p: Vec3, u_choice: f64, u: Vec2) -> LightAsk {
-        let chosen = (self.choices > 0).then(|| self.chosen(u_choice).0);
+        let chosen = (self.choices > 0).then(|| self.chosen(u_choice, p).0);
         let row = match chosen {
             Some(PathLight::Environment(m)) => Some(m.sample_row(u)),
             _ => None,
@@ -694,7 +765,7 @@ impl Lights {
         // (A lane has a row only where an environment map was chosen.)
         let map = |ask: &LightAsk| {
             let row = ask.row?;
-            match self.chosen(ask.u_choice) {
+            match self.chosen(ask.u_choice, ask.p) {
                 (PathLight::Environment(m), choice_pdf) => Some((m.as_ref(), row, choice_pdf)),
                 _ => None,
             }

@@ -249,7 +249,7 @@ impl<'a> PathTracer<'a> {
             .collect();
         let mut lights = Lights::build_for(scene, sampling);
         if scene.render.light_choice == alhazen_scene::LightChoice::Measured {
-            lights.choose_by(crate::light_choice::measured_pmf(scene, world, camera, &lights));
+            lights.choose_by(crate::light_choice::measured_choice(scene, world, camera, &lights));
         }
         let mirrors = scene
             .render
@@ -416,7 +416,7 @@ impl<'a> PathTracer<'a> {
     /// the glossy scene.
     #[inline(always)]
     fn escaped_inline(&self, ray: &Ray, prev: &Previous, beta: Vec3, mode: ColorMode) -> Option<Vec3> {
-        self.escaped_from(self.lights.sky(ray.dir), prev, beta, mode)
+        self.escaped_from(self.lights.sky(ray.dir, prev.p), prev, beta, mode)
     }
 
     /// [`Self::escaped`] with the sky's radiance and density along the ray looked up

@@ -773,7 +773,8 @@ impl PathTracer<'_> {
             for (p, lane) in lanes.iter_mut().enumerate().filter(|(_, l)| l.live) {
                 let (g, i) = (p / LANES, p % LANES);
                 if let (Some(dir), Some(texels)) = (escaping[p], &sky_texels) {
-                    let (path, sky) = (&mut lane.path, self.lights.sky_at(dir, texels[p]));
+                    let sky = self.lights.sky_at(dir, texels[p], lane.path.prev.p);
+                    let path = &mut lane.path;
                     path.l += self.escaped_from(sky, &path.prev, path.beta, lane.mode).unwrap_or(Vec3::ZERO);
                 }
                 let open = !tested[g][i] || clear[g][i];
@@ -944,9 +945,9 @@ impl PathTracer<'_> {
         match &self.lane_lights {
             _ if kernel.is_delta() => v.light.put(i, false),
             Some(all) => {
-                let chosen = self.lights.choose(choice);
+                let chosen = self.lights.choose(choice, h.p);
                 let k = &all[chosen];
-                lights.choice_pdf[i] = self.lights.choice_pdf(chosen);
+                lights.choice_pdf[i] = self.lights.choice_pdf(chosen, h.p);
                 set(&mut lights.corner, i, k.corner);
                 set(&mut lights.e1, i, k.e1);
                 set(&mut lights.e2, i, k.e2);

@@ -167,12 +167,12 @@ fn against_bsdf_samples_a_gradient_sky_is_not_chosen() {
     let (whole, against) = (Lights::build(&scene), Lights::build_for(&scene, LightSampling::AgainstBsdf));
     assert_eq!((whole.len(), whole.choices()), (2, 2));
     assert_eq!((against.len(), against.choices()), (2, 1));
-    assert!(whole.sky(Vec3::Y).1 > 0.0);
-    assert_eq!(against.sky(Vec3::Y), (whole.sky(Vec3::Y).0, 0.0));
+    assert!(whole.sky(Vec3::Y, Vec3::ZERO).1 > 0.0);
+    assert_eq!(against.sky(Vec3::Y, Vec3::ZERO), (whole.sky(Vec3::Y, Vec3::ZERO).0, 0.0));
     let lamp = against.of_object(1).unwrap();
     assert!(matches!(against.all()[lamp], PathLight::Area { .. }) && lamp < against.choices());
     for u in [0.0, 0.5, 0.999] {
-        assert_eq!(against.choose(u), lamp);
+        assert_eq!(against.choose(u, Vec3::ZERO), lamp);
     }
 }
 
