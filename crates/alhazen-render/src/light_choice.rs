@@ -2,9 +2,14 @@
 //! ([`alhazen_scene::LightChoice::Measured`]): a pilot pass follows camera rays through a grid
 //! over the film to the surfaces they meet and there draws one point of every light, shadow ray
 //! and all, so each light's share of the direct light on what the camera sees is known before
-//! the first sample. Lights are then chosen in proportion to it, mixed with a uniform share —
-//! choosing lights by an estimate of their contribution is Shirley, Wang and Zimmerman's
-//! (1996, "Monte Carlo techniques for direct lighting calculations", §4); the uniform share is
+//! the first sample. The measures are summed cell by cell of a grid over those surfaces, and a
+//! light sample drawn from a point chooses lights in proportion to its cell's sums (blended
+//! with the whole image's where the cell holds few points), so the lamp overhead is chosen in
+//! its stretch of a corridor and the next lamp in the next — in spirit the spatial light
+//! choice of Cycles' and pbrt-v4's light trees, measured rather than bounded, shadows
+//! included —, mixed with a uniform share. Choosing lights by an estimate of their
+//! contribution is Shirley, Wang and Zimmerman's (1996, "Monte Carlo techniques for direct
+//! lighting calculations", §4); the uniform share is
 //! Hesterberg's defensive mixture, so a light the pilot saw little of (one that lights only
 //! what mirrors or later bounces show) keeps samples; with thousands of lights the pilot's
 //! points per light are fewer and that share grows. A lamp behind a wall, which power alone
