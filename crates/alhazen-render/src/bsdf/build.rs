@@ -315,7 +315,7 @@ pub fn tangent_at(m: &Material, hit: &crate::shape::SurfaceHit, images: &[Arc<Im
     match &m.bsdf {
         Some(BsdfDesc::BlinnPhong { scratches, .. }) => Some(*scratches),
         Some(BsdfDesc::MetallicRoughness { anisotropy, anisotropy_map, .. })
-            if anisotropy.is_anisotropic() && dpdu != Vec3::ZERO =>
+            if dpdu != Vec3::ZERO && anisotropy.is_anisotropic() =>
         {
             let rotation = match anisotropy_map {
                 Some(map) => anisotropy.at_texel(texture::eval(map, hit.uv, images)).rotation,
@@ -323,7 +323,9 @@ pub fn tangent_at(m: &Material, hit: &crate::shape::SurfaceHit, images: &[Arc<Im
             };
             Some(turned_tangent(hit.dpduv, hit.n, rotation))
         }
-        Some(desc) if desc.is_anisotropic() && dpdu != Vec3::ZERO => Some(dpdu),
+        // `dpdu` first: it is zero wherever the world computed no tangents (no anisotropic
+        // material), and the walk down the description costs more.
+        Some(desc) if dpdu != Vec3::ZERO && desc.is_anisotropic() => Some(dpdu),
         _ => None,
     }
 }
