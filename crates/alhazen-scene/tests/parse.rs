@@ -1146,3 +1146,19 @@ fn coats_read_write_back_and_refuse_nonsense() {
         assert!(e.contains("s.toml:2") && e.contains(says), "{bsdf}: {e}");
     }
 }
+
+/// Every light choice survives being written back out (the default, `measured`, unwritten).
+#[test]
+fn light_choices_survive_the_round_trip() {
+    use alhazen_scene::LightChoice;
+    let dir = tempfile::tempdir().unwrap();
+    for (name, choice) in
+        [("measured", LightChoice::Measured), ("power", LightChoice::Power), ("uniform", LightChoice::Uniform)]
+    {
+        let s = parse_scene("c.toml".as_ref(), &format!("[render]\nlight_choice = \"{name}\"\n")).unwrap();
+        assert_eq!(s.render.light_choice, choice);
+        let path = dir.path().join("again.toml");
+        alhazen_scene::write::write_scene(&s, &path, &dir.path().join("assets"), "").unwrap();
+        assert_eq!(load_scene(&path).unwrap().render.light_choice, choice, "{name}");
+    }
+}
