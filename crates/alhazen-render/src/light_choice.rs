@@ -9,11 +9,10 @@
 //! choice of Cycles' and pbrt-v4's light trees, measured rather than bounded, shadows
 //! included —, mixed with a uniform share. Choosing lights by an estimate of their
 //! contribution is Shirley, Wang and Zimmerman's (1996, "Monte Carlo techniques for direct
-//! lighting calculations", §4); the uniform share is
-//! Hesterberg's defensive mixture, so a light the pilot saw little of (one that lights only
-//! what mirrors or later bounces show) keeps samples; with thousands of lights the pilot's
-//! points per light are fewer and that share grows. A lamp behind a wall, which power alone
-//! would choose most, is chosen least.
+//! lighting calculations", §4); the uniform share is Hesterberg's defensive mixture, so a
+//! light the pilot saw little of (one that lights only what mirrors or later bounces show)
+//! keeps samples; with thousands of lights the pilot's points per light are fewer and that
+//! share grows. A lamp behind a wall, which power alone would choose most, is chosen least.
 //!
 //! The pass is a pure function of the scene and camera (its own fixed numbers, not the
 //! render's seed): every band, pass and checkpoint of one image chooses alike.
