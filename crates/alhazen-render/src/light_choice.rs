@@ -38,8 +38,10 @@ const PRIOR: f64 = 4.0;
 const CELLS_ALONG: u32 = 8;
 /// …and, on average, at least this many points per cell…
 const POINTS_PER_CELL: f64 = 8.0;
-/// …and at most this many probabilities in the table (cells × lights).
+/// …and at most this many probabilities in the table (cells × lights); the grid spans the
+/// points but this share of the outermost at each end of each axis.
 const TABLE_ENTRIES: usize = 1 << 20;
+const OUTLIERS: f64 = 0.02;
 /// The pilot's grid is at most this many points along each side of the film…
 const GRID: u32 = 64;
 /// …and its shadow rays at most this many in all (fewer points for many lights).
@@ -96,7 +98,18 @@ pub fn measured_choice(scene: &Scene, world: &World, camera: &Camera, lights: &L
 /// it), as many along the others as keeps cells near cubes, and at most [`TABLE_ENTRIES`]
 /// probabilities in all for `n` lights; one cell where the points are few or all in one place.
 fn cells_of(measures: &[Measure], n: usize) -> Cells {
-    let (lo, hi) = measures.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), m| (lo.min(m.p), hi.max(m.p)));
+    // The box of all but the outermost points along each axis: a ground plane met near the
+    // horizon would stretch the whole box and coarsen the cells near the camera (points
+    // beyond the box take the nearest cell).
+    let within = |axis: usize, q: f64| {
+        let mut at: Vec<f64> = measures.iter().map(|m| m.p[axis]).collect();
+        at.sort_by(f64::total_cmp);
+        at.get(((at.len().max(1) - 1) as f64 * q).round() as usize).copied().unwrap_or(0.0)
+    };
+    let (lo, hi) = (
+        Vec3::from_array(std::array::from_fn(|a| within(a, OUTLIERS))),
+        Vec3::from_array(std::array::from_fn(|a| within(a, 1.0 - OUTLIERS))),
+    );
     let extent = hi - lo;
     let longest = extent.max_element();
     let by_points = (measures.len() as f64 / POINTS_PER_CELL).cbrt();
@@ -286,6 +299,22 @@ material = {{ color = 0, emission = [4, 4, 4] }}
         assert!(left[0] > 0.6 && right[1] > 0.6, "{left:?} {right:?}");
         let middle = pmf(&lights, Vec3::new(0.0, 0.0, 0.5));
         assert!((middle[0] - middle[1]).abs() < 0.1, "{middle:?}");
+    }
+
+    /// The same seen low over a ground plane to its horizon, whose far points would stretch a
+    /// grid over all points: near the camera each lamp is still chosen most at its own end.
+    #[test]
+    fn far_ground_does_not_coarsen_the_cells_near_the_camera() {
+        let point = |x: f64| format!("[[light]]\ntype = \"point\"\nposition = [{x}, 0.4, 3]\nintensity = 2\n");
+        let text = format!(
+            "[render]\nwidth = 64\nheight = 48\nintegrator = \"path\"\n[camera]\neye = [0, 1, 6]\ntarget = [0, 0.8, 0]\nfov = 60\n\
+             [[object]]\nshape = \"plane\"\nnormal = [0, 1, 0]\nmaterial = {{ color = 0.5 }}\n{}{}",
+            point(-1.5),
+            point(1.5)
+        );
+        let (lights, _) = measured(&parse_scene("far.toml".as_ref(), &text).unwrap());
+        let (left, right) = (pmf(&lights, Vec3::new(-1.5, 0.0, 3.0)), pmf(&lights, Vec3::new(1.5, 0.0, 3.0)));
+        assert!(left[0] > 0.6 && right[1] > 0.6, "{left:?} {right:?}");
     }
 
     /// With thousands of lights the pilot has fewer points, each light's measure is noisier,
