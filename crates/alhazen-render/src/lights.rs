@@ -305,9 +305,8 @@ impl ChoiceTable {
         self.cells.index(at) * self.n
     }
 
-    /// The light `u_choice` chooses from `at`.
-    fn choose(&self, u_choice: f64, at: Vec3) -> usize {
-        let cell = self.cell(at);
+    /// The light `u_choice` chooses in the cell whose entries start at `cell`.
+    fn choose_in(&self, cell: usize, u_choice: f64) -> usize {
         self.cdf[cell..cell + self.n].partition_point(|&c| c <= u_choice).min(self.n - 1)
     }
 }
@@ -317,16 +316,16 @@ impl ChoiceTable {
 /// tenth of its uniform share of samples beside a bright one that lights little of it).
 pub(crate) const UNIFORM_SHARE: f64 = 0.1;
 
-/// How often each of `lights` is chosen under [`LightChoice::Power`] (`None` for the other
-/// choices, and where that is equally often): lights in the scene by their power mixed with a
-/// uniform share ([`UNIFORM_SHARE`]); each light at infinity (directional, environment, sky), whose power grows with the scene's size,
-/// as often as all lights in the scene together (pbrt-v4's `BVHLightSampler` places them so).
-/// `area_density(i)` is light `i`'s density per unit area.
-fn choice_pmf(lights: &[PathLight], area_density: impl Fn(usize) -> f64, choice: LightChoice) -> Option<Vec<f64>> {
-    let powers: Vec<Option<f64>> = lights.iter().enumerate().map(|(i, l)| power(l, area_density(i))).collect();
+/// How often each of `lights` is chosen under [`LightChoice::Power`] (`None` where that is
+/// equally often): lights in the scene by their power mixed with a uniform share
+/// ([`UNIFORM_SHARE`]); each light at infinity (directional, environment, sky), whose power
+/// grows with the scene's size, as often as all lights in the scene together (pbrt-v4's
+/// `BVHLightSampler` places them so).
+fn power_pmf(lights: &[PathLight]) -> Option<Vec<f64>> {
+    let powers: Vec<Option<f64>> = lights.iter().map(power).collect();
     let local = powers.iter().flatten().count();
     let total: f64 = powers.iter().flatten().sum();
-    if choice != LightChoice::Power || local == 0 || !(total > 0.0 && total.is_finite()) {
+    if local == 0 || !(total > 0.0 && total.is_finite()) {
         return None;
     }
     let group = 1.0 / (lights.len() - local + 1) as f64;
@@ -348,14 +347,14 @@ pub(crate) fn unless_uniform(pmf: Vec<f64>) -> Option<Vec<f64>> {
 }
 
 /// A light's power, its channels' mean (the flux it emits), for the choice among lights;
-/// `None` for a light at infinity. `area_density` is an area light's density per unit area.
-fn power(light: &PathLight, area_density: f64) -> Option<f64> {
+/// `None` for a light at infinity.
+fn power(light: &PathLight) -> Option<f64> {
     let mean = |c: Vec3| c.element_sum().max(0.0) / 3.0;
     match light {
         PathLight::Point { intensity, .. } => Some(4.0 * PI * mean(*intensity)),
         // Its cone's solid angle: an upper bound on a profile that falls off inside it.
         PathLight::Spot { cos_cutoff, intensity, .. } => Some(2.0 * PI * (1.0 - cos_cutoff) * mean(*intensity)),
-        PathLight::Area { radiance, .. } => Some(PI * mean(*radiance) / area_density),
+        PathLight::Area { radiance, .. } => Some(PI * mean(*radiance) / area_density(light)),
         PathLight::Directional { .. } | PathLight::Environment(_) | PathLight::Background(_) => None,
     }
 }
@@ -548,8 +547,8 @@ impl Lights {
             choices -= 1;
         }
         let has_environment = lights.iter().any(|l| matches!(l, PathLight::Environment(_)));
-        let density = |i: usize| area_density(&lights[i]);
-        let choice = choice_pmf(&lights[..choices], density, scene.render.light_choice).map(ChoiceTable::everywhere);
+        let by_power = scene.render.light_choice == LightChoice::Power;
+        let choice = by_power.then(|| power_pmf(&lights[..choices])).flatten().map(ChoiceTable::everywhere);
         Self { lights, by_object, sky, has_environment, choices, choice }
     }
 
@@ -602,15 +601,29 @@ impl Lights {
         let n = u32::try_from(self.choices).unwrap_or(u32::MAX);
         match &self.choice {
             None => ((u_choice * f64::from(n)) as u32).min(n - 1) as usize,
-            Some(t) => t.choose(u_choice, at),
+            Some(t) => t.choose_in(t.cell(at), u_choice),
+        }
+    }
+
+    /// The light `u_choice` chooses from `at` ([`Self::choose`]) and the probability of that
+    /// choice ([`Self::choice_pdf`]), the cell found once.
+    #[inline(always)]
+    pub fn choose_with_pdf(&self, u_choice: f64, at: Vec3) -> (usize, f64) {
+        match &self.choice {
+            None => (self.choose(u_choice, at), 1.0 / self.choices as f64),
+            Some(t) => {
+                let cell = t.cell(at);
+                let i = t.choose_in(cell, u_choice);
+                (i, t.pmf[cell + i])
+            }
         }
     }
 
     /// The light `u_choice` picks from `at` and the probability of that choice.
     #[inline]
     fn chosen(&self, u_choice: f64, at: Vec3) -> (&PathLight, f64) {
-        let i = self.choose(u_choice, at);
-        (&self.lights[i], self.choice_pdf(i, at))
+        let (i, pdf) = self.choose_with_pdf(u_choice, at);
+        (&self.lights[i], pdf)
     }
 
     /// The probability that a light sample drawn from `at` chooses the sky (0 where it is left

@@ -945,9 +945,9 @@ impl PathTracer<'_> {
         match &self.lane_lights {
             _ if kernel.is_delta() => v.light.put(i, false),
             Some(all) => {
-                let chosen = self.lights.choose(choice, h.p);
+                let (chosen, choice_pdf) = self.lights.choose_with_pdf(choice, h.p);
                 let k = &all[chosen];
-                lights.choice_pdf[i] = self.lights.choice_pdf(chosen, h.p);
+                lights.choice_pdf[i] = choice_pdf;
                 set(&mut lights.corner, i, k.corner);
                 set(&mut lights.e1, i, k.e1);
                 set(&mut lights.e2, i, k.e2);
