@@ -226,28 +226,23 @@ def main():
     if "ALHAZEN" not in os.environ:
         subprocess.run(["cargo", "build", "--release", "-q", "-p", "alhazen-cli"], cwd=ROOT, check=True)
     tmp = tempfile.mkdtemp()
-    if a.mode == "errors":
-        print(f"alhazen at {a.spp} spp against the references, means over seeds 1-{a.seeds}")
-        print("| scene | RMSE | mean rel. | image mean vs ref. |")
-        print("|---|---|---|---|")
-        for n in names:
-            seed_errors(n, a.spp, a.seeds, tmp)
-        return
-    if a.mode == "depths":
-        print(f"{os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}; render alone, alhazen / Mitsuba llvm")
-        print("| scene | depth 1 | depth 2 | depth 3 | the scene's depth |")
-        print("|---|---|---|---|---|")
-        for n in names:
-            depths(n, a.runs, a.spp, tmp)
-        return
-    print(f"{os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}")
-    print("| scene | alhazen | Mitsuba llvm | Mitsuba scalar | alhazen/llvm | alhazen render alone: /llvm "
-          "| alhazen/scalar | alhazen at llvm's time: RMSE / mean rel. | Mitsuba llvm: RMSE / mean rel. "
-          "| mean vs ref. |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    # Per mode: the table's caption, its columns, and what fills a scene's row.
+    cores = f"{os.cpu_count()} cores, {a.spp} spp, medians of {a.runs}"
+    modes = {
+        "errors": (f"alhazen at {a.spp} spp against the references, means over seeds 1-{a.seeds}",
+                   ["RMSE", "mean rel.", "image mean vs ref."], lambda n: seed_errors(n, a.spp, a.seeds, tmp)),
+        "depths": (f"{cores}; render alone, alhazen / Mitsuba llvm",
+                   ["depth 1", "depth 2", "depth 3", "the scene's depth"], lambda n: depths(n, a.runs, a.spp, tmp)),
+        "run": (cores, ["alhazen", "Mitsuba llvm", "Mitsuba scalar", "alhazen/llvm", "alhazen render alone: /llvm",
+                        "alhazen/scalar", "alhazen at llvm's time: RMSE / mean rel.",
+                        "Mitsuba llvm: RMSE / mean rel.", "mean vs ref."], lambda n: run(n, a.runs, a.spp, tmp)),
+    }
+    caption, columns, row = modes[a.mode]
+    print(caption)
+    print("| scene | " + " | ".join(columns) + " |")
+    print("|---" * (len(columns) + 1) + "|")
     for n in names:
-        run(n, a.runs, a.spp, tmp)
-
+        row(n)
 
 if __name__ == "__main__":
     main()

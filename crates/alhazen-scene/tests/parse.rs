@@ -89,6 +89,7 @@ fn mistakes_are_located_and_explained() {
     assert!(err("[[object]]\nshape = \"curve\"\npoints = [[0, 0, 0]]\n").contains("at least 2 control points"));
     assert!(err("[[object]]\nshape = \"subdivision\"\nbase = \"cuboid\"\n").contains("did you mean \"cube\"?"));
     assert!(err("[render]\nlight_choice = \"measure\"\n").contains("did you mean \"measured\"?"));
+    assert!(err("[render]\nlight_choice = 3\n").contains("s.toml:2:16: `light_choice`: expected a string"));
     assert!(
         err("[[object]]\nshape = \"subdivision\"\nbase = \"cube\"\nlevels = 9\n")
             .contains("`levels` must be an integer in 0..=6")
