@@ -229,8 +229,11 @@ impl TriangleMesh {
             // A triangle of no area adds nothing (its angles may be undefined).
             let Some(n) = (p[1] - p[0]).cross(p[2] - p[0]).try_normalize() else { return [Vec3::ZERO; 3] };
             std::array::from_fn(|k| {
+                // The angle as `atan2(|a × b|, a · b)`: accurate at every angle, neither edge
+                // normalised, and our own `atan2` (the library's `acos` was a fifth of the
+                // loading of a million triangles).
                 let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
-                n * a.normalize_or_zero().angle_between(b.normalize_or_zero())
+                n * alhazen_math::elementary::atan2(a.cross(b).length(), a.dot(b))
             })
         };
         let mut acc = vec![Vec3::ZERO; self.positions.len()];
