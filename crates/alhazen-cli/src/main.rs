@@ -338,16 +338,13 @@ pub(crate) fn load(path: &Path, parameters: &SceneParameters, environment: &Envi
             format.name()
         )));
     }
-    let environment = environment.read()?;
-    let options = alhazen_import::LoadOptions {
-        memory_budget: memory_budget(),
-        parameters: &parameters.defines,
-        environment: environment.as_ref(),
-    };
-    let imported = alhazen_import::load_with(path, &options).map_err(|e| match e {
+    let unlit = alhazen_import::read_unlit(path, memory_budget(), &parameters.defines).map_err(|e| match e {
         SceneError::Io { .. } => Failure::input(e.to_string()),
         SceneError::Syntax(d) => Failure::input(d.to_string()),
     })?;
+    // The --environment map (perhaps large) only once the scene has proved readable.
+    let environment = environment.read()?;
+    let imported = alhazen_import::light(unlit, path, environment.as_ref());
     for w in &imported.warnings {
         eprintln!("warning: {w}");
     }

@@ -912,6 +912,10 @@ fn an_environment_map_given_on_the_command_line_lights_the_scene() {
         assert!(err.contains(says), "{extra:?}: {err}");
         assert!(!exists);
     }
+    // The scene is read before the map (which may be large): a scene's error is told first.
+    let (code, err, _) = render("[render]\nwidth = \"wide\"\n", &["--environment", "missing.hdr"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("scene.toml:2") && !err.contains("--environment"), "{err}");
 }
 
 /// What the fuzz test (tests/fuzz.rs) found: each used to panic.

@@ -136,10 +136,16 @@ pub struct LoadOptions<'a> {
 /// Reads a scene file as `options` say. A glTF file, which has no sky of its own, is lit by
 /// a uniform white sky (with a warning) when it has no light and no environment is given.
 pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Imported, SceneError> {
-    let mut imported = read(path, options.memory_budget, options.parameters)?;
+    Ok(light(read_unlit(path, options.memory_budget, options.parameters)?, path, options.environment))
+}
+
+/// [`load_with`]'s second step, after [`read_unlit`]: the scene read from `path` lit by
+/// `environment` (or a glTF file without lights by a white sky), its cut-outs checked. Apart,
+/// so that a front end may read a large map only once the scene has proved readable.
+pub fn light(mut imported: Imported, path: &Path, environment: Option<&OutsideEnvironment>) -> Imported {
     let scene = &mut imported.scene;
     let warn = |message: &str| Warning { file: path.to_path_buf(), line: 0, message: message.to_string() };
-    match options.environment {
+    match environment {
         Some(env) => scene.light_by(env),
         None if SceneFormat::from_path(path) == SceneFormat::Gltf
             && scene.lights.is_empty()
@@ -152,10 +158,12 @@ pub fn load_with(path: &Path, options: &LoadOptions) -> Result<Imported, SceneEr
     }
     let cut_outs = imported.scene.opaque_cut_outs();
     imported.warnings.extend(cut_outs.iter().map(|message| warn(message)));
-    Ok(imported)
+    imported
 }
 
-fn read(path: &Path, memory_budget: u64, parameters: &[(String, String)]) -> Result<Imported, SceneError> {
+/// [`load_with`]'s first step: the scene file read, with its `parameters`, no environment
+/// applied yet (then [`light`]).
+pub fn read_unlit(path: &Path, memory_budget: u64, parameters: &[(String, String)]) -> Result<Imported, SceneError> {
     match SceneFormat::from_path(path) {
         SceneFormat::Alhazen => {
             let (scene, warnings) = alhazen_scene::load_scene_reporting(path, memory_budget)?;
