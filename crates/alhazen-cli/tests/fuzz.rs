@@ -355,6 +355,8 @@ fn every_parser_survives_mutated_input() {
         assert_eq!(run_once(dir.path(), &t, limit).1, Some(0), "{}: the first seed is not accepted", t.name);
         let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ t.name.len() as u64 | 1);
         let (start, mut done, mut slowest) = (Instant::now(), 0usize, Duration::ZERO);
+        // The slowest input of a long campaign is kept too, to see what made it slow.
+        let slowest_file = findings_dir.join(format!("slowest-{}-{seed}-{}", t.name, t.file));
         while seconds.map_or(done < runs, |s| start.elapsed() < Duration::from_secs(s)) {
             let k = rng.below(t.seeds.len());
             let other = &t.seeds[rng.below(t.seeds.len())];
@@ -366,6 +368,10 @@ fn every_parser_survives_mutated_input() {
                 let saved = findings_dir.join(format!("{}-{seed}-{done}-{}", t.name, t.file));
                 std::fs::write(&saved, &input).unwrap();
                 findings.push(format!("{}: {what} (input saved as {})", t.name, saved.display()));
+            }
+            if began.elapsed() > slowest && seconds.is_some() {
+                std::fs::create_dir_all(&findings_dir).unwrap();
+                std::fs::write(&slowest_file, &input).unwrap();
             }
             slowest = slowest.max(began.elapsed());
             done += 1;

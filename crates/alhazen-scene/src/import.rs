@@ -278,6 +278,9 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
         if el.name == "vertex" && xyz.iter().any(Option::is_none) {
             return Err("the vertex element lacks x, y or z".into());
         }
+        if el.name == "face" && face_list.is_some_and(|i| el.props[i].list.is_none()) {
+            return Err("the face element's vertex_indices is a number, not a list".into());
+        }
         let mut vals = vec![0.0; el.props.len()];
         let (vertex, face) = (el.name == "vertex", el.name == "face");
         // One buffer reused by every face (a million faces would otherwise make a million
@@ -332,7 +335,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
                     mesh.colors.push(Vec3::new(linear(r, 0), linear(g, 1), linear(b, 2)));
                 }
             } else if face {
-                if face_list.is_none() {
+                if face_list.is_none() || corners.len() < 3 {
                     return Err("a face has fewer than 3 vertices".into());
                 }
                 for k in 1..corners.len() - 1 {
@@ -626,5 +629,9 @@ mod tests {
         let cut = &ASCII_QUAD.as_bytes()[..ASCII_QUAD.len() - 6];
         assert!(parse_ply(cut).is_err());
         assert!(parse_ply(b"hello").is_err());
+        // Found by fuzzing (it indexed an empty list): a face's indices that are no list.
+        let scalar = ASCII_QUAD.replace("property list uchar int vertex_indices", "property int vertex_indices");
+        assert_ne!(scalar, ASCII_QUAD, "the fixture names its list as this test expects");
+        assert!(parse_ply(scalar.as_bytes()).unwrap_err().contains("not a list"));
     }
 }
