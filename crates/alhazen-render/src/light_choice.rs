@@ -38,9 +38,9 @@ const PRIOR: f64 = 4.0;
 const CELLS_ALONG: u32 = 8;
 /// …and, on average, at least this many points per cell…
 const POINTS_PER_CELL: f64 = 8.0;
-/// …and at most this many probabilities in the table (cells × lights); the grid spans the
-/// points but this share of the outermost at each end of each axis.
+/// …and at most this many probabilities in the table (cells × lights).
 const TABLE_ENTRIES: usize = 1 << 20;
+/// The grid spans the points but this share of the outermost at each end of each axis.
 const OUTLIERS: f64 = 0.02;
 /// The pilot's grid is at most this many points along each side of the film…
 const GRID: u32 = 64;
@@ -101,15 +101,14 @@ fn cells_of(measures: &[Measure], n: usize) -> Cells {
     // The box of all but the outermost points along each axis: a ground plane met near the
     // horizon would stretch the whole box and coarsen the cells near the camera (points
     // beyond the box take the nearest cell).
-    let within = |axis: usize, q: f64| {
+    // Each axis's coordinates sorted once, both ends read off them.
+    let ends: [(f64, f64); 3] = std::array::from_fn(|axis| {
         let mut at: Vec<f64> = measures.iter().map(|m| m.p[axis]).collect();
         at.sort_by(f64::total_cmp);
-        at.get(((at.len().max(1) - 1) as f64 * q).round() as usize).copied().unwrap_or(0.0)
-    };
-    let (lo, hi) = (
-        Vec3::from_array(std::array::from_fn(|a| within(a, OUTLIERS))),
-        Vec3::from_array(std::array::from_fn(|a| within(a, 1.0 - OUTLIERS))),
-    );
+        let quantile = |q: f64| at.get(((at.len().max(1) - 1) as f64 * q).round() as usize).copied().unwrap_or(0.0);
+        (quantile(OUTLIERS), quantile(1.0 - OUTLIERS))
+    });
+    let (lo, hi) = (Vec3::from_array(ends.map(|e| e.0)), Vec3::from_array(ends.map(|e| e.1)));
     let extent = hi - lo;
     let longest = extent.max_element();
     let by_points = (measures.len() as f64 / POINTS_PER_CELL).cbrt();

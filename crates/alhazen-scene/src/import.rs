@@ -335,7 +335,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriangleMesh, String> {
                     mesh.colors.push(Vec3::new(linear(r, 0), linear(g, 1), linear(b, 2)));
                 }
             } else if face {
-                if face_list.is_none() || corners.len() < 3 {
+                if face_list.is_none() {
                     return Err("a face has fewer than 3 vertices".into());
                 }
                 for k in 1..corners.len() - 1 {
