@@ -12,7 +12,8 @@
 
 use super::layered::{DiffuseSpecular, SpecularLobe};
 use super::{half_vector, reflect};
-use alhazen_math::{Vec2, Vec3};
+use alhazen_math::elementary::pow;
+use alhazen_math::{Vec2, Vec3, sin_cos_turns};
 use std::f64::consts::PI;
 
 /// The stretched `⟨ĥ, n⟩^{2m}` lobe.
@@ -29,6 +30,7 @@ pub type BlinnPhong = DiffuseSpecular<BlinnPhongLobe>;
 
 impl BlinnPhongLobe {
     /// The half-vector density `D_a(h)`, `h` in the upper hemisphere.
+    #[inline(always)]
     fn density(&self, h: Vec3) -> f64 {
         if h.z <= 0.0 {
             return 0.0;
@@ -37,28 +39,38 @@ impl BlinnPhongLobe {
         let stretched = Vec3::new(h.x, a * h.y, h.z);
         let len = stretched.length();
         let cos = h.z / len;
-        (2.0 * self.exponent + 1.0) / (2.0 * PI) * cos.powf(2.0 * self.exponent) * a / (len * len * len)
+        (2.0 * self.exponent + 1.0) / (2.0 * PI) * pow(cos, 2.0 * self.exponent) * a / (len * len * len)
     }
 }
 
 impl SpecularLobe for BlinnPhongLobe {
+    #[inline(always)]
     fn value(&self, v: Vec3, l: Vec3) -> f64 {
         let Some(h) = half_vector(v, l) else { return 0.0 };
         self.density(h) / (4.0 * h.dot(l).abs() * l.z.abs().max(v.z.abs()))
     }
 
     /// The half-vector density mapped to `l` (Jacobian `1/(4⟨h,l⟩)`).
+    #[inline(always)]
     fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
         let Some(h) = half_vector(v, l) else { return 0.0 };
         self.density(h) / (4.0 * h.dot(l).abs())
     }
 
+    #[inline(always)]
+    fn value_pdf(&self, v: Vec3, l: Vec3) -> (f64, f64) {
+        let Some(h) = half_vector(v, l) else { return (0.0, 0.0) };
+        let (density, jacobian) = (self.density(h), 4.0 * h.dot(l).abs());
+        (density / (jacobian * l.z.abs().max(v.z.abs())), density / jacobian)
+    }
+
     /// A half vector from the stretched `cos^{2m}` lobe, `v` reflected about it.
+    #[inline(always)]
     fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
-        let cos = u.x.powf(1.0 / (2.0 * self.exponent + 1.0));
+        let cos = pow(u.x, 1.0 / (2.0 * self.exponent + 1.0));
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
-        let phi = 2.0 * PI * u.y;
-        let hs = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+        let (sin_phi, cos_phi) = sin_cos_turns(u.y);
+        let hs = Vec3::new(sin * cos_phi, sin * sin_phi, cos);
         let h = Vec3::new(hs.x, hs.y / self.anisotropy, hs.z).normalize();
         Some(reflect(v, h * v.z.signum()))
     }

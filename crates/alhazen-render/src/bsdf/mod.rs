@@ -126,6 +126,8 @@ impl Bsdf {
             Bsdf::Dielectric(d) => d.eval_pdf(v, l),
             Bsdf::Plastic(p) => p.eval_pdf(v, l),
             Bsdf::CookTorrance(c) => c.rough_eval_pdf(&c.lobe.facets, v, l),
+            Bsdf::Phong(p) => p.eval_pdf(v, l),
+            Bsdf::BlinnPhong(b) => b.eval_pdf(v, l),
             Bsdf::Mix(m) => m.eval_pdf(v, l),
             Bsdf::Coated(c) => c.eval_pdf(v, l),
             Bsdf::Sheened(c) => c.eval_pdf(v, l),
@@ -245,6 +247,7 @@ pub(crate) fn same_side(v: Vec3, l: Vec3) -> bool {
 }
 
 /// Cosine-weighted direction in the hemisphere of `v` (Malley's method), density `|cos|/π`.
+#[inline(always)]
 pub(crate) fn cosine_hemisphere(u: Vec2, v: Vec3) -> Vec3 {
     let r = u.x.sqrt();
     let (sin, cos) = alhazen_math::sin_cos_turns(u.y);
@@ -303,6 +306,7 @@ pub(crate) fn half_vector(v: Vec3, l: Vec3) -> Option<Vec3> {
 }
 
 /// A cosine-weighted sample of a diffuse lobe whose value is `eval(l)`.
+#[inline(always)]
 pub(crate) fn sample_cosine(v: Vec3, u: Vec2, eval: impl Fn(Vec3) -> Vec3) -> Option<BsdfSample> {
     let l = cosine_hemisphere(u, v);
     let pdf = cosine_pdf(v, l);

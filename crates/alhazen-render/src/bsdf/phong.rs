@@ -10,7 +10,8 @@
 
 use super::layered::{DiffuseSpecular, SpecularLobe};
 use super::{Frame, reflect};
-use alhazen_math::{Vec2, Vec3};
+use alhazen_math::elementary::pow;
+use alhazen_math::{Vec2, Vec3, sin_cos_turns};
 use std::f64::consts::PI;
 
 /// The `cos^m` lobe around the mirror direction.
@@ -23,23 +24,42 @@ pub struct PhongLobe {
 /// Normalised Phong.
 pub type Phong = DiffuseSpecular<PhongLobe>;
 
+#[inline(always)]
 fn mirror(v: Vec3) -> Vec3 {
     reflect(v, Vec3::new(0.0, 0.0, v.z.signum()))
 }
 
+impl PhongLobe {
+    /// `max(0, ⟨r, l⟩)^m`, the power by our own [`pow`] (no library call: the same bits on
+    /// every processor).
+    #[inline(always)]
+    fn power(&self, v: Vec3, l: Vec3) -> f64 {
+        pow(mirror(v).dot(l).max(0.0), self.exponent)
+    }
+}
+
 impl SpecularLobe for PhongLobe {
+    #[inline(always)]
     fn value(&self, v: Vec3, l: Vec3) -> f64 {
-        (self.exponent + 2.0) / (2.0 * PI) * mirror(v).dot(l).max(0.0).powf(self.exponent)
+        (self.exponent + 2.0) / (2.0 * PI) * self.power(v, l)
     }
 
+    #[inline(always)]
     fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        (self.exponent + 1.0) / (2.0 * PI) * mirror(v).dot(l).max(0.0).powf(self.exponent)
+        (self.exponent + 1.0) / (2.0 * PI) * self.power(v, l)
     }
 
+    #[inline(always)]
+    fn value_pdf(&self, v: Vec3, l: Vec3) -> (f64, f64) {
+        let power = self.power(v, l);
+        ((self.exponent + 2.0) / (2.0 * PI) * power, (self.exponent + 1.0) / (2.0 * PI) * power)
+    }
+
+    #[inline(always)]
     fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
-        let cos = u.x.powf(1.0 / (self.exponent + 1.0));
+        let cos = pow(u.x, 1.0 / (self.exponent + 1.0));
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
-        let phi = 2.0 * PI * u.y;
-        Some(Frame::around(mirror(v)).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)))
+        let (sin_phi, cos_phi) = sin_cos_turns(u.y);
+        Some(Frame::around(mirror(v)).to_world(Vec3::new(sin * cos_phi, sin * sin_phi, cos)))
     }
 }
