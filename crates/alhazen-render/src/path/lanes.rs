@@ -42,8 +42,9 @@
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic, shadow_segment};
 use crate::bsdf::layered::SpecularLobe;
 use crate::bsdf::{
-    Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe, Dielectric, Frame, Microfacet,
-    MicrofacetLobes, Plastic, cosine_hemisphere, cosine_pdf, same_side,
+    BlinnPhong, BlinnPhongLobe, Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe,
+    Dielectric, Frame, Microfacet, MicrofacetLobes, OrenNayar, Phong, PhongLobe, Plastic, cosine_hemisphere,
+    cosine_pdf, same_side,
 };
 use crate::lights::{Emitter, LightAsk, LightSample, Lights, PathLight};
 use crate::sampler::{PixelSeeds, SampleStream};
@@ -118,12 +119,18 @@ struct Vertices {
     diffuse_weight: Lanes,
     /// A mix's weight of its first component ([`crate::bsdf::Mix`]).
     mix_weight: Lanes,
-    /// A rough dielectric's relative index `η_inside/η_outside`, or a plastic coat's.
+    /// A rough dielectric's relative index `η_inside/η_outside`, or a plastic coat's;
+    /// Blinn–Phong's anisotropy `a`.
     ior: Lanes,
-    /// A plastic's colouring of its inner reflection (its coat is its batch's: [`Batch::coat`]).
+    /// A plastic's colouring of its inner reflection (its coat is its batch's: [`Batch::coat`]);
+    /// whether an Oren–Nayar surface adds its interreflection term.
     nonlinear: Flags,
     /// A rough conductor's index `η + iκ` and tint; the roughnesses `m_u, m_v` of a rough
     /// conductor or dielectric, and its tangent where it is anisotropic (`tangent_given`).
+    /// The kernels of other materials keep their numbers in these lanes too (four more
+    /// fields cost the Cornell boxes 2 %): an Oren–Nayar surface's roughness `σ` in `alpha[0]`,
+    /// a Phong or Blinn–Phong lobe's exponent in `alpha[1]`, Blinn–Phong's scratches in
+    /// `tangent`.
     eta: Lanes3,
     k: Lanes3,
     tint: Lanes3,
@@ -374,6 +381,11 @@ pub(crate) enum Kernel {
     Escaped,
     /// Lambert: textured or not, bump-mapped or not.
     Lambert,
+    /// The course's rough diffuse reflection ([`OrenNayar`]).
+    OrenNayar,
+    /// The course's Phong and (anisotropic) Blinn–Phong lobes over Lambert, normalised.
+    Phong,
+    BlinnPhong,
     /// A rough conductor of Trowbridge–Reitz facets with Smith's shadowing and the exact
     /// Fresnel term ([`conductor_facets`]): textured or not, bump-mapped or not, anisotropic
     /// or not.
@@ -415,8 +427,11 @@ pub(crate) enum Kernel {
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 17] = [
+const MATERIAL_KERNELS: [Kernel; 20] = [
     Kernel::Lambert,
+    Kernel::OrenNayar,
+    Kernel::Phong,
+    Kernel::BlinnPhong,
     Kernel::RoughConductor,
     Kernel::RoughDielectric,
     Kernel::RoughPlastic,
@@ -450,7 +465,9 @@ impl Kernel {
     fn chooses_lobe(self) -> bool {
         matches!(
             self,
-            Kernel::RoughDielectric
+            Kernel::Phong
+                | Kernel::BlinnPhong
+                | Kernel::RoughDielectric
                 | Kernel::RoughPlastic
                 | Kernel::SmoothDielectric
                 | Kernel::SmoothPlastic
@@ -494,6 +511,9 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
         // So is a translucent sheet's (the kernels shade reflection only).
         _ if translucent(m) => Kernel::General,
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
+        Bsdf::OrenNayar(_) => Kernel::OrenNayar,
+        Bsdf::Phong(p) if p.transmittance == Vec3::ZERO => Kernel::Phong,
+        Bsdf::BlinnPhong(b) if b.transmittance == Vec3::ZERO => Kernel::BlinnPhong,
         // The light of several facets is the general kernel's.
         Bsdf::Conductor(c) if c.multiple_scattering(Vec3::Z).is_some() || c.film.is_some() => Kernel::General,
         Bsdf::Conductor(c) => match (c.facets.map(|_| conductor_facets(c)), c.schlick) {
@@ -737,7 +757,7 @@ impl PathTracer<'_> {
                     continue;
                 }
                 kernels[p] = Kernel::General;
-                self.vertex(&mut lane.path, hit, lane.mode, &mut lane.stream, &mut general[p]);
+                self.general_vertex(&mut lane.path, hit, lane.mode, &mut lane.stream, &mut general[p]);
                 if let Some((ray, d)) = general[p].shadow {
                     (tested[g][i], dist[g][i]) = (true, d);
                     shadows[g].set(i, &ray);
@@ -796,6 +816,21 @@ impl PathTracer<'_> {
         }
     }
 
+    /// [`Self::vertex`] for a lane no material kernel shades, out of line: inlined, the
+    /// general kernel's every BSDF grew the per-path stage the kernels' lanes run through
+    /// (and cost the Lambert-only Cornell box 4 %).
+    #[inline(never)]
+    fn general_vertex(
+        &self,
+        path: &mut PathState,
+        hit: Option<&WorldHit>,
+        mode: ColorMode,
+        stream: &mut SampleStream,
+        out: &mut Vertex,
+    ) {
+        self.vertex(path, hit, mode, stream, out)
+    }
+
     /// Starts `lane`'s path in pixel `(x, y)`, its stream restarted, as [`Self::sample_of`]
     /// starts it: its film position, its camera ray.
     fn start(&self, lane: &mut LanePath, (x, y): (u32, u32)) {
@@ -845,6 +880,20 @@ impl PathTracer<'_> {
         let Batch { vertices: v, lights, .. } = &mut batches.all[b];
         match bsdf {
             Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
+            Bsdf::OrenNayar(o) => {
+                set(&mut v.albedo, i, o.albedo);
+                v.alpha[0][i] = o.sigma;
+                v.nonlinear.put(i, o.interreflection);
+            }
+            Bsdf::Phong(p) => {
+                set(&mut v.albedo, i, p.diffuse);
+                (v.ks[i], v.alpha[1][i]) = (p.ks, p.lobe.exponent);
+            }
+            Bsdf::BlinnPhong(b) => {
+                set(&mut v.albedo, i, b.diffuse);
+                (v.ks[i], v.alpha[1][i], v.ior[i]) = (b.ks, b.lobe.exponent, b.lobe.anisotropy);
+                set_tangent(v, i, crate::bsdf::tangent_at(m, &wh.hit, &self.scene.images));
+            }
             Bsdf::Conductor(c) => {
                 set(&mut v.eta, i, c.eta);
                 set(&mut v.k, i, c.k);
@@ -1014,6 +1063,11 @@ fn set_light(v: &mut Vertices, i: usize, sample: Option<LightSample>) {
 /// Lane `i`'s microfacets and tangent.
 fn set_facets(v: &mut Vertices, i: usize, facets: &Microfacet, tangent: Option<Vec3>) {
     (v.alpha[0][i], v.alpha[1][i]) = (facets.alpha_u, facets.alpha_v);
+    set_tangent(v, i, tangent);
+}
+
+/// Lane `i`'s tangent, where its lobes turn with one.
+fn set_tangent(v: &mut Vertices, i: usize, tangent: Option<Vec3>) {
     v.tangent_given.put(i, tangent.is_some());
     set(&mut v.tangent, i, tangent.unwrap_or(Vec3::X));
 }
@@ -1174,6 +1228,96 @@ impl LaneBsdf for Lambertian {
     }
 }
 
+/// The course's Oren–Nayar model ([`OrenNayar`]), cosine-weighted sampling.
+struct LaneOrenNayar;
+
+impl LaneOrenNayar {
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> OrenNayar {
+        OrenNayar { albedo: get(&v.albedo, i), sigma: v.alpha[0][i], interreflection: v.nonlinear.at(i) }
+    }
+}
+
+impl LaneBsdf for LaneOrenNayar {
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let b = Self::at(v, i);
+        (b.eval(wv, l), b.pdf(wv, l))
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        lane_sample(Self::at(v, i).sample(wv, uc, u))
+    }
+}
+
+/// Normalised Phong over Lambert ([`Phong`]): a lobe chosen by `uc`, then a direction from it.
+struct LanePhong;
+
+impl LaneBsdf for LanePhong {
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        LanePhong::at(v, i).eval_pdf(wv, l)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        lane_sample(LanePhong::at(v, i).sample(wv, uc, u))
+    }
+}
+
+impl LanePhong {
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> Phong {
+        let lobe = PhongLobe { exponent: v.alpha[1][i] };
+        Phong { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe, transmittance: Vec3::ZERO }
+    }
+}
+
+/// Normalised, anisotropic Blinn–Phong over Lambert ([`BlinnPhong`]), in the frame of its
+/// scratches.
+struct LaneBlinnPhong;
+
+impl LaneBlinnPhong {
+    #[inline(always)]
+    fn at(v: &Vertices, i: usize) -> BlinnPhong {
+        let lobe = BlinnPhongLobe { exponent: v.alpha[1][i], anisotropy: v.ior[i] };
+        BlinnPhong { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe, transmittance: Vec3::ZERO }
+    }
+}
+
+impl LaneBsdf for LaneBlinnPhong {
+    #[inline(always)]
+    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
+        tangent_frame(v, i, ns)
+    }
+
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        Self::at(v, i).eval_pdf(wv, l)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        lane_sample(Self::at(v, i).sample(wv, uc, u))
+    }
+}
+
+/// The frame `PathTracer::shading_frame` turns with lane `i`'s tangent, or about `ns` alone
+/// where it has none.
+#[inline(always)]
+fn tangent_frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
+    let (around, along) = (Frame::around(ns), Frame::new(ns, get(&v.tangent, i)));
+    if v.tangent_given.at(i) { along } else { around }
+}
+
+/// A sample as the kernels return it: whether there is one (none ends the path).
+#[inline(always)]
+fn lane_sample(sample: Option<BsdfSample>) -> (bool, BsdfSample) {
+    let none = BsdfSample { l: Vec3::Z, f: Vec3::ZERO, pdf: 0.0, delta: false, eta: 1.0, dispersive: false };
+    (sample.is_some(), sample.unwrap_or(none))
+}
+
 /// A BSDF of microfacets a rough kernel ([`Rough`]) evaluates: built for lane `i` with the
 /// lane's facets, then evaluated and sampled through its own [`MicrofacetLobes`].
 trait RoughBsdf: MicrofacetLobes {
@@ -1293,12 +1437,10 @@ impl<B: RoughBsdf, const BECKMANN: bool> LaneBsdf for Rough<B, BECKMANN> {
 
     #[inline(always)]
     fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
-        let around = Frame::around(ns);
         if !B::TANGENT {
-            return around;
+            return Frame::around(ns);
         }
-        let along = Frame::new(ns, get(&v.tangent, i));
-        if v.tangent_given.at(i) { along } else { around }
+        tangent_frame(v, i, ns)
     }
 
     #[inline(always)]
@@ -1452,6 +1594,9 @@ impl LaneBsdf for MetallicRoughness {
 fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize, unit: VectorUnit) {
     match kernel {
         Kernel::Lambert => shade::<Lambertian>(v, coat, out, len, unit),
+        Kernel::OrenNayar => shade::<LaneOrenNayar>(v, coat, out, len, unit),
+        Kernel::Phong => shade::<LanePhong>(v, coat, out, len, unit),
+        Kernel::BlinnPhong => shade::<LaneBlinnPhong>(v, coat, out, len, unit),
         Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, coat, out, len, unit),
         Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, coat, out, len, unit),
         Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, coat, out, len, unit),
@@ -1826,6 +1971,16 @@ shape = "sphere"
 center = [-1.9, 2.1, -2.0]
 radius = 0.4
 material = { bsdf = { type = "metallic-roughness", metallic = 0.9, roughness = 0.8, color = { checker = { even = [0.9, 0.6, 0.2], odd = [0.3, 0.3, 0.35], size = 0.15 } } } }
+[[object]]
+shape = "sphere"
+center = [-0.9, 2.3, -1.4]
+radius = 0.3
+material = { bsdf = { type = "phong", ks = 0.4, exponent = 40, color = { checker = { even = [0.9, 0.2, 0.2], odd = [0.2, 0.2, 0.9], size = 0.1 } } } }
+[[object]]
+shape = "box"
+min = [0.8, 2.0, -2.4]
+max = [1.5, 2.6, -1.8]
+material = { bsdf = { type = "blinn-phong", ks = 0.5, exponent = 25, anisotropy = 0.2, scratches = [1, 0, 1], color = [0.7, 0.7, 0.2] } }
 "#;
 
     /// [`MIXED`] with its metallic–roughness sphere given a map (4 × 4 texels: roughness from
