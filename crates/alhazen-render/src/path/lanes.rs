@@ -40,11 +40,10 @@
 //! `lanes_match_the_per_path_tracer`).
 
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic, shadow_segment};
-use crate::bsdf::layered::SpecularLobe;
+use crate::bsdf::layered::{DiffuseSpecular, SpecularLobe};
 use crate::bsdf::{
-    BlinnPhong, BlinnPhongLobe, Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe,
-    Dielectric, Frame, Microfacet, MicrofacetLobes, OrenNayar, Phong, PhongLobe, Plastic, cosine_hemisphere,
-    cosine_pdf, same_side,
+    BlinnPhongLobe, Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe, Dielectric, Frame,
+    Microfacet, MicrofacetLobes, OrenNayar, PhongLobe, Plastic, cosine_hemisphere, cosine_pdf, same_side,
 };
 use crate::lights::{Emitter, LightAsk, LightSample, Lights, PathLight};
 use crate::sampler::{PixelSeeds, SampleStream};
@@ -1251,45 +1250,44 @@ impl LaneBsdf for LaneOrenNayar {
     }
 }
 
-/// Normalised Phong over Lambert ([`Phong`]): a lobe chosen by `uc`, then a direction from it.
-struct LanePhong;
+/// The course's Lambert-plus-lobe BSDFs ([`DiffuseSpecular`]: normalised Phong, anisotropic
+/// Blinn–Phong): a lobe chosen by `uc`, then a direction from it.
+struct LaneDiffuseSpecular<S>(std::marker::PhantomData<S>);
 
-impl LaneBsdf for LanePhong {
-    #[inline(always)]
-    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        LanePhong::at(v, i).eval_pdf(wv, l)
-    }
+/// A specular lobe the lanes build from a lane's numbers.
+trait LaneLobe: SpecularLobe + Sized {
+    /// The lobe turns with the lane's tangent (Blinn–Phong's scratches).
+    const TANGENT: bool;
+    fn at(v: &Vertices, i: usize) -> Self;
+}
 
+impl LaneLobe for PhongLobe {
+    const TANGENT: bool = false;
     #[inline(always)]
-    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        lane_sample(LanePhong::at(v, i).sample(wv, uc, u))
+    fn at(v: &Vertices, i: usize) -> Self {
+        PhongLobe { exponent: v.alpha[1][i] }
     }
 }
 
-impl LanePhong {
+impl LaneLobe for BlinnPhongLobe {
+    const TANGENT: bool = true;
     #[inline(always)]
-    fn at(v: &Vertices, i: usize) -> Phong {
-        let lobe = PhongLobe { exponent: v.alpha[1][i] };
-        Phong { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe, transmittance: Vec3::ZERO }
+    fn at(v: &Vertices, i: usize) -> Self {
+        BlinnPhongLobe { exponent: v.alpha[1][i], anisotropy: v.ior[i] }
     }
 }
 
-/// Normalised, anisotropic Blinn–Phong over Lambert ([`BlinnPhong`]), in the frame of its
-/// scratches.
-struct LaneBlinnPhong;
-
-impl LaneBlinnPhong {
+impl<S: LaneLobe> LaneDiffuseSpecular<S> {
     #[inline(always)]
-    fn at(v: &Vertices, i: usize) -> BlinnPhong {
-        let lobe = BlinnPhongLobe { exponent: v.alpha[1][i], anisotropy: v.ior[i] };
-        BlinnPhong { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe, transmittance: Vec3::ZERO }
+    fn at(v: &Vertices, i: usize) -> DiffuseSpecular<S> {
+        DiffuseSpecular { diffuse: get(&v.albedo, i), ks: v.ks[i], lobe: S::at(v, i), transmittance: Vec3::ZERO }
     }
 }
 
-impl LaneBsdf for LaneBlinnPhong {
+impl<S: LaneLobe> LaneBsdf for LaneDiffuseSpecular<S> {
     #[inline(always)]
     fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
-        tangent_frame(v, i, ns)
+        if S::TANGENT { tangent_frame(v, i, ns) } else { Frame::around(ns) }
     }
 
     #[inline(always)]
@@ -1595,8 +1593,8 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
     match kernel {
         Kernel::Lambert => shade::<Lambertian>(v, coat, out, len, unit),
         Kernel::OrenNayar => shade::<LaneOrenNayar>(v, coat, out, len, unit),
-        Kernel::Phong => shade::<LanePhong>(v, coat, out, len, unit),
-        Kernel::BlinnPhong => shade::<LaneBlinnPhong>(v, coat, out, len, unit),
+        Kernel::Phong => shade::<LaneDiffuseSpecular<PhongLobe>>(v, coat, out, len, unit),
+        Kernel::BlinnPhong => shade::<LaneDiffuseSpecular<BlinnPhongLobe>>(v, coat, out, len, unit),
         Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, coat, out, len, unit),
         Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, coat, out, len, unit),
         Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, coat, out, len, unit),
