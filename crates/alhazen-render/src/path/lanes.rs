@@ -124,7 +124,8 @@ struct Vertices {
     /// A plastic's colouring of its inner reflection (its coat is its batch's: [`Batch::coat`]);
     /// whether an Oren–Nayar surface adds its interreflection term.
     nonlinear: Flags,
-    /// A rough conductor's index `η + iκ` and tint; the roughnesses `m_u, m_v` of a rough
+    /// A rough conductor's index `η + iκ` and tint (a glass's tint: what its refracted light
+    /// keeps, white where clear); the roughnesses `m_u, m_v` of a rough
     /// conductor or dielectric, and its tangent where it is anisotropic (`tangent_given`).
     /// The kernels of other materials keep their numbers in these lanes too (four more
     /// fields cost the Cornell boxes 2 %): an Oren–Nayar surface's roughness `σ` in `alpha[0]`,
@@ -504,9 +505,6 @@ pub(super) fn material_kernels(tracer: &PathTracer) -> Vec<Kernel> {
 /// The kernel of `bsdf`, material `m`'s at some point.
 fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
     match bsdf {
-        // Glass that may be tinted somewhere is tinted nowhere at some points (a white texel):
-        // the general kernel's everywhere.
-        _ if tints_glass(m) => Kernel::General,
         // So is a translucent sheet's (the kernels shade reflection only).
         _ if translucent(m) => Kernel::General,
         Bsdf::Lambert(_) if !crate::bsdf::is_anisotropic(m) => Kernel::Lambert,
@@ -524,7 +522,7 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             (Some(Some(true)), true) => Kernel::BeckmannSchlickConductor,
             (Some(None), _) => Kernel::General,
         },
-        Bsdf::Dielectric(d) if d.thin || d.tint != Vec3::ONE || d.film.is_some() => Kernel::General,
+        Bsdf::Dielectric(d) if d.thin || d.film.is_some() => Kernel::General,
         Bsdf::Dielectric(d) if d.facets.is_none() && !d.schlick && !d.dispersive => Kernel::SmoothDielectric,
         Bsdf::Dielectric(d) => match dielectric_facets(d) {
             Some(false) => Kernel::RoughDielectric,
@@ -548,23 +546,6 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
         }
         _ => Kernel::General,
     }
-}
-
-/// True where `m`'s glass may be tinted at some point: a transmittance that is not plain white,
-/// or vertex colours over glass (the kernels' glass is clear).
-fn tints_glass(m: &alhazen_scene::Material) -> bool {
-    use alhazen_scene::bsdf::BsdfDesc;
-    fn walk(d: &BsdfDesc, vertex: bool) -> bool {
-        match d {
-            BsdfDesc::Dielectric { transmittance, .. } => {
-                vertex || *transmittance != alhazen_scene::Texture::Solid(Vec3::ONE)
-            }
-            BsdfDesc::Mix { a, b, .. } => walk(a, vertex) || walk(b, vertex),
-            BsdfDesc::Coated { base, .. } | BsdfDesc::Sheened { base, .. } => walk(base, vertex),
-            _ => false,
-        }
-    }
-    m.bsdf.as_ref().is_some_and(|d| walk(d, m.vertex_colors))
 }
 
 /// True where `m` passes light diffusely through somewhere (a Cook–Torrance `transmittance`
@@ -903,6 +884,7 @@ impl PathTracer<'_> {
             }
             Bsdf::Dielectric(d) => {
                 v.ior[i] = d.eta;
+                set(&mut v.tint, i, d.tint);
                 if let Some(facets) = &d.facets {
                     set_facets(v, i, facets, crate::bsdf::tangent_at(m, &wh.hit, &self.scene.images));
                 }
@@ -1371,7 +1353,7 @@ impl RoughBsdf for Dielectric {
 
     #[inline(always)]
     fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
-        Dielectric::clear(Some(facets), v.ior[i])
+        Dielectric { tint: get(&v.tint, i), ..Dielectric::clear(Some(facets), v.ior[i]) }
     }
 }
 
@@ -1478,7 +1460,7 @@ impl LaneBsdf for SmoothDielectric {
 
     #[inline(always)]
     fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
-        Dielectric::clear(None, v.ior[i]).smooth_sample(wv, uc)
+        Dielectric { tint: get(&v.tint, i), ..Dielectric::clear(None, v.ior[i]) }.smooth_sample(wv, uc)
     }
 }
 
@@ -1815,7 +1797,8 @@ mod tests {
     /// textured surfaces, bump maps, rough and smooth glass, rough conductors (one anisotropic
     /// and bump-mapped, one of Beckmann facets) and a smooth one, rough plastics (one textured,
     /// one of Beckmann facets) and a smooth one, Beckmann glass, glass that absorbs (rough
-    /// and smooth), a mirror
+    /// and smooth), tinted glass (rough, and smooth under a checkered tint), Phong and
+    /// anisotropic Blinn–Phong, a mirror
     /// (with specular connections) and a Lambert surface with a mirror's gloss (the course's
     /// Whitted material), a glTF metallic–roughness mix, Schlick conductors (a glTF metal's; rough and smooth),
     /// spheres, boxes and a plane, an emitting box (triangles)
@@ -1979,6 +1962,16 @@ shape = "box"
 min = [0.8, 2.0, -2.4]
 max = [1.5, 2.6, -1.8]
 material = { bsdf = { type = "blinn-phong", ks = 0.5, exponent = 25, anisotropy = 0.2, scratches = [1, 0, 1], color = [0.7, 0.7, 0.2] } }
+[[object]]
+shape = "sphere"
+center = [0.4, 0.35, 2.6]
+radius = 0.35
+material = { bsdf = { type = "dielectric", ior = 1.45, transmittance = { checker = { even = [1, 1, 1], odd = [0.5, 0.8, 0.6], size = 0.15 } } } }
+[[object]]
+shape = "sphere"
+center = [-0.5, 1.0, 0.6]
+radius = 0.3
+material = { bsdf = { type = "dielectric", roughness = 0.2, distribution = "ggx", ior = 1.5, transmittance = [0.6, 0.8, 0.9] } }
 "#;
 
     /// [`MIXED`] with its metallic–roughness sphere given a map (4 × 4 texels: roughness from
@@ -2204,10 +2197,10 @@ material = { bsdf = { type = "blinn-phong", ks = 0.5, exponent = 25, anisotropy 
     }
 
     /// Glass whose transmittance is an image, white at one texel: every point, that one
-    /// included, takes the general kernel (the kernels' glass is clear), and so does clear glass
-    /// under vertex colours; plain clear glass keeps its own kernel.
+    /// included, takes the glass kernel (which carries each lane's tint), and so does clear
+    /// glass under vertex colours and plain clear glass.
     #[test]
-    fn glass_that_may_be_tinted_takes_the_general_kernel_everywhere() {
+    fn glass_tinted_anywhere_takes_the_glass_kernel_everywhere() {
         use alhazen_scene::bsdf::{BsdfDesc, Ior};
         let images = [std::sync::Arc::new(alhazen_scene::ImageData::new(2, 1, vec![[1.0; 3], [0.9, 0.5, 0.2]]))];
         let map = alhazen_scene::Texture::Image { image: 0, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 };
@@ -2227,11 +2220,11 @@ material = { bsdf = { type = "blinn-phong", ks = 0.5, exponent = 25, anisotropy 
                 .to_vec()
         };
         let tinted = alhazen_scene::Material::from_bsdf("tinted", glass(map));
-        assert_eq!(kernels(&tinted), [Kernel::General, Kernel::General]);
+        assert_eq!(kernels(&tinted), [Kernel::SmoothDielectric, Kernel::SmoothDielectric]);
         let clear = alhazen_scene::Material::from_bsdf("clear", glass(alhazen_scene::Texture::Solid(Vec3::ONE)));
         assert_eq!(kernels(&clear), [Kernel::SmoothDielectric, Kernel::SmoothDielectric]);
         let painted = alhazen_scene::Material { vertex_colors: true, ..clear };
-        assert_eq!(kernels(&painted), [Kernel::General, Kernel::General]);
+        assert_eq!(kernels(&painted), [Kernel::SmoothDielectric, Kernel::SmoothDielectric]);
     }
 
     /// A film whose map gives it no weight anywhere, over a metallic–roughness map whose
