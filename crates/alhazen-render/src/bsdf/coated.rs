@@ -45,15 +45,12 @@ impl Coated {
     /// `w·E_c(μ)`: the share of the light leaving along a direction of cosine `cos` with the
     /// normal that the coat reflects.
     pub(crate) fn coat_albedo(&self, cos: f64) -> f64 {
-        let mu = cos.abs().min(1.0);
-        self.weight * lookup_in(mu, self.row) * fresnel_dielectric(mu, self.coat.ior)
+        coat_albedo(self.weight, self.row, self.coat.ior, cos)
     }
 
-    /// The probability of sampling the coat rather than the base: its albedo's share, at
-    /// least a fifth of its weight (a glossy coat over a bright base still gets its
-    /// reflections sampled).
-    fn coat_choice(&self, albedo: f64) -> f64 {
-        albedo.max(0.2 * self.weight).min(0.9)
+    /// Where the coat's roughness falls in the albedo table.
+    pub(crate) fn row(&self) -> Row {
+        self.row
     }
 
     /// `ρ(v, l)`.
@@ -68,37 +65,67 @@ impl Coated {
 
     /// [`Self::eval`] and [`Self::pdf`] at once.
     pub fn eval_pdf(&self, v: Vec3, l: Vec3) -> (Vec3, f64) {
-        let albedo = self.coat_albedo(v.z);
-        let q = self.coat_choice(albedo);
-        let (fb, pb) = self.base.eval_pdf(v, l);
-        let (fc, pc) = if same_side(v, l) { self.coat.value_pdf(v, l) } else { (0.0, 0.0) };
-        (fb * (1.0 - albedo) + Vec3::splat(self.weight * fc), q * pc + (1.0 - q) * pb)
+        under_coat(&self.coat, self.weight, self.coat_albedo(v.z), self.base.eval_pdf(v, l), v, l)
     }
 
     /// The coat's facet reflection by `uc` below its share, else the base's sample (`uc`
     /// rescaled for it); a delta sample of the base keeps its own weight under the coat.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let albedo = self.coat_albedo(v.z);
-        let q = self.coat_choice(albedo);
-        sample_under_layer(&self.base, (v, uc, u), (q, albedo), || self.coat.sample(v, u), |l| self.eval_pdf(v, l))
+        let q = coat_choice(albedo, self.weight);
+        let base = |uc| self.base.sample(v, uc, u);
+        sample_under_layer(base, uc, (q, albedo), || self.coat.sample(v, u), |l| self.eval_pdf(v, l))
     }
 }
 
-/// A sample of a layer over `base` (a coat, a sheen): the layer's own direction (`top`) where
-/// `uc` falls below its share `q`, else the base's sample (`uc` rescaled for it) — a delta
-/// sample of the base keeping its own weight times what the layer of albedo `albedo` lets
-/// through —, a direction not a delta valued by the whole (`eval_pdf`).
+/// `w·E_c(μ)` of a coat of weight `weight`, roughness `row` and index `ior`, seen at cosine
+/// `cos` ([`Coated::coat_albedo`]).
+#[inline(always)]
+pub(crate) fn coat_albedo(weight: f64, row: Row, ior: f64, cos: f64) -> f64 {
+    let mu = cos.abs().min(1.0);
+    weight * lookup_in(mu, row) * fresnel_dielectric(mu, ior)
+}
+
+/// The probability of sampling the coat rather than the base: its albedo's share, at least a
+/// fifth of its weight (a glossy coat over a bright base still gets its reflections sampled).
+#[inline(always)]
+pub(crate) fn coat_choice(albedo: f64, weight: f64) -> f64 {
+    albedo.max(0.2 * weight).min(0.9)
+}
+
+/// `(ρ, pdf)` of the coat `coat` of weight `weight` and albedo `albedo` towards the viewer over
+/// a base whose `(ρ, pdf)` is `base` ([`Coated::eval_pdf`]; the lanes' coated kernels too).
+#[inline(always)]
+pub(crate) fn under_coat(
+    coat: &CookTorranceLobe,
+    weight: f64,
+    albedo: f64,
+    (fb, pb): (Vec3, f64),
+    v: Vec3,
+    l: Vec3,
+) -> (Vec3, f64) {
+    let q = coat_choice(albedo, weight);
+    let (fc, pc) = if same_side(v, l) { coat.value_pdf(v, l) } else { (0.0, 0.0) };
+    (fb * (1.0 - albedo) + Vec3::splat(weight * fc), q * pc + (1.0 - q) * pb)
+}
+
+/// A sample of a layer over a base (a coat, a sheen): the layer's own direction (`top`) where
+/// `uc` falls below its share `q`, else the base's sample (`base`, drawn with
+/// [`base_choice`]`(uc, q)`) — a delta sample of the base keeping its own weight times what the
+/// layer of albedo `albedo` lets through —, a direction not a delta valued by the whole
+/// (`eval_pdf`). Only the sample chosen is drawn.
+#[inline(always)]
 pub(crate) fn sample_under_layer(
-    base: &Bsdf,
-    (v, uc, u): (Vec3, f64, Vec2),
+    base: impl FnOnce(f64) -> Option<BsdfSample>,
+    uc: f64,
     (q, albedo): (f64, f64),
     top: impl FnOnce() -> Option<Vec3>,
-    eval_pdf: impl Fn(Vec3) -> (Vec3, f64),
+    eval_pdf: impl FnOnce(Vec3) -> (Vec3, f64),
 ) -> Option<BsdfSample> {
     let l = if uc < q {
         top()?
     } else {
-        let mut s = base.sample(v, ((uc - q) / (1.0 - q)).min(1.0 - 1e-16), u)?;
+        let mut s = base(base_choice(uc, q))?;
         if s.delta {
             s.f *= 1.0 - albedo;
             s.pdf *= 1.0 - q;
@@ -108,4 +135,10 @@ pub(crate) fn sample_under_layer(
     };
     let (f, pdf) = eval_pdf(l);
     (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+}
+
+/// The base's lobe choice when the layer's share `q` is not chosen by `uc`: `uc` rescaled.
+#[inline(always)]
+fn base_choice(uc: f64, q: f64) -> f64 {
+    ((uc - q) / (1.0 - q)).min(1.0 - 1e-16)
 }

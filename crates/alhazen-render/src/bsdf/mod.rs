@@ -9,7 +9,7 @@
 
 mod blinn_phong;
 mod build;
-mod coated;
+pub(crate) mod coated;
 mod conductor;
 mod cook_torrance;
 mod dielectric;
@@ -18,7 +18,7 @@ pub mod layered;
 mod layering;
 pub mod microfacet;
 mod mix;
-mod multiscatter;
+pub(crate) mod multiscatter;
 mod oren_nayar;
 mod phong;
 mod plastic;

@@ -91,7 +91,7 @@ fn lookup(mu: f64, alpha: f64) -> f64 {
 }
 
 /// Where a roughness falls between the table's rows: the lower row and the weight of the next.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Row {
     i: usize,
     fy: f64,

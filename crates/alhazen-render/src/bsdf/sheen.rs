@@ -79,8 +79,8 @@ impl Sheened {
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let albedo = self.sheen_albedo(v.z);
         let q = self.sheen_choice(albedo);
-        let top = || Some(cosine_hemisphere(u, v));
-        super::coated::sample_under_layer(&self.base, (v, uc, u), (q, albedo), top, |l| self.eval_pdf(v, l))
+        let (top, base) = (|| Some(cosine_hemisphere(u, v)), |uc| self.base.sample(v, uc, u));
+        super::coated::sample_under_layer(base, uc, (q, albedo), top, |l| self.eval_pdf(v, l))
     }
 }
 

@@ -40,7 +40,9 @@
 //! `lanes_match_the_per_path_tracer`).
 
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic, shadow_segment};
+use crate::bsdf::coated::{coat_albedo, coat_choice, sample_under_layer, under_coat};
 use crate::bsdf::layered::{DiffuseSpecular, SpecularLobe};
+use crate::bsdf::multiscatter::Row;
 use crate::bsdf::{
     BlinnPhongLobe, Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe, Dielectric, Frame,
     Microfacet, MicrofacetLobes, OrenNayar, PhongLobe, Plastic, cosine_hemisphere, cosine_pdf, same_side,
@@ -153,7 +155,26 @@ struct Vertices {
     u_bsdf: [Lanes; 2],
     roulette: Flags,
     u_roulette: Lanes,
+    /// A coated kernel's coats, made when its batch first needs them (in the batch's own
+    /// lanes, their fields cost every kernel: see `alpha`).
+    coats: Option<Box<CoatLanes>>,
 }
+
+/// Each lane's clear coat ([`crate::bsdf::Coated`]) over the base the other lanes describe: its
+/// weight, its facets' roughness (isotropic Trowbridge–Reitz, Smith's shadowing), its index and
+/// where that roughness falls in the albedo table, and its albedo towards the viewer
+/// (`weigh_layers`).
+#[derive(Clone, Debug, Default)]
+struct CoatLanes {
+    weight: Lanes,
+    alpha: Lanes,
+    ior: Lanes,
+    row: [Row; LANES],
+    albedo: Lanes,
+}
+
+/// The coats of a batch without any.
+static NO_COATS: std::sync::LazyLock<CoatLanes> = std::sync::LazyLock::new(CoatLanes::default);
 
 /// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`) or a point
 /// light (`point`: at `corner`, `radiance` its intensity, as `Lights::sample` takes it).
@@ -423,11 +444,17 @@ pub(crate) enum Kernel {
     /// metallic texture's mean, between 0 and 1): a [`crate::bsdf::Mix`] of a rough conductor
     /// with Schlick's term and Cook–Torrance, both on isotropic Trowbridge–Reitz facets.
     MetallicRoughness,
+    /// A clear coat ([`crate::bsdf::Coated`]: isotropic Trowbridge–Reitz facets, Smith's
+    /// shadowing, exact Fresnel term) over Lambert, Cook–Torrance or the metallic–roughness mix
+    /// (glTF's `KHR_materials_clearcoat` over its base).
+    CoatedLambert,
+    CoatedCookTorrance,
+    CoatedMetallicRoughness,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 20] = [
+const MATERIAL_KERNELS: [Kernel; 23] = [
     Kernel::Lambert,
     Kernel::OrenNayar,
     Kernel::Phong,
@@ -448,6 +475,9 @@ const MATERIAL_KERNELS: [Kernel; 20] = [
     Kernel::SmoothSchlickConductor,
     Kernel::LambertMirror,
     Kernel::MetallicRoughness,
+    Kernel::CoatedLambert,
+    Kernel::CoatedCookTorrance,
+    Kernel::CoatedMetallicRoughness,
 ];
 
 impl Kernel {
@@ -477,6 +507,9 @@ impl Kernel {
                 | Kernel::BeckmannCookTorrance
                 | Kernel::LambertMirror
                 | Kernel::MetallicRoughness
+                | Kernel::CoatedLambert
+                | Kernel::CoatedCookTorrance
+                | Kernel::CoatedMetallicRoughness
         )
     }
 
@@ -540,6 +573,12 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             Some(true) => Kernel::BeckmannCookTorrance,
             None => Kernel::General,
         },
+        Bsdf::Coated(c) if lane_coat(c) => match kernel_of(&c.base, m) {
+            Kernel::Lambert => Kernel::CoatedLambert,
+            Kernel::CookTorrance => Kernel::CoatedCookTorrance,
+            Kernel::MetallicRoughness => Kernel::CoatedMetallicRoughness,
+            _ => Kernel::General,
+        },
         Bsdf::Mix(mix) if lambert_mirror(mix).is_some() && !crate::bsdf::is_anisotropic(m) => Kernel::LambertMirror,
         Bsdf::Mix(mix) if metallic_roughness(mix).is_some() && !crate::bsdf::is_anisotropic(m) => {
             Kernel::MetallicRoughness
@@ -599,6 +638,13 @@ fn metallic_roughness(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &CookTorran
         }
         _ => None,
     }
+}
+
+/// A coat the coated kernels take: isotropic Trowbridge–Reitz facets with Smith's shadowing,
+/// the exact Fresnel term, not layered itself.
+fn lane_coat(c: &crate::bsdf::Coated) -> bool {
+    let f = &c.coat.facets;
+    f.smith_kind() == Some(false) && f.alpha_u == f.alpha_v && !c.coat.schlick && c.coat.layer == 0.0
 }
 
 /// [`conductor_facets`] for a dielectric of one index for every colour.
@@ -860,6 +906,21 @@ impl PathTracer<'_> {
         let Batch { vertices: v, lights, .. } = &mut batches.all[b];
         match bsdf {
             Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
+            Bsdf::Coated(c) => {
+                match &c.base {
+                    Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
+                    Bsdf::CookTorrance(base) => set_cook_torrance(v, i, base),
+                    Bsdf::Mix(mix) if let Some((metal, base, weight)) = metallic_roughness(mix) => {
+                        set_metallic_roughness(v, i, (metal, base, weight))
+                    }
+                    _ => {
+                        // No coated kernel's (`kernel_of` gives none to other bases).
+                        batches.all[b].len -= 1;
+                        return None;
+                    }
+                }
+                set_coat(v, i, c);
+            }
             Bsdf::OrenNayar(o) => {
                 set(&mut v.albedo, i, o.albedo);
                 v.alpha[0][i] = o.sigma;
@@ -889,11 +950,7 @@ impl PathTracer<'_> {
                     set_facets(v, i, facets, crate::bsdf::tangent_at(m, &wh.hit, &self.scene.images));
                 }
             }
-            Bsdf::CookTorrance(c) => {
-                set(&mut v.albedo, i, c.diffuse);
-                (v.ks[i], v.ior[i], v.layer[i]) = (c.ks, c.lobe.ior, c.lobe.layer);
-                set_facets(v, i, &c.lobe.facets, None);
-            }
+            Bsdf::CookTorrance(c) => set_cook_torrance(v, i, c),
             Bsdf::Mix(mix) if let Some((c, lambert, weight)) = lambert_mirror(mix) => {
                 set(&mut v.albedo, i, lambert.albedo);
                 set(&mut v.eta, i, c.eta);
@@ -901,16 +958,7 @@ impl PathTracer<'_> {
                 set(&mut v.tint, i, c.tint);
                 v.mix_weight[i] = weight;
             }
-            Bsdf::Mix(mix) if let Some((metal, base, weight)) = metallic_roughness(mix) => {
-                set(&mut v.eta, i, metal.eta);
-                set(&mut v.k, i, metal.k);
-                set(&mut v.tint, i, metal.tint);
-                let metal_alpha = metal.facets.map_or(0.0, |f| f.alpha_u);
-                (v.alpha[0][i], v.alpha[1][i]) = (metal_alpha, base.lobe.facets.alpha_u);
-                set(&mut v.albedo, i, base.diffuse);
-                (v.ks[i], v.ior[i], v.layer[i]) = (base.ks, base.lobe.ior, base.lobe.layer);
-                v.mix_weight[i] = weight;
-            }
+            Bsdf::Mix(mix) if let Some(parts) = metallic_roughness(mix) => set_metallic_roughness(v, i, parts),
             Bsdf::Plastic(p) => {
                 set(&mut v.albedo, i, p.albedo);
                 v.ior[i] = p.eta;
@@ -1039,6 +1087,34 @@ fn set_light(v: &mut Vertices, i: usize, sample: Option<LightSample>) {
         (v.light_dist[i], v.light_pdf[i]) = (ls.dist, ls.pdf);
         v.light_delta.put(i, ls.delta);
     }
+}
+
+/// Lane `i`'s Cook–Torrance surface.
+#[inline(always)]
+fn set_cook_torrance(v: &mut Vertices, i: usize, c: &CookTorrance) {
+    set(&mut v.albedo, i, c.diffuse);
+    (v.ks[i], v.ior[i], v.layer[i]) = (c.ks, c.lobe.ior, c.lobe.layer);
+    set_facets(v, i, &c.lobe.facets, None);
+}
+
+/// Lane `i`'s metallic–roughness mix: its metal, its Cook–Torrance base, the metal's weight.
+#[inline(always)]
+fn set_metallic_roughness(v: &mut Vertices, i: usize, (metal, base, weight): (&Conductor, &CookTorrance, f64)) {
+    set(&mut v.eta, i, metal.eta);
+    set(&mut v.k, i, metal.k);
+    set(&mut v.tint, i, metal.tint);
+    let metal_alpha = metal.facets.map_or(0.0, |f| f.alpha_u);
+    (v.alpha[0][i], v.alpha[1][i]) = (metal_alpha, base.lobe.facets.alpha_u);
+    set(&mut v.albedo, i, base.diffuse);
+    (v.ks[i], v.ior[i], v.layer[i]) = (base.ks, base.lobe.ior, base.lobe.layer);
+    v.mix_weight[i] = weight;
+}
+
+/// Lane `i`'s clear coat (its albedo towards the viewer found later, `weigh_layers`).
+fn set_coat(v: &mut Vertices, i: usize, c: &crate::bsdf::Coated) {
+    let coats = v.coats.get_or_insert_with(Box::default);
+    (coats.weight[i], coats.alpha[i], coats.ior[i]) = (c.weight, c.coat.facets.alpha_u, c.coat.ior);
+    coats.row[i] = c.row();
 }
 
 /// Lane `i`'s microfacets and tangent.
@@ -1296,6 +1372,48 @@ fn tangent_frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
 fn lane_sample(sample: Option<BsdfSample>) -> (bool, BsdfSample) {
     let none = BsdfSample { l: Vec3::Z, f: Vec3::ZERO, pdf: 0.0, delta: false, eta: 1.0, dispersive: false };
     (sample.is_some(), sample.unwrap_or(none))
+}
+
+/// A clear coat over the base `B` ([`crate::bsdf::Coated`]), its albedo towards the viewer found
+/// before the loop (`weigh_layers`: a table lookup would keep the loop scalar), the base
+/// through `B`'s own lane functions.
+struct LaneCoated<B>(std::marker::PhantomData<B>);
+
+impl<B: LaneBsdf> LaneCoated<B> {
+    /// Lane `i`'s coat: its lobe, weight and albedo towards the viewer.
+    #[inline(always)]
+    fn coat(v: &Vertices, i: usize) -> (CookTorranceLobe, f64, f64) {
+        let c = v.coats.as_deref().unwrap_or(&NO_COATS);
+        let facets = Microfacet::smith::<false>(c.alpha[i], c.alpha[i]);
+        (CookTorranceLobe { facets, ior: c.ior[i], schlick: false, layer: 0.0 }, c.weight[i], c.albedo[i])
+    }
+}
+
+impl<B: LaneBsdf> LaneBsdf for LaneCoated<B> {
+    const TRANSMITS: bool = B::TRANSMITS;
+
+    #[inline(always)]
+    fn frame(v: &Vertices, i: usize, ns: Vec3) -> Frame {
+        B::frame(v, i, ns)
+    }
+
+    #[inline(always)]
+    fn eval_pdf(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (lobe, weight, albedo) = Self::coat(v, i);
+        under_coat(&lobe, weight, albedo, B::eval_pdf(v, coat, i, wv, l), wv, l)
+    }
+
+    #[inline(always)]
+    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let (lobe, weight, albedo) = Self::coat(v, i);
+        let q = coat_choice(albedo, weight);
+        let base = |uc| {
+            let (sampled, s) = B::sample(v, coat, i, wv, uc, u);
+            sampled.then_some(s)
+        };
+        let whole = |l| Self::eval_pdf(v, coat, i, wv, l);
+        lane_sample(sample_under_layer(base, uc, (q, albedo), || lobe.sample(wv, u), whole))
+    }
 }
 
 /// A BSDF of microfacets a rough kernel ([`Rough`]) evaluates: built for lane `i` with the
@@ -1591,6 +1709,9 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
         Kernel::SmoothSchlickConductor => shade::<SmoothConductor<true>>(v, coat, out, len, unit),
         Kernel::LambertMirror => shade::<LambertMirror>(v, coat, out, len, unit),
         Kernel::MetallicRoughness => shade::<MetallicRoughness>(v, coat, out, len, unit),
+        Kernel::CoatedLambert => shade::<LaneCoated<Lambertian>>(v, coat, out, len, unit),
+        Kernel::CoatedCookTorrance => shade::<LaneCoated<Rough<LaneCookTorrance, false>>>(v, coat, out, len, unit),
+        Kernel::CoatedMetallicRoughness => shade::<LaneCoated<MetallicRoughness>>(v, coat, out, len, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, coat, out, len, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, coat, out, len, unit),
         Kernel::Idle | Kernel::General | Kernel::Escaped => {}
@@ -1764,8 +1885,30 @@ fn weigh_layers(kernel: Kernel, v: &mut Vertices, len: usize) {
         Kernel::MetallicRoughness => weigh_layers_of::<MetallicRoughness>(v, len, |v, i| {
             Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i])
         }),
+        Kernel::CoatedLambert => weigh_coats::<LaneCoated<Lambertian>>(v, len),
+        Kernel::CoatedCookTorrance => {
+            type M = LaneCoated<Rough<LaneCookTorrance, false>>;
+            weigh_layers_of::<M>(v, len, |v, i| Microfacet::smith::<false>(v.alpha[0][i], v.alpha[1][i]));
+            weigh_coats::<M>(v, len);
+        }
+        Kernel::CoatedMetallicRoughness => {
+            type M = LaneCoated<MetallicRoughness>;
+            weigh_layers_of::<M>(v, len, |v, i| Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]));
+            weigh_coats::<M>(v, len);
+        }
         _ => {}
     }
+}
+
+/// Each coated vertex's coat albedo towards its viewer ([`crate::bsdf::Coated::coat_albedo`]),
+/// for kernel `M`.
+fn weigh_coats<M: LaneBsdf>(v: &mut Vertices, len: usize) {
+    let mut coats = v.coats.take().unwrap_or_default();
+    for i in 0..len {
+        let cos = view::<M>(v, i).wv.z;
+        coats.albedo[i] = coat_albedo(coats.weight[i], coats.row[i], coats.ior[i], cos);
+    }
+    v.coats = Some(coats);
 }
 
 /// [`weigh_layers`] for kernel `M`, whose Cook–Torrance lobe has the facets `facets` gives.
@@ -1972,6 +2115,21 @@ shape = "sphere"
 center = [-0.5, 1.0, 0.6]
 radius = 0.3
 material = { bsdf = { type = "dielectric", roughness = 0.2, distribution = "ggx", ior = 1.5, transmittance = [0.6, 0.8, 0.9] } }
+[[object]]
+shape = "sphere"
+center = [1.9, 0.35, 2.6]
+radius = 0.35
+material = { bsdf = { type = "coated", roughness = 0.05, weight = 0.8, base = { type = "lambert", color = { checker = { even = [0.8, 0.1, 0.1], odd = [0.9, 0.9, 0.8], size = 0.1 } } } } }
+[[object]]
+shape = "box"
+min = [-1.2, 0, -2.8]
+max = [-0.4, 0.8, -2.0]
+material = { bsdf = { type = "coated", roughness = 0.15, ior = 1.6, base = { type = "cook-torrance", roughness = 0.3, distribution = "ggx", color = [0.2, 0.3, 0.7], ks = 1.0, layered = true } } }
+[[object]]
+shape = "sphere"
+center = [2.9, 1.2, 1.2]
+radius = 0.4
+material = { bsdf = { type = "coated", roughness = 0.02, base = { type = "metallic-roughness", metallic = 0.6, roughness = 0.5, color = [0.7, 0.1, 0.1] } } }
 "#;
 
     /// [`MIXED`] with its metallic–roughness sphere given a map (4 × 4 texels: roughness from
