@@ -844,7 +844,7 @@ impl PathTracer<'_> {
 
     /// [`Self::vertex`] for a lane no material kernel shades, out of line: inlined, the
     /// general kernel's every BSDF grew the per-path stage the kernels' lanes run through
-    /// (and cost the Lambert-only Cornell box 4 %).
+    /// (and cost the Lambert-only Cornell box 2–4 %).
     #[inline(never)]
     fn general_vertex(
         &self,
