@@ -2341,6 +2341,39 @@ material = { bsdf = { type = "coated", roughness = 0.02, base = { type = "metall
         }
     }
 
+    /// The course's BSDFs and the layered ones at the ends of their parameters — a Phong
+    /// lobe of exponent 0 and 10⁵, Blinn–Phong of anisotropy 0.001 and exponent 0.01,
+    /// Oren–Nayar of σ 90° and 0, coats of weight 0 and of index 3 over a smooth metal, black
+    /// glass — give finite samples, the lanes' the per-path tracer's bits.
+    #[test]
+    fn extreme_parameters_give_finite_samples() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        let text = std::fs::read_to_string(root.join("cornell-box.toml")).unwrap();
+        let materials = [
+            r#"{ type = "phong", color = [0.8, 0.8, 0.8], ks = 1.0, kd = 0, exponent = 0 }"#,
+            r#"{ type = "phong", color = [0.8, 0.8, 0.8], ks = 0.5, exponent = 100000 }"#,
+            r#"{ type = "blinn-phong", color = [0.8, 0.8, 0.8], ks = 0.9, exponent = 5000, anisotropy = 0.001 }"#,
+            r#"{ type = "blinn-phong", color = [0.8, 0.8, 0.8], ks = 0.3, exponent = 0.01 }"#,
+            r#"{ type = "oren-nayar", color = [0.8, 0.8, 0.8], sigma = 90 }"#,
+            r#"{ type = "oren-nayar", color = [0.8, 0.8, 0.8], sigma = 0 }"#,
+            r#"{ type = "coated", weight = 0, base = { type = "lambert", color = [0.8, 0.8, 0.8] } }"#,
+            r#"{ type = "coated", roughness = 0.01, ior = 3, base = { type = "metallic-roughness", metallic = 1, roughness = 0 } }"#,
+            r#"{ type = "dielectric", ior = 1.5, transmittance = [0, 0, 0] }"#,
+        ];
+        for bsdf in materials {
+            let walls = text.replace(
+                r#"bsdf = { type = "lambert", color = [0.885809, 0.698859, 0.666422] }"#,
+                &format!("bsdf = {bsdf}"),
+            );
+            assert_ne!(walls, text, "the white walls take {bsdf}");
+            let mut scene = alhazen_scene::parse_scene("extreme.toml".as_ref(), &walls).unwrap();
+            (scene.render.width, scene.render.height, scene.render.spp, scene.render.max_depth) = (10, 10, 5, 5);
+            let (lanes, per_path) = samples(&scene, VectorUnit::detect());
+            assert!(lanes.iter().all(|c| c.is_finite()), "{bsdf}: not finite");
+            assert!(same_bits(&lanes, &per_path), "{bsdf}: the lanes' samples differ");
+        }
+    }
+
     /// The mixed scene's materials take every material kernel, so that
     /// `lanes_match_the_per_path_tracer` checks each of them.
     #[test]
