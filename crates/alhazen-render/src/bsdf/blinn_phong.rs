@@ -46,15 +46,13 @@ impl BlinnPhongLobe {
 impl SpecularLobe for BlinnPhongLobe {
     #[inline(always)]
     fn value(&self, v: Vec3, l: Vec3) -> f64 {
-        let Some(h) = half_vector(v, l) else { return 0.0 };
-        self.density(h) / (4.0 * h.dot(l).abs() * l.z.abs().max(v.z.abs()))
+        self.value_pdf(v, l).0
     }
 
     /// The half-vector density mapped to `l` (Jacobian `1/(4⟨h,l⟩)`).
     #[inline(always)]
     fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        let Some(h) = half_vector(v, l) else { return 0.0 };
-        self.density(h) / (4.0 * h.dot(l).abs())
+        self.value_pdf(v, l).1
     }
 
     #[inline(always)]

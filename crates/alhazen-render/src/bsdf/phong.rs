@@ -29,29 +29,22 @@ fn mirror(v: Vec3) -> Vec3 {
     reflect(v, Vec3::new(0.0, 0.0, v.z.signum()))
 }
 
-impl PhongLobe {
-    /// `max(0, ⟨r, l⟩)^m`, the power by our own [`pow`] (no library call: the same bits on
-    /// every processor).
-    #[inline(always)]
-    fn power(&self, v: Vec3, l: Vec3) -> f64 {
-        pow(mirror(v).dot(l).max(0.0), self.exponent)
-    }
-}
-
 impl SpecularLobe for PhongLobe {
     #[inline(always)]
     fn value(&self, v: Vec3, l: Vec3) -> f64 {
-        (self.exponent + 2.0) / (2.0 * PI) * self.power(v, l)
+        self.value_pdf(v, l).0
     }
 
     #[inline(always)]
     fn pdf(&self, v: Vec3, l: Vec3) -> f64 {
-        (self.exponent + 1.0) / (2.0 * PI) * self.power(v, l)
+        self.value_pdf(v, l).1
     }
 
+    /// `max(0, ⟨r, l⟩)^m` once, by our own [`pow`] (no library call: the same bits on every
+    /// processor).
     #[inline(always)]
     fn value_pdf(&self, v: Vec3, l: Vec3) -> (f64, f64) {
-        let power = self.power(v, l);
+        let power = pow(mirror(v).dot(l).max(0.0), self.exponent);
         ((self.exponent + 2.0) / (2.0 * PI) * power, (self.exponent + 1.0) / (2.0 * PI) * power)
     }
 

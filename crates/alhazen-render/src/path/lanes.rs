@@ -906,21 +906,7 @@ impl PathTracer<'_> {
         let Batch { vertices: v, lights, .. } = &mut batches.all[b];
         match bsdf {
             Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
-            Bsdf::Coated(c) => {
-                match &c.base {
-                    Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
-                    Bsdf::CookTorrance(base) => set_cook_torrance(v, i, base),
-                    Bsdf::Mix(mix) if let Some((metal, base, weight)) = metallic_roughness(mix) => {
-                        set_metallic_roughness(v, i, (metal, base, weight))
-                    }
-                    _ => {
-                        // No coated kernel's (`kernel_of` gives none to other bases).
-                        batches.all[b].len -= 1;
-                        return None;
-                    }
-                }
-                set_coat(v, i, c);
-            }
+            Bsdf::Coated(c) if set_coated_base(v, i, &c.base) => set_coat(v, i, c),
             Bsdf::OrenNayar(o) => {
                 set(&mut v.albedo, i, o.albedo);
                 v.alpha[0][i] = o.sigma;
@@ -1108,6 +1094,18 @@ fn set_metallic_roughness(v: &mut Vertices, i: usize, (metal, base, weight): (&C
     set(&mut v.albedo, i, base.diffuse);
     (v.ks[i], v.ior[i], v.layer[i]) = (base.ks, base.lobe.ior, base.lobe.layer);
     v.mix_weight[i] = weight;
+}
+
+/// Lane `i`'s base under a clear coat; false where no coated kernel has it (`kernel_of` gives
+/// none to other bases: the slot is then given back, as for any BSDF without a kernel).
+fn set_coated_base(v: &mut Vertices, i: usize, base: &Bsdf) -> bool {
+    match base {
+        Bsdf::Lambert(lambert) => set(&mut v.albedo, i, lambert.albedo),
+        Bsdf::CookTorrance(base) => set_cook_torrance(v, i, base),
+        Bsdf::Mix(mix) if let Some(parts) = metallic_roughness(mix) => set_metallic_roughness(v, i, parts),
+        _ => return false,
+    }
+    true
 }
 
 /// Lane `i`'s clear coat (its albedo towards the viewer found later, `weigh_layers`).
