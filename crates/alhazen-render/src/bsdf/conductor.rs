@@ -123,7 +123,8 @@ impl Conductor {
 
     /// [`Self::eval_pdf`] on `facets` with the lobe of several facets `ms` seen from `v` and
     /// the probability of sampling it.
-    fn eval_pdf_with(
+    #[inline(always)]
+    pub(crate) fn eval_pdf_with(
         &self,
         facets: &Microfacet,
         ms: Option<(&super::multiscatter::MultipleScattering, f64)>,
@@ -139,14 +140,15 @@ impl Conductor {
     }
 
     /// The lobe of several facets seen from `v` and the probability of sampling it.
-    fn lobe_seen_from(&self, v: Vec3) -> Option<(super::multiscatter::MultipleScattering, f64)> {
+    pub(crate) fn lobe_seen_from(&self, v: Vec3) -> Option<(super::multiscatter::MultipleScattering, f64)> {
         let ms = self.multiple_scattering(v)?;
         Some((ms, ms.choice(self.fresnel(v.z))))
     }
 
     /// The mirror direction, or reflection about a sampled facet (or, with
     /// [`Self::multiscatter`], by `uc`, a cosine-weighted direction for the light of several
-    /// facets), valued as the whole BSDF.
+    /// facets), valued as the whole BSDF. (The lanes' kernels draw it as `several_lobe_sample`
+    /// in `path/lanes.rs`, every candidate computed and then one taken: the same numbers.)
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let Some(facets) = &self.facets else { return Some(self.smooth_sample(v)) };
         let Some((ms, p)) = self.lobe_seen_from(v) else {

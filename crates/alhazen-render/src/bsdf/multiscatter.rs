@@ -22,32 +22,25 @@ const N: usize = 32;
 /// Stratified directions per table cell (`STRATA²`).
 const STRATA: usize = 16;
 
-/// `E(μ, α)` on the grid `μ_j = j/(N−1)`, `r_i = i/(N−1)` (`α = r²`), and `E_avg` per `r_i`.
-struct Tables {
-    albedo: [[f64; N]; N],
-    average: [f64; N],
-}
+/// `E(μ, α)` on the grid `μ_j = j/(N−1)` (columns), `r_i = i/(N−1)` (rows, `α = r²`): the
+/// values [`single_scattering_albedo`] gives (test `the_albedo_table_is_the_computed_one`),
+/// written out so that a lookup reads a fixed address — the lanes' loops gather from it
+/// without first asking whether a table has been made.
+static ALBEDO: [[f64; N]; N] = include!("multiscatter_albedo.rs");
 
-fn tables() -> &'static Tables {
-    static TABLES: OnceLock<Tables> = OnceLock::new();
-    TABLES.get_or_init(|| {
-        let mut albedo = [[0.0; N]; N];
-        for (i, row) in albedo.iter_mut().enumerate() {
-            let alpha = alpha_at(i);
-            for (j, e) in row.iter_mut().enumerate() {
-                *e = single_scattering_albedo(j as f64 / (N - 1) as f64, alpha);
-            }
-        }
-        // E_avg = 2 ∫ E(μ) μ dμ by the trapezoid rule on the grid.
-        let average = std::array::from_fn(|i| {
+/// `E_avg` per `r_i`: `2 ∫ E(μ) μ dμ` by the trapezoid rule on the grid.
+fn averages() -> &'static [f64; N] {
+    static AVERAGES: OnceLock<[f64; N]> = OnceLock::new();
+    AVERAGES.get_or_init(|| {
+        std::array::from_fn(|i| {
             let h = 1.0 / (N - 1) as f64;
-            let f = |j: usize| albedo[i][j] * (j as f64 * h);
+            let f = |j: usize| ALBEDO[i][j] * (j as f64 * h);
             2.0 * h * ((1..N - 1).map(f).sum::<f64>() + 0.5 * (f(0) + f(N - 1)))
-        });
-        Tables { albedo, average }
+        })
     })
 }
 
+#[cfg(test)]
 /// The `α` of table row `i` (at least the facets' least, 10⁻³).
 fn alpha_at(i: usize) -> f64 {
     let r = i as f64 / (N - 1) as f64;
@@ -55,6 +48,7 @@ fn alpha_at(i: usize) -> f64 {
 }
 
 /// `∫ D G / (4 μ_v μ_l) μ_l dω_l` for `F = 1` at `μ_v = mu`.
+#[cfg(test)]
 fn single_scattering_albedo(mu: f64, alpha: f64) -> f64 {
     stratified_albedo(&Microfacet::smith::<false>(alpha, alpha), mu, |_| 1.0)
 }
@@ -106,29 +100,31 @@ impl Row {
 }
 
 /// Bilinear lookup of the table at `mu` between the rows of `row`.
+#[inline(always)]
 pub(crate) fn lookup_in(mu: f64, Row { i, fy }: Row) -> f64 {
-    let t = tables();
     let x = mu.clamp(0.0, 1.0) * (N - 1) as f64;
     let j = (x as usize).min(N - 2);
     let fx = x - j as f64;
-    let row = |i: usize| t.albedo[i][j] * (1.0 - fx) + t.albedo[i][j + 1] * fx;
+    // (A row's index is at most N − 2 already: said again, so that no bound is checked.)
+    let i = i.min(N - 2);
+    let row = |i: usize| ALBEDO[i][j] * (1.0 - fx) + ALBEDO[i][j + 1] * fx;
     row(i) * (1.0 - fy) + row(i + 1) * fy
 }
 
 /// `E_avg` at `alpha`, interpolated.
 fn average(alpha: f64) -> f64 {
-    let t = tables();
+    let t = averages();
     let y = alpha.max(0.0).sqrt().min(1.0) * (N - 1) as f64;
     let i = (y as usize).min(N - 2);
     let fy = y - i as f64;
-    t.average[i] * (1.0 - fy) + t.average[i + 1] * fy
+    t[i] * (1.0 - fy) + t[i + 1] * fy
 }
 
 /// What the compensating lobe of a material keeps whatever the directions: where the facets'
 /// roughness `alpha` (for two roughnesses, their geometric mean) falls in the table, `E_avg(α)`, and
 /// `F_ms / (π (1 − E_avg))` for its Fresnel term's mean. Found once per material (or per
 /// point of a textured one), not at every evaluation.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SeveralFacets {
     row: Row,
     e_avg: f64,
@@ -152,7 +148,7 @@ impl SeveralFacets {
 }
 
 /// The compensating lobe seen from one direction.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct MultipleScattering {
     /// `1 − E(μ_v)`: the energy the single-scattering lobe loses towards `v`.
     lost_v: f64,
@@ -161,6 +157,7 @@ pub(crate) struct MultipleScattering {
 
 impl MultipleScattering {
     /// `f_ms(v, l)` for `l` on `v`'s side.
+    #[inline(always)]
     pub(crate) fn eval(&self, l: Vec3) -> Vec3 {
         self.lobe.scale * (self.lost_v * (1.0 - lookup_in(l.z.abs(), self.lobe.row)))
     }
@@ -192,6 +189,18 @@ pub(crate) fn fresnel_average(fresnel: impl Fn(f64) -> Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The written-out table is what the albedo's quadrature gives (to 10⁻¹²: another C
+    /// library's square roots or sines could move a last bit).
+    #[test]
+    fn the_albedo_table_is_the_computed_one() {
+        for (i, row) in ALBEDO.iter().enumerate() {
+            for (j, &e) in row.iter().enumerate() {
+                let computed = single_scattering_albedo(j as f64 / (N - 1) as f64, alpha_at(i));
+                assert!((e - computed).abs() <= 1e-12, "row {i}, column {j}: {e} written, {computed} computed");
+            }
+        }
+    }
 
     /// The single-scattering albedo falls with roughness; smooth facets lose nothing.
     #[test]

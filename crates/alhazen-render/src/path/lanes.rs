@@ -42,7 +42,7 @@
 use super::{PathState, PathTracer, RR_DEPTH, Terminator, Vertex, offset, power_heuristic, shadow_segment};
 use crate::bsdf::coated::{coat_albedo, coat_choice, sample_under_layer, under_coat};
 use crate::bsdf::layered::{DiffuseSpecular, SpecularLobe};
-use crate::bsdf::multiscatter::Row;
+use crate::bsdf::multiscatter::{MultipleScattering, Row, SeveralFacets};
 use crate::bsdf::{
     BlinnPhongLobe, Bsdf, BsdfSample, Coat, ColorMode, Conductor, CookTorrance, CookTorranceLobe, Dielectric, Frame,
     Microfacet, MicrofacetLobes, OrenNayar, PhongLobe, Plastic, cosine_hemisphere, cosine_pdf, same_side,
@@ -158,6 +158,14 @@ struct Vertices {
     /// A coated kernel's coats, made when its batch first needs them (in the batch's own
     /// lanes, their fields cost every kernel: see `alpha`).
     coats: Option<Box<CoatLanes>>,
+    /// The metals' light of several facets ([`Conductor::multiscatter`]) of a kernel whose
+    /// metals give it back, made when its batch first needs it (as `coats`), and
+    /// (`weigh_layers`) that lobe seen from the viewer with the probability of sampling it:
+    /// found once for the vertex's light sample, its continuation and their evaluations, where
+    /// the per-path tracer finds it for each. (The latter in the batch's own lanes: read
+    /// through an `Option` the kernel's loop would stay scalar.)
+    several: Option<Box<[SeveralFacets; LANES]>>,
+    several_seen: [(MultipleScattering, f64); LANES],
 }
 
 /// Each lane's clear coat ([`crate::bsdf::Coated`]) over the base the other lanes describe: its
@@ -450,11 +458,19 @@ pub(crate) enum Kernel {
     CoatedLambert,
     CoatedCookTorrance,
     CoatedMetallicRoughness,
+    /// [`Kernel::MetallicRoughness`] and [`Kernel::CoatedMetallicRoughness`] whose metal gives
+    /// back the light of several facets ([`Conductor::multiscatter`]), and rough conductors
+    /// that do (Trowbridge–Reitz facets, Smith's shadowing; exact or Schlick's Fresnel term):
+    /// every glTF material's, as Blender's Principled BSDF has it.
+    SeveralMetallicRoughness,
+    CoatedSeveralMetallicRoughness,
+    SeveralConductor,
+    SeveralSchlickConductor,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 23] = [
+const MATERIAL_KERNELS: [Kernel; 27] = [
     Kernel::Lambert,
     Kernel::OrenNayar,
     Kernel::Phong,
@@ -478,6 +494,10 @@ const MATERIAL_KERNELS: [Kernel; 23] = [
     Kernel::CoatedLambert,
     Kernel::CoatedCookTorrance,
     Kernel::CoatedMetallicRoughness,
+    Kernel::SeveralMetallicRoughness,
+    Kernel::CoatedSeveralMetallicRoughness,
+    Kernel::SeveralConductor,
+    Kernel::SeveralSchlickConductor,
 ];
 
 impl Kernel {
@@ -510,6 +530,10 @@ impl Kernel {
                 | Kernel::CoatedLambert
                 | Kernel::CoatedCookTorrance
                 | Kernel::CoatedMetallicRoughness
+                | Kernel::SeveralMetallicRoughness
+                | Kernel::CoatedSeveralMetallicRoughness
+                | Kernel::SeveralConductor
+                | Kernel::SeveralSchlickConductor
         )
     }
 
@@ -545,7 +569,12 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
         Bsdf::Phong(p) if p.transmittance == Vec3::ZERO => Kernel::Phong,
         Bsdf::BlinnPhong(b) if b.transmittance == Vec3::ZERO => Kernel::BlinnPhong,
         // The light of several facets is the general kernel's.
-        Bsdf::Conductor(c) if c.multiple_scattering(Vec3::Z).is_some() || c.film.is_some() => Kernel::General,
+        Bsdf::Conductor(c) if c.film.is_some() => Kernel::General,
+        Bsdf::Conductor(c) if c.multiscatter.is_some() => match (conductor_facets(c), c.schlick) {
+            (Some(false), false) => Kernel::SeveralConductor,
+            (Some(false), true) => Kernel::SeveralSchlickConductor,
+            _ => Kernel::General,
+        },
         Bsdf::Conductor(c) => match (c.facets.map(|_| conductor_facets(c)), c.schlick) {
             (None, false) => Kernel::SmoothConductor,
             (None, true) => Kernel::SmoothSchlickConductor,
@@ -577,11 +606,18 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             Kernel::Lambert => Kernel::CoatedLambert,
             Kernel::CookTorrance => Kernel::CoatedCookTorrance,
             Kernel::MetallicRoughness => Kernel::CoatedMetallicRoughness,
+            Kernel::SeveralMetallicRoughness => Kernel::CoatedSeveralMetallicRoughness,
             _ => Kernel::General,
         },
         Bsdf::Mix(mix) if lambert_mirror(mix).is_some() && !crate::bsdf::is_anisotropic(m) => Kernel::LambertMirror,
-        Bsdf::Mix(mix) if metallic_roughness(mix).is_some() && !crate::bsdf::is_anisotropic(m) => {
-            Kernel::MetallicRoughness
+        Bsdf::Mix(mix)
+            if let Some((metal, ..)) = metallic_roughness(mix)
+                && !crate::bsdf::is_anisotropic(m) =>
+        {
+            match metal.multiscatter {
+                None => Kernel::MetallicRoughness,
+                Some(_) => Kernel::SeveralMetallicRoughness,
+            }
         }
         _ => Kernel::General,
     }
@@ -628,7 +664,6 @@ fn metallic_roughness(mix: &crate::bsdf::Mix) -> Option<(&Conductor, &CookTorran
     match (&mix.a, &mix.b) {
         (Bsdf::Conductor(c), Bsdf::CookTorrance(base))
             if c.schlick
-                && c.multiscatter.is_none()
                 && c.film.is_none()
                 && conductor_facets(c) == Some(false)
                 && c.facets.is_some_and(|f| f.alpha_u == f.alpha_v)
@@ -925,6 +960,7 @@ impl PathTracer<'_> {
                 set(&mut v.eta, i, c.eta);
                 set(&mut v.k, i, c.k);
                 set(&mut v.tint, i, c.tint);
+                set_several(v, i, c);
                 if let Some(facets) = &c.facets {
                     set_facets(v, i, facets, crate::bsdf::tangent_at(m, &wh.hit, &self.scene.images));
                 }
@@ -1094,6 +1130,15 @@ fn set_metallic_roughness(v: &mut Vertices, i: usize, (metal, base, weight): (&C
     set(&mut v.albedo, i, base.diffuse);
     (v.ks[i], v.ior[i], v.layer[i]) = (base.ks, base.lobe.ior, base.lobe.layer);
     v.mix_weight[i] = weight;
+    set_several(v, i, metal);
+}
+
+/// Lane `i`'s metal's light of several facets, where it gives it back.
+#[inline(always)]
+fn set_several(v: &mut Vertices, i: usize, metal: &Conductor) {
+    if let Some(several) = metal.multiscatter {
+        v.several.get_or_insert_with(Box::default)[i] = several;
+    }
 }
 
 /// Lane `i`'s base under a clear coat; false where no coated kernel has it (`kernel_of` gives
@@ -1643,12 +1688,14 @@ impl LaneBsdf for LambertMirror {
 
 /// The glTF metallic–roughness mix (lane `i`'s `mix_weight` the metal's share): a rough
 /// conductor with Schlick's term on the lane's `alpha[0]` and Cook–Torrance on its `alpha[1]`,
-/// both isotropic Trowbridge–Reitz facets; [`crate::bsdf::Mix`]'s arithmetic, its sample
+/// both isotropic Trowbridge–Reitz facets, the metal giving back the light of several facets
+/// with `SEVERAL` (the lanes' `several_seen`); [`crate::bsdf::Mix`]'s arithmetic, its sample
 /// drawn from both components and then chosen.
-struct MetallicRoughness;
+struct MetallicRoughness<const SEVERAL: bool>;
 
-impl MetallicRoughness {
-    /// Lane `i`'s metal and its facets, its Cook–Torrance base, and the metal's weight.
+impl<const SEVERAL: bool> MetallicRoughness<SEVERAL> {
+    /// Lane `i`'s metal (its light of several facets, if any, apart: [`several_lobe`]) and its
+    /// facets, its Cook–Torrance base, and the metal's weight.
     #[inline(always)]
     fn at(v: &Vertices, i: usize) -> ((Conductor, Microfacet), CookTorrance, f64) {
         let metal_facets = Microfacet::smith::<false>(v.alpha[0][i], v.alpha[0][i]);
@@ -1662,26 +1709,88 @@ impl MetallicRoughness {
     }
 }
 
-impl LaneBsdf for MetallicRoughness {
+impl<const SEVERAL: bool> LaneBsdf for MetallicRoughness<SEVERAL> {
     #[inline(always)]
     fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let ((metal, metal_facets), base, w) = Self::at(v, i);
-        let (fa, pa) = metal.rough_eval_pdf(&metal_facets, wv, l);
+        let several = if SEVERAL { Some(v.several_seen[i]) } else { None };
+        let (fa, pa) = metal.eval_pdf_with(&metal_facets, several.as_ref().map(|(ms, p)| (ms, *p)), wv, l);
         let (fb, pb) = base.eval_pdf_weighted(v.diffuse_weight[i], wv, l);
         (crate::bsdf::blend(w, fa, fb), crate::bsdf::blend_density(w, pa, pb))
     }
 
     /// `Mix::sample`: the metal with probability `w`, else the base (each drawn as
-    /// `Bsdf::sample` draws it: the metal's without its lobe number), valued as the whole mix.
+    /// `Bsdf::sample` draws it: the metal's without its lobe number, or, with several facets,
+    /// with it, rescaled: [`several_lobe_sample`]), valued as the whole mix; every candidate
+    /// computed, then the chosen one taken.
     #[inline(always)]
     fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let ((metal, metal_facets), base, w) = Self::at(v, i);
         let (first, uc) = crate::bsdf::Mix::component_choice(w, uc);
-        let (metal_ok, metal_sample) = metal.rough_sample(&metal_facets, wv, 0.0, u);
+        let (metal_ok, metal_sample) = match SEVERAL {
+            true => several_lobe_sample(&metal, &metal_facets, v.several_seen[i], wv, uc, u),
+            false => metal.rough_sample(&metal_facets, wv, 0.0, u),
+        };
         let (base_ok, base_sample) = base.sample_weighted(v.diffuse_weight[i], wv, uc, u);
         let (sampled, l) = if first { (metal_ok, metal_sample.l) } else { (base_ok, base_sample.l) };
         let (f, pdf) = Self::eval_pdf(v, coat, i, wv, l);
         (sampled && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+    }
+}
+
+/// [`Conductor::sample`] with several facets, in the lanes' form: `metal` on `facets` with its
+/// lobe of several facets seen from `wv` and the probability of sampling it (`seen`), the lobe
+/// chosen by `uc` — its cosine-weighted direction and the facet's both computed, then one
+/// taken —, kept where the metal's own density is not 0.
+#[inline(always)]
+fn several_lobe_sample(
+    metal: &Conductor,
+    facets: &Microfacet,
+    (ms, p): (MultipleScattering, f64),
+    wv: Vec3,
+    uc: f64,
+    u: Vec2,
+) -> (bool, BsdfSample) {
+    let (facet_ok, facet) = metal.rough_sample(facets, wv, 0.0, u);
+    let several = uc < p;
+    let l = if several { cosine_hemisphere(u, wv) } else { facet.l };
+    let (f, pdf) = metal.eval_pdf_with(facets, Some((&ms, p)), wv, l);
+    ((several || facet_ok) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+}
+
+/// A rough conductor (Trowbridge–Reitz facets, Smith's shadowing; Schlick's Fresnel term
+/// where `SCHLICK`) giving back the light of several facets: [`Conductor::eval_pdf`] and
+/// [`Conductor::sample`], its lobe seen from the viewer found before the loop
+/// (`several_seen`).
+struct SeveralConductor<const SCHLICK: bool>(Conductor, (MultipleScattering, f64));
+
+impl<const SCHLICK: bool> SeveralConductor<SCHLICK> {
+    /// Lane `i`'s metal without its lobe of several facets.
+    #[inline(always)]
+    fn metal(v: &Vertices, i: usize) -> Conductor {
+        let facets = Microfacet::smith::<false>(v.alpha[0][i], v.alpha[1][i]);
+        let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
+        Conductor { facets: Some(facets), eta, k, tint, schlick: SCHLICK, multiscatter: None, film: None }
+    }
+}
+
+impl<const SCHLICK: bool> MicrofacetLobes for SeveralConductor<SCHLICK> {
+    #[inline(always)]
+    fn rough_eval_pdf(&self, facets: &Microfacet, v: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (ms, p) = self.1;
+        self.0.eval_pdf_with(facets, Some((&ms, p)), v, l)
+    }
+
+    #[inline(always)]
+    fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        several_lobe_sample(&self.0, facets, self.1, v, uc, u)
+    }
+}
+
+impl<const SCHLICK: bool> RoughBsdf for SeveralConductor<SCHLICK> {
+    #[inline(always)]
+    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
+        SeveralConductor(Conductor { facets: Some(facets), ..Self::metal(v, i) }, v.several_seen[i])
     }
 }
 
@@ -1706,10 +1815,14 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
         Kernel::BeckmannSchlickConductor => shade::<Rough<SchlickConductor, true>>(v, coat, out, len, unit),
         Kernel::SmoothSchlickConductor => shade::<SmoothConductor<true>>(v, coat, out, len, unit),
         Kernel::LambertMirror => shade::<LambertMirror>(v, coat, out, len, unit),
-        Kernel::MetallicRoughness => shade::<MetallicRoughness>(v, coat, out, len, unit),
+        Kernel::MetallicRoughness => shade::<MetallicRoughness<false>>(v, coat, out, len, unit),
+        Kernel::SeveralMetallicRoughness => shade::<MetallicRoughness<true>>(v, coat, out, len, unit),
+        Kernel::SeveralConductor => shade::<Rough<SeveralConductor<false>, false>>(v, coat, out, len, unit),
+        Kernel::SeveralSchlickConductor => shade::<Rough<SeveralConductor<true>, false>>(v, coat, out, len, unit),
         Kernel::CoatedLambert => shade::<LaneCoated<Lambertian>>(v, coat, out, len, unit),
         Kernel::CoatedCookTorrance => shade::<LaneCoated<Rough<LaneCookTorrance, false>>>(v, coat, out, len, unit),
-        Kernel::CoatedMetallicRoughness => shade::<LaneCoated<MetallicRoughness>>(v, coat, out, len, unit),
+        Kernel::CoatedMetallicRoughness => shade::<LaneCoated<MetallicRoughness<false>>>(v, coat, out, len, unit),
+        Kernel::CoatedSeveralMetallicRoughness => shade::<LaneCoated<MetallicRoughness<true>>>(v, coat, out, len, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, coat, out, len, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, coat, out, len, unit),
         Kernel::Idle | Kernel::General | Kernel::Escaped => {}
@@ -1880,9 +1993,22 @@ fn weigh_layers(kernel: Kernel, v: &mut Vertices, len: usize) {
         Kernel::BeckmannCookTorrance => weigh_layers_of::<Rough<LaneCookTorrance, true>>(v, len, |v, i| {
             Microfacet::smith::<true>(v.alpha[0][i], v.alpha[1][i])
         }),
-        Kernel::MetallicRoughness => weigh_layers_of::<MetallicRoughness>(v, len, |v, i| {
+        Kernel::MetallicRoughness => weigh_layers_of::<MetallicRoughness<false>>(v, len, |v, i| {
             Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i])
         }),
+        Kernel::SeveralMetallicRoughness => {
+            type M = MetallicRoughness<true>;
+            weigh_layers_of::<M>(v, len, |v, i| Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]));
+            weigh_several::<M>(v, len, |v, i| M::at(v, i).0.0);
+        }
+        Kernel::SeveralConductor => {
+            type M = Rough<SeveralConductor<false>, false>;
+            weigh_several::<M>(v, len, SeveralConductor::<false>::metal);
+        }
+        Kernel::SeveralSchlickConductor => {
+            type M = Rough<SeveralConductor<true>, false>;
+            weigh_several::<M>(v, len, SeveralConductor::<true>::metal);
+        }
         Kernel::CoatedLambert => weigh_coats::<LaneCoated<Lambertian>>(v, len),
         Kernel::CoatedCookTorrance => {
             type M = LaneCoated<Rough<LaneCookTorrance, false>>;
@@ -1890,9 +2016,15 @@ fn weigh_layers(kernel: Kernel, v: &mut Vertices, len: usize) {
             weigh_coats::<M>(v, len);
         }
         Kernel::CoatedMetallicRoughness => {
-            type M = LaneCoated<MetallicRoughness>;
+            type M = LaneCoated<MetallicRoughness<false>>;
             weigh_layers_of::<M>(v, len, |v, i| Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]));
             weigh_coats::<M>(v, len);
+        }
+        Kernel::CoatedSeveralMetallicRoughness => {
+            type M = LaneCoated<MetallicRoughness<true>>;
+            weigh_layers_of::<M>(v, len, |v, i| Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]));
+            weigh_coats::<M>(v, len);
+            weigh_several::<M>(v, len, |v, i| MetallicRoughness::<true>::at(v, i).0.0);
         }
         _ => {}
     }
@@ -1907,6 +2039,18 @@ fn weigh_coats<M: LaneBsdf>(v: &mut Vertices, len: usize) {
         coats.albedo[i] = coat_albedo(coats.weight[i], coats.row[i], coats.ior[i], cos);
     }
     v.coats = Some(coats);
+}
+
+/// Each vertex's metal's lobe of several facets seen from its viewer, with the probability of
+/// sampling it ([`Conductor::lobe_seen_from`]), for kernel `M` whose lane `i`'s metal
+/// (without that lobe) `metal` gives (a coat over the metal sees it from the same direction).
+fn weigh_several<M: LaneBsdf>(v: &mut Vertices, len: usize, metal: impl Fn(&Vertices, usize) -> Conductor) {
+    let several = v.several.take().unwrap_or_default();
+    for i in 0..len {
+        let metal = Conductor { multiscatter: Some(several[i]), ..metal(v, i) };
+        v.several_seen[i] = metal.lobe_seen_from(view::<M>(v, i).wv).unwrap_or_default();
+    }
+    v.several = Some(several);
 }
 
 /// [`weigh_layers`] for kernel `M`, whose Cook–Torrance lobe has the facets `facets` gives.
@@ -2128,6 +2272,26 @@ shape = "sphere"
 center = [2.9, 1.2, 1.2]
 radius = 0.4
 material = { bsdf = { type = "coated", roughness = 0.02, base = { type = "metallic-roughness", metallic = 0.6, roughness = 0.5, color = [0.7, 0.1, 0.1] } } }
+[[object]]
+shape = "sphere"
+center = [-2.6, 0.45, 1.6]
+radius = 0.45
+material = { bsdf = { type = "metallic-roughness", metallic = 0.7, roughness = 0.45, multiscatter = true, color = { checker = { even = [0.95, 0.7, 0.3], odd = [0.2, 0.5, 0.3], size = 0.12 } } } }
+[[object]]
+shape = "box"
+min = [2.2, 1.6, -2.8]
+max = [2.9, 2.3, -2.1]
+material = { bsdf = { type = "coated", roughness = 0.1, weight = 0.7, base = { type = "metallic-roughness", metallic = 0.4, roughness = 0.6, multiscatter = true, color = [0.3, 0.6, 0.9] } } }
+[[object]]
+shape = "sphere"
+center = [-2.9, 1.5, 0.2]
+radius = 0.4
+material = { bsdf = { type = "conductor", roughness = 0.55, distribution = "ggx", eta = [3.0, 2.2, 1.5], k = [0, 0, 0], fresnel = "schlick", multiscatter = true, tint = [0.95, 0.9, 0.8] } }
+[[object]]
+shape = "sphere"
+center = [1.6, 2.4, 0.8]
+radius = 0.35
+material = { bsdf = { type = "conductor", metal = "copper", roughness = 0.35, multiscatter = true } }
 "#;
 
     /// [`MIXED`] with its metallic–roughness sphere given a map (4 × 4 texels: roughness from
