@@ -150,17 +150,22 @@ impl Dielectric {
     /// reflected by its faces and the bounces between them (`R` a face's reflectance, the same
     /// from either side), or `−v` straight through the sheet.
     pub(crate) fn thin_sample(&self, v: Vec3, uc: f64) -> Option<BsdfSample> {
-        if v.z == 0.0 || !v.z.is_finite() {
-            return None;
-        }
+        let (sampled, sample) = self.thin_sample_whole(v, uc);
+        sampled.then_some(sample)
+    }
+
+    /// [`Self::thin_sample`] computed whole and then chosen, for the lanes as for it: whether
+    /// there is one (`v` off the sheet's plane, finite) and the sample.
+    #[inline(always)]
+    pub(crate) fn thin_sample_whole(&self, v: Vec3, uc: f64) -> (bool, BsdfSample) {
         let r = self.fresnel(v.z.abs());
         let reflectance = 2.0 * r / (1.0 + r);
-        let (l, p, tint) = if uc < reflectance {
-            (reflect(v, Vec3::Z), reflectance, Vec3::ONE)
-        } else {
-            (-v, 1.0 - reflectance, self.tint)
-        };
-        Some(BsdfSample { l, f: Vec3::splat(p / l.z.abs()) * tint, pdf: p, delta: true, eta: 1.0, dispersive: false })
+        let reflects = uc < reflectance;
+        let (l, p, tint) =
+            if reflects { (reflect(v, Vec3::Z), reflectance, Vec3::ONE) } else { (-v, 1.0 - reflectance, self.tint) };
+        let sample =
+            BsdfSample { l, f: Vec3::splat(p / l.z.abs()) * tint, pdf: p, delta: true, eta: 1.0, dispersive: false };
+        (v.z != 0.0 && v.z.is_finite(), sample)
     }
 
     /// The smooth boundary's mirror direction (with probability `F`, when `uc < F`) or

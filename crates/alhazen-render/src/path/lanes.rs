@@ -466,11 +466,14 @@ pub(crate) enum Kernel {
     CoatedSeveralMetallicRoughness,
     SeveralConductor,
     SeveralSchlickConductor,
+    /// A thin sheet of glass (a window: [`Dielectric::thin`]), exact Fresnel term, an index
+    /// that does not disperse.
+    ThinDielectric,
 }
 
 /// The material kernels, in the order of the lanes' [`Shaded`] they write (their order in
 /// [`Kernel`]).
-const MATERIAL_KERNELS: [Kernel; 27] = [
+const MATERIAL_KERNELS: [Kernel; 28] = [
     Kernel::Lambert,
     Kernel::OrenNayar,
     Kernel::Phong,
@@ -498,6 +501,7 @@ const MATERIAL_KERNELS: [Kernel; 27] = [
     Kernel::CoatedSeveralMetallicRoughness,
     Kernel::SeveralConductor,
     Kernel::SeveralSchlickConductor,
+    Kernel::ThinDielectric,
 ];
 
 impl Kernel {
@@ -534,12 +538,19 @@ impl Kernel {
                 | Kernel::CoatedSeveralMetallicRoughness
                 | Kernel::SeveralConductor
                 | Kernel::SeveralSchlickConductor
+                | Kernel::ThinDielectric
         )
     }
 
     /// The kernel's BSDF is a delta distribution: its vertices sample no light.
     fn is_delta(self) -> bool {
-        matches!(self, Kernel::SmoothConductor | Kernel::SmoothSchlickConductor | Kernel::SmoothDielectric)
+        matches!(
+            self,
+            Kernel::SmoothConductor
+                | Kernel::SmoothSchlickConductor
+                | Kernel::SmoothDielectric
+                | Kernel::ThinDielectric
+        )
     }
 
     /// The kernel's BSDF has a delta lobe (a path may leave its vertices specularly).
@@ -584,6 +595,9 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
             (Some(Some(true)), true) => Kernel::BeckmannSchlickConductor,
             (Some(None), _) => Kernel::General,
         },
+        Bsdf::Dielectric(d) if d.thin && d.film.is_none() && d.facets.is_none() && !d.schlick && !d.dispersive => {
+            Kernel::ThinDielectric
+        }
         Bsdf::Dielectric(d) if d.thin || d.film.is_some() => Kernel::General,
         Bsdf::Dielectric(d) if d.facets.is_none() && !d.schlick && !d.dispersive => Kernel::SmoothDielectric,
         Bsdf::Dielectric(d) => match dielectric_facets(d) {
@@ -1625,6 +1639,19 @@ impl LaneBsdf for SmoothDielectric {
     }
 }
 
+/// A thin sheet of glass: [`Dielectric::thin_sample`]; nothing to evaluate (a delta
+/// distribution).
+struct ThinDielectric;
+
+impl LaneBsdf for ThinDielectric {
+    const TRANSMITS: bool = true;
+
+    #[inline(always)]
+    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
+        Dielectric { tint: get(&v.tint, i), thin: true, ..Dielectric::clear(None, v.ior[i]) }.thin_sample_whole(wv, uc)
+    }
+}
+
 /// Plastic under a smooth coat: [`Plastic::smooth_eval_pdf`] (its base) and
 /// [`Plastic::smooth_sample`] (the coat's mirror or the base).
 struct SmoothPlastic;
@@ -1824,6 +1851,7 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
         Kernel::CoatedMetallicRoughness => shade::<LaneCoated<MetallicRoughness<false>>>(v, coat, out, len, unit),
         Kernel::CoatedSeveralMetallicRoughness => shade::<LaneCoated<MetallicRoughness<true>>>(v, coat, out, len, unit),
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, coat, out, len, unit),
+        Kernel::ThinDielectric => shade::<ThinDielectric>(v, coat, out, len, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, coat, out, len, unit),
         Kernel::Idle | Kernel::General | Kernel::Escaped => {}
     }
@@ -2292,6 +2320,11 @@ shape = "sphere"
 center = [1.6, 2.4, 0.8]
 radius = 0.35
 material = { bsdf = { type = "conductor", metal = "copper", roughness = 0.35, multiscatter = true } }
+[[object]]
+shape = "box"
+min = [-2.2, 0.0, 2.0]
+max = [-1.2, 1.1, 2.5]
+material = { bsdf = { type = "thin-dielectric", ior = 1.5 } }
 "#;
 
     /// [`MIXED`] with its metallic–roughness sphere given a map (4 × 4 texels: roughness from
