@@ -140,6 +140,7 @@ impl Conductor {
     }
 
     /// The lobe of several facets seen from `v` and the probability of sampling it.
+    #[inline(always)]
     pub(crate) fn lobe_seen_from(&self, v: Vec3) -> Option<(super::multiscatter::MultipleScattering, f64)> {
         let ms = self.multiple_scattering(v)?;
         Some((ms, ms.choice(self.fresnel(v.z))))
@@ -169,6 +170,7 @@ impl Conductor {
     }
 
     /// The lobe of the light of several facets seen from `v`, with [`Self::multiscatter`].
+    #[inline(always)]
     pub(crate) fn multiple_scattering(&self, v: Vec3) -> Option<super::multiscatter::MultipleScattering> {
         Some(self.multiscatter?.seen_from(v))
     }

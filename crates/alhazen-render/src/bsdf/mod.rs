@@ -314,7 +314,7 @@ pub(crate) fn sample_cosine(v: Vec3, u: Vec2, eval: impl Fn(Vec3) -> Vec3) -> Op
 }
 
 /// Lobe choice probability proportional to two non-negative weights (0.5 each when both vanish).
-#[inline]
+#[inline(always)]
 pub(crate) fn lobe_probability(a: f64, b: f64) -> f64 {
     if a + b > 0.0 { a / (a + b) } else { 0.5 }
 }

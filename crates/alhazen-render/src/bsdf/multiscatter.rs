@@ -142,6 +142,7 @@ impl SeveralFacets {
     }
 
     /// The lobe seen from `v` (local frame).
+    #[inline(always)]
     pub(crate) fn seen_from(&self, v: Vec3) -> MultipleScattering {
         MultipleScattering { lost_v: 1.0 - lookup_in(v.z.abs(), self.row), lobe: *self }
     }
@@ -165,6 +166,7 @@ impl MultipleScattering {
     /// The probability of sampling this lobe rather than the single-scattering one, whose
     /// Fresnel term towards `v` is `f_v`: their albedos' shares (`F_ms (1 − E(μ_v))` against
     /// about `F(μ_v) E(μ_v)`, mean channels).
+    #[inline(always)]
     pub(crate) fn choice(&self, f_v: Vec3) -> f64 {
         let multiple = (self.lobe.scale * (PI * (1.0 - self.lobe.e_avg) * self.lost_v)).element_sum() / 3.0;
         let single = f_v.element_sum() / 3.0 * (1.0 - self.lost_v);
