@@ -45,7 +45,7 @@ fn fresnel_conductor(cos_i: f64, eta: f64, k: f64) -> f64 {
     fresnel_conductor_channels(cos_i, [eta; 4], [k; 4])[0]
 }
 
-/// [`fresnel_conductor`] for four channels at once, each with the same operations in the same
+/// `fresnel_conductor` for four channels at once, each with the same operations in the same
 /// order (so the same bits): written lane by lane, the square roots and divisions of all
 /// channels go through the vector unit together instead of one after another.
 #[inline(always)]

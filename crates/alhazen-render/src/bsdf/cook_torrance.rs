@@ -23,7 +23,7 @@ pub struct CookTorranceLobe {
     /// Use Schlick's `F`.
     pub schlick: bool,
     /// The specular weight the diffuse term is layered under (`k_d(1 − layer·E(μ_o))`,
-    /// [`super::layering`]); 0 for a diffuse weight that does not vary.
+    /// `bsdf::layering`); 0 for a diffuse weight that does not vary.
     pub layer: f64,
 }
 

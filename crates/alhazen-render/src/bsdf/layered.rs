@@ -22,7 +22,7 @@ pub trait SpecularLobe {
     /// A direction `l` from `u ∈ [0, 1)²`.
     fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3>;
     /// What the diffuse term is weighed by, seen at cosine `mu`: 1 unless the lobe layers it
-    /// ([`super::layering`]).
+    /// (`bsdf::layering`).
     #[inline(always)]
     fn diffuse_weight(&self, _mu: f64) -> f64 {
         1.0

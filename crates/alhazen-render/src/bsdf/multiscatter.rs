@@ -23,7 +23,7 @@ const N: usize = 32;
 const STRATA: usize = 16;
 
 /// `E(μ, α)` on the grid `μ_j = j/(N−1)` (columns), `r_i = i/(N−1)` (rows, `α = r²`): the
-/// values [`single_scattering_albedo`] gives (test `the_albedo_table_is_the_computed_one`),
+/// values `single_scattering_albedo` gives (test `the_albedo_table_is_the_computed_one`),
 /// written out so that a lookup reads a fixed address — the lanes' loops gather from it
 /// without first asking whether a table has been made.
 static ALBEDO: [[f64; N]; N] = include!("multiscatter_albedo.rs");

@@ -69,7 +69,7 @@ impl OrenNayar {
         cosine_pdf(v, l)
     }
 
-    /// Cosine-weighted sampling ([`sample_cosine`]'s, written out: the path tracer's lanes
+    /// Cosine-weighted sampling (`sample_cosine`'s, written out: the path tracer's lanes
     /// then evaluate it inline, in vector registers).
     #[inline(always)]
     pub fn sample(&self, v: Vec3, _uc: f64, u: Vec2) -> Option<BsdfSample> {

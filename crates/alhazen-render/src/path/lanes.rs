@@ -579,7 +579,9 @@ fn kernel_of(bsdf: &Bsdf, m: &alhazen_scene::Material) -> Kernel {
         Bsdf::OrenNayar(_) => Kernel::OrenNayar,
         Bsdf::Phong(p) if p.transmittance == Vec3::ZERO => Kernel::Phong,
         Bsdf::BlinnPhong(b) if b.transmittance == Vec3::ZERO => Kernel::BlinnPhong,
-        // The light of several facets is the general kernel's.
+        // A filmed metal is the general kernel's; one that gives back the light of several
+        // facets takes its own kernel where its facets are Trowbridge–Reitz with Smith's
+        // shadowing (the only ones whose albedo is tabulated).
         Bsdf::Conductor(c) if c.film.is_some() => Kernel::General,
         Bsdf::Conductor(c) if c.multiscatter.is_some() => match (conductor_facets(c), c.schlick) {
             (Some(false), false) => Kernel::SeveralConductor,
@@ -1721,8 +1723,8 @@ impl LaneBsdf for LambertMirror {
 struct MetallicRoughness<const SEVERAL: bool>;
 
 impl<const SEVERAL: bool> MetallicRoughness<SEVERAL> {
-    /// Lane `i`'s metal (its light of several facets, if any, apart: [`several_lobe`]) and its
-    /// facets, its Cook–Torrance base, and the metal's weight.
+    /// Lane `i`'s metal (its light of several facets, if any, apart: the lanes' `several_seen`)
+    /// and its facets, its Cook–Torrance base, and the metal's weight.
     #[inline(always)]
     fn at(v: &Vertices, i: usize) -> ((Conductor, Microfacet), CookTorrance, f64) {
         let metal_facets = Microfacet::smith::<false>(v.alpha[0][i], v.alpha[0][i]);
@@ -1936,7 +1938,7 @@ fn shade_lanes<M: LaneBsdf, const BUMPS: bool, const FROM: usize, const TO: usiz
 }
 
 /// Lane `i`'s vertex: the per-path tracer's own functions (`shading_frame`'s rule, `M`'s
-/// frame, evaluation and sampling, [`offset`], [`epsilon`], [`power_heuristic`]) on one lane,
+/// frame, evaluation and sampling, [`offset`], `epsilon`, [`power_heuristic`]) on one lane,
 /// inlined into the all-lane loop.
 #[inline(always)]
 fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat, out: &mut Shaded, i: usize) {
