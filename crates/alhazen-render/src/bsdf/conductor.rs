@@ -148,25 +148,36 @@ impl Conductor {
 
     /// The mirror direction, or reflection about a sampled facet (or, with
     /// [`Self::multiscatter`], by `uc`, a cosine-weighted direction for the light of several
-    /// facets), valued as the whole BSDF. (The lanes' kernels draw it as `several_lobe_sample`
-    /// in `path/lanes.rs`, every candidate computed and then one taken: the same numbers.)
+    /// facets), valued as the whole BSDF.
     pub fn sample(&self, v: Vec3, uc: f64, u: Vec2) -> Option<BsdfSample> {
         let Some(facets) = &self.facets else { return Some(self.smooth_sample(v)) };
         let Some((ms, p)) = self.lobe_seen_from(v) else {
             let (sampled, sample) = self.rough_sample(facets, v, 0.0, u);
             return sampled.then_some(sample);
         };
-        let l = if uc < p {
-            super::cosine_hemisphere(u, v)
-        } else {
-            let (sampled, sample) = self.rough_sample(facets, v, 0.0, u);
-            if !sampled {
-                return None;
-            }
-            sample.l
-        };
-        let (f, pdf) = self.eval_pdf_with(facets, Some((&ms, p)), v, l);
-        (pdf > 0.0).then_some(BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
+        let (sampled, sample) = self.several_sample_whole(facets, (&ms, p), v, uc, u);
+        sampled.then_some(sample)
+    }
+
+    /// [`Self::sample`] on `facets` with the lobe of several facets `ms` seen from `v` and the
+    /// probability `p` of sampling it, computed whole and then chosen, for the lanes as for
+    /// it: the lobe chosen by `uc` — its cosine-weighted direction and the facet's both
+    /// computed, one taken —, kept where the density is not 0; whether there is one, and the
+    /// sample.
+    #[inline(always)]
+    pub(crate) fn several_sample_whole(
+        &self,
+        facets: &Microfacet,
+        (ms, p): (&super::multiscatter::MultipleScattering, f64),
+        v: Vec3,
+        uc: f64,
+        u: Vec2,
+    ) -> (bool, BsdfSample) {
+        let (facet_ok, facet) = self.rough_sample(facets, v, 0.0, u);
+        let several = uc < p;
+        let l = if several { super::cosine_hemisphere(u, v) } else { facet.l };
+        let (f, pdf) = self.eval_pdf_with(facets, Some((ms, p)), v, l);
+        ((several || facet_ok) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 
     /// The lobe of the light of several facets seen from `v`, with [`Self::multiscatter`].

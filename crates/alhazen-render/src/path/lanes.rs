@@ -1750,14 +1750,17 @@ impl<const SEVERAL: bool> LaneBsdf for MetallicRoughness<SEVERAL> {
 
     /// `Mix::sample`: the metal with probability `w`, else the base (each drawn as
     /// `Bsdf::sample` draws it: the metal's without its lobe number, or, with several facets,
-    /// with it, rescaled: [`several_lobe_sample`]), valued as the whole mix; every candidate
+    /// with it, rescaled: [`Conductor::several_sample_whole`]), valued as the whole mix; every candidate
     /// computed, then the chosen one taken.
     #[inline(always)]
     fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let ((metal, metal_facets), base, w) = Self::at(v, i);
         let (first, uc) = crate::bsdf::Mix::component_choice(w, uc);
         let (metal_ok, metal_sample) = match SEVERAL {
-            true => several_lobe_sample(&metal, &metal_facets, v.several_seen[i], wv, uc, u),
+            true => {
+                let (ms, p) = v.several_seen[i];
+                metal.several_sample_whole(&metal_facets, (&ms, p), wv, uc, u)
+            }
             false => metal.rough_sample(&metal_facets, wv, 0.0, u),
         };
         let (base_ok, base_sample) = base.sample_weighted(v.diffuse_weight[i], wv, uc, u);
@@ -1765,26 +1768,6 @@ impl<const SEVERAL: bool> LaneBsdf for MetallicRoughness<SEVERAL> {
         let (f, pdf) = Self::eval_pdf(v, coat, i, wv, l);
         (sampled && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
-}
-
-/// [`Conductor::sample`] with several facets, in the lanes' form: `metal` on `facets` with its
-/// lobe of several facets seen from `wv` and the probability of sampling it (`seen`), the lobe
-/// chosen by `uc` — its cosine-weighted direction and the facet's both computed, then one
-/// taken —, kept where the metal's own density is not 0.
-#[inline(always)]
-fn several_lobe_sample(
-    metal: &Conductor,
-    facets: &Microfacet,
-    (ms, p): (MultipleScattering, f64),
-    wv: Vec3,
-    uc: f64,
-    u: Vec2,
-) -> (bool, BsdfSample) {
-    let (facet_ok, facet) = metal.rough_sample(facets, wv, 0.0, u);
-    let several = uc < p;
-    let l = if several { cosine_hemisphere(u, wv) } else { facet.l };
-    let (f, pdf) = metal.eval_pdf_with(facets, Some((&ms, p)), wv, l);
-    ((several || facet_ok) && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
 }
 
 /// A rough conductor (Trowbridge–Reitz facets, Smith's shadowing; Schlick's Fresnel term
@@ -1812,7 +1795,8 @@ impl<const SCHLICK: bool> MicrofacetLobes for SeveralConductor<SCHLICK> {
 
     #[inline(always)]
     fn rough_sample(&self, facets: &Microfacet, v: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        several_lobe_sample(&self.0, facets, self.1, v, uc, u)
+        let (ms, p) = self.1;
+        self.0.several_sample_whole(facets, (&ms, p), v, uc, u)
     }
 }
 
