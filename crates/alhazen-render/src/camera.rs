@@ -190,7 +190,7 @@ impl Camera {
     /// filter (perhaps beyond the pixel): a stereo pair's eye is the pixel's, a sample beyond
     /// its image's edge seeing on through the same eye (as beyond any image's edge), never the
     /// other eye's view.
-    #[inline]
+    #[inline(always)]
     pub fn pixel_ray(&self, column: u32, fx: f64, fy: f64) -> Ray {
         match &self.kind {
             Kind::Stereo { left, right } => {

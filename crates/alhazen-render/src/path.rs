@@ -552,7 +552,9 @@ impl PathTracer<'_> {
     /// The camera's ray through film position `(fx, fy)` of a sample of a pixel in column `x`:
     /// through a lens, the stream's next pair picks the lens point (the pinhole's draws nothing,
     /// so its images keep their bits).
-    #[inline]
+    // Inlined: a ray returned through the stack and copied into a lane's record stalled the
+    // copy's loads (store forwarding fails across two stores): envmap and glossy ~1 %.
+    #[inline(always)]
     fn camera_ray(&self, x: u32, (fx, fy): (f64, f64), s: &mut SampleStream) -> Ray {
         match self.camera.has_lens() {
             true => self.camera.pixel_lens_ray(x, fx, fy, s.next_2d()),
