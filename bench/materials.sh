@@ -27,7 +27,7 @@ each '{ type = "coated", base = { type = "metallic-roughness", color = \1, metal
 each '{ type = "metallic-roughness", color = \1, metallic = 0.5, roughness = 0.4' metallic-roughness
 each '{ type = "metallic-roughness", color = \1, metallic = 0.5, roughness = 0.4, multiscatter = true' metallic-roughness-gltf
 each '{ type = "sheen", base = { type = "lambert", color = \1 }' sheen
-for m in lambert oren-nayar phong blinn-phong cook-torrance coated coated-metallic-roughness metallic-roughness metallic-roughness-gltf sheen; do
+for m in ${MATERIALS:-lambert oren-nayar phong blinn-phong cook-torrance coated coated-metallic-roughness metallic-roughness metallic-roughness-gltf sheen}; do
     for r in $(seq "$rounds"); do
         for bin in "$@"; do
             t=$("$bin" render "$tmp/$m.toml" -o "$tmp/out.exr" --threads 1 --spp "$spp" 2>&1 | grep -o "in [0-9.]* s" | cut -d' ' -f2)

@@ -159,13 +159,9 @@ struct Vertices {
     /// lanes, their fields cost every kernel: see `alpha`).
     coats: Option<Box<CoatLanes>>,
     /// The metals' light of several facets ([`Conductor::multiscatter`]) of a kernel whose
-    /// metals give it back, made when its batch first needs it (as `coats`), and
-    /// (`weigh_layers`) that lobe seen from the viewer with the probability of sampling it:
-    /// found once for the vertex's light sample, its continuation and their evaluations, where
-    /// the per-path tracer finds it for each. (The latter in the batch's own lanes: read
-    /// through an `Option` the kernel's loop would stay scalar.)
+    /// metals give it back, made when its batch first needs it (as `coats`); the lobe seen
+    /// from the viewer is the batch's [`Batch::several_seen`].
     several: Option<Box<[SeveralFacets; LANES]>>,
-    several_seen: [(MultipleScattering, f64); LANES],
 }
 
 /// Each lane's clear coat ([`crate::bsdf::Coated`]) over the base the other lanes describe: its
@@ -287,8 +283,24 @@ struct Batch {
     coat: Option<&'static Coat>,
     len: usize,
     vertices: Vertices,
+    /// The lobe of several facets of each vertex's metal seen from its viewer, with the
+    /// probability of sampling it (`weigh_layers`): found once for the vertex's light sample,
+    /// its continuation and their evaluations, where the per-path tracer finds it for each.
+    /// Handed to the kernel beside the vertices ([`Tables`]): read from the vertices' own
+    /// lanes it cost every other kernel ~2 % (the Lambert Cornell box), read through a pointer
+    /// in them the loop stayed scalar.
+    several_seen: Box<[(MultipleScattering, f64); LANES]>,
     lights: LightLanes,
     shaded: Shaded,
+}
+
+/// What a batch's kernel reads besides its vertices, each table through a pointer of its own
+/// (function arguments, which the compiler can tell from the records the kernel writes, and
+/// may read ahead of a branch): the plastics' coat, the metals' lobes seen from the viewer.
+#[derive(Clone, Copy)]
+struct Tables<'a> {
+    coat: &'static Coat,
+    several_seen: &'a [(MultipleScattering, f64); LANES],
 }
 
 /// A bounce's batches (`all[..used]`); each kernel's newest one (`open`) takes its next vertex.
@@ -328,7 +340,8 @@ impl Batches {
         if self.used == self.all.len() {
             let lights = LightLanes { any_point: self.any_point, ..LightLanes::default() };
             let (vertices, shaded) = (Vertices::default(), Shaded::default());
-            self.all.push(Batch { kernel, coat, len: 0, vertices, lights, shaded });
+            let several_seen = Box::new([(MultipleScattering::default(), 0.0); LANES]);
+            self.all.push(Batch { kernel, coat, len: 0, vertices, several_seen, lights, shaded });
         }
         let b = self.used;
         self.used += 1;
@@ -848,8 +861,9 @@ impl PathTracer<'_> {
                     let v = &mut b.vertices;
                     self.lights.sample_lanes(&b.lights.asks, |i, sample| set_light(v, i, sample));
                 }
-                weigh_layers(b.kernel, &mut b.vertices, b.len);
-                shade_with(b.kernel, &b.vertices, b.coat.unwrap_or(&Coat::NONE), &mut b.shaded, b.len, unit);
+                weigh_layers(b.kernel, &mut b.vertices, &mut b.several_seen, b.len);
+                let tables = Tables { coat: b.coat.unwrap_or(&Coat::NONE), several_seen: &b.several_seen };
+                shade_with(b.kernel, &b.vertices, tables, &mut b.shaded, b.len, unit);
             }
             for (p, kernel) in kernels.iter().enumerate().filter(|(_, k)| k.is_material()) {
                 let ((g, i), (b, s)) = ((p / LANES, p % LANES), at[p]);
@@ -1317,12 +1331,12 @@ trait LaneBsdf {
     /// `ρ` and the sampling density towards `l`, seen from `wv` (local): `Bsdf::eval_pdf`;
     /// nothing for a delta distribution (the default).
     #[inline(always)]
-    fn eval_pdf(_: &Vertices, _: &'static Coat, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(_: &Vertices, _: Tables<'_>, _: usize, _: Vec3, _: Vec3) -> (Vec3, f64) {
         (Vec3::ZERO, 0.0)
     }
     /// The continuation drawn with the numbers `uc, u`, as `Bsdf::sample` draws it: whether
     /// there is one, and the sample.
-    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
+    fn sample(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample);
 }
 
 /// Lambert's BSDF ([`crate::bsdf::Lambert`]), cosine-weighted sampling (`sample_cosine`).
@@ -1330,13 +1344,13 @@ struct Lambertian;
 
 impl LaneBsdf for Lambertian {
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let rho = get(&v.albedo, i) * FRAC_1_PI;
         (if same_side(wv, l) { rho } else { Vec3::ZERO }, cosine_pdf(wv, l))
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, _: f64, u: Vec2) -> (bool, BsdfSample) {
         // `cosine_hemisphere` keeps `l` on the side of `wv`, where `ρ` is the albedo's.
         let l = cosine_hemisphere(u, wv);
         let (f, pdf) = (get(&v.albedo, i) * FRAC_1_PI, cosine_pdf(wv, l));
@@ -1356,13 +1370,13 @@ impl LaneOrenNayar {
 
 impl LaneBsdf for LaneOrenNayar {
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let b = Self::at(v, i);
         (b.eval(wv, l), b.pdf(wv, l))
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         lane_sample(Self::at(v, i).sample(wv, uc, u))
     }
 }
@@ -1408,12 +1422,12 @@ impl<S: LaneLobe> LaneBsdf for LaneDiffuseSpecular<S> {
     }
 
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         Self::at(v, i).eval_pdf(wv, l)
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         lane_sample(Self::at(v, i).sample(wv, uc, u))
     }
 }
@@ -1457,20 +1471,20 @@ impl<B: LaneBsdf> LaneBsdf for LaneCoated<B> {
     }
 
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let (lobe, weight, albedo) = Self::coat(v, i);
-        under_coat(&lobe, weight, albedo, B::eval_pdf(v, coat, i, wv, l), wv, l)
+        under_coat(&lobe, weight, albedo, B::eval_pdf(v, tables, i, wv, l), wv, l)
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let (lobe, weight, albedo) = Self::coat(v, i);
         let q = coat_choice(albedo, weight);
         let base = |uc| {
-            let (sampled, s) = B::sample(v, coat, i, wv, uc, u);
+            let (sampled, s) = B::sample(v, tables, i, wv, uc, u);
             sampled.then_some(s)
         };
-        let whole = |l| Self::eval_pdf(v, coat, i, wv, l);
+        let whole = |l| Self::eval_pdf(v, tables, i, wv, l);
         lane_sample(sample_under_layer(base, uc, (q, albedo), || lobe.sample(wv, u), whole))
     }
 }
@@ -1483,12 +1497,12 @@ trait RoughBsdf: MicrofacetLobes {
     /// The BSDF may be anisotropic: a tangent frame where the lane has a tangent.
     const TANGENT: bool = true;
     /// Lane `i`'s BSDF on `facets`, its Fresnel mode a constant the compiler folds.
-    fn at(v: &Vertices, coat: &'static Coat, i: usize, facets: Microfacet) -> Self;
+    fn at(v: &Vertices, tables: Tables<'_>, i: usize, facets: Microfacet) -> Self;
 }
 
 impl RoughBsdf for Conductor {
     #[inline(always)]
-    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
+    fn at(v: &Vertices, _: Tables<'_>, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         Conductor { facets: Some(facets), eta, k, tint, schlick: false, multiscatter: None, film: None }
     }
@@ -1511,7 +1525,7 @@ impl MicrofacetLobes for SchlickConductor {
 
 impl RoughBsdf for SchlickConductor {
     #[inline(always)]
-    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
+    fn at(v: &Vertices, _: Tables<'_>, i: usize, facets: Microfacet) -> Self {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         SchlickConductor(Conductor {
             facets: Some(facets),
@@ -1529,7 +1543,7 @@ impl RoughBsdf for Dielectric {
     const TRANSMITS: bool = true;
 
     #[inline(always)]
-    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
+    fn at(v: &Vertices, _: Tables<'_>, i: usize, facets: Microfacet) -> Self {
         Dielectric { tint: get(&v.tint, i), ..Dielectric::clear(Some(facets), v.ior[i]) }
     }
 }
@@ -1555,7 +1569,7 @@ impl RoughBsdf for LaneCookTorrance {
     const TANGENT: bool = false;
 
     #[inline(always)]
-    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
+    fn at(v: &Vertices, _: Tables<'_>, i: usize, facets: Microfacet) -> Self {
         let lobe = CookTorranceLobe { facets, ior: v.ior[i], schlick: false, layer: v.layer[i] };
         let transmittance = Vec3::ZERO;
         LaneCookTorrance(
@@ -1570,8 +1584,8 @@ impl RoughBsdf for Plastic {
     const TANGENT: bool = false;
 
     #[inline(always)]
-    fn at(v: &Vertices, coat: &'static Coat, i: usize, facets: Microfacet) -> Self {
-        plastic_at(v, coat, i, Some(facets))
+    fn at(v: &Vertices, tables: Tables<'_>, i: usize, facets: Microfacet) -> Self {
+        plastic_at(v, tables, i, Some(facets))
     }
 }
 
@@ -1583,9 +1597,9 @@ struct Rough<B, const BECKMANN: bool>(std::marker::PhantomData<B>);
 impl<B: RoughBsdf, const BECKMANN: bool> Rough<B, BECKMANN> {
     /// Lane `i`'s BSDF and its facets.
     #[inline(always)]
-    fn at(v: &Vertices, coat: &'static Coat, i: usize) -> (B, Microfacet) {
+    fn at(v: &Vertices, tables: Tables<'_>, i: usize) -> (B, Microfacet) {
         let facets = Microfacet::smith::<BECKMANN>(v.alpha[0][i], v.alpha[1][i]);
-        (B::at(v, coat, i, facets), facets)
+        (B::at(v, tables, i, facets), facets)
     }
 }
 
@@ -1601,14 +1615,14 @@ impl<B: RoughBsdf, const BECKMANN: bool> LaneBsdf for Rough<B, BECKMANN> {
     }
 
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        let (bsdf, facets) = Self::at(v, coat, i);
+    fn eval_pdf(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        let (bsdf, facets) = Self::at(v, tables, i);
         bsdf.rough_eval_pdf(&facets, wv, l)
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        let (bsdf, facets) = Self::at(v, coat, i);
+    fn sample(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        let (bsdf, facets) = Self::at(v, tables, i);
         bsdf.rough_sample(&facets, wv, uc, u)
     }
 }
@@ -1619,7 +1633,7 @@ struct SmoothConductor<const SCHLICK: bool>;
 
 impl<const SCHLICK: bool> LaneBsdf for SmoothConductor<SCHLICK> {
     #[inline(always)]
-    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, _: f64, _: Vec2) -> (bool, BsdfSample) {
         let (eta, k, tint) = (get(&v.eta, i), get(&v.k, i), get(&v.tint, i));
         (
             true,
@@ -1636,7 +1650,7 @@ impl LaneBsdf for SmoothDielectric {
     const TRANSMITS: bool = true;
 
     #[inline(always)]
-    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
         Dielectric { tint: get(&v.tint, i), ..Dielectric::clear(None, v.ior[i]) }.smooth_sample(wv, uc)
     }
 }
@@ -1649,7 +1663,7 @@ impl LaneBsdf for ThinDielectric {
     const TRANSMITS: bool = true;
 
     #[inline(always)]
-    fn sample(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, uc: f64, _: Vec2) -> (bool, BsdfSample) {
         Dielectric { tint: get(&v.tint, i), thin: true, ..Dielectric::clear(None, v.ior[i]) }.thin_sample_whole(wv, uc)
     }
 }
@@ -1660,20 +1674,20 @@ struct SmoothPlastic;
 
 /// Lane `i`'s plastic, its coat on `facets` (smooth for `None`).
 #[inline(always)]
-fn plastic_at(v: &Vertices, coat: &'static Coat, i: usize, facets: Option<Microfacet>) -> Plastic {
+fn plastic_at(v: &Vertices, tables: Tables<'_>, i: usize, facets: Option<Microfacet>) -> Plastic {
     let (albedo, eta, nonlinear) = (get(&v.albedo, i), v.ior[i], v.nonlinear.at(i));
-    Plastic { albedo, eta, facets, nonlinear, coat }
+    Plastic { albedo, eta, facets, nonlinear, coat: tables.coat }
 }
 
 impl LaneBsdf for SmoothPlastic {
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
-        plastic_at(v, coat, i, None).smooth_eval_pdf(wv, l)
+    fn eval_pdf(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+        plastic_at(v, tables, i, None).smooth_eval_pdf(wv, l)
     }
 
     #[inline(always)]
-    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
-        plastic_at(v, coat, i, None).smooth_sample(wv, uc, u)
+    fn sample(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+        plastic_at(v, tables, i, None).smooth_sample(wv, uc, u)
     }
 }
 
@@ -1693,7 +1707,7 @@ impl LambertMirror {
 
 impl LaneBsdf for LambertMirror {
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(v: &Vertices, _: Tables<'_>, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let (mirror, lambert, w) = Self::at(v, i);
         let f = crate::bsdf::blend(w, mirror.eval(wv, l), lambert.eval(wv, l));
         (f, crate::bsdf::blend_density(w, mirror.pdf(wv, l), lambert.pdf(wv, l)))
@@ -1702,12 +1716,12 @@ impl LaneBsdf for LambertMirror {
     /// `Mix::sample`: the mirror with probability `w` (its delta sample's value and density
     /// times `w`), else Lambert's cosine-weighted direction valued as the whole mix.
     #[inline(always)]
-    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let (mirror, _, w) = Self::at(v, i);
         let mut reflected = mirror.smooth_sample(wv);
         (reflected.f, reflected.pdf) = (reflected.f * w, reflected.pdf * w);
         let l = cosine_hemisphere(u, wv);
-        let (f, pdf) = Self::eval_pdf(v, coat, i, wv, l);
+        let (f, pdf) = Self::eval_pdf(v, tables, i, wv, l);
         let diffuse = BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false };
         // `sample_cosine`'s condition, then the mix's.
         let first = uc < w;
@@ -1740,9 +1754,9 @@ impl<const SEVERAL: bool> MetallicRoughness<SEVERAL> {
 
 impl<const SEVERAL: bool> LaneBsdf for MetallicRoughness<SEVERAL> {
     #[inline(always)]
-    fn eval_pdf(v: &Vertices, _: &'static Coat, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
+    fn eval_pdf(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, l: Vec3) -> (Vec3, f64) {
         let ((metal, metal_facets), base, w) = Self::at(v, i);
-        let several = if SEVERAL { Some(v.several_seen[i]) } else { None };
+        let several = if SEVERAL { Some(tables.several_seen[i]) } else { None };
         let (fa, pa) = metal.eval_pdf_with(&metal_facets, several.as_ref().map(|(ms, p)| (ms, *p)), wv, l);
         let (fb, pb) = base.eval_pdf_weighted(v.diffuse_weight[i], wv, l);
         (crate::bsdf::blend(w, fa, fb), crate::bsdf::blend_density(w, pa, pb))
@@ -1753,19 +1767,19 @@ impl<const SEVERAL: bool> LaneBsdf for MetallicRoughness<SEVERAL> {
     /// with it, rescaled: [`Conductor::several_sample_whole`]), valued as the whole mix; every candidate
     /// computed, then the chosen one taken.
     #[inline(always)]
-    fn sample(v: &Vertices, coat: &'static Coat, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
+    fn sample(v: &Vertices, tables: Tables<'_>, i: usize, wv: Vec3, uc: f64, u: Vec2) -> (bool, BsdfSample) {
         let ((metal, metal_facets), base, w) = Self::at(v, i);
         let (first, uc) = crate::bsdf::Mix::component_choice(w, uc);
         let (metal_ok, metal_sample) = match SEVERAL {
             true => {
-                let (ms, p) = v.several_seen[i];
+                let (ms, p) = tables.several_seen[i];
                 metal.several_sample_whole(&metal_facets, (&ms, p), wv, uc, u)
             }
             false => metal.rough_sample(&metal_facets, wv, 0.0, u),
         };
         let (base_ok, base_sample) = base.sample_weighted(v.diffuse_weight[i], wv, uc, u);
         let (sampled, l) = if first { (metal_ok, metal_sample.l) } else { (base_ok, base_sample.l) };
-        let (f, pdf) = Self::eval_pdf(v, coat, i, wv, l);
+        let (f, pdf) = Self::eval_pdf(v, tables, i, wv, l);
         (sampled && pdf > 0.0, BsdfSample { l, f, pdf, delta: false, eta: 1.0, dispersive: false })
     }
 }
@@ -1802,43 +1816,43 @@ impl<const SCHLICK: bool> MicrofacetLobes for SeveralConductor<SCHLICK> {
 
 impl<const SCHLICK: bool> RoughBsdf for SeveralConductor<SCHLICK> {
     #[inline(always)]
-    fn at(v: &Vertices, _: &'static Coat, i: usize, facets: Microfacet) -> Self {
-        SeveralConductor(Conductor { facets: Some(facets), ..Self::metal(v, i) }, v.several_seen[i])
+    fn at(v: &Vertices, tables: Tables<'_>, i: usize, facets: Microfacet) -> Self {
+        SeveralConductor(Conductor { facets: Some(facets), ..Self::metal(v, i) }, tables.several_seen[i])
     }
 }
 
 /// Every lane's vertex at once as `kernel` shades it (lanes from `len` on, unused, may be
 /// left as they were).
-fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize, unit: VectorUnit) {
+fn shade_with(kernel: Kernel, v: &Vertices, tables: Tables<'_>, out: &mut Shaded, len: usize, unit: VectorUnit) {
     match kernel {
-        Kernel::Lambert => shade::<Lambertian>(v, coat, out, len, unit),
-        Kernel::OrenNayar => shade::<LaneOrenNayar>(v, coat, out, len, unit),
-        Kernel::Phong => shade::<LaneDiffuseSpecular<PhongLobe>>(v, coat, out, len, unit),
-        Kernel::BlinnPhong => shade::<LaneDiffuseSpecular<BlinnPhongLobe>>(v, coat, out, len, unit),
-        Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, coat, out, len, unit),
-        Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, coat, out, len, unit),
-        Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, coat, out, len, unit),
-        Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, coat, out, len, unit),
-        Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, coat, out, len, unit),
-        Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, coat, out, len, unit),
-        Kernel::CookTorrance => shade::<Rough<LaneCookTorrance, false>>(v, coat, out, len, unit),
-        Kernel::BeckmannCookTorrance => shade::<Rough<LaneCookTorrance, true>>(v, coat, out, len, unit),
-        Kernel::SmoothConductor => shade::<SmoothConductor<false>>(v, coat, out, len, unit),
-        Kernel::RoughSchlickConductor => shade::<Rough<SchlickConductor, false>>(v, coat, out, len, unit),
-        Kernel::BeckmannSchlickConductor => shade::<Rough<SchlickConductor, true>>(v, coat, out, len, unit),
-        Kernel::SmoothSchlickConductor => shade::<SmoothConductor<true>>(v, coat, out, len, unit),
-        Kernel::LambertMirror => shade::<LambertMirror>(v, coat, out, len, unit),
-        Kernel::MetallicRoughness => shade::<MetallicRoughness<false>>(v, coat, out, len, unit),
-        Kernel::SeveralMetallicRoughness => shade::<MetallicRoughness<true>>(v, coat, out, len, unit),
-        Kernel::SeveralConductor => shade::<Rough<SeveralConductor<false>, false>>(v, coat, out, len, unit),
-        Kernel::SeveralSchlickConductor => shade::<Rough<SeveralConductor<true>, false>>(v, coat, out, len, unit),
-        Kernel::CoatedLambert => shade::<LaneCoated<Lambertian>>(v, coat, out, len, unit),
-        Kernel::CoatedCookTorrance => shade::<LaneCoated<Rough<LaneCookTorrance, false>>>(v, coat, out, len, unit),
-        Kernel::CoatedMetallicRoughness => shade::<LaneCoated<MetallicRoughness<false>>>(v, coat, out, len, unit),
-        Kernel::CoatedSeveralMetallicRoughness => shade::<LaneCoated<MetallicRoughness<true>>>(v, coat, out, len, unit),
-        Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, coat, out, len, unit),
-        Kernel::ThinDielectric => shade::<ThinDielectric>(v, coat, out, len, unit),
-        Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, coat, out, len, unit),
+        Kernel::Lambert => shade::<Lambertian>(v, tables, out, len, unit),
+        Kernel::OrenNayar => shade::<LaneOrenNayar>(v, tables, out, len, unit),
+        Kernel::Phong => shade::<LaneDiffuseSpecular<PhongLobe>>(v, tables, out, len, unit),
+        Kernel::BlinnPhong => shade::<LaneDiffuseSpecular<BlinnPhongLobe>>(v, tables, out, len, unit),
+        Kernel::RoughConductor => shade::<Rough<Conductor, false>>(v, tables, out, len, unit),
+        Kernel::RoughDielectric => shade::<Rough<Dielectric, false>>(v, tables, out, len, unit),
+        Kernel::RoughPlastic => shade::<Rough<Plastic, false>>(v, tables, out, len, unit),
+        Kernel::BeckmannConductor => shade::<Rough<Conductor, true>>(v, tables, out, len, unit),
+        Kernel::BeckmannDielectric => shade::<Rough<Dielectric, true>>(v, tables, out, len, unit),
+        Kernel::BeckmannPlastic => shade::<Rough<Plastic, true>>(v, tables, out, len, unit),
+        Kernel::CookTorrance => shade::<Rough<LaneCookTorrance, false>>(v, tables, out, len, unit),
+        Kernel::BeckmannCookTorrance => shade::<Rough<LaneCookTorrance, true>>(v, tables, out, len, unit),
+        Kernel::SmoothConductor => shade::<SmoothConductor<false>>(v, tables, out, len, unit),
+        Kernel::RoughSchlickConductor => shade::<Rough<SchlickConductor, false>>(v, tables, out, len, unit),
+        Kernel::BeckmannSchlickConductor => shade::<Rough<SchlickConductor, true>>(v, tables, out, len, unit),
+        Kernel::SmoothSchlickConductor => shade::<SmoothConductor<true>>(v, tables, out, len, unit),
+        Kernel::LambertMirror => shade::<LambertMirror>(v, tables, out, len, unit),
+        Kernel::MetallicRoughness => shade::<MetallicRoughness<false>>(v, tables, out, len, unit),
+        Kernel::SeveralMetallicRoughness => shade::<MetallicRoughness<true>>(v, tables, out, len, unit),
+        Kernel::SeveralConductor => shade::<Rough<SeveralConductor<false>, false>>(v, tables, out, len, unit),
+        Kernel::SeveralSchlickConductor => shade::<Rough<SeveralConductor<true>, false>>(v, tables, out, len, unit),
+        Kernel::CoatedLambert => shade::<LaneCoated<Lambertian>>(v, tables, out, len, unit),
+        Kernel::CoatedCookTorrance => shade::<LaneCoated<Rough<LaneCookTorrance, false>>>(v, tables, out, len, unit),
+        Kernel::CoatedMetallicRoughness => shade::<LaneCoated<MetallicRoughness<false>>>(v, tables, out, len, unit),
+        Kernel::CoatedSeveralMetallicRoughness => shade::<LaneCoated<MetallicRoughness<true>>>(v, tables, out, len, unit),
+        Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, tables, out, len, unit),
+        Kernel::ThinDielectric => shade::<ThinDielectric>(v, tables, out, len, unit),
+        Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, tables, out, len, unit),
         Kernel::Idle | Kernel::General | Kernel::Escaped => {}
     }
 }
@@ -1846,11 +1860,11 @@ fn shade_with(kernel: Kernel, v: &Vertices, coat: &'static Coat, out: &mut Shade
 /// Every lane's vertex at once as material `M` shades it, with the per-path tracer's
 /// arithmetic; with the bump terminator's arithmetic where some lane's normal may be bent (a
 /// kernel apiece, the plain one as lean as before bump maps took it).
-fn shade<M: LaneBsdf>(v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize, unit: VectorUnit) {
+fn shade<M: LaneBsdf>(v: &Vertices, tables: Tables<'_>, out: &mut Shaded, len: usize, unit: VectorUnit) {
     if v.bumped.any() {
-        shade_in::<M, true>(v, coat, out, len, unit)
+        shade_in::<M, true>(v, tables, out, len, unit)
     } else {
-        shade_in::<M, false>(v, coat, out, len, unit)
+        shade_in::<M, false>(v, tables, out, len, unit)
     }
 }
 
@@ -1861,7 +1875,7 @@ const HALF: usize = LANES / 2;
 #[allow(unsafe_code)]
 fn shade_in<M: LaneBsdf, const BUMPS: bool>(
     v: &Vertices,
-    coat: &'static Coat,
+    tables: Tables<'_>,
     out: &mut Shaded,
     len: usize,
     unit: VectorUnit,
@@ -1869,15 +1883,15 @@ fn shade_in<M: LaneBsdf, const BUMPS: bool>(
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx512() {
         // SAFETY: a `VectorUnit` says AVX-512 (F, DQ, VL, BW) only where the processor has them.
-        return unsafe { shade_avx512::<M, BUMPS>(v, coat, out, len) };
+        return unsafe { shade_avx512::<M, BUMPS>(v, tables, out, len) };
     }
     #[cfg(target_arch = "x86_64")]
     if unit.is_avx2() {
         // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
-        return unsafe { shade_avx2::<M, BUMPS>(v, coat, out, len) };
+        return unsafe { shade_avx2::<M, BUMPS>(v, tables, out, len) };
     }
     let _ = unit;
-    (0..len).for_each(|i| shade_lane::<M, BUMPS>(v, coat, out, i));
+    (0..len).for_each(|i| shade_lane::<M, BUMPS>(v, tables, out, i));
 }
 
 /// One loop over all lanes, or over the first half of them for a batch that fits.
@@ -1886,14 +1900,14 @@ fn shade_in<M: LaneBsdf, const BUMPS: bool>(
 #[allow(unsafe_code)]
 unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(
     v: &Vertices,
-    coat: &'static Coat,
+    tables: Tables<'_>,
     out: &mut Shaded,
     len: usize,
 ) {
     if len <= HALF {
-        shade_lanes::<M, BUMPS, 0, HALF>(v, coat, out)
+        shade_lanes::<M, BUMPS, 0, HALF>(v, tables, out)
     } else {
-        shade_lanes::<M, BUMPS, 0, LANES>(v, coat, out)
+        shade_lanes::<M, BUMPS, 0, LANES>(v, tables, out)
     }
 }
 
@@ -1902,10 +1916,10 @@ unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx2<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat, out: &mut Shaded, len: usize) {
-    shade_lanes::<M, BUMPS, 0, HALF>(v, coat, out);
+unsafe fn shade_avx2<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, tables: Tables<'_>, out: &mut Shaded, len: usize) {
+    shade_lanes::<M, BUMPS, 0, HALF>(v, tables, out);
     if len > HALF {
-        shade_lanes::<M, BUMPS, HALF, LANES>(v, coat, out);
+        shade_lanes::<M, BUMPS, HALF, LANES>(v, tables, out);
     }
 }
 
@@ -1913,11 +1927,11 @@ unsafe fn shade_avx2<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'stati
 #[inline(always)]
 fn shade_lanes<M: LaneBsdf, const BUMPS: bool, const FROM: usize, const TO: usize>(
     v: &Vertices,
-    coat: &'static Coat,
+    tables: Tables<'_>,
     out: &mut Shaded,
 ) {
     for i in FROM..TO {
-        shade_lane::<M, BUMPS>(v, coat, out, i);
+        shade_lane::<M, BUMPS>(v, tables, out, i);
     }
 }
 
@@ -1925,7 +1939,7 @@ fn shade_lanes<M: LaneBsdf, const BUMPS: bool, const FROM: usize, const TO: usiz
 /// frame, evaluation and sampling, [`offset`], `epsilon`, [`power_heuristic`]) on one lane,
 /// inlined into the all-lane loop.
 #[inline(always)]
-fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat, out: &mut Shaded, i: usize) {
+fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, tables: Tables<'_>, out: &mut Shaded, i: usize) {
     let p = get(&v.p, i);
     let View { ng, ns, n0, frame, wv } = view::<M>(v, i);
     // The bump terminator's shadowing (`Terminator::shadowing`), chosen without branches.
@@ -1935,7 +1949,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat,
     // Next event (`PathTracer::next_event`).
     let dir = get(&v.light_dir, i);
     let l = frame.to_local(dir);
-    let (f, pdf_bsdf) = M::eval_pdf(v, coat, i, wv, l);
+    let (f, pdf_bsdf) = M::eval_pdf(v, tables, i, wv, l);
     let f = f * l.z.abs() * shadowing(dir);
     let shadow = v.light.at(i) && !(f == Vec3::ZERO || (ng.dot(dir) > 0.0) != (l.z > 0.0) && !M::TRANSMITS);
     let pdf_light = v.light_pdf[i];
@@ -1948,7 +1962,7 @@ fn shade_lane<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, coat: &'static Coat,
     set(&mut out.shadow_dir, i, toward);
     out.shadow_dist[i] = dist;
     // The continuation.
-    let (sampled, bs) = M::sample(v, coat, i, wv, v.u_lobe[i], Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
+    let (sampled, bs) = M::sample(v, tables, i, wv, v.u_lobe[i], Vec2::new(v.u_bsdf[0][i], v.u_bsdf[1][i]));
     let (l, pdf) = (bs.l, bs.pdf);
     let dir = frame.to_world(l);
     let weight = bs.f * (l.z.abs() / pdf) * shadowing(dir);
@@ -1999,7 +2013,7 @@ fn view<M: LaneBsdf>(v: &Vertices, i: usize) -> View {
 /// ([`CookTorranceLobe::diffuse_weight`], 1 where it is not layered), for the kernels that have
 /// one, found one lane after another before the kernel's vector loop: a table lookup inside it
 /// would keep the loop scalar.
-fn weigh_layers(kernel: Kernel, v: &mut Vertices, len: usize) {
+fn weigh_layers(kernel: Kernel, v: &mut Vertices, several_seen: &mut [(MultipleScattering, f64); LANES], len: usize) {
     match kernel {
         Kernel::CookTorrance => weigh_layers_of::<Rough<LaneCookTorrance, false>>(v, len, |v, i| {
             Microfacet::smith::<false>(v.alpha[0][i], v.alpha[1][i])
@@ -2013,15 +2027,15 @@ fn weigh_layers(kernel: Kernel, v: &mut Vertices, len: usize) {
         Kernel::SeveralMetallicRoughness => {
             type M = MetallicRoughness<true>;
             weigh_layers_of::<M>(v, len, |v, i| Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]));
-            weigh_several::<M>(v, len, |v, i| M::at(v, i).0.0);
+            weigh_several::<M>(v, several_seen, len, |v, i| M::at(v, i).0.0);
         }
         Kernel::SeveralConductor => {
             type M = Rough<SeveralConductor<false>, false>;
-            weigh_several::<M>(v, len, SeveralConductor::<false>::metal);
+            weigh_several::<M>(v, several_seen, len, SeveralConductor::<false>::metal);
         }
         Kernel::SeveralSchlickConductor => {
             type M = Rough<SeveralConductor<true>, false>;
-            weigh_several::<M>(v, len, SeveralConductor::<true>::metal);
+            weigh_several::<M>(v, several_seen, len, SeveralConductor::<true>::metal);
         }
         Kernel::CoatedLambert => weigh_coats::<LaneCoated<Lambertian>>(v, len),
         Kernel::CoatedCookTorrance => {
@@ -2038,7 +2052,7 @@ fn weigh_layers(kernel: Kernel, v: &mut Vertices, len: usize) {
             type M = LaneCoated<MetallicRoughness<true>>;
             weigh_layers_of::<M>(v, len, |v, i| Microfacet::smith::<false>(v.alpha[1][i], v.alpha[1][i]));
             weigh_coats::<M>(v, len);
-            weigh_several::<M>(v, len, |v, i| MetallicRoughness::<true>::at(v, i).0.0);
+            weigh_several::<M>(v, several_seen, len, |v, i| MetallicRoughness::<true>::at(v, i).0.0);
         }
         _ => {}
     }
@@ -2058,13 +2072,18 @@ fn weigh_coats<M: LaneBsdf>(v: &mut Vertices, len: usize) {
 /// Each vertex's metal's lobe of several facets seen from its viewer, with the probability of
 /// sampling it ([`Conductor::lobe_seen_from`]), for kernel `M` whose lane `i`'s metal
 /// (without that lobe) `metal` gives (a coat over the metal sees it from the same direction).
-fn weigh_several<M: LaneBsdf>(v: &mut Vertices, len: usize, metal: impl Fn(&Vertices, usize) -> Conductor) {
-    let several = v.several.take().unwrap_or_default();
+fn weigh_several<M: LaneBsdf>(
+    v: &Vertices,
+    seen: &mut [(MultipleScattering, f64); LANES],
+    len: usize,
+    metal: impl Fn(&Vertices, usize) -> Conductor,
+) {
+    let none = <[SeveralFacets; LANES]>::default();
+    let several = v.several.as_deref().unwrap_or(&none);
     for i in 0..len {
         let metal = Conductor { multiscatter: Some(several[i]), ..metal(v, i) };
-        v.several_seen[i] = metal.lobe_seen_from(view::<M>(v, i).wv).unwrap_or_default();
+        seen[i] = metal.lobe_seen_from(view::<M>(v, i).wv).unwrap_or_default();
     }
-    v.several = Some(several);
 }
 
 /// [`weigh_layers`] for kernel `M`, whose Cook–Torrance lobe has the facets `facets` gives.
