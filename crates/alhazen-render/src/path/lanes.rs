@@ -99,6 +99,7 @@ fn set(v: &mut Lanes3, i: usize, x: Vec3) {
 
 /// What the per-path stage leaves for [`shade`], lane by lane.
 #[derive(Clone, Debug, Default)]
+#[repr(C, align(64))]
 struct Vertices {
     /// Towards the viewer (`−ray.dir`).
     wo: Lanes3,
@@ -169,12 +170,13 @@ struct Vertices {
 /// where that roughness falls in the albedo table, and its albedo towards the viewer
 /// (`weigh_layers`).
 #[derive(Clone, Debug, Default)]
+#[repr(C, align(64))]
 struct CoatLanes {
     weight: Lanes,
     alpha: Lanes,
     ior: Lanes,
-    row: [Row; LANES],
     albedo: Lanes,
+    row: [Row; LANES],
 }
 
 /// The coats of a batch without any.
@@ -224,6 +226,7 @@ pub(super) fn lane_lights(lights: &Lights) -> Option<Vec<LaneLight>> {
 /// Where the lanes sample parallelogram and point lights: each lane's light and its two
 /// numbers.
 #[derive(Clone, Debug, Default)]
+#[repr(C, align(64))]
 struct LightLanes {
     corner: Lanes3,
     e1: Lanes3,
@@ -243,6 +246,7 @@ struct LightLanes {
 
 /// What [`shade`] returns, lane by lane.
 #[derive(Clone, Debug, Default)]
+#[repr(C, align(64))]
 struct Shaded {
     /// Next-event contribution (before `beta`) if the shadow ray is clear; zero when there is
     /// no light to test (`shadow` unset).

@@ -124,6 +124,7 @@ pub struct FlatPacket {
 /// Eight rays, coordinate by coordinate: ray `r` starts at `origin[axis][r]` and goes along
 /// `dir[axis][r]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(64))]
 pub struct RayPacket {
     /// Origins.
     pub origin: [[f64; LANES]; 3],
