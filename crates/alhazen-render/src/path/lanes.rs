@@ -1853,7 +1853,9 @@ fn shade_with(kernel: Kernel, v: &Vertices, tables: Tables<'_>, out: &mut Shaded
         Kernel::CoatedLambert => shade::<LaneCoated<Lambertian>>(v, tables, out, len, unit),
         Kernel::CoatedCookTorrance => shade::<LaneCoated<Rough<LaneCookTorrance, false>>>(v, tables, out, len, unit),
         Kernel::CoatedMetallicRoughness => shade::<LaneCoated<MetallicRoughness<false>>>(v, tables, out, len, unit),
-        Kernel::CoatedSeveralMetallicRoughness => shade::<LaneCoated<MetallicRoughness<true>>>(v, tables, out, len, unit),
+        Kernel::CoatedSeveralMetallicRoughness => {
+            shade::<LaneCoated<MetallicRoughness<true>>>(v, tables, out, len, unit)
+        }
         Kernel::SmoothDielectric => shade::<SmoothDielectric>(v, tables, out, len, unit),
         Kernel::ThinDielectric => shade::<ThinDielectric>(v, tables, out, len, unit),
         Kernel::SmoothPlastic => shade::<SmoothPlastic>(v, tables, out, len, unit),
@@ -1902,12 +1904,7 @@ fn shade_in<M: LaneBsdf, const BUMPS: bool>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
 #[allow(unsafe_code)]
-unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(
-    v: &Vertices,
-    tables: Tables<'_>,
-    out: &mut Shaded,
-    len: usize,
-) {
+unsafe fn shade_avx512<M: LaneBsdf, const BUMPS: bool>(v: &Vertices, tables: Tables<'_>, out: &mut Shaded, len: usize) {
     if len <= HALF {
         shade_lanes::<M, BUMPS, 0, HALF>(v, tables, out)
     } else {
