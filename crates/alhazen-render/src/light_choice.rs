@@ -386,6 +386,27 @@ material = {{ color = 0, emission = [4, 4, 4] }}
             proptest::prop_assert!((reckoned - ls.pdf).abs() <= 1e-9 * ls.pdf, "light {light}: sampled {}, reckoned {reckoned}", ls.pdf);
         }
 
+        /// Counting the cumulative probabilities at or below a number picks the light a binary
+        /// search picks, zero probabilities, numbers on the steps and the threshold between the
+        /// two ways included.
+        #[test]
+        fn lights_are_chosen_by_counting_as_by_search(
+            weights in proptest::collection::vec(proptest::prop_oneof![proptest::strategy::Just(0.0), 0.01..10.0f64], 2..40),
+            numbers in proptest::collection::vec(0.0..1.0f64, 8),
+        ) {
+            proptest::prop_assume!(weights.iter().any(|&w| w > 0.0));
+            let scene = room(&"[[light]]\ntype = \"point\"\nposition = [0, 2, 1]\n".repeat(weights.len() - 1));
+            let mut lights = Lights::build(&scene);
+            let total: f64 = weights.iter().sum();
+            let pmf: Vec<f64> = weights.iter().map(|w| w / total).collect();
+            let cdf: Vec<f64> = pmf.iter().scan(0.0, |sum, p| { *sum += p; Some(*sum) }).collect();
+            lights.choose_by(Some(ChoiceTable::everywhere(pmf.clone())));
+            for u in numbers.iter().chain(&cdf).copied() {
+                let searched = cdf.partition_point(|&c| c <= u).min(pmf.len() - 1);
+                proptest::prop_assert_eq!(lights.choose(u, Vec3::ZERO), searched, "u {}", u);
+            }
+        }
+
         /// A light is chosen as often as its probability says: over `n` evenly spread numbers,
         /// each light within one of `n · p` times.
         #[test]
