@@ -182,6 +182,18 @@ struct CoatLanes {
 /// The coats of a batch without any.
 static NO_COATS: std::sync::LazyLock<CoatLanes> = std::sync::LazyLock::new(CoatLanes::default);
 
+/// The metals' facets of a batch without any.
+static NO_FACETS: std::sync::LazyLock<[SeveralFacets; LANES]> = std::sync::LazyLock::new(Default::default);
+
+// Every eight-lane field of the lanes' records lies on a cache line of its own: each record is
+// aligned to 64 bytes and its lane fields (multiples of 64 bytes) come before its others.
+const _: () = {
+    use std::mem::offset_of;
+    assert!(offset_of!(Vertices, coats) % 64 == 0);
+    assert!(offset_of!(CoatLanes, row) % 64 == 0);
+    assert!(offset_of!(LightLanes, point) % 64 == 0);
+};
+
 /// A parallelogram light as the lanes sample it ([`crate::lights`]' `sample_area`) or a point
 /// light (`point`: at `corner`, `radiance` its intensity, as `Lights::sample` takes it).
 #[derive(Clone, Copy, Debug)]
@@ -290,9 +302,8 @@ struct Batch {
     /// The lobe of several facets of each vertex's metal seen from its viewer, with the
     /// probability of sampling it (`weigh_layers`): found once for the vertex's light sample,
     /// its continuation and their evaluations, where the per-path tracer finds it for each.
-    /// Handed to the kernel beside the vertices ([`Tables`]): read from the vertices' own
-    /// lanes it cost every other kernel ~2 % (the Lambert Cornell box), read through a pointer
-    /// in them the loop stayed scalar.
+    /// Handed to the kernel beside the vertices ([`Tables`]): read through a pointer kept in
+    /// the vertices' records, the kernel's loop stayed scalar.
     several_seen: Box<[(MultipleScattering, f64); LANES]>,
     lights: LightLanes,
     shaded: Shaded,
@@ -2079,8 +2090,7 @@ fn weigh_several<M: LaneBsdf>(
     len: usize,
     metal: impl Fn(&Vertices, usize) -> Conductor,
 ) {
-    let none = <[SeveralFacets; LANES]>::default();
-    let several = v.several.as_deref().unwrap_or(&none);
+    let several = v.several.as_deref().unwrap_or(&NO_FACETS);
     for i in 0..len {
         let metal = Conductor { multiscatter: Some(several[i]), ..metal(v, i) };
         seen[i] = metal.lobe_seen_from(view::<M>(v, i).wv).unwrap_or_default();
