@@ -138,6 +138,57 @@ impl PixelSeeds {
     }
 }
 
+/// Where a sample's [`SampleStream`] starts, computed ahead of it by [`PixelSeeds::starts`]:
+/// its Sobol pairs and its generator's state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StreamStart {
+    sobol: [[u32; SOBOL_LANES]; 2],
+    rng: u64,
+}
+
+impl PixelSeeds {
+    /// The starts of samples `indices` of this pixel, into `out` (as many): for
+    /// [`SampleStream::restart_from`]. With AVX-512, two samples' eight pairs are hashed in
+    /// each register's sixteen lanes (and with GFNI a byte's bits reversed in one instruction):
+    /// the hashing was a quarter of a sample that only starts and leaves (session 62).
+    pub fn starts(&self, indices: std::ops::Range<u32>, out: &mut [StreamStart]) {
+        let n = out.len().min(indices.len());
+        for (index, start) in indices.clone().zip(out.iter_mut()) {
+            start.rng = mix(self.rng ^ index as u64);
+        }
+        if self.sequence != Sequence::Sobol {
+            return;
+        }
+        let mut done = 0;
+        #[cfg(target_arch = "x86_64")]
+        if self.unit.is_avx512() {
+            // Two samples per loop in the sixteen lanes of AVX-512 registers.
+            let twice = TwiceScrambles::of(&self.scrambles);
+            let gfni = std::arch::is_x86_feature_detected!("gfni");
+            for pair in out[..n - n % 2].chunks_exact_mut(2) {
+                let index = indices.start + done as u32;
+                let [a, b] = pair else { unreachable!() };
+                let reversed = [index.reverse_bits(), (index + 1).reverse_bits()];
+                // SAFETY: an AVX-512 `VectorUnit` is one whose processor has AVX-512 F, VL
+                // and BW; GFNI is asked of it.
+                #[allow(unsafe_code)]
+                unsafe {
+                    if gfni {
+                        sobol_points_twice_gfni(&twice, reversed, [&mut a.sobol, &mut b.sobol])
+                    } else {
+                        sobol_points_twice_avx512(&twice, reversed, [&mut a.sobol, &mut b.sobol])
+                    }
+                }
+                done += 2;
+            }
+        }
+        for (k, start) in out[..n].iter_mut().enumerate().skip(done) {
+            let index = indices.start + k as u32;
+            sobol_points(&self.scrambles, index.reverse_bits(), self.unit, &mut start.sobol);
+        }
+    }
+}
+
 /// The numbers of one sample of one pixel, dimension after dimension (by default, independent
 /// numbers of a zero seed: a stream to [`PixelSeeds::restart`]).
 #[derive(Clone, Debug)]
@@ -216,6 +267,17 @@ impl Default for SampleStream {
 }
 
 impl SampleStream {
+    /// Makes this the stream that `start` (of [`PixelSeeds::starts`], whose sequence is
+    /// `sequence`) begins: [`PixelSeeds::restart`] with its hashing done ahead.
+    #[inline]
+    pub fn restart_from(&mut self, sequence: Sequence, start: &StreamStart) {
+        self.sequence = sequence;
+        self.rng = Rng(start.rng);
+        self.sobol = start.sobol;
+        self.dimension = 0;
+        self.ahead = self.pair();
+    }
+
     /// The stream of sample `index` of pixel `(x, y)` (for many samples of one pixel,
     /// [`PixelSeeds::stream`] hashes the pixel once).
     pub fn new(sequence: Sequence, seed: u64, x: u32, y: u32, index: u32, unit: VectorUnit) -> Self {
@@ -287,6 +349,55 @@ fn sobol_points_in(scrambles: &Scrambles, index_reversed: u32, out: &mut [[u32; 
         out[0][d] = scramble_reversed(shuffled, scrambles.first[d]).reverse_bits();
         out[1][d] = scramble_reversed(sobol1_reversed(shuffled), scrambles.second[d]).reverse_bits();
     }
+}
+
+/// [`Scrambles`] twice over, for two samples in sixteen lanes.
+#[cfg(target_arch = "x86_64")]
+struct TwiceScrambles {
+    shuffle: [u32; 2 * SOBOL_LANES],
+    first: [u32; 2 * SOBOL_LANES],
+    second: [u32; 2 * SOBOL_LANES],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl TwiceScrambles {
+    fn of(s: &Scrambles) -> Self {
+        let twice = |a: &[u32; SOBOL_LANES]| std::array::from_fn(|l| a[l % SOBOL_LANES]);
+        Self { shuffle: twice(&s.shuffle), first: twice(&s.first), second: twice(&s.second) }
+    }
+}
+
+/// [`sobol_points_in`] for two samples (their indices reversed) at once: lane `l` computes
+/// pair `l mod 8` of sample `l div 8`, the same integers.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn sobol_points_twice_in(s: &TwiceScrambles, reversed: [u32; 2], out: [&mut [[u32; SOBOL_LANES]; 2]; 2]) {
+    let index: [u32; 2 * SOBOL_LANES] = std::array::from_fn(|l| reversed[l / SOBOL_LANES]);
+    let (mut first, mut second) = ([0u32; 2 * SOBOL_LANES], [0u32; 2 * SOBOL_LANES]);
+    for l in 0..2 * SOBOL_LANES {
+        let shuffled = scramble_reversed(index[l], s.shuffle[l]).reverse_bits();
+        first[l] = scramble_reversed(shuffled, s.first[l]).reverse_bits();
+        second[l] = scramble_reversed(sobol1_reversed(shuffled), s.second[l]).reverse_bits();
+    }
+    for (k, points) in out.into_iter().enumerate() {
+        points[0].copy_from_slice(&first[k * SOBOL_LANES..][..SOBOL_LANES]);
+        points[1].copy_from_slice(&second[k * SOBOL_LANES..][..SOBOL_LANES]);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw")]
+unsafe fn sobol_points_twice_avx512(s: &TwiceScrambles, reversed: [u32; 2], out: [&mut [[u32; SOBOL_LANES]; 2]; 2]) {
+    sobol_points_twice_in(s, reversed, out)
+}
+
+/// [`sobol_points_twice_avx512`] where GFNI reverses each byte's bits in one instruction.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,gfni")]
+unsafe fn sobol_points_twice_gfni(s: &TwiceScrambles, reversed: [u32; 2], out: [&mut [[u32; SOBOL_LANES]; 2]; 2]) {
+    sobol_points_twice_in(s, reversed, out)
 }
 
 /// The position in `[0, 1)²` of sample `i` of `n` in a pixel: jittered on a `k × k` grid when
@@ -395,6 +506,35 @@ mod tests {
             for d in 0..SOBOL_LANES {
                 let pair = sobol_pair_by_definition(index, seeds[d], seeds[SOBOL_LANES + d], seeds[2 * SOBOL_LANES + d]);
                 proptest::prop_assert_eq!((portable[0][d], portable[1][d]), pair, "lane {}", d);
+            }
+        }
+    }
+
+    proptest::proptest! {
+        /// Streams started from starts computed ahead, many at once on any kernel, draw the
+        /// numbers of streams started one by one.
+        #[test]
+        fn streams_started_ahead_are_the_streams(
+            seed in proptest::prelude::any::<u64>(),
+            (x, y) in (0u32..4096, 0u32..4096),
+            first in proptest::prelude::any::<u32>(),
+            n in 0usize..9,
+        ) {
+            for sequence in [Sequence::Sobol, Sequence::Independent] {
+                let alone = PixelSeeds::new(sequence, seed, x, y, VectorUnit::PORTABLE);
+                for unit in VectorUnit::available() {
+                    let seeds = PixelSeeds::new(sequence, seed, x, y, unit);
+                    let mut starts = [StreamStart::default(); 9];
+                    let indices = first..first.saturating_add(n as u32);
+                    seeds.starts(indices.clone(), &mut starts[..n]);
+                    for (k, index) in indices.enumerate() {
+                        let (mut ahead, mut one) = (SampleStream::default(), alone.stream(index));
+                        ahead.restart_from(sequence, &starts[k]);
+                        for _ in 0..SOBOL_PAIRS + 2 {
+                            proptest::prop_assert_eq!(ahead.next_2d(), one.next_2d(), "{:?} {:?} {}", sequence, unit, index);
+                        }
+                    }
+                }
             }
         }
     }
