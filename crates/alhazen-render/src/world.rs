@@ -979,7 +979,7 @@ impl World {
         let lanes = unsafe { crate::shape::ray_in_lanes(&ray) };
         let mut visit = AnyInLanes { world: self, ray: &ray, lanes, blocked: false };
         // SAFETY: the caller's contract.
-        unsafe { self.bvh.traverse_leaves_prefetching_with::<true>(&ray, dist, |_| {}, &mut visit) };
+        unsafe { self.bvh.any_leaf_with::<true>(&ray, dist, |_| {}, &mut visit) };
         !visit.blocked
     }
 
@@ -999,7 +999,7 @@ impl World {
             blocked.then_some(0.0)
         };
         // SAFETY: without AVX2.
-        unsafe { self.bvh.traverse_leaves_prefetching_with::<false>(&ray, dist, |_| {}, visit) };
+        unsafe { self.bvh.any_leaf_with::<false>(&ray, dist, |_| {}, visit) };
         !blocked
     }
 

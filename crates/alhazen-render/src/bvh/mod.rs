@@ -391,6 +391,42 @@ impl Bvh {
     pub unsafe fn traverse_leaves_prefetching_with<const AVX2: bool>(
         &self,
         ray: &Ray,
+        t_max: f64,
+        prefetch: impl Fn(std::ops::Range<usize>),
+        visit: impl LeafVisit,
+    ) -> f64 {
+        // SAFETY: the caller's contract.
+        unsafe { self.walk::<AVX2, true>(ray, t_max, prefetch, visit) }
+    }
+
+    /// [`Self::traverse_leaves_prefetching_with`] for a visit that only asks whether some leaf
+    /// holds a hit (it returns `Some(0.0)` or `None`): the children met are visited in slot
+    /// order, not sorted by distance — which leaf answers first cannot change the answer.
+    ///
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    pub unsafe fn any_leaf_with<const AVX2: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        prefetch: impl Fn(std::ops::Range<usize>),
+        visit: impl LeafVisit,
+    ) -> f64 {
+        // SAFETY: the caller's contract.
+        unsafe { self.walk::<AVX2, false>(ray, t_max, prefetch, visit) }
+    }
+
+    /// The walk of both: children met nearest first when `NEAREST`, in slot order otherwise.
+    ///
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn walk<const AVX2: bool, const NEAREST: bool>(
+        &self,
+        ray: &Ray,
         mut t_max: f64,
         prefetch: impl Fn(std::ops::Range<usize>),
         mut visit: impl LeafVisit,
@@ -429,7 +465,7 @@ impl Bvh {
                     // Two: the nearer descended into (the first in slot order on a tie), the
                     // other waits; both asked of memory.
                     let (a, b) = (hits.trailing_zeros() as usize, (hits & (hits - 1)).trailing_zeros() as usize);
-                    let (first, second) = if near[b] < near[a] { (b, a) } else { (a, b) };
+                    let (first, second) = if NEAREST && near[b] < near[a] { (b, a) } else { (a, b) };
                     let later = Slab::child(node, second, near[second]);
                     stack[sp].write(later);
                     sp += 1;
@@ -441,6 +477,25 @@ impl Bvh {
                             Slab::prefetch(&self.wide[child.offset as usize]);
                         }
                     }
+                    continue;
+                }
+                if hits != 0 && !NEAREST {
+                    // Slot order: the first descended into, the rest wait (all asked of memory).
+                    let k = hits.trailing_zeros() as usize;
+                    let mut rest = hits & (hits - 1);
+                    while rest != 0 {
+                        let j = 31 - rest.leading_zeros() as usize;
+                        rest &= !(1 << j);
+                        let child = Slab::child(node, j, near[j]);
+                        stack[sp].write(child);
+                        sp += 1;
+                        if child.is_leaf() {
+                            prefetch(child.labels());
+                        } else {
+                            Slab::prefetch(&self.wide[child.offset as usize]);
+                        }
+                    }
+                    at = Slab::child(node, k, near[k]);
                     continue;
                 }
                 if hits != 0 {
@@ -827,6 +882,67 @@ mod tests {
             seen.sort_unstable();
             proptest::prop_assert!(seen.iter().copied().eq(0..bins.len() as u32));
             proptest::prop_assert!(items.iter().all(|it| bins[it.index as usize] == it.bin));
+        }
+    }
+
+    proptest::proptest! {
+        /// The any-hit walk meets the leaves the nearest-first walk meets, only in another
+        /// order: with a visit that never stops, the same set; with one that stops at a leaf,
+        /// the same answer (a leaf was met or none).
+        #[test]
+        fn any_leaf_walk_meets_the_leaves_of_the_nearest_first_walk(
+            seed in 1u64..u64::MAX,
+            origin in proptest::array::uniform3(-20.0..120.0f64),
+            dir in proptest::array::uniform3(-1.0..1.0f64),
+            t_max in 1.0..300.0f64,
+            stop in 0usize..40,
+        ) {
+            let mut state = seed;
+            let mut next = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let bounds: Vec<Bounds3> = (0..300)
+                .map(|_| {
+                    let c = Vec3::new(next(), next(), next()) * 100.0;
+                    let r = Vec3::new(next(), next(), next()) * 4.0;
+                    Bounds3 { min: c - r, max: c + r }
+                })
+                .collect();
+            let bvh = Bvh::build(&bounds);
+            let ray = Ray::new(Vec3::from(origin), Vec3::from(dir));
+            #[cfg(target_arch = "x86_64")]
+            let avx2 = std::arch::is_x86_feature_detected!("avx2");
+            #[cfg(not(target_arch = "x86_64"))]
+            let avx2 = false;
+            let walks = |nearest: bool, stop_at: Option<usize>| {
+                let mut met = Vec::new();
+                let visit = |labels: std::ops::Range<usize>, _| {
+                    met.push(labels.start);
+                    (Some(met.len()) == stop_at).then_some(0.0)
+                };
+                // SAFETY: AVX2 only where the processor has it.
+                #[allow(unsafe_code)]
+                let t = unsafe {
+                    match (nearest, avx2) {
+                        (true, true) => bvh.walk::<true, true>(&ray, t_max, |_| {}, visit),
+                        (true, false) => bvh.walk::<false, true>(&ray, t_max, |_| {}, visit),
+                        (false, true) => bvh.walk::<true, false>(&ray, t_max, |_| {}, visit),
+                        (false, false) => bvh.walk::<false, false>(&ray, t_max, |_| {}, visit),
+                    }
+                };
+                (met, t)
+            };
+            let (mut nearest, _) = walks(true, None);
+            let (mut any, _) = walks(false, None);
+            nearest.sort_unstable();
+            any.sort_unstable();
+            proptest::prop_assert_eq!(&nearest, &any);
+            let stopped = |nearest| walks(nearest, Some(stop)).1 == 0.0;
+            proptest::prop_assert_eq!(stopped(true), stopped(false));
+            proptest::prop_assert_eq!(stopped(false), stop >= 1 && stop <= any.len());
         }
     }
 

@@ -206,6 +206,20 @@ impl MeshShape {
         unsafe { a.bvh.traverse_leaves_prefetching_with::<AVX2>(ray, t_max, prefetch, visit) };
     }
 
+    /// [`Self::traverse`] for an any-hit visit: the leaves in the tree's order, not nearest
+    /// first ([`crate::bvh::Bvh::any_leaf_with`]).
+    ///
+    /// # Safety
+    /// `AVX2` only on a processor with AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn traverse_any<const AVX2: bool>(&self, ray: &Ray, t_max: f64, visit: impl crate::bvh::LeafVisit) {
+        let a = &*self.accel;
+        let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
+        // SAFETY: the caller's contract.
+        unsafe { a.bvh.any_leaf_with::<AVX2>(ray, t_max, prefetch, visit) };
+    }
+
     /// Nearest hit in `(0, t_max)`; `aux` is the triangle.
     #[allow(unsafe_code)]
     pub fn hit(&self, ray: &Ray, t_max: f64) -> Option<Candidate> {
@@ -362,7 +376,7 @@ impl MeshShape {
         let mut visit =
             AnyInLanes { packets: &a.packets, ray: unsafe { super::flat_packet::ray_in_lanes(ray) }, blocked: false };
         // SAFETY: the caller's contract.
-        unsafe { self.traverse::<true>(ray, t_max, &mut visit) };
+        unsafe { self.traverse_any::<true>(ray, t_max, &mut visit) };
         visit.blocked
     }
 
@@ -380,7 +394,7 @@ impl MeshShape {
             blocked.then_some(0.0)
         };
         // SAFETY: without AVX2.
-        unsafe { self.traverse::<false>(ray, t_max, visit) };
+        unsafe { self.traverse_any::<false>(ray, t_max, visit) };
         blocked
     }
 
@@ -403,7 +417,7 @@ impl MeshShape {
             blocked.then_some(0.0)
         };
         // SAFETY: the caller's contract.
-        unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
+        unsafe { self.traverse_any::<AVX2>(ray, t_max, visit) };
         blocked
     }
 
