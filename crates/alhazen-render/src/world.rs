@@ -600,7 +600,7 @@ impl World {
         let lanes = unsafe { crate::shape::ray_in_lanes(ray) };
         let mut visit = NearestInLanes { world: self, ray, lanes, best, best_flat: None };
         // SAFETY: the caller's contract.
-        unsafe { self.bvh.traverse_leaves_prefetching_with::<true>(ray, t_best, |_| {}, &mut visit) };
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<true, true>(ray, t_best, |_| {}, &mut visit) };
         visit.best_flat.map(|(k, h)| Nearest::Flat(k, h)).or(visit.best.map(|(c, i)| Nearest::Other(c, i)))
     }
 
@@ -622,7 +622,7 @@ impl World {
             self.nearest_in_leaf(leaf, ray, t_max, flats, &mut best, &mut best_flat)
         };
         // SAFETY: without AVX2.
-        unsafe { self.bvh.traverse_leaves_prefetching_with::<false>(ray, t_best, |_| {}, visit) };
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<false, true>(ray, t_best, |_| {}, visit) };
         best_flat.map(|(k, h)| Nearest::Flat(k, h)).or(best.map(|(c, i)| Nearest::Other(c, i)))
     }
 
@@ -979,7 +979,7 @@ impl World {
         let lanes = unsafe { crate::shape::ray_in_lanes(&ray) };
         let mut visit = AnyInLanes { world: self, ray: &ray, lanes, blocked: false };
         // SAFETY: the caller's contract.
-        unsafe { self.bvh.any_leaf_with::<true>(&ray, dist, |_| {}, &mut visit) };
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<true, false>(&ray, dist, |_| {}, &mut visit) };
         !visit.blocked
     }
 
@@ -999,7 +999,7 @@ impl World {
             blocked.then_some(0.0)
         };
         // SAFETY: without AVX2.
-        unsafe { self.bvh.any_leaf_with::<false>(&ray, dist, |_| {}, visit) };
+        unsafe { self.bvh.traverse_leaves_prefetching_with::<false, false>(&ray, dist, |_| {}, visit) };
         !blocked
     }
 

@@ -377,54 +377,21 @@ impl Bvh {
         visit: impl FnMut(std::ops::Range<usize>, f64) -> Option<f64>,
     ) -> f64 {
         // SAFETY: without AVX2.
-        unsafe { self.traverse_leaves_prefetching_with::<false>(ray, t_max, prefetch, visit) }
+        unsafe { self.traverse_leaves_prefetching_with::<false, true>(ray, t_max, prefetch, visit) }
     }
 
     /// [`Self::traverse_leaves_prefetching`] with each node's eight children tested in one
     /// AVX2 register when `AVX2`: the same leaves in the same order. Fast where the caller is
     /// compiled for AVX2 (`#[target_feature(enable = "avx2")]`), so the node test is inlined.
+    /// Without `NEAREST` the children met are visited in slot order, not sorted by distance:
+    /// for a visit that only asks whether some leaf holds a hit (it returns `Some(0.0)` or
+    /// `None`), which leaf answers first cannot change the answer.
     ///
     /// # Safety
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]
     #[allow(unsafe_code)]
-    pub unsafe fn traverse_leaves_prefetching_with<const AVX2: bool>(
-        &self,
-        ray: &Ray,
-        t_max: f64,
-        prefetch: impl Fn(std::ops::Range<usize>),
-        visit: impl LeafVisit,
-    ) -> f64 {
-        // SAFETY: the caller's contract.
-        unsafe { self.walk::<AVX2, true>(ray, t_max, prefetch, visit) }
-    }
-
-    /// [`Self::traverse_leaves_prefetching_with`] for a visit that only asks whether some leaf
-    /// holds a hit (it returns `Some(0.0)` or `None`): the children met are visited in slot
-    /// order, not sorted by distance — which leaf answers first cannot change the answer.
-    ///
-    /// # Safety
-    /// `AVX2` only on a processor with AVX2.
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    pub unsafe fn any_leaf_with<const AVX2: bool>(
-        &self,
-        ray: &Ray,
-        t_max: f64,
-        prefetch: impl Fn(std::ops::Range<usize>),
-        visit: impl LeafVisit,
-    ) -> f64 {
-        // SAFETY: the caller's contract.
-        unsafe { self.walk::<AVX2, false>(ray, t_max, prefetch, visit) }
-    }
-
-    /// The walk of both: children met nearest first when `NEAREST`, in slot order otherwise.
-    ///
-    /// # Safety
-    /// `AVX2` only on a processor with AVX2.
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    unsafe fn walk<const AVX2: bool, const NEAREST: bool>(
+    pub unsafe fn traverse_leaves_prefetching_with<const AVX2: bool, const NEAREST: bool>(
         &self,
         ray: &Ray,
         mut t_max: f64,
@@ -864,6 +831,25 @@ fn partition(items: &mut [Item], pred: impl Fn(&Item) -> bool) -> usize {
 mod tests {
     use super::*;
 
+    /// `count` boxes of half-extents up to `size` centred in a cube of side 100, drawn by a
+    /// xorshift generator from `seed` (not 0).
+    fn scattered_boxes(seed: u64, count: usize, size: f64) -> Vec<Bounds3> {
+        let mut state = seed;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..count)
+            .map(|_| {
+                let c = Vec3::new(next(), next(), next()) * 100.0;
+                let r = Vec3::new(next(), next(), next()) * size;
+                Bounds3 { min: c - r, max: c + r }
+            })
+            .collect()
+    }
+
     proptest::proptest! {
         /// The two-ended partition moves the items that satisfy the predicate before the
         /// others, loses none and duplicates none, and says how many there are.
@@ -897,20 +883,7 @@ mod tests {
             t_max in 1.0..300.0f64,
             stop in 0usize..40,
         ) {
-            let mut state = seed;
-            let mut next = || {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state >> 11) as f64 / (1u64 << 53) as f64
-            };
-            let bounds: Vec<Bounds3> = (0..300)
-                .map(|_| {
-                    let c = Vec3::new(next(), next(), next()) * 100.0;
-                    let r = Vec3::new(next(), next(), next()) * 4.0;
-                    Bounds3 { min: c - r, max: c + r }
-                })
-                .collect();
+            let bounds = scattered_boxes(seed, 300, 4.0);
             let bvh = Bvh::build(&bounds);
             let ray = Ray::new(Vec3::from(origin), Vec3::from(dir));
             #[cfg(target_arch = "x86_64")]
@@ -927,10 +900,10 @@ mod tests {
                 #[allow(unsafe_code)]
                 let t = unsafe {
                     match (nearest, avx2) {
-                        (true, true) => bvh.walk::<true, true>(&ray, t_max, |_| {}, visit),
-                        (true, false) => bvh.walk::<false, true>(&ray, t_max, |_| {}, visit),
-                        (false, true) => bvh.walk::<true, false>(&ray, t_max, |_| {}, visit),
-                        (false, false) => bvh.walk::<false, false>(&ray, t_max, |_| {}, visit),
+                        (true, true) => bvh.traverse_leaves_prefetching_with::<true, true>(&ray, t_max, |_| {}, visit),
+                        (true, false) => bvh.traverse_leaves_prefetching_with::<false, true>(&ray, t_max, |_| {}, visit),
+                        (false, true) => bvh.traverse_leaves_prefetching_with::<true, false>(&ray, t_max, |_| {}, visit),
+                        (false, false) => bvh.traverse_leaves_prefetching_with::<false, false>(&ray, t_max, |_| {}, visit),
                     }
                 };
                 (met, t)
@@ -973,20 +946,7 @@ mod tests {
     /// Building subtrees on several threads lays out the very tree one thread builds.
     #[test]
     fn parallel_build_is_the_sequential_tree() {
-        let mut state = 0x9e3779b97f4a7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let bounds: Vec<Bounds3> = (0..50_000)
-            .map(|_| {
-                let c = Vec3::new(next(), next(), next()) * 100.0;
-                let r = Vec3::new(next(), next(), next());
-                Bounds3 { min: c - r, max: c + r }
-            })
-            .collect();
+        let bounds = scattered_boxes(0x9e3779b97f4a7c15, 50_000, 1.0);
         for method in [BuildMethod::Sah, BuildMethod::Morton] {
             let sequential =
                 Bvh::build_split_from(bounds.len(), |i| bounds[i], |i| i % 3 == 0, usize::MAX, method, Leaves::WORLD);

@@ -191,7 +191,8 @@ impl MeshShape {
         alhazen_scene::texture::uv_tangents([p0, p1, p2], idx.map(|i| m.uvs[i]))
     }
 
-    /// The tree's leaves `ray` may meet, nearest first ([`Bvh::traverse_leaves_prefetching`]):
+    /// The tree's leaves `ray` may meet, nearest first ([`Bvh::traverse_leaves_prefetching`]),
+    /// or in the tree's order for an any-hit visit (without `NEAREST`):
     /// `visit(packets, t_max)`, each leaf's packets prefetched as soon as its box is met; the
     /// nodes tested in AVX2 registers with `AVX2`.
     ///
@@ -199,25 +200,16 @@ impl MeshShape {
     /// `AVX2` only on a processor with AVX2.
     #[inline(always)]
     #[allow(unsafe_code)]
-    unsafe fn traverse<const AVX2: bool>(&self, ray: &Ray, t_max: f64, visit: impl crate::bvh::LeafVisit) {
+    unsafe fn traverse<const AVX2: bool, const NEAREST: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        visit: impl crate::bvh::LeafVisit,
+    ) {
         let a = &*self.accel;
         let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
         // SAFETY: the caller's contract.
-        unsafe { a.bvh.traverse_leaves_prefetching_with::<AVX2>(ray, t_max, prefetch, visit) };
-    }
-
-    /// [`Self::traverse`] for an any-hit visit: the leaves in the tree's order, not nearest
-    /// first ([`crate::bvh::Bvh::any_leaf_with`]).
-    ///
-    /// # Safety
-    /// `AVX2` only on a processor with AVX2.
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    unsafe fn traverse_any<const AVX2: bool>(&self, ray: &Ray, t_max: f64, visit: impl crate::bvh::LeafVisit) {
-        let a = &*self.accel;
-        let prefetch = |packets: std::ops::Range<usize>| a.packets.prefetch(packets.start);
-        // SAFETY: the caller's contract.
-        unsafe { a.bvh.any_leaf_with::<AVX2>(ray, t_max, prefetch, visit) };
+        unsafe { a.bvh.traverse_leaves_prefetching_with::<AVX2, NEAREST>(ray, t_max, prefetch, visit) };
     }
 
     /// Nearest hit in `(0, t_max)`; `aux` is the triangle.
@@ -272,7 +264,7 @@ impl MeshShape {
         let mut visit =
             NearestInLanes { packets: &a.packets, ray: unsafe { super::flat_packet::ray_in_lanes(ray) }, best: None };
         // SAFETY: the caller's contract.
-        unsafe { self.traverse::<true>(ray, t_max, &mut visit) };
+        unsafe { self.traverse::<true, true>(ray, t_max, &mut visit) };
         visit.best.map(|(lane, h)| lane.candidate(h.t, h.b1, h.b2))
     }
 
@@ -291,7 +283,7 @@ impl MeshShape {
             Some(h.t)
         };
         // SAFETY: without AVX2.
-        unsafe { self.traverse::<false>(ray, t_max, visit) };
+        unsafe { self.traverse::<false, true>(ray, t_max, visit) };
         best.map(|(lane, h)| lane.candidate(h.t, h.b1, h.b2))
     }
 
@@ -319,7 +311,7 @@ impl MeshShape {
             Some(h.t)
         };
         // SAFETY: the caller's contract.
-        unsafe { self.traverse::<AVX2>(ray, t_max, visit) };
+        unsafe { self.traverse::<AVX2, true>(ray, t_max, visit) };
         best
     }
 
@@ -376,7 +368,7 @@ impl MeshShape {
         let mut visit =
             AnyInLanes { packets: &a.packets, ray: unsafe { super::flat_packet::ray_in_lanes(ray) }, blocked: false };
         // SAFETY: the caller's contract.
-        unsafe { self.traverse_any::<true>(ray, t_max, &mut visit) };
+        unsafe { self.traverse::<true, false>(ray, t_max, &mut visit) };
         visit.blocked
     }
 
@@ -394,7 +386,7 @@ impl MeshShape {
             blocked.then_some(0.0)
         };
         // SAFETY: without AVX2.
-        unsafe { self.traverse_any::<false>(ray, t_max, visit) };
+        unsafe { self.traverse::<false, false>(ray, t_max, visit) };
         blocked
     }
 
@@ -417,7 +409,7 @@ impl MeshShape {
             blocked.then_some(0.0)
         };
         // SAFETY: the caller's contract.
-        unsafe { self.traverse_any::<AVX2>(ray, t_max, visit) };
+        unsafe { self.traverse::<AVX2, false>(ray, t_max, visit) };
         blocked
     }
 
