@@ -409,6 +409,14 @@ impl Bvh {
         // Not zeroed: a traversal of a small tree would spend longer clearing it than using it.
         let mut stack = [const { std::mem::MaybeUninit::<Entry>::uninit() }; STACK];
         let mut sp = 0;
+        // A child met is asked of memory before it is visited: a leaf's contents or a node.
+        let ask_memory = |child: Entry| {
+            if child.is_leaf() {
+                prefetch(child.labels());
+            } else {
+                Slab::prefetch(&self.wide[child.offset as usize]);
+            }
+        };
         loop {
             if at.is_leaf() {
                 if let Some(t) = visit.visit(at.labels(), t_max) {
@@ -437,17 +445,12 @@ impl Bvh {
                     stack[sp].write(later);
                     sp += 1;
                     at = Slab::child(node, first, near[first]);
-                    for child in [at, later] {
-                        if child.is_leaf() {
-                            prefetch(child.labels());
-                        } else {
-                            Slab::prefetch(&self.wide[child.offset as usize]);
-                        }
-                    }
+                    ask_memory(at);
+                    ask_memory(later);
                     continue;
                 }
                 if hits != 0 && !NEAREST {
-                    // Slot order: the first descended into, the rest wait (all asked of memory).
+                    // Slot order: the first descended into, the rest wait (asked of memory).
                     let k = hits.trailing_zeros() as usize;
                     let mut rest = hits & (hits - 1);
                     while rest != 0 {
@@ -456,11 +459,7 @@ impl Bvh {
                         let child = Slab::child(node, j, near[j]);
                         stack[sp].write(child);
                         sp += 1;
-                        if child.is_leaf() {
-                            prefetch(child.labels());
-                        } else {
-                            Slab::prefetch(&self.wide[child.offset as usize]);
-                        }
+                        ask_memory(child);
                     }
                     at = Slab::child(node, k, near[k]);
                     continue;
@@ -475,12 +474,7 @@ impl Bvh {
                     }
                     // Load the nodes met while the nearest is descended into.
                     for &key in &met[..n] {
-                        let child = Slab::child(node, wide::slot_of(key), 0.0);
-                        if child.is_leaf() {
-                            prefetch(child.labels());
-                        } else {
-                            Slab::prefetch(&self.wide[child.offset as usize]);
-                        }
+                        ask_memory(Slab::child(node, wide::slot_of(key), 0.0));
                     }
                     let k = wide::slot_of(met[0]);
                     at = Slab::child(node, k, near[k]);
