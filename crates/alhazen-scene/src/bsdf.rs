@@ -571,21 +571,50 @@ pub fn eta_from_f0(f0: Rgb) -> Rgb {
 }
 
 impl BsdfDesc {
-    /// True when some colour of it is a texture (so hits need texture coordinates).
+    /// True when some colour of it is a texture, or some map is given (so hits need texture
+    /// coordinates): a thin film's maps on glass included.
     pub fn is_textured(&self) -> bool {
-        let t = |x: &Texture| !matches!(x, Texture::Solid(_));
+        let mut textured = false;
+        self.each_texture(&mut |t, map| textured |= map || !matches!(t, Texture::Solid(_)));
+        textured
+    }
+
+    /// Calls `f` on every texture a point's BSDF is built from, the lobes' within a layer or
+    /// mix included; `map` is true for the maps given only when they vary (a metallic–roughness
+    /// map, a film's thickness…), false for colours that are always there.
+    pub fn each_texture(&self, f: &mut impl FnMut(&Texture, bool)) {
+        let maps = |ts: &[&Option<Texture>], f: &mut dyn FnMut(&Texture, bool)| {
+            ts.iter().filter_map(|t| t.as_ref()).for_each(|t| f(t, true))
+        };
+        let film = |i: &Option<Box<Iridescence>>, f: &mut dyn FnMut(&Texture, bool)| {
+            if let Some(i) = i {
+                [&i.factor_map, &i.thickness_map].into_iter().flatten().for_each(|t| f(t, true));
+            }
+        };
         match self {
-            BsdfDesc::Lambert { albedo } | BsdfDesc::OrenNayar { albedo, .. } => t(albedo),
-            BsdfDesc::Phong { albedo, .. }
+            BsdfDesc::Lambert { albedo }
+            | BsdfDesc::OrenNayar { albedo, .. }
+            | BsdfDesc::Phong { albedo, .. }
             | BsdfDesc::BlinnPhong { albedo, .. }
-            | BsdfDesc::CookTorrance { albedo, .. }
-            | BsdfDesc::Plastic { albedo, .. } => t(albedo),
-            BsdfDesc::Mix { a, b, weight_map, .. } => a.is_textured() || b.is_textured() || weight_map.is_some(),
+            | BsdfDesc::Plastic { albedo, .. } => f(albedo, false),
+            // (Its transmittance is the layered form's, read with the albedo.)
+            BsdfDesc::CookTorrance { albedo, transmittance, .. } => {
+                f(albedo, false);
+                f(transmittance, false);
+            }
+            BsdfDesc::Mix { a, b, weight_map, .. } => {
+                a.each_texture(f);
+                b.each_texture(f);
+                maps(&[weight_map], f);
+            }
             BsdfDesc::Coated { base, weight_map, roughness_map, .. } => {
-                base.is_textured() || weight_map.is_some() || roughness_map.is_some()
+                base.each_texture(f);
+                maps(&[weight_map, roughness_map], f);
             }
             BsdfDesc::Sheened { base, color, roughness_map, .. } => {
-                base.is_textured() || t(color) || roughness_map.is_some()
+                base.each_texture(f);
+                f(color, false);
+                maps(&[roughness_map], f);
             }
             BsdfDesc::MetallicRoughness {
                 base,
@@ -598,13 +627,18 @@ impl BsdfDesc {
                 translucency_color_map,
                 ..
             } => {
-                let film = iridescence.as_ref().is_some_and(|i| i.factor_map.is_some() || i.thickness_map.is_some());
-                let specular = specular_map.is_some() || specular_color_map.is_some();
-                let through = translucency_map.is_some() || translucency_color_map.is_some();
-                t(base) || map.is_some() || anisotropy_map.is_some() || film || specular || through
+                f(base, false);
+                maps(
+                    &[map, anisotropy_map, specular_map, specular_color_map, translucency_map, translucency_color_map],
+                    f,
+                );
+                film(iridescence, f);
             }
-            BsdfDesc::Dielectric { transmittance, .. } => t(transmittance),
-            BsdfDesc::Conductor { .. } | BsdfDesc::ThinDielectric { .. } => false,
+            BsdfDesc::Dielectric { transmittance, film: glass_film, .. } => {
+                f(transmittance, false);
+                film(glass_film, f);
+            }
+            BsdfDesc::Conductor { .. } | BsdfDesc::ThinDielectric { .. } => {}
         }
     }
 
@@ -682,4 +716,77 @@ pub const GLASSES: &[(&str, [f64; 3], [f64; 3])] = &[
 /// The complex index `(η, κ)` of a metal of [`METALS`] by name.
 pub fn metal(name: &str) -> Option<(Rgb, Rgb)> {
     METALS.iter().find(|m| m.0 == name).map(|m| (Vec3::from_array(m.1), Vec3::from_array(m.2)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alhazen_math::Vec2;
+
+    fn image(image: usize) -> Texture {
+        Texture::Image { image, scale: Vec2::ONE, offset: Vec2::ZERO, rotation: 0.0 }
+    }
+
+    fn glass(film: Option<Box<Iridescence>>, transmittance: Texture) -> BsdfDesc {
+        BsdfDesc::Dielectric { facets: None, ior: Ior::Constant(1.5), fresnel: FresnelMode::Exact, transmittance, film }
+    }
+
+    fn film(factor_map: Option<Texture>, thickness_map: Option<Texture>) -> Option<Box<Iridescence>> {
+        Some(Box::new(Iridescence {
+            factor: 1.0,
+            ior: 1.3,
+            thickness: [100.0, 400.0],
+            outside: 1.0,
+            factor_map,
+            thickness_map,
+        }))
+    }
+
+    /// Glass whose film varies over it, and a layered Cook–Torrance surface whose
+    /// transmittance does, are read at each point: their hits need texture coordinates (they
+    /// were once taken for uniform, their maps read at `uv = 0` everywhere).
+    #[test]
+    fn every_map_makes_a_bsdf_textured() {
+        let white = Texture::Solid(Vec3::ONE);
+        assert!(!glass(None, white.clone()).is_textured());
+        assert!(!glass(film(None, None), white.clone()).is_textured());
+        assert!(glass(film(Some(image(0)), None), white.clone()).is_textured());
+        assert!(glass(film(None, Some(white.clone())), white.clone()).is_textured(), "a map given is read");
+        assert!(glass(None, image(1)).is_textured());
+        let cook_torrance = |transmittance| BsdfDesc::CookTorrance {
+            albedo: Texture::Solid(Vec3::splat(0.5)),
+            kd: 1.0,
+            ks: 0.5,
+            facets: ggx(0.2, 0.2),
+            ior: 1.5,
+            fresnel: FresnelMode::Exact,
+            layered: true,
+            transmittance,
+        };
+        assert!(!cook_torrance(white.clone()).is_textured());
+        assert!(cook_torrance(image(2)).is_textured());
+    }
+
+    /// Textures within mixes and layers are found, each once, in order.
+    #[test]
+    fn nested_textures_are_each_visited() {
+        let lambert = |k| BsdfDesc::Lambert { albedo: image(k) };
+        let coated = BsdfDesc::Coated {
+            base: Box::new(lambert(1)),
+            weight: 1.0,
+            facets: ggx(0.1, 0.1),
+            ior: 1.5,
+            weight_map: Some(image(2)),
+            roughness_map: None,
+        };
+        let mix =
+            BsdfDesc::Mix { a: Box::new(lambert(0)), b: Box::new(coated), weight: 0.5, weight_map: Some(image(3)) };
+        let mut seen = vec![];
+        mix.each_texture(&mut |t, map| {
+            if let Texture::Image { image, .. } = t {
+                seen.push((*image, map));
+            }
+        });
+        assert_eq!(seen, [(0, false), (1, false), (2, true), (3, true)]);
+    }
 }
