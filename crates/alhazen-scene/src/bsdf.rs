@@ -588,7 +588,7 @@ impl BsdfDesc {
         };
         let film = |i: &Option<Box<Iridescence>>, f: &mut dyn FnMut(&Texture, bool)| {
             if let Some(i) = i {
-                [&i.factor_map, &i.thickness_map].into_iter().flatten().for_each(|t| f(t, true));
+                maps(&[&i.factor_map, &i.thickness_map], f);
             }
         };
         match self {
@@ -597,7 +597,7 @@ impl BsdfDesc {
             | BsdfDesc::Phong { albedo, .. }
             | BsdfDesc::BlinnPhong { albedo, .. }
             | BsdfDesc::Plastic { albedo, .. } => f(albedo, false),
-            // (Its transmittance is the layered form's, read with the albedo.)
+            // The layered form's transmittance is looked up at each point too (`bsdf::build`).
             BsdfDesc::CookTorrance { albedo, transmittance, .. } => {
                 f(albedo, false);
                 f(transmittance, false);
