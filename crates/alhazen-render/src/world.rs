@@ -882,13 +882,17 @@ impl World {
             let open = std::array::from_fn(|r| {
                 live[r] && !blocked[r] && (self.unbounded.is_empty() || !self.unbounded_blocks(&rays.ray(r), dist[r]))
             });
-            let spheres = if self.flats_only { [None; LANES] } else { self.spheres_of_rays(leaf, rays, dist, open) };
+            let spheres = &self.spheres[leaf.spheres.clone()];
+            let sphere_blocks = if self.flats_only || spheres.is_empty() {
+                [false; LANES]
+            } else {
+                SpherePacket::any_of_rays(spheres, rays, dist, open, self.vectors)
+            };
             let inv = (!leaf.objects.is_empty()).then(|| inverse_dirs(rays));
             return std::array::from_fn(|r| {
                 let inv = inv.as_ref().map(|inv| (inv, r));
                 open[r]
-                    && (self.flats_only
-                        || spheres[r].is_none() && !self.objects_block(leaf, &rays.ray(r), dist[r], inv))
+                    && (self.flats_only || !sphere_blocks[r] && !self.objects_block(leaf, &rays.ray(r), dist[r], inv))
             });
         }
         std::array::from_fn(|r| {

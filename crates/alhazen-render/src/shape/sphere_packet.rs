@@ -107,6 +107,35 @@ impl SpherePacket {
     }
 }
 
+impl SpherePacket {
+    /// Whether each of eight rays meets a sphere of `packets` at `0 < t < t_max[r]` (false
+    /// where not `live`): `nearest_of_rays(…)[r].is_some()`, a shadow ray's question, answered
+    /// without keeping the nearest — each sphere's test waits on no earlier one's limit, and
+    /// the tests stop once every live ray is blocked.
+    #[inline]
+    #[allow(unsafe_code)]
+    pub fn any_of_rays(
+        packets: &[Self],
+        rays: &RayPacket,
+        t_max: &[f64; SPHERE_LANES],
+        live: [bool; SPHERE_LANES],
+        unit: VectorUnit,
+    ) -> [bool; SPHERE_LANES] {
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx512() {
+            // SAFETY: a `VectorUnit` says AVX-512F only where the processor has it.
+            return unsafe { avx512::any_rays(packets, rays, t_max, live) };
+        }
+        #[cfg(target_arch = "x86_64")]
+        if unit.is_avx2() {
+            // SAFETY: a `VectorUnit` says AVX2 only where the processor has it.
+            return unsafe { any_rays_avx2(packets, rays, t_max, live) };
+        }
+        let _ = unit;
+        std::array::from_fn(|r| live[r] && Self::nearest_portable(packets, &rays.ray(r), t_max[r]).is_some())
+    }
+}
+
 /// `a·b` summed as glam's `dot` (and `Sphere::roots`): `(x·x + y·y) + z·z`.
 #[inline(always)]
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -220,6 +249,44 @@ fn nearest_rays_avx2(
         let id = which[r] as usize;
         (hit[r] && live[r]).then(|| (id / SPHERE_LANES, id % SPHERE_LANES, best[r]))
     })
+}
+
+/// [`SpherePacket::any_of_rays`] in loops over the eight rays without branches (AVX2 code), as
+/// [`nearest_rays_avx2`] tests them against a limit that does not shrink.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn any_rays_avx2(
+    packets: &[SpherePacket],
+    rays: &RayPacket,
+    t_max: &[f64; SPHERE_LANES],
+    live: [bool; SPHERE_LANES],
+) -> [bool; SPHERE_LANES] {
+    const R: usize = SPHERE_LANES;
+    let (o, d) = (&rays.origin, &rays.dir);
+    let a: [f64; R] = std::array::from_fn(|r| dot([d[0][r], d[1][r], d[2][r]], [d[0][r], d[1][r], d[2][r]]));
+    let inv_a = a.map(|a| 1.0 / a);
+    let mut blocked = live.map(|l| !l);
+    for p in packets {
+        for lane in 0..p.used {
+            let (center, radius) = ([p.center[0][lane], p.center[1][lane], p.center[2][lane]], p.radius[lane]);
+            let meets = (0..R).fold(false, |any, r| {
+                let (origin, dir) = ([o[0][r], o[1][r], o[2][r]], [d[0][r], d[1][r], d[2][r]]);
+                any | sphere_disc(center, radius, origin, dir, a[r], inv_a[r]).3
+            });
+            if !meets {
+                continue;
+            }
+            for r in 0..R {
+                let (origin, dir) = ([o[0][r], o[1][r], o[2][r]], [d[0][r], d[1][r], d[2][r]]);
+                let t = sphere_t(center, radius, origin, dir, a[r], inv_a[r]);
+                blocked[r] |= t > 0.0 && t < t_max[r];
+            }
+            if !blocked.contains(&false) {
+                return live;
+            }
+        }
+    }
+    std::array::from_fn(|r| blocked[r] && live[r])
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -355,6 +422,31 @@ mod avx512 {
             (hit >> r & 1 == 1 && live[r]).then(|| (id / SPHERE_LANES, id % SPHERE_LANES, t[r]))
         })
     }
+
+    /// [`SpherePacket::any_of_rays`]: each sphere in order broadcast against the rays, the
+    /// limit fixed, until every live ray is blocked.
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn any_rays(
+        packets: &[SpherePacket],
+        rays: &RayPacket,
+        t_max: &[f64; SPHERE_LANES],
+        live: [bool; SPHERE_LANES],
+    ) -> [bool; SPHERE_LANES] {
+        let ray = SphereRays::new(RayLanes { origin: load3(&rays.origin), dir: load3(&rays.dir) });
+        let limit = load(t_max);
+        let live_mask = (0..SPHERE_LANES).fold(0u8, |m, r| m | u8::from(live[r]) << r);
+        let mut blocked = 0u8;
+        'spheres: for p in packets {
+            for lane in 0..p.used {
+                let center = [0, 1, 2].map(|i| _mm512_set1_pd(p.center[i][lane]));
+                blocked |= lanes(center, _mm512_set1_pd(p.radius[lane]), &ray, limit).1;
+                if blocked & live_mask == live_mask {
+                    break 'spheres;
+                }
+            }
+        }
+        std::array::from_fn(|r| (blocked & live_mask) >> r & 1 == 1)
+    }
 }
 
 #[cfg(test)]
@@ -420,9 +512,11 @@ mod tests {
             }
             for unit in VectorUnit::available() {
                 let together = SpherePacket::nearest_of_rays(&packets, &packet, &t_max, live, unit);
+                let blocked = SpherePacket::any_of_rays(&packets, &packet, &t_max, live, unit);
                 for r in 0..SPHERE_LANES {
                     let alone = SpherePacket::nearest_of(&packets, &packet.ray(r), t_max[r], unit).filter(|_| live[r]);
                     prop_assert_eq!(together[r], alone, "ray {} {:?}", r, unit);
+                    prop_assert_eq!(blocked[r], alone.is_some(), "any hit of ray {} {:?}", r, unit);
                 }
             }
         }
