@@ -610,6 +610,74 @@ mod tests {
         }
     }
 
+    /// One mesh written as ASCII and in either binary order: vertices of floats, colour codes
+    /// and doubles interleaved, polygons of three to five corners, and maybe a face property
+    /// after the index list.
+    fn ply_in(format: &str, vertices: &[[f32; 5]], faces: &[Vec<u32>], face_flag: bool) -> Vec<u8> {
+        let flag = if face_flag { "property uchar flags\n" } else { "" };
+        let mut b = format!(
+            "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\nproperty uchar red\nproperty float y\n\
+             property float z\nproperty uchar green\nproperty uchar blue\nproperty double u\nproperty double v\n\
+             element face {}\nproperty list uchar int vertex_indices\n{flag}end_header\n",
+            vertices.len(),
+            faces.len()
+        )
+        .into_bytes();
+        let big = format == "binary_big_endian";
+        let mut put = |b: &mut Vec<u8>, le: &[u8], text: String| match format {
+            "ascii" => b.extend(format!("{text} ").bytes()),
+            _ if big => b.extend(le.iter().rev()),
+            _ => b.extend(le),
+        };
+        for v in vertices {
+            put(&mut b, &v[0].to_le_bytes(), f64::from(v[0]).to_string());
+            put(&mut b, &[v[3] as u8], (v[3] as u8).to_string());
+            put(&mut b, &v[1].to_le_bytes(), f64::from(v[1]).to_string());
+            put(&mut b, &v[2].to_le_bytes(), f64::from(v[2]).to_string());
+            put(&mut b, &[v[4] as u8], (v[4] as u8).to_string());
+            put(&mut b, &[7], "7".into());
+            put(&mut b, &f64::from(v[0]).to_le_bytes(), f64::from(v[0]).to_string());
+            put(&mut b, &f64::from(v[1]).to_le_bytes(), f64::from(v[1]).to_string());
+        }
+        for f in faces {
+            put(&mut b, &[f.len() as u8], f.len().to_string());
+            f.iter().for_each(|&i| put(&mut b, &(i as i32).to_le_bytes(), i.to_string()));
+            if face_flag {
+                put(&mut b, &[1], "1".into());
+            }
+        }
+        b
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn binary_ply_reads_as_ascii_does(
+            vertices in proptest::collection::vec(proptest::array::uniform5(-100.0f32..255.0), 3..12),
+            faces in proptest::collection::vec(proptest::collection::vec(0u32..12, 3..6), 0..6),
+            face_flag: bool,
+            cut in 0usize..40,
+        ) {
+            let faces: Vec<Vec<u32>> = faces.iter().map(|f| f.iter().map(|&i| i % vertices.len() as u32).collect()).collect();
+            let vertices: Vec<[f32; 5]> = vertices.iter().map(|v| [v[0], v[1], v[2], v[3].abs(), v[4].abs()]).collect();
+            let ascii = parse_ply(&ply_in("ascii", &vertices, &faces, face_flag)).unwrap();
+            let fan: usize = faces.iter().map(|f| f.len() - 2).sum();
+            proptest::prop_assert_eq!(ascii.triangles.len(), fan);
+            proptest::prop_assert_eq!(ascii.uvs.len(), vertices.len());
+            for format in ["binary_little_endian", "binary_big_endian"] {
+                let b = ply_in(format, &vertices, &faces, face_flag);
+                let m = parse_ply(&b).unwrap();
+                proptest::prop_assert_eq!(&m.positions, &ascii.positions);
+                proptest::prop_assert_eq!(&m.colors, &ascii.colors);
+                proptest::prop_assert_eq!(&m.uvs, &ascii.uvs);
+                proptest::prop_assert_eq!(&m.triangles, &ascii.triangles);
+                // Cut anywhere in the body: an error, not a panic or a shorter mesh.
+                let body = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+                let at = body + cut * (b.len() - body) / 40;
+                proptest::prop_assert!(at == b.len() || parse_ply(&b[..at]).is_err());
+            }
+        }
+    }
+
     #[test]
     fn the_teapot_data_set_tessellates() {
         let text =
