@@ -624,7 +624,7 @@ mod tests {
         )
         .into_bytes();
         let big = format == "binary_big_endian";
-        let mut put = |b: &mut Vec<u8>, le: &[u8], text: String| match format {
+        let put = |b: &mut Vec<u8>, le: &[u8], text: String| match format {
             "ascii" => b.extend(format!("{text} ").bytes()),
             _ if big => b.extend(le.iter().rev()),
             _ => b.extend(le),
