@@ -650,6 +650,7 @@ mod tests {
     }
 
     proptest::proptest! {
+        /// Both binary orders read as ASCII does, and ASCII reads what was written.
         #[test]
         fn binary_ply_reads_as_ascii_does(
             vertices in proptest::collection::vec(proptest::array::uniform5(-100.0f32..255.0), 3..12),
@@ -661,6 +662,8 @@ mod tests {
             let vertices: Vec<[f32; 5]> = vertices.iter().map(|v| [v[0], v[1], v[2], v[3].abs(), v[4].abs()]).collect();
             let ascii = parse_ply(&ply_in("ascii", &vertices, &faces, face_flag)).unwrap();
             let fan: usize = faces.iter().map(|f| f.len() - 2).sum();
+            let written: Vec<Vec3> = vertices.iter().map(|v| Vec3::new(v[0].into(), v[1].into(), v[2].into())).collect();
+            proptest::prop_assert_eq!(&ascii.positions, &written);
             proptest::prop_assert_eq!(ascii.triangles.len(), fan);
             proptest::prop_assert_eq!(ascii.uvs.len(), vertices.len());
             for format in ["binary_little_endian", "binary_big_endian"] {
