@@ -312,6 +312,31 @@ mod tests {
             proptest::prop_assert_eq!(m.is_closed(), closed_by_hashing(&m));
         }
 
+        /// Angle-weighted normals are, bit for bit, each vertex's corner weights summed in
+        /// triangle order, on one thread or several.
+        #[test]
+        fn angle_weighted_normals_are_the_sums_in_triangle_order(
+            p in proptest::collection::vec(proptest::array::uniform3(-4i8..4), 1..40),
+            tris in proptest::collection::vec(proptest::array::uniform3(0usize..64), 0..80),
+            threads in 1usize..5,
+        ) {
+            let positions: Vec<Vec3> = p.iter().map(|c| Vec3::new(c[0] as f64, c[1] as f64 * 0.7, c[2] as f64 * 1.3)).collect();
+            let triangles = tris.iter().map(|t| t.map(|v| (v % positions.len()) as u32)).collect();
+            let mut m = TriangleMesh { positions, triangles, ..TriangleMesh::default() };
+            let mut want = vec![Vec3::ZERO; m.positions.len()];
+            for tri in &m.triangles {
+                let w = corner_weights(tri.map(|v| m.positions[v as usize]));
+                for k in 0..3 {
+                    want[tri[k] as usize] += w[k];
+                }
+            }
+            let want: Vec<Vec3> = want.iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect();
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| m.compute_angle_weighted_normals());
+            let bits = |v: &[Vec3]| v.iter().map(|n| n.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+            proptest::prop_assert_eq!(bits(&m.normals), bits(&want));
+        }
+
         /// One cross product for a triangle's three corners gives each corner's weight as its
         /// own two edges' `atan2(|a × b|, a · b)` does (to 1e-12), down to slivers; the angles
         /// sum to π.

@@ -136,21 +136,33 @@ impl FlatLane {
 /// hold a hundred megabytes of them while it packs them): consecutive pairs that form a
 /// parallelogram become one; triangles without area are dropped.
 pub fn flat_primitives(mesh: &TriangleMesh) -> Vec<FlatLane> {
+    use rayon::prelude::*;
+    // What each triangle would start, found on all threads: a parallelogram with the next, a
+    // triangle, or nothing (no area). Then the pairs are taken greedily in triangle order.
+    const NOTHING: u8 = 0;
+    const TRIANGLE: u8 = 1;
+    const PARALLELOGRAM: u8 = 2;
+    let start = |t: usize| {
+        if spans_area(mesh, t, true) {
+            PARALLELOGRAM
+        } else if spans_area(mesh, t, false) {
+            TRIANGLE
+        } else {
+            NOTHING
+        }
+    };
+    let mut starts = Vec::new();
+    (0..mesh.triangle_count()).into_par_iter().map(start).collect_into_vec(&mut starts);
     // At most one flat per triangle: reserved once, so the vector is not copied as it grows
     // (pages reserved and never written cost no memory).
     let mut lanes = Vec::with_capacity(mesh.triangle_count());
     let mut t = 0;
-    while t < mesh.triangle_count() {
-        let lane = FlatLane { triangle: t as u32, parallelogram: true };
-        if spans_area(mesh, t, true) {
+    while t < starts.len() {
+        let lane = FlatLane { triangle: t as u32, parallelogram: starts[t] == PARALLELOGRAM };
+        if starts[t] != NOTHING {
             lanes.push(lane);
-            t += 2;
-            continue;
         }
-        if spans_area(mesh, t, false) {
-            lanes.push(FlatLane { parallelogram: false, ..lane });
-        }
-        t += 1;
+        t += if lane.parallelogram { 2 } else { 1 };
     }
     lanes
 }
@@ -159,6 +171,47 @@ pub fn flat_primitives(mesh: &TriangleMesh) -> Vec<FlatLane> {
 mod tests {
     use super::*;
     use alhazen_math::Ray;
+
+    proptest::proptest! {
+        /// The flats are what taking triangles in order gives: a parallelogram with the next
+        /// where the two form one, else the triangle where it has area (a row of quads).
+        #[test]
+        fn flats_pair_triangles_greedily_in_order(
+            quads in proptest::collection::vec((0u8..4, proptest::bool::ANY), 0..40),
+        ) {
+            let mut mesh = TriangleMesh::default();
+            for (q, &(kind, flip)) in quads.iter().enumerate() {
+                let x = q as f64;
+                let base = mesh.positions.len() as u32;
+                // Quad a, b, c, d counter-clockwise: [a, b, c], [a, c, d] form a parallelogram
+                // unless d is moved off (kind 1), the first is rotated (flip), has no area
+                // (kind 2) or stands alone (kind 3).
+                let d_y = if kind == 1 { 0.5 } else { 1.0 };
+                mesh.positions.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 0.0), Vec3::new(x, d_y, 0.0)]);
+                let [a, b, c, d] = [base, base + 1, base + 2, base + 3];
+                let first = if kind == 2 { [a, a, b] } else if flip { [b, c, a] } else { [a, b, c] };
+                mesh.triangles.push(first);
+                if kind != 3 {
+                    mesh.triangles.push([a, c, d]);
+                }
+            }
+            let mut want = vec![];
+            let mut t = 0;
+            while t < mesh.triangle_count() {
+                if spans_area(&mesh, t, true) {
+                    want.push((t as u32, true));
+                    t += 2;
+                    continue;
+                }
+                if spans_area(&mesh, t, false) {
+                    want.push((t as u32, false));
+                }
+                t += 1;
+            }
+            let got: Vec<_> = flat_primitives(&mesh).iter().map(|l| (l.triangle, l.parallelogram)).collect();
+            proptest::prop_assert_eq!(got, want);
+        }
+    }
 
     #[test]
     fn triangle_barycentrics_reproduce_the_hit_point() {
